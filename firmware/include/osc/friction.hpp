@@ -1,0 +1,44 @@
+// Joint friction model (2) and its linear-in-the-parameters form (18)-(20).
+#pragma once
+
+#include "osc/model.hpp"
+
+namespace osc {
+
+template <class S> using Regressor = Eigen::Matrix<S, kDof, 3 * kDof>;
+
+/// Coefficients of (2). theta = [tau_vis; tau_cou; tau_sti] (20); tau_dec is known.
+template <class S>
+struct FrictionParams {
+  Vec6<S> vis, cou, sti, dec;
+
+  Vec18<S> theta() const {
+    Vec18<S> t;
+    t << vis, cou, sti;
+    return t;
+  }
+};
+
+/// Friction torque (2): tau_f = vis qd + [cou + sti exp(-dec qd^2)] sgn(qd), per joint (10).
+template <class S>
+Vec6<S> friction_torque(const FrictionParams<S>& p, const Vec6In<S>& qd) {
+  Vec6<S> tau;
+  for (int i = 0; i < kDof; ++i)
+    tau(i) = p.vis(i) * qd(i) + (p.cou(i) + p.sti(i) * math::exp(-p.dec(i) * qd(i) * qd(i))) * math::sgn(qd(i));
+  return tau;
+}
+
+/// Regressor W_j(qd) of (19): [diag(qd), diag(sgn qd), diag(sgn(qd) exp(-dec qd^2))].
+template <class S>
+Regressor<S> friction_regressor(const Vec6<S>& qd, const Vec6<S>& dec) {
+  Regressor<S> W = Regressor<S>::Zero();
+  for (int i = 0; i < kDof; ++i) {
+    const S s = math::sgn(qd(i));
+    W(i, i) = qd(i);
+    W(i, kDof + i) = s;
+    W(i, 2 * kDof + i) = s * math::exp(-dec(i) * qd(i) * qd(i));
+  }
+  return W;
+}
+
+}  // namespace osc

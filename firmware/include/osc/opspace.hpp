@@ -1,0 +1,128 @@
+// Operational-space dynamics (4)-(5): Lambda(x), Psi(x,y) z, p(x), f, Gamma = J^T F.
+//
+// The PUMA's frame-6 origin is the wrist centre, so the linear-velocity rows of J do not depend
+// on joints 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian).
+// J is therefore factored as two 3x3 LU decompositions; det J = det J11 det J22, and every
+// solve with J or J^T is two 3x3 solves. No 6x6 matrix is ever inverted.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+#include "osc/dynamics.hpp"
+
+namespace osc {
+
+/// Factorisation of a block lower-triangular 6x6 Jacobian.
+template <class S>
+struct JacobianFactor {
+  Eigen::PartialPivLU<Mat3<S>> arm;    // J11: position rows, joints 1-3
+  Eigen::PartialPivLU<Mat3<S>> wrist;  // J22: orientation rows, joints 4-6
+  Mat3<S> J21;
+  /// Reciprocal condition estimate (1-norm) of the worse of the two blocks; 0 when singular.
+  /// Callers refuse to act when it falls below their threshold.
+  S rcond = S(0);
+
+  void compute(const Mat6<S>& J) {
+    arm.compute(J.template topLeftCorner<3, 3>());
+    wrist.compute(J.template bottomRightCorner<3, 3>());
+    J21 = J.template bottomLeftCorner<3, 3>();
+    const S r1 = arm.rcond(), r2 = wrist.rcond();
+    rcond = r1 < r2 ? r1 : r2;
+    if (!math::isfinite(rcond)) rcond = S(0);
+  }
+  /// J^{-1} b.
+  Vec6<S> solve(const Vec6In<S>& b) const {
+    Vec6<S> x;
+    x.template head<3>() = arm.solve(b.template head<3>());
+    x.template tail<3>() = wrist.solve(b.template tail<3>() - J21 * x.template head<3>());
+    return x;
+  }
+  /// J^{-T} b.
+  Vec6<S> solve_transpose(const Vec6In<S>& b) const {
+    Vec6<S> x;
+    x.template tail<3>() = wrist.transpose().solve(b.template tail<3>());
+    x.template head<3>() = arm.transpose().solve(b.template head<3>() - J21.transpose() * x.template tail<3>());
+    return x;
+  }
+};
+
+/// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised.
+template <class S>
+Mat6<S> operational_inertia(const Mat6<S>& A, const JacobianFactor<S>& Jf) {
+  Mat6<S> Y;  // Y = J^{-T} A
+  for (int k = 0; k < kDof; ++k) Y.col(k) = Jf.solve_transpose(A.col(k));
+  Mat6<S> L;  // L^T = J^{-T} Y^T
+  for (int k = 0; k < kDof; ++k) L.row(k) = Jf.solve_transpose(Y.row(k).transpose()).transpose();
+  return lit<S>(0.5) * (L + L.transpose());
+}
+
+/// Operational-space state of the robot at q with task reference orientation R_ref: everything
+/// the observer and controller need that depends on q only.
+template <class S>
+struct OpSpace {
+  Vec6<S> x;               // [p; phi]
+  Mat6<S> Ja;              // analytic Jacobian
+  JacobianFactor<S> Jf;    // factorisation of Ja
+  Eigen::LLT<Mat6<S>> A_llt;
+  Mat6<S> Lambda;
+  Vec6<S> g;               // joint gravity torques
+};
+
+/// Computes kinematics, A(q), g(q), Ja, its factorisation and Lambda at q.
+template <class S>
+void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q,
+                    const Mat3<S>& R_ref) {
+  forward_kinematics(model, data, q);
+  geometric_jacobian(data);
+  joint_inertia(model, data);
+  os.x = operational_coordinates(data, R_ref);
+  os.Ja = analytic_jacobian(data.J, Vec3<S>(os.x.template tail<3>()));
+  os.Jf.compute(os.Ja);
+  os.A_llt.compute(data.A);
+  os.Lambda = operational_inertia(data.A, os.Jf);
+  os.g = gravity_torques(model, data);
+}
+
+/// p(x) = J^{-T} g(q) (5).
+template <class S>
+Vec6<S> operational_gravity(const OpSpace<S>& os) { return os.Jf.solve_transpose(os.g); }
+
+/// f = J^{-T} tau_f (5), (31).
+template <class S>
+Vec6<S> operational_friction(const OpSpace<S>& os, const Vec6In<S>& tau_f) { return os.Jf.solve_transpose(tau_f); }
+
+/// Gamma = J^T F (5).
+template <class S>
+Vec6<S> joint_torques(const OpSpace<S>& os, const Vec6In<S>& F) { return os.Ja.transpose() * F; }
+
+/// Lambda^{-1} w = J A^{-1} J^T w, by the Cholesky factor of A.
+template <class S>
+Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
+  return os.Ja * os.A_llt.solve(os.Ja.transpose() * w);
+}
+
+/// Analytic Jdot(q, qd) qd.
+template <class S>
+Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qd) {
+  const VelocityProducts<S> vp = velocity_products(model, data, qd);
+  return analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
+}
+
+/// h(v) = Psi(x, v) v = J^{-T} c(q, qd_v) - Lambda Jdot(q, qd_v) qd_v, with qd_v = J^{-1} v.
+template <class S>
+Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& v) {
+  const Vec6<S> qd = os.Jf.solve(v);
+  const VelocityProducts<S> vp = velocity_products(model, data, qd);
+  const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
+  return os.Jf.solve_transpose(vp.c) - os.Lambda * jdqd;
+}
+
+/// Psi(x, y) z, the symmetric bilinear form of (8), by polarisation: (h(y+z) - h(y-z)) / 4.
+template <class S>
+Vec6<S> psi_bilinear(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+                     const Vec6In<S>& z) {
+  return lit<S>(0.25) * (psi_quadratic(model, data, os, y + z) - psi_quadratic(model, data, os, y - z));
+}
+
+}  // namespace osc
