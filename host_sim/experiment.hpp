@@ -1,0 +1,59 @@
+// The paper's experiment (Section VI) in closed loop: the firmware's control task, bound to the
+// simulated plant through the HAL, tracking trajectory (68) for a given duration.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "osc/controller.hpp"
+#include "plant.hpp"
+
+namespace sim {
+
+enum class Scalar { kDouble, kFloat };
+
+struct ExperimentConfig {
+  double duration = 120.0;                          ///< [s]
+  osc::FrictionMode mode = osc::FrictionMode::kAdaptive;
+  Scalar scalar = Scalar::kDouble;                  ///< controller arithmetic
+  PlantConfig plant{};
+  double model_error = 0.0;                         ///< controller's link mass/inertia relative error
+  double log_period = 0.01;                         ///< time-series decimation [s]
+  double final_window = 20.0;                       ///< "last 20 s" statistics [s]
+  std::function<void(double fraction)> progress;    ///< optional progress callback
+};
+
+/// One logged sample of the time series.
+struct LogRow {
+  double t;
+  double e[6];          // tracking error of the true plant: mm (x, y, z), deg (about X, Y, Z)
+  double x_tilde[6];    // observer position error: mm, deg
+  double theta_hat[18];
+  double tau_f[6];      // true plant friction [N m]
+  double tau_f_hat[6];  // estimated friction (30) [N m]
+};
+
+struct ExperimentResult {
+  std::string mode;
+  std::string friction_preset;
+  double duration = 0;
+  double max_error[6] = {};          // over the whole run: mm, mm, mm, deg, deg, deg
+  double final_max_error[6] = {};    // over the last final_window seconds
+  double max_observer_error[6] = {}; // |x~| over the last final_window seconds: mm, deg
+  double theta_hat[18] = {};
+  double theta_true[18] = {};
+  double friction_rms_error = 0;     // rms of tau_f_hat - tau_f over the last window [N m]
+  double friction_rms = 0;           // rms of tau_f over the last window [N m]
+  std::uint32_t status = 0;          // first non-ok control-step status (0: none)
+  double wall_seconds = 0;
+  std::vector<LogRow> log;
+};
+
+ExperimentResult run_experiment(const ExperimentConfig& cfg);
+
+/// Paper tables (NOTES.md) for side-by-side printing.
+extern const double kPaperTable1[6];
+extern const double kPaperTable3[6];
+
+}  // namespace sim

@@ -1,0 +1,69 @@
+// Simulated PUMA 560: rigid-body dynamics (1) in double by the articulated-body algorithm (its own
+// code path, independent of the controller's CRBA/RNEA/operational-space kernels), true friction
+// by model (2), RK4 integration at a fine step, zero-order-hold torques applied after the
+// controller's computation delay inside each sample.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "osc/params.hpp"
+
+namespace sim {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;
+
+struct PlantConfig {
+  osc::params::FrictionPreset friction = osc::params::kFrictionPaper;
+  double tau_dec = osc::params::kTauDec;
+  double substep = 1e-4;              ///< RK4 step [s] (10 kHz)
+  double compute_delay = 0.2e-3;      ///< from the encoder sample to the DAC update [s]
+  double link_scale = 1.0;            ///< scales every link mass and inertia (model-error studies)
+};
+
+/// Articulated-body forward dynamics of the PUMA 560 (armature on each joint's scalar inertia).
+class ArticulatedBody {
+ public:
+  explicit ArticulatedBody(double link_scale = 1.0);
+  /// q_dd for joint torques tau (friction already subtracted), gravity along -z0.
+  Vec6 forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
+
+ private:
+  Mat6 inertia_[6];         // spatial inertia of link i in its joint frame B_i (origin o_{i-1}, z = axis i)
+  Mat3 rot_fixed_[6];       // rotation of B_i's parent joint frame to F_{i-1}: Rx(alpha_{i-1})
+  Vec3 pos_fixed_[6];       // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1})
+  double armature_[6];
+};
+
+/// The robot: state, friction, integration.
+class Plant {
+ public:
+  explicit Plant(const PlantConfig& cfg = {});
+  void reset(const Vec6& q0, const Vec6& qd0 = Vec6::Zero());
+  /// Advances one control sample of length dt: tau_old is held for the computation delay, then tau_new.
+  void advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt);
+  /// Integrates for duration with constant torque tau.
+  void integrate(const Vec6& tau, double duration);
+
+  Vec6 friction(const Vec6& qd) const;
+  Vec6 acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
+  /// Kinetic plus potential energy (for integration checks).
+  double energy() const;
+
+  const Vec6& q() const { return q_; }
+  const Vec6& qd() const { return qd_; }
+  double time() const { return t_; }
+  const PlantConfig& config() const { return cfg_; }
+  osc::params::FrictionPreset& friction_preset() { return cfg_.friction; }
+
+ private:
+  void rk4(const Vec6& tau, double h);
+  PlantConfig cfg_;
+  ArticulatedBody body_;
+  Vec6 q_ = Vec6::Zero(), qd_ = Vec6::Zero();
+  double t_ = 0;
+};
+
+}  // namespace sim

@@ -1,0 +1,39 @@
+// HAL binding of the firmware's encoder and DAC interfaces (hal/hal.hpp) to the simulated plant.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "hal/hal.hpp"
+#include "osc/io.hpp"
+#include "plant.hpp"
+
+namespace sim {
+
+class PlantHal {
+ public:
+  PlantHal(Plant& plant, const Vec6& q_start) : plant_(plant), q_start_(q_start) {}
+
+  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad).
+  void read_encoders(std::int32_t counts[hal::kJoints]) const {
+    for (int i = 0; i < hal::kJoints; ++i)
+      counts[i] = static_cast<std::int32_t>(
+          std::floor((plant_.q()(i) - q_start_(i)) * osc::params::encoder_counts_per_rad(i)));
+  }
+  void write_dacs(const std::int32_t codes[hal::kJoints]) {
+    for (int i = 0; i < hal::kJoints; ++i) codes_[i] = codes[i];
+  }
+  /// Joint torques the amplifiers produce from the last DAC codes.
+  Vec6 torque() const {
+    Vec6 t;
+    for (int i = 0; i < hal::kJoints; ++i) t(i) = osc::code_to_torque(i, codes_[i]);
+    return t;
+  }
+
+ private:
+  Plant& plant_;
+  Vec6 q_start_;
+  std::int32_t codes_[hal::kJoints] = {0, 0, 0, 0, 0, 0};
+};
+
+}  // namespace sim

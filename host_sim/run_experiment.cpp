@@ -1,0 +1,277 @@
+// puma_experiment: the paper's experiment (Section VI) on the simulated PUMA 560, with adaptive
+// friction compensation and without, printed side by side with the paper's Tables I-III.
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli.hpp"
+#include "experiment.hpp"
+
+namespace {
+
+const char* kUsage =
+    "usage: puma_experiment [options]\n"
+    "  --duration S        simulated seconds per run (default 120; 1..3600)\n"
+    "  --mode M            both | adaptive | none (default both)\n"
+    "  --friction P        plant friction preset: paper | corke | none (default paper)\n"
+    "  --scalar T          controller arithmetic: double | float (default double)\n"
+    "  --model-error F     controller link mass/inertia relative error (default 0; -0.5..0.5)\n"
+    "  --substep S         plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)\n"
+    "  --delay S           computation delay inside the sample (default 2e-4; 0..1e-3)\n"
+    "  --json FILE         write the summary as JSON\n"
+    "  --csv-dir DIR       write time series CSV files there (default: out)\n"
+    "  --no-csv            do not write time series\n"
+    "  --no-progress       no progress bar\n"
+    "  --help              this text\n";
+
+struct Options {
+  double duration = 120;
+  bool run_adaptive = true, run_none = true;
+  sim::ExperimentConfig base;
+  std::string json, csv_dir = "out";
+  bool csv = true, progress = true;
+};
+
+int fail(const std::string& msg) {
+  std::cerr << "puma_experiment: " << msg << "\n" << kUsage;
+  return 2;
+}
+
+bool parse(int argc, char** argv, Options& o, std::string& err) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
+    auto take = [&]() -> const char* {
+      ++i;
+      return v;
+    };
+    if (a == "--help" || a == "-h") {
+      std::cout << kUsage;
+      std::exit(0);
+    } else if (a == "--duration") {
+      if (!sim::parse_number(a, take(), 1, 3600, o.duration, err)) return false;
+    } else if (a == "--mode") {
+      const char* m = take();
+      const std::string s = m ? m : "";
+      if (s == "both") o.run_adaptive = o.run_none = true;
+      else if (s == "adaptive") o.run_adaptive = true, o.run_none = false;
+      else if (s == "none") o.run_adaptive = false, o.run_none = true;
+      else return err = "--mode: expected both, adaptive or none, got '" + s + "'", false;
+    } else if (a == "--friction") {
+      const char* m = take();
+      const std::string s = m ? m : "";
+      if (s == "paper") o.base.plant.friction = osc::params::kFrictionPaper;
+      else if (s == "corke") o.base.plant.friction = osc::params::kFrictionCorke;
+      else if (s == "none") o.base.plant.friction = osc::params::kFrictionNone;
+      else return err = "--friction: expected paper, corke or none, got '" + s + "'", false;
+    } else if (a == "--scalar") {
+      const char* m = take();
+      const std::string s = m ? m : "";
+      if (s == "double") o.base.scalar = sim::Scalar::kDouble;
+      else if (s == "float") o.base.scalar = sim::Scalar::kFloat;
+      else return err = "--scalar: expected double or float, got '" + s + "'", false;
+    } else if (a == "--model-error") {
+      if (!sim::parse_number(a, take(), -0.5, 0.5, o.base.model_error, err)) return false;
+    } else if (a == "--substep") {
+      if (!sim::parse_number(a, take(), 1e-6, 1e-3, o.base.plant.substep, err)) return false;
+    } else if (a == "--delay") {
+      if (!sim::parse_number(a, take(), 0, osc::params::kDt, o.base.plant.compute_delay, err)) return false;
+    } else if (a == "--json") {
+      const char* f = take();
+      if (!f || !*f) return err = "--json needs a file name", false;
+      o.json = f;
+    } else if (a == "--csv-dir") {
+      const char* f = take();
+      if (!f || !*f) return err = "--csv-dir needs a directory", false;
+      o.csv_dir = f;
+    } else if (a == "--no-csv") {
+      o.csv = false;
+    } else if (a == "--no-progress") {
+      o.progress = false;
+    } else {
+      return err = "unknown option '" + a + "'", false;
+    }
+  }
+  return true;
+}
+
+const char* kAxes[6] = {"e_x [mm]", "e_y [mm]", "e_z [mm]", "e_phx [deg]", "e_phy [deg]", "e_phz [deg]"};
+
+void print_tables(const std::vector<sim::ExperimentResult>& runs) {
+  std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')\n", runs[0].duration,
+              runs[0].friction_preset.c_str());
+  std::printf("%-12s", "axis");
+  for (const auto& r : runs) std::printf(" %14s %14s", (r.mode + " all").c_str(), (r.mode + " last20s").c_str());
+  std::printf(" %10s %10s\n", "paper T.I", "paper T.III");
+  for (int i = 0; i < 6; ++i) {
+    std::printf("%-12s", kAxes[i]);
+    for (const auto& r : runs) std::printf(" %14.3f %14.3f", r.max_error[i], r.final_max_error[i]);
+    std::printf(" %10.2f %10.2f\n", sim::kPaperTable1[i], sim::kPaperTable3[i]);
+  }
+  const sim::ExperimentResult* ad = nullptr;
+  const sim::ExperimentResult* no = nullptr;
+  for (const auto& r : runs) (r.mode == "adaptive" ? ad : no) = &r;
+  if (ad && no) {
+    std::printf("\nRatio without / with friction compensation (whole run, last 20 s; paper Table III / Table I)\n");
+    for (int i = 0; i < 6; ++i)
+      std::printf("  %-12s %6.1fx %6.1fx   paper %4.1fx\n", kAxes[i], no->max_error[i] / ad->max_error[i],
+                  no->final_max_error[i] / ad->final_max_error[i], sim::kPaperTable3[i] / sim::kPaperTable1[i]);
+  }
+  if (ad) {
+    static const char* names[3] = {"tau_vis [N m s/rad]", "tau_cou [N m]", "tau_sti [N m]"};
+    std::printf("\nIdentified friction coefficients after %.0f s (estimate / plant's true value; paper Table II is "
+                "the plant's default)\n%-20s",
+                ad->duration, "");
+    for (int j = 0; j < 6; ++j) std::printf("      J%d       ", j + 1);
+    std::printf("\n");
+    for (int k = 0; k < 3; ++k) {
+      std::printf("%-20s", names[k]);
+      for (int j = 0; j < 6; ++j) std::printf(" %6.2f / %5.2f", ad->theta_hat[6 * k + j], ad->theta_true[6 * k + j]);
+      std::printf("\n");
+    }
+    std::printf("estimated vs true joint friction over the last 20 s: rms error %.3f N m (rms friction %.3f N m)\n",
+                ad->friction_rms_error, ad->friction_rms);
+  }
+  for (const auto& r : runs) {
+    std::printf("[%s] simulated %.0f s in %.2f s wall (%.0fx real time)%s\n", r.mode.c_str(), r.duration,
+                r.wall_seconds, r.duration / r.wall_seconds,
+                r.status ? "  WARNING: a control step faulted (zero torque commanded)" : "");
+  }
+}
+
+void json_array(std::ostream& os, const double* v, int n, double scale = 1) {
+  os << "[";
+  for (int i = 0; i < n; ++i) os << (i ? ", " : "") << v[i] * scale;
+  os << "]";
+}
+
+void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* indent) {
+  os << indent << "\"mode\": \"" << r.mode << "\",\n";
+  os << indent << "\"duration_s\": " << r.duration << ",\n";
+  os << indent << "\"friction_preset\": \"" << r.friction_preset << "\",\n";
+  os << indent << "\"max_error_mm\": ";
+  json_array(os, r.max_error, 3);
+  os << ",\n" << indent << "\"max_error_deg\": ";
+  json_array(os, r.max_error + 3, 3);
+  os << ",\n" << indent << "\"final20s_max_error_mm\": ";
+  json_array(os, r.final_max_error, 3);
+  os << ",\n" << indent << "\"final20s_max_error_deg\": ";
+  json_array(os, r.final_max_error + 3, 3);
+  os << ",\n" << indent << "\"theta_hat\": ";
+  json_array(os, r.theta_hat, 18);
+  os << ",\n" << indent << "\"theta_true\": ";
+  json_array(os, r.theta_true, 18);
+  os << ",\n" << indent << "\"friction_rms_error_Nm\": " << r.friction_rms_error;
+  os << ",\n" << indent << "\"fault_status\": " << r.status;
+  os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
+}
+
+bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, std::string& err) {
+  std::ostringstream os;
+  os.precision(9);
+  os << "{\n";
+  json_run(os, runs[0], "  ");  // the primary run (adaptive when it ran)
+  os.seekp(-1, std::ios_base::end);
+  os << ",\n  \"runs\": [\n";
+  for (size_t i = 0; i < runs.size(); ++i) {
+    os << "    {\n";
+    json_run(os, runs[i], "      ");
+    os << "    }" << (i + 1 < runs.size() ? "," : "") << "\n";
+  }
+  os << "  ]\n}\n";
+  // Write to a temporary file, then rename: an existing file is never left half-written.
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (!(f << os.str())) return err = "cannot write " + tmp, false;
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) return err = "cannot rename " + tmp + " to " + path, false;
+  return true;
+}
+
+bool write_csv(const std::string& dir, const sim::ExperimentResult& r, std::string& err) {
+  const std::string path = dir + "/timeseries_" + r.mode + ".csv";
+  std::ofstream f(path + ".tmp");
+  if (!f) return err = "cannot write " + path + " (does the directory exist?)", false;
+  f << "t,e_x_mm,e_y_mm,e_z_mm,e_phx_deg,e_phy_deg,e_phz_deg,xt_x_mm,xt_y_mm,xt_z_mm,xt_phx_deg,xt_phy_deg,xt_phz_deg";
+  for (int i = 0; i < 18; ++i) f << ",theta_hat_" << i;
+  for (int i = 0; i < 6; ++i) f << ",tau_f_" << i;
+  for (int i = 0; i < 6; ++i) f << ",tau_f_hat_" << i;
+  f << "\n";
+  for (const auto& row : r.log) {
+    f << row.t;
+    for (double v : row.e) f << "," << v;
+    for (double v : row.x_tilde) f << "," << v;
+    for (double v : row.theta_hat) f << "," << v;
+    for (double v : row.tau_f) f << "," << v;
+    for (double v : row.tau_f_hat) f << "," << v;
+    f << "\n";
+  }
+  f.close();
+  if (!f || std::rename((path + ".tmp").c_str(), path.c_str()) != 0) return err = "cannot write " + path, false;
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  std::string err;
+  if (!parse(argc, argv, o, err)) return fail(err);
+  o.base.duration = o.duration;
+  if (o.csv && !o.csv_dir.empty()) {
+    const std::string mk = "mkdir -p '" + o.csv_dir + "'";
+    if (std::system(mk.c_str()) != 0) return fail("cannot create directory " + o.csv_dir);
+  }
+
+  std::vector<sim::ExperimentConfig> cfgs;
+  if (o.run_adaptive) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kAdaptive;
+  if (o.run_none) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kNone;
+
+  // Progress bar on a terminal only, for runs longer than a second.
+  const bool bar = o.progress && isatty(STDERR_FILENO) && o.duration > 1.0;
+  std::vector<std::atomic<double>> frac(cfgs.size());
+  for (auto& f : frac) f = 0;
+  for (size_t i = 0; i < cfgs.size(); ++i)
+    if (bar) cfgs[i].progress = [&frac, i](double x) { frac[i] = x; };
+
+  // The runs are independent: one thread each (the machine has two cores).
+  std::vector<sim::ExperimentResult> runs(cfgs.size());
+  std::vector<std::thread> threads;
+  for (size_t i = 0; i < cfgs.size(); ++i)
+    threads.emplace_back([&, i] { runs[i] = sim::run_experiment(cfgs[i]); });
+  if (bar) {
+    for (;;) {
+      double sum = 0;
+      for (auto& f : frac) sum += f;
+      const double p = sum / frac.size();
+      const int w = 40, n = static_cast<int>(p * w);
+      std::fprintf(stderr, "\r[%s%s] %3.0f%%", std::string(n, '#').c_str(), std::string(w - n, ' ').c_str(), p * 100);
+      if (p >= 1.0) break;
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    }
+    std::fprintf(stderr, "\n");
+  }
+  for (auto& t : threads) t.join();
+
+  print_tables(runs);
+  if (o.csv) {
+    for (const auto& r : runs)
+      if (!write_csv(o.csv_dir, r, err)) return fail(err);
+    std::printf("time series: %s/timeseries_*.csv\n", o.csv_dir.c_str());
+  }
+  if (!o.json.empty()) {
+    if (!write_json(o.json, runs, err)) return fail(err);
+    std::printf("summary: %s\n", o.json.c_str());
+  }
+  for (const auto& r : runs)
+    if (r.status) return 1;
+  return 0;
+}
