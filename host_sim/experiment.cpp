@@ -34,6 +34,11 @@ ExperimentResult run(const ExperimentConfig& cfg) {
   auto task_ptr = std::make_unique<osc::ControlTask<S>>();  // large: keep off the stack
   osc::ControlTask<S>& task = *task_ptr;
   task.init(osc::Model<S>::puma560(cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
+  // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
+  for (int i = 0; i < 6; ++i) {
+    task.state.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
+    task.state.y(i) += task.gains.k(i) * static_cast<S>(cfg.observer_offset[i]);
+  }
 
   // Ground truth for the error statistics: the plant's own state through double kinematics.
   const osc::Model<double> truth = osc::Model<double>::puma560();

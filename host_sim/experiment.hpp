@@ -21,6 +21,7 @@ struct ExperimentConfig {
   double model_error = 0.0;                         ///< controller's link mass/inertia relative error
   double log_period = 0.01;                         ///< time-series decimation [s]
   double final_window = 20.0;                       ///< "last 20 s" statistics [s]
+  double observer_offset[6] = {0, 0, 0, 0, 0, 0};    ///< x^(0) - x(0), to test observer convergence
   std::function<void(double fraction)> progress;    ///< optional progress callback
 };
 

@@ -1,0 +1,134 @@
+// Closed-loop tests of issue 3: the firmware's control task on the simulated PUMA 560. The full
+// 120 s experiment is the runner's default; CI runs shorter windows.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "experiment.hpp"
+#include "osc/opspace.hpp"
+
+using namespace sim;
+
+namespace {
+
+void print(const char* what, const ExperimentResult& r) {
+  std::printf("%-28s max |e| all: %.3f %.3f %.3f mm %.4f %.4f %.4f deg | last: %.3f %.3f %.3f mm %.4f %.4f %.4f deg"
+              " | |x~| last: %.3f %.3f %.3f mm\n",
+              what, r.max_error[0], r.max_error[1], r.max_error[2], r.max_error[3], r.max_error[4], r.max_error[5],
+              r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], r.final_max_error[3],
+              r.final_max_error[4], r.final_max_error[5], r.max_observer_error[0], r.max_observer_error[1],
+              r.max_observer_error[2]);
+}
+
+/// Worst-case Cartesian error of one encoder count on every joint at the start pose [mm]:
+/// sum_j |J_ij| / counts_per_rad_j, maximised over the translational rows.
+double position_quantum_mm() {
+  const osc::Model<double> model = osc::Model<double>::puma560();
+  osc::Data<double> data;
+  Vec6 q;
+  for (int i = 0; i < 6; ++i) q(i) = osc::params::kQStart[i];
+  osc::forward_kinematics(model, data, q);
+  osc::geometric_jacobian(data);
+  double worst = 0;
+  for (int r = 0; r < 3; ++r) {
+    double s = 0;
+    for (int j = 0; j < 6; ++j) s += std::abs(data.J(r, j)) / osc::params::encoder_counts_per_rad(j);
+    worst = std::max(worst, s);
+  }
+  return worst * 1e3;
+}
+
+ExperimentConfig config(double duration, osc::FrictionMode mode, const osc::params::FrictionPreset& friction) {
+  ExperimentConfig c;
+  c.duration = duration;
+  c.mode = mode;
+  c.plant.friction = friction;
+  c.final_window = duration / 3;
+  c.log_period = 1.0;
+  return c;
+}
+
+TEST(ClosedLoop, FrictionlessPlantTracksAtEncoderQuantisationLevelAndObserverConverges) {
+  ExperimentConfig c = config(12, osc::FrictionMode::kNone, osc::params::kFrictionNone);
+  // Start the observer 2 mm / 0.2 deg off: x~ must decay.
+  for (int i = 0; i < 3; ++i) c.observer_offset[i] = 2e-3;
+  for (int i = 3; i < 6; ++i) c.observer_offset[i] = 0.2 * osc::puma560::kPi / 180;
+  const ExperimentResult r = run_experiment(c);
+  print("frictionless, no comp.", r);
+  const double quantum = position_quantum_mm();
+  std::printf("one-count position quantum at the start pose: %.4f mm\n", quantum);
+  ASSERT_EQ(r.status, 0u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(r.final_max_error[i], 2.0 * quantum) << "axis " << i;
+    EXPECT_LT(r.max_observer_error[i], 0.1 * 2.0) << "axis " << i;  // decayed below a tenth of 2 mm
+  }
+  for (int i = 3; i < 6; ++i) {
+    EXPECT_LT(r.final_max_error[i], 0.02) << "axis " << i;
+    EXPECT_LT(r.max_observer_error[i], 0.1 * 0.2) << "axis " << i;
+  }
+}
+
+struct WithFriction : ::testing::Test {
+  static ExperimentResult adaptive, none;
+  static void SetUpTestSuite() {
+    adaptive = run_experiment(config(30, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper));
+    none = run_experiment(config(30, osc::FrictionMode::kNone, osc::params::kFrictionPaper));
+    print("paper friction, adaptive", adaptive);
+    print("paper friction, no comp.", none);
+  }
+};
+ExperimentResult WithFriction::adaptive, WithFriction::none;
+
+TEST_F(WithFriction, CompensationReducesEveryTranslationalErrorAtLeastTwofold) {
+  ASSERT_EQ(adaptive.status, 0u);
+  ASSERT_EQ(none.status, 0u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_GT(none.max_error[i], 2.0 * adaptive.max_error[i]) << "axis " << i;
+    EXPECT_GT(none.final_max_error[i], 2.0 * adaptive.final_max_error[i]) << "axis " << i;
+  }
+}
+
+TEST_F(WithFriction, EstimatedFrictionTorqueMatchesThePlant) {
+  std::printf("friction rms error %.3f N m of rms %.3f N m\n", adaptive.friction_rms_error, adaptive.friction_rms);
+  EXPECT_LT(adaptive.friction_rms_error, 0.25 * adaptive.friction_rms);
+}
+
+TEST_F(WithFriction, CoefficientsApproachTheTrueValues) {
+  // The strongly excited parameters: Coulomb + Stribeck of joints 1-2 (large arm joints, every
+  // velocity reversal). After 30 s they are within 25 % of the truth; see docs/experiment.md for the
+  // full 120 s table and the weakly excited wrist parameters.
+  for (int j : {0, 1}) {
+    for (int k : {1, 2}) {
+      const int idx = 6 * k + j;
+      EXPECT_NEAR(adaptive.theta_hat[idx], adaptive.theta_true[idx], 0.25 * adaptive.theta_true[idx])
+          << "theta index " << idx;
+    }
+  }
+  // Nothing diverged.
+  for (int i = 0; i < 18; ++i) EXPECT_LT(std::abs(adaptive.theta_hat[i]), 20.0) << i;
+}
+
+TEST(ClosedLoop, TracksWithTenPercentModelError) {
+  for (double err : {-0.1, 0.1}) {
+    ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper);
+    c.model_error = err;
+    const ExperimentResult r = run_experiment(c);
+    print(err < 0 ? "model -10 %, adaptive" : "model +10 %, adaptive", r);
+    ASSERT_EQ(r.status, 0u);
+    for (int i = 0; i < 3; ++i) EXPECT_LT(r.final_max_error[i], 1.0) << "axis " << i << " err " << err;
+    for (int i = 3; i < 6; ++i) EXPECT_LT(r.final_max_error[i], 0.1) << "axis " << i << " err " << err;
+  }
+}
+
+TEST(ClosedLoop, FloatControllerTracksLikeDouble) {
+  ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper);
+  const ExperimentResult d = run_experiment(c);
+  c.scalar = Scalar::kFloat;
+  const ExperimentResult f = run_experiment(c);
+  print("double controller", d);
+  print("float controller", f);
+  ASSERT_EQ(f.status, 0u);
+  for (int i = 0; i < 3; ++i) EXPECT_LT(f.final_max_error[i], 1.5 * d.final_max_error[i] + 0.02) << i;
+}
+
+}  // namespace

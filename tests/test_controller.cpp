@@ -1,0 +1,179 @@
+// Control kernels of issue 3: trajectory (68), adaptation (67), observer discretisation, faults,
+// allocation-free stepping.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+
+#include "osc/controller.hpp"
+#include "test_util.hpp"
+
+using namespace osc;
+
+namespace {
+
+Vec6<double> q_start() {
+  Vec6<double> q;
+  for (int i = 0; i < kDof; ++i) q(i) = params::kQStart[i];
+  return q;
+}
+
+TEST(Trajectory, StartsAtRestAndDerivativesMatchFiniteDifferences) {
+  const Vec3<double> p0(0.6, -0.15, 0.0);
+  const Desired<double> d0 = trajectory(p0, 0.0);
+  EXPECT_LT((d0.x.head<3>() - p0).norm(), 1e-15);
+  EXPECT_LT(d0.xd.norm(), 1e-15);
+  EXPECT_LT(d0.xdd.norm(), 1e-15);
+  EXPECT_EQ(d0.x.tail<3>().norm(), 0.0);  // orientation held
+  const double h = 1e-5;
+  for (double t : {0.3, 1.7, 4.2, 9.9, 33.3, 119.0}) {
+    const Desired<double> d = trajectory(p0, t), dp = trajectory(p0, t + h), dm = trajectory(p0, t - h);
+    EXPECT_LT(((dp.x - dm.x) / (2 * h) - d.xd).norm(), 1e-8) << t;
+    EXPECT_LT(((dp.xd - dm.xd) / (2 * h) - d.xdd).norm(), 1e-7) << t;
+  }
+  // After the envelope: +-50 mm, y and z equal (f = 1).
+  const Desired<double> d = trajectory(p0, 100.0 + 1.25);  // sin = 1 at a quarter period
+  EXPECT_NEAR(d.x(0) - p0(0), params::kAmplitude, 1e-9);
+  EXPECT_NEAR(d.x(1) - p0(1), d.x(2) - p0(2), 1e-15);
+}
+
+TEST(Adaptation, SampledLawMatchesEquation67) {
+  // Two steps at rest-free poses: the second step's theta^ must equal
+  // theta^ - K_ad W_j^T(q^dot_prev) [q - q_prev - q^dot_prev dt], computed here independently.
+  const Model<double> model = Model<double>::puma560();
+  const Gains<double> G = Gains<double>::paper();
+  auto st = std::make_unique<ControllerState<double>>();
+  const Vec6<double> q0 = q_start();
+  controller_init(model, *st, q0);
+  st->y << 0.01, -0.02, 0.015, 0.01, -0.01, 0.02;  // a non-zero observed velocity
+  control_step(model, G, FrictionMode::kAdaptive, *st, q0, 0.0);
+  const Vec6<double> qdh = st->qd_hat_prev;
+  ASSERT_GT(qdh.cwiseAbs().minCoeff(), 0.0);
+  Vec6<double> q1 = q0;
+  q1 << q0(0) + 2e-5, q0(1) - 1e-5, q0(2) + 3e-5, q0(3), q0(4) + 1e-5, q0(5) - 2e-5;
+  control_step(model, G, FrictionMode::kAdaptive, *st, q1, 1e-3);
+  Vec18<double> expect;
+  for (int i = 0; i < kDof; ++i) {
+    const double Dq = q1(i) - q0(i) - qdh(i) * 1e-3;
+    const double s = qdh(i) > 0 ? 1 : -1;
+    expect(i) = -500 * qdh(i) * Dq;
+    expect(6 + i) = -500 * s * Dq;
+    expect(12 + i) = -500 * s * std::exp(-qdh(i) * qdh(i)) * Dq;
+  }
+  EXPECT_LT((st->theta_hat - expect).norm(), 1e-12 * (1 + expect.norm()));
+}
+
+TEST(Adaptation, NoCompensationModeNeverAdapts) {
+  const Model<double> model = Model<double>::puma560();
+  const Gains<double> G = Gains<double>::paper();
+  auto st = std::make_unique<ControllerState<double>>();
+  Vec6<double> q = q_start();
+  controller_init(model, *st, q);
+  for (int k = 0; k < 50; ++k) {
+    q(0) += 1e-5;
+    const StepOutput<double> out = control_step(model, G, FrictionMode::kNone, *st, q, k * 1e-3);
+    ASSERT_EQ(out.status, kStepOk);
+    EXPECT_EQ(out.tau_f_hat.norm(), 0.0);
+  }
+  EXPECT_EQ(st->theta_hat.norm(), 0.0);
+}
+
+// The discrete observer error map of the semi-implicit Euler scheme, linearised about a pose:
+// [x~; y~]_{n+1} = [[I - k dt - B dt^2, -dt I], [B dt, I]] [x~; y~]_n with B = Lambda^{-1} k_i.
+// Its spectral radius must be below 1 at the start pose and along the trajectory.
+double spectral_radius(const Mat6<double>& Lambda, bool semi_implicit) {
+  const Gains<double> G = Gains<double>::paper();
+  const double dt = G.dt;
+  const Mat6<double> B = Lambda.llt().solve(Mat6<double>(G.ki.asDiagonal()));
+  Eigen::Matrix<double, 12, 12> M;
+  const Mat6<double> I = Mat6<double>::Identity();
+  const Mat6<double> K = G.k.asDiagonal();
+  M.topLeftCorner<6, 6>() = I - K * dt - (semi_implicit ? Mat6<double>(B * dt * dt) : Mat6<double>::Zero());
+  M.topRightCorner<6, 6>() = -dt * I;
+  M.bottomLeftCorner<6, 6>() = B * dt;
+  M.bottomRightCorner<6, 6>() = I;
+  return M.eigenvalues().cwiseAbs().maxCoeff();
+}
+
+TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
+  const Model<double> model = Model<double>::puma560();
+  Data<double> data;
+  OpSpace<double> os;
+  forward_kinematics(model, data, q_start());
+  const Mat3<double> R_ref = data.R[kDof];
+  double worst_semi = 0, worst_explicit = 0;
+  // Along a sweep of the task workspace around the start pose.
+  for (double s = -1; s <= 1; s += 0.25) {
+    Vec6<double> q = q_start();
+    q(0) += 0.1 * s;
+    q(1) += 0.08 * s;
+    q(2) -= 0.1 * s;
+    opspace_update(model, data, os, q, R_ref);
+    worst_semi = std::max(worst_semi, spectral_radius(os.Lambda, true));
+    worst_explicit = std::max(worst_explicit, spectral_radius(os.Lambda, false));
+  }
+  RecordProperty("spectral_radius_semi_implicit", std::to_string(worst_semi));
+  RecordProperty("spectral_radius_explicit", std::to_string(worst_explicit));
+  std::printf("observer error map spectral radius: semi-implicit %.6f, explicit Euler %.6f\n", worst_semi,
+              worst_explicit);
+  EXPECT_LT(worst_semi, 1.0);
+}
+
+TEST(ControlStep, FaultsCommandZeroTorque) {
+  const Model<double> model = Model<double>::puma560();
+  const Gains<double> G = Gains<double>::paper();
+  auto st = std::make_unique<ControllerState<double>>();
+  controller_init(model, *st, q_start());
+  Vec6<double> q = q_start();
+  q(3) = std::numeric_limits<double>::quiet_NaN();
+  StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, 0.0);
+  EXPECT_EQ(out.status, kStepNonFinite);
+  EXPECT_EQ(out.tau.norm(), 0.0);
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(out.status, kStepNonFinite);
+  EXPECT_EQ(out.tau.norm(), 0.0);
+  // Wrist singularity (q5 = 0).
+  q = q_start();
+  q(4) = 0.0;
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q, 0.0);
+  EXPECT_EQ(out.status, kStepSingular);
+  EXPECT_EQ(out.tau.norm(), 0.0);
+  // A healthy step afterwards works and produces finite torques.
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), 0.0);
+  EXPECT_EQ(out.status, kStepOk);
+  EXPECT_TRUE(math::all_finite(out.tau));
+}
+
+TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
+  // x = x_d, observer at rest: F = p(x), so Gamma = J^T p = g(q).
+  const Model<double> model = Model<double>::puma560();
+  const Gains<double> G = Gains<double>::paper();
+  auto st = std::make_unique<ControllerState<double>>();
+  controller_init(model, *st, q_start());
+  const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), 0.0);
+  ASSERT_EQ(out.status, kStepOk);
+  Data<double> data;
+  forward_kinematics(model, data, q_start());
+  EXPECT_LT((out.tau - gravity_torques(model, data)).norm(), 1e-9);
+}
+
+template <class S>
+void run_steps_without_allocation() {
+  const Model<S> model = Model<S>::puma560();
+  const Gains<S> G = Gains<S>::paper();
+  auto st = std::make_unique<ControllerState<S>>();
+  Vec6<S> q = q_start().cast<S>();
+  controller_init(model, *st, q);
+  test::NoMalloc guard;
+  for (int k = 0; k < 20; ++k) {
+    q(1) += lit<S>(1e-5);
+    const StepOutput<S> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, lit<S>(k * 1e-3));
+    ASSERT_EQ(out.status, kStepOk);
+  }
+}
+
+TEST(ControlStep, AllocationFreeInDoubleAndFloat) {
+  run_steps_without_allocation<double>();
+  run_steps_without_allocation<float>();
+}
+
+}  // namespace
