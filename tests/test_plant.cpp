@@ -1,0 +1,181 @@
+// The simulated plant (host_sim/): articulated-body dynamics against the kernels' inverse
+// dynamics, energy conservation of the integrator, step-size adequacy, and the HAL binding.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "experiment.hpp"
+#include "hal/hal.hpp"
+#include "osc/dynamics.hpp"
+#include "osc/io.hpp"
+#include "plant_hal.hpp"
+#include "test_util.hpp"
+
+using namespace sim;
+
+namespace {
+
+Vec6 q_start() {
+  Vec6 q;
+  for (int i = 0; i < 6; ++i) q(i) = osc::params::kQStart[i];
+  return q;
+}
+
+TEST(Plant, ArticulatedBodyInvertsTheKernelsInverseDynamics) {
+  // ABA (plant) and CRBA/RNEA (controller kernels) are separate code paths: A qdd + c + g must
+  // reproduce the torque that produced qdd.
+  osc::test::RandomStates rs;
+  const osc::Model<double> model = osc::Model<double>::puma560();
+  osc::Data<double> data;
+  ArticulatedBody body;
+  double worst = 0;
+  for (int k = 0; k < 500; ++k) {
+    const Vec6 q = rs.q_nonsingular(), qd = rs.vec(2.0), tau = rs.vec(30.0);
+    const Vec6 qdd = body.forward_dynamics(q, qd, tau);
+    osc::forward_kinematics(model, data, q);
+    const Vec6 back = osc::rnea(model, data, qd, qdd, true).tau;
+    worst = std::max(worst, (back - tau).norm() / (1.0 + tau.norm()));
+  }
+  std::printf("ABA vs RNEA worst relative torque error: %.3e\n", worst);
+  EXPECT_LT(worst, 1e-11);
+}
+
+TEST(Plant, EnergyIsConservedWithoutTorqueAndFriction) {
+  PlantConfig cfg;
+  cfg.friction = osc::params::kFrictionNone;
+  Plant plant(cfg);
+  Vec6 qd0;
+  qd0 << 0.5, -0.3, 0.4, 1.0, -0.8, 1.2;
+  plant.reset(q_start(), qd0);
+  const double E0 = plant.energy();
+  double drift = 0;
+  for (int k = 0; k < 2000; ++k) {  // 2 s of free motion (falling and swinging under gravity)
+    plant.integrate(Vec6::Zero(), 1e-3);
+    drift = std::max(drift, std::abs(plant.energy() - E0));
+  }
+  const double scale = std::abs(E0) + 0.5 * qd0.squaredNorm();
+  std::printf("energy drift over 2 s at a 0.1 ms RK4 step: %.3e J (E0 = %.3f J)\n", drift, E0);
+  EXPECT_LT(drift, 1e-6 * scale);
+}
+
+TEST(Plant, FrictionFollowsModel2) {
+  Plant plant;
+  Vec6 qd;
+  qd << 0.5, -0.5, 0.0, 2.0, -1e-3, 0.1;
+  const Vec6 f = plant.friction(qd);
+  const auto& p = osc::params::kFrictionPaper;
+  for (int i = 0; i < 6; ++i) {
+    const double s = qd(i) > 0 ? 1 : (qd(i) < 0 ? -1 : 0);
+    EXPECT_DOUBLE_EQ(f(i), p.vis[i] * qd(i) + (p.cou[i] + p.sti[i] * std::exp(-qd(i) * qd(i))) * s);
+  }
+  EXPECT_EQ(f(2), 0.0);  // sgn(0) = 0
+}
+
+TEST(Plant, HalvingTheStepInOpenLoop) {
+  // Integration error alone (no feedback): 2 s under a sinusoidal torque that makes every joint
+  // reverse. Without friction the dynamics are smooth and RK4 converges to round-off; with the
+  // paper's friction the sgn() of model (2) is discontinuous at zero velocity, fixed-step
+  // integration is first order at each reversal, and a joint that the torque cannot break away
+  // chatters about zero velocity; the difference is then of the order of an encoder count.
+  auto run = [](double h, const osc::params::FrictionPreset& friction) {
+    PlantConfig cfg;
+    cfg.substep = h;
+    cfg.friction = friction;
+    Plant plant(cfg);
+    plant.reset(q_start());
+    osc::Data<double> data;
+    const osc::Model<double> model = osc::Model<double>::puma560();
+    for (int k = 0; k < 2000; ++k) {
+      osc::forward_kinematics(model, data, plant.q());
+      Vec6 tau = osc::gravity_torques(model, data);
+      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::puma560::kPi * (0.7 + 0.2 * i) * k * 1e-3);
+      plant.integrate(tau, 1e-3);
+    }
+    return plant.q();
+  };
+  const double smooth = (run(1e-4, osc::params::kFrictionNone) - run(5e-5, osc::params::kFrictionNone)).cwiseAbs().maxCoeff();
+  const double rough = (run(1e-4, osc::params::kFrictionPaper) - run(5e-5, osc::params::kFrictionPaper)).cwiseAbs().maxCoeff();
+  std::printf("open loop, step 1e-4 vs 5e-5 s, max joint-angle difference after 2 s: %.2e rad without friction, "
+              "%.2e rad with the paper's friction\n", smooth, rough);
+  EXPECT_LT(smooth, 1e-9);
+  EXPECT_LT(rough, 5e-4);  // a few encoder counts (one count is 6e-5 .. 1.2e-4 rad on joints 1-3)
+}
+
+TEST(Plant, HalvingTheStepChangesA10sClosedLoopRunByLessThanTolerance) {
+  // In closed loop a one-count encoder flip propagates, so samples may differ by about one count;
+  // the run's statistics must agree.
+  ExperimentConfig a;
+  a.duration = 10;
+  a.final_window = 5;
+  a.log_period = 0.001;
+  ExperimentConfig b = a;
+  b.plant.substep = a.plant.substep / 2;
+  const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
+  ASSERT_EQ(ra.log.size(), rb.log.size());
+  double dpos = 0, dang = 0;
+  for (size_t k = 0; k < ra.log.size(); ++k) {
+    for (int i = 0; i < 3; ++i) dpos = std::max(dpos, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
+    for (int i = 3; i < 6; ++i) dang = std::max(dang, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
+  }
+  double dmax_pos = 0, dmax_ang = 0;
+  for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
+  for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
+  std::printf("closed loop, step %.0e vs %.0e s: max sample difference %.3f mm %.4f deg; max-error statistics "
+              "differ by %.4f mm %.5f deg\n",
+              a.plant.substep, b.plant.substep, dpos, dang, dmax_pos, dmax_ang);
+  // Stated tolerance on the table entries: one encoder quantum at the start pose (0.069 mm) and 0.01 deg.
+  EXPECT_LT(dmax_pos, 0.069);
+  EXPECT_LT(dmax_ang, 0.01);
+  EXPECT_LT(dpos, 0.15);  // samples: about two encoder quanta
+}
+
+TEST(PlantHal, EncodersQuantiseAndDacsScaleAndSaturate) {
+  Plant plant;
+  const Vec6 q0 = q_start();
+  Vec6 q = q0;
+  q(1) += 0.01;
+  q(2) -= 0.02;
+  plant.reset(q);
+  PlantHal hal(plant, q0);
+  std::int32_t counts[6];
+  hal.read_encoders(counts);
+  EXPECT_EQ(counts[0], 0);
+  EXPECT_EQ(counts[1], static_cast<std::int32_t>(std::floor(0.01 * osc::params::encoder_counts_per_rad(1))));
+  EXPECT_EQ(counts[2], static_cast<std::int32_t>(std::floor(-0.02 * osc::params::encoder_counts_per_rad(2))));
+  // Angle reconstruction is within one count.
+  for (int i = 0; i < 6; ++i) {
+    const double back = osc::counts_to_angle<double>(i, counts[i], q0(i));
+    EXPECT_LE(q(i) - back, 1.0 / osc::params::encoder_counts_per_rad(i) + 1e-12);
+    EXPECT_GE(q(i) - back, 0.0);
+  }
+  // DAC: rounding, saturation, and a non-finite torque giving code 0.
+  std::int32_t code = 7;
+  EXPECT_FALSE(osc::torque_to_code(1, 10.0, code));
+  EXPECT_NEAR(osc::code_to_torque(1, code), 10.0, osc::params::kTorqueLimit[1] / osc::params::kDacMaxCode);
+  EXPECT_TRUE(osc::torque_to_code(1, 1e6, code));
+  EXPECT_EQ(code, osc::params::kDacMaxCode);
+  EXPECT_TRUE(osc::torque_to_code(1, -1e6, code));
+  EXPECT_EQ(code, -osc::params::kDacMaxCode);
+  EXPECT_TRUE(osc::torque_to_code(1, std::nan(""), code));
+  EXPECT_EQ(code, 0);
+  const std::int32_t codes[6] = {100, -200, 300, 0, osc::params::kDacMaxCode, -osc::params::kDacMaxCode};
+  hal.write_dacs(codes);
+  EXPECT_DOUBLE_EQ(hal.torque()(4), osc::params::kTorqueLimit[4]);
+  EXPECT_DOUBLE_EQ(hal.torque()(5), -osc::params::kTorqueLimit[5]);
+}
+
+TEST(Hal, EncoderUnwrapExtendsA16BitCounterAcrossWraps) {
+  hal::EncoderUnwrap<16> enc;
+  std::int64_t truth = 0;
+  std::uint32_t raw = 0;
+  // Move forward past several wraps, then back below zero, in steps below half the range.
+  for (int k = 0; k < 1000; ++k) {
+    const int step = k < 600 ? 500 : -900;
+    truth += step;
+    raw = static_cast<std::uint32_t>(truth) & 0xFFFFu;
+    ASSERT_EQ(enc.update(raw), truth) << k;
+  }
+  EXPECT_LT(truth, 0);
+}
+
+}  // namespace
