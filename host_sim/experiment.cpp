@@ -72,8 +72,9 @@ ExperimentResult run(const ExperimentConfig& cfg) {
     for (int i = 0; i < 3; ++i) e[3 + i] = -phi(i) * kRadToDeg;
 
     // The control task: encoders -> control step -> DAC codes.
-    const osc::StepOutput<S>& out = osc::control_tick(task, hal);
-    if (out.status != osc::kStepOk && res.status == 0) res.status = out.status;
+    const std::uint32_t faults = osc::control_tick(task, hal);
+    const osc::StepOutput<S>& out = task.last;
+    if (faults != 0 && res.status == 0) res.status = faults;
     const Vec6 tau_new = hal.torque();
 
     for (int i = 0; i < 6; ++i) {

@@ -23,6 +23,9 @@ class PlantHal {
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) codes_[i] = codes[i];
   }
+  /// The host build has no cycle counter and no link: timing reads 0, no I/O faults.
+  std::uint32_t cycles() const { return 0; }
+  std::uint32_t io_faults() const { return 0; }
   /// Joint torques the amplifiers produce from the last DAC codes.
   Vec6 torque() const {
     Vec6 t;

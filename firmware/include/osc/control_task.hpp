@@ -1,6 +1,10 @@
 // The control task the 1 kHz timer interrupt runs: read encoders -> angles -> control step
-// (observer, controller, adaptation) -> torques -> DAC codes -> write. Bound to a HAL at compile
-// time; the same code runs against the simulated plant on the host and on the targets.
+// (observer, controller, adaptation) -> torques -> DAC codes -> write, under the supervisor.
+// Bound to a HAL at compile time; the same code runs against the simulated plant on the host and
+// on the targets.
+//
+// HAL requirements (see hal/hal.hpp): read_encoders(counts), write_dacs(codes), cycles() (a free-
+// running 32-bit counter), io_faults() (fault bits the I/O layer detected, e.g. the link).
 #pragma once
 
 #include <cstdint>
@@ -8,31 +12,63 @@
 #include "hal/hal.hpp"
 #include "osc/controller.hpp"
 #include "osc/io.hpp"
+#include "osc/supervisor.hpp"
 
 namespace osc {
+
+/// Per-step timing, in the HAL's cycle-counter units.
+struct StepTiming {
+  std::uint32_t last = 0, max = 0;
+  std::uint64_t sum = 0;
+  std::uint32_t count = 0;
+  std::uint32_t mean() const { return count ? static_cast<std::uint32_t>(sum / count) : 0; }
+  void add(std::uint32_t c) {
+    last = c;
+    if (c > max) max = c;
+    sum += c;
+    ++count;
+  }
+};
 
 template <class S>
 struct ControlTask {
   Model<S> model;
   Gains<S> gains;
   FrictionMode mode;
-  Vec6<S> q_start;           // joint angles at which the encoders read zero
-  std::uint32_t tick;        // samples since start
+  Vec6<S> q_start;            // joint angles at which the encoders read zero
+  std::uint32_t tick;         // samples since start
   ControllerState<S> state;
-  StepOutput<S> last;        // the most recent step, for telemetry
-  std::int32_t codes[kDof];  // the most recent DAC codes
-  std::uint32_t saturated;   // bit i: joint i's torque was clipped at the DAC range this tick
+  StepOutput<S> last;         // the most recent step, for telemetry
+  std::int32_t codes[kDof];   // the most recent DAC codes
+  std::int32_t prev_counts[kDof];
+  std::int32_t max_count_step[kDof];  // largest plausible encoder change per tick
+  std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
+  Supervisor sup;
+  std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
+  StepTiming timing;
 
-  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0) {
+  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0,
+            std::uint32_t period = 0) {
     model = m;
     gains = g;
     mode = fm;
     q_start = q0;
     tick = 0;
     controller_init(model, state, q0);
-    for (int i = 0; i < kDof; ++i) codes[i] = 0;
-    saturated = 0;
+    for (int i = 0; i < kDof; ++i) {
+      codes[i] = 0;
+      prev_counts[i] = 0;
+      sat_ticks[i] = 0;
+      // Speed limit times the sample, in counts, plus one count of quantisation.
+      max_count_step[i] = static_cast<std::int32_t>(params::kMaxJointSpeed[i] * params::kDt *
+                                                    params::encoder_counts_per_rad(i)) + 1;
+    }
+    sup = {SupervisorState::kInit, 0};
+    period_cycles = period;
+    timing = {};
   }
+  /// Test hook (fault injection): poisons the observer state with a NaN.
+  void inject_nonfinite() { state.y(0) = S(0) / S(0); }
 };
 
 /// Encoder counts to joint angles.
@@ -43,22 +79,50 @@ Vec6<S> angles_from_counts(const Vec6<S>& q_start, const std::int32_t counts[kDo
   return q;
 }
 
-/// One tick. On any step fault every DAC gets code 0 in this same tick.
+/// One tick. Returns the fault bits detected in this tick. On any fault, and whenever the
+/// supervisor is not in kRun, every DAC gets code 0 in this same tick.
 template <class S, class Hal>
-const StepOutput<S>& control_tick(ControlTask<S>& task, Hal& hal) {
+std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
+  const std::uint32_t c0 = hal.cycles();
+  std::uint32_t faults = hal.io_faults();
   std::int32_t counts[kDof];
   hal.read_encoders(counts);
-  const Vec6<S> q = angles_from_counts(task.q_start, counts);
-  const S t = static_cast<S>(task.tick) * task.gains.dt;
-  task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
-  task.saturated = 0;
-  for (int i = 0; i < kDof; ++i) {
-    if (torque_to_code(i, task.last.tau(i), task.codes[i])) task.saturated |= 1u << i;
-    if (task.last.status != kStepOk) task.codes[i] = 0;
+  // An encoder change beyond the physical joint speed (comparison written so that it cannot wrap).
+  if (task.tick > 0) {
+    for (int i = 0; i < kDof; ++i) {
+      const std::int64_t d = static_cast<std::int64_t>(counts[i]) - task.prev_counts[i];
+      if (d > task.max_count_step[i] || d < -static_cast<std::int64_t>(task.max_count_step[i]))
+        faults |= kFaultEncoderJump;
+      task.prev_counts[i] = counts[i];
+    }
+  } else {
+    for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i];
   }
+
+  for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
+  if (task.sup.state != SupervisorState::kFault && faults == 0) {
+    const Vec6<S> q = angles_from_counts(task.q_start, counts);
+    const S t = static_cast<S>(task.tick) * task.gains.dt;
+    task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
+    if (task.last.status & kStepNonFinite) faults |= kFaultNonFinite;
+    if (task.last.status & kStepSingular) faults |= kFaultSingular;
+    for (int i = 0; i < kDof; ++i) {
+      const bool clipped = torque_to_code(i, task.last.tau(i), task.codes[i]);
+      task.sat_ticks[i] = clipped ? static_cast<std::uint16_t>(task.sat_ticks[i] + 1) : 0;
+      if (task.sat_ticks[i] >= params::kSaturationTicks) faults |= kFaultSaturation;
+    }
+  }
+  // The step's own duration against the period (the next tick would have arrived).
+  const std::uint32_t elapsed = hal.cycles() - c0;
+  if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
+
+  task.sup = supervisor_next(task.sup, {faults, true});
+  if (!torque_enabled(task.sup))
+    for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   hal.write_dacs(task.codes);
+  task.timing.add(hal.cycles() - c0);
   ++task.tick;
-  return task.last;
+  return faults;
 }
 
 }  // namespace osc

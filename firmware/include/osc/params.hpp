@@ -42,6 +42,15 @@ constexpr double encoder_counts_per_rad(int joint) {
   return kEncoderCountsPerMotorRev * (G < 0 ? -G : G) / (2 * puma560::kPi);
 }
 
+/// Supervision limits.
+/// Joint speed above which an encoder change between two ticks is implausible [rad/s] (assumed:
+/// about twice the PUMA 560's maximum joint speeds).
+constexpr double kMaxJointSpeed[6] = {8.0, 8.0, 8.0, 16.0, 16.0, 16.0};
+/// Consecutive ticks a torque may stay clipped at the DAC range before the saturation fault.
+constexpr int kSaturationTicks = 50;
+/// Sensor-frame timeout of the processor-in-the-loop link [s] (virtual time of the target).
+constexpr double kLinkTimeout = 0.05;
+
 /// Friction presets of the simulated plant, model (2): link-side coefficients.
 struct FrictionPreset {
   const char* name;

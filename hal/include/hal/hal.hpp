@@ -6,6 +6,10 @@
 //       already extended (see EncoderUnwrap).
 //   void write_dacs(const std::int32_t codes[hal::kJoints]);
 //       Signed DAC codes in [-kDacMaxCode, kDacMaxCode] (osc/params.hpp).
+//   std::uint32_t cycles();
+//       A free-running 32-bit counter for step timing (0 where there is none).
+//   std::uint32_t io_faults();
+//       osc::Fault bits the I/O layer detected since the last tick (lost or corrupt link).
 // Bindings: host_sim/plant_hal.hpp (the simulated PUMA 560); boards/<board>/ for targets.
 #pragma once
 

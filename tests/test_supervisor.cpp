@@ -1,0 +1,160 @@
+// The supervisor (exhaustively) and the control task's fault handling with a scripted HAL.
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "osc/control_task.hpp"
+
+using namespace osc;
+
+namespace {
+
+// Independent oracle: the specification of supervisor_next written as plain rules.
+Supervisor oracle(Supervisor s, SupervisorInput in) {
+  Supervisor n = s;
+  n.latched = s.latched | (in.faults & kAllFaults);
+  if (s.state == SupervisorState::kFault) n.state = SupervisorState::kFault;
+  else if (n.latched) n.state = SupervisorState::kFault;
+  else if (s.state == SupervisorState::kInit) n.state = in.ready ? SupervisorState::kRun : SupervisorState::kInit;
+  else n.state = SupervisorState::kRun;
+  return n;
+}
+
+TEST(Supervisor, ExhaustiveAgainstTheSpecification) {
+  int cases = 0;
+  for (int st = 0; st < 3; ++st)
+    for (std::uint32_t latched = 0; latched <= kAllFaults; ++latched)
+      for (std::uint32_t f = 0; f <= 0xFF; ++f)  // includes an undefined bit (0x80)
+        for (int ready = 0; ready < 2; ++ready) {
+          const Supervisor s{static_cast<SupervisorState>(st), st == 2 ? latched : 0u};
+          if (st != 2 && latched != 0) continue;  // only kFault carries latched bits
+          const SupervisorInput in{f, ready != 0};
+          const Supervisor got = supervisor_next(s, in), want = oracle(s, in);
+          ASSERT_EQ(got.state, want.state) << st << " " << f << " " << ready;
+          ASSERT_EQ(got.latched, want.latched);
+          // Properties: faults are sticky and always disable torque.
+          if (f & kAllFaults) {
+            ASSERT_FALSE(torque_enabled(got));
+          }
+          if (st == 2) {
+            ASSERT_EQ(got.state, SupervisorState::kFault);
+          }
+          ASSERT_EQ(got.latched & s.latched, s.latched);
+          ++cases;
+        }
+  EXPECT_GT(cases, 1000);
+}
+
+/// A HAL whose encoder counts, cycle counter and I/O faults the test scripts.
+struct ScriptedHal {
+  std::int32_t counts[kDof] = {0, 0, 0, 0, 0, 0};
+  std::int32_t written[kDof] = {1, 1, 1, 1, 1, 1};
+  std::uint32_t clock = 0, clock_step = 10, faults = 0;
+  int writes = 0;
+  void read_encoders(std::int32_t c[kDof]) {
+    for (int i = 0; i < kDof; ++i) c[i] = counts[i];
+  }
+  void write_dacs(const std::int32_t c[kDof]) {
+    for (int i = 0; i < kDof; ++i) written[i] = c[i];
+    ++writes;
+  }
+  std::uint32_t cycles() { return clock += clock_step; }
+  std::uint32_t io_faults() {
+    const std::uint32_t f = faults;
+    faults = 0;
+    return f;
+  }
+  bool all_zero() const {
+    for (int c : written)
+      if (c != 0) return false;
+    return true;
+  }
+};
+
+struct TaskFixture : ::testing::Test {
+  std::unique_ptr<ControlTask<float>> task = std::make_unique<ControlTask<float>>();
+  ScriptedHal hal;
+  void SetUp() override { start(params::kQStart); }
+  void start(const double (&q0)[kDof], std::uint32_t period = 0) {
+    Vec6<float> q;
+    for (int i = 0; i < kDof; ++i) q(i) = static_cast<float>(q0[i]);
+    task->init(Model<float>::puma560(), Gains<float>::paper(), FrictionMode::kAdaptive, q, period);
+  }
+  /// Runs ticks; returns the faults of the last.
+  std::uint32_t run(int n) {
+    std::uint32_t f = 0;
+    for (int k = 0; k < n; ++k) f = control_tick(*task, hal);
+    return f;
+  }
+  void expect_latched(std::uint32_t bit) {
+    EXPECT_EQ(task->sup.state, SupervisorState::kFault);
+    EXPECT_TRUE(task->sup.latched & bit) << task->sup.latched;
+    EXPECT_TRUE(hal.all_zero());
+    // Stays latched with healthy inputs afterwards.
+    run(3);
+    EXPECT_EQ(task->sup.state, SupervisorState::kFault);
+    EXPECT_TRUE(hal.all_zero());
+  }
+};
+
+TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
+  EXPECT_EQ(run(5), 0u);
+  EXPECT_EQ(task->sup.state, SupervisorState::kRun);
+  EXPECT_FALSE(hal.all_zero());  // holds gravity
+  EXPECT_EQ(hal.writes, 5);
+  EXPECT_EQ(task->timing.count, 5u);
+  EXPECT_GT(task->timing.max, 0u);
+}
+
+TEST_F(TaskFixture, EncoderJumpFaultsInTheSameTick) {
+  run(3);
+  hal.counts[1] += task->max_count_step[1];  // the largest plausible step is fine
+  EXPECT_EQ(run(1), 0u);
+  hal.counts[1] += task->max_count_step[1] + 1;
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
+  expect_latched(kFaultEncoderJump);
+}
+
+TEST_F(TaskFixture, NonFiniteStateFaultsInTheSameTick) {
+  run(3);
+  task->inject_nonfinite();
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultNonFinite));
+  expect_latched(kFaultNonFinite);
+}
+
+TEST_F(TaskFixture, SingularPoseFaults) {
+  double q[kDof];
+  for (int i = 0; i < kDof; ++i) q[i] = params::kQStart[i];
+  q[4] = 0.0;  // wrist singularity
+  start(q);
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultSingular));
+  expect_latched(kFaultSingular);
+}
+
+TEST_F(TaskFixture, PersistentSaturationFaults) {
+  // The robot does not move (encoders frozen) while the trajectory runs away: the error grows until
+  // the torques clip, and after kSaturationTicks clipped ticks the fault latches.
+  int k = 0;
+  std::uint32_t f = 0;
+  for (; k < 20000 && f == 0; ++k) f = run(1);
+  EXPECT_EQ(f, static_cast<std::uint32_t>(kFaultSaturation)) << "after " << k << " ticks";
+  expect_latched(kFaultSaturation);
+}
+
+TEST_F(TaskFixture, OverrunFaults) {
+  start(params::kQStart, 1000);
+  hal.clock_step = 100;
+  EXPECT_EQ(run(2), 0u);
+  hal.clock_step = 2000;  // the step now takes longer than the period
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultOverrun));
+  expect_latched(kFaultOverrun);
+}
+
+TEST_F(TaskFixture, LinkFaultsFromTheIoLayer) {
+  run(2);
+  hal.faults = kFaultLinkLost;
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultLinkLost));
+  expect_latched(kFaultLinkLost);
+}
+
+}  // namespace
