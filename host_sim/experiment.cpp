@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "osc/control_task.hpp"
+#include "pil_client.hpp"
 #include "plant_hal.hpp"
 
 namespace sim {
@@ -16,29 +17,88 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / osc::puma560::kPi;
 
-template <class S>
-ExperimentResult run(const ExperimentConfig& cfg) {
-  const auto wall0 = std::chrono::steady_clock::now();
-  ExperimentResult res;
-  res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
-  res.duration = cfg.duration;
-  res.friction_preset = cfg.plant.friction.name;
+/// What the controller reports back each tick.
+struct TickReport {
+  std::uint32_t faults = 0;
+  bool has_observer = false;  // x_tilde is available (in-process controller only)
+  double x_tilde[6] = {};
+  double tau_f_hat[6] = {};
+  double theta_hat[18] = {};
+};
 
-  Vec6 q0;
-  for (int i = 0; i < 6; ++i) q0(i) = osc::params::kQStart[i];
+/// The host-built controller: the firmware's control task, in process.
+template <class S>
+class LocalController {
+ public:
+  explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
+    task_->init(osc::Model<S>::puma560(cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
+    // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
+    for (int i = 0; i < 6; ++i) {
+      task_->state.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
+      task_->state.y(i) += task_->gains.k(i) * static_cast<S>(cfg.observer_offset[i]);
+    }
+  }
+  bool tick(PlantHal& hal, TickReport& r, std::string&) {
+    r.faults = osc::control_tick(*task_, hal);
+    const osc::StepOutput<S>& out = task_->last;
+    r.has_observer = true;
+    for (int i = 0; i < 6; ++i) {
+      r.x_tilde[i] = static_cast<double>(out.x_tilde(i));
+      r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
+    }
+    for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.theta_hat(i));
+    return true;
+  }
+  void finish(ExperimentResult&) {}
+
+ private:
+  std::unique_ptr<osc::ControlTask<S>> task_;  // large: keep off the stack
+};
+
+/// The firmware image (or any PIL peer) over the link, one exchange per tick.
+class RemoteController {
+ public:
+  RemoteController(const ExperimentConfig& cfg, std::string& err) : timeout_(cfg.pil_timeout) {
+    ok_ = link_.start(cfg.pil_command, err);
+  }
+  bool ok() const { return ok_; }
+  bool tick(PlantHal& hal, TickReport& r, std::string& err) {
+    pil::SensorFrame s;
+    s.seq = seq_++;
+    hal.read_encoders(s.counts);
+    pil::ActuatorFrame a;
+    if (!link_.send(s, err) || !link_.receive(a, timeout_, err)) return false;
+    if (a.seq != s.seq) {
+      err = "actuator frame for tick " + std::to_string(a.seq) + " answered tick " + std::to_string(s.seq);
+      return false;
+    }
+    hal.write_dacs(a.codes);
+    r.faults = a.faults;
+    for (int i = 0; i < 6; ++i) r.tau_f_hat[i] = a.tau_f_hat[i];
+    for (int i = 0; i < 18; ++i) r.theta_hat[i] = a.theta_hat[i];
+    last_ = a;
+    return true;
+  }
+  void finish(ExperimentResult& res) {
+    res.max_step_cycles = last_.max_cycles;
+    res.mean_step_cycles = last_.mean_cycles;
+    res.stack_used = last_.stack_used;
+    link_.stop();
+  }
+
+ private:
+  PilClient link_;
+  double timeout_;
+  bool ok_ = false;
+  std::uint32_t seq_ = 0;
+  pil::ActuatorFrame last_;
+};
+
+template <class Controller>
+void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
   PlantHal hal(plant, q0);
-
-  // The firmware's control task, in the chosen scalar, with the (possibly perturbed) model.
-  auto task_ptr = std::make_unique<osc::ControlTask<S>>();  // large: keep off the stack
-  osc::ControlTask<S>& task = *task_ptr;
-  task.init(osc::Model<S>::puma560(cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
-  // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
-  for (int i = 0; i < 6; ++i) {
-    task.state.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
-    task.state.y(i) += task.gains.k(i) * static_cast<S>(cfg.observer_offset[i]);
-  }
 
   // Ground truth for the error statistics: the plant's own state through double kinematics.
   const osc::Model<double> truth = osc::Model<double>::puma560();
@@ -46,12 +106,6 @@ ExperimentResult run(const ExperimentConfig& cfg) {
   osc::forward_kinematics(truth, tdata, q0);
   const Vec3 p0 = tdata.o[6];
   const Mat3 R_ref = tdata.R[6];
-
-  for (int i = 0; i < 6; ++i) {
-    res.theta_true[i] = cfg.plant.friction.vis[i];
-    res.theta_true[6 + i] = cfg.plant.friction.cou[i];
-    res.theta_true[12 + i] = cfg.plant.friction.sti[i];
-  }
 
   const double dt = osc::params::kDt;
   const long n = std::lround(cfg.duration / dt);
@@ -61,6 +115,7 @@ ExperimentResult run(const ExperimentConfig& cfg) {
   long fr_n = 0;
   Vec6 tau_old = Vec6::Zero();
   const long progress_every = std::max(1L, n / 100);
+  TickReport rep;
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
     // Errors of the true plant at the sample instant.
@@ -71,24 +126,27 @@ ExperimentResult run(const ExperimentConfig& cfg) {
     for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - tdata.o[6](i)) * 1e3;
     for (int i = 0; i < 3; ++i) e[3 + i] = -phi(i) * kRadToDeg;
 
-    // The control task: encoders -> control step -> DAC codes.
-    const std::uint32_t faults = osc::control_tick(task, hal);
-    const osc::StepOutput<S>& out = task.last;
-    if (faults != 0 && res.status == 0) res.status = faults;
+    // The controller: encoders -> control step -> DAC codes.
+    if (!ctrl.tick(hal, rep, res.error)) {
+      res.error = "tick " + std::to_string(k) + ": " + res.error;
+      break;
+    }
+    if (rep.faults != 0 && res.status == 0) res.status = rep.faults;
     const Vec6 tau_new = hal.torque();
 
+    double xt[6];
+    for (int i = 0; i < 6; ++i) xt[i] = rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg);
     for (int i = 0; i < 6; ++i) {
       res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
       if (t >= t_final) {
         res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
-        const double xt = static_cast<double>(out.x_tilde(i)) * (i < 3 ? 1e3 : kRadToDeg);
-        res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt));
+        res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
       }
     }
     const Vec6 tau_f = plant.friction(plant.qd());
     if (t >= t_final) {
       for (int i = 0; i < 6; ++i) {
-        const double df = static_cast<double>(out.tau_f_hat(i)) - tau_f(i);
+        const double df = rep.tau_f_hat[i] - tau_f(i);
         fr_err2 += df * df;
         fr2 += tau_f(i) * tau_f(i);
       }
@@ -99,31 +157,53 @@ ExperimentResult run(const ExperimentConfig& cfg) {
       r.t = t;
       for (int i = 0; i < 6; ++i) {
         r.e[i] = e[i];
-        r.x_tilde[i] = static_cast<double>(out.x_tilde(i)) * (i < 3 ? 1e3 : kRadToDeg);
+        r.x_tilde[i] = xt[i];
         r.tau_f[i] = tau_f(i);
-        r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
+        r.tau_f_hat[i] = rep.tau_f_hat[i];
       }
-      for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task.state.theta_hat(i));
+      for (int i = 0; i < 18; ++i) r.theta_hat[i] = rep.theta_hat[i];
       res.log.push_back(r);
     }
     plant.advance_sample(tau_old, tau_new, dt);
     tau_old = tau_new;
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);
   }
-  for (int i = 0; i < 18; ++i) res.theta_hat[i] = static_cast<double>(task.state.theta_hat(i));
+  for (int i = 0; i < 18; ++i) res.theta_hat[i] = rep.theta_hat[i];
   if (fr_n > 0) {
     res.friction_rms_error = std::sqrt(fr_err2 / (6.0 * fr_n));
     res.friction_rms = std::sqrt(fr2 / (6.0 * fr_n));
   }
+  ctrl.finish(res);
   if (cfg.progress) cfg.progress(1.0);
-  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  return res;
 }
 
 }  // namespace
 
 ExperimentResult run_experiment(const ExperimentConfig& cfg) {
-  return cfg.scalar == Scalar::kFloat ? run<float>(cfg) : run<double>(cfg);
+  const auto wall0 = std::chrono::steady_clock::now();
+  ExperimentResult res;
+  res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
+  res.duration = cfg.duration;
+  res.friction_preset = cfg.plant.friction.name;
+  for (int i = 0; i < 6; ++i) {
+    res.theta_true[i] = cfg.plant.friction.vis[i];
+    res.theta_true[6 + i] = cfg.plant.friction.cou[i];
+    res.theta_true[12 + i] = cfg.plant.friction.sti[i];
+  }
+  Vec6 q0;
+  for (int i = 0; i < 6; ++i) q0(i) = osc::params::kQStart[i];
+  if (!cfg.pil_command.empty()) {
+    RemoteController ctrl(cfg, res.error);
+    if (ctrl.ok()) run(cfg, q0, ctrl, res);
+  } else if (cfg.scalar == Scalar::kFloat) {
+    LocalController<float> ctrl(cfg, q0);
+    run(cfg, q0, ctrl, res);
+  } else {
+    LocalController<double> ctrl(cfg, q0);
+    run(cfg, q0, ctrl, res);
+  }
+  res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return res;
 }
 
 }  // namespace sim

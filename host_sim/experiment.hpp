@@ -23,6 +23,10 @@ struct ExperimentConfig {
   double final_window = 20.0;                       ///< "last 20 s" statistics [s]
   double observer_offset[6] = {0, 0, 0, 0, 0, 0};    ///< x^(0) - x(0), to test observer convergence
   std::function<void(double fraction)> progress;    ///< optional progress callback
+  /// Processor-in-the-loop: the command that starts the firmware (e.g. qemu-system-arm with the
+  /// image, see PilClient::qemu_command); empty runs the host-built controller in process.
+  std::vector<std::string> pil_command;
+  double pil_timeout = 10.0;                        ///< wall-clock wait per actuator frame [s]
 };
 
 /// One logged sample of the time series.
@@ -46,7 +50,9 @@ struct ExperimentResult {
   double theta_true[18] = {};
   double friction_rms_error = 0;     // rms of tau_f_hat - tau_f over the last window [N m]
   double friction_rms = 0;           // rms of tau_f over the last window [N m]
-  std::uint32_t status = 0;          // first non-ok control-step status (0: none)
+  std::uint32_t status = 0;          // first fault bits reported (0: none)
+  std::string error;                 // link error (PIL), empty when the run completed
+  std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
   double wall_seconds = 0;
   std::vector<LogRow> log;
 };

@@ -1,0 +1,203 @@
+// Processor-in-the-loop link protocol: framed, checksummed, little-endian, lockstep (one sensor
+// frame from the host and one actuator frame back per tick). Shared by the firmware and host_sim.
+//
+// Frame:  0xA5 0x5A | type (1) | length (1) | payload (length bytes) | CRC-16/CCITT-FALSE (2, LE)
+// The CRC covers type, length and payload. Sensor frames carry the tick's sequence number, the six
+// encoder counts and fault-injection requests (test builds); actuator frames carry the DAC codes,
+// the supervisor state and fault bits, step timing, stack use and the friction estimates.
+#pragma once
+
+#include <cstdint>
+#include <cstring>
+
+namespace pil {
+
+constexpr std::uint8_t kSync0 = 0xA5, kSync1 = 0x5A;
+constexpr int kJoints = 6;
+
+enum FrameType : std::uint8_t { kSensorFrame = 1, kActuatorFrame = 2 };
+
+/// Fault-injection requests in a sensor frame.
+enum Inject : std::uint8_t {
+  kInjectNone = 0,
+  kInjectNonFinite = 1u << 0,  ///< poison the observer state with a NaN
+  kInjectOverrun = 1u << 1,    ///< burn more than one period inside the tick
+};
+
+struct SensorFrame {
+  std::uint32_t seq = 0;
+  std::int32_t counts[kJoints] = {};
+  std::uint8_t inject = 0;
+};
+
+struct ActuatorFrame {
+  std::uint32_t seq = 0;
+  std::int32_t codes[kJoints] = {};
+  std::uint32_t faults = 0;      ///< latched osc::Fault bits
+  std::uint8_t state = 0;        ///< osc::SupervisorState
+  std::uint32_t step_cycles = 0, max_cycles = 0, mean_cycles = 0;
+  std::uint32_t stack_used = 0;  ///< bytes, high-water mark
+  float theta_hat[3 * kJoints] = {};
+  float tau_f_hat[kJoints] = {};
+};
+
+constexpr int kSensorPayload = 4 + 4 * kJoints + 1;
+constexpr int kActuatorPayload = 4 + 4 * kJoints + 4 + 1 + 4 * 4 + 4 * 3 * kJoints + 4 * kJoints;
+constexpr int kOverhead = 6;
+constexpr int kMaxFrame = kActuatorPayload + kOverhead;
+static_assert(kActuatorPayload < 256, "length fits a byte");
+
+/// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), bitwise.
+inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
+  for (int i = 0; i < n; ++i) {
+    crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(p[i]) << 8));
+    for (int b = 0; b < 8; ++b)
+      crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : (crc << 1));
+  }
+  return crc;
+}
+
+namespace detail {
+struct Writer {
+  std::uint8_t* p;
+  void u8(std::uint8_t v) { *p++ = v; }
+  void u32(std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) *p++ = static_cast<std::uint8_t>(v >> (8 * i));
+  }
+  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
+  void f32(float v) {
+    std::uint32_t u;
+    std::memcpy(&u, &v, 4);
+    u32(u);
+  }
+};
+struct Reader {
+  const std::uint8_t* p;
+  std::uint8_t u8() { return *p++; }
+  std::uint32_t u32() {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(*p++) << (8 * i);
+    return v;
+  }
+  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
+  float f32() {
+    const std::uint32_t u = u32();
+    float v;
+    std::memcpy(&v, &u, 4);
+    return v;
+  }
+};
+inline int finish(std::uint8_t* buf, FrameType type, int payload) {
+  buf[0] = kSync0;
+  buf[1] = kSync1;
+  buf[2] = type;
+  buf[3] = static_cast<std::uint8_t>(payload);
+  const std::uint16_t crc = crc16(buf + 2, payload + 2);
+  buf[4 + payload] = static_cast<std::uint8_t>(crc & 0xFF);
+  buf[5 + payload] = static_cast<std::uint8_t>(crc >> 8);
+  return payload + kOverhead;
+}
+}  // namespace detail
+
+/// Encodes into buf (at least kMaxFrame bytes); returns the frame length.
+inline int encode(const SensorFrame& f, std::uint8_t* buf) {
+  detail::Writer w{buf + 4};
+  w.u32(f.seq);
+  for (int i = 0; i < kJoints; ++i) w.i32(f.counts[i]);
+  w.u8(f.inject);
+  return detail::finish(buf, kSensorFrame, kSensorPayload);
+}
+
+inline int encode(const ActuatorFrame& f, std::uint8_t* buf) {
+  detail::Writer w{buf + 4};
+  w.u32(f.seq);
+  for (int i = 0; i < kJoints; ++i) w.i32(f.codes[i]);
+  w.u32(f.faults);
+  w.u8(f.state);
+  w.u32(f.step_cycles);
+  w.u32(f.max_cycles);
+  w.u32(f.mean_cycles);
+  w.u32(f.stack_used);
+  for (float v : f.theta_hat) w.f32(v);
+  for (float v : f.tau_f_hat) w.f32(v);
+  return detail::finish(buf, kActuatorFrame, kActuatorPayload);
+}
+
+/// Streaming frame parser: feed bytes one at a time.
+class Parser {
+ public:
+  enum Result : std::uint8_t { kPending, kFrame, kBadChecksum, kBadHeader };
+
+  Result feed(std::uint8_t b) {
+    switch (stage_) {
+      case 0:  // hunting for the first sync byte; anything else is skipped
+        if (b == kSync0) stage_ = 1;
+        return kPending;
+      case 1:
+        if (b == kSync1) {
+          stage_ = 2;
+          return kPending;
+        }
+        stage_ = b == kSync0 ? 1 : 0;
+        return kBadHeader;
+      case 2:
+        buf_[0] = b;
+        stage_ = 3;
+        return kPending;
+      case 3: {
+        buf_[1] = b;
+        const int expect = buf_[0] == kSensorFrame ? kSensorPayload : buf_[0] == kActuatorFrame ? kActuatorPayload : -1;
+        if (expect < 0 || b != expect) {
+          stage_ = 0;
+          return kBadHeader;
+        }
+        need_ = b + 2;  // payload and CRC
+        have_ = 0;
+        stage_ = 4;
+        return kPending;
+      }
+      default: {
+        buf_[2 + have_++] = b;
+        if (have_ < need_) return kPending;
+        stage_ = 0;
+        const int n = buf_[1];
+        const std::uint16_t crc = static_cast<std::uint16_t>(buf_[2 + n] | (buf_[3 + n] << 8));
+        return crc16(buf_, n + 2) == crc ? kFrame : kBadChecksum;
+      }
+    }
+  }
+  /// True while a frame has started but not completed (a timeout here is a short frame).
+  bool in_frame() const { return stage_ != 0; }
+  void reset() { stage_ = 0; }
+  FrameType type() const { return static_cast<FrameType>(buf_[0]); }
+
+  bool decode(SensorFrame& f) const {
+    if (type() != kSensorFrame) return false;
+    detail::Reader r{buf_ + 2};
+    f.seq = r.u32();
+    for (int i = 0; i < kJoints; ++i) f.counts[i] = r.i32();
+    f.inject = r.u8();
+    return true;
+  }
+  bool decode(ActuatorFrame& f) const {
+    if (type() != kActuatorFrame) return false;
+    detail::Reader r{buf_ + 2};
+    f.seq = r.u32();
+    for (int i = 0; i < kJoints; ++i) f.codes[i] = r.i32();
+    f.faults = r.u32();
+    f.state = r.u8();
+    f.step_cycles = r.u32();
+    f.max_cycles = r.u32();
+    f.mean_cycles = r.u32();
+    f.stack_used = r.u32();
+    for (float& v : f.theta_hat) v = r.f32();
+    for (float& v : f.tau_f_hat) v = r.f32();
+    return true;
+  }
+
+ private:
+  std::uint8_t buf_[kMaxFrame] = {};
+  int stage_ = 0, need_ = 0, have_ = 0;
+};
+
+}  // namespace pil

@@ -1,0 +1,100 @@
+// The firmware side of the processor-in-the-loop link: a HAL binding of the control task whose
+// encoders and DACs are the frames of osc/pil.hpp. Board-independent; a board supplies
+//   static void uart_write(const std::uint8_t* p, int n);
+//   static std::uint32_t cycles();          // free-running cycle counter
+//   static std::uint32_t stack_used();      // main-stack high-water mark [bytes]
+//   static void burn(std::uint32_t cycles); // busy-wait (fault injection only)
+// and runs: on_byte() for every received byte, tick() from the control interrupt when on_byte()
+// asked for it, and on_timeout() when no complete frame arrived within the link timeout.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control_task.hpp"
+#include "osc/pil.hpp"
+
+namespace osc {
+
+template <class S, class Board>
+class PilNode {
+ public:
+  ControlTask<S> task;
+
+  void init(const Vec6In<S>& q_start, FrictionMode mode, std::uint32_t period_cycles) {
+    task.init(Model<S>::puma560(), Gains<S>::paper(), mode, q_start, period_cycles);
+    expected_seq_ = 0;
+    pending_faults_ = 0;
+    parser_.reset();
+  }
+
+  /// Feeds one received byte. Returns true when a tick is due (a sensor frame, valid or not, must
+  /// be answered by exactly one actuator frame).
+  bool on_byte(std::uint8_t b) {
+    const pil::Parser::Result r = parser_.feed(b);
+    if (r == pil::Parser::kPending) return false;
+    if (r == pil::Parser::kFrame) {
+      pil::SensorFrame f;
+      if (!parser_.decode(f)) {
+        pending_faults_ |= kFaultLinkCorrupt;
+        return true;
+      }
+      if (f.seq != expected_seq_) pending_faults_ |= kFaultLinkCorrupt;
+      expected_seq_ = f.seq + 1;
+      frame_ = f;
+      return true;
+    }
+    // Bad checksum or header: the link is corrupt; answer so the host sees the fault at once.
+    pending_faults_ |= kFaultLinkCorrupt;
+    return r == pil::Parser::kBadChecksum;
+  }
+
+  /// Link timeout: no complete sensor frame in time (missing or short frame).
+  void on_timeout() {
+    pending_faults_ |= parser_.in_frame() ? kFaultLinkCorrupt : kFaultLinkLost;
+    parser_.reset();
+    frame_.inject = 0;
+    tick();
+  }
+
+  /// One control tick on the latest sensor frame (runs in the control interrupt).
+  void tick() {
+    if (frame_.inject & pil::kInjectNonFinite) task.inject_nonfinite();
+    control_tick(task, *this);
+    frame_.inject = 0;
+  }
+
+  // HAL binding used by control_tick.
+  void read_encoders(std::int32_t counts[kDof]) {
+    for (int i = 0; i < kDof; ++i) counts[i] = frame_.counts[i];
+    if (frame_.inject & pil::kInjectOverrun) Board::burn(2 * task.period_cycles + 1);
+  }
+  void write_dacs(const std::int32_t codes[kDof]) {
+    pil::ActuatorFrame a;
+    a.seq = frame_.seq;
+    for (int i = 0; i < kDof; ++i) a.codes[i] = codes[i];
+    a.faults = task.sup.latched;
+    a.state = static_cast<std::uint8_t>(task.sup.state);
+    a.step_cycles = task.timing.last;
+    a.max_cycles = task.timing.max;
+    a.mean_cycles = task.timing.mean();
+    a.stack_used = Board::stack_used();
+    for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.theta_hat(i));
+    for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
+    std::uint8_t buf[pil::kMaxFrame];
+    Board::uart_write(buf, pil::encode(a, buf));
+  }
+  std::uint32_t cycles() const { return Board::cycles(); }
+  std::uint32_t io_faults() {
+    const std::uint32_t f = pending_faults_;
+    pending_faults_ = 0;
+    return f;
+  }
+
+ private:
+  pil::Parser parser_;
+  pil::SensorFrame frame_;
+  std::uint32_t expected_seq_ = 0;
+  std::uint32_t pending_faults_ = 0;
+};
+
+}  // namespace osc

@@ -1,0 +1,39 @@
+// Host side of the processor-in-the-loop link: starts the firmware (qemu-system-arm with the
+// image, or any program speaking osc/pil.hpp on its standard input/output), and exchanges one
+// sensor frame and one actuator frame per tick. Every wait is bounded; errors are reported as text.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "osc/pil.hpp"
+
+namespace sim {
+
+class PilClient {
+ public:
+  PilClient() = default;
+  PilClient(const PilClient&) = delete;
+  PilClient& operator=(const PilClient&) = delete;
+  ~PilClient();
+
+  /// Starts argv[0] with the given arguments; its stdin/stdout carry the link.
+  bool start(const std::vector<std::string>& argv, std::string& err);
+  /// The QEMU command line that runs a firmware image on mps2-an386, deterministically (-icount).
+  static std::vector<std::string> qemu_command(const std::string& qemu, const std::string& elf);
+
+  bool send(const pil::SensorFrame& f, std::string& err);
+  bool send_raw(const std::uint8_t* p, int n, std::string& err);
+  /// Waits up to timeout_s (wall clock) for one actuator frame.
+  bool receive(pil::ActuatorFrame& f, double timeout_s, std::string& err);
+  /// Stops the peer (SIGKILL after a grace period) and returns its exit status (-1 if killed).
+  int stop();
+  bool running() const { return pid_ > 0; }
+
+ private:
+  int pid_ = -1;
+  int to_child_ = -1, from_child_ = -1;
+  pil::Parser parser_;
+};
+
+}  // namespace sim

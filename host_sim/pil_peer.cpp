@@ -1,0 +1,50 @@
+// pil_peer: the firmware's PIL node (osc/pil_node.hpp, float) built for the host, speaking the link
+// on stdin/stdout. It stands in for the QEMU image in tests of the host side and of the protocol,
+// and runs exactly the firmware's board-independent code.
+#include <poll.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <memory>
+
+#include "osc/params.hpp"
+#include "osc/pil_node.hpp"
+
+namespace {
+
+struct StdioBoard {
+  static inline std::uint32_t clock = 0;
+  static void uart_write(const std::uint8_t* p, int n) {
+    while (n > 0) {
+      const ssize_t w = write(STDOUT_FILENO, p, static_cast<size_t>(n));
+      if (w <= 0) _exit(3);
+      p += w;
+      n -= static_cast<int>(w);
+    }
+  }
+  static std::uint32_t cycles() { return clock += 1000; }  // a nominal 1000 cycles per call
+  static std::uint32_t stack_used() { return 0; }
+  static void burn(std::uint32_t c) { clock += c; }
+};
+
+}  // namespace
+
+int main() {
+  auto node = std::make_unique<osc::PilNode<float, StdioBoard>>();
+  osc::Vec6<float> q0;
+  for (int i = 0; i < 6; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
+  node->init(q0, osc::FrictionMode::kAdaptive, 1000000);
+  const int timeout_ms = static_cast<int>(osc::params::kLinkTimeout * 1000);
+  for (;;) {
+    pollfd p{STDIN_FILENO, POLLIN, 0};
+    const int r = poll(&p, 1, timeout_ms);
+    if (r == 0) {
+      node->on_timeout();
+      continue;
+    }
+    std::uint8_t b;
+    const ssize_t n = read(STDIN_FILENO, &b, 1);
+    if (n <= 0) return 0;  // host closed the link
+    if (node->on_byte(b)) node->tick();
+  }
+}
