@@ -13,6 +13,7 @@
 
 #include "cli.hpp"
 #include "experiment.hpp"
+#include "pil_client.hpp"
 
 namespace {
 
@@ -25,6 +26,8 @@ const char* kUsage =
     "  --model-error F     controller link mass/inertia relative error (default 0; -0.5..0.5)\n"
     "  --substep S         plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)\n"
     "  --delay S           computation delay inside the sample (default 2e-4; 0..1e-3)\n"
+    "  --qemu              run the controller as the firmware image in qemu-system-arm (PIL)\n"
+    "  --elf FILE          firmware image for --qemu (default: the m4f build's pil_firmware.elf)\n"
     "  --json FILE         write the summary as JSON\n"
     "  --csv-dir DIR       write time series CSV files there (default: out)\n"
     "  --no-csv            do not write time series\n"
@@ -37,6 +40,8 @@ struct Options {
   sim::ExperimentConfig base;
   std::string json, csv_dir = "out";
   bool csv = true, progress = true;
+  bool qemu = false;
+  std::string elf = OSC_DEFAULT_PIL_ELF;
 };
 
 int fail(const std::string& msg) {
@@ -83,6 +88,12 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
       if (!sim::parse_number(a, take(), 1e-6, 1e-3, o.base.plant.substep, err)) return false;
     } else if (a == "--delay") {
       if (!sim::parse_number(a, take(), 0, osc::params::kDt, o.base.plant.compute_delay, err)) return false;
+    } else if (a == "--qemu") {
+      o.qemu = true;
+    } else if (a == "--elf") {
+      const char* f = take();
+      if (!f || !*f) return err = "--elf needs a file name", false;
+      o.elf = f;
     } else if (a == "--json") {
       const char* f = take();
       if (!f || !*f) return err = "--json needs a file name", false;
@@ -140,6 +151,10 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
                 ad->friction_rms_error, ad->friction_rms);
   }
   for (const auto& r : runs) {
+    if (!r.error.empty()) std::printf("[%s] LINK ERROR: %s\n", r.mode.c_str(), r.error.c_str());
+    if (r.max_step_cycles)
+      std::printf("[%s] firmware control step: max %u, mean %u instructions (QEMU -icount shift=0); stack used %u bytes\n",
+                  r.mode.c_str(), r.max_step_cycles, r.mean_step_cycles, r.stack_used);
     std::printf("[%s] simulated %.0f s in %.2f s wall (%.0fx real time)%s\n", r.mode.c_str(), r.duration,
                 r.wall_seconds, r.duration / r.wall_seconds,
                 r.status ? "  WARNING: a control step faulted (zero torque commanded)" : "");
@@ -170,6 +185,12 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
   json_array(os, r.theta_true, 18);
   os << ",\n" << indent << "\"friction_rms_error_Nm\": " << r.friction_rms_error;
   os << ",\n" << indent << "\"fault_status\": " << r.status;
+  if (r.max_step_cycles) {
+    os << ",\n" << indent << "\"firmware_step_instructions_max\": " << r.max_step_cycles;
+    os << ",\n" << indent << "\"firmware_step_instructions_mean\": " << r.mean_step_cycles;
+    os << ",\n" << indent << "\"firmware_stack_used_bytes\": " << r.stack_used;
+  }
+  if (!r.error.empty()) os << ",\n" << indent << "\"error\": \"" << r.error << "\"";
   os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
 }
 
@@ -226,6 +247,13 @@ int main(int argc, char** argv) {
   std::string err;
   if (!parse(argc, argv, o, err)) return fail(err);
   o.base.duration = o.duration;
+  if (o.qemu) {
+    if (o.base.model_error != 0) return fail("--model-error applies to the host-built controller only, not with --qemu");
+    if (access(o.elf.c_str(), R_OK) != 0)
+      return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
+    if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float
+    o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
+  }
   if (o.csv && !o.csv_dir.empty()) {
     const std::string mk = "mkdir -p '" + o.csv_dir + "'";
     if (std::system(mk.c_str()) != 0) return fail("cannot create directory " + o.csv_dir);
@@ -272,6 +300,6 @@ int main(int argc, char** argv) {
     std::printf("summary: %s\n", o.json.c_str());
   }
   for (const auto& r : runs)
-    if (r.status) return 1;
+    if (r.status || !r.error.empty()) return 1;
   return 0;
 }
