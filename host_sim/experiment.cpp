@@ -58,7 +58,8 @@ class LocalController {
 /// The firmware image (or any PIL peer) over the link, one exchange per tick.
 class RemoteController {
  public:
-  RemoteController(const ExperimentConfig& cfg, std::string& err) : timeout_(cfg.pil_timeout) {
+  RemoteController(const ExperimentConfig& cfg, std::string& err)
+      : timeout_(cfg.pil_timeout), no_compensation_(cfg.mode == osc::FrictionMode::kNone) {
     ok_ = link_.start(cfg.pil_command, err);
   }
   bool ok() const { return ok_; }
@@ -66,6 +67,7 @@ class RemoteController {
     pil::SensorFrame s;
     s.seq = seq_++;
     hal.read_encoders(s.counts);
+    if (s.seq == 0 && no_compensation_) s.inject = pil::kConfigNoCompensation;
     pil::ActuatorFrame a;
     if (!link_.send(s, err) || !link_.receive(a, timeout_, err)) return false;
     if (a.seq != s.seq) {
@@ -89,6 +91,7 @@ class RemoteController {
  private:
   PilClient link_;
   double timeout_;
+  bool no_compensation_;
   bool ok_ = false;
   std::uint32_t seq_ = 0;
   pil::ActuatorFrame last_;

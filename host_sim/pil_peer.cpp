@@ -40,6 +40,7 @@ int main() {
     const int r = poll(&p, 1, timeout_ms);
     if (r == 0) {
       node->on_timeout();
+      node->tick();
       continue;
     }
     std::uint8_t b;

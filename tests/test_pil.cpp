@@ -162,7 +162,7 @@ TEST_F(Link, MissingFrameIsLinkLostWithZeroTorque) {
   healthy(5);
   pil::ActuatorFrame a;  // send nothing: the firmware reports on its own after the timeout
   ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
-  EXPECT_TRUE(a.faults & osc::kFaultLinkLost) << a.faults;
+  EXPECT_TRUE(a.faults & osc::kFaultLinkLost) << "faults " << a.faults << " seq " << a.seq << " state " << int(a.state);
   EXPECT_TRUE(zero(a));
 }
 

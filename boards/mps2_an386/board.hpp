@@ -106,7 +106,13 @@ inline void control_timer_start(std::uint32_t hz) {
 }
 /// Enables the control interrupt without the hardware timer: software pends it (PIL mode).
 inline void control_irq_enable() { nvic_iser0() = 1u << kTimer0Irq; }
-inline void control_irq_pend() { nvic_ispr0() = 1u << kTimer0Irq; }
+/// Pends the control interrupt. The barriers make every store made before the call (e.g. fault
+/// flags the interrupt reads) visible to it: the interrupt is taken right after the write.
+inline void control_irq_pend() {
+  __asm__ volatile("dsb" ::: "memory");
+  nvic_ispr0() = 1u << kTimer0Irq;
+  __asm__ volatile("dsb\n isb" ::: "memory");
+}
 inline void control_timer_ack() { timer0().INTSTATUS = 1; }
 inline bool control_timer_pending() { return (timer0().INTSTATUS & 1u) != 0; }
 

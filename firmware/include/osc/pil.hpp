@@ -22,6 +22,8 @@ enum Inject : std::uint8_t {
   kInjectNone = 0,
   kInjectNonFinite = 1u << 0,  ///< poison the observer state with a NaN
   kInjectOverrun = 1u << 1,    ///< burn more than one period inside the tick
+  /// Configuration, honoured in the first frame only: run without friction compensation.
+  kConfigNoCompensation = 1u << 7,
 };
 
 struct SensorFrame {

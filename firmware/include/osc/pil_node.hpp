@@ -4,8 +4,9 @@
 //   static std::uint32_t cycles();          // free-running cycle counter
 //   static std::uint32_t stack_used();      // main-stack high-water mark [bytes]
 //   static void burn(std::uint32_t cycles); // busy-wait (fault injection only)
-// and runs: on_byte() for every received byte, tick() from the control interrupt when on_byte()
-// asked for it, and on_timeout() when no complete frame arrived within the link timeout.
+// and runs: on_byte() for every received byte, and tick() from the control interrupt when
+// on_byte() asked for it or after on_timeout(), which it calls when no complete frame arrived
+// within the link timeout.
 #pragma once
 
 #include <cstdint>
@@ -39,6 +40,7 @@ class PilNode {
         return true;
       }
       if (f.seq != expected_seq_) pending_faults_ |= kFaultLinkCorrupt;
+      if (task.tick == 0 && (f.inject & pil::kConfigNoCompensation)) task.mode = FrictionMode::kNone;
       expected_seq_ = f.seq + 1;
       frame_ = f;
       return true;
@@ -48,12 +50,12 @@ class PilNode {
     return r == pil::Parser::kBadChecksum;
   }
 
-  /// Link timeout: no complete sensor frame in time (missing or short frame).
+  /// Link timeout: no complete sensor frame in time (missing or short frame). A tick must follow,
+  /// so that the fault and zero torque go out at once.
   void on_timeout() {
     pending_faults_ |= parser_.in_frame() ? kFaultLinkCorrupt : kFaultLinkLost;
     parser_.reset();
     frame_.inject = 0;
-    tick();
   }
 
   /// One control tick on the latest sensor frame (runs in the control interrupt).

@@ -1,0 +1,52 @@
+// The processor-in-the-loop firmware for mps2-an386: UART0 carries the link (osc/pil.hpp) to the
+// simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector) runs the control task;
+// here it is pended by the arrival of each sensor frame, so the host's plant sets the sample
+// clock (lockstep) and the run is deterministic under -icount. The link watchdog in the main loop
+// reports a missing or short frame as a fault with zero torque.
+#include <cstdint>
+
+#include "board.hpp"
+#include "osc/params.hpp"
+#include "osc/pil_node.hpp"
+
+namespace {
+
+struct Mps2Board {
+  static void uart_write(const std::uint8_t* p, int n) { board::uart_write(p, n); }
+  static std::uint32_t cycles() { return board::cycles(); }
+  static std::uint32_t stack_used() { return board::stack_used(); }
+  static void burn(std::uint32_t ns) { board::busy_wait(ns); }
+};
+
+osc::PilNode<float, Mps2Board> g_node;  // a few kB: static, never on the stack
+
+/// Overrun budget: one control period in virtual ns (= instructions under -icount shift=0).
+constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;
+constexpr std::uint32_t kLinkTimeoutNs = static_cast<std::uint32_t>(osc::params::kLinkTimeout * 1e9);
+
+}  // namespace
+
+extern "C" void TIMER0_Handler() {
+  board::control_timer_ack();
+  g_node.tick();
+}
+
+int main() {
+  board::cycle_counter_init();
+  board::uart_init();
+  osc::Vec6<float> q0;
+  for (int i = 0; i < osc::kDof; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
+  g_node.init(q0, osc::FrictionMode::kAdaptive, kPeriodNs);
+  board::control_irq_enable();
+  std::uint32_t last = board::cycles();
+  for (;;) {
+    if (board::uart_rx_ready()) {
+      if (g_node.on_byte(board::uart_read())) board::control_irq_pend();  // the tick runs now
+      last = board::cycles();
+    } else if (board::cycles() - last > kLinkTimeoutNs) {
+      g_node.on_timeout();
+      board::control_irq_pend();
+      last = board::cycles();
+    }
+  }
+}
