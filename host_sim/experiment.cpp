@@ -71,7 +71,8 @@ class RemoteController {
     pil::ActuatorFrame a;
     if (!link_.send(s, err) || !link_.receive(a, timeout_, err)) return false;
     if (a.seq != s.seq) {
-      err = "actuator frame for tick " + std::to_string(a.seq) + " answered tick " + std::to_string(s.seq);
+      err = "actuator frame for tick " + std::to_string(a.seq) + " answered tick " + std::to_string(s.seq) +
+            " (faults " + std::to_string(a.faults) + ")";
       return false;
     }
     hal.write_dacs(a.codes);
@@ -84,6 +85,7 @@ class RemoteController {
   void finish(ExperimentResult& res) {
     res.max_step_cycles = last_.max_cycles;
     res.mean_step_cycles = last_.mean_cycles;
+    res.max_tick_cycles = last_.tick_max_cycles;
     res.stack_used = last_.stack_used;
     link_.stop();
   }

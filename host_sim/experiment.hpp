@@ -52,7 +52,7 @@ struct ExperimentResult {
   double friction_rms = 0;           // rms of tau_f over the last window [N m]
   std::uint32_t status = 0;          // first fault bits reported (0: none)
   std::string error;                 // link error (PIL), empty when the run completed
-  std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
+  std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
   double wall_seconds = 0;
   std::vector<LogRow> log;
 };

@@ -25,7 +25,7 @@ std::vector<std::string> PilClient::qemu_command(const std::string& qemu, const 
           "-kernel",  elf};
 }
 
-bool PilClient::start(const std::vector<std::string>& argv, std::string& err) {
+bool PilClient::start(const std::vector<std::string>& argv, std::string& err, double ready_timeout_s) {
   int in[2], out[2];
   if (pipe(in) != 0 || pipe(out) != 0) return err = std::string("pipe: ") + std::strerror(errno), false;
   const pid_t pid = fork();
@@ -51,6 +51,10 @@ bool PilClient::start(const std::vector<std::string>& argv, std::string& err) {
   pid_ = pid;
   signal(SIGPIPE, SIG_IGN);  // a dead peer is an error return, not a signal
   parser_.reset();
+  rx_len_ = rx_pos_ = 0;
+  pil::ActuatorFrame hello;
+  if (!receive(hello, ready_timeout_s, err)) return err = "firmware not ready: " + err, false;
+  if (hello.seq != pil::kHelloSeq) return err = "firmware did not start with its hello frame", false;
   return true;
 }
 
@@ -75,8 +79,21 @@ bool PilClient::send(const pil::SensorFrame& f, std::string& err) {
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
-  std::uint8_t buf[256];
   for (;;) {
+    // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
+    while (rx_pos_ < rx_len_) {
+      switch (parser_.feed(rx_[rx_pos_++])) {
+        case pil::Parser::kPending:
+          break;
+        case pil::Parser::kFrame:
+          if (!parser_.decode(f)) return err = "unexpected frame type from the firmware", false;
+          return true;
+        case pil::Parser::kBadChecksum:
+          return err = "corrupted actuator frame (checksum mismatch)", false;
+        case pil::Parser::kBadHeader:
+          return err = "corrupted actuator frame (bad header)", false;
+      }
+    }
     const double left = std::chrono::duration<double>(deadline - clock::now()).count();
     if (left <= 0) {
       return err = std::string("no actuator frame from the firmware within ") + std::to_string(timeout_s) + " s" +
@@ -88,24 +105,14 @@ bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& er
     if (r < 0 && errno == EINTR) continue;
     if (r < 0) return err = std::string("poll: ") + std::strerror(errno), false;
     if (r == 0) continue;
-    // Read one byte at a time so bytes after this frame stay in the pipe for the next call.
-    const ssize_t n = read(from_child_, buf, 1);
+    const ssize_t n = read(from_child_, rx_, sizeof rx_);
     if (n == 0) return err = "the firmware closed the link (exited)", false;
     if (n < 0) {
       if (errno == EINTR) continue;
       return err = std::string("link read failed: ") + std::strerror(errno), false;
     }
-    switch (parser_.feed(buf[0])) {
-      case pil::Parser::kPending:
-        break;
-      case pil::Parser::kFrame:
-        if (!parser_.decode(f)) return err = "unexpected frame type from the firmware", false;
-        return true;
-      case pil::Parser::kBadChecksum:
-        return err = "corrupted actuator frame (checksum mismatch)", false;
-      case pil::Parser::kBadHeader:
-        return err = "corrupted actuator frame (bad header)", false;
-    }
+    rx_len_ = static_cast<int>(n);
+    rx_pos_ = 0;
   }
 }
 

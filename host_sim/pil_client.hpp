@@ -17,8 +17,9 @@ class PilClient {
   PilClient& operator=(const PilClient&) = delete;
   ~PilClient();
 
-  /// Starts argv[0] with the given arguments; its stdin/stdout carry the link.
-  bool start(const std::vector<std::string>& argv, std::string& err);
+  /// Starts argv[0] with the given arguments (its stdin/stdout carry the link) and waits up to
+  /// ready_timeout_s for the peer's hello frame.
+  bool start(const std::vector<std::string>& argv, std::string& err, double ready_timeout_s = 30.0);
   /// The QEMU command line that runs a firmware image on mps2-an386, deterministically (-icount).
   static std::vector<std::string> qemu_command(const std::string& qemu, const std::string& elf);
 
@@ -34,6 +35,8 @@ class PilClient {
   int pid_ = -1;
   int to_child_ = -1, from_child_ = -1;
   pil::Parser parser_;
+  std::uint8_t rx_[512];
+  int rx_len_ = 0, rx_pos_ = 0;  // bytes read from the peer but not parsed yet
 };
 
 }  // namespace sim

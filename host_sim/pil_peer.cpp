@@ -34,6 +34,7 @@ int main() {
   osc::Vec6<float> q0;
   for (int i = 0; i < 6; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
   node->init(q0, osc::FrictionMode::kAdaptive, 1000000);
+  node->hello();
   const int timeout_ms = static_cast<int>(osc::params::kLinkTimeout * 1000);
   for (;;) {
     pollfd p{STDIN_FILENO, POLLIN, 0};

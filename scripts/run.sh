@@ -1,12 +1,26 @@
 #!/usr/bin/env bash
 # Main job: set up, build, and run the paper's experiment on the simulated PUMA 560 (120 s, with
 # and without friction compensation); writes out/summary.json, out/timeseries_*.csv and PNG figures.
-# Extra arguments go to puma_experiment (e.g. --duration 30, --scalar float).
+# Extra arguments go to puma_experiment (e.g. --duration 30, --scalar float, --qemu).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake --preset host >/dev/null
 cmake --build --preset host --target puma_experiment
-mkdir -p out
-./build/host/host_sim/puma_experiment --json out/summary.json --csv-dir out "$@"
-/usr/bin/python3 host_sim/plot_experiment.py out
+# --qemu runs the controller as the Cortex-M4F firmware image in QEMU: build it first.
+for a in "$@"; do
+  if [ "$a" = "--qemu" ]; then
+    cmake --preset m4f >/dev/null
+    cmake --build --preset m4f --target pil_firmware
+  fi
+done
+# Outputs go to out/ unless --csv-dir names another folder.
+dir=out
+prev=""
+for a in "$@"; do
+  [ "$prev" = "--csv-dir" ] && dir=$a
+  prev=$a
+done
+mkdir -p "$dir"
+./build/host/host_sim/puma_experiment --json "$dir/summary.json" --csv-dir "$dir" "$@"
+/usr/bin/python3 host_sim/plot_experiment.py "$dir"

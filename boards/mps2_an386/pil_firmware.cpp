@@ -38,12 +38,18 @@ int main() {
   for (int i = 0; i < osc::kDof; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
   g_node.init(q0, osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
+  g_node.hello();  // bytes the host sent before this point may have been dropped
+  // The main loop polls the UART (under -icount, polling makes virtual time advance with the
+  // instructions executed, so the link timeout is measured deterministically; a WFI-idle loop
+  // lets QEMU warp virtual time). The watchdog is armed by the first byte.
+  bool link_up = false;
   std::uint32_t last = board::cycles();
   for (;;) {
     if (board::uart_rx_ready()) {
       if (g_node.on_byte(board::uart_read())) board::control_irq_pend();  // the tick runs now
       last = board::cycles();
-    } else if (board::cycles() - last > kLinkTimeoutNs) {
+      link_up = true;
+    } else if (link_up && board::cycles() - last > kLinkTimeoutNs) {
       g_node.on_timeout();
       board::control_irq_pend();
       last = board::cycles();

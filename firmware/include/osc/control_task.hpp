@@ -45,7 +45,8 @@ struct ControlTask {
   std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
   Supervisor sup;
   std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
-  StepTiming timing;
+  StepTiming timing;                  // the whole tick: I/O, step, supervision
+  StepTiming step_timing;             // the control step alone: observer + controller + adaptation
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0,
             std::uint32_t period = 0) {
@@ -66,6 +67,7 @@ struct ControlTask {
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
     timing = {};
+    step_timing = {};
   }
   /// Test hook (fault injection): poisons the observer state with a NaN.
   void inject_nonfinite() { state.y(0) = S(0) / S(0); }
@@ -103,7 +105,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (task.sup.state != SupervisorState::kFault && faults == 0) {
     const Vec6<S> q = angles_from_counts(task.q_start, counts);
     const S t = static_cast<S>(task.tick) * task.gains.dt;
+    const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
+    task.step_timing.add(hal.cycles() - s0);
     if (task.last.status & kStepNonFinite) faults |= kFaultNonFinite;
     if (task.last.status & kStepSingular) faults |= kFaultSingular;
     for (int i = 0; i < kDof; ++i) {

@@ -49,7 +49,7 @@ constexpr double kMaxJointSpeed[6] = {8.0, 8.0, 8.0, 16.0, 16.0, 16.0};
 /// Consecutive ticks a torque may stay clipped at the DAC range before the saturation fault.
 constexpr int kSaturationTicks = 50;
 /// Sensor-frame timeout of the processor-in-the-loop link [s] (virtual time of the target).
-constexpr double kLinkTimeout = 0.05;
+constexpr double kLinkTimeout = 0.1;
 
 /// Friction presets of the simulated plant, model (2): link-side coefficients.
 struct FrictionPreset {

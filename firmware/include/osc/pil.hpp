@@ -13,6 +13,9 @@
 namespace pil {
 
 constexpr std::uint8_t kSync0 = 0xA5, kSync1 = 0x5A;
+/// Sequence number of the actuator frame the firmware sends once it is ready to receive (bytes sent
+/// before that may be lost). The host waits for it before its first sensor frame.
+constexpr std::uint32_t kHelloSeq = 0xFFFFFFFFu;
 constexpr int kJoints = 6;
 
 enum FrameType : std::uint8_t { kSensorFrame = 1, kActuatorFrame = 2 };
@@ -37,14 +40,16 @@ struct ActuatorFrame {
   std::int32_t codes[kJoints] = {};
   std::uint32_t faults = 0;      ///< latched osc::Fault bits
   std::uint8_t state = 0;        ///< osc::SupervisorState
-  std::uint32_t step_cycles = 0, max_cycles = 0, mean_cycles = 0;
+  /// Control step (observer + controller + adaptation) of the previous tick, its max and mean, and
+  /// the max of the whole tick (encoders to DACs, with this frame's transmission), in cycles.
+  std::uint32_t step_cycles = 0, max_cycles = 0, mean_cycles = 0, tick_max_cycles = 0;
   std::uint32_t stack_used = 0;  ///< bytes, high-water mark
   float theta_hat[3 * kJoints] = {};
   float tau_f_hat[kJoints] = {};
 };
 
 constexpr int kSensorPayload = 4 + 4 * kJoints + 1;
-constexpr int kActuatorPayload = 4 + 4 * kJoints + 4 + 1 + 4 * 4 + 4 * 3 * kJoints + 4 * kJoints;
+constexpr int kActuatorPayload = 4 + 4 * kJoints + 4 + 1 + 4 * 5 + 4 * 3 * kJoints + 4 * kJoints;
 constexpr int kOverhead = 6;
 constexpr int kMaxFrame = kActuatorPayload + kOverhead;
 static_assert(kActuatorPayload < 256, "length fits a byte");
@@ -119,6 +124,7 @@ inline int encode(const ActuatorFrame& f, std::uint8_t* buf) {
   w.u32(f.step_cycles);
   w.u32(f.max_cycles);
   w.u32(f.mean_cycles);
+  w.u32(f.tick_max_cycles);
   w.u32(f.stack_used);
   for (float v : f.theta_hat) w.f32(v);
   for (float v : f.tau_f_hat) w.f32(v);
@@ -191,6 +197,7 @@ class Parser {
     f.step_cycles = r.u32();
     f.max_cycles = r.u32();
     f.mean_cycles = r.u32();
+    f.tick_max_cycles = r.u32();
     f.stack_used = r.u32();
     for (float& v : f.theta_hat) v = r.f32();
     for (float& v : f.tau_f_hat) v = r.f32();

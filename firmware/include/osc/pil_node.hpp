@@ -28,6 +28,15 @@ class PilNode {
     parser_.reset();
   }
 
+  /// Announces that the receiver is ready (call once, after enabling reception).
+  void hello() {
+    const std::uint32_t seq = frame_.seq;
+    frame_.seq = pil::kHelloSeq;
+    const std::int32_t zero[kDof] = {0, 0, 0, 0, 0, 0};
+    write_dacs(zero);
+    frame_.seq = seq;
+  }
+
   /// Feeds one received byte. Returns true when a tick is due (a sensor frame, valid or not, must
   /// be answered by exactly one actuator frame).
   bool on_byte(std::uint8_t b) {
@@ -76,9 +85,10 @@ class PilNode {
     for (int i = 0; i < kDof; ++i) a.codes[i] = codes[i];
     a.faults = task.sup.latched;
     a.state = static_cast<std::uint8_t>(task.sup.state);
-    a.step_cycles = task.timing.last;
-    a.max_cycles = task.timing.max;
-    a.mean_cycles = task.timing.mean();
+    a.step_cycles = task.step_timing.last;
+    a.max_cycles = task.step_timing.max;
+    a.mean_cycles = task.step_timing.mean();
+    a.tick_max_cycles = task.timing.max;
     a.stack_used = Board::stack_used();
     for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.theta_hat(i));
     for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
