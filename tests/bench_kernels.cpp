@@ -1,0 +1,190 @@
+// Google Benchmark: every kernel in double and float, the full control step, the plant, and KDL
+// computing the same quantities. Not a test: run build/host/tests/osc_bench.
+#include <benchmark/benchmark.h>
+
+#include <kdl/chaindynparam.hpp>
+#include <kdl/chainfdsolver_recursive_newton_euler.hpp>
+#include <kdl/chainfksolverpos_recursive.hpp>
+#include <kdl/chainjnttojacdotsolver.hpp>
+#include <kdl/chainjnttojacsolver.hpp>
+#include <memory>
+
+#include "kdl_puma.hpp"
+#include "osc/controller.hpp"
+#include "plant.hpp"
+
+using namespace osc;
+
+namespace {
+
+template <class S>
+struct Fixture {
+  Model<S> model = Model<S>::puma560();
+  Data<S> data{};
+  OpSpace<S> os{};
+  Vec6<S> q, qd, v;
+  Mat3<S> R_ref;
+  Fixture() {
+    for (int i = 0; i < kDof; ++i) q(i) = static_cast<S>(params::kQStart[i]);
+    qd << S(0.1), S(-0.2), S(0.3), S(0.05), S(-0.1), S(0.2);
+    v << S(0.05), S(-0.02), S(0.03), S(0.01), S(0.02), S(-0.01);
+    forward_kinematics(model, data, q);
+    R_ref = data.R[kDof];
+    opspace_update(model, data, os, q, R_ref);
+  }
+};
+
+template <class S> void BM_forward_kinematics(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) {
+    forward_kinematics(f.model, f.data, f.q);
+    benchmark::DoNotOptimize(f.data.o[kDof]);
+  }
+}
+template <class S> void BM_geometric_jacobian(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) {
+    geometric_jacobian(f.data);
+    benchmark::DoNotOptimize(f.data.J);
+  }
+}
+template <class S> void BM_joint_inertia(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) {
+    joint_inertia(f.model, f.data);
+    benchmark::DoNotOptimize(f.data.A);
+  }
+}
+template <class S> void BM_gravity(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) benchmark::DoNotOptimize(gravity_torques(f.model, f.data));
+}
+template <class S> void BM_velocity_products(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) benchmark::DoNotOptimize(velocity_products(f.model, f.data, f.qd));
+}
+template <class S> void BM_friction_regressor(benchmark::State& st) {
+  Fixture<S> f;
+  const Vec6<S> dec = Vec6<S>::Ones();
+  for (auto _ : st) benchmark::DoNotOptimize(friction_regressor(f.qd, dec));
+}
+template <class S> void BM_jacobian_factor_solve(benchmark::State& st) {
+  Fixture<S> f;
+  JacobianFactor<S> jf;
+  for (auto _ : st) {
+    jf.compute(f.os.Ja);
+    benchmark::DoNotOptimize(jf.solve(f.v));
+  }
+}
+template <class S> void BM_operational_inertia(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) benchmark::DoNotOptimize(operational_inertia(f.data.A, f.os.Jf));
+}
+template <class S> void BM_opspace_update(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) {
+    opspace_update(f.model, f.data, f.os, f.q, f.R_ref);
+    benchmark::DoNotOptimize(f.os.Lambda);
+  }
+}
+template <class S> void BM_psi_quadratic(benchmark::State& st) {
+  Fixture<S> f;
+  for (auto _ : st) benchmark::DoNotOptimize(psi_quadratic(f.model, f.data, f.os, f.v));
+}
+template <class S> void BM_control_step(benchmark::State& st) {
+  Fixture<S> f;
+  const Gains<S> g = Gains<S>::paper();
+  auto cs = std::make_unique<ControllerState<S>>();
+  controller_init(f.model, *cs, f.q);
+  Vec6<S> q = f.q;
+  int k = 0;
+  for (auto _ : st) {
+    q(1) = f.q(1) + static_cast<S>(1e-6 * (k % 100));
+    benchmark::DoNotOptimize(control_step(f.model, g, FrictionMode::kAdaptive, *cs, q, static_cast<S>(1e-3 * (k % 1000))));
+    ++k;
+  }
+}
+
+#define OSC_BENCH(name) \
+  BENCHMARK_TEMPLATE(name, double); \
+  BENCHMARK_TEMPLATE(name, float)
+OSC_BENCH(BM_forward_kinematics);
+OSC_BENCH(BM_geometric_jacobian);
+OSC_BENCH(BM_joint_inertia);
+OSC_BENCH(BM_gravity);
+OSC_BENCH(BM_velocity_products);
+OSC_BENCH(BM_friction_regressor);
+OSC_BENCH(BM_jacobian_factor_solve);
+OSC_BENCH(BM_operational_inertia);
+OSC_BENCH(BM_opspace_update);
+OSC_BENCH(BM_psi_quadratic);
+OSC_BENCH(BM_control_step);
+
+void BM_plant_forward_dynamics(benchmark::State& st) {
+  sim::ArticulatedBody body;
+  Fixture<double> f;
+  const sim::Vec6 tau = sim::Vec6::Constant(1.0);
+  for (auto _ : st) benchmark::DoNotOptimize(body.forward_dynamics(f.q, f.qd, tau));
+}
+BENCHMARK(BM_plant_forward_dynamics);
+
+// KDL computing the same quantities.
+struct KdlFixture {
+  KDL::Chain chain = test::puma560_chain();
+  Fixture<double> f;
+  KDL::JntArray q = test::to_kdl(f.q), qd = test::to_kdl(f.qd);
+};
+void BM_kdl_forward_kinematics(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainFkSolverPos_recursive fk(k.chain);
+  KDL::Frame F;
+  for (auto _ : st) benchmark::DoNotOptimize(fk.JntToCart(k.q, F));
+}
+void BM_kdl_jacobian(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainJntToJacSolver s(k.chain);
+  KDL::Jacobian J(kDof);
+  for (auto _ : st) benchmark::DoNotOptimize(s.JntToJac(k.q, J));
+}
+void BM_kdl_mass(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntSpaceInertiaMatrix H(kDof);
+  for (auto _ : st) benchmark::DoNotOptimize(d.JntToMass(k.q, H));
+}
+void BM_kdl_coriolis(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray C(kDof);
+  for (auto _ : st) benchmark::DoNotOptimize(d.JntToCoriolis(k.q, k.qd, C));
+}
+void BM_kdl_gravity(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray G(kDof);
+  for (auto _ : st) benchmark::DoNotOptimize(d.JntToGravity(k.q, G));
+}
+void BM_kdl_jacdot(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainJntToJacDotSolver s(k.chain);
+  KDL::Twist t;
+  for (auto _ : st) benchmark::DoNotOptimize(s.JntToJacDot(KDL::JntArrayVel(k.q, k.qd), t));
+}
+void BM_kdl_forward_dynamics(benchmark::State& st) {
+  KdlFixture k;
+  KDL::ChainFdSolver_RNE s(k.chain, KDL::Vector(0, 0, -9.81));
+  KDL::JntArray tau(kDof), qdd(kDof);
+  KDL::Wrenches f(k.chain.getNrOfSegments(), KDL::Wrench::Zero());
+  for (auto _ : st) benchmark::DoNotOptimize(s.CartToJnt(k.q, k.qd, tau, f, qdd));
+}
+BENCHMARK(BM_kdl_forward_kinematics);
+BENCHMARK(BM_kdl_jacobian);
+BENCHMARK(BM_kdl_mass);
+BENCHMARK(BM_kdl_coriolis);
+BENCHMARK(BM_kdl_gravity);
+BENCHMARK(BM_kdl_jacdot);
+BENCHMARK(BM_kdl_forward_dynamics);
+
+}  // namespace
+
+BENCHMARK_MAIN();
