@@ -20,5 +20,5 @@ stack=$((16#$top - 16#$limit))
 echo "flash (text+data): $((text + data)) bytes; RAM: data $data + bss $bss + main stack $stack = $((data + bss + stack)) bytes"
 if [ -n "$su_dir" ] && [ -d "$su_dir" ]; then
   echo "largest stack frames (-fstack-usage):"
-  find "$su_dir" -name '*.su' -exec cat {} + | sort -t$'\t' -k2 -n -r | head -8 | sed 's/^/  /'
+  find "$su_dir" -name '*.su' -exec cat {} + | sort -t$'\t' -k2 -n -r | sed -n '1,8s/^/  /p'
 fi

@@ -25,6 +25,7 @@ struct StdioBoard {
   static std::uint32_t cycles() { return clock += 1000; }  // a nominal 1000 cycles per call
   static std::uint32_t stack_used() { return 0; }
   static void burn(std::uint32_t c) { clock += c; }
+  static void fault_output(bool) {}  // the frame's state carries it
 };
 
 }  // namespace

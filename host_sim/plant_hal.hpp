@@ -26,6 +26,8 @@ class PlantHal {
   /// The host build has no cycle counter and no link: timing reads 0, no I/O faults.
   std::uint32_t cycles() const { return 0; }
   std::uint32_t io_faults() const { return 0; }
+  void fault_output(bool active) { fault_ = active; }
+  bool fault() const { return fault_; }
   /// Joint torques the amplifiers produce from the last DAC codes.
   Vec6 torque() const {
     Vec6 t;
@@ -37,6 +39,7 @@ class PlantHal {
   Plant& plant_;
   Vec6 q_start_;
   std::int32_t codes_[hal::kJoints] = {0, 0, 0, 0, 0, 0};
+  bool fault_ = false;
 };
 
 }  // namespace sim

@@ -82,6 +82,38 @@ TEST(PilProtocol, ResynchronisesAfterGarbage) {
   EXPECT_EQ(t.counts[2], -77);
 }
 
+// ---------------------------------------------------------------- host-side errors are clear, never hangs
+TEST(PilClientErrors, PeerThatNeverAnswersTimesOut) {
+  PilClient c;
+  std::string err;
+  EXPECT_FALSE(c.start({"sh", "-c", "exec sleep 30"}, err, 0.3));
+  EXPECT_NE(err.find("no actuator frame from the firmware within"), std::string::npos) << err;
+}
+
+TEST(PilClientErrors, PeerThatExitsIsReported) {
+  PilClient c;
+  std::string err;
+  EXPECT_FALSE(c.start({"true"}, err, 5.0));
+  EXPECT_NE(err.find("closed the link"), std::string::npos) << err;
+  PilClient d;
+  EXPECT_FALSE(d.start({"/nonexistent/firmware-runner"}, err, 5.0));
+  EXPECT_NE(err.find("closed the link"), std::string::npos) << err;
+}
+
+TEST(PilClientErrors, CorruptedOrShortFramesAreReported) {
+  PilClient c;
+  std::string err;
+  // A header whose length does not match its type.
+  EXPECT_FALSE(c.start({"sh", "-c", "printf '\\245\\132\\002\\003abc'; exec sleep 30"}, err, 5.0));
+  EXPECT_NE(err.find("bad header"), std::string::npos) << err;
+  // A valid header, then silence: a short frame, reported at the timeout.
+  PilClient d;
+  char cmd[96];
+  std::snprintf(cmd, sizeof cmd, "printf '\\245\\132\\002\\%03oabc'; exec sleep 30", pil::kActuatorPayload);
+  EXPECT_FALSE(d.start({"sh", "-c", cmd}, err, 0.3));
+  EXPECT_NE(err.find("short frame"), std::string::npos) << err;
+}
+
 // ---------------------------------------------------------------- link with a live peer
 struct Link : ::testing::Test {
   PilClient link;

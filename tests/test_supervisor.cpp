@@ -51,6 +51,8 @@ struct ScriptedHal {
   std::int32_t written[kDof] = {1, 1, 1, 1, 1, 1};
   std::uint32_t clock = 0, clock_step = 10, faults = 0;
   int writes = 0;
+  bool fault_line = false;
+  void fault_output(bool a) { fault_line = a; }
   void read_encoders(std::int32_t c[kDof]) {
     for (int i = 0; i < kDof; ++i) c[i] = counts[i];
   }
@@ -90,6 +92,7 @@ struct TaskFixture : ::testing::Test {
     EXPECT_EQ(task->sup.state, SupervisorState::kFault);
     EXPECT_TRUE(task->sup.latched & bit) << task->sup.latched;
     EXPECT_TRUE(hal.all_zero());
+    EXPECT_TRUE(hal.fault_line);
     // Stays latched with healthy inputs afterwards.
     run(3);
     EXPECT_EQ(task->sup.state, SupervisorState::kFault);
@@ -102,6 +105,7 @@ TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
   EXPECT_EQ(task->sup.state, SupervisorState::kRun);
   EXPECT_FALSE(hal.all_zero());  // holds gravity
   EXPECT_EQ(hal.writes, 5);
+  EXPECT_FALSE(hal.fault_line);
   EXPECT_EQ(task->timing.count, 5u);
   EXPECT_GT(task->timing.max, 0u);
 }

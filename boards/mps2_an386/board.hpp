@@ -116,6 +116,12 @@ inline void control_irq_pend() {
 inline void control_timer_ack() { timer0().INTSTATUS = 1; }
 inline bool control_timer_pending() { return (timer0().INTSTATUS & 1u) != 0; }
 
+// ---------------------------------------------------------------- fault line
+/// QEMU's mps2-an386 models no free output pin for an interlock; the binding keeps the level here
+/// (a real board drives its amplifier-enable line). The link frames carry the state to the host.
+inline volatile bool g_fault_line = false;
+inline void fault_output(bool active) { g_fault_line = active; }
+
 // ---------------------------------------------------------------- stack
 /// Bytes of the main stack ever used (painted at reset).
 std::uint32_t stack_used();

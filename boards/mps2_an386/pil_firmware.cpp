@@ -16,6 +16,7 @@ struct Mps2Board {
   static std::uint32_t cycles() { return board::cycles(); }
   static std::uint32_t stack_used() { return board::stack_used(); }
   static void burn(std::uint32_t ns) { board::busy_wait(ns); }
+  static void fault_output(bool active) { board::fault_output(active); }
 };
 
 osc::PilNode<float, Mps2Board> g_node;  // a few kB: static, never on the stack

@@ -19,6 +19,7 @@ struct StillHal {
     for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];
   }
   std::uint32_t cycles() { return board::cycles(); }
+  void fault_output(bool active) { board::fault_output(active); }
   std::uint32_t io_faults() {
     // The next tick already pending when this one starts: the previous one overran.
     return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;

@@ -4,7 +4,8 @@
 // on the targets.
 //
 // HAL requirements (see hal/hal.hpp): read_encoders(counts), write_dacs(codes), cycles() (a free-
-// running 32-bit counter), io_faults() (fault bits the I/O layer detected, e.g. the link).
+// running 32-bit counter), io_faults() (fault bits the I/O layer detected, e.g. the link),
+// fault_output(active).
 #pragma once
 
 #include <cstdint>
@@ -124,6 +125,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (!torque_enabled(task.sup))
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   hal.write_dacs(task.codes);
+  hal.fault_output(task.sup.state == SupervisorState::kFault);
   task.timing.add(hal.cycles() - c0);
   ++task.tick;
   return faults;

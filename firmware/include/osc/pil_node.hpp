@@ -4,6 +4,7 @@
 //   static std::uint32_t cycles();          // free-running cycle counter
 //   static std::uint32_t stack_used();      // main-stack high-water mark [bytes]
 //   static void burn(std::uint32_t cycles); // busy-wait (fault injection only)
+//   static void fault_output(bool active);  // the board's fault line
 // and runs: on_byte() for every received byte, and tick() from the control interrupt when
 // on_byte() asked for it or after on_timeout(), which it calls when no complete frame arrived
 // within the link timeout.
@@ -96,6 +97,7 @@ class PilNode {
     Board::uart_write(buf, pil::encode(a, buf));
   }
   std::uint32_t cycles() const { return Board::cycles(); }
+  void fault_output(bool active) { Board::fault_output(active); }
   std::uint32_t io_faults() {
     const std::uint32_t f = pending_faults_;
     pending_faults_ = 0;

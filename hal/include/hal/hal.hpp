@@ -10,6 +10,11 @@
 //       A free-running 32-bit counter for step timing (0 where there is none).
 //   std::uint32_t io_faults();
 //       osc::Fault bits the I/O layer detected since the last tick (lost or corrupt link).
+//   void fault_output(bool active);
+//       The hardware fault line (e.g. an amplifier-enable interlock or a LED), driven every tick.
+// The periodic control timer is the board's (boards/<board>/board.hpp: control_timer_start()); its
+// interrupt calls osc::control_tick(). Telemetry: the task's StepTiming, supervisor state and fault
+// bits; over the PIL link every actuator frame carries them (osc/pil.hpp).
 // Bindings: host_sim/plant_hal.hpp (the simulated PUMA 560); boards/<board>/ for targets.
 #pragma once
 
