@@ -162,6 +162,16 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
   }
 }
 
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
+    else out += c;
+  }
+  return out + "\"";
+}
+
 void json_array(std::ostream& os, const double* v, int n, double scale = 1) {
   os << "[";
   for (int i = 0; i < n; ++i) os << (i ? ", " : "") << v[i] * scale;
@@ -192,7 +202,7 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
     os << ",\n" << indent << "\"firmware_tick_instructions_max\": " << r.max_tick_cycles;
     os << ",\n" << indent << "\"firmware_stack_used_bytes\": " << r.stack_used;
   }
-  if (!r.error.empty()) os << ",\n" << indent << "\"error\": \"" << r.error << "\"";
+  if (!r.error.empty()) os << ",\n" << indent << "\"error\": " << json_string(r.error);
   os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
 }
 
