@@ -1,7 +1,7 @@
 // The one place the kernels touch elementary functions and literals.
-// double and float forward to <cmath>; a fixed-point type supplies its own
-// overloads of these functions (found by argument-dependent lookup) and a
-// constructor from double for literals.
+// double and float forward to <cmath>; a fixed-point type adds its own overloads
+// of these functions to osc::math (the kernels call them qualified) and a
+// constructor from double for literals (lit<S>).
 #pragma once
 
 #include <cmath>
