@@ -18,33 +18,17 @@ Mat3 rot_x(double a) {
   m << 1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a);
   return m;
 }
-/// A parent-to-child frame change: child rotation E and origin r, both expressed in the parent.
-struct Transform {
-  Mat3 E;
-  Vec3 r;
-  /// Motion vector to the child: w_c = E^T w_p, v_c = E^T (v_p - r x w_p).
-  void motion_to_child(const Vec3& w, const Vec3& v, Vec3& wc, Vec3& vc) const {
-    wc.noalias() = E.transpose() * w;
-    vc.noalias() = E.transpose() * (v - r.cross(w));
-  }
-  /// Force vector to the parent: f_p = E f_c, n_p = E n_c + r x f_p.
-  void force_to_parent(const Vec3& n, const Vec3& f, Vec3& np, Vec3& fp) const {
-    fp.noalias() = E * f;
-    np.noalias() = E * n;
-    np += r.cross(fp);
-  }
-  /// Spatial inertia to the parent, X^T I X with X the motion transform above.
-  void add_inertia_to_parent(const SpatialInertia& I, SpatialInertia& out) const {
-    const Mat3 Ib = E * I.Ib * E.transpose();
-    const Mat3 H = E * I.H * E.transpose();
-    const Mat3 M = E * I.M * E.transpose();
-    const Mat3 R = skew(r);
-    const Mat3 RM = R * M;
-    out.Ib += Ib + R * H.transpose() - H * R - RM * R;
-    out.H += H + RM;
-    out.M += M;
-  }
-};
+/// Spatial cross products at a common point, ordering [angular; linear].
+Vec6 cross_motion(const Vec6& v, const Vec6& m) {
+  Vec6 out;
+  out << v.head<3>().cross(m.head<3>()), v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
+  return out;
+}
+Vec6 cross_force(const Vec6& v, const Vec6& f) {
+  Vec6 out;
+  out << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
+  return out;
+}
 
 }  // namespace
 
@@ -57,7 +41,7 @@ ArticulatedBody::ArticulatedBody(double link_scale) {
     const Vec3 c = Vec3(L.a, 0, L.d) + Ra * Vec3(L.com[0], L.com[1], L.com[2]);
     const Mat3 Ic = Ra * Vec3(L.inertia[0], L.inertia[1], L.inertia[2]).asDiagonal() * Ra.transpose() * link_scale;
     const double m = L.mass * link_scale;
-    inertia_[i] = SpatialInertia{Ic + m * skew(c) * skew(c).transpose(), m * skew(c), m * Mat3::Identity()};
+    body_[i] = Body{m, c, Ic};
     armature_[i] = L.gear_ratio * L.gear_ratio * L.motor_inertia;
     if (i == 0) {
       rot_fixed_[i] = Mat3::Identity();
@@ -71,64 +55,55 @@ ArticulatedBody::ArticulatedBody(double link_scale) {
 }
 
 Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau) const {
-  Transform X[6];
-  SpatialInertia IA[6];
-  Vec3 w[6], v[6], cw[6], cv[6], pn[6], pf[6], Ut[6], Ub[6];
+  Mat6 IA[6];
+  Vec6 S[6], c[6], pA[6], U[6];
   double D[6], u[6];
-  // Pass 1, base to tip: link velocities, velocity-product accelerations c, bias forces p.
-  Vec3 wp = Vec3::Zero(), vp = Vec3::Zero();
+  // Pass 1, base to tip: joint frames, axes S = [z; o x z], velocities, velocity-product
+  // accelerations c = V x S qd, link inertias at the base origin and bias forces V x* I V.
+  Mat3 W = Mat3::Identity();
+  Vec3 o = Vec3::Zero();
+  Vec6 V = Vec6::Zero();
   for (int i = 0; i < 6; ++i) {
+    o += W * pos_fixed_[i];
     const double cq = std::cos(q(i)), sq = std::sin(q(i));
     Mat3 Rz;
     Rz << cq, -sq, 0, sq, cq, 0, 0, 0, 1;
-    X[i].E.noalias() = rot_fixed_[i] * Rz;
-    X[i].r = pos_fixed_[i];
-    X[i].motion_to_child(wp, vp, w[i], v[i]);
-    const Vec3 wJ(0, 0, qd(i));  // S qd, S = z (angular)
-    w[i] += wJ;
-    cw[i] = w[i].cross(wJ);
-    cv[i] = v[i].cross(wJ);
-    IA[i] = inertia_[i];
-    const Vec3 hn = inertia_[i].Ib * w[i] + inertia_[i].H * v[i];   // I v: angular part
-    const Vec3 hf = inertia_[i].H.transpose() * w[i] + inertia_[i].M * v[i];  // linear part
-    pn[i] = w[i].cross(hn) + v[i].cross(hf);
-    pf[i] = w[i].cross(hf);
-    wp = w[i];
-    vp = v[i];
+    W = W * rot_fixed_[i] * Rz;
+    const Vec3 z = W.col(2);
+    S[i] << z, o.cross(z);
+    const Vec6 vJ = S[i] * qd(i);
+    V += vJ;
+    c[i] = cross_motion(V, vJ);
+    const Body& b = body_[i];
+    const Vec3 com = o + W * b.com;
+    const Mat3 C = skew(com);
+    Mat6& I = IA[i];
+    I.topLeftCorner<3, 3>() = W * b.inertia * W.transpose() + b.mass * C * C.transpose();
+    I.topRightCorner<3, 3>() = b.mass * C;
+    I.bottomLeftCorner<3, 3>() = b.mass * C.transpose();
+    I.bottomRightCorner<3, 3>() = b.mass * Mat3::Identity();
+    pA[i] = cross_force(V, I * V);
   }
-  // Pass 2, tip to base: articulated inertias and bias forces.
+  // Pass 2, tip to base: articulated inertias and bias forces (no transforms: all at the origin).
   for (int i = 5; i >= 0; --i) {
-    Ut[i] = IA[i].Ib.col(2);
-    Ub[i] = IA[i].H.row(2).transpose();
-    D[i] = Ut[i](2) + armature_[i];
-    u[i] = tau(i) - pn[i](2);
+    U[i].noalias() = IA[i] * S[i];
+    D[i] = S[i].dot(U[i]) + armature_[i];
+    u[i] = tau(i) - S[i].dot(pA[i]);
     if (i > 0) {
-      SpatialInertia Ia = IA[i];
       const double invD = 1.0 / D[i];
-      Ia.Ib.noalias() -= invD * Ut[i] * Ut[i].transpose();
-      Ia.H.noalias() -= invD * Ut[i] * Ub[i].transpose();
-      Ia.M.noalias() -= invD * Ub[i] * Ub[i].transpose();
-      const Vec3 an = pn[i] + Ia.Ib * cw[i] + Ia.H * cv[i] + Ut[i] * (u[i] * invD);
-      const Vec3 af = pf[i] + Ia.H.transpose() * cw[i] + Ia.M * cv[i] + Ub[i] * (u[i] * invD);
-      X[i].add_inertia_to_parent(Ia, IA[i - 1]);
-      Vec3 np, fp;
-      X[i].force_to_parent(an, af, np, fp);
-      pn[i - 1] += np;
-      pf[i - 1] += fp;
+      const Mat6 Ia = IA[i] - invD * U[i] * U[i].transpose();
+      IA[i - 1] += Ia;
+      pA[i - 1] += pA[i] + Ia * c[i] + U[i] * (u[i] * invD);
     }
   }
   // Pass 3, base to tip: accelerations; gravity as an upward base acceleration.
-  Vec3 ap = Vec3::Zero(), lp(0, 0, osc::puma560::kGravity);
+  Vec6 a;
+  a << 0, 0, 0, 0, 0, osc::puma560::kGravity;
   Vec6 qdd;
   for (int i = 0; i < 6; ++i) {
-    Vec3 a, l;
-    X[i].motion_to_child(ap, lp, a, l);
-    a += cw[i];
-    l += cv[i];
-    qdd(i) = (u[i] - Ut[i].dot(a) - Ub[i].dot(l)) / D[i];
-    a(2) += qdd(i);
-    ap = a;
-    lp = l;
+    a += c[i];
+    qdd(i) = (u[i] - U[i].dot(a)) / D[i];
+    a += S[i] * qdd(i);
   }
   return qdd;
 }

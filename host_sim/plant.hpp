@@ -23,14 +23,9 @@ struct PlantConfig {
   double link_scale = 1.0;            ///< scales every link mass and inertia (model-error studies)
 };
 
-/// Spatial inertia in 3x3 blocks, motion vectors ordered [angular; linear]:
-/// I [w; v] = [Ib w + H v; H^T w + M v]. For a rigid body Ib = Ic + m [c][c]^T, H = m [c], M = m 1.
-struct SpatialInertia {
-  Mat3 Ib, H, M;
-};
-
 /// Articulated-body forward dynamics of the PUMA 560 (armature on each joint's scalar inertia),
-/// Featherstone's algorithm with 3x3-block spatial algebra.
+/// Featherstone's algorithm with every spatial quantity expressed at the base origin in base axes,
+/// so that no transform is needed between links.
 class ArticulatedBody {
  public:
   explicit ArticulatedBody(double link_scale = 1.0);
@@ -38,9 +33,14 @@ class ArticulatedBody {
   Vec6 forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
 
  private:
-  SpatialInertia inertia_[6];  // link i in its joint frame B_i (origin o_{i-1}, z = axis i)
-  Mat3 rot_fixed_[6];       // rotation of B_i's parent joint frame to F_{i-1}: Rx(alpha_{i-1})
-  Vec3 pos_fixed_[6];       // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1})
+  struct Body {
+    double mass;
+    Vec3 com;      // COM in the joint frame B_i (origin o_{i-1}, z = axis i)
+    Mat3 inertia;  // about the COM, axes of B_i
+  };
+  Body body_[6];
+  Mat3 rot_fixed_[6];  // rotation of F_{i-1} in B_{i-1}: Rx(alpha_{i-1})
+  Vec3 pos_fixed_[6];  // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1})
   double armature_[6];
 };
 
