@@ -1,11 +1,23 @@
-// Properties of the kernels on random states: A symmetric positive definite; analytic Jacobian and
-// Jdot qd against finite differences; Lambda_dot - 2 Psi skew-symmetric (7); Psi symmetric (8) and
-// the Christoffel form (property 2); friction regressor (18)-(19); block factorisation of J;
-// float against double. Every kernel call runs with Eigen's malloc check armed.
+// Properties of the kernels on random non-singular states (deterministic seed):
+//   A(q) symmetric positive definite;
+//   analytic Jacobian and analytic Jdot qd against central finite differences of x(q) and Ja(q);
+//   (7)  Lambda_dot - 2 Psi(x, x_dot) skew-symmetric;
+//   (8)  Psi(x, y) z = Psi(x, z) y;  property 2: B(q, y) z = B(q, z) y;  h(v) = Psi(x, v) v;
+//   (18)-(19) W_j(qd) theta = friction torque (2), including joints at rest (sgn 0 = 0);
+//   block factorisation of J against a dense 6x6 LU; rcond at the named poses;
+//   float kernels against double.
+// Every kernel call runs with Eigen's malloc check armed (test::NoMalloc). Guards are never nested:
+// the inner guard's destructor would re-enable allocation.
+//
+// Finite differences: central, step h = 1e-6 (rad, or s along q(t) = q + t qd with |qd_i| <= 1).
+// Truncation error ~ h^2 |f'''| ~ 1e-12 and round-off ~ eps |f| / h ~ 1e-10 relative, amplified
+// by the conditioning of Lambda (two solves with Ja); the tolerances below leave >= 10x margin
+// over the worst value seen (printed).
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <cstdio>
 
 #include "osc/friction.hpp"
 #include "osc/opspace.hpp"
@@ -17,7 +29,8 @@ using test::NoMalloc;
 
 namespace {
 
-constexpr int kStates = 200;
+constexpr int kStates = 300;
+constexpr double kH = 1e-6;
 
 struct Props : ::testing::Test {
   Model<double> model = Model<double>::puma560();
@@ -25,79 +38,91 @@ struct Props : ::testing::Test {
   OpSpace<double> os{};
   test::RandomStates rs;
 
-  /// x(q) with orientation relative to R_ref.
+  /// x(q) = [p; phi] with orientation relative to R_ref.
   Vec6<double> x_of(const Vec6<double>& q, const Mat3<double>& R_ref) {
     NoMalloc guard;
     forward_kinematics(model, data, q);
     return operational_coordinates(data, R_ref);
   }
+  /// opspace_update at q: fills data (frames, J, A) and os (x, Ja, Jf, A_llt, Lambda, g).
   void update(const Vec6<double>& q, const Mat3<double>& R_ref) {
     NoMalloc guard;
     opspace_update(model, data, os, q, R_ref);
   }
+  /// End-effector orientation R_6(q).
   Mat3<double> orientation(const Vec6<double>& q) {
+    NoMalloc guard;
     forward_kinematics(model, data, q);
     return data.R[kDof];
+  }
+  /// Reference orientation for state k: even k its own orientation (phi = 0 at q), odd k the
+  /// orientation at a nearby perturbed configuration (|dq_i| <= 0.2 rad, phi != 0).
+  Mat3<double> reference_for(int k, const Vec6<double>& q) {
+    return orientation(k % 2 == 0 ? q : Vec6<double>(q + rs.vec(0.2)));
   }
 };
 
 TEST_F(Props, InertiaIsSymmetricPositiveDefinite) {
+  double worst_sym = 0, min_eig = 1e300;
   for (int k = 0; k < kStates; ++k) {
     update(rs.q_nonsingular(), Mat3<double>::Identity());
-    EXPECT_LT((data.A - data.A.transpose()).norm(), 1e-14);
-    EXPECT_GT(Eigen::SelfAdjointEigenSolver<Mat6<double>>(data.A).eigenvalues().minCoeff(), 0.0);
+    worst_sym = std::max(worst_sym, (data.A - data.A.transpose()).norm() / data.A.norm());
+    min_eig = std::min(min_eig, Eigen::SelfAdjointEigenSolver<Mat6<double>>(data.A).eigenvalues().minCoeff());
+    EXPECT_EQ(os.A_llt.info(), Eigen::Success);
   }
+  std::printf("A: max ||A - A^T|| / ||A|| %.1e, min eigenvalue %.3f kg m^2\n", worst_sym, min_eig);
+  EXPECT_LT(worst_sym, 1e-15);
+  EXPECT_GT(min_eig, 0.0);
 }
 
 TEST_F(Props, AnalyticJacobianAndJdotMatchFiniteDifferences) {
-  const double h = 1e-6;
   double worst_J = 0, worst_Jd = 0;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(1.0);
-    // Reference orientation: the state's own, then one 0.3 rad away.
-    Vec6<double> q_ref = q;
-    if (k % 2) q_ref += rs.vec(0.3);
-    const Mat3<double> R_ref = orientation(q_ref);
+    const Mat3<double> R_ref = reference_for(k, q);
     update(q, R_ref);
     const Mat6<double> Ja = os.Ja;
+    // dx/dq by central differences of operational_coordinates.
     Mat6<double> fd;
     for (int j = 0; j < kDof; ++j) {
-      const Vec6<double> e = Vec6<double>::Unit(j) * h;
-      fd.col(j) = (x_of(q + e, R_ref) - x_of(q - e, R_ref)) / (2 * h);
+      const Vec6<double> e = Vec6<double>::Unit(j) * kH;
+      fd.col(j) = (x_of(q + e, R_ref) - x_of(q - e, R_ref)) / (2 * kH);
     }
     worst_J = std::max(worst_J, (fd - Ja).norm() / Ja.norm());
-    // d/dt (Ja(q + t qd)) qd by central differences.
-    update(q + h * qd, R_ref);
+    // d/dt (Ja(q + t qd)) qd at t = 0, R_ref fixed.
+    update(q + kH * qd, R_ref);
     const Mat6<double> Jp = os.Ja;
-    update(q - h * qd, R_ref);
+    update(q - kH * qd, R_ref);
     const Mat6<double> Jm = os.Ja;
-    const Vec6<double> jd_fd = (Jp - Jm) / (2 * h) * qd;
+    const Vec6<double> jd_fd = (Jp - Jm) / (2 * kH) * qd;
     update(q, R_ref);
     Vec6<double> jd;
     {
       NoMalloc guard;
       jd = analytic_jdot_qd(model, data, os, qd);
     }
-    worst_Jd = std::max(worst_Jd, (jd_fd - jd).norm() / (1e-3 + jd.norm()));
+    worst_Jd = std::max(worst_Jd, (jd_fd - jd).norm() / std::max(jd.norm(), 1e-3));
   }
-  std::printf("analytic Jacobian vs central differences: %.2e; analytic Jdot qd: %.2e\n", worst_J, worst_Jd);
+  std::printf("analytic Jacobian vs central differences: %.2e; analytic Jdot qd: %.2e (relative)\n", worst_J,
+              worst_Jd);
   EXPECT_LT(worst_J, 1e-7);
   EXPECT_LT(worst_Jd, 1e-6);
 }
 
 TEST_F(Props, LambdaDotMinusTwoPsiIsSkewSymmetric) {
-  // (7): z^T (Lambda_dot - 2 Psi(x, x_dot)) z = 0, i.e. the symmetric part vanishes.
-  const double h = 1e-6;
-  double worst = 0;
+  // (7): z^T (Lambda_dot - 2 Psi(x, x_dot)) z = 0 for all z, i.e. the symmetric part vanishes.
+  // Lambda_dot by central differences along q(t) = q + t qd with R_ref fixed; x_dot = Ja qd;
+  // Psi(x, x_dot) column k = psi_bilinear(x_dot, e_k).
+  double worst = 0, worst_ref = 0;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(1.0);
-    const Mat3<double> R_ref = orientation(q + rs.vec(0.2));
-    update(q + h * qd, R_ref);
+    const Mat3<double> R_ref = reference_for(k, q);
+    update(q + kH * qd, R_ref);
     const Mat6<double> Lp = os.Lambda;
-    update(q - h * qd, R_ref);
+    update(q - kH * qd, R_ref);
     const Mat6<double> Lm = os.Lambda;
     update(q, R_ref);
-    const Mat6<double> Ldot = (Lp - Lm) / (2 * h);
+    const Mat6<double> Ldot = (Lp - Lm) / (2 * kH);
     const Vec6<double> xd = os.Ja * qd;
     Mat6<double> Psi;
     {
@@ -105,32 +130,44 @@ TEST_F(Props, LambdaDotMinusTwoPsiIsSkewSymmetric) {
       for (int j = 0; j < kDof; ++j) Psi.col(j) = psi_bilinear(model, data, os, xd, Vec6<double>::Unit(j));
     }
     const Mat6<double> N = Ldot - 2 * Psi;
-    worst = std::max(worst, (N + N.transpose()).norm() / (Ldot.norm() + 2 * Psi.norm()));
+    const double scale = Ldot.norm() + 2 * Psi.norm();
+    worst = std::max(worst, (N + N.transpose()).norm() / scale);
+    // The check is not vacuous: Psi itself is far from skew (its symmetric part is O(Lambda_dot)).
+    worst_ref = std::max(worst_ref, (Psi + Psi.transpose()).norm() / scale);
   }
-  std::printf("||sym(Lambda_dot - 2 Psi)|| / scale: %.2e\n", worst);
+  std::printf("||sym(Lambda_dot - 2 Psi)|| / (||Lambda_dot|| + 2||Psi||): %.2e (same for Psi alone: %.2e)\n", worst,
+              worst_ref);
   EXPECT_LT(worst, 1e-6);
+  EXPECT_GT(worst_ref, 1e-2);
 }
 
 TEST_F(Props, PsiAndChristoffelFormsAreSymmetricBilinear) {
-  double worst_psi = 0, worst_B = 0, worst_h = 0;
+  double worst_psi = 0, worst_B = 0, worst_h = 0, worst_c = 0;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular();
-    update(q, orientation(q + rs.vec(0.2)));
+    const Mat3<double> R_ref = reference_for(k, q);
+    update(q, R_ref);
     const Vec6<double> y = rs.vec(0.5), z = rs.vec(0.5), u = rs.vec(1.0), v = rs.vec(1.0);
     NoMalloc guard;
+    // (8)
     const Vec6<double> a = psi_bilinear(model, data, os, y, z), b = psi_bilinear(model, data, os, z, y);
-    worst_psi = std::max(worst_psi, (a - b).norm() / (1e-9 + a.norm()));  // (8)
+    worst_psi = std::max(worst_psi, (a - b).norm() / std::max(a.norm(), 1e-9));
+    // Property 2
     const Vec6<double> c1 = coriolis_bilinear(model, data, u, v), c2 = coriolis_bilinear(model, data, v, u);
-    worst_B = std::max(worst_B, (c1 - c2).norm() / (1e-9 + c1.norm()));  // property 2
-    // Quadratic and bilinear forms agree, and B(q, qd) qd = c(q, qd).
+    worst_B = std::max(worst_B, (c1 - c2).norm() / std::max(c1.norm(), 1e-9));
+    // Quadratic and bilinear forms agree: psi_quadratic(v) = psi_bilinear(v, v).
     const Vec6<double> hq = psi_quadratic(model, data, os, y), hb = psi_bilinear(model, data, os, y, y);
-    worst_h = std::max(worst_h, (hq - hb).norm() / (1e-9 + hq.norm()));
+    worst_h = std::max(worst_h, (hq - hb).norm() / std::max(hq.norm(), 1e-9));
+    // B(q, qd) qd = c(q, qd) (Christoffel matrix against the RNEA velocity products).
     const Vec6<double> cq = velocity_products(model, data, u).c;
-    worst_h = std::max(worst_h, (coriolis_matrix(model, data, u) * u - cq).norm() / (1e-9 + cq.norm()));
+    worst_c = std::max(worst_c, (coriolis_matrix(model, data, u) * u - cq).norm() / std::max(cq.norm(), 1e-9));
   }
+  std::printf("relative: (8) %.1e, property 2 %.1e, psi_quadratic vs psi_bilinear %.1e, B qd vs c %.1e\n",
+              worst_psi, worst_B, worst_h, worst_c);
   EXPECT_LT(worst_psi, 1e-10);
   EXPECT_LT(worst_B, 1e-12);
-  EXPECT_LT(worst_h, 1e-10);
+  EXPECT_LT(worst_h, 1e-12);
+  EXPECT_LT(worst_c, 1e-12);
 }
 
 TEST_F(Props, FrictionRegressorReproducesModel2IncludingZeroVelocity) {
@@ -141,80 +178,141 @@ TEST_F(Props, FrictionRegressorReproducesModel2IncludingZeroVelocity) {
     p.sti(i) = params::kFrictionPaper.sti[i];
     p.dec(i) = 0.5 + i;
   }
+  const Vec18<double> theta = p.theta();
   for (int k = 0; k < kStates; ++k) {
     Vec6<double> qd = rs.vec(2.0);
-    qd(k % kDof) = 0.0;  // sgn(0) = 0: no friction on a joint at rest
-    NoMalloc guard;
-    const Vec6<double> tau = friction_torque(p, qd);
-    const Vec6<double> tw = friction_regressor(qd, p.dec) * p.theta();
-    EXPECT_LT((tau - tw).norm(), 1e-12);
-    EXPECT_EQ(tau(k % kDof), 0.0);
+    const int rest = k % kDof;
+    qd(rest) = 0.0;                                     // sgn(0) = 0: no friction on a joint at rest
+    if (k % 3 == 0) qd((rest + 3) % kDof) = -0.0;       // negative zero too
+    Vec6<double> tau, tw;
+    Regressor<double> W;
+    {
+      NoMalloc guard;
+      tau = friction_torque(p, qd);
+      W = friction_regressor(qd, p.dec);
+      tw = W * theta;
+    }
+    EXPECT_LT((tau - tw).norm(), 1e-12 * std::max(tau.norm(), 1.0));
     // Model (2) written out independently.
     for (int i = 0; i < kDof; ++i) {
       const double s = qd(i) > 0 ? 1 : (qd(i) < 0 ? -1 : 0);
       EXPECT_NEAR(tau(i), p.vis(i) * qd(i) + (p.cou(i) + p.sti(i) * std::exp(-p.dec(i) * qd(i) * qd(i))) * s, 1e-12);
+      if (qd(i) == 0.0) {
+        EXPECT_EQ(tau(i), 0.0);
+        EXPECT_EQ(tw(i), 0.0);
+        EXPECT_EQ(W.row(i).cwiseAbs().maxCoeff(), 0.0);
+      }
     }
   }
 }
 
 TEST_F(Props, BlockFactorisationOfTheJacobian) {
+  double worst_s = 0, worst_t = 0, worst_block = 0, min_rcond = 1e300;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular();
-    update(q, orientation(q));
-    EXPECT_LT((data.J.topRightCorner<3, 3>().norm()), 1e-15);  // wrist centre at the frame-6 origin
+    update(q, reference_for(k, q));
+    // The wrist axes meet at the frame-6 origin: zero upper-right block (geometric and analytic J).
+    worst_block = std::max({worst_block, data.J.topRightCorner<3, 3>().norm(), os.Ja.topRightCorner<3, 3>().norm()});
     const Vec6<double> b = rs.vec(1.0);
-    const Eigen::PartialPivLU<Mat6<double>> lu(os.Ja), lut(Mat6<double>(os.Ja.transpose()));
-    EXPECT_LT((os.Jf.solve(b) - lu.solve(b)).norm(), 1e-9 * (1 + lu.solve(b).norm()));
-    EXPECT_LT((os.Jf.solve_transpose(b) - lut.solve(b)).norm(), 1e-9 * (1 + lut.solve(b).norm()));
-    EXPECT_GT(os.Jf.rcond, 0.0);
+    Vec6<double> xs, xt;
+    {
+      NoMalloc guard;
+      xs = os.Jf.solve(b);
+      xt = os.Jf.solve_transpose(b);
+    }
+    const Vec6<double> rs_ = Eigen::PartialPivLU<Mat6<double>>(os.Ja).solve(b);
+    const Vec6<double> rt = Eigen::PartialPivLU<Mat6<double>>(Mat6<double>(os.Ja.transpose())).solve(b);
+    worst_s = std::max(worst_s, (xs - rs_).norm() / rs_.norm());
+    worst_t = std::max(worst_t, (xt - rt).norm() / rt.norm());
+    min_rcond = std::min(min_rcond, static_cast<double>(os.Jf.rcond));
   }
+  std::printf("J factor vs dense 6x6 LU, relative: solve %.1e, solve_transpose %.1e; |J12| max %.1e; "
+              "min rcond on random states %.1e\n",
+              worst_s, worst_t, worst_block, min_rcond);
+  EXPECT_LT(worst_block, 1e-15);
+  EXPECT_LT(worst_s, 1e-10);
+  EXPECT_LT(worst_t, 1e-10);
+  EXPECT_GT(min_rcond, 0.0);
+
+  // Named poses: qz, qr and qs are wrist-singular (q5 = 0); qn is well conditioned.
   JacobianFactor<double> f;
-  for (const Vec6<double>& pose : {test::from_array(puma560::kQz), test::from_array(puma560::kQr),
-                                   test::from_array(puma560::kQs)}) {
-    forward_kinematics(model, data, pose);
+  auto rcond_at = [&](const double (&pose)[kDof]) {
+    NoMalloc guard;
+    forward_kinematics(model, data, test::from_array(pose));
     geometric_jacobian(data);
     f.compute(data.J);
-    EXPECT_LT(f.rcond, 1e-12);
-  }
-  forward_kinematics(model, data, test::from_array(puma560::kQn));
-  geometric_jacobian(data);
-  f.compute(data.J);
-  EXPECT_GT(f.rcond, 1e-3);
+    return static_cast<double>(f.rcond);
+  };
+  const double rz = rcond_at(puma560::kQz), rr = rcond_at(puma560::kQr), rsg = rcond_at(puma560::kQs),
+               rn = rcond_at(puma560::kQn);
+  std::printf("rcond: qz %.1e, qr %.1e, qs %.1e, qn %.3f\n", rz, rr, rsg, rn);
+  EXPECT_LT(rz, 1e-12);
+  EXPECT_LT(rr, 1e-12);
+  EXPECT_LT(rsg, 1e-12);
+  EXPECT_GT(rn, 1e-3);
 }
 
 TEST_F(Props, FloatKernelsAgreeWithDouble) {
-  // Float has a 6e-8 unit round-off; through the recursions and two 3x3 solves the stated
-  // tolerance is 1e-4 relative (2e-4 for Psi, which divides by J twice and differences h).
+  // Tolerance, relative (Frobenius / Euclidean): 1e-4 for A, J, Ja, g, c, tau_f, Lambda; 2e-4 for
+  // Psi. Justification: float round-off is u = 6e-8. A, J, g, c come from short recursions (~6
+  // levels of 3x3 products and cross products, sums of same-size terms): a few hundred u at most,
+  // ~3e-5, before counting the rounding of q itself (u |q| |dF/dq| / |F| ~ a few u). Lambda =
+  // J^-T A J^-1 and Psi (two solves with Ja and a difference of h(y+z), h(y-z)) multiply that by
+  // the condition number of the 3x3 blocks, which q_nonsingular bounds (|sin q5|, |cos(q3+0.047)|
+  // >= 0.2): observed worst (printed) is 10-100x below these bounds.
   const Model<float> mf = Model<float>::puma560();
   Data<float> df;
   OpSpace<float> of;
-  double wA = 0, wL = 0, wc = 0, wg = 0, wJ = 0, wP = 0;
+  FrictionParams<double> pd;
+  for (int i = 0; i < kDof; ++i) {
+    pd.vis(i) = params::kFrictionPaper.vis[i];
+    pd.cou(i) = params::kFrictionPaper.cou[i];
+    pd.sti(i) = params::kFrictionPaper.sti[i];
+    pd.dec(i) = params::kTauDec;
+  }
+  const FrictionParams<float> pf{pd.vis.cast<float>(), pd.cou.cast<float>(), pd.sti.cast<float>(),
+                                 pd.dec.cast<float>()};
+  auto rel = [](const auto& f, const auto& d) {
+    return (f.template cast<double>() - d).norm() / std::max(d.norm(), 1e-6);
+  };
+  double wA = 0, wL = 0, wc = 0, wg = 0, wJ = 0, wJa = 0, wP = 0, wF = 0;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(1.0), v = rs.vec(0.2);
-    const Mat3<double> R_ref = orientation(q + rs.vec(0.2));
+    const Mat3<double> R_ref = reference_for(k, q);
+    const Vec6<float> qf = q.cast<float>(), qdf = qd.cast<float>(), vf = v.cast<float>();
+    const Mat3<float> R_ref_f = R_ref.cast<float>();
+    Vec6<double> c, h, tf;
+    Vec6<float> cf, hf, tff;
     update(q, R_ref);
-    const Vec6<double> c = velocity_products(model, data, qd).c, h = psi_quadratic(model, data, os, v);
     {
       NoMalloc guard;
-      opspace_update(mf, df, of, q.cast<float>(), Mat3<float>(R_ref.cast<float>()));
+      c = velocity_products(model, data, qd).c;
+      h = psi_quadratic(model, data, os, v);
+      tf = friction_torque(pd, qd);
+      opspace_update(mf, df, of, qf, R_ref_f);
+      cf = velocity_products(mf, df, qdf).c;
+      hf = psi_quadratic(mf, df, of, vf);
+      tff = friction_torque(pf, qdf);
     }
-    const Vec6<float> cf = velocity_products(mf, df, qd.cast<float>()).c;
-    const Vec6<float> hf = psi_quadratic(mf, df, of, v.cast<float>());
-    auto rel = [](const auto& a, const auto& b) { return (a.template cast<double>() - b).norm() / (1e-6 + b.norm()); };
     wA = std::max(wA, rel(df.A, data.A));
+    wJ = std::max(wJ, rel(df.J, data.J));
+    wJa = std::max(wJa, rel(of.Ja, os.Ja));
     wL = std::max(wL, rel(of.Lambda, os.Lambda));
-    wJ = std::max(wJ, rel(of.Ja, os.Ja));
     wg = std::max(wg, rel(of.g, os.g));
     wc = std::max(wc, rel(cf, c));
     wP = std::max(wP, rel(hf, h));
+    wF = std::max(wF, rel(tff, tf));
   }
-  std::printf("float vs double, max relative: A %.1e, Lambda %.1e, Ja %.1e, g %.1e, c %.1e, Psi %.1e\n", wA, wL,
-              wJ, wg, wc, wP);
+  std::printf("float vs double, max relative: A %.1e, J %.1e, Ja %.1e, Lambda %.1e, g %.1e, c %.1e, Psi %.1e, "
+              "tau_f %.1e\n",
+              wA, wJ, wJa, wL, wg, wc, wP, wF);
   EXPECT_LT(wA, 1e-4);
-  EXPECT_LT(wL, 1e-4);
   EXPECT_LT(wJ, 1e-4);
+  EXPECT_LT(wJa, 1e-4);
+  EXPECT_LT(wL, 1e-4);
   EXPECT_LT(wg, 1e-4);
   EXPECT_LT(wc, 1e-4);
+  EXPECT_LT(wF, 1e-4);
   EXPECT_LT(wP, 2e-4);
 }
 
