@@ -4,7 +4,7 @@
 #include <cmath>
 #include <memory>
 
-#include "osc/control_task.hpp"
+#include "osc/runtime/control_task.hpp"
 #include "pil_client.hpp"
 #include "plant_hal.hpp"
 

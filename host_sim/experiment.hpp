@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "osc/controller.hpp"
+#include "osc/control/controller.hpp"
 #include "plant.hpp"
 
 namespace sim {

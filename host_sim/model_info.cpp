@@ -5,7 +5,7 @@
 #include <string>
 
 #include "cli.hpp"
-#include "osc/opspace.hpp"
+#include "osc/kernels/opspace.hpp"
 
 namespace {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "osc/pil.hpp"
+#include "osc/link/frames.hpp"
 
 namespace sim {
 

@@ -7,8 +7,8 @@
 #include <cstdint>
 #include <memory>
 
-#include "osc/params.hpp"
-#include "osc/pil_node.hpp"
+#include "osc/control/params.hpp"
+#include "osc/link/node.hpp"
 
 namespace {
 

@@ -2,8 +2,8 @@
 
 #include <cmath>
 
-#include "osc/dynamics.hpp"
-#include "osc/puma560.hpp"
+#include "osc/kernels/dynamics.hpp"
+#include "osc/robots/puma560.hpp"
 
 namespace sim {
 namespace {

@@ -6,7 +6,7 @@
 
 #include <Eigen/Core>
 
-#include "osc/params.hpp"
+#include "osc/control/params.hpp"
 
 namespace sim {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "hal/hal.hpp"
-#include "osc/io.hpp"
+#include "osc/runtime/io.hpp"
 #include "plant.hpp"
 
 namespace sim {

@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "kdl_puma.hpp"
-#include "osc/controller.hpp"
+#include "osc/control/controller.hpp"
 #include "plant.hpp"
 
 using namespace osc;

@@ -6,7 +6,7 @@
 #include <kdl/frames.hpp>
 #include <kdl/jntarray.hpp>
 
-#include "osc/model.hpp"
+#include "osc/kernels/model.hpp"
 
 namespace osc::test {
 

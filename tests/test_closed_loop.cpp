@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "experiment.hpp"
-#include "osc/opspace.hpp"
+#include "osc/kernels/opspace.hpp"
 
 using namespace sim;
 

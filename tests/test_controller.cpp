@@ -4,7 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "osc/controller.hpp"
+#include "osc/control/controller.hpp"
 #include "test_util.hpp"
 
 using namespace osc;

@@ -18,7 +18,7 @@
 #include <kdl/chainjnttojacsolver.hpp>
 
 #include "kdl_puma.hpp"
-#include "osc/dynamics.hpp"
+#include "osc/kernels/dynamics.hpp"
 #include "plant.hpp"
 #include "test_util.hpp"
 

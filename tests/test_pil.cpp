@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "experiment.hpp"
-#include "osc/pil.hpp"
-#include "osc/supervisor.hpp"
+#include "osc/link/frames.hpp"
+#include "osc/runtime/supervisor.hpp"
 #include "pil_client.hpp"
 
 using namespace sim;

@@ -6,8 +6,8 @@
 
 #include "experiment.hpp"
 #include "hal/hal.hpp"
-#include "osc/dynamics.hpp"
-#include "osc/io.hpp"
+#include "osc/kernels/dynamics.hpp"
+#include "osc/runtime/io.hpp"
 #include "plant_hal.hpp"
 #include "test_util.hpp"
 

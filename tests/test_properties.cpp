@@ -19,9 +19,9 @@
 #include <Eigen/LU>
 #include <cstdio>
 
-#include "osc/friction.hpp"
-#include "osc/opspace.hpp"
-#include "osc/params.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/kernels/opspace.hpp"
+#include "osc/control/params.hpp"
 #include "test_util.hpp"
 
 using namespace osc;

@@ -1,8 +1,8 @@
 // The published PUMA 560 test vectors of ../shared/reference/puma560.md, sections 5 and 6.
 #include <gtest/gtest.h>
 
-#include "osc/friction.hpp"
-#include "osc/opspace.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/kernels/opspace.hpp"
 #include "test_util.hpp"
 
 using namespace osc;

@@ -3,7 +3,7 @@
 
 #include <memory>
 
-#include "osc/control_task.hpp"
+#include "osc/runtime/control_task.hpp"
 
 using namespace osc;
 

@@ -4,7 +4,7 @@
 #include <Eigen/Core>
 #include <random>
 
-#include "osc/model.hpp"
+#include "osc/kernels/model.hpp"
 
 namespace osc::test {
 

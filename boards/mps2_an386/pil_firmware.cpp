@@ -6,8 +6,8 @@
 #include <cstdint>
 
 #include "board.hpp"
-#include "osc/params.hpp"
-#include "osc/pil_node.hpp"
+#include "osc/control/params.hpp"
+#include "osc/link/node.hpp"
 
 namespace {
 

@@ -5,7 +5,7 @@
 #include <cstdint>
 
 #include "board.hpp"
-#include "osc/control_task.hpp"
+#include "osc/runtime/control_task.hpp"
 #include "text.hpp"
 
 namespace {
@@ -61,14 +61,14 @@ int main() {
     lo = d < lo ? d : lo;
     hi = d > hi ? d : hi;
   }
-  board::text::Line().str("ticks: ").i32(g_ticks).str(", spacing ").u32(lo).str("..").u32(hi).str(" ns").emit();
-  board::text::Line().str("control step: max ").u32(g_task.timing.max).str(", mean ").u32(g_task.timing.mean())
+  cortex_m::text::Line().str("ticks: ").i32(g_ticks).str(", spacing ").u32(lo).str("..").u32(hi).str(" ns").emit();
+  cortex_m::text::Line().str("control step: max ").u32(g_task.timing.max).str(", mean ").u32(g_task.timing.mean())
       .str(" instructions (-icount shift=0)").emit();
-  board::text::Line().str("supervisor state ").u32(static_cast<std::uint32_t>(g_task.sup.state)).str(", faults ")
+  cortex_m::text::Line().str("supervisor state ").u32(static_cast<std::uint32_t>(g_task.sup.state)).str(", faults ")
       .u32(g_faults).str(", torque code joint 2: ").i32(g_hal.codes[1]).emit();
-  board::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
+  cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   const bool spacing_ok = lo + 100 >= kPeriodNs && hi <= kPeriodNs + 100;
   const bool ok = spacing_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun && g_hal.codes[1] != 0;
-  board::text::Line().str(ok ? "timer_firmware: pass" : "timer_firmware: FAIL").emit();
+  cortex_m::text::Line().str(ok ? "timer_firmware: pass" : "timer_firmware: FAIL").emit();
   return ok ? 0 : 1;
 }

@@ -9,7 +9,7 @@
 // singular exactly at qn, where the tool axis points along base +x.
 #pragma once
 
-#include "osc/model.hpp"
+#include "osc/kernels/model.hpp"
 
 namespace osc {
 

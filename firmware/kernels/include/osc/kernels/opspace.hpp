@@ -9,7 +9,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
-#include "osc/dynamics.hpp"
+#include "osc/kernels/dynamics.hpp"
 
 namespace osc {
 

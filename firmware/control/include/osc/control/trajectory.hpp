@@ -3,8 +3,8 @@
 // The orientation is held at its start value (phi_d = 0 relative to the start orientation).
 #pragma once
 
-#include "osc/model.hpp"
-#include "osc/params.hpp"
+#include "osc/kernels/model.hpp"
+#include "osc/control/params.hpp"
 
 namespace osc {
 

@@ -11,9 +11,9 @@
 #include <cstdint>
 
 #include "hal/hal.hpp"
-#include "osc/controller.hpp"
-#include "osc/io.hpp"
-#include "osc/supervisor.hpp"
+#include "osc/control/controller.hpp"
+#include "osc/runtime/io.hpp"
+#include "osc/runtime/supervisor.hpp"
 
 namespace osc {
 

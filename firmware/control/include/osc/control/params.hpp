@@ -2,11 +2,12 @@
 // source of truth for firmware, simulator and tests.
 #pragma once
 
-#include "osc/puma560.hpp"
+#include "osc/robots/puma560.hpp"
 
 namespace osc::params {
 
-constexpr double kDt = 1e-3;  ///< sampling time [s]
+constexpr unsigned kControlHz = 1000;                 ///< control rate: the timer interrupt [Hz]
+constexpr double kDt = 1.0 / kControlHz;              ///< sampling time [s]
 
 /// Gains (69), diagonal, one entry per operational axis: x, y, z, then the three rotations.
 constexpr double kKnd[6] = {120, 120, 120, 35, 35, 35};

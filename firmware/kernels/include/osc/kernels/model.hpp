@@ -4,8 +4,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "osc/puma560.hpp"
-#include "osc/scalar.hpp"
+#include "osc/robots/puma560.hpp"
+#include "osc/kernels/scalar.hpp"
 
 namespace osc {
 

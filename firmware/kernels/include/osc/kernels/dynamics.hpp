@@ -2,7 +2,7 @@
 // All functions read the frames that forward_kinematics left in data.
 #pragma once
 
-#include "osc/kinematics.hpp"
+#include "osc/kernels/kinematics.hpp"
 
 namespace osc {
 

@@ -1,7 +1,7 @@
 // Joint friction model (2) and its linear-in-the-parameters form (18)-(20).
 #pragma once
 
-#include "osc/model.hpp"
+#include "osc/kernels/model.hpp"
 
 namespace osc {
 

@@ -4,8 +4,8 @@
 
 #include <cstdint>
 
-#include "osc/model.hpp"
-#include "osc/params.hpp"
+#include "osc/kernels/model.hpp"
+#include "osc/control/params.hpp"
 
 namespace osc {
 

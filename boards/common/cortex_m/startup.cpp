@@ -1,9 +1,11 @@
-// Reset and vector table for mps2-an386: FPU on, .data copied, .bss zeroed, the main stack painted
-// for the high-water mark, static constructors, main(), semihosting exit with main's status.
+// Reset and system exceptions, shared by every Cortex-M board: FPU on (where there is one), .data
+// copied, .bss zeroed, the main stack painted for the high-water mark, static constructors, main(),
+// semihosting exit with main's status. The 16 system entries of the vector table are here, in
+// section .isr_vector; each board's vectors.cpp places its external interrupts right after them,
+// in .isr_vector.irq (the linker scripts keep the two in that order).
 #include <cstdint>
-#include <cstring>
 
-#include "board.hpp"
+#include "cortex_m.hpp"
 
 extern "C" {
 extern std::uint32_t __stack_limit__, __stack_top__;
@@ -23,8 +25,6 @@ void UsageFault_Handler() __attribute__((weak, alias("HardFault_Handler")));
 void SVC_Handler() __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler() __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler() __attribute__((weak, alias("Default_Handler")));
-void TIMER0_Handler() __attribute__((weak, alias("Default_Handler")));
-void TIMER1_Handler() __attribute__((weak, alias("Default_Handler")));
 }
 
 namespace {
@@ -32,8 +32,7 @@ constexpr std::uint32_t kPaint = 0xC0FFEE11u;
 using Handler = void (*)();
 }  // namespace
 
-// 16 system exceptions + 32 interrupts.
-__attribute__((section(".isr_vector"), used)) const Handler g_vectors[16 + 32] = {
+__attribute__((section(".isr_vector"), used)) const Handler g_system_vectors[16] = {
     reinterpret_cast<Handler>(&__stack_top__),
     Reset_Handler,
     NMI_Handler,
@@ -46,29 +45,24 @@ __attribute__((section(".isr_vector"), used)) const Handler g_vectors[16 + 32] =
     nullptr, nullptr,
     PendSV_Handler,
     SysTick_Handler,
-    // IRQ 0..31
-    Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler,
-    Default_Handler, Default_Handler, TIMER0_Handler, TIMER1_Handler, Default_Handler, Default_Handler,
-    Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler,
-    Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler,
-    Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler, Default_Handler,
-    Default_Handler, Default_Handler,
 };
 
 extern "C" void Default_Handler() {
-  board::semihost::write("unexpected interrupt\n");
-  board::semihost::exit(90);
+  cortex_m::semihost::write("unexpected interrupt\n");
+  cortex_m::semihost::exit(90);
 }
 
 extern "C" void HardFault_Handler() {
-  board::semihost::write("hard fault\n");
-  board::semihost::exit(91);
+  cortex_m::semihost::write("hard fault\n");
+  cortex_m::semihost::exit(91);
 }
 
 extern "C" [[noreturn]] void Reset_Handler() {
+#if defined(__ARM_FP)
   // FPU: full access to CP10 and CP11 before any floating-point instruction.
-  board::scb_cpacr() |= (0xFu << 20);
+  cortex_m::scb_cpacr() |= (0xFu << 20);
   __asm__ volatile("dsb\n isb" ::: "memory");
+#endif
   for (std::uint32_t *s = &__data_load__, *d = &__data_start__; d < &__data_end__;) *d++ = *s++;
   for (std::uint32_t* d = &__bss_start__; d < &__bss_end__;) *d++ = 0;
   // Paint the stack below the current frame.
@@ -76,10 +70,10 @@ extern "C" [[noreturn]] void Reset_Handler() {
   __asm__ volatile("mov %0, sp" : "=r"(sp));
   for (std::uint32_t* p = &__stack_limit__; p < sp - 16; ++p) *p = kPaint;
   for (void (**f)() = &__init_array_start; f < &__init_array_end; ++f) (*f)();
-  board::semihost::exit(application_main());
+  cortex_m::semihost::exit(application_main());
 }
 
-std::uint32_t board::stack_used() {
+std::uint32_t cortex_m::stack_used() {
   const std::uint32_t* p = &__stack_limit__;
   while (p < &__stack_top__ && *p == kPaint) ++p;
   return static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&__stack_top__) -

@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "board.hpp"
-#include "osc/control_task.hpp"
+#include "osc/runtime/control_task.hpp"
 #include "text.hpp"
 
 namespace {
@@ -16,7 +16,7 @@ int g_failures = 0;
 void check(const char* what, F got, F want, F tol) {
   const F err = math::abs(got - want);
   if (!(err <= tol)) {
-    board::text::Line().str("FAIL ").str(what).str(" got ").fix(got, 5).str(" want ").fix(want, 5).emit();
+    cortex_m::text::Line().str("FAIL ").str(what).str(" got ").fix(got, 5).str(" want ").fix(want, 5).emit();
     ++g_failures;
   }
 }
@@ -27,7 +27,7 @@ struct Timer {
   explicit Timer(const char* n) : name(n) {}
   ~Timer() {
     const std::uint32_t dt = board::cycles() - t0;
-    board::text::Line().str("  ").str(name).str(": ").u32(dt).str(" instructions").emit();
+    cortex_m::text::Line().str("  ").str(name).str(": ").u32(dt).str(" instructions").emit();
   }
 };
 
@@ -184,10 +184,10 @@ int main() {
     if (dt > worst) worst = dt;
     check("control_step status", static_cast<F>(out.status), 0.0f, 0.0f);
   }
-  board::text::Line().str("  control_step (observer + controller + adaptation), worst of 20: ").u32(worst).str(" instructions").emit();
+  cortex_m::text::Line().str("  control_step (observer + controller + adaptation), worst of 20: ").u32(worst).str(" instructions").emit();
   check("control_step holds gravity at rest", (g_state.x_hat - g_os.x).norm() < 1.0f ? 1.0f : 0.0f, 1.0f, 0.0f);
 
-  board::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
-  board::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
+  cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
+  cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
   return g_failures ? 1 : 0;
 }

@@ -12,8 +12,8 @@
 
 #include <cstdint>
 
-#include "osc/control_task.hpp"
-#include "osc/pil.hpp"
+#include "osc/runtime/control_task.hpp"
+#include "osc/link/frames.hpp"
 
 namespace osc {
 

@@ -17,10 +17,10 @@
 
 #include <cstdint>
 
-#include "osc/friction.hpp"
-#include "osc/opspace.hpp"
-#include "osc/params.hpp"
-#include "osc/trajectory.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/kernels/opspace.hpp"
+#include "osc/control/params.hpp"
+#include "osc/control/trajectory.hpp"
 
 namespace osc {
 

@@ -3,9 +3,9 @@
 
 #include <cstdint>
 
-#include "board.hpp"
+#include "cortex_m.hpp"
 
-namespace board::text {
+namespace cortex_m::text {
 
 class Line {
  public:
@@ -61,4 +61,4 @@ class Line {
   int n_ = 0;
 };
 
-}  // namespace board::text
+}  // namespace cortex_m::text

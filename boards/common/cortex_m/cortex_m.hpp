@@ -1,0 +1,66 @@
+// Code shared by every Cortex-M3/M4 board: core registers (SCB, NVIC, SysTick), semihosting, the
+// SysTick-based cycle counter and the main-stack high-water mark. A board adds its own clock,
+// peripherals and interrupt table (boards/<board>/board.hpp, vectors.cpp).
+#pragma once
+
+#include <cstdint>
+
+namespace cortex_m {
+
+struct SysTickRegs {
+  volatile std::uint32_t CSR, RVR, CVR, CALIB;
+};
+inline SysTickRegs& systick() { return *reinterpret_cast<SysTickRegs*>(0xE000E010u); }
+inline volatile std::uint32_t& nvic_iser0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E100u); }
+inline volatile std::uint32_t& nvic_ispr0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E200u); }
+inline volatile std::uint32_t& scb_cpacr() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000ED88u); }
+
+/// Enables external interrupt irq (0..31).
+inline void irq_enable(int irq) { nvic_iser0() = 1u << irq; }
+/// Pends external interrupt irq. The barriers make every store made before the call (e.g. fault
+/// flags the interrupt reads) visible to it: the interrupt is taken right after the write.
+inline void irq_pend(int irq) {
+  __asm__ volatile("dsb" ::: "memory");
+  nvic_ispr0() = 1u << irq;
+  __asm__ volatile("dsb\n isb" ::: "memory");
+}
+
+// ---------------------------------------------------------------- semihosting
+namespace semihost {
+inline int call(int op, const void* arg) {
+  register int r0 __asm__("r0") = op;
+  register const void* r1 __asm__("r1") = arg;
+  __asm__ volatile("bkpt 0xAB" : "+r"(r0) : "r"(r1) : "memory");
+  return r0;
+}
+inline void write(const char* s) { call(0x04, s); }  // SYS_WRITE0
+[[noreturn]] inline void exit(int code) {
+  const std::uint32_t block[2] = {0x20026u, static_cast<std::uint32_t>(code)};  // ApplicationExit
+  call(0x20, block);  // SYS_EXIT_EXTENDED
+  for (;;) {
+  }
+}
+}  // namespace semihost
+
+// ---------------------------------------------------------------- cycle counter
+/// Starts SysTick free-running on the processor clock (24-bit down counter).
+inline void systick_free_run() {
+  systick().RVR = 0x00FFFFFF;
+  systick().CVR = 0;
+  systick().CSR = (1u << 2) | 1u;  // processor clock, enabled, no interrupt
+}
+/// Processor clock cycles since systick_free_run(), extended from the 24-bit SysTick to 32 bits.
+/// Must be called at least every 2^24 cycles to follow the wrap.
+inline std::uint32_t systick_cycles() {
+  static std::uint32_t high = 0, last = 0;
+  const std::uint32_t v = 0x00FFFFFFu - (systick().CVR & 0x00FFFFFFu);
+  if (v < last) high += 1u << 24;
+  last = v;
+  return high + v;
+}
+
+// ---------------------------------------------------------------- stack
+/// Bytes of the main stack ever used (painted at reset by the common startup code).
+std::uint32_t stack_used();
+
+}  // namespace cortex_m
