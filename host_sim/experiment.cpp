@@ -15,7 +15,7 @@ const double kPaperTable3[6] = {1.84, 1.58, 1.30, 0.11, 0.09, 0.19};
 
 namespace {
 
-constexpr double kRadToDeg = 180.0 / osc::puma560::kPi;
+constexpr double kRadToDeg = 180.0 / osc::kPi;
 
 /// What the controller reports back each tick.
 struct TickReport {
@@ -31,7 +31,7 @@ template <class S>
 class LocalController {
  public:
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
-    task_->init(osc::Model<S>::puma560(cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
+    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
       task_->state.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
@@ -106,7 +106,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   PlantHal hal(plant, q0);
 
   // Ground truth for the error statistics: the plant's own state through double kinematics.
-  const osc::Model<double> truth = osc::Model<double>::puma560();
+  const osc::Model<double> truth = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> tdata;
   osc::forward_kinematics(truth, tdata, q0);
   const Vec3 p0 = tdata.o[6];
@@ -195,8 +195,7 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
     res.theta_true[6 + i] = cfg.plant.friction.cou[i];
     res.theta_true[12 + i] = cfg.plant.friction.sti[i];
   }
-  Vec6 q0;
-  for (int i = 0; i < 6; ++i) q0(i) = osc::params::kQStart[i];
+  const Vec6 q0 = osc::joint_vector<double>(osc::robot::kQStart);
   if (!cfg.pil_command.empty()) {
     RemoteController ctrl(cfg, res.error);
     if (ctrl.ok()) run(cfg, q0, ctrl, res);

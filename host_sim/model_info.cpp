@@ -6,6 +6,7 @@
 
 #include "cli.hpp"
 #include "osc/kernels/opspace.hpp"
+#include "osc/robot.hpp"
 
 namespace {
 
@@ -39,9 +40,8 @@ bool parse_vec(const std::string& flag, const char* text, osc::Vec6<double>& v, 
 
 int main(int argc, char** argv) {
   using namespace osc;
-  Vec6<double> q, qd = Vec6<double>::Zero();
+  Vec6<double> q = joint_vector<double>(puma560::kQn), qd = Vec6<double>::Zero();
   std::string name = "qn", err;
-  for (int i = 0; i < kDof; ++i) q(i) = puma560::kQn[i];
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     const char* v = i + 1 < argc ? argv[++i] : nullptr;
@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
   OpSpace<double> os;
   forward_kinematics(model, data, q);

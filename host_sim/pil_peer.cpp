@@ -9,6 +9,7 @@
 
 #include "osc/control/params.hpp"
 #include "osc/link/node.hpp"
+#include "osc/robot.hpp"
 
 namespace {
 
@@ -32,9 +33,7 @@ struct StdioBoard {
 
 int main() {
   auto node = std::make_unique<osc::PilNode<float, StdioBoard>>();
-  osc::Vec6<float> q0;
-  for (int i = 0; i < 6; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
-  node->init(q0, osc::FrictionMode::kAdaptive, 1000000);
+  node->init(osc::joint_vector<float>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, 1000000);
   node->hello();
   const int timeout_ms = static_cast<int>(osc::params::kLinkTimeout * 1000);
   for (;;) {

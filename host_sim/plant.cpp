@@ -3,7 +3,9 @@
 #include <cmath>
 
 #include "osc/kernels/dynamics.hpp"
-#include "osc/robots/puma560.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/robot.hpp"
+#include "osc/robot.hpp"
 
 namespace sim {
 namespace {
@@ -33,7 +35,7 @@ Vec6 cross_force(const Vec6& v, const Vec6& f) {
 }  // namespace
 
 ArticulatedBody::ArticulatedBody(double link_scale) {
-  using osc::puma560::kLinks;
+  const osc::LinkParams* kLinks = osc::robot::kArm.links;
   for (int i = 0; i < 6; ++i) {
     const auto& L = kLinks[i];
     // Link i in its joint frame B_i = F_{i-1} Rz(q_i): F_i = B_i Tz(d) Tx(a) Rx(alpha).
@@ -98,7 +100,7 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
   }
   // Pass 3, base to tip: accelerations; gravity as an upward base acceleration.
   Vec6 a;
-  a << 0, 0, 0, 0, 0, osc::puma560::kGravity;
+  a << 0, 0, 0, 0, 0, osc::robot::kArm.gravity;
   Vec6 qdd;
   for (int i = 0; i < 6; ++i) {
     a += c[i];
@@ -108,7 +110,8 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
   return qdd;
 }
 
-Plant::Plant(const PlantConfig& cfg) : cfg_(cfg), body_(cfg.link_scale) {}
+Plant::Plant(const PlantConfig& cfg)
+    : cfg_(cfg), body_(cfg.link_scale), friction_(osc::FrictionParams<double>::from(cfg.friction, cfg.tau_dec)) {}
 
 void Plant::reset(const Vec6& q0, const Vec6& qd0) {
   q_ = q0;
@@ -116,15 +119,7 @@ void Plant::reset(const Vec6& q0, const Vec6& qd0) {
   t_ = 0;
 }
 
-Vec6 Plant::friction(const Vec6& qd) const {
-  Vec6 f;
-  for (int i = 0; i < 6; ++i) {
-    const double s = qd(i) > 0 ? 1.0 : (qd(i) < 0 ? -1.0 : 0.0);
-    f(i) = cfg_.friction.vis[i] * qd(i) +
-           (cfg_.friction.cou[i] + cfg_.friction.sti[i] * std::exp(-cfg_.tau_dec * qd(i) * qd(i))) * s;
-  }
-  return f;
-}
+Vec6 Plant::friction(const Vec6& qd) const { return osc::friction_torque(friction_, qd); }
 
 Vec6 Plant::acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const {
   return body_.forward_dynamics(q, qd, tau - friction(qd));
@@ -155,7 +150,7 @@ void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) 
 
 double Plant::energy() const {
   // Uses the kernels' CRBA only as an energy probe; the dynamics above never call it.
-  const osc::Model<double> model = osc::Model<double>::puma560(cfg_.link_scale - 1.0);
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm, cfg_.link_scale - 1.0);
   osc::Data<double> data;
   osc::forward_kinematics(model, data, q_);
   osc::joint_inertia(model, data);

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 
 #include "osc/control/params.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/robot.hpp"
 
 namespace sim {
 
@@ -16,7 +18,7 @@ using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
 struct PlantConfig {
-  osc::params::FrictionPreset friction = osc::params::kFrictionPaper;
+  osc::FrictionCoefficients friction = osc::robot::kFrictionPaper;
   double tau_dec = osc::params::kTauDec;
   double substep = 1e-4;              ///< RK4 step [s] (10 kHz)
   double compute_delay = 0.2e-3;      ///< from the encoder sample to the DAC update [s]
@@ -63,12 +65,12 @@ class Plant {
   const Vec6& qd() const { return qd_; }
   double time() const { return t_; }
   const PlantConfig& config() const { return cfg_; }
-  osc::params::FrictionPreset& friction_preset() { return cfg_.friction; }
 
  private:
   void rk4(const Vec6& tau, double h);
   PlantConfig cfg_;
   ArticulatedBody body_;
+  osc::FrictionParams<double> friction_;  // the true friction, model (2) (the kernels' friction_torque)
   Vec6 q_ = Vec6::Zero(), qd_ = Vec6::Zero();
   double t_ = 0;
 };

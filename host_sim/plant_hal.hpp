@@ -18,7 +18,7 @@ class PlantHal {
   void read_encoders(std::int32_t counts[hal::kJoints]) const {
     for (int i = 0; i < hal::kJoints; ++i)
       counts[i] = static_cast<std::int32_t>(
-          std::floor((plant_.q()(i) - q_start_(i)) * osc::params::encoder_counts_per_rad(i)));
+          std::floor((plant_.q()(i) - q_start_(i)) * osc::counts_per_rad(i)));
   }
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) codes_[i] = codes[i];

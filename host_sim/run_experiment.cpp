@@ -72,9 +72,9 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
     } else if (a == "--friction") {
       const char* m = take();
       const std::string s = m ? m : "";
-      if (s == "paper") o.base.plant.friction = osc::params::kFrictionPaper;
-      else if (s == "corke") o.base.plant.friction = osc::params::kFrictionCorke;
-      else if (s == "none") o.base.plant.friction = osc::params::kFrictionNone;
+      if (s == "paper") o.base.plant.friction = osc::robot::kFrictionPaper;
+      else if (s == "corke") o.base.plant.friction = osc::robot::kFrictionCorke;
+      else if (s == "none") o.base.plant.friction = osc::kFrictionNone;
       else return err = "--friction: expected paper, corke or none, got '" + s + "'", false;
     } else if (a == "--scalar") {
       const char* m = take();

@@ -19,13 +19,13 @@ namespace {
 
 template <class S>
 struct Fixture {
-  Model<S> model = Model<S>::puma560();
+  Model<S> model = Model<S>::of(robot::kArm);
   Data<S> data{};
   OpSpace<S> os{};
   Vec6<S> q, qd, v;
   Mat3<S> R_ref;
   Fixture() {
-    for (int i = 0; i < kDof; ++i) q(i) = static_cast<S>(params::kQStart[i]);
+    q = joint_vector<S>(robot::kQStart);
     qd << S(0.1), S(-0.2), S(0.3), S(0.05), S(-0.1), S(0.2);
     v << S(0.05), S(-0.02), S(0.03), S(0.01), S(0.02), S(-0.01);
     forward_kinematics(model, data, q);

@@ -1,5 +1,5 @@
 // The PUMA 560 as an Orocos KDL chain, built from the same parameter table as the kernels
-// (osc::puma560::kLinks in osc/puma560.hpp, no numbers repeated here), for independent cross-checks.
+// (osc::robot::kArm.links in osc/puma560.hpp, no numbers repeated here), for independent cross-checks.
 #pragma once
 
 #include <kdl/chain.hpp>
@@ -7,12 +7,13 @@
 #include <kdl/jntarray.hpp>
 
 #include "osc/kernels/model.hpp"
+#include "osc/robot.hpp"
 
 namespace osc::test {
 
 /// Armature G^2 Jm of joint i (link side), from the parameter table.
 inline double armature(int i) {
-  const puma560::LinkParams& L = puma560::kLinks[i];
+  const LinkParams& L = robot::kArm.links[i];
   return L.gear_ratio * L.gear_ratio * L.motor_inertia;
 }
 
@@ -28,7 +29,7 @@ inline double armature(int i) {
 inline KDL::Chain puma560_chain(bool with_armature = true) {
   KDL::Chain chain;
   for (int i = 0; i < kDof; ++i) {
-    const puma560::LinkParams& L = puma560::kLinks[i];
+    const LinkParams& L = robot::kArm.links[i];
     const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0,
                            /*inertia=*/with_armature ? armature(i) : 0.0);
     const KDL::RigidBodyInertia I(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),

@@ -6,6 +6,7 @@
 
 #include "experiment.hpp"
 #include "osc/kernels/opspace.hpp"
+#include "osc/runtime/io.hpp"
 
 using namespace sim;
 
@@ -23,22 +24,21 @@ void print(const char* what, const ExperimentResult& r) {
 /// Worst-case Cartesian error of one encoder count on every joint at the start pose [mm]:
 /// sum_j |J_ij| / counts_per_rad_j, maximised over the translational rows.
 double position_quantum_mm() {
-  const osc::Model<double> model = osc::Model<double>::puma560();
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> data;
-  Vec6 q;
-  for (int i = 0; i < 6; ++i) q(i) = osc::params::kQStart[i];
+  const Vec6 q = osc::joint_vector<double>(osc::robot::kQStart);
   osc::forward_kinematics(model, data, q);
   osc::geometric_jacobian(data);
   double worst = 0;
   for (int r = 0; r < 3; ++r) {
     double s = 0;
-    for (int j = 0; j < 6; ++j) s += std::abs(data.J(r, j)) / osc::params::encoder_counts_per_rad(j);
+    for (int j = 0; j < 6; ++j) s += std::abs(data.J(r, j)) / osc::counts_per_rad(j);
     worst = std::max(worst, s);
   }
   return worst * 1e3;
 }
 
-ExperimentConfig config(double duration, osc::FrictionMode mode, const osc::params::FrictionPreset& friction) {
+ExperimentConfig config(double duration, osc::FrictionMode mode, const osc::FrictionCoefficients& friction) {
   ExperimentConfig c;
   c.duration = duration;
   c.mode = mode;
@@ -49,10 +49,10 @@ ExperimentConfig config(double duration, osc::FrictionMode mode, const osc::para
 }
 
 TEST(ClosedLoop, FrictionlessPlantTracksAtEncoderQuantisationLevelAndObserverConverges) {
-  ExperimentConfig c = config(12, osc::FrictionMode::kNone, osc::params::kFrictionNone);
+  ExperimentConfig c = config(12, osc::FrictionMode::kNone, osc::kFrictionNone);
   // Start the observer 2 mm / 0.2 deg off: x~ must decay.
   for (int i = 0; i < 3; ++i) c.observer_offset[i] = 2e-3;
-  for (int i = 3; i < 6; ++i) c.observer_offset[i] = 0.2 * osc::puma560::kPi / 180;
+  for (int i = 3; i < 6; ++i) c.observer_offset[i] = 0.2 * osc::kPi / 180;
   const ExperimentResult r = run_experiment(c);
   print("frictionless, no comp.", r);
   const double quantum = position_quantum_mm();
@@ -71,8 +71,8 @@ TEST(ClosedLoop, FrictionlessPlantTracksAtEncoderQuantisationLevelAndObserverCon
 struct WithFriction : ::testing::Test {
   static ExperimentResult adaptive, none;
   static void SetUpTestSuite() {
-    adaptive = run_experiment(config(30, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper));
-    none = run_experiment(config(30, osc::FrictionMode::kNone, osc::params::kFrictionPaper));
+    adaptive = run_experiment(config(30, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper));
+    none = run_experiment(config(30, osc::FrictionMode::kNone, osc::robot::kFrictionPaper));
     print("paper friction, adaptive", adaptive);
     print("paper friction, no comp.", none);
   }
@@ -110,7 +110,7 @@ TEST_F(WithFriction, CoefficientsApproachTheTrueValues) {
 
 TEST(ClosedLoop, TracksWithTenPercentModelError) {
   for (double err : {-0.1, 0.1}) {
-    ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper);
+    ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
     c.model_error = err;
     const ExperimentResult r = run_experiment(c);
     print(err < 0 ? "model -10 %, adaptive" : "model +10 %, adaptive", r);
@@ -121,7 +121,7 @@ TEST(ClosedLoop, TracksWithTenPercentModelError) {
 }
 
 TEST(ClosedLoop, FloatControllerTracksLikeDouble) {
-  ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::params::kFrictionPaper);
+  ExperimentConfig c = config(15, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
   const ExperimentResult d = run_experiment(c);
   c.scalar = Scalar::kFloat;
   const ExperimentResult f = run_experiment(c);

@@ -12,9 +12,7 @@ using namespace osc;
 namespace {
 
 Vec6<double> q_start() {
-  Vec6<double> q;
-  for (int i = 0; i < kDof; ++i) q(i) = params::kQStart[i];
-  return q;
+  return joint_vector<double>(robot::kQStart);
 }
 
 TEST(Trajectory, StartsAtRestAndDerivativesMatchFiniteDifferences) {
@@ -39,7 +37,7 @@ TEST(Trajectory, StartsAtRestAndDerivativesMatchFiniteDifferences) {
 TEST(Adaptation, SampledLawMatchesEquation67) {
   // Two steps at rest-free poses: the second step's theta^ must equal
   // theta^ - K_ad W_j^T(q^dot_prev) [q - q_prev - q^dot_prev dt], computed here independently.
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   const Vec6<double> q0 = q_start();
@@ -63,7 +61,7 @@ TEST(Adaptation, SampledLawMatchesEquation67) {
 }
 
 TEST(Adaptation, NoCompensationModeNeverAdapts) {
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   Vec6<double> q = q_start();
@@ -95,7 +93,7 @@ double spectral_radius(const Mat6<double>& Lambda, bool semi_implicit) {
 }
 
 TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
   OpSpace<double> os;
   forward_kinematics(model, data, q_start());
@@ -119,7 +117,7 @@ TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
 }
 
 TEST(ControlStep, FaultsCommandZeroTorque) {
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   controller_init(model, *st, q_start());
@@ -145,7 +143,7 @@ TEST(ControlStep, FaultsCommandZeroTorque) {
 
 TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
   // x = x_d, observer at rest: F = p(x), so Gamma = J^T p = g(q).
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   controller_init(model, *st, q_start());
@@ -158,7 +156,7 @@ TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
 
 template <class S>
 void run_steps_without_allocation() {
-  const Model<S> model = Model<S>::puma560();
+  const Model<S> model = Model<S>::of(robot::kArm);
   const Gains<S> G = Gains<S>::paper();
   auto st = std::make_unique<ControllerState<S>>();
   Vec6<S> q = q_start().cast<S>();

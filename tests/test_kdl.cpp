@@ -33,7 +33,7 @@ constexpr int kPlantStates = 1000;  // plant forward dynamics (>= 500 asked)
 constexpr double kTol = 1e-9;
 constexpr double kFloor = 1e-3;
 
-const KDL::Vector kGravityVec(0, 0, -puma560::kGravity);
+const KDL::Vector kGravityVec(0, 0, -robot::kArm.gravity);
 
 /// Running maximum of the relative error of one quantity.
 struct Worst {
@@ -88,7 +88,7 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
   KDL::ChainJntToJacDotSolver jacdot(chain);
   jacdot.setRepresentation(KDL::ChainJntToJacDotSolver::HYBRID);  // ref point frame-6 origin, base axes
 
-  const Model<double> model = Model<double>::puma560();
+  const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
   test::RandomStates rs;
   Worst w_fk{"FK, all link frames [R p]"}, w_jac{"geometric Jacobian"}, w_A{"A(q) with armature"},

@@ -16,16 +16,14 @@ using namespace sim;
 namespace {
 
 Vec6 q_start() {
-  Vec6 q;
-  for (int i = 0; i < 6; ++i) q(i) = osc::params::kQStart[i];
-  return q;
+  return osc::joint_vector<double>(osc::robot::kQStart);
 }
 
 TEST(Plant, ArticulatedBodyInvertsTheKernelsInverseDynamics) {
   // ABA (plant) and CRBA/RNEA (controller kernels) are separate code paths: A qdd + c + g must
   // reproduce the torque that produced qdd.
   osc::test::RandomStates rs;
-  const osc::Model<double> model = osc::Model<double>::puma560();
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> data;
   ArticulatedBody body;
   double worst = 0;
@@ -42,7 +40,7 @@ TEST(Plant, ArticulatedBodyInvertsTheKernelsInverseDynamics) {
 
 TEST(Plant, EnergyIsConservedWithoutTorqueAndFriction) {
   PlantConfig cfg;
-  cfg.friction = osc::params::kFrictionNone;
+  cfg.friction = osc::kFrictionNone;
   Plant plant(cfg);
   Vec6 qd0;
   qd0 << 0.5, -0.3, 0.4, 1.0, -0.8, 1.2;
@@ -63,7 +61,7 @@ TEST(Plant, FrictionFollowsModel2) {
   Vec6 qd;
   qd << 0.5, -0.5, 0.0, 2.0, -1e-3, 0.1;
   const Vec6 f = plant.friction(qd);
-  const auto& p = osc::params::kFrictionPaper;
+  const auto& p = osc::robot::kFrictionPaper;
   for (int i = 0; i < 6; ++i) {
     const double s = qd(i) > 0 ? 1 : (qd(i) < 0 ? -1 : 0);
     EXPECT_DOUBLE_EQ(f(i), p.vis[i] * qd(i) + (p.cou[i] + p.sti[i] * std::exp(-qd(i) * qd(i))) * s);
@@ -77,24 +75,24 @@ TEST(Plant, HalvingTheStepInOpenLoop) {
   // paper's friction the sgn() of model (2) is discontinuous at zero velocity, fixed-step
   // integration is first order at each reversal, and a joint that the torque cannot break away
   // chatters about zero velocity; the difference is then of the order of an encoder count.
-  auto run = [](double h, const osc::params::FrictionPreset& friction) {
+  auto run = [](double h, const osc::FrictionCoefficients& friction) {
     PlantConfig cfg;
     cfg.substep = h;
     cfg.friction = friction;
     Plant plant(cfg);
     plant.reset(q_start());
     osc::Data<double> data;
-    const osc::Model<double> model = osc::Model<double>::puma560();
+    const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
     for (int k = 0; k < 2000; ++k) {
       osc::forward_kinematics(model, data, plant.q());
       Vec6 tau = osc::gravity_torques(model, data);
-      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::puma560::kPi * (0.7 + 0.2 * i) * k * 1e-3);
+      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::kPi * (0.7 + 0.2 * i) * k * 1e-3);
       plant.integrate(tau, 1e-3);
     }
     return plant.q();
   };
-  const double smooth = (run(1e-4, osc::params::kFrictionNone) - run(5e-5, osc::params::kFrictionNone)).cwiseAbs().maxCoeff();
-  const double rough = (run(1e-4, osc::params::kFrictionPaper) - run(5e-5, osc::params::kFrictionPaper)).cwiseAbs().maxCoeff();
+  const double smooth = (run(1e-4, osc::kFrictionNone) - run(5e-5, osc::kFrictionNone)).cwiseAbs().maxCoeff();
+  const double rough = (run(1e-4, osc::robot::kFrictionPaper) - run(5e-5, osc::robot::kFrictionPaper)).cwiseAbs().maxCoeff();
   std::printf("open loop, step 1e-4 vs 5e-5 s, max joint-angle difference after 2 s: %.2e rad without friction, "
               "%.2e rad with the paper's friction\n", smooth, rough);
   EXPECT_LT(smooth, 1e-9);
@@ -140,28 +138,28 @@ TEST(PlantHal, EncodersQuantiseAndDacsScaleAndSaturate) {
   std::int32_t counts[6];
   hal.read_encoders(counts);
   EXPECT_EQ(counts[0], 0);
-  EXPECT_EQ(counts[1], static_cast<std::int32_t>(std::floor(0.01 * osc::params::encoder_counts_per_rad(1))));
-  EXPECT_EQ(counts[2], static_cast<std::int32_t>(std::floor(-0.02 * osc::params::encoder_counts_per_rad(2))));
+  EXPECT_EQ(counts[1], static_cast<std::int32_t>(std::floor(0.01 * osc::counts_per_rad(1))));
+  EXPECT_EQ(counts[2], static_cast<std::int32_t>(std::floor(-0.02 * osc::counts_per_rad(2))));
   // Angle reconstruction is within one count.
   for (int i = 0; i < 6; ++i) {
     const double back = osc::counts_to_angle<double>(i, counts[i], q0(i));
-    EXPECT_LE(q(i) - back, 1.0 / osc::params::encoder_counts_per_rad(i) + 1e-12);
+    EXPECT_LE(q(i) - back, 1.0 / osc::counts_per_rad(i) + 1e-12);
     EXPECT_GE(q(i) - back, 0.0);
   }
   // DAC: rounding, saturation, and a non-finite torque giving code 0.
   std::int32_t code = 7;
   EXPECT_FALSE(osc::torque_to_code(1, 10.0, code));
-  EXPECT_NEAR(osc::code_to_torque(1, code), 10.0, osc::params::kTorqueLimit[1] / osc::params::kDacMaxCode);
+  EXPECT_NEAR(osc::code_to_torque(1, code), 10.0, osc::robot::kDrives.torque_limit[1] / osc::kDacMaxCode);
   EXPECT_TRUE(osc::torque_to_code(1, 1e6, code));
-  EXPECT_EQ(code, osc::params::kDacMaxCode);
+  EXPECT_EQ(code, osc::kDacMaxCode);
   EXPECT_TRUE(osc::torque_to_code(1, -1e6, code));
-  EXPECT_EQ(code, -osc::params::kDacMaxCode);
+  EXPECT_EQ(code, -osc::kDacMaxCode);
   EXPECT_TRUE(osc::torque_to_code(1, std::nan(""), code));
   EXPECT_EQ(code, 0);
-  const std::int32_t codes[6] = {100, -200, 300, 0, osc::params::kDacMaxCode, -osc::params::kDacMaxCode};
+  const std::int32_t codes[6] = {100, -200, 300, 0, osc::kDacMaxCode, -osc::kDacMaxCode};
   hal.write_dacs(codes);
-  EXPECT_DOUBLE_EQ(hal.torque()(4), osc::params::kTorqueLimit[4]);
-  EXPECT_DOUBLE_EQ(hal.torque()(5), -osc::params::kTorqueLimit[5]);
+  EXPECT_DOUBLE_EQ(hal.torque()(4), osc::robot::kDrives.torque_limit[4]);
+  EXPECT_DOUBLE_EQ(hal.torque()(5), -osc::robot::kDrives.torque_limit[5]);
 }
 
 TEST(Hal, EncoderUnwrapExtendsA16BitCounterAcrossWraps) {

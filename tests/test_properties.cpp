@@ -33,7 +33,7 @@ constexpr int kStates = 300;
 constexpr double kH = 1e-6;
 
 struct Props : ::testing::Test {
-  Model<double> model = Model<double>::puma560();
+  Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data{};
   OpSpace<double> os{};
   test::RandomStates rs;
@@ -173,9 +173,9 @@ TEST_F(Props, PsiAndChristoffelFormsAreSymmetricBilinear) {
 TEST_F(Props, FrictionRegressorReproducesModel2IncludingZeroVelocity) {
   FrictionParams<double> p;
   for (int i = 0; i < kDof; ++i) {
-    p.vis(i) = params::kFrictionPaper.vis[i];
-    p.cou(i) = params::kFrictionPaper.cou[i];
-    p.sti(i) = params::kFrictionPaper.sti[i];
+    p.vis(i) = robot::kFrictionPaper.vis[i];
+    p.cou(i) = robot::kFrictionPaper.cou[i];
+    p.sti(i) = robot::kFrictionPaper.sti[i];
     p.dec(i) = 0.5 + i;
   }
   const Vec18<double> theta = p.theta();
@@ -260,14 +260,14 @@ TEST_F(Props, FloatKernelsAgreeWithDouble) {
   // J^-T A J^-1 and Psi (two solves with Ja and a difference of h(y+z), h(y-z)) multiply that by
   // the condition number of the 3x3 blocks, which q_nonsingular bounds (|sin q5|, |cos(q3+0.047)|
   // >= 0.2): observed worst (printed) is 10-100x below these bounds.
-  const Model<float> mf = Model<float>::puma560();
+  const Model<float> mf = Model<float>::of(robot::kArm);
   Data<float> df;
   OpSpace<float> of;
   FrictionParams<double> pd;
   for (int i = 0; i < kDof; ++i) {
-    pd.vis(i) = params::kFrictionPaper.vis[i];
-    pd.cou(i) = params::kFrictionPaper.cou[i];
-    pd.sti(i) = params::kFrictionPaper.sti[i];
+    pd.vis(i) = robot::kFrictionPaper.vis[i];
+    pd.cou(i) = robot::kFrictionPaper.cou[i];
+    pd.sti(i) = robot::kFrictionPaper.sti[i];
     pd.dec(i) = params::kTauDec;
   }
   const FrictionParams<float> pf{pd.vis.cast<float>(), pd.cou.cast<float>(), pd.sti.cast<float>(),

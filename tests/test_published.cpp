@@ -3,6 +3,7 @@
 
 #include "osc/kernels/friction.hpp"
 #include "osc/kernels/opspace.hpp"
+#include "osc/robot.hpp"
 #include "test_util.hpp"
 
 using namespace osc;
@@ -11,7 +12,7 @@ using osc::test::from_array;
 namespace {
 
 struct Fixture : ::testing::Test {
-  Model<double> model = Model<double>::puma560();
+  Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data{};
   Vec6<double> qn = from_array(puma560::kQn);
 
@@ -24,7 +25,7 @@ struct Fixture : ::testing::Test {
   static Vec6<double> toolbox_friction_compensation(const Vec6<double>& qd) {
     Vec6<double> t;
     for (int i = 0; i < kDof; ++i) {
-      const double G = std::abs(puma560::kLinks[i].gear_ratio);
+      const double G = std::abs(robot::kArm.links[i].gear_ratio);
       const double tc = qd(i) > 0 ? puma560::kMotorCoulombPos[i] : (qd(i) < 0 ? puma560::kMotorCoulombNeg[i] : 0.0);
       t(i) = G * (puma560::kMotorViscous[i] * G * qd(i) + tc);
     }

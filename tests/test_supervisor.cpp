@@ -76,11 +76,11 @@ struct ScriptedHal {
 struct TaskFixture : ::testing::Test {
   std::unique_ptr<ControlTask<float>> task = std::make_unique<ControlTask<float>>();
   ScriptedHal hal;
-  void SetUp() override { start(params::kQStart); }
+  void SetUp() override { start(robot::kQStart); }
   void start(const double (&q0)[kDof], std::uint32_t period = 0) {
     Vec6<float> q;
     for (int i = 0; i < kDof; ++i) q(i) = static_cast<float>(q0[i]);
-    task->init(Model<float>::puma560(), Gains<float>::paper(), FrictionMode::kAdaptive, q, period);
+    task->init(Model<float>::of(robot::kArm), Gains<float>::paper(), FrictionMode::kAdaptive, q, period);
   }
   /// Runs ticks; returns the faults of the last.
   std::uint32_t run(int n) {
@@ -128,7 +128,7 @@ TEST_F(TaskFixture, NonFiniteStateFaultsInTheSameTick) {
 
 TEST_F(TaskFixture, SingularPoseFaults) {
   double q[kDof];
-  for (int i = 0; i < kDof; ++i) q[i] = params::kQStart[i];
+  for (int i = 0; i < kDof; ++i) q[i] = robot::kQStart[i];
   q[4] = 0.0;  // wrist singularity
   start(q);
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultSingular));
@@ -146,7 +146,7 @@ TEST_F(TaskFixture, PersistentSaturationFaults) {
 }
 
 TEST_F(TaskFixture, OverrunFaults) {
-  start(params::kQStart, 1000);
+  start(robot::kQStart, 1000);
   hal.clock_step = 100;
   EXPECT_EQ(run(2), 0u);
   hal.clock_step = 2000;  // the step now takes longer than the period

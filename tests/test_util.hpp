@@ -5,6 +5,7 @@
 #include <random>
 
 #include "osc/kernels/model.hpp"
+#include "osc/robot.hpp"
 
 namespace osc::test {
 
@@ -30,7 +31,7 @@ struct RandomStates {
     for (;;) {
       Vec6<double> q;
       for (int i = 0; i < kDof; ++i) {
-        const double lo = puma560::kQMin[i], hi = puma560::kQMax[i];
+        const double lo = robot::kArm.q_min[i], hi = robot::kArm.q_max[i];
         q(i) = lo + (hi - lo) * 0.5 * (u(rng) + 1.0);
       }
       if (std::abs(std::sin(q(4))) < 0.2) continue;                      // wrist
@@ -40,10 +41,6 @@ struct RandomStates {
   }
 };
 
-inline Vec6<double> from_array(const double (&a)[kDof]) {
-  Vec6<double> v;
-  for (int i = 0; i < kDof; ++i) v(i) = a[i];
-  return v;
-}
+inline Vec6<double> from_array(const double (&a)[kDof]) { return joint_vector<double>(a); }
 
 }  // namespace osc::test

@@ -4,6 +4,7 @@
 
 #include "board.hpp"
 #include "osc/runtime/control_task.hpp"
+#include "osc/robot.hpp"
 #include "text.hpp"
 
 namespace {
@@ -42,12 +43,9 @@ ControllerState<F> g_state;
 int main() {
   board::cycle_counter_init();
   board::semihost::write("kernels_image: PUMA 560 kernels in float on Cortex-M4F\n");
-  g_model = Model<F>::puma560();
-  Vec6<F> qn, q0, qd, one;
-  for (int i = 0; i < kDof; ++i) {
-    qn(i) = static_cast<F>(puma560::kQn[i]);
-    q0(i) = static_cast<F>(params::kQStart[i]);
-  }
+  g_model = Model<F>::of(robot::kArm);
+  const Vec6<F> qn = joint_vector<F>(puma560::kQn), q0 = joint_vector<F>(robot::kQStart);
+  Vec6<F> qd, one;
   qd << 1, 2, 3, 1, 2, 3;
   one.setOnes();
   Vec6<F> g, c, tau;
@@ -96,9 +94,9 @@ int main() {
   Regressor<F> W;
   FrictionParams<F> fp{};
   for (int i = 0; i < kDof; ++i) {
-    fp.vis(i) = static_cast<F>(params::kFrictionPaper.vis[i]);
-    fp.cou(i) = static_cast<F>(params::kFrictionPaper.cou[i]);
-    fp.sti(i) = static_cast<F>(params::kFrictionPaper.sti[i]);
+    fp.vis(i) = static_cast<F>(robot::kFrictionPaper.vis[i]);
+    fp.cou(i) = static_cast<F>(robot::kFrictionPaper.cou[i]);
+    fp.sti(i) = static_cast<F>(robot::kFrictionPaper.sti[i]);
     fp.dec(i) = 1;
   }
   {

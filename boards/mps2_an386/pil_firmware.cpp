@@ -8,6 +8,7 @@
 #include "board.hpp"
 #include "osc/control/params.hpp"
 #include "osc/link/node.hpp"
+#include "osc/robot.hpp"
 
 namespace {
 
@@ -35,9 +36,7 @@ extern "C" void TIMER0_Handler() {
 int main() {
   board::cycle_counter_init();
   board::uart_init();
-  osc::Vec6<float> q0;
-  for (int i = 0; i < osc::kDof; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
-  g_node.init(q0, osc::FrictionMode::kAdaptive, kPeriodNs);
+  g_node.init(osc::joint_vector<float>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
   g_node.hello();  // bytes the host sent before this point may have been dropped
   // The main loop polls the UART (under -icount, polling makes virtual time advance with the

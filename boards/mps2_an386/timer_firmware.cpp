@@ -6,6 +6,7 @@
 
 #include "board.hpp"
 #include "osc/runtime/control_task.hpp"
+#include "osc/robot.hpp"
 #include "text.hpp"
 
 namespace {
@@ -48,9 +49,8 @@ extern "C" void TIMER0_Handler() {
 
 int main() {
   board::cycle_counter_init();
-  osc::Vec6<float> q0;
-  for (int i = 0; i < osc::kDof; ++i) q0(i) = static_cast<float>(osc::params::kQStart[i]);
-  g_task.init(osc::Model<float>::puma560(), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive, q0, kPeriodNs);
+  g_task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
+              osc::joint_vector<float>(osc::robot::kQStart), kPeriodNs);
   board::control_timer_start(board::kControlHz);
   while (g_ticks < kTicks) {
   }

@@ -12,6 +12,18 @@ template <class S>
 struct FrictionParams {
   Vec6<S> vis, cou, sti, dec;
 
+  /// From a table of coefficients (osc/robots/arm.hpp) and every tau_dec = dec.
+  static FrictionParams from(const FrictionCoefficients& c, double dec_all) {
+    FrictionParams p;
+    for (int i = 0; i < kDof; ++i) {
+      p.vis(i) = lit<S>(c.vis[i]);
+      p.cou(i) = lit<S>(c.cou[i]);
+      p.sti(i) = lit<S>(c.sti[i]);
+      p.dec(i) = lit<S>(dec_all);
+    }
+    return p;
+  }
+
   Vec18<S> theta() const {
     Vec18<S> t;
     t << vis, cou, sti;

@@ -4,12 +4,10 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "osc/robots/puma560.hpp"
+#include "osc/robots/arm.hpp"
 #include "osc/kernels/scalar.hpp"
 
 namespace osc {
-
-constexpr int kDof = puma560::kDof;
 
 template <class S> using Vec3 = Eigen::Matrix<S, 3, 1>;
 template <class S> using Vec6 = Eigen::Matrix<S, 6, 1>;
@@ -21,6 +19,14 @@ template <class S> using Mat6 = Eigen::Matrix<S, 6, 6>;
 /// Eigen expressions can be passed directly.
 template <class T> struct NonDeduced { using type = T; };
 template <class S> using Vec6In = typename NonDeduced<Vec6<S>>::type;
+
+/// A joint vector of a robot table (angles, limits, poses) in the kernel's scalar.
+template <class S>
+Vec6<S> joint_vector(const double (&a)[kDof]) {
+  Vec6<S> v;
+  for (int i = 0; i < kDof; ++i) v(i) = lit<S>(a[i]);
+  return v;
+}
 
 /// Constant parameters of a 6-joint standard-DH arm, in the kernel's scalar.
 template <class S>
@@ -35,13 +41,13 @@ struct Model {
   Vec6<S> armature;       // G^2 * Jm, added to the diagonal of A(q)
   S gravity;              // along -z0
 
-  /// PUMA 560 from the single parameter table, with every link mass and inertia scaled
-  /// by (1 + mass_inertia_error) (used to test robustness to model error).
-  static Model puma560(double mass_inertia_error = 0.0) {
+  /// The model of an arm from its description (osc/robots/arm.hpp), with every link mass and
+  /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error).
+  static Model of(const ArmDescription& arm, double mass_inertia_error = 0.0) {
     Model m{};
     const double s = 1.0 + mass_inertia_error;
     for (int i = 0; i < kDof; ++i) {
-      const puma560::LinkParams& p = puma560::kLinks[i];
+      const LinkParams& p = arm.links[i];
       Link& l = m.link[i];
       l.a = lit<S>(p.a);
       l.d = lit<S>(p.d);
@@ -54,7 +60,7 @@ struct Model {
       l.inertia = Vec3<S>(lit<S>(p.inertia[0] * s), lit<S>(p.inertia[1] * s), lit<S>(p.inertia[2] * s));
       m.armature(i) = lit<S>(p.gear_ratio * p.gear_ratio * p.motor_inertia);
     }
-    m.gravity = lit<S>(puma560::kGravity);
+    m.gravity = lit<S>(arm.gravity);
     return m;
   }
 };

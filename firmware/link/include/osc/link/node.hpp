@@ -23,7 +23,7 @@ class PilNode {
   ControlTask<S> task;
 
   void init(const Vec6In<S>& q_start, FrictionMode mode, std::uint32_t period_cycles) {
-    task.init(Model<S>::puma560(), Gains<S>::paper(), mode, q_start, period_cycles);
+    task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), mode, q_start, period_cycles);
     expected_seq_ = 0;
     pending_faults_ = 0;
     parser_.reset();

@@ -62,8 +62,8 @@ struct ControlTask {
       prev_counts[i] = 0;
       sat_ticks[i] = 0;
       // Speed limit times the sample, in counts, plus one count of quantisation.
-      max_count_step[i] = static_cast<std::int32_t>(params::kMaxJointSpeed[i] * params::kDt *
-                                                    params::encoder_counts_per_rad(i)) + 1;
+      max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt *
+                                                    counts_per_rad(i)) + 1;
     }
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;

@@ -5,32 +5,37 @@
 #include <cstdint>
 
 #include "osc/kernels/model.hpp"
-#include "osc/control/params.hpp"
+#include "osc/robot.hpp"
 
 namespace osc {
+
+/// Encoder counts per joint radian of the robot's drives.
+constexpr double counts_per_rad(int joint) { return encoder_counts_per_rad(robot::kArm, robot::kDrives, joint); }
+/// Largest DAC code magnitude of the robot's drives.
+constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
 
 /// Joint angle [rad] of an encoder count, relative to the count taken at the start pose.
 template <class S>
 S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
-  return q_at_zero + static_cast<S>(counts) / lit<S>(params::encoder_counts_per_rad(joint));
+  return q_at_zero + static_cast<S>(counts) / lit<S>(counts_per_rad(joint));
 }
 
 /// DAC code of a joint torque, saturated at the code range. Returns true when it saturated.
 template <class S>
 bool torque_to_code(int joint, S tau, std::int32_t& code) {
-  const S scale = lit<S>(static_cast<double>(params::kDacMaxCode) / params::kTorqueLimit[joint]);
+  const S scale = lit<S>(static_cast<double>(kDacMaxCode) / robot::kDrives.torque_limit[joint]);
   const S c = tau * scale;
-  const S max = lit<S>(static_cast<double>(params::kDacMaxCode));
+  const S max = lit<S>(static_cast<double>(kDacMaxCode));
   if (!math::isfinite(c)) {
     code = 0;
     return true;
   }
   if (c >= max) {
-    code = static_cast<std::int32_t>(params::kDacMaxCode);
+    code = static_cast<std::int32_t>(kDacMaxCode);
     return true;
   }
   if (c <= -max) {
-    code = -static_cast<std::int32_t>(params::kDacMaxCode);
+    code = -static_cast<std::int32_t>(kDacMaxCode);
     return true;
   }
   // Round to nearest.
@@ -40,7 +45,7 @@ bool torque_to_code(int joint, S tau, std::int32_t& code) {
 
 /// Joint torque [N m] that a DAC code commands (the amplifier side of the same scale).
 inline double code_to_torque(int joint, std::int32_t code) {
-  return static_cast<double>(code) * params::kTorqueLimit[joint] / static_cast<double>(params::kDacMaxCode);
+  return static_cast<double>(code) * robot::kDrives.torque_limit[joint] / static_cast<double>(kDacMaxCode);
 }
 
 }  // namespace osc

@@ -1,0 +1,64 @@
+// The robot description format: what a 6-joint, standard-DH, revolute arm is to the firmware.
+// A robot is one constant table in this format (firmware/robots/<arm>/), and the build selects
+// one (osc/robot.hpp, CMake OSC_ROBOT); nothing above this layer names a particular arm.
+#pragma once
+
+namespace osc {
+
+/// Joints of every arm the kernels handle (fixed-size matrices throughout).
+constexpr int kDof = 6;
+constexpr double kPi = 3.14159265358979323846;
+
+/// Standard DH row and inertial data of one link (inertia about the COM, axes of frame i).
+struct LinkParams {
+  double a, d, alpha;        // [m], [m], [rad]
+  double mass;               // [kg]
+  double com[3];             // COM in frame i [m]
+  double inertia[3];         // Ixx, Iyy, Izz about the COM [kg m^2]; products are 0
+  double motor_inertia;      // Jm [kg m^2], motor side
+  double gear_ratio;         // G (signed), motor turns per joint turn
+};
+
+/// The arm: kinematics, inertia, gravity and joint limits.
+struct ArmDescription {
+  const char* name;
+  LinkParams links[kDof];
+  double gravity;            ///< magnitude [m/s^2]; gravity acts along -z0
+  double q_min[kDof];        ///< joint limits [rad]
+  double q_max[kDof];
+};
+
+/// The drive electronics: encoders on the motor shafts, a bipolar DAC per joint commanding torque
+/// (amplifier in current mode), and the speeds beyond which an encoder change is implausible.
+struct DriveParams {
+  double encoder_counts_per_motor_rev;  ///< after quadrature decoding
+  int dac_bits;                         ///< bipolar: codes in [-(2^(bits-1) - 1), 2^(bits-1) - 1]
+  double torque_limit[kDof];            ///< joint torque at full-scale DAC code [N m]
+  double max_joint_speed[kDof];         ///< [rad/s]
+};
+
+/// Joint friction of model (2), link side: viscous, Coulomb and Stribeck coefficients.
+struct FrictionCoefficients {
+  const char* name;
+  double vis[kDof], cou[kDof], sti[kDof];
+};
+constexpr FrictionCoefficients kFrictionNone = {"none", {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}, {0, 0, 0, 0, 0, 0}};
+
+constexpr double abs_of(double v) { return v < 0 ? -v : v; }
+
+/// Encoder counts per joint radian: counts per motor rev * |G| / (2 pi).
+constexpr double encoder_counts_per_rad(const ArmDescription& arm, const DriveParams& drives, int joint) {
+  return drives.encoder_counts_per_motor_rev * abs_of(arm.links[joint].gear_ratio) / (2 * kPi);
+}
+/// Largest DAC code magnitude.
+constexpr long dac_max_code(const DriveParams& drives) { return (1L << (drives.dac_bits - 1)) - 1; }
+
+/// True when the last three joint axes meet at the frame-6 origin (a spherical wrist with the
+/// operational point at its centre): a4 = a5 = a6 = 0 and d5 = d6 = 0. Then the linear rows of the
+/// Jacobian do not depend on joints 4-6, and J is block lower-triangular (kernels/opspace.hpp).
+constexpr bool has_spherical_wrist(const ArmDescription& arm) {
+  return arm.links[3].a == 0 && arm.links[4].a == 0 && arm.links[5].a == 0 && arm.links[4].d == 0 &&
+         arm.links[5].d == 0;
+}
+
+}  // namespace osc
