@@ -34,8 +34,8 @@ class LocalController {
     task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
-      task_->state.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
-      task_->state.y(i) += task_->gains.k(i) * static_cast<S>(cfg.observer_offset[i]);
+      task_->state.obs.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
+      task_->state.obs.y(i) += task_->gains.k(i) * static_cast<S>(cfg.observer_offset[i]);
     }
   }
   bool tick(PlantHal& hal, TickReport& r, std::string&) {
@@ -46,7 +46,7 @@ class LocalController {
       r.x_tilde[i] = static_cast<double>(out.x_tilde(i));
       r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
     }
-    for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.theta_hat(i));
+    for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
     return true;
   }
   void finish(ExperimentResult&) {}

@@ -91,7 +91,7 @@ class PilNode {
     a.mean_cycles = task.step_timing.mean();
     a.tick_max_cycles = task.timing.max;
     a.stack_used = Board::stack_used();
-    for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.theta_hat(i));
+    for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.adapt.theta_hat(i));
     for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
     std::uint8_t buf[pil::kMaxFrame];
     Board::uart_write(buf, pil::encode(a, buf));

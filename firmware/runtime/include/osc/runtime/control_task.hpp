@@ -71,7 +71,7 @@ struct ControlTask {
     step_timing = {};
   }
   /// Test hook (fault injection): poisons the observer state with a NaN.
-  void inject_nonfinite() { state.y(0) = S(0) / S(0); }
+  void inject_nonfinite() { state.obs.y(0) = S(0) / S(0); }
 };
 
 /// Encoder counts to joint angles.
@@ -109,8 +109,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
     task.step_timing.add(hal.cycles() - s0);
-    if (task.last.status & kStepNonFinite) faults |= kFaultNonFinite;
-    if (task.last.status & kStepSingular) faults |= kFaultSingular;
+    faults |= task.last.status;  // non_finite, singular
     for (int i = 0; i < kDof; ++i) {
       const bool clipped = torque_to_code(i, task.last.tau(i), task.codes[i]);
       task.sat_ticks[i] = clipped ? static_cast<std::uint16_t>(task.sat_ticks[i] + 1) : 0;

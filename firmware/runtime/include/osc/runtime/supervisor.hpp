@@ -5,24 +5,9 @@
 
 #include <cstdint>
 
+#include "osc/control/faults.hpp"
+
 namespace osc {
-
-/// Named fault bits (sticky).
-enum Fault : std::uint32_t {
-  kFaultNone = 0,
-  kFaultNonFinite = 1u << 0,      ///< a non-finite value anywhere in the step
-  kFaultEncoderJump = 1u << 1,    ///< an encoder moved further in one tick than the joint can
-  kFaultSaturation = 1u << 2,     ///< a torque stayed clipped at the DAC range for too many ticks
-  kFaultSingular = 1u << 3,       ///< Jacobian reciprocal condition below the threshold
-  kFaultOverrun = 1u << 4,        ///< the next tick arrived before this one ended
-  kFaultLinkLost = 1u << 5,       ///< no sensor frame within the link timeout
-  kFaultLinkCorrupt = 1u << 6,    ///< a frame with a bad checksum, length or sequence number
-};
-constexpr std::uint32_t kAllFaults = 0x7F;
-
-/// Names of the fault bits, in bit order (for telemetry and logs).
-constexpr const char* kFaultNames[] = {"non_finite", "encoder_jump", "saturation", "singular",
-                                       "overrun",    "link_lost",    "link_corrupt"};
 
 enum class SupervisorState : std::uint8_t { kInit = 0, kRun = 1, kFault = 2 };
 

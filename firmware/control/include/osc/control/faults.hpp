@@ -1,0 +1,55 @@
+// The firmware's fault catalogue: one list, from which the bits, their names and the mask of all
+// faults are generated. Every fault latches in the supervisor (osc/runtime/supervisor.hpp) and
+// commands zero torque in the tick that detects it. The control step itself raises two of them
+// (non_finite, singular); the runtime and the link raise the rest.
+#pragma once
+
+#include <cstdint>
+
+namespace osc {
+
+// X(Name, "name", description), in bit order.
+#define OSC_FAULT_LIST(X)                                                                        \
+  X(NonFinite, "non_finite", "a non-finite value anywhere in the step")                          \
+  X(EncoderJump, "encoder_jump", "an encoder moved further in one tick than the joint can")       \
+  X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")      \
+  X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                   \
+  X(Overrun, "overrun", "the next tick arrived before this one ended")                           \
+  X(LinkLost, "link_lost", "no sensor frame within the link timeout")                            \
+  X(LinkCorrupt, "link_corrupt", "a frame with a bad checksum, length or sequence number")
+
+namespace detail {
+enum FaultBit : unsigned {
+#define OSC_FAULT_BIT(Name, name, doc) kBit##Name,
+  OSC_FAULT_LIST(OSC_FAULT_BIT)
+#undef OSC_FAULT_BIT
+  kFaultCount
+};
+}  // namespace detail
+
+/// Named fault bits (sticky once latched).
+enum Fault : std::uint32_t {
+  kFaultNone = 0,
+#define OSC_FAULT_ENUM(Name, name, doc) kFault##Name = 1u << detail::kBit##Name,
+  OSC_FAULT_LIST(OSC_FAULT_ENUM)
+#undef OSC_FAULT_ENUM
+};
+
+constexpr int kFaultCount = detail::kFaultCount;
+/// Every defined fault bit.
+constexpr std::uint32_t kAllFaults = (1u << kFaultCount) - 1u;
+/// Names of the fault bits, in bit order (for telemetry and logs).
+constexpr const char* kFaultNames[kFaultCount] = {
+#define OSC_FAULT_NAME(Name, name, doc) name,
+    OSC_FAULT_LIST(OSC_FAULT_NAME)
+#undef OSC_FAULT_NAME
+};
+
+/// Name of the lowest fault bit set in bits ("none" for 0).
+constexpr const char* fault_name(std::uint32_t bits) {
+  for (int i = 0; i < kFaultCount; ++i)
+    if (bits & (1u << i)) return kFaultNames[i];
+  return "none";
+}
+
+}  // namespace osc

@@ -1,0 +1,46 @@
+// The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, and the choices
+// a caller makes (friction mode, adaptation law). Defaults from params.hpp.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/params.hpp"
+#include "osc/kernels/model.hpp"
+
+namespace osc {
+
+/// With adaptive friction compensation (Table I), or without (f^ = 0, no adaptation: Table III).
+enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
+
+/// The law that updates the friction estimates (osc/control/adaptation.hpp).
+enum class AdaptationLaw : std::uint8_t {
+  kPaper,  ///< the paper's sampled law (67), exactly
+};
+
+template <class S>
+struct Gains {
+  Vec6<S> knd, k, ks, ki;
+  S kad;
+  Vec6<S> tau_dec;
+  S dt;
+  S min_rcond;
+  AdaptationLaw adaptation;
+
+  static Gains paper() {
+    Gains g;
+    for (int i = 0; i < kDof; ++i) {
+      g.knd(i) = lit<S>(params::kKnd[i]);
+      g.k(i) = lit<S>(params::kK[i]);
+      g.ks(i) = lit<S>(params::kKs[i]);
+      g.ki(i) = lit<S>(params::kKi[i]);
+      g.tau_dec(i) = lit<S>(params::kTauDec);
+    }
+    g.kad = lit<S>(params::kKad);
+    g.dt = lit<S>(params::kDt);
+    g.min_rcond = lit<S>(params::kMinJacobianRcond);
+    g.adaptation = AdaptationLaw::kPaper;
+    return g;
+  }
+};
+
+}  // namespace osc
