@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   std::printf("Jacobian reciprocal condition (worse 3x3 block): %.3e%s\n", os.Jf.rcond,
               os.Jf.rcond < 1e-3 ? "  (near-singular: Lambda not computed)" : "");
   if (os.Jf.rcond >= 1e-3) {
-    JacobianFactor<double> Jg;
+    SphericalWristJacobianFactor<double> Jg;
     Jg.compute(data.J);
     print("Lambda with the geometric Jacobian", operational_inertia(data.A, Jg));
     print("Lambda with the analytic Jacobian (orientation relative to this pose)", os.Lambda);

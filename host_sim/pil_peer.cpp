@@ -28,6 +28,7 @@ struct StdioBoard {
   static void burn(std::uint32_t c) { clock += c; }
   static void fault_output(bool) {}  // the frame's state carries it
 };
+static_assert(osc::PilBoard<StdioBoard>);
 
 }  // namespace
 

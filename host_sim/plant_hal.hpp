@@ -41,5 +41,6 @@ class PlantHal {
   std::int32_t codes_[hal::kJoints] = {0, 0, 0, 0, 0, 0};
   bool fault_ = false;
 };
+static_assert(hal::ControlHal<PlantHal>);
 
 }  // namespace sim

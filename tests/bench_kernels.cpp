@@ -70,7 +70,7 @@ template <class S> void BM_friction_regressor(benchmark::State& st) {
 }
 template <class S> void BM_jacobian_factor_solve(benchmark::State& st) {
   Fixture<S> f;
-  JacobianFactor<S> jf;
+  SphericalWristJacobianFactor<S> jf;
   for (auto _ : st) {
     jf.compute(f.os.Ja);
     benchmark::DoNotOptimize(jf.solve(f.v));

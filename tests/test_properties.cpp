@@ -235,7 +235,7 @@ TEST_F(Props, BlockFactorisationOfTheJacobian) {
   EXPECT_GT(min_rcond, 0.0);
 
   // Named poses: qz, qr and qs are wrist-singular (q5 = 0); qn is well conditioned.
-  JacobianFactor<double> f;
+  SphericalWristJacobianFactor<double> f;
   auto rcond_at = [&](const double (&pose)[kDof]) {
     NoMalloc guard;
     forward_kinematics(model, data, test::from_array(pose));

@@ -119,7 +119,7 @@ TEST_F(Fixture, CoriolisMatrixAtQn) {
 
 TEST_F(Fixture, OperationalInertiaAtQnGeometricJacobian) {
   at(qn);
-  JacobianFactor<double> Jf;
+  SphericalWristJacobianFactor<double> Jf;
   Jf.compute(data.J);
   const double L[36] = {17.2954, -2.7542, -9.6233, -0.0000, 0.2795, 0.0000,   //
                         -2.7542, 12.1909, 1.2459, -0.3254, -0.0703, -0.9652,  //
@@ -152,7 +152,7 @@ TEST_F(Fixture, ForwardKinematicsAndJacobianDerivedValues) {
   EXPECT_NEAR(data.A(1, 2), 0.3727, 0.5e-4);
   expect_vec(gravity_torques(model, data), {0, 37.4837, 0.2489, 0, 0, 0}, 0.5e-4);
   // qz is wrist-singular: the Jacobian factor reports it.
-  JacobianFactor<double> Jf;
+  SphericalWristJacobianFactor<double> Jf;
   Jf.compute(data.J);
   EXPECT_LT(Jf.rcond, 1e-12);
 }

@@ -72,6 +72,20 @@ struct ScriptedHal {
     return true;
   }
 };
+static_assert(hal::ControlHal<ScriptedHal>);
+// The concept is a real check: a binding that lacks one function, or returns the wrong type, fails it.
+struct HalWithoutFaultLine {
+  void read_encoders(std::int32_t*) {}
+  void write_dacs(const std::int32_t*) {}
+  std::uint32_t cycles() { return 0; }
+  std::uint32_t io_faults() { return 0; }
+};
+struct HalWithFloatCycles : HalWithoutFaultLine {
+  float cycles() { return 0; }
+  void fault_output(bool) {}
+};
+static_assert(!hal::ControlHal<HalWithoutFaultLine>);
+static_assert(!hal::ControlHal<HalWithFloatCycles>);
 
 struct TaskFixture : ::testing::Test {
   std::unique_ptr<ControlTask<float>> task = std::make_unique<ControlTask<float>>();

@@ -115,13 +115,13 @@ int main() {
     Timer t("opspace_update (FK, J, A, g, Ja, LU, LLT, Lambda)");
     opspace_update(g_model, g_data, g_os, q0, R_ref);
   }
-  JacobianFactor<F> Jg;
+  SphericalWristJacobianFactor<F> Jg;
   Mat6<F> Lg;
   forward_kinematics(g_model, g_data, qn);
   geometric_jacobian(g_data);
   joint_inertia(g_model, g_data);
   {
-    Timer t("JacobianFactor::compute");
+    Timer t("SphericalWristJacobianFactor::compute");
     Jg.compute(g_data.J);
   }
   {

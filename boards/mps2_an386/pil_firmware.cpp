@@ -19,6 +19,8 @@ struct Mps2Board {
   static void burn(std::uint32_t ns) { board::busy_wait(ns); }
   static void fault_output(bool active) { board::fault_output(active); }
 };
+static_assert(osc::PilBoard<Mps2Board>);
+static_assert(hal::ControlHal<osc::PilNode<float, Mps2Board>>);
 
 osc::PilNode<float, Mps2Board> g_node;  // a few kB: static, never on the stack
 

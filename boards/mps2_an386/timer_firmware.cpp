@@ -26,6 +26,7 @@ struct StillHal {
     return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;
   }
 };
+static_assert(hal::ControlHal<StillHal>);
 
 constexpr int kTicks = 200;
 constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;

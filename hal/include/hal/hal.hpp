@@ -1,28 +1,39 @@
 // Hardware abstraction: compile-time interfaces, bound by template parameter (no virtual calls).
-//
-// A HAL binding is a type H with these members (all may be static):
-//   void read_encoders(std::int32_t counts[hal::kJoints]);
-//       Accumulated signed counts per joint since start-up, wrap-around of the hardware counters
-//       already extended (see EncoderUnwrap).
-//   void write_dacs(const std::int32_t codes[hal::kJoints]);
-//       Signed DAC codes in [-kDacMaxCode, kDacMaxCode] (osc/params.hpp).
-//   std::uint32_t cycles();
-//       A free-running 32-bit counter for step timing (0 where there is none).
-//   std::uint32_t io_faults();
-//       osc::Fault bits the I/O layer detected since the last tick (lost or corrupt link).
-//   void fault_output(bool active);
-//       The hardware fault line (e.g. an amplifier-enable interlock or a LED), driven every tick.
+// ControlHal is what the control task (osc/runtime/control_task.hpp) needs from the hardware; every
+// binding states that it satisfies it (static_assert), and control_tick() requires it:
+//   host_sim/plant_hal.hpp (the simulated PUMA 560), the link node (osc/link/node.hpp, the PIL
+//   firmware's encoders and DACs), boards/<board>/ (e.g. the still-robot stub of timer_firmware),
+//   and the scripted HAL of tests/test_supervisor.cpp.
 // The periodic control timer is the board's (boards/<board>/board.hpp: control_timer_start()); its
 // interrupt calls osc::control_tick(). Telemetry: the task's StepTiming, supervisor state and fault
-// bits; over the PIL link every actuator frame carries them (osc/pil.hpp).
-// Bindings: host_sim/plant_hal.hpp (the simulated PUMA 560); boards/<board>/ for targets.
+// bits; over the PIL link every actuator frame carries them (osc/link/frames.hpp).
 #pragma once
 
+#include <concepts>
 #include <cstdint>
+
+#include "osc/robots/arm.hpp"
 
 namespace hal {
 
-constexpr int kJoints = 6;
+/// One encoder and one DAC per joint of the robot.
+constexpr int kJoints = osc::kDof;
+
+/// The control task's view of the hardware.
+template <class H>
+concept ControlHal = requires(H& h, std::int32_t* counts, const std::int32_t* codes, bool active) {
+  /// Accumulated signed counts per joint since start-up, wrap-around of the hardware counters
+  /// already extended (see EncoderUnwrap).
+  { h.read_encoders(counts) } -> std::same_as<void>;
+  /// Signed DAC codes in [-kDacMaxCode, kDacMaxCode] (osc/runtime/io.hpp).
+  { h.write_dacs(codes) } -> std::same_as<void>;
+  /// A free-running 32-bit counter for step timing (0 where there is none).
+  { h.cycles() } -> std::same_as<std::uint32_t>;
+  /// osc::Fault bits the I/O layer detected since the last tick (lost or corrupt link).
+  { h.io_faults() } -> std::same_as<std::uint32_t>;
+  /// The hardware fault line (e.g. an amplifier-enable interlock or a LED), driven every tick.
+  { h.fault_output(active) } -> std::same_as<void>;
+};
 
 /// Extends a free-running N-bit hardware counter (e.g. a 16-bit timer in encoder mode) to a
 /// 32-bit position. Correct as long as fewer than 2^(N-1) counts pass between two reads.

@@ -1,7 +1,8 @@
 // Operational-space dynamics (4)-(5): Lambda(x), Psi(x,y) z, p(x), f, Gamma = J^T F.
 //
-// The PUMA's frame-6 origin is the wrist centre, so the linear-velocity rows of J do not depend
-// on joints 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian).
+// For an arm with a spherical wrist whose centre is the frame-6 origin (has_spherical_wrist(), in
+// osc/robots/arm.hpp; the PUMA 560 is one), the linear-velocity rows of J do not depend on joints
+// 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian).
 // J is therefore factored as two 3x3 LU decompositions; det J = det J11 det J22, and every
 // solve with J or J^T is two 3x3 solves. No 6x6 matrix is ever inverted.
 #pragma once
@@ -13,9 +14,10 @@
 
 namespace osc {
 
-/// Factorisation of a block lower-triangular 6x6 Jacobian.
+/// Factorisation of the block lower-triangular 6x6 Jacobian of a spherical-wrist arm. Valid only
+/// when has_spherical_wrist(arm) holds (the runtime checks it at compile time for the built robot).
 template <class S>
-struct JacobianFactor {
+struct SphericalWristJacobianFactor {
   Eigen::PartialPivLU<Mat3<S>> arm;    // J11: position rows, joints 1-3
   Eigen::PartialPivLU<Mat3<S>> wrist;  // J22: orientation rows, joints 4-6
   Mat3<S> J21;
@@ -49,7 +51,7 @@ struct JacobianFactor {
 
 /// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised.
 template <class S>
-Mat6<S> operational_inertia(const Mat6<S>& A, const JacobianFactor<S>& Jf) {
+Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor<S>& Jf) {
   Mat6<S> Y;  // Y = J^{-T} A
   for (int k = 0; k < kDof; ++k) Y.col(k) = Jf.solve_transpose(A.col(k));
   Mat6<S> L;  // L^T = J^{-T} Y^T
@@ -63,7 +65,7 @@ template <class S>
 struct OpSpace {
   Vec6<S> x;               // [p; phi]
   Mat6<S> Ja;              // analytic Jacobian
-  JacobianFactor<S> Jf;    // factorisation of Ja
+  SphericalWristJacobianFactor<S> Jf;    // factorisation of Ja
   Eigen::LLT<Mat6<S>> A_llt;
   Mat6<S> Lambda;
   Vec6<S> g;               // joint gravity torques

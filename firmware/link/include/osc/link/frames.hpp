@@ -10,13 +10,15 @@
 #include <cstdint>
 #include <cstring>
 
+#include "osc/robots/arm.hpp"
+
 namespace pil {
 
 constexpr std::uint8_t kSync0 = 0xA5, kSync1 = 0x5A;
 /// Sequence number of the actuator frame the firmware sends once it is ready to receive (bytes sent
 /// before that may be lost). The host waits for it before its first sensor frame.
 constexpr std::uint32_t kHelloSeq = 0xFFFFFFFFu;
-constexpr int kJoints = 6;
+constexpr int kJoints = osc::kDof;
 
 enum FrameType : std::uint8_t { kSensorFrame = 1, kActuatorFrame = 2 };
 

@@ -1,11 +1,6 @@
-// The firmware side of the processor-in-the-loop link: a HAL binding of the control task whose
-// encoders and DACs are the frames of osc/pil.hpp. Board-independent; a board supplies
-//   static void uart_write(const std::uint8_t* p, int n);
-//   static std::uint32_t cycles();          // free-running cycle counter
-//   static std::uint32_t stack_used();      // main-stack high-water mark [bytes]
-//   static void burn(std::uint32_t cycles); // busy-wait (fault injection only)
-//   static void fault_output(bool active);  // the board's fault line
-// and runs: on_byte() for every received byte, and tick() from the control interrupt when
+// The firmware side of the processor-in-the-loop link: a HAL binding (hal::ControlHal) of the
+// control task whose encoders and DACs are the frames of osc/link/frames.hpp. Board-independent; a
+// board supplies the static functions of the concept PilBoard below, and runs: on_byte() for every received byte, and tick() from the control interrupt when
 // on_byte() asked for it or after on_timeout(), which it calls when no complete frame arrived
 // within the link timeout.
 #pragma once
@@ -17,7 +12,17 @@
 
 namespace osc {
 
-template <class S, class Board>
+/// What the link node needs from a board (all static).
+template <class B>
+concept PilBoard = requires(const std::uint8_t* bytes, int n, std::uint32_t cycles, bool active) {
+  { B::uart_write(bytes, n) } -> std::same_as<void>;       // blocking write of n bytes
+  { B::cycles() } -> std::same_as<std::uint32_t>;          // free-running cycle counter
+  { B::stack_used() } -> std::same_as<std::uint32_t>;      // main-stack high-water mark [bytes]
+  { B::burn(cycles) } -> std::same_as<void>;               // busy-wait (fault injection only)
+  { B::fault_output(active) } -> std::same_as<void>;       // the board's fault line
+};
+
+template <class S, PilBoard Board>
 class PilNode {
  public:
   ControlTask<S> task;

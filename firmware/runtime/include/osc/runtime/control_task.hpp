@@ -2,10 +2,7 @@
 // (observer, controller, adaptation) -> torques -> DAC codes -> write, under the supervisor.
 // Bound to a HAL at compile time; the same code runs against the simulated plant on the host and
 // on the targets.
-//
-// HAL requirements (see hal/hal.hpp): read_encoders(counts), write_dacs(codes), cycles() (a free-
-// running 32-bit counter), io_faults() (fault bits the I/O layer detected, e.g. the link),
-// fault_output(active).
+// The HAL is the concept hal::ControlHal (hal/hal.hpp).
 #pragma once
 
 #include <cstdint>
@@ -16,6 +13,10 @@
 #include "osc/runtime/supervisor.hpp"
 
 namespace osc {
+
+static_assert(has_spherical_wrist(robot::kArm),
+              "the kernels factor J block-triangularly (SphericalWristJacobianFactor): the robot needs a "
+              "spherical wrist centred at the frame-6 origin");
 
 /// Per-step timing, in the HAL's cycle-counter units.
 struct StepTiming {
@@ -84,7 +85,7 @@ Vec6<S> angles_from_counts(const Vec6<S>& q_start, const std::int32_t counts[kDo
 
 /// One tick. Returns the fault bits detected in this tick. On any fault, and whenever the
 /// supervisor is not in kRun, every DAC gets code 0 in this same tick.
-template <class S, class Hal>
+template <class S, hal::ControlHal Hal>
 std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const std::uint32_t c0 = hal.cycles();
   std::uint32_t faults = hal.io_faults();
