@@ -31,7 +31,9 @@ template <class S>
 class LocalController {
  public:
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
-    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), osc::Gains<S>::paper(), cfg.mode, q0.cast<S>());
+    osc::Gains<S> gains = osc::Gains<S>::paper();
+    gains.adaptation = cfg.adaptation;
+    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), gains, cfg.mode, q0.cast<S>());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
       task_->state.obs.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
@@ -59,7 +61,9 @@ class LocalController {
 class RemoteController {
  public:
   RemoteController(const ExperimentConfig& cfg, std::string& err)
-      : timeout_(cfg.pil_timeout), no_compensation_(cfg.mode == osc::FrictionMode::kNone) {
+      : timeout_(cfg.pil_timeout),
+        config_(static_cast<std::uint8_t>((cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
+                                          pil::config_adaptation(cfg.adaptation))) {
     ok_ = link_.start(cfg.pil_command, err);
   }
   bool ok() const { return ok_; }
@@ -67,7 +71,7 @@ class RemoteController {
     pil::SensorFrame s;
     s.seq = seq_++;
     hal.read_encoders(s.counts);
-    if (s.seq == 0 && no_compensation_) s.inject = pil::kConfigNoCompensation;
+    if (s.seq == 0) s.inject = config_;
     pil::ActuatorFrame a;
     if (!link_.send(s, err) || !link_.receive(a, timeout_, err)) return false;
     if (a.seq != s.seq) {
@@ -93,7 +97,7 @@ class RemoteController {
  private:
   PilClient link_;
   double timeout_;
-  bool no_compensation_;
+  std::uint8_t config_;  // configuration bits of the first sensor frame
   bool ok_ = false;
   std::uint32_t seq_ = 0;
   pil::ActuatorFrame last_;
@@ -120,6 +124,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   long fr_n = 0;
   Vec6 tau_old = Vec6::Zero();
   const long progress_every = std::max(1L, n / 100);
+  const long window_ticks = std::max(1L, std::lround(cfg.window / dt));
+  res.window = cfg.window;
   TickReport rep;
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
@@ -141,7 +147,18 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
 
     double xt[6];
     for (int i = 0; i < 6; ++i) xt[i] = rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg);
+    if (k % window_ticks == 0) {
+      res.window_max.push_back({0, 0, 0, 0, 0, 0});
+      res.window_theta_range.push_back({rep.theta_hat[0], rep.theta_hat[0]});
+    }
+    auto& wmax = res.window_max.back();
+    auto& wth = res.window_theta_range.back();
+    for (int i = 0; i < 18; ++i) {
+      wth[0] = std::min(wth[0], rep.theta_hat[i]);
+      wth[1] = std::max(wth[1], rep.theta_hat[i]);
+    }
     for (int i = 0; i < 6; ++i) {
+      wmax[i] = std::max(wmax[i], std::abs(e[i]));
       res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
       if (t >= t_final) {
         res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
@@ -189,6 +206,7 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   ExperimentResult res;
   res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
   res.duration = cfg.duration;
+  res.adaptation = osc::adaptation_law_name(cfg.adaptation);
   res.friction_preset = cfg.plant.friction.name;
   for (int i = 0; i < 6; ++i) {
     res.theta_true[i] = cfg.plant.friction.vis[i];

@@ -2,11 +2,13 @@
 // simulated plant through the HAL, tracking trajectory (68) for a given duration.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "osc/control/controller.hpp"
+#include "osc/control/gains.hpp"
 #include "plant.hpp"
 
 namespace sim {
@@ -21,6 +23,8 @@ struct ExperimentConfig {
   double model_error = 0.0;                         ///< controller's link mass/inertia relative error
   double log_period = 0.01;                         ///< time-series decimation [s]
   double final_window = 20.0;                       ///< "last 20 s" statistics [s]
+  double window = 60.0;                             ///< length of the per-window maxima [s]
+  osc::AdaptationLaw adaptation = osc::Gains<double>::paper().adaptation;  ///< the firmware's default
   double observer_offset[6] = {0, 0, 0, 0, 0, 0};    ///< x^(0) - x(0), to test observer convergence
   std::function<void(double fraction)> progress;    ///< optional progress callback
   /// Processor-in-the-loop: the command that starts the firmware (e.g. qemu-system-arm with the
@@ -48,6 +52,10 @@ struct ExperimentResult {
   double max_observer_error[6] = {}; // |x~| over the last final_window seconds: mm, deg
   double theta_hat[18] = {};
   double theta_true[18] = {};
+  double window = 0;                              // [s]
+  std::vector<std::array<double, 6>> window_max;  // max |e| per consecutive window: mm, deg
+  std::vector<std::array<double, 2>> window_theta_range;  // min and max of all theta^ per window
+  std::string adaptation;                         // the adaptation law's name
   double friction_rms_error = 0;     // rms of tau_f_hat - tau_f over the last window [N m]
   double friction_rms = 0;           // rms of tau_f over the last window [N m]
   std::uint32_t status = 0;          // first fault bits reported (0: none)

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """Turns the experiment's time series (out/timeseries_{adaptive,none}.csv) into PNG figures:
-fig1_tracking_errors.png (Fig. 1 of the paper, both modes) and friction_estimates.png."""
+fig1_tracking_errors.png (Fig. 1 of the paper, both modes) and friction_estimates.png; and, from
+out/summary.json, window_max_errors.png (the worst error per window over the whole run)."""
 import csv
+import json
 import os
 import sys
 
@@ -21,6 +23,44 @@ def load(path):
     if not rows:
         raise ValueError(f"{path}: no rows")
     return {k: [float(r[k]) for r in rows] for k in rows[0]}
+
+
+TABLE1 = [0.38, 0.44, 0.28, 0.06, 0.04, 0.06]
+
+
+def plot_windows(out):
+    """The worst |e| per window of every run in summary.json, with the paper's Table I."""
+    p = os.path.join(out, "summary.json")
+    if not os.path.exists(p):
+        return
+    with open(p) as f:
+        runs = json.load(f).get("runs", [])
+    runs = [r for r in runs if r.get("window_max_error")]
+    if not runs:
+        return
+    fig, axs = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+    for r in runs:
+        w = r["window_s"]
+        t = [w * (k + 1) for k in range(len(r["window_max_error"]))]
+        for i, name in enumerate("xyz"):
+            axs[0].semilogy(t, [m[i] for m in r["window_max_error"]], lw=0.9,
+                            label=f"{r['mode']} ({r.get('adaptation', '')}) e_{name}")
+        for i, name in enumerate("xyz"):
+            axs[1].semilogy(t, [m[3 + i] for m in r["window_max_error"]], lw=0.9, label=f"{r['mode']} e_φ{name}")
+    for i, ls in zip(range(3), ("-", "--", ":")):
+        axs[0].axhline(TABLE1[i], color="k", lw=0.6, ls=ls, label="Table I " + "xyz"[i] if i == 0 else None)
+        axs[1].axhline(TABLE1[3 + i], color="k", lw=0.6, ls=ls)
+    axs[0].set_ylabel("max |e| per window [mm]")
+    axs[1].set_ylabel("max |e| per window [deg]")
+    axs[-1].set_xlabel("end of window [s]")
+    for a in axs:
+        a.grid(True, lw=0.3, which="both")
+    axs[0].legend(fontsize=7, ncol=2)
+    fig.suptitle(f"Worst tracking error per {runs[0]['window_s']:.0f} s window; black: paper Table I")
+    fig.tight_layout()
+    p3 = os.path.join(out, "window_max_errors.png")
+    fig.savefig(p3, dpi=110)
+    print(f"wrote {p3}")
 
 
 def main(argv):
@@ -68,6 +108,7 @@ def main(argv):
         p2 = os.path.join(out, "friction_estimates.png")
         fig.savefig(p2, dpi=110)
         print(f"wrote {p2}")
+    plot_windows(out)
     return 0
 
 

@@ -19,10 +19,11 @@ namespace {
 
 const char* kUsage =
     "usage: puma_experiment [options]\n"
-    "  --duration S        simulated seconds per run (default 120; 1..3600)\n"
+    "  --duration S        simulated seconds per run (default 120; 1..86400)\n"
     "  --mode M            both | adaptive | none (default both)\n"
     "  --friction P        plant friction preset: paper | corke | none (default paper)\n"
     "  --scalar T          controller arithmetic: double | float (default double)\n"
+    "  --adaptation L      friction adaptation law: paper (default: the firmware's)\n"
     "  --model-error F     controller link mass/inertia relative error (default 0; -0.5..0.5)\n"
     "  --substep S         plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)\n"
     "  --delay S           computation delay inside the sample (default 2e-4; 0..1e-3)\n"
@@ -61,7 +62,7 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
       std::cout << kUsage;
       std::exit(0);
     } else if (a == "--duration") {
-      if (!sim::parse_number(a, take(), 1, 3600, o.duration, err)) return false;
+      if (!sim::parse_number(a, take(), 1, 86400, o.duration, err)) return false;
     } else if (a == "--mode") {
       const char* m = take();
       const std::string s = m ? m : "";
@@ -82,6 +83,14 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
       if (s == "double") o.base.scalar = sim::Scalar::kDouble;
       else if (s == "float") o.base.scalar = sim::Scalar::kFloat;
       else return err = "--scalar: expected double or float, got '" + s + "'", false;
+    } else if (a == "--adaptation") {
+      const char* m = take();
+      const std::string s = m ? m : "";
+      if (!osc::adaptation_law_from_name(s, o.base.adaptation)) {
+        err = "--adaptation: expected";
+        for (int k = 0; k < osc::kAdaptationLawCount; ++k) err += std::string(k ? " or " : " ") + osc::kAdaptationLawNames[k];
+        return err += ", got '" + s + "'", false;
+      }
     } else if (a == "--model-error") {
       if (!sim::parse_number(a, take(), -0.5, 0.5, o.base.model_error, err)) return false;
     } else if (a == "--substep") {
@@ -114,6 +123,25 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
 }
 
 const char* kAxes[6] = {"e_x [mm]", "e_y [mm]", "e_z [mm]", "e_phx [deg]", "e_phy [deg]", "e_phz [deg]"};
+
+/// The worst max |e| per window over the run, in blocks of about ten, so that growth shows.
+void print_windows(const sim::ExperimentResult& r) {
+  const size_t n = r.window_max.size();
+  if (n < 3) return;
+  const size_t block = std::max<size_t>(1, n / 10);
+  std::printf("\n[%s] worst max |e| per %.0f s window (x, y, z mm; about X, Y, Z deg) and the range of theta^:\n",
+              r.mode.c_str(), r.window);
+  for (size_t b = 0; b < n; b += block) {
+    double w[6] = {}, lo = 1e300, hi = -1e300;
+    for (size_t k = b; k < std::min(n, b + block); ++k) {
+      for (int i = 0; i < 6; ++i) w[i] = std::max(w[i], r.window_max[k][i]);
+      lo = std::min(lo, r.window_theta_range[k][0]);
+      hi = std::max(hi, r.window_theta_range[k][1]);
+    }
+    std::printf("  t %6.0f..%6.0f s: %.3f %.3f %.3f mm  %.4f %.4f %.4f deg   theta^ in [%.2f, %.2f]\n", b * r.window,
+                std::min(n, b + block) * r.window, w[0], w[1], w[2], w[3], w[4], w[5], lo, hi);
+  }
+}
 
 void print_tables(const std::vector<sim::ExperimentResult>& runs) {
   std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')\n", runs[0].duration,
@@ -150,6 +178,7 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
     std::printf("estimated vs true joint friction over the last 20 s: rms error %.3f N m (rms friction %.3f N m)\n",
                 ad->friction_rms_error, ad->friction_rms);
   }
+  for (const auto& r : runs) print_windows(r);
   for (const auto& r : runs) {
     if (!r.error.empty()) std::printf("[%s] LINK ERROR: %s\n", r.mode.c_str(), r.error.c_str());
     if (r.max_step_cycles)
@@ -182,6 +211,19 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
   os << indent << "\"mode\": \"" << r.mode << "\",\n";
   os << indent << "\"duration_s\": " << r.duration << ",\n";
   os << indent << "\"friction_preset\": \"" << r.friction_preset << "\",\n";
+  os << indent << "\"adaptation\": \"" << r.adaptation << "\",\n";
+  os << indent << "\"window_s\": " << r.window << ",\n";
+  os << indent << "\"window_max_error\": [";
+  for (size_t w = 0; w < r.window_max.size(); ++w) {
+    os << (w ? ", " : "");
+    json_array(os, r.window_max[w].data(), 6);
+  }
+  os << "],\n" << indent << "\"window_theta_range\": [";
+  for (size_t w = 0; w < r.window_theta_range.size(); ++w) {
+    os << (w ? ", " : "");
+    json_array(os, r.window_theta_range[w].data(), 2);
+  }
+  os << "],\n";
   os << indent << "\"max_error_mm\": ";
   json_array(os, r.max_error, 3);
   os << ",\n" << indent << "\"max_error_deg\": ";

@@ -131,4 +131,23 @@ TEST(ClosedLoop, FloatControllerTracksLikeDouble) {
   for (int i = 0; i < 3; ++i) EXPECT_LT(f.final_max_error[i], 1.5 * d.final_max_error[i] + 0.02) << i;
 }
 
+TEST(Windows, PerWindowMaximaCoverTheRunAndAgreeWithTheWholeRunMaximum) {
+  ExperimentConfig c = config(7, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
+  c.window = 2.0;
+  const ExperimentResult r = run_experiment(c);
+  ASSERT_EQ(r.window_max.size(), 4u);  // [0,2) [2,4) [4,6) [6,7)
+  ASSERT_EQ(r.window_theta_range.size(), 4u);
+  EXPECT_EQ(r.adaptation, "paper");
+  for (int i = 0; i < 6; ++i) {
+    double m = 0;
+    for (const auto& w : r.window_max) m = std::max(m, w[i]);
+    EXPECT_EQ(m, r.max_error[i]) << i;
+  }
+  for (const auto& th : r.window_theta_range) EXPECT_LE(th[0], th[1]);
+  for (int i = 0; i < 18; ++i) {
+    EXPECT_GE(r.theta_hat[i], r.window_theta_range.back()[0]);
+    EXPECT_LE(r.theta_hat[i], r.window_theta_range.back()[1]);
+  }
+}
+
 }  // namespace

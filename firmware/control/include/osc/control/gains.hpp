@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 
 #include "osc/control/params.hpp"
 #include "osc/kernels/model.hpp"
@@ -16,6 +17,22 @@ enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
 enum class AdaptationLaw : std::uint8_t {
   kPaper,  ///< the paper's sampled law (67), exactly
 };
+/// Names of the laws, in enum order (command lines, logs).
+constexpr const char* kAdaptationLawNames[] = {"paper"};
+constexpr int kAdaptationLawCount = sizeof(kAdaptationLawNames) / sizeof(kAdaptationLawNames[0]);
+
+constexpr const char* adaptation_law_name(AdaptationLaw law) {
+  return kAdaptationLawNames[static_cast<int>(law)];
+}
+/// The law of a name; false when there is none.
+constexpr bool adaptation_law_from_name(std::string_view name, AdaptationLaw& law) {
+  for (int i = 0; i < kAdaptationLawCount; ++i)
+    if (name == kAdaptationLawNames[i]) {
+      law = static_cast<AdaptationLaw>(i);
+      return true;
+    }
+  return false;
+}
 
 template <class S>
 struct Gains {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "osc/control/gains.hpp"
 #include "osc/robots/arm.hpp"
 
 namespace pil {
@@ -27,9 +28,18 @@ enum Inject : std::uint8_t {
   kInjectNone = 0,
   kInjectNonFinite = 1u << 0,  ///< poison the observer state with a NaN
   kInjectOverrun = 1u << 1,    ///< burn more than one period inside the tick
-  /// Configuration, honoured in the first frame only: run without friction compensation.
+  /// Configuration, honoured in the first frame only: the adaptation law + 1 in bits 5-6 (0: the
+  /// firmware's default), and no friction compensation in bit 7.
+  kConfigAdaptationShift = 5,
+  kConfigAdaptationMask = 3u << 5,
   kConfigNoCompensation = 1u << 7,
 };
+static_assert(osc::kAdaptationLawCount <= 3, "the adaptation law fits the configuration field");
+
+/// The configuration bits that select an adaptation law.
+constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
+  return static_cast<std::uint8_t>((static_cast<unsigned>(law) + 1u) << kConfigAdaptationShift);
+}
 
 struct SensorFrame {
   std::uint32_t seq = 0;

@@ -55,7 +55,7 @@ class PilNode {
         return true;
       }
       if (f.seq != expected_seq_) pending_faults_ |= kFaultLinkCorrupt;
-      if (task.tick == 0 && (f.inject & pil::kConfigNoCompensation)) task.mode = FrictionMode::kNone;
+      if (task.tick == 0) configure(f.inject);
       expected_seq_ = f.seq + 1;
       frame_ = f;
       return true;
@@ -110,6 +110,14 @@ class PilNode {
   }
 
  private:
+  /// The configuration bits of the first sensor frame.
+  void configure(std::uint8_t config) {
+    if (config & pil::kConfigNoCompensation) task.mode = FrictionMode::kNone;
+    const unsigned law = (config & pil::kConfigAdaptationMask) >> pil::kConfigAdaptationShift;
+    if (law != 0 && law <= static_cast<unsigned>(kAdaptationLawCount))
+      task.gains.adaptation = static_cast<AdaptationLaw>(law - 1);
+  }
+
   pil::Parser parser_;
   pil::SensorFrame frame_;
   std::uint32_t expected_seq_ = 0;
