@@ -156,6 +156,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     for (int i = 0; i < 18; ++i) {
       wth[0] = std::min(wth[0], rep.theta_hat[i]);
       wth[1] = std::max(wth[1], rep.theta_hat[i]);
+      res.theta_min_seen[i] = k == 0 ? rep.theta_hat[i] : std::min(res.theta_min_seen[i], rep.theta_hat[i]);
+      res.theta_max_seen[i] = k == 0 ? rep.theta_hat[i] : std::max(res.theta_max_seen[i], rep.theta_hat[i]);
     }
     for (int i = 0; i < 6; ++i) {
       wmax[i] = std::max(wmax[i], std::abs(e[i]));

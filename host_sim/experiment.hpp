@@ -52,6 +52,8 @@ struct ExperimentResult {
   double max_observer_error[6] = {}; // |x~| over the last final_window seconds: mm, deg
   double theta_hat[18] = {};
   double theta_true[18] = {};
+  double theta_min_seen[18] = {};                 // extremes of each theta^ over the run
+  double theta_max_seen[18] = {};
   double window = 0;                              // [s]
   std::vector<std::array<double, 6>> window_max;  // max |e| per consecutive window: mm, deg
   std::vector<std::array<double, 2>> window_theta_range;  // min and max of all theta^ per window

@@ -38,7 +38,8 @@ TEST(Adaptation, SampledLawMatchesEquation67) {
   // Two steps at rest-free poses: the second step's theta^ must equal
   // theta^ - K_ad W_j^T(q^dot_prev) [q - q_prev - q^dot_prev dt], computed here independently.
   const Model<double> model = Model<double>::of(robot::kArm);
-  const Gains<double> G = Gains<double>::paper();
+  Gains<double> G = Gains<double>::paper();
+  G.adaptation = AdaptationLaw::kPaper;
   auto st = std::make_unique<ControllerState<double>>();
   const Vec6<double> q0 = q_start();
   controller_init(model, *st, q0);
@@ -232,14 +233,16 @@ TEST_F(Stages, FrictionEstimateIsEquation30) {
 }
 
 TEST_F(Stages, AdaptationWaitsForItsFirstSampleThenFollowsEquation67) {
+  G.adaptation = AdaptationLaw::kPaper;
   AdaptationState<double> a{};
   a.theta_hat.setConstant(1.0);
   a.q_prev = q;
   a.qd_hat_prev = v6(0.1, -0.2, 0.3, 0.0, 0.5, -0.6);
-  a.have_prev = false;
+  a.qd_hat_prev2 = v6(9, 9, 9, 9, 9, 9);  // not used by (67)
+  a.samples = 0;
   const Vec6<double> q1 = q + v6(1e-4, -2e-4, 3e-4, 0, 5e-4, -6e-4);
   EXPECT_EQ(adaptation_step(G, a, q1), a.theta_hat);
-  a.have_prev = true;
+  a.samples = 1;
   const Vec18<double> t = adaptation_step(G, a, q1);
   for (int i = 0; i < kDof; ++i) {
     const double Dq = q1(i) - q(i) - a.qd_hat_prev(i) * G.dt, w = a.qd_hat_prev(i);
@@ -248,6 +251,39 @@ TEST_F(Stages, AdaptationWaitsForItsFirstSampleThenFollowsEquation67) {
     EXPECT_NEAR(t(6 + i), 1 - 500 * s * Dq, 1e-12);
     EXPECT_NEAR(t(12 + i), 1 - 500 * s * std::exp(-w * w) * Dq, 1e-12);
   }
+}
+
+TEST_F(Stages, RobustLawUsesTheOlderRegressorLeaksAndProjects) {
+  ASSERT_EQ(G.adaptation, AdaptationLaw::kRobust);  // the default
+  AdaptationState<double> a{};
+  for (int i = 0; i < 18; ++i) a.theta_hat(i) = 0.5 * params::kThetaMax[i];
+  a.theta_hat(0) = params::kThetaMax[0] - 1e-9;  // pushed over its upper bound below
+  a.theta_hat(7) = 1e-9;                         // pushed under 0 below
+  a.q_prev = q;
+  a.qd_hat_prev = v6(0.1, -0.2, 0.3, 0.0, 0.5, -0.6);
+  a.qd_hat_prev2 = v6(-0.2, 0.1, 0.3, 0.05, -0.5, 0.4);
+  const Vec6<double> q1 = q + v6(1e-3, 2e-3, 3e-4, 1e-4, 5e-4, -6e-4);
+  a.samples = 1;
+  EXPECT_EQ(adaptation_step(G, a, q1), a.theta_hat);  // needs two samples
+  a.samples = 2;
+  const Vec18<double> t = adaptation_step(G, a, q1);
+  const double leak = 1 - params::kAdaptationLeakage * G.dt;
+  int clipped_hi = 0, clipped_lo = 0;
+  for (int i = 0; i < kDof; ++i) {
+    const double Dq = q1(i) - q(i) - a.qd_hat_prev(i) * G.dt, w = a.qd_hat_prev2(i);  // regressor at t - 2 dt
+    const double s = w > 0 ? 1 : (w < 0 ? -1 : 0);
+    const double raw[3] = {leak * a.theta_hat(i) - 500 * w * Dq, leak * a.theta_hat(6 + i) - 500 * s * Dq,
+                           leak * a.theta_hat(12 + i) - 500 * s * std::exp(-w * w) * Dq};
+    for (int k = 0; k < 3; ++k) {
+      const int idx = 6 * k + i;
+      const double want = std::min(std::max(raw[k], 0.0), params::kThetaMax[idx]);
+      clipped_hi += raw[k] > params::kThetaMax[idx];
+      clipped_lo += raw[k] < 0;
+      EXPECT_NEAR(t(idx), want, 1e-12) << idx;
+    }
+  }
+  EXPECT_GT(clipped_hi, 0);  // the projection was exercised both ways
+  EXPECT_GT(clipped_lo, 0);
 }
 
 TEST_F(Stages, ForceCommandIsEquations32_36) {

@@ -267,4 +267,43 @@ TEST(PilClosedLoop, TracksLikeTheInProcessFloatController) {
   }
 }
 
+// The adaptation law chosen on the host reaches the controller over the link (first frame's
+// configuration bits): over the link it follows the in-process controller with the same law, and the
+// two laws give different estimates.
+TEST(PilClosedLoop, TheAdaptationLawIsConfiguredOverTheLink) {
+  const bool qemu = std::getenv("PIL_FIRMWARE_ELF") != nullptr;
+  ExperimentConfig c;
+  c.duration = 3.0;
+  c.final_window = 1.0;
+  c.scalar = Scalar::kFloat;
+  double spread[2] = {0, 0};
+  ExperimentResult remote_of[2];
+  const osc::AdaptationLaw laws[2] = {osc::AdaptationLaw::kPaper, osc::AdaptationLaw::kRobust};
+  for (int l = 0; l < 2; ++l) {
+    c.adaptation = laws[l];
+    c.pil_command.clear();
+    const ExperimentResult local = run_experiment(c);
+    c.pil_command = peer_command();
+    remote_of[l] = run_experiment(c);
+    ASSERT_TRUE(remote_of[l].error.empty()) << remote_of[l].error;
+    for (int i = 0; i < 18; ++i) spread[l] = std::max(spread[l], std::abs(remote_of[l].theta_hat[i] - local.theta_hat[i]));
+  }
+  double between = 0;
+  for (int i = 0; i < 18; ++i) between = std::max(between, std::abs(remote_of[0].theta_hat[i] - remote_of[1].theta_hat[i]));
+  std::printf("theta^ over the link vs in process: paper %.3g, robust %.3g; paper vs robust %.3g\n", spread[0],
+              spread[1], between);
+  double lowest[2] = {0, 0};
+  for (int l = 0; l < 2; ++l)
+    for (int i = 0; i < 18; ++i) lowest[l] = std::min(lowest[l], remote_of[l].theta_min_seen[i]);
+  std::printf("lowest theta^ over the link: paper %.3g, robust %.3g\n", lowest[0], lowest[1]);
+  if (!qemu) {
+    EXPECT_EQ(spread[0], 0.0);  // host peer: bit-identical
+    EXPECT_EQ(spread[1], 0.0);
+    EXPECT_GT(between, 0.1);
+  }
+  // On any target: the robust law projects onto theta^ >= 0, the paper's (67) does not.
+  EXPECT_EQ(lowest[1], 0.0);
+  EXPECT_LT(lowest[0], -0.01);
+}
+
 }  // namespace

@@ -1,7 +1,7 @@
 // The adaptive observer-controller of the paper. One call of control_step() is one sample: encoder
 // angles q(t) in, joint torques out. It reads as the block diagram, one stage per call:
 //   kinematics and dynamics at q           opspace_update          (4), (5)
-//   friction adaptation                    adaptation_step         (67)      adaptation.hpp
+//   friction adaptation                    adaptation_step         (67) or robust   adaptation.hpp
 //   observer output                        observer_output         (21), (23), (28)  observer.hpp
 //   friction estimate                      friction_estimate       (30), (31)
 //   desired trajectory                     trajectory              (68)      trajectory.hpp
@@ -52,10 +52,7 @@ void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In
   st.R_ref = st.data.R[kDof];
   st.obs.x_hat << st.p0, Vec3<S>::Zero();
   st.obs.y.setZero();
-  st.adapt.theta_hat.setZero();
-  st.adapt.q_prev = q0;
-  st.adapt.qd_hat_prev.setZero();
-  st.adapt.have_prev = false;
+  adaptation_init(st.adapt, Vec6<S>(q0));
 }
 
 template <class S>
@@ -125,10 +122,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
     return out;
   }
   st.obs = next;
-  st.adapt.theta_hat = theta_hat;
-  st.adapt.q_prev = q;
-  st.adapt.qd_hat_prev = ob.qd_hat;
-  st.adapt.have_prev = true;
+  adaptation_record(st.adapt, theta_hat, Vec6<S>(q), ob.qd_hat);
   out.tau = tau;
   out.e = c.e;
   out.x_tilde = ob.x_tilde;

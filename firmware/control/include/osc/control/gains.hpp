@@ -1,5 +1,6 @@
 // The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, and the choices
-// a caller makes (friction mode, adaptation law). Defaults from params.hpp.
+// a caller makes (friction mode, adaptation law). Defaults from params.hpp; the adaptation law
+// defaults to the robust one (docs/adaptation.md); AdaptationLaw::kPaper gives (67) exactly.
 #pragma once
 
 #include <cstdint>
@@ -15,10 +16,11 @@ enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
 
 /// The law that updates the friction estimates (osc/control/adaptation.hpp).
 enum class AdaptationLaw : std::uint8_t {
-  kPaper,  ///< the paper's sampled law (67), exactly
+  kPaper,   ///< the paper's sampled law (67), exactly
+  kRobust,  ///< (67)'s error with the regressor one sample older, projection, leakage (the default)
 };
 /// Names of the laws, in enum order (command lines, logs).
-constexpr const char* kAdaptationLawNames[] = {"paper"};
+constexpr const char* kAdaptationLawNames[] = {"paper", "robust"};
 constexpr int kAdaptationLawCount = sizeof(kAdaptationLawNames) / sizeof(kAdaptationLawNames[0]);
 
 constexpr const char* adaptation_law_name(AdaptationLaw law) {
@@ -42,6 +44,8 @@ struct Gains {
   S dt;
   S min_rcond;
   AdaptationLaw adaptation;
+  Vec18<S> theta_max;  // projection bounds of the robust law (lower bounds 0)
+  S leakage;           // sigma of the robust law [1/s]
 
   static Gains paper() {
     Gains g;
@@ -55,7 +59,9 @@ struct Gains {
     g.kad = lit<S>(params::kKad);
     g.dt = lit<S>(params::kDt);
     g.min_rcond = lit<S>(params::kMinJacobianRcond);
-    g.adaptation = AdaptationLaw::kPaper;
+    g.adaptation = AdaptationLaw::kRobust;
+    for (int i = 0; i < 3 * kDof; ++i) g.theta_max(i) = lit<S>(params::kThetaMax[i]);
+    g.leakage = lit<S>(params::kAdaptationLeakage);
     return g;
   }
 };

@@ -18,6 +18,17 @@ constexpr double kKi[6] = {2000, 2000, 2000, 3000, 3000, 3000};
 constexpr double kKad = 500;      ///< every diagonal entry of K_ad (18x18)
 constexpr double kTauDec = 1;     ///< every tau_dec (known Stribeck coefficient) [s^2/rad^2]
 
+/// The robust adaptation law (osc/control/adaptation.hpp, docs/adaptation.md).
+/// Projection bounds of theta = [vis; cou; sti] for a PUMA 560: three times the larger of the paper's
+/// Table II and the Corke/Armstrong-Helouvry values per joint, rounded up; the Stribeck excess is
+/// bounded like the Coulomb level. The lower bounds are 0 (friction dissipates).
+constexpr double kThetaMax[18] = {18, 30, 18, 2, 6, 3,     // vis [N m s/rad]
+                                  80, 32, 20, 4, 3, 4,     // cou [N m]
+                                  80, 32, 20, 4, 3, 4};    // sti [N m]
+/// Leakage (sigma-modification towards 0) [1/s]: a time constant of 1000 s, slow against the
+/// adaptation (about 60 s) and fast against the residual quantisation drift.
+constexpr double kAdaptationLeakage = 1e-3;
+
 /// Trajectory (68): amplitude, angular frequency (period 5 s, f = 1) and envelope rate.
 constexpr double kAmplitude = 0.050;            ///< [m]
 constexpr double kOmega = 0.4 * kPi;            ///< [rad/s]
