@@ -34,6 +34,7 @@ class LocalController {
     osc::Gains<S> gains = osc::Gains<S>::paper();
     gains.adaptation = cfg.adaptation;
     task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), gains, cfg.mode, q0.cast<S>());
+    task_->set_encoder_resolution(cfg.encoder_counts_per_motor_rev);
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
       task_->state.obs.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
@@ -107,7 +108,7 @@ template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
-  PlantHal hal(plant, q0);
+  PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev);
 
   // Ground truth for the error statistics: the plant's own state through double kinematics.
   const osc::Model<double> truth = osc::Model<double>::of(osc::robot::kArm);

@@ -20,6 +20,8 @@ struct ExperimentConfig {
   osc::FrictionMode mode = osc::FrictionMode::kAdaptive;
   Scalar scalar = Scalar::kDouble;                  ///< controller arithmetic
   PlantConfig plant{};
+  /// Encoder resolution of plant and controller alike (in-process controller only) [counts/motor rev].
+  double encoder_counts_per_motor_rev = osc::robot::kDrives.encoder_counts_per_motor_rev;
   double model_error = 0.0;                         ///< controller's link mass/inertia relative error
   double log_period = 0.01;                         ///< time-series decimation [s]
   double final_window = 20.0;                       ///< "last 20 s" statistics [s]

@@ -12,13 +12,19 @@ namespace sim {
 
 class PlantHal {
  public:
-  PlantHal(Plant& plant, const Vec6& q_start) : plant_(plant), q_start_(q_start) {}
+  /// counts_per_motor_rev: the encoders' resolution (default: the robot table's).
+  PlantHal(Plant& plant, const Vec6& q_start,
+           double counts_per_motor_rev = osc::robot::kDrives.encoder_counts_per_motor_rev)
+      : plant_(plant), q_start_(q_start) {
+    osc::DriveParams drives = osc::robot::kDrives;
+    drives.encoder_counts_per_motor_rev = counts_per_motor_rev;
+    for (int i = 0; i < hal::kJoints; ++i) counts_per_rad_[i] = osc::encoder_counts_per_rad(osc::robot::kArm, drives, i);
+  }
 
   /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad).
   void read_encoders(std::int32_t counts[hal::kJoints]) const {
     for (int i = 0; i < hal::kJoints; ++i)
-      counts[i] = static_cast<std::int32_t>(
-          std::floor((plant_.q()(i) - q_start_(i)) * osc::counts_per_rad(i)));
+      counts[i] = static_cast<std::int32_t>(std::floor((plant_.q()(i) - q_start_(i)) * counts_per_rad_[i]));
   }
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) codes_[i] = codes[i];
@@ -38,6 +44,7 @@ class PlantHal {
  private:
   Plant& plant_;
   Vec6 q_start_;
+  double counts_per_rad_[hal::kJoints];
   std::int32_t codes_[hal::kJoints] = {0, 0, 0, 0, 0, 0};
   bool fault_ = false;
 };

@@ -25,6 +25,7 @@ const char* kUsage =
     "  --scalar T          controller arithmetic: double | float (default double)\n"
     "  --adaptation L      friction adaptation law: paper (default: the firmware's)\n"
     "  --model-error F     controller link mass/inertia relative error (default 0; -0.5..0.5)\n"
+    "  --encoder-cpr C     encoder counts per motor revolution, plant and controller (default 1000; 100..1e7)\n"
     "  --substep S         plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)\n"
     "  --delay S           computation delay inside the sample (default 2e-4; 0..1e-3)\n"
     "  --qemu              run the controller as the firmware image in qemu-system-arm (PIL)\n"
@@ -91,6 +92,8 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
         for (int k = 0; k < osc::kAdaptationLawCount; ++k) err += std::string(k ? " or " : " ") + osc::kAdaptationLawNames[k];
         return err += ", got '" + s + "'", false;
       }
+    } else if (a == "--encoder-cpr") {
+      if (!sim::parse_number(a, take(), 100, 1e7, o.base.encoder_counts_per_motor_rev, err)) return false;
     } else if (a == "--model-error") {
       if (!sim::parse_number(a, take(), -0.5, 0.5, o.base.model_error, err)) return false;
     } else if (a == "--substep") {
@@ -303,6 +306,8 @@ int main(int argc, char** argv) {
   o.base.duration = o.duration;
   if (o.qemu) {
     if (o.base.model_error != 0) return fail("--model-error applies to the host-built controller only, not with --qemu");
+    if (o.base.encoder_counts_per_motor_rev != osc::robot::kDrives.encoder_counts_per_motor_rev)
+      return fail("--encoder-cpr applies to the host-built controller only, not with --qemu");
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float

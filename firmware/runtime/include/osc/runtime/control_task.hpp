@@ -38,6 +38,7 @@ struct ControlTask {
   Gains<S> gains;
   FrictionMode mode;
   Vec6<S> q_start;            // joint angles at which the encoders read zero
+  Vec6<S> counts_per_rad;     // encoder counts per joint radian (the robot's drives by default)
   std::uint32_t tick;         // samples since start
   ControllerState<S> state;
   StepOutput<S> last;         // the most recent step, for telemetry
@@ -62,14 +63,24 @@ struct ControlTask {
       codes[i] = 0;
       prev_counts[i] = 0;
       sat_ticks[i] = 0;
-      // Speed limit times the sample, in counts, plus one count of quantisation.
-      max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt *
-                                                    counts_per_rad(i)) + 1;
     }
+    set_encoder_resolution(robot::kDrives.encoder_counts_per_motor_rev);
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
     timing = {};
     step_timing = {};
+  }
+  /// Encoders of another resolution than the robot table's (counts per motor revolution, after
+  /// quadrature decoding): the count scaling and the plausible step per tick follow it.
+  void set_encoder_resolution(double counts_per_motor_rev) {
+    DriveParams drives = robot::kDrives;
+    drives.encoder_counts_per_motor_rev = counts_per_motor_rev;
+    for (int i = 0; i < kDof; ++i) {
+      const double c = encoder_counts_per_rad(robot::kArm, drives, i);
+      counts_per_rad(i) = lit<S>(c);
+      // Speed limit times the sample, in counts, plus one count of quantisation.
+      max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt * c) + 1;
+    }
   }
   /// Test hook (fault injection): poisons the observer state with a NaN.
   void inject_nonfinite() { state.obs.y(0) = S(0) / S(0); }
@@ -77,9 +88,9 @@ struct ControlTask {
 
 /// Encoder counts to joint angles.
 template <class S>
-Vec6<S> angles_from_counts(const Vec6<S>& q_start, const std::int32_t counts[kDof]) {
+Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<S>& counts_per_rad, const std::int32_t counts[kDof]) {
   Vec6<S> q;
-  for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(i, counts[i], q_start(i));
+  for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(counts[i], counts_per_rad(i), q_start(i));
   return q;
 }
 
@@ -105,7 +116,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
 
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (task.sup.state != SupervisorState::kFault && faults == 0) {
-    const Vec6<S> q = angles_from_counts(task.q_start, counts);
+    const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
     const S t = static_cast<S>(task.tick) * task.gains.dt;
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);

@@ -16,8 +16,13 @@ constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
 
 /// Joint angle [rad] of an encoder count, relative to the count taken at the start pose.
 template <class S>
+S counts_to_angle(std::int32_t counts, S counts_per_rad, S q_at_zero) {
+  return q_at_zero + static_cast<S>(counts) / counts_per_rad;
+}
+/// The same with the robot's drives.
+template <class S>
 S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
-  return q_at_zero + static_cast<S>(counts) / lit<S>(counts_per_rad(joint));
+  return counts_to_angle<S>(counts, lit<S>(counts_per_rad(joint)), q_at_zero);
 }
 
 /// DAC code of a joint torque, saturated at the code range. Returns true when it saturated.
