@@ -127,6 +127,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   const long progress_every = std::max(1L, n / 100);
   const long window_ticks = std::max(1L, std::lround(cfg.window / dt));
   res.window = cfg.window;
+  res.final_window = std::min(cfg.final_window, cfg.duration);
   TickReport rep;
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;

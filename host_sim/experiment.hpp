@@ -54,6 +54,7 @@ struct ExperimentResult {
   double max_observer_error[6] = {}; // |x~| over the last final_window seconds: mm, deg
   double theta_hat[18] = {};
   double theta_true[18] = {};
+  double final_window = 0;                        // [s] of the "last" statistics
   double theta_min_seen[18] = {};                 // extremes of each theta^ over the run
   double theta_max_seen[18] = {};
   double window = 0;                              // [s]

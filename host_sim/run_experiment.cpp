@@ -32,6 +32,7 @@ const char* kUsage =
     "  --elf FILE          firmware image for --qemu (default: the m4f build's pil_firmware.elf)\n"
     "  --json FILE         write the summary as JSON\n"
     "  --csv-dir DIR       write time series CSV files there (default: out)\n"
+    "  --final-window S    length of the \"last\" statistics at the end of the run (default 20; 1..3600)\n"
     "  --no-csv            do not write time series\n"
     "  --no-progress       no progress bar\n"
     "  --help              this text\n";
@@ -114,6 +115,8 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
       const char* f = take();
       if (!f || !*f) return err = "--csv-dir needs a directory", false;
       o.csv_dir = f;
+    } else if (a == "--final-window") {
+      if (!sim::parse_number(a, take(), 1, 3600, o.base.final_window, err)) return false;
     } else if (a == "--no-csv") {
       o.csv = false;
     } else if (a == "--no-progress") {
@@ -226,7 +229,11 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
     os << (w ? ", " : "");
     json_array(os, r.window_theta_range[w].data(), 2);
   }
-  os << "],\n";
+  os << "],\n" << indent << "\"theta_min_seen\": ";
+  json_array(os, r.theta_min_seen, 18);
+  os << ",\n" << indent << "\"theta_max_seen\": ";
+  json_array(os, r.theta_max_seen, 18);
+  os << ",\n" << indent << "\"final_window_s\": " << r.final_window << ",\n";
   os << indent << "\"max_error_mm\": ";
   json_array(os, r.max_error, 3);
   os << ",\n" << indent << "\"max_error_deg\": ";
