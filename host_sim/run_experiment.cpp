@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <filesystem>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -321,8 +322,11 @@ int main(int argc, char** argv) {
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
   }
   if (o.csv && !o.csv_dir.empty()) {
-    const std::string mk = "mkdir -p '" + o.csv_dir + "'";
-    if (std::system(mk.c_str()) != 0) return fail("cannot create directory " + o.csv_dir);
+    // No shell: the name is a path, never a command.
+    std::error_code ec;
+    std::filesystem::create_directories(o.csv_dir, ec);
+    if (ec || !std::filesystem::is_directory(o.csv_dir))
+      return fail("cannot create directory " + o.csv_dir + (ec ? ": " + ec.message() : ""));
   }
 
   std::vector<sim::ExperimentConfig> cfgs;

@@ -176,4 +176,14 @@ TEST(Hal, EncoderUnwrapExtendsA16BitCounterAcrossWraps) {
   EXPECT_LT(truth, 0);
 }
 
+TEST(Hal, EncoderUnwrapWrapsModularlyPastTheInt32Range) {
+  // A 32-bit position that runs past INT32_MAX wraps to INT32_MIN (modular), never through signed
+  // overflow (the test binaries run under UBSan in the sanitizer build).
+  hal::EncoderUnwrap<16> enc;
+  enc.position = 2147483647 - 100;
+  std::uint32_t raw = 0;
+  raw = (raw + 300) & 0xFFFFu;
+  EXPECT_EQ(enc.update(raw), static_cast<std::int32_t>(-2147483647 - 1 + 199));
+}
+
 }  // namespace

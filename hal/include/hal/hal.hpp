@@ -49,7 +49,9 @@ struct EncoderUnwrap {
     last = raw & mask;
     // Sign-extend the N-bit difference.
     std::int32_t d = static_cast<std::int32_t>(delta << (32 - Bits)) >> (32 - Bits);
-    position += d;
+    // Modular 32-bit position: a counter that runs past INT32_MAX wraps instead of overflowing a
+    // signed integer (undefined behaviour); the control task checks the step between ticks.
+    position = static_cast<std::int32_t>(static_cast<std::uint32_t>(position) + static_cast<std::uint32_t>(d));
     return position;
   }
 };
