@@ -178,7 +178,7 @@ TEST(Hal, EncoderUnwrapExtendsA16BitCounterAcrossWraps) {
 
 TEST(Hal, EncoderUnwrapWrapsModularlyPastTheInt32Range) {
   // A 32-bit position that runs past INT32_MAX wraps to INT32_MIN (modular), never through signed
-  // overflow (the test binaries run under UBSan in the sanitizer build).
+  // overflow.
   hal::EncoderUnwrap<16> enc;
   enc.position = 2147483647 - 100;
   std::uint32_t raw = 0;
