@@ -52,6 +52,7 @@ class LocalController {
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
     return true;
   }
+  void skip_ticks(std::uint64_t n) { task_->tick += n; }
   void finish(ExperimentResult&) {}
 
  private:
@@ -125,20 +126,25 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   long fr_n = 0;
   Vec6 tau_old = Vec6::Zero();
   const long progress_every = std::max(1L, n / 100);
+  const long jump_tick = cfg.jump_at >= 0 ? std::lround(cfg.jump_at / dt) : -1;
   const long window_ticks = std::max(1L, std::lround(cfg.window / dt));
   res.window = cfg.window;
   res.final_window = std::min(cfg.final_window, cfg.duration);
   TickReport rep;
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
+    const double t_ref = osc::trajectory_time<double>(static_cast<std::uint64_t>(k), dt);  // as the controller
     // Errors of the true plant at the sample instant.
     osc::forward_kinematics(truth, tdata, plant.q());
-    const osc::Desired<double> d = osc::trajectory(p0, t);
+    const osc::Desired<double> d = osc::trajectory(p0, t_ref);
     const Vec3 phi = osc::orientation_coordinates(tdata.R[6], R_ref);
     double e[6];
     for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - tdata.o[6](i)) * 1e3;
     for (int i = 0; i < 3; ++i) e[3 + i] = -phi(i) * kRadToDeg;
 
+    if constexpr (requires { ctrl.skip_ticks(std::uint64_t{0}); }) {
+      if (cfg.jump_at >= 0 && k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
+    }
     // The controller: encoders -> control step -> DAC codes.
     if (!ctrl.tick(hal, rep, res.error)) {
       res.error = "tick " + std::to_string(k) + ": " + res.error;

@@ -28,6 +28,11 @@ struct ExperimentConfig {
   double window = 60.0;                             ///< length of the per-window maxima [s]
   osc::AdaptationLaw adaptation = osc::Gains<double>::paper().adaptation;  ///< the firmware's default
   double observer_offset[6] = {0, 0, 0, 0, 0, 0};    ///< x^(0) - x(0), to test observer convergence
+  /// Uptime test (in-process controller only): at jump_at [s] the controller's sample counter
+  /// advances by jump_ticks, as if it had been running that much longer (a multiple of the
+  /// trajectory's period keeps the reference unchanged).
+  double jump_at = -1;
+  std::uint64_t jump_ticks = 0;
   std::function<void(double fraction)> progress;    ///< optional progress callback
   /// Processor-in-the-loop: the command that starts the firmware (e.g. qemu-system-arm with the
   /// image, see PilClient::qemu_command); empty runs the host-built controller in process.

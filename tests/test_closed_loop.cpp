@@ -202,4 +202,34 @@ TEST(ClosedLoop, PaperLawDriftScalesWithTheSquareOfTheEncoderQuantum) {
   EXPECT_LT(vis_j1(osc::AdaptationLaw::kRobust, 1000), 0.1);
 }
 
+// Time that never runs out: after 25 s the controller's sample counter jumps to 2^31, 2^32 - 10,
+// 240 h and 50 days of uptime (rounded to the trajectory's period, so the reference is the same).
+// The tracking errors from then on must equal those of the run without the jump exactly, in double
+// and in float (a float n dt had stopped advancing after 4.6 h).
+TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
+  for (const Scalar scalar : {Scalar::kDouble, Scalar::kFloat}) {
+    ExperimentConfig c = config(35, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
+    c.scalar = scalar;
+    c.final_window = 10;
+    const ExperimentResult base = run_experiment(c);
+    ASSERT_EQ(base.status, 0u);
+    const long jump_at_tick = 25000;
+    for (const std::uint64_t target : {std::uint64_t{1} << 31, (std::uint64_t{1} << 32) - 10,
+                                       std::uint64_t{240} * 3600 * 1000, std::uint64_t{50} * 86400 * 1000}) {
+      const std::uint64_t period = osc::kTrajectoryPeriodTicks;
+      c.jump_at = jump_at_tick * 1e-3;
+      c.jump_ticks = (target - jump_at_tick) / period * period;
+      const ExperimentResult r = run_experiment(c);
+      ASSERT_EQ(r.status, 0u);
+      for (int i = 0; i < 6; ++i)
+        EXPECT_EQ(r.final_max_error[i], base.final_max_error[i]) << "uptime " << target << " axis " << i;
+      std::printf("%s controller, counter jumps to %llu at 25 s: last 10 s max |e| %.4f %.4f %.4f mm (without: %.4f %.4f %.4f)\n",
+                  scalar == Scalar::kFloat ? "float " : "double", static_cast<unsigned long long>(jump_at_tick + c.jump_ticks),
+                  r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], base.final_max_error[0],
+                  base.final_max_error[1], base.final_max_error[2]);
+    }
+    c.jump_at = -1;
+  }
+}
+
 }  // namespace

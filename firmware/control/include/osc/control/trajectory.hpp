@@ -3,10 +3,30 @@
 // The orientation is held at its start value (phi_d = 0 relative to the start orientation).
 #pragma once
 
+#include <cstdint>
+
 #include "osc/kernels/model.hpp"
 #include "osc/control/params.hpp"
 
 namespace osc {
+
+/// (68) repeats every 2 pi / omega = 5 s = 5000 samples once its envelope has risen.
+constexpr std::uint64_t kTrajectoryPeriodTicks = 5000;
+/// After 20 s the envelope 1 - exp(-0.05 t^3) is 1 to within exp(-400): nothing but the phase changes.
+constexpr std::uint64_t kEnvelopeSettledTicks = 4 * kTrajectoryPeriodTicks;
+static_assert(abs_of(params::kOmega * kTrajectoryPeriodTicks * params::kDt - 2 * kPi) < 1e-12,
+              "the period in samples is a whole number of the trajectory's periods");
+static_assert(params::kEnvelope * 20.0 * 20.0 * 20.0 >= 400.0, "the envelope has settled by then");
+
+/// The trajectory's time at sample n, from the integer sample count: n dt while the envelope rises,
+/// then 20 s plus the phase within the period. Its precision therefore does not depend on uptime
+/// (a float n dt advances in 1.5 ms steps after 2.3 h and stops after 4.6 h), and a 64-bit count
+/// never wraps in service.
+template <class S>
+S trajectory_time(std::uint64_t n, S dt) {
+  if (n < kEnvelopeSettledTicks) return static_cast<S>(n) * dt;
+  return static_cast<S>(kEnvelopeSettledTicks + (n - kEnvelopeSettledTicks) % kTrajectoryPeriodTicks) * dt;
+}
 
 template <class S>
 struct Desired {

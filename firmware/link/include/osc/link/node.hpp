@@ -31,6 +31,7 @@ class PilNode {
     task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), mode, q_start, period_cycles);
     expected_seq_ = 0;
     pending_faults_ = 0;
+    configured_ = false;
     parser_.reset();
   }
 
@@ -55,7 +56,7 @@ class PilNode {
         return true;
       }
       if (f.seq != expected_seq_) pending_faults_ |= kFaultLinkCorrupt;
-      if (task.tick == 0) configure(f.inject);
+      if (!configured_) configure(f.inject);  // the first valid frame configures, once
       expected_seq_ = f.seq + 1;
       frame_ = f;
       return true;
@@ -112,6 +113,7 @@ class PilNode {
  private:
   /// The configuration bits of the first sensor frame.
   void configure(std::uint8_t config) {
+    configured_ = true;
     if (config & pil::kConfigNoCompensation) task.mode = FrictionMode::kNone;
     const unsigned law = (config & pil::kConfigAdaptationMask) >> pil::kConfigAdaptationShift;
     if (law != 0 && law <= static_cast<unsigned>(kAdaptationLawCount))
@@ -122,6 +124,7 @@ class PilNode {
   pil::SensorFrame frame_;
   std::uint32_t expected_seq_ = 0;
   std::uint32_t pending_faults_ = 0;
+  bool configured_ = false;
 };
 
 }  // namespace osc

@@ -39,7 +39,8 @@ struct ControlTask {
   FrictionMode mode;
   Vec6<S> q_start;            // joint angles at which the encoders read zero
   Vec6<S> counts_per_rad;     // encoder counts per joint radian (the robot's drives by default)
-  std::uint32_t tick;         // samples since start
+  std::uint64_t tick;         // samples since start (64 bits: never wraps in service)
+  bool have_counts;           // a first encoder sample has been taken
   ControllerState<S> state;
   StepOutput<S> last;         // the most recent step, for telemetry
   std::int32_t codes[kDof];   // the most recent DAC codes
@@ -58,6 +59,7 @@ struct ControlTask {
     mode = fm;
     q_start = q0;
     tick = 0;
+    have_counts = false;
     controller_init(model, state, q0);
     for (int i = 0; i < kDof; ++i) {
       codes[i] = 0;
@@ -103,7 +105,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   std::int32_t counts[kDof];
   hal.read_encoders(counts);
   // An encoder change beyond the physical joint speed (comparison written so that it cannot wrap).
-  if (task.tick > 0) {
+  if (task.have_counts) {
     for (int i = 0; i < kDof; ++i) {
       const std::int64_t d = static_cast<std::int64_t>(counts[i]) - task.prev_counts[i];
       if (d > task.max_count_step[i] || d < -static_cast<std::int64_t>(task.max_count_step[i]))
@@ -112,12 +114,13 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
     }
   } else {
     for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i];
+    task.have_counts = true;
   }
 
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (task.sup.state != SupervisorState::kFault && faults == 0) {
     const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
-    const S t = static_cast<S>(task.tick) * task.gains.dt;
+    const S t = trajectory_time<S>(task.tick, task.gains.dt);
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
     task.step_timing.add(hal.cycles() - s0);
