@@ -24,7 +24,7 @@ TEST(Supervisor, ExhaustiveAgainstTheSpecification) {
   int cases = 0;
   for (int st = 0; st < 3; ++st)
     for (std::uint32_t latched = 0; latched <= kAllFaults; ++latched)
-      for (std::uint32_t f = 0; f <= 0xFF; ++f)  // includes an undefined bit (0x80)
+      for (std::uint32_t f = 0; f <= 2 * kAllFaults + 1; ++f)  // includes an undefined bit
         for (int ready = 0; ready < 2; ++ready) {
           const Supervisor s{static_cast<SupervisorState>(st), st == 2 ? latched : 0u};
           if (st != 2 && latched != 0) continue;  // only kFault carries latched bits
@@ -131,6 +131,27 @@ TEST_F(TaskFixture, EncoderJumpFaultsInTheSameTick) {
   hal.counts[1] += task->max_count_step[1] + 1;
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
   expect_latched(kFaultEncoderJump);
+}
+
+TEST_F(TaskFixture, GarbageFirstEncoderSampleFaultsWithZeroTorque) {
+  // INT32_MAX counts at the very first sample used to drive full scale on every DAC.
+  hal.counts[2] = 2147483647;
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderRange));
+  EXPECT_EQ(hal.writes, 1);
+  expect_latched(kFaultEncoderRange);
+}
+
+TEST_F(TaskFixture, ReadingsWithinTheLimitsPlusMarginAreAcceptedBeyondThemNot) {
+  // The first sample at the edge of the plausible range of joint 1 (its limit plus the margin,
+  // less one count): accepted; one count further: a fault.
+  const double c = task->counts_per_rad(0);
+  const auto edge = static_cast<std::int32_t>((robot::kArm.q_max[0] + params::kJointLimitMargin - robot::kQStart[0]) * c);
+  hal.counts[0] = edge;
+  run(1);
+  EXPECT_EQ(task->sup.latched & kFaultEncoderRange, 0u);
+  start(robot::kQStart);
+  hal.counts[0] = edge + 3;
+  EXPECT_TRUE(run(1) & kFaultEncoderRange);
 }
 
 TEST_F(TaskFixture, NonFiniteStateFaultsInTheSameTick) {

@@ -16,7 +16,8 @@ namespace osc {
   X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                   \
   X(Overrun, "overrun", "the next tick arrived before this one ended")                           \
   X(LinkLost, "link_lost", "no sensor frame within the link timeout")                            \
-  X(LinkCorrupt, "link_corrupt", "a frame with a bad checksum, length or sequence number")
+  X(LinkCorrupt, "link_corrupt", "a frame with a bad checksum, length or sequence number")         \
+  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")
 
 namespace detail {
 enum FaultBit : unsigned {

@@ -38,6 +38,9 @@ constexpr double kEnvelope = 0.05;              ///< 1 - exp(-kEnvelope t^3)
 constexpr double kMinJacobianRcond = 1e-3;
 
 /// Supervision limits.
+/// How far an encoder reading may lie outside the joint limits (overtravel to the hard stops)
+/// before it is implausible, from the first sample on [rad].
+constexpr double kJointLimitMargin = 0.1;
 /// Consecutive ticks a torque may stay clipped at the DAC range before the saturation fault.
 constexpr int kSaturationTicks = 50;
 /// Sensor-frame timeout of the processor-in-the-loop link [s] (virtual time of the target).

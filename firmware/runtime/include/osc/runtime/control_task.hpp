@@ -46,6 +46,7 @@ struct ControlTask {
   std::int32_t codes[kDof];   // the most recent DAC codes
   std::int32_t prev_counts[kDof];
   std::int32_t max_count_step[kDof];  // largest plausible encoder change per tick
+  std::int64_t min_counts[kDof], max_counts[kDof];  // plausible readings: joint limits plus a margin
   std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
   Supervisor sup;
   std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
@@ -82,6 +83,10 @@ struct ControlTask {
       counts_per_rad(i) = lit<S>(c);
       // Speed limit times the sample, in counts, plus one count of quantisation.
       max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt * c) + 1;
+      // The joint limits plus the margin, relative to the start pose, in counts (rounded outwards).
+      const double q0 = static_cast<double>(q_start(i));
+      min_counts[i] = static_cast<std::int64_t>((robot::kArm.q_min[i] - params::kJointLimitMargin - q0) * c) - 1;
+      max_counts[i] = static_cast<std::int64_t>((robot::kArm.q_max[i] + params::kJointLimitMargin - q0) * c) + 1;
     }
   }
   /// Test hook (fault injection): poisons the observer state with a NaN.
@@ -104,6 +109,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   std::uint32_t faults = hal.io_faults();
   std::int32_t counts[kDof];
   hal.read_encoders(counts);
+  // Every reading, the first included, must lie within the joint limits plus the margin.
+  for (int i = 0; i < kDof; ++i)
+    if (counts[i] < task.min_counts[i] || counts[i] > task.max_counts[i]) faults |= kFaultEncoderRange;
   // An encoder change beyond the physical joint speed (comparison written so that it cannot wrap).
   if (task.have_counts) {
     for (int i = 0; i < kDof; ++i) {
