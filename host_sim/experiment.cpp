@@ -143,7 +143,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     for (int i = 0; i < 3; ++i) e[3 + i] = -phi(i) * kRadToDeg;
 
     if constexpr (requires { ctrl.skip_ticks(std::uint64_t{0}); }) {
-      if (cfg.jump_at >= 0 && k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
+      if (k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
     }
     // The controller: encoders -> control step -> DAC codes.
     if (!ctrl.tick(hal, rep, res.error)) {

@@ -16,9 +16,7 @@ class PlantHal {
   PlantHal(Plant& plant, const Vec6& q_start,
            double counts_per_motor_rev = osc::robot::kDrives.encoder_counts_per_motor_rev)
       : plant_(plant), q_start_(q_start) {
-    osc::DriveParams drives = osc::robot::kDrives;
-    drives.encoder_counts_per_motor_rev = counts_per_motor_rev;
-    for (int i = 0; i < hal::kJoints; ++i) counts_per_rad_[i] = osc::encoder_counts_per_rad(osc::robot::kArm, drives, i);
+    for (int i = 0; i < hal::kJoints; ++i) counts_per_rad_[i] = osc::counts_per_rad(i, counts_per_motor_rev);
   }
 
   /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad).

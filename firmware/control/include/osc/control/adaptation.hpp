@@ -35,17 +35,24 @@ struct AdaptationState {
   int samples;           // samples recorded so far (saturates at 2)
 };
 
+/// The error signal of (67): the measured increment less the observer's prediction,
+/// Dq = q(t) - q(t-dt) - q^dot(t-dt) dt.
+template <class S>
+Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
+  return q - a.q_prev - a.qd_hat_prev * G.dt;
+}
+
 /// The paper's sampled law (67).
 template <class S>
 Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
-  const Vec6<S> Dq = q - a.q_prev - a.qd_hat_prev * G.dt;
+  const Vec6<S> Dq = increment_error(G, a, q);
   return a.theta_hat - G.kad * (friction_regressor(a.qd_hat_prev, G.tau_dec).transpose() * Dq);
 }
 
 /// The robust law: (67)'s error Dq, the regressor at q^dot(t-2dt), leakage, projection.
 template <class S>
 Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
-  const Vec6<S> Dq = q - a.q_prev - a.qd_hat_prev * G.dt;
+  const Vec6<S> Dq = increment_error(G, a, q);
   Vec18<S> theta = a.theta_hat - (G.leakage * G.dt) * a.theta_hat;
   theta -= G.kad * (friction_regressor(a.qd_hat_prev2, G.tau_dec).transpose() * Dq);
   for (int i = 0; i < 3 * kDof; ++i) {
@@ -58,12 +65,7 @@ Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const
 /// theta^(t) by the law the gains select; unchanged until the law has the samples it needs.
 template <class S>
 Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
-  switch (G.adaptation) {
-    case AdaptationLaw::kRobust:
-      return a.samples >= 2 ? adaptation_robust(G, a, q) : a.theta_hat;
-    case AdaptationLaw::kPaper:
-      break;
-  }
+  if (G.adaptation == AdaptationLaw::kRobust) return a.samples >= 2 ? adaptation_robust(G, a, q) : a.theta_hat;
   return a.samples >= 1 ? adaptation_paper(G, a, q) : a.theta_hat;
 }
 

@@ -46,10 +46,6 @@ constexpr FrictionCoefficients kFrictionNone = {"none", {0, 0, 0, 0, 0, 0}, {0, 
 
 constexpr double abs_of(double v) { return v < 0 ? -v : v; }
 
-/// Encoder counts per joint radian: counts per motor rev * |G| / (2 pi).
-constexpr double encoder_counts_per_rad(const ArmDescription& arm, const DriveParams& drives, int joint) {
-  return drives.encoder_counts_per_motor_rev * abs_of(arm.links[joint].gear_ratio) / (2 * kPi);
-}
 /// Largest DAC code magnitude.
 constexpr long dac_max_code(const DriveParams& drives) { return (1L << (drives.dac_bits - 1)) - 1; }
 

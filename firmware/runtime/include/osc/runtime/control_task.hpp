@@ -76,10 +76,8 @@ struct ControlTask {
   /// Encoders of another resolution than the robot table's (counts per motor revolution, after
   /// quadrature decoding): the count scaling and the plausible step per tick follow it.
   void set_encoder_resolution(double counts_per_motor_rev) {
-    DriveParams drives = robot::kDrives;
-    drives.encoder_counts_per_motor_rev = counts_per_motor_rev;
     for (int i = 0; i < kDof; ++i) {
-      const double c = encoder_counts_per_rad(robot::kArm, drives, i);
+      const double c = osc::counts_per_rad(i, counts_per_motor_rev);
       counts_per_rad(i) = lit<S>(c);
       // Speed limit times the sample, in counts, plus one count of quantisation.
       max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt * c) + 1;

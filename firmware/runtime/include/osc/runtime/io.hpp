@@ -9,8 +9,12 @@
 
 namespace osc {
 
-/// Encoder counts per joint radian of the robot's drives.
-constexpr double counts_per_rad(int joint) { return encoder_counts_per_rad(robot::kArm, robot::kDrives, joint); }
+/// Encoder counts per joint radian of the robot's drives, or of encoders with another resolution
+/// (counts per motor revolution, after quadrature decoding).
+constexpr double counts_per_rad(int joint,
+                                double counts_per_motor_rev = robot::kDrives.encoder_counts_per_motor_rev) {
+  return counts_per_motor_rev * abs_of(robot::kArm.links[joint].gear_ratio) / (2 * kPi);
+}
 /// Largest DAC code magnitude of the robot's drives.
 constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
 
