@@ -33,7 +33,8 @@ class LocalController {
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
     osc::Gains<S> gains = osc::Gains<S>::paper();
     gains.adaptation = cfg.adaptation;
-    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), gains, cfg.mode, q0.cast<S>());
+    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), gains, cfg.mode, q0.cast<S>(),
+                PlantHal::kPeriodNs);
     task_->set_encoder_resolution(cfg.encoder_counts_per_motor_rev);
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
@@ -53,7 +54,10 @@ class LocalController {
     return true;
   }
   void skip_ticks(std::uint64_t n) { task_->tick += n; }
-  void finish(ExperimentResult&) {}
+  void finish(ExperimentResult& res) {
+    for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck_peak(i));
+    for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck_dtau_peak(i));
+  }
 
  private:
   std::unique_ptr<osc::ControlTask<S>> task_;  // large: keep off the stack
@@ -109,7 +113,9 @@ template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
-  PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev);
+  PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev, cfg.injection);
+  InjectionResult& ir = res.injection;
+  ir.injection = cfg.injection;
 
   // Ground truth for the error statistics: the plant's own state through double kinematics.
   const osc::Model<double> truth = osc::Model<double>::of(osc::robot::kArm);
@@ -146,12 +152,23 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       if (k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
     }
     // The controller: encoders -> control step -> DAC codes.
+    hal.begin_sample(t);
     if (!ctrl.tick(hal, rep, res.error)) {
       res.error = "tick " + std::to_string(k) + ": " + res.error;
       break;
     }
-    if (rep.faults != 0 && res.status == 0) res.status = rep.faults;
+    if (rep.faults != 0 && res.status == 0) res.status = rep.faults, res.fault_time = t;
     const Vec6 tau_new = hal.torque();
+    if (hal.injection_active()) {
+      if (rep.faults != 0 && ir.detected < 0) ir.detected = t, ir.faults = rep.faults;
+      if (ir.zero_torque < 0) {
+        ir.excursion_mm = std::max(ir.excursion_mm, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
+        if ((tau_new.array() == 0.0).all()) ir.zero_torque = t;
+      }
+      if (ir.detected >= 0)
+        for (int i = 0; i < 6; ++i)
+          if (std::abs(tau_new(i)) > ir.max_torque_after) ir.max_torque_after = std::abs(tau_new(i)), ir.max_torque_joint = i;
+    }
 
     double xt[6];
     for (int i = 0; i < 6; ++i) xt[i] = rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg);

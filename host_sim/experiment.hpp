@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "osc/control/controller.hpp"
+#include "injection.hpp"
 #include "osc/control/gains.hpp"
 #include "plant.hpp"
 
@@ -33,6 +34,7 @@ struct ExperimentConfig {
   /// trajectory's period keeps the reference unchanged).
   double jump_at = -1;
   std::uint64_t jump_ticks = 0;
+  Injection injection;                              ///< a fault of the simulated hardware (none by default)
   std::function<void(double fraction)> progress;    ///< optional progress callback
   /// Processor-in-the-loop: the command that starts the firmware (e.g. qemu-system-arm with the
   /// image, see PilClient::qemu_command); empty runs the host-built controller in process.
@@ -48,6 +50,17 @@ struct LogRow {
   double theta_hat[18];
   double tau_f[6];      // true plant friction [N m]
   double tau_f_hat[6];  // estimated friction (30) [N m]
+};
+
+/// What an injected fault did (ExperimentConfig::injection).
+struct InjectionResult {
+  Injection injection;
+  double detected = -1;        ///< [s] first tick with a fault at or after the injection (-1: never)
+  std::uint32_t faults = 0;    ///< the fault bits raised in that tick
+  double zero_torque = -1;     ///< [s] first sample from which every amplifier torque is zero (-1: never)
+  double excursion_mm = 0;     ///< largest |p - p_d| of the true tip from injection to zero torque (or the end)
+  double max_torque_after = 0; ///< largest |tau| an amplifier applied after detection [N m]
+  int max_torque_joint = -1;   ///< its joint (0-based)
 };
 
 struct ExperimentResult {
@@ -68,7 +81,11 @@ struct ExperimentResult {
   std::string adaptation;                         // the adaptation law's name
   double friction_rms_error = 0;     // rms of tau_f_hat - tau_f over the last window [N m]
   double friction_rms = 0;           // rms of tau_f over the last window [N m]
+  double stuck_peak[6] = {};
+  double stuck_dtau_peak[6] = {};          // the stuck-encoder monitor's largest value per joint [counts] (in process)
   std::uint32_t status = 0;          // first fault bits reported (0: none)
+  double fault_time = -1;            // [s] of the first fault (-1: none)
+  InjectionResult injection;         // when cfg.injection.enabled
   std::string error;                 // link error (PIL), empty when the run completed
   std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
   double wall_seconds = 0;

@@ -14,6 +14,7 @@
 
 #include "cli.hpp"
 #include "experiment.hpp"
+#include "injection.hpp"
 #include "pil_client.hpp"
 
 namespace {
@@ -33,6 +34,9 @@ const char* kUsage =
     "  --elf FILE          firmware image for --qemu (default: the m4f build's pil_firmware.elf)\n"
     "  --json FILE         write the summary as JSON\n"
     "  --csv-dir DIR       write time series CSV files there (default: out)\n"
+    "  --inject KIND[:J]@S inject a fault into the simulated hardware at S seconds, on joint J (1..6;\n"
+    "                      default every joint): encoder-stuck | encoder-jump | encoder-garbage |\n"
+    "                      encoder-noise | dac-stuck | overrun | estop (docs/safety.md)\n"
     "  --final-window S    length of the \"last\" statistics at the end of the run (default 20; 1..3600)\n"
     "  --no-csv            do not write time series\n"
     "  --no-progress       no progress bar\n"
@@ -118,6 +122,9 @@ bool parse(int argc, char** argv, Options& o, std::string& err) {
       o.csv_dir = f;
     } else if (a == "--final-window") {
       if (!sim::parse_number(a, take(), 1, 3600, o.base.final_window, err)) return false;
+    } else if (a == "--inject") {
+      const char* f = take();
+      if (!sim::parse_injection(f ? f : "", o.base.injection, err)) return false;
     } else if (a == "--no-csv") {
       o.csv = false;
     } else if (a == "--no-progress") {
@@ -192,9 +199,24 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
       std::printf("[%s] firmware control step (observer + controller + adaptation, float): max %u, mean %u "
                   "instructions (QEMU -icount shift=0); whole tick incl. link I/O max %u; stack used %u bytes\n",
                   r.mode.c_str(), r.max_step_cycles, r.mean_step_cycles, r.max_tick_cycles, r.stack_used);
-    std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time)%s\n", r.mode.c_str(), r.duration,
-                r.wall_seconds, r.duration / r.wall_seconds,
-                r.status ? "  WARNING: a control step faulted (zero torque commanded)" : "");
+    std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time)\n", r.mode.c_str(), r.duration,
+                r.wall_seconds, r.duration / r.wall_seconds);
+    if (r.status) {
+      std::printf("[%s] FAULT at t = %.3f s:", r.mode.c_str(), r.fault_time);
+      for (int i = 0; i < osc::kFaultCount; ++i)
+        if (r.status & (1u << i)) std::printf(" %s", osc::kFaultNames[i]);
+      std::printf(" (latched; zero torque from that tick on)\n");
+    }
+    if (r.injection.injection.enabled) {
+      const sim::InjectionResult& ir = r.injection;
+      std::printf("[%s] injected %s: ", r.mode.c_str(), sim::to_string(ir.injection).c_str());
+      if (ir.detected < 0) std::printf("never detected");
+      else std::printf("detected after %.1f ms as %s", (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults));
+      if (ir.zero_torque < 0) std::printf(", torque never zero");
+      else std::printf(", zero torque after %.1f ms", (ir.zero_torque - ir.injection.at) * 1e3);
+      std::printf(", tip excursion %.2f mm, largest torque after detection %.2f N m\n", ir.excursion_mm,
+                  ir.max_torque_after);
+    }
   }
 }
 
@@ -212,6 +234,23 @@ void json_array(std::ostream& os, const double* v, int n, double scale = 1) {
   os << "[";
   for (int i = 0; i < n; ++i) os << (i ? ", " : "") << v[i] * scale;
   os << "]";
+}
+
+/// A time in seconds, or null for "never" (negative).
+std::string json_time(double t) {
+  if (t < 0) return "null";
+  std::ostringstream os;
+  os.precision(9);
+  os << t;
+  return os.str();
+}
+
+/// The names of the fault bits, as a JSON array.
+std::string json_faults(std::uint32_t bits) {
+  std::string s = "[";
+  for (int i = 0; i < osc::kFaultCount; ++i)
+    if (bits & (1u << i)) s += (s.size() > 1 ? ", " : "") + json_string(osc::kFaultNames[i]);
+  return s + "]";
 }
 
 void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* indent) {
@@ -254,6 +293,27 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
     os << ",\n" << indent << "\"firmware_step_instructions_mean\": " << r.mean_step_cycles;
     os << ",\n" << indent << "\"firmware_tick_instructions_max\": " << r.max_tick_cycles;
     os << ",\n" << indent << "\"firmware_stack_used_bytes\": " << r.stack_used;
+  }
+  os << ",\n" << indent << "\"stuck_monitor_peak_counts\": ";
+  json_array(os, r.stuck_peak, 6);
+  os << ",\n" << indent << "\"stuck_monitor_peak_dtau_Nm\": ";
+  json_array(os, r.stuck_dtau_peak, 6);
+  os << ",\n" << indent << "\"faults\": " << json_faults(r.status);
+  os << ",\n" << indent << "\"fault_time_s\": " << json_time(r.fault_time);
+  if (r.injection.injection.enabled) {
+    const sim::InjectionResult& ir = r.injection;
+    const std::string in2 = std::string(indent) + "  ";
+    os << ",\n" << indent << "\"injection\": {\n";
+    os << in2 << "\"kind\": \"" << sim::info(ir.injection.kind).name << "\",\n";
+    os << in2 << "\"joint\": " << (ir.injection.joint < 0 ? "null" : std::to_string(ir.injection.joint + 1)) << ",\n";
+    os << in2 << "\"at_s\": " << ir.injection.at << ",\n";
+    os << in2 << "\"detected_s\": " << json_time(ir.detected) << ",\n";
+    os << in2 << "\"fault\": " << (ir.detected < 0 ? "null" : json_string(osc::fault_name(ir.faults))) << ",\n";
+    os << in2 << "\"faults\": " << json_faults(ir.faults) << ",\n";
+    os << in2 << "\"zero_torque_s\": " << json_time(ir.zero_torque) << ",\n";
+    os << in2 << "\"excursion_mm\": " << ir.excursion_mm << ",\n";
+    os << in2 << "\"max_torque_after_detection_Nm\": " << ir.max_torque_after << "\n";
+    os << indent << "}";
   }
   if (!r.error.empty()) os << ",\n" << indent << "\"error\": " << json_string(r.error);
   os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
@@ -316,6 +376,9 @@ int main(int argc, char** argv) {
     if (o.base.model_error != 0) return fail("--model-error applies to the host-built controller only, not with --qemu");
     if (o.base.encoder_counts_per_motor_rev != osc::robot::kDrives.encoder_counts_per_motor_rev)
       return fail("--encoder-cpr applies to the host-built controller only, not with --qemu");
+    if (o.base.injection.enabled && !sim::info(o.base.injection.kind).per_joint)
+      return fail(std::string("--inject ") + sim::info(o.base.injection.kind).name +
+                  " applies to the host-built controller only, not with --qemu");
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float
@@ -369,7 +432,8 @@ int main(int argc, char** argv) {
     if (!write_json(o.json, runs, err)) return fail(err);
     std::printf("summary: %s\n", o.json.c_str());
   }
+  // A fault is a failed run, unless a fault was injected on purpose (then the JSON tells how it went).
   for (const auto& r : runs)
-    if (r.status || !r.error.empty()) return 1;
+    if ((r.status && !o.base.injection.enabled) || !r.error.empty()) return 1;
   return 0;
 }

@@ -232,4 +232,83 @@ TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
   }
 }
 
+// Fault injection into the simulated hardware (docs/safety.md), as puma_experiment --inject does.
+ExperimentResult inject(const char* spec, double duration, osc::FrictionMode mode = osc::FrictionMode::kAdaptive) {
+  ExperimentConfig c = config(duration, mode, osc::robot::kFrictionPaper);
+  std::string err;
+  EXPECT_TRUE(parse_injection(spec, c.injection, err)) << err;
+  const ExperimentResult r = run_experiment(c);
+  const InjectionResult& ir = r.injection;
+  std::printf("%-22s detected after %6.1f ms as %-14s zero torque after %6.1f ms, excursion %.2f mm\n", spec,
+              (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults), (ir.zero_torque - ir.injection.at) * 1e3,
+              ir.excursion_mm);
+  return r;
+}
+
+TEST(Injection, GarbageFirstReadingGivesZeroTorqueFromTheFirstTick) {
+  for (const char* spec : {"encoder-garbage:1@0", "encoder-garbage:6@0", "encoder-garbage@0"}) {
+    const ExperimentResult r = inject(spec, 0.5);
+    EXPECT_EQ(r.injection.detected, 0.0) << spec;
+    EXPECT_EQ(r.injection.zero_torque, 0.0) << spec;  // every amplifier at zero from tick 0 on
+    EXPECT_EQ(r.injection.faults & osc::kFaultEncoderRange, osc::kFaultEncoderRange) << spec;
+    EXPECT_EQ(r.injection.max_torque_after, 0.0) << spec;
+  }
+}
+
+TEST(Injection, JumpOverrunAndEstopAreDetectedInTheSameTick) {
+  const std::pair<const char*, std::uint32_t> cases[] = {{"encoder-jump:2@3.5", osc::kFaultEncoderJump},
+                                                         {"encoder-jump:5@3.5", osc::kFaultEncoderJump},
+                                                         {"overrun@3.5", osc::kFaultOverrun},
+                                                         {"estop@3.5", osc::kFaultEstop}};
+  for (const auto& [spec, fault] : cases) {
+    const ExperimentResult r = inject(spec, 4);
+    EXPECT_NEAR(r.injection.detected, 3.5, 1e-9) << spec;
+    EXPECT_NEAR(r.injection.zero_torque, 3.5, 1e-9) << spec;
+    EXPECT_EQ(r.injection.faults, fault) << spec;
+    EXPECT_EQ(r.status, fault) << spec;  // nothing before the injection
+  }
+}
+
+// A stuck encoder on any joint while the reference moves it: detected within 50 ms with a tip
+// excursion of at most 5 mm (the times where this cannot hold are in docs/safety.md).
+TEST(Injection, StuckEncoderIsDetectedWithin50msAndExcursionBelow5mm) {
+  for (int j = 1; j <= 6; ++j) {
+    const std::string spec = "encoder-stuck:" + std::to_string(j) + "@21.25";
+    const ExperimentResult r = inject(spec.c_str(), 21.5);
+    ASSERT_GE(r.injection.detected, 0) << spec;
+    EXPECT_LE(r.injection.detected - 21.25, 0.050 + 1e-9) << spec;
+    EXPECT_EQ(r.injection.zero_torque, r.injection.detected) << spec;
+    EXPECT_LE(r.injection.excursion_mm, 5.0) << spec;
+    EXPECT_EQ(r.fault_time, r.injection.detected) << spec;  // no fault before the injection
+  }
+}
+
+// A stuck amplifier cannot be zeroed by its DAC code: the monitors notice the motion it causes, and
+// the fault line (the amplifier enable) removes the torque.
+TEST(Injection, StuckAmplifierIsCaughtAndDisabledByTheFaultLine) {
+  const ExperimentResult r = inject("dac-stuck:2@3.5", 4.5);
+  ASSERT_GE(r.injection.detected, 0);
+  EXPECT_LE(r.injection.detected - 3.5, 0.6);
+  EXPECT_EQ(r.injection.zero_torque, r.injection.detected);
+  EXPECT_LE(r.injection.excursion_mm, 11.0);
+  EXPECT_EQ(r.injection.max_torque_after, 0.0);
+}
+
+TEST(Injection, ParserRejectsBadSpecifications) {
+  Injection inj;
+  std::string err;
+  for (const char* bad : {"", "encoder-stuck", "encoder-stuck@", "encoder-stuck@-1", "encoder-stuck@nan",
+                          "encoder-stuck:0@1", "encoder-stuck:7@1", "encoder-stuck:12@1", "encoder-stuck:@1",
+                          "overrun:1@1", "melt@1", "estop@1x"}) {
+    err.clear();
+    EXPECT_FALSE(parse_injection(bad, inj, err)) << bad;
+    EXPECT_FALSE(err.empty()) << bad;
+  }
+  ASSERT_TRUE(parse_injection("encoder-stuck:3@12.5", inj, err));
+  EXPECT_EQ(inj.kind, InjectionKind::kEncoderStuck);
+  EXPECT_EQ(inj.joint, 2);
+  EXPECT_EQ(inj.at, 12.5);
+  EXPECT_EQ(to_string(inj), "encoder-stuck:3@12.5");
+}
+
 }  // namespace

@@ -40,6 +40,7 @@ struct StepOutput {
   Vec6<S> x_tilde;    // observer position error (23)
   Vec6<S> xd_hat;     // observed velocity (21)
   Vec6<S> tau_f_hat;  // estimated friction (30)
+  Vec6<S> qd_ref;     // joint velocity the reference commands, J^{-1} x_d dot (stuck-encoder monitor)
   S rcond;
   std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular (then tau = 0)
 };
@@ -93,6 +94,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.x_tilde.setZero();
   out.xd_hat.setZero();
   out.tau_f_hat.setZero();
+  out.qd_ref.setZero();
   out.rcond = S(0);
   out.status = kFaultNone;
   if (!math::all_finite(q) || !math::isfinite(t)) {
@@ -128,6 +130,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.x_tilde = ob.x_tilde;
   out.xd_hat = ob.xd_hat;
   out.tau_f_hat = tau_f_hat;
+  out.qd_ref = os.Jf.solve(d.xd);
   return out;
 }
 

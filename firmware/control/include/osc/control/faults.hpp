@@ -17,7 +17,11 @@ namespace osc {
   X(Overrun, "overrun", "the next tick arrived before this one ended")                           \
   X(LinkLost, "link_lost", "no sensor frame within the link timeout")                            \
   X(LinkCorrupt, "link_corrupt", "a frame with a bad checksum, length or sequence number")         \
-  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")
+  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")          \
+  X(EncoderStuck, "encoder_stuck", "an encoder stood still while the reference moved its joint by more than the bound") \
+  X(Tracking, "tracking", "the measured tracking error exceeded its bound")                               \
+  X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                    \
+  X(Estop, "estop", "the emergency-stop input is active")
 
 namespace detail {
 enum FaultBit : unsigned {

@@ -43,6 +43,25 @@ constexpr double kMinJacobianRcond = 1e-3;
 constexpr double kJointLimitMargin = 0.1;
 /// Consecutive ticks a torque may stay clipped at the DAC range before the saturation fault.
 constexpr int kSaturationTicks = 50;
+/// Stuck-encoder monitor: the joint motion the reference commands while an encoder stands still,
+/// accumulated from the last count change, beyond which the encoder is stuck [counts]
+/// (docs/safety.md derives it from the fault-free peaks).
+constexpr double kStuckMotionCounts = 100;
+/// ... or the commanded joint torque has changed by more than this since the encoder's last change
+/// [N m]: a joint held by static friction breaks away within a bounded torque change, a joint whose
+/// encoder is stuck while it moves makes the controller ramp its torque without bound.
+constexpr double kStuckTorque[6] = {27, 31, 12, 14, 6, 9};
+/// ... and the encoder has been silent for more than this many of its recent intervals between
+/// counts.
+constexpr int kStuckIntervals = 10;
+/// Tracking-error bounds on the measured error e (36): position [m] and each orientation
+/// coordinate [rad]; about 2.5 times the worst fault-free error without friction compensation.
+constexpr double kTrackingLimitPosition = 0.010;
+constexpr double kTrackingLimitOrientation = 0.02;
+/// The supervisor's bounds on the friction estimates: the robust law's projection set [0, theta_max]
+/// widened by theta_max on each side, [-theta_max, 2 theta_max]. The robust law never leaves
+/// [0, theta_max]; (67), which has no bounds, faults when it drifts that far.
+constexpr double kThetaFaultBand = 1.0;
 /// Sensor-frame timeout of the processor-in-the-loop link [s] (virtual time of the target).
 constexpr double kLinkTimeout = 0.1;
 

@@ -32,6 +32,9 @@ struct StepTiming {
   }
 };
 
+/// Longest interval between encoder changes the stuck-encoder monitor keeps [ticks].
+constexpr std::uint32_t kStuckIntervalCap = 1u << 20;
+
 template <class S>
 struct ControlTask {
   Model<S> model;
@@ -48,6 +51,12 @@ struct ControlTask {
   std::int32_t max_count_step[kDof];  // largest plausible encoder change per tick
   std::int64_t min_counts[kDof], max_counts[kDof];  // plausible readings: joint limits plus a margin
   std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
+  Vec6<S> stuck_motion;               // reference motion since each encoder's last change [counts]
+  std::uint64_t last_move_tick[kDof];  // tick of each encoder's last change
+  std::uint32_t move_interval[kDof];   // ticks between its last two changes (its recent count rate)
+  Vec6<S> tau_at_move;                // the torque commanded at each encoder's last change
+  Vec6<S> stuck_dtau_peak;            // the largest torque change seen while an encoder stood still
+  Vec6<S> stuck_peak;                 // the largest stuck_motion seen (the monitor's headroom)
   Supervisor sup;
   std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
   StepTiming timing;                  // the whole tick: I/O, step, supervision
@@ -66,6 +75,14 @@ struct ControlTask {
       codes[i] = 0;
       prev_counts[i] = 0;
       sat_ticks[i] = 0;
+    }
+    stuck_motion.setZero();
+    stuck_peak.setZero();
+    tau_at_move.setZero();
+    stuck_dtau_peak.setZero();
+    for (int i = 0; i < kDof; ++i) {
+      last_move_tick[i] = 0;
+      move_interval[i] = kStuckIntervalCap;
     }
     set_encoder_resolution(robot::kDrives.encoder_counts_per_motor_rev);
     sup = {SupervisorState::kInit, 0};
@@ -99,6 +116,51 @@ Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<S>& counts_per_rad
   return q;
 }
 
+/// The checks of a completed step against what the controller commanded (docs/safety.md):
+///  - encoder_stuck: an encoder stood still while the reference moved its joint by more than
+///    params::kStuckMotionCounts counts since its last change;
+///  - tracking: the measured tracking error e (36) beyond params::kTrackingLimit*;
+///  - theta_bounds: a friction estimate outside [-band theta_max, (1 + band) theta_max].
+template <class S>
+std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) {
+  std::uint32_t faults = 0;
+  const StepOutput<S>& out = task.last;
+  for (int i = 0; i < kDof; ++i) {
+    S& m = task.stuck_motion(i);
+    if (moved[i]) {
+      const std::uint64_t gap = task.tick - task.last_move_tick[i];
+      task.move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
+      task.last_move_tick[i] = task.tick;
+      m = S(0);
+      task.tau_at_move(i) = out.tau(i);
+      continue;
+    }
+    const S dtau = math::abs(out.tau(i) - task.tau_at_move(i));
+    if (dtau > task.stuck_dtau_peak(i)) task.stuck_dtau_peak(i) = dtau;
+    if (dtau > lit<S>(params::kStuckTorque[i])) faults |= kFaultEncoderStuck;
+    m += math::abs(out.qd_ref(i)) * task.gains.dt * task.counts_per_rad(i);
+    // Stuck: the reference has moved the joint far, and the encoder has been silent for many times
+    // its recent interval between counts (a joint that was slowing down, as at a reversal held by
+    // static friction, had long intervals already).
+    const std::uint64_t silent = task.tick - task.last_move_tick[i];
+    if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * task.move_interval[i]) continue;
+    if (m > task.stuck_peak(i)) task.stuck_peak(i) = m;
+    if (m > lit<S>(params::kStuckMotionCounts)) faults |= kFaultEncoderStuck;
+  }
+  const S lp = lit<S>(params::kTrackingLimitPosition), lo = lit<S>(params::kTrackingLimitOrientation);
+  if (out.e.template head<3>().squaredNorm() > lp * lp) faults |= kFaultTracking;
+  for (int i = 3; i < 6; ++i)
+    if (math::abs(out.e(i)) > lo) faults |= kFaultTracking;
+  if (task.mode == FrictionMode::kAdaptive) {
+    const S band = lit<S>(params::kThetaFaultBand);
+    for (int i = 0; i < 3 * kDof; ++i) {
+      const S th = task.state.adapt.theta_hat(i), mx = task.gains.theta_max(i);
+      if (!(th >= -band * mx && th <= (S(1) + band) * mx)) faults |= kFaultThetaBounds;
+    }
+  }
+  return faults;
+}
+
 /// One tick. Returns the fault bits detected in this tick. On any fault, and whenever the
 /// supervisor is not in kRun, every DAC gets code 0 in this same tick.
 template <class S, hal::ControlHal Hal>
@@ -111,15 +173,17 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   for (int i = 0; i < kDof; ++i)
     if (counts[i] < task.min_counts[i] || counts[i] > task.max_counts[i]) faults |= kFaultEncoderRange;
   // An encoder change beyond the physical joint speed (comparison written so that it cannot wrap).
+  bool moved[kDof] = {};
   if (task.have_counts) {
     for (int i = 0; i < kDof; ++i) {
       const std::int64_t d = static_cast<std::int64_t>(counts[i]) - task.prev_counts[i];
       if (d > task.max_count_step[i] || d < -static_cast<std::int64_t>(task.max_count_step[i]))
         faults |= kFaultEncoderJump;
+      moved[i] = d != 0;
       task.prev_counts[i] = counts[i];
     }
   } else {
-    for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i];
+    for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i], moved[i] = true;  // the monitors start here
     task.have_counts = true;
   }
 
@@ -131,6 +195,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
     task.step_timing.add(hal.cycles() - s0);
     faults |= task.last.status;  // non_finite, singular
+    if (task.last.status == kFaultNone) faults |= plausibility_faults(task, moved);
     for (int i = 0; i < kDof; ++i) {
       const bool clipped = torque_to_code(i, task.last.tau(i), task.codes[i]);
       task.sat_ticks[i] = clipped ? static_cast<std::uint16_t>(task.sat_ticks[i] + 1) : 0;
