@@ -319,6 +319,51 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
   os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
 }
 
+/// Writes a temporary file beside path, then renames it: an existing file is never left
+/// half-written, and nothing is left behind on failure.
+bool write_atomically(const std::string& path, const std::string& text, std::string& err) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream f(tmp);
+    if (f) f << text;
+    f.close();
+    if (!f) {
+      std::remove(tmp.c_str());
+      return err = "cannot write " + path, false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    return err = "cannot write " + path + " (rename failed)", false;
+  }
+  return true;
+}
+
+/// Before the run: an output file can be created there (the file itself is written at the end).
+bool check_writable(const std::string& path, std::string& err) {
+  if (std::filesystem::is_directory(path)) return err = "cannot write " + path + ": it is a directory", false;
+  const std::string tmp = path + ".tmp";
+  std::ofstream f(tmp);
+  const bool ok = static_cast<bool>(f);
+  f.close();
+  std::remove(tmp.c_str());
+  if (!ok) return err = "cannot write " + path + " (does its directory exist and is it writable?)", false;
+  return true;
+}
+
+/// The --qemu image must be a 32-bit little-endian ARM ELF file.
+bool check_arm_elf(const std::string& path, std::string& err) {
+  std::ifstream f(path, std::ios::binary);
+  unsigned char h[20] = {};
+  if (!f.read(reinterpret_cast<char*>(h), sizeof h))
+    return err = "firmware image " + path + " is not an ELF file (too short or unreadable)", false;
+  if (h[0] != 0x7F || h[1] != 'E' || h[2] != 'L' || h[3] != 'F')
+    return err = "firmware image " + path + " is not an ELF file; pass the .elf the m4f build makes", false;
+  if (h[4] != 1 || h[5] != 1 || (h[18] | (h[19] << 8)) != 40)
+    return err = "firmware image " + path + " is not a 32-bit little-endian ARM ELF file", false;
+  return true;
+}
+
 bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, std::string& err) {
   std::ostringstream os;
   os.precision(9);
@@ -332,20 +377,12 @@ bool write_json(const std::string& path, const std::vector<sim::ExperimentResult
     os << "    }" << (i + 1 < runs.size() ? "," : "") << "\n";
   }
   os << "  ]\n}\n";
-  // Write to a temporary file, then rename: an existing file is never left half-written.
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (!(f << os.str())) return err = "cannot write " + tmp, false;
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) return err = "cannot rename " + tmp + " to " + path, false;
-  return true;
+  return write_atomically(path, os.str(), err);
 }
 
 bool write_csv(const std::string& dir, const sim::ExperimentResult& r, std::string& err) {
   const std::string path = dir + "/timeseries_" + r.mode + ".csv";
-  std::ofstream f(path + ".tmp");
-  if (!f) return err = "cannot write " + path + " (does the directory exist?)", false;
+  std::ostringstream f;
   f << "t,e_x_mm,e_y_mm,e_z_mm,e_phx_deg,e_phy_deg,e_phz_deg,xt_x_mm,xt_y_mm,xt_z_mm,xt_phx_deg,xt_phy_deg,xt_phz_deg";
   for (int i = 0; i < 18; ++i) f << ",theta_hat_" << i;
   for (int i = 0; i < 6; ++i) f << ",tau_f_" << i;
@@ -360,9 +397,7 @@ bool write_csv(const std::string& dir, const sim::ExperimentResult& r, std::stri
     for (double v : row.tau_f_hat) f << "," << v;
     f << "\n";
   }
-  f.close();
-  if (!f || std::rename((path + ".tmp").c_str(), path.c_str()) != 0) return err = "cannot write " + path, false;
-  return true;
+  return write_atomically(path, f.str(), err);
 }
 
 }  // namespace
@@ -381,6 +416,7 @@ int main(int argc, char** argv) {
                   " applies to the host-built controller only, not with --qemu");
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
+    if (!check_arm_elf(o.elf, err)) return fail(err);
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
   }
@@ -391,6 +427,8 @@ int main(int argc, char** argv) {
     if (ec || !std::filesystem::is_directory(o.csv_dir))
       return fail("cannot create directory " + o.csv_dir + (ec ? ": " + ec.message() : ""));
   }
+
+  if (!o.json.empty() && !check_writable(o.json, err)) return fail(err);
 
   std::vector<sim::ExperimentConfig> cfgs;
   if (o.run_adaptive) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kAdaptive;
