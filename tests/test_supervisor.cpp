@@ -35,10 +35,13 @@ TEST(Supervisor, ExhaustiveAgainstTheSpecification) {
           // Properties: faults are sticky and always disable torque.
           if (f & kAllFaults) {
             ASSERT_FALSE(torque_enabled(got));
+            ASSERT_FALSE(supervisor_healthy(got));  // a faulting tick never feeds the watchdog
           }
           if (st == 2) {
             ASSERT_EQ(got.state, SupervisorState::kFault);
+            ASSERT_FALSE(supervisor_healthy(got));
           }
+          ASSERT_EQ(supervisor_healthy(got), want.state != SupervisorState::kFault && want.latched == 0);
           ASSERT_EQ(got.latched & s.latched, s.latched);
           ++cases;
         }
@@ -107,10 +110,12 @@ struct TaskFixture : ::testing::Test {
     EXPECT_TRUE(task->sup.latched & bit) << task->sup.latched;
     EXPECT_TRUE(hal.all_zero());
     EXPECT_TRUE(hal.fault_line);
+    EXPECT_FALSE(supervisor_healthy(task->sup));  // the faulting tick does not feed the watchdog
     // Stays latched with healthy inputs afterwards.
     run(3);
     EXPECT_EQ(task->sup.state, SupervisorState::kFault);
     EXPECT_TRUE(hal.all_zero());
+    EXPECT_FALSE(supervisor_healthy(task->sup));
   }
 };
 
@@ -120,6 +125,7 @@ TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
   EXPECT_FALSE(hal.all_zero());  // holds gravity
   EXPECT_EQ(hal.writes, 5);
   EXPECT_FALSE(hal.fault_line);
+  EXPECT_TRUE(supervisor_healthy(task->sup));  // healthy ticks feed the watchdog
   EXPECT_EQ(task->timing.count, 5u);
   EXPECT_GT(task->timing.max, 0u);
 }

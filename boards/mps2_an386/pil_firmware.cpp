@@ -3,6 +3,15 @@
 // here it is pended by the arrival of each sensor frame, so the host's plant sets the sample
 // clock (lockstep) and the run is deterministic under -icount. The link watchdog in the main loop
 // reports a missing or short frame as a fault with zero torque.
+//
+// The CMSDK watchdog (board.hpp) starts with the link (the first received byte). Its PIL policy
+// (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop
+// while it waits for the host's next frame, once per control period, provided every tick it pended
+// has run. The host sets the pace and may take far longer than the 8 ms to the reset between two
+// frames (virtual time advances while the main loop polls), so ticks alone cannot feed it here. A
+// hung or disabled control interrupt or a hung main loop lets it expire; a latched fault does not:
+// the link keeps answering every frame with zero torque and the latched bits, which the host needs.
+// Feeding never changes what a tick computes, so the lockstep run stays deterministic.
 #include <cstdint>
 
 #include "board.hpp"
@@ -28,11 +37,28 @@ osc::PilNode<float, Mps2Board> g_node;  // a few kB: static, never on the stack
 constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;
 constexpr std::uint32_t kLinkTimeoutNs = static_cast<std::uint32_t>(osc::params::kLinkTimeout * 1e9);
 
+// Ticks pended by the main loop and ticks run by the control interrupt: equal when none is stuck.
+volatile std::uint32_t g_ticks_pended = 0, g_ticks_run = 0;
+
+void pend_tick() {
+  g_ticks_pended = g_ticks_pended + 1;
+  board::control_irq_pend();  // the tick runs now
+}
+
 }  // namespace
 
 extern "C" void TIMER0_Handler() {
   board::control_timer_ack();
   g_node.tick();
+  g_ticks_run = g_ticks_run + 1;
+  if (osc::supervisor_healthy(g_node.task.sup)) board::watchdog_feed();
+}
+
+// The watchdog's first expiry: fault line active, the cause noted, then the reset (under -no-reboot
+// QEMU ends and the host reports the closed link).
+extern "C" void NMI_Handler() {
+  board::watchdog_expired(g_node.task.sup.latched);
+  board::await_reset();
 }
 
 int main() {
@@ -43,18 +69,29 @@ int main() {
   g_node.hello();  // bytes the host sent before this point may have been dropped
   // The main loop polls the UART (under -icount, polling makes virtual time advance with the
   // instructions executed, so the link timeout is measured deterministically; a WFI-idle loop
-  // lets QEMU warp virtual time). The watchdog is armed by the first byte.
+  // lets QEMU warp virtual time). The link watchdog and the CMSDK watchdog are armed by the first
+  // byte.
   bool link_up = false;
-  std::uint32_t last = board::cycles();
+  std::uint32_t last = board::cycles(), last_feed = last;
   for (;;) {
     if (board::uart_rx_ready()) {
-      if (g_node.on_byte(board::uart_read())) board::control_irq_pend();  // the tick runs now
+      if (!link_up) {
+        link_up = true;
+        board::watchdog_start();
+        last_feed = board::cycles();
+      }
+      if (g_node.on_byte(board::uart_read())) pend_tick();
       last = board::cycles();
-      link_up = true;
-    } else if (link_up && board::cycles() - last > kLinkTimeoutNs) {
-      g_node.on_timeout();
-      board::control_irq_pend();
-      last = board::cycles();
+    } else if (link_up) {
+      const std::uint32_t now = board::cycles();
+      if (now - last > kLinkTimeoutNs) {
+        g_node.on_timeout();
+        pend_tick();
+        last = board::cycles();
+      } else if (now - last_feed >= kPeriodNs && g_ticks_run == g_ticks_pended) {
+        board::watchdog_feed();  // waiting for the host, every pended tick done
+        last_feed = now;
+      }
     }
   }
 }

@@ -1,7 +1,10 @@
 // The control task in the 1 kHz TIMER0 interrupt, standalone: a HAL with the encoders held at the
-// start pose (no plant) and the DAC codes kept in memory. Runs 200 ticks, then checks that they
-// came 1 ms apart in virtual time, that no tick overran or faulted, and reports the step timing
-// and the stack high-water mark. Exit status 0 = pass.
+// start pose (no plant) and the DAC codes kept in memory. The CMSDK watchdog runs and is fed at the
+// end of every healthy tick (osc::supervisor_healthy); its first expiry (the NMI) would drop the
+// fault line and wait for the reset. Runs 200 ticks, then stops the watchdog and checks that the
+// ticks came 1 ms apart in virtual time, that no tick overran or faulted, that every tick fed the
+// watchdog and it never expired, and reports the step timing, the stack high-water mark and the
+// cause of the last reset. Prints "timer_firmware: pass" and exits 0 on success.
 #include <cstdint>
 
 #include "board.hpp"
@@ -34,6 +37,7 @@ constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;
 osc::ControlTask<float> g_task;
 StillHal g_hal;
 volatile int g_ticks = 0;
+volatile int g_feeds = 0;
 volatile std::uint32_t g_faults = 0;
 std::uint32_t g_stamp[kTicks];
 
@@ -45,16 +49,32 @@ extern "C" void TIMER0_Handler() {
   if (k >= kTicks) return;
   g_stamp[k] = board::cycles();
   g_faults = g_faults | osc::control_tick(g_task, g_hal);
+  // The watchdog is fed only at the end of a healthy tick.
+  if (osc::supervisor_healthy(g_task.sup)) {
+    board::watchdog_feed();
+    g_feeds = g_feeds + 1;
+  }
   g_ticks = k + 1;
+}
+
+// The watchdog's first expiry: fault line active, the cause noted, then the reset (under the
+// tests' -no-reboot QEMU ends without the pass line).
+extern "C" void NMI_Handler() {
+  board::watchdog_expired(g_task.sup.latched);
+  board::await_reset();
 }
 
 int main() {
   board::cycle_counter_init();
+  const cortex_m::ResetCause cause = board::reset_cause();
   g_task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
               osc::joint_vector<float>(osc::robot::kQStart), kPeriodNs);
+  board::watchdog_start();
   board::control_timer_start(board::kControlHz);
   while (g_ticks < kTicks) {
   }
+  const bool watchdog_ok = g_feeds == kTicks && !board::Watchdog::expired_once();
+  board::watchdog_stop();  // the run is over: no more ticks feed it
   // Tick spacing in virtual time.
   std::uint32_t lo = 0xFFFFFFFFu, hi = 0;
   for (int k = 1; k < kTicks; ++k) {
@@ -68,8 +88,12 @@ int main() {
   cortex_m::text::Line().str("supervisor state ").u32(static_cast<std::uint32_t>(g_task.sup.state)).str(", faults ")
       .u32(g_faults).str(", torque code joint 2: ").i32(g_hal.codes[1]).emit();
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
+  cortex_m::text::Line().str("watchdog: fed by ").i32(g_feeds).str(" of ").i32(kTicks).str(" ticks, ")
+      .str(watchdog_ok ? "never expired" : "EXPIRED or unfed").str("; reset cause ")
+      .str(board::reset_cause_name(cause)).emit();
   const bool spacing_ok = lo + 100 >= kPeriodNs && hi <= kPeriodNs + 100;
-  const bool ok = spacing_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun && g_hal.codes[1] != 0;
+  const bool ok = spacing_ok && watchdog_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun &&
+                  g_hal.codes[1] != 0;
   cortex_m::text::Line().str(ok ? "timer_firmware: pass" : "timer_firmware: FAIL").emit();
   return ok ? 0 : 1;
 }

@@ -13,11 +13,15 @@ if [ -n "$hits$undef" ]; then
   exit 1
 fi
 echo "no heap, exception or RTTI symbols in $(basename "$elf")"
-read -r text data bss _ < <(arm-none-eabi-size "$elf" | tail -1)
+read -r text data _ < <(arm-none-eabi-size "$elf" | tail -1)
+# RAM by section (size's "bss" column sums every NOBITS section, the main stack and .noinit too).
+section() { arm-none-eabi-size -A "$elf" | awk -v s="$1" '$1==s{n=$2} END{print n+0}'; }
+bss=$(section .bss)
+noinit=$(section .noinit)
 top=$(arm-none-eabi-nm "$elf" | awk '$3=="__stack_top__"{print $1}')
 limit=$(arm-none-eabi-nm "$elf" | awk '$3=="__stack_limit__"{print $1}')
 stack=$((16#$top - 16#$limit))
-echo "flash (text+data): $((text + data)) bytes; RAM: data $data + bss $bss + main stack $stack = $((data + bss + stack)) bytes"
+echo "flash (text+data): $((text + data)) bytes; RAM: data $data + bss $bss + noinit $noinit + main stack $stack = $((data + bss + noinit + stack)) bytes"
 if [ -n "$su_dir" ] && [ -d "$su_dir" ]; then
   echo "largest stack frames (-fstack-usage):"
   find "$su_dir" -name '*.su' -exec cat {} + | sort -t$'\t' -k2 -n -r | sed -n '1,8s/^/  /p'

@@ -1,6 +1,6 @@
 // Code shared by every Cortex-M3/M4 board: core registers (SCB, NVIC, SysTick), semihosting, the
-// SysTick-based cycle counter and the main-stack high-water mark. A board adds its own clock,
-// peripherals and interrupt table (boards/<board>/board.hpp, vectors.cpp).
+// SysTick-based cycle counter, the main-stack high-water mark and the reset record. A board adds
+// its own clock, peripherals and interrupt table (boards/<board>/board.hpp, vectors.cpp).
 #pragma once
 
 #include <cstdint>
@@ -12,11 +12,17 @@ struct SysTickRegs {
 };
 inline SysTickRegs& systick() { return *reinterpret_cast<SysTickRegs*>(0xE000E010u); }
 inline volatile std::uint32_t& nvic_iser0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E100u); }
+inline volatile std::uint32_t& nvic_icer0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E180u); }
 inline volatile std::uint32_t& nvic_ispr0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E200u); }
 inline volatile std::uint32_t& scb_cpacr() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000ED88u); }
 
 /// Enables external interrupt irq (0..31).
 inline void irq_enable(int irq) { nvic_iser0() = 1u << irq; }
+/// Disables external interrupt irq (0..31); it is not taken after this call returns.
+inline void irq_disable(int irq) {
+  nvic_icer0() = 1u << irq;
+  __asm__ volatile("dsb\n isb" ::: "memory");
+}
 /// Pends external interrupt irq. The barriers make every store made before the call (e.g. fault
 /// flags the interrupt reads) visible to it: the interrupt is taken right after the write.
 inline void irq_pend(int irq) {
@@ -62,5 +68,26 @@ inline std::uint32_t systick_cycles() {
 // ---------------------------------------------------------------- stack
 /// Bytes of the main stack ever used (painted at reset by the common startup code).
 std::uint32_t stack_used();
+
+// ---------------------------------------------------------------- reset record
+// Neither the Cortex-M3/M4 core nor QEMU's MPS2 boards have a reset-cause register. The cause is
+// kept in a record in .noinit RAM (the linker script places it; the startup code neither loads nor
+// zeroes it): the watchdog's interrupt, one timeout before its reset, notes that the reset to come
+// is the watchdog's (note_watchdog_expiry); the startup code reads and clears the note before
+// main(). A check word tells a written record from the undefined RAM of a power-on.
+enum class ResetCause : std::uint8_t {
+  kPowerOn = 0,   ///< no valid record: RAM was not retained
+  kWatchdog = 1,  ///< the watchdog expired (its interrupt ran) before this reset
+  kOther = 2,     ///< RAM retained, the watchdog not involved (e.g. a debugger or software reset)
+};
+/// The cause of the last reset (set by the startup code before main()).
+ResetCause reset_cause();
+/// Watchdog resets since the last power-on.
+std::uint32_t watchdog_resets();
+/// The fault bits passed to note_watchdog_expiry() before the last watchdog reset (0 otherwise).
+std::uint32_t watchdog_faults();
+/// Called from the watchdog's interrupt: the next reset is the watchdog's; `faults` (e.g. the
+/// supervisor's latched bits) are kept for the next boot.
+void note_watchdog_expiry(std::uint32_t faults);
 
 }  // namespace cortex_m

@@ -1,6 +1,6 @@
 // Reset and system exceptions, shared by every Cortex-M board: FPU on (where there is one), .data
-// copied, .bss zeroed, the main stack painted for the high-water mark, static constructors, main(),
-// semihosting exit with main's status. The 16 system entries of the vector table are here, in
+// copied, .bss zeroed, the main stack painted for the high-water mark, the reset record read (the
+// cause of this reset), static constructors, main(), semihosting exit with main's status. The 16 system entries of the vector table are here, in
 // section .isr_vector; each board's vectors.cpp places its external interrupts right after them,
 // in .isr_vector.irq (the linker scripts keep the two in that order).
 #include <cstdint>
@@ -30,6 +30,48 @@ void SysTick_Handler() __attribute__((weak, alias("Default_Handler")));
 namespace {
 constexpr std::uint32_t kPaint = 0xC0FFEE11u;
 using Handler = void (*)();
+
+/// The reset record (cortex_m.hpp), in RAM that survives a reset.
+struct ResetRecord {
+  std::uint32_t magic;            // kRecordMagic: written by this firmware since the power-on
+  std::uint32_t watchdog_noted;   // note_watchdog_expiry() ran: the next reset is the watchdog's
+  std::uint32_t watchdog_resets;  // since the power-on
+  std::uint32_t faults;           // as noted at the last watchdog expiry
+  std::uint32_t check;            // seal(): tells a written record from undefined RAM
+  std::uint32_t seal() const { return ~(magic ^ watchdog_noted ^ (watchdog_resets * 0x9E3779B9u) ^ faults); }
+};
+constexpr std::uint32_t kRecordMagic = 0x52535431u;
+__attribute__((section(".noinit"))) volatile ResetRecord g_reset_record;
+cortex_m::ResetCause g_reset_cause;
+std::uint32_t g_watchdog_faults;
+
+/// Reads the record left by the previous run (if any) and starts a new one.
+void read_reset_record() {
+  ResetRecord r;
+  r.magic = g_reset_record.magic;
+  r.watchdog_noted = g_reset_record.watchdog_noted;
+  r.watchdog_resets = g_reset_record.watchdog_resets;
+  r.faults = g_reset_record.faults;
+  r.check = g_reset_record.check;
+  if (r.magic != kRecordMagic || r.check != r.seal()) {
+    g_reset_cause = cortex_m::ResetCause::kPowerOn;
+    r.watchdog_resets = 0;
+  } else if (r.watchdog_noted != 0) {
+    g_reset_cause = cortex_m::ResetCause::kWatchdog;
+    ++r.watchdog_resets;
+    g_watchdog_faults = r.faults;
+  } else {
+    g_reset_cause = cortex_m::ResetCause::kOther;
+  }
+  r.magic = kRecordMagic;
+  r.watchdog_noted = 0;
+  r.faults = 0;
+  g_reset_record.magic = r.magic;
+  g_reset_record.watchdog_noted = r.watchdog_noted;
+  g_reset_record.watchdog_resets = r.watchdog_resets;
+  g_reset_record.faults = r.faults;
+  g_reset_record.check = r.seal();
+}
 }  // namespace
 
 __attribute__((section(".isr_vector"), used)) const Handler g_system_vectors[16] = {
@@ -69,6 +111,7 @@ extern "C" [[noreturn]] void Reset_Handler() {
   std::uint32_t* sp;
   __asm__ volatile("mov %0, sp" : "=r"(sp));
   for (std::uint32_t* p = &__stack_limit__; p < sp - 16; ++p) *p = kPaint;
+  read_reset_record();
   for (void (**f)() = &__init_array_start; f < &__init_array_end; ++f) (*f)();
   cortex_m::semihost::exit(application_main());
 }
@@ -78,4 +121,20 @@ std::uint32_t cortex_m::stack_used() {
   while (p < &__stack_top__ && *p == kPaint) ++p;
   return static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&__stack_top__) -
                                     reinterpret_cast<std::uintptr_t>(p));
+}
+
+cortex_m::ResetCause cortex_m::reset_cause() { return g_reset_cause; }
+std::uint32_t cortex_m::watchdog_resets() { return g_reset_record.watchdog_resets; }
+std::uint32_t cortex_m::watchdog_faults() { return g_watchdog_faults; }
+
+void cortex_m::note_watchdog_expiry(std::uint32_t faults) {
+  ResetRecord r;
+  r.magic = kRecordMagic;
+  r.watchdog_noted = 1;
+  r.watchdog_resets = g_reset_record.watchdog_resets;
+  r.faults = faults;
+  g_reset_record.watchdog_noted = r.watchdog_noted;
+  g_reset_record.faults = r.faults;
+  g_reset_record.check = r.seal();
+  g_reset_record.magic = r.magic;
 }

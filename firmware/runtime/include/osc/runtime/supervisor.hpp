@@ -37,4 +37,11 @@ constexpr Supervisor supervisor_next(Supervisor s, SupervisorInput in) {
 /// Torque may be commanded only in kRun.
 constexpr bool torque_enabled(const Supervisor& s) { return s.state == SupervisorState::kRun; }
 
+/// A tick that ends in this state may feed a hardware watchdog: kRun, or kInit, with no fault
+/// latched. A tick that latched a fault (and every tick after it) is not healthy, so the watchdog
+/// expires (docs/firmware.md, "Watchdog").
+constexpr bool supervisor_healthy(const Supervisor& s) {
+  return s.state != SupervisorState::kFault && s.latched == 0;
+}
+
 }  // namespace osc
