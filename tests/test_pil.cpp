@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "experiment.hpp"
+#include "osc/runtime/io.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/supervisor.hpp"
 #include "pil_client.hpp"
@@ -215,27 +216,24 @@ TEST_F(Link, OverrunFaultsInTheSameTick) {
 }
 
 TEST_F(Link, NearSingularJacobianFaults) {
-  healthy(2);
-  // Drive joint 5 towards 0 (wrist singularity) just below the plausible-speed limit (16 rad/s),
-  // so that the Jacobian test trips before the torques have been clipped for 50 ticks.
-  pil::ActuatorFrame a;
-  for (int k = 0; k < 2000; ++k) {
-    counts[4] -= 180;
-    a = exchange();
-    if (a.faults) break;
-  }
+  // The first sample puts joint 5 at 0 (the wrist singularity; within its limits): the Jacobian test
+  // refuses to act in that tick. (Driving the wrist there from the start pose trips the tracking
+  // bound first: the reference orientation does not follow.)
+  counts[4] = -static_cast<std::int32_t>(osc::robot::kQStart[4] * osc::counts_per_rad(4));
+  const pil::ActuatorFrame a = exchange();
   EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultSingular));
   EXPECT_TRUE(zero(a));
 }
 
-TEST_F(Link, PersistentSaturationFaults) {
-  // Encoders frozen while the trajectory moves away: the torques clip and stay clipped.
+TEST_F(Link, FrozenEncodersFaultAsStuck) {
+  // Encoders frozen while the trajectory moves away: the stuck-encoder monitor latches (before it,
+  // the torques clipped and stayed clipped until the saturation check).
   pil::ActuatorFrame a;
   for (int k = 0; k < 20000; ++k) {
     a = exchange();
     if (a.faults) break;
   }
-  EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultSaturation));
+  EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultEncoderStuck));
   EXPECT_TRUE(zero(a));
 }
 

@@ -132,8 +132,8 @@ TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
 
 TEST_F(TaskFixture, EncoderJumpFaultsInTheSameTick) {
   run(3);
-  hal.counts[1] += task->max_count_step[1];  // the largest plausible step is fine
-  EXPECT_EQ(run(1), 0u);
+  hal.counts[1] += task->max_count_step[1];  // the largest plausible step is no jump (the torque it
+  EXPECT_EQ(run(1) & kFaultEncoderJump, 0u);  // asks for while the other joints stand still is another matter)
   hal.counts[1] += task->max_count_step[1] + 1;
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
   expect_latched(kFaultEncoderJump);
@@ -176,14 +176,80 @@ TEST_F(TaskFixture, SingularPoseFaults) {
   expect_latched(kFaultSingular);
 }
 
-TEST_F(TaskFixture, PersistentSaturationFaults) {
-  // The robot does not move (encoders frozen) while the trajectory runs away: the error grows until
-  // the torques clip, and after kSaturationTicks clipped ticks the fault latches.
+TEST_F(TaskFixture, FrozenEncodersWhileTheReferenceMovesFaultAsStuck) {
+  // The robot's encoders do not move while the trajectory runs away: the stuck-encoder monitor
+  // (reference motion or torque change while an encoder stands still) latches long before the
+  // torques clip (this used to take the saturation check hundreds of ticks at full scale).
   int k = 0;
   std::uint32_t f = 0;
   for (; k < 20000 && f == 0; ++k) f = run(1);
+  EXPECT_EQ(f, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "after " << k << " ticks";
+  EXPECT_EQ(task->sup.latched & kFaultSaturation, 0u);
+  expect_latched(kFaultEncoderStuck);
+}
+
+TEST_F(TaskFixture, PersistentSaturationFaults) {
+  // Joint 1 creeps away from the reference by one count per tick (0.06 mm at the tip) and the other
+  // encoders dither by a count (so that none stands still): the torque on joint 1 clips within a
+  // millimetre of error, long before the 10 mm tracking bound, and after kSaturationTicks clipped
+  // ticks the fault latches.
+  std::uint32_t f = 0;
+  int k = 0, first_clip = -1;
+  for (; k < 1000 && f == 0; ++k) {
+    hal.counts[0] = k;
+    for (int i = 1; i < kDof; ++i) hal.counts[i] = k % 2;
+    f = run(1);
+    if (first_clip < 0 && task->sat_ticks[0] > 0) first_clip = k;
+  }
   EXPECT_EQ(f, static_cast<std::uint32_t>(kFaultSaturation)) << "after " << k << " ticks";
+  ASSERT_GE(first_clip, 0);
+  int longest = 0;  // the joint that tripped it has been clipped exactly kSaturationTicks ticks
+  for (int i = 0; i < kDof; ++i) longest = std::max<int>(longest, task->sat_ticks[i]);
+  EXPECT_EQ(longest, params::kSaturationTicks);
   expect_latched(kFaultSaturation);
+}
+
+TEST_F(TaskFixture, TrackingErrorBeyondItsBoundFaults) {
+  // Joint 2 reads 0.01 rad off the start pose (about 6 mm at the tip): within the bound; 0.03 rad
+  // (about 18 mm): a fault in that tick.
+  hal.counts[1] = static_cast<std::int32_t>(0.01 * task->counts_per_rad(1));
+  EXPECT_EQ(run(1), 0u);
+  start(robot::kQStart);
+  hal.counts[1] = static_cast<std::int32_t>(0.03 * task->counts_per_rad(1));
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultTracking));
+  expect_latched(kFaultTracking);
+}
+
+TEST_F(TaskFixture, FrictionEstimateOutOfItsBoundsFaults) {
+  // (67) has no bounds of its own: an estimate beyond [-theta_max, 2 theta_max] latches theta_bounds.
+  // (The encoders dither by a count, so that the torque step the estimate causes is not taken for
+  // a stuck encoder.)
+  auto dither = [&](int n) {
+    std::uint32_t f = 0;
+    for (int k = 0; k < n; ++k) {
+      for (int i = 0; i < kDof; ++i) hal.counts[i] ^= 1;
+      f = run(1);
+    }
+    return f;
+  };
+  task->gains.adaptation = AdaptationLaw::kPaper;
+  EXPECT_EQ(dither(2), 0u);
+  task->state.adapt.theta_hat(7) = 2.1f * task->gains.theta_max(7);
+  EXPECT_EQ(dither(1), static_cast<std::uint32_t>(kFaultThetaBounds));
+  expect_latched(kFaultThetaBounds);
+  // The robust law projects a stray estimate back into [0, theta_max] in the step: no fault.
+  start(robot::kQStart);
+  EXPECT_EQ(dither(2), 0u);
+  task->state.adapt.theta_hat(7) = 2.1f * task->gains.theta_max(7);
+  EXPECT_EQ(dither(1), 0u);
+  EXPECT_LE(task->state.adapt.theta_hat(7), task->gains.theta_max(7));
+}
+
+TEST_F(TaskFixture, EstopInputFaultsInTheSameTick) {
+  run(2);
+  hal.faults = kFaultEstop;
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEstop));
+  expect_latched(kFaultEstop);
 }
 
 TEST_F(TaskFixture, OverrunFaults) {
