@@ -19,10 +19,12 @@ class PlantHal {
     for (int i = 0; i < hal::kJoints; ++i) counts_per_rad_[i] = osc::counts_per_rad(i, counts_per_motor_rev);
   }
 
-  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad).
-  void read_encoders(std::int32_t counts[hal::kJoints]) const {
+  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad). Every
+  /// tick has a sample.
+  bool read_encoders(std::int32_t counts[hal::kJoints]) const {
     for (int i = 0; i < hal::kJoints; ++i)
       counts[i] = static_cast<std::int32_t>(std::floor((plant_.q()(i) - q_start_(i)) * counts_per_rad_[i]));
+    return true;
   }
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) codes_[i] = codes[i];

@@ -82,9 +82,10 @@ class PilNode {
   }
 
   // HAL binding used by control_tick.
-  void read_encoders(std::int32_t counts[kDof]) {
+  bool read_encoders(std::int32_t counts[kDof]) {
     for (int i = 0; i < kDof; ++i) counts[i] = frame_.counts[i];
     if (frame_.inject & pil::kInjectOverrun) Board::burn(2 * task.period_cycles + 1);
+    return true;
   }
   void write_dacs(const std::int32_t codes[kDof]) {
     pil::ActuatorFrame a;
