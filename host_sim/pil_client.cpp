@@ -84,6 +84,7 @@ bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& er
     while (rx_pos_ < rx_len_) {
       switch (parser_.feed(rx_[rx_pos_++])) {
         case pil::Parser::kPending:
+        case pil::Parser::kJunk:  // skipped between frames
           break;
         case pil::Parser::kFrame:
           if (!parser_.decode(f)) return err = "unexpected frame type from the firmware", false;
@@ -91,6 +92,7 @@ bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& er
         case pil::Parser::kBadChecksum:
           return err = "corrupted actuator frame (checksum mismatch)", false;
         case pil::Parser::kBadHeader:
+        case pil::Parser::kBadLength:
           return err = "corrupted actuator frame (bad header)", false;
       }
     }

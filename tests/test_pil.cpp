@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "experiment.hpp"
+#include "osc/control/params.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/supervisor.hpp"
 #include "pil_client.hpp"
@@ -115,6 +116,11 @@ TEST(PilClientErrors, CorruptedOrShortFramesAreReported) {
 }
 
 // ---------------------------------------------------------------- link with a live peer
+std::vector<std::uint8_t> with(std::vector<std::uint8_t> b, std::size_t at, std::uint8_t xor_mask) {
+  b[at] ^= xor_mask;
+  return b;
+}
+
 struct Link : ::testing::Test {
   PilClient link;
   std::uint32_t seq = 0;
@@ -122,16 +128,25 @@ struct Link : ::testing::Test {
   std::string err;
   void SetUp() override { ASSERT_TRUE(link.start(peer_command(), err)) << err; }
   void TearDown() override { link.stop(); }
-  pil::ActuatorFrame exchange(std::uint8_t inject = 0) {
+  pil::ActuatorFrame last;  // the latest answer
+  /// The next sensor frame's bytes.
+  std::vector<std::uint8_t> frame(std::uint8_t inject = 0) {
     pil::SensorFrame s;
     s.seq = seq++;
     for (int i = 0; i < 6; ++i) s.counts[i] = counts[i];
     s.inject = inject;
-    pil::ActuatorFrame a;
-    EXPECT_TRUE(link.send(s, err)) << err;
-    EXPECT_TRUE(link.receive(a, 10.0, err)) << err;
-    return a;
+    std::vector<std::uint8_t> b(pil::kMaxFrame);
+    b.resize(static_cast<std::size_t>(pil::encode(s, b.data())));
+    return b;
   }
+  /// Sends bytes and returns the one answer.
+  pil::ActuatorFrame answer(const std::vector<std::uint8_t>& b) {
+    pil::ActuatorFrame a;
+    EXPECT_TRUE(link.send_raw(b.data(), static_cast<int>(b.size()), err)) << err;
+    EXPECT_TRUE(link.receive(a, 10.0, err)) << err;
+    return last = a;
+  }
+  pil::ActuatorFrame exchange(std::uint8_t inject = 0) { return answer(frame(inject)); }
   static bool zero(const pil::ActuatorFrame& a) {
     for (int c : a.codes)
       if (c != 0) return false;
@@ -146,6 +161,16 @@ struct Link : ::testing::Test {
     EXPECT_TRUE(b.faults & bit);
     EXPECT_TRUE(zero(b));
   }
+  /// A link error's answer: zero codes for the tick the host waits for (a lost frame's answer carries
+  /// its number), counted, not latched; then torque again with healthy frames.
+  void expect_zeroed_once(const pil::ActuatorFrame& a, pil::LinkError kind, std::uint32_t count = 1) {
+    EXPECT_TRUE(zero(a));
+    EXPECT_EQ(a.seq, seq - 1);
+    EXPECT_EQ(a.link[kind], count) << pil::kLinkErrorNames[kind];
+    EXPECT_EQ(a.faults, 0u);
+    EXPECT_EQ(a.state, static_cast<std::uint8_t>(osc::SupervisorState::kRun));
+    healthy(2);
+  }
   void healthy(int n) {
     for (int k = 0; k < n; ++k) {
       const pil::ActuatorFrame a = exchange();
@@ -158,44 +183,56 @@ struct Link : ::testing::Test {
 
 TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) { healthy(20); }
 
-TEST_F(Link, CorruptedFrameIsALinkFaultWithZeroTorque) {
+// Link errors (the firmware's side; every kind in detail: tests/test_link.cpp): the answer carries
+// zero codes at once and counts the error, a single error does not latch, repeated errors do.
+TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
   healthy(5);
-  pil::SensorFrame s;
-  s.seq = seq++;
-  std::uint8_t buf[pil::kMaxFrame];
-  const int n = pil::encode(s, buf);
-  buf[10] ^= 0x40;  // flip a payload bit
-  ASSERT_TRUE(link.send_raw(buf, n, err)) << err;
-  pil::ActuatorFrame a;
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
+  for (std::uint32_t n = 1; n < static_cast<std::uint32_t>(osc::params::kLinkErrorLimit); ++n)
+    expect_zeroed_once(answer(with(frame(), 10, 0x40)), pil::kErrCrc, n);  // a payload bit flipped
+  const pil::ActuatorFrame a = answer(with(frame(), 10, 0x40));
+  EXPECT_EQ(a.link[pil::kErrCrc], static_cast<std::uint32_t>(osc::params::kLinkErrorLimit));
   expect_fault_now(a, osc::kFaultLinkCorrupt);
 }
 
-TEST_F(Link, SequenceGapIsALinkFault) {
+TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
+  healthy(5);
+  expect_zeroed_once(answer(with(frame(), 2, 0x07)), pil::kErrHeader);  // unknown frame type
+  EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
+}
+
+TEST_F(Link, JunkBetweenFramesZeroesTheNextTick) {
+  healthy(5);
+  std::vector<std::uint8_t> b = {0x00, 0x13, 0xA5, 0x77, 0xFF};
+  const std::vector<std::uint8_t> f = frame();
+  b.insert(b.end(), f.begin(), f.end());
+  expect_zeroed_once(answer(b), pil::kErrJunk, 5);
+}
+
+TEST_F(Link, SequenceGapZeroesTheTick) {
   healthy(5);
   ++seq;  // skip one
-  expect_fault_now(exchange(), osc::kFaultLinkCorrupt);
+  expect_zeroed_once(exchange(), pil::kErrSeq);
 }
 
-TEST_F(Link, ShortFrameTimesOutAsALinkFault) {
+TEST_F(Link, ShortFrameTimesOutWithZeroCodes) {
   healthy(5);
-  pil::SensorFrame s;
-  s.seq = seq++;
-  std::uint8_t buf[pil::kMaxFrame];
-  pil::encode(s, buf);
-  ASSERT_TRUE(link.send_raw(buf, 12, err)) << err;  // then silence
+  std::vector<std::uint8_t> b = frame();
+  b.resize(12);  // then silence: the firmware answers after its link timeout
+  expect_zeroed_once(answer(b), pil::kErrShortFrame);
+}
+
+TEST_F(Link, SilenceGetsZeroCodesRepeatedSilenceLatchesLinkLost) {
+  healthy(5);
   pil::ActuatorFrame a;
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;  // the firmware answers after its link timeout
-  EXPECT_TRUE(a.faults & osc::kFaultLinkCorrupt) << a.faults;
-  EXPECT_TRUE(zero(a));
-}
-
-TEST_F(Link, MissingFrameIsLinkLostWithZeroTorque) {
-  healthy(5);
-  pil::ActuatorFrame a;  // send nothing: the firmware reports on its own after the timeout
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
-  EXPECT_TRUE(a.faults & osc::kFaultLinkLost) << "faults " << a.faults << " seq " << a.seq << " state " << int(a.state);
-  EXPECT_TRUE(zero(a));
+  for (int n = 1; n <= osc::params::kLinkErrorLimit; ++n) {
+    // Send nothing: the firmware answers on its own after its link timeout.
+    ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
+    EXPECT_TRUE(zero(a));
+    EXPECT_EQ(a.seq, seq - 1);  // no frame was lost: the number of the last one
+    EXPECT_EQ(a.link[pil::kErrSilence], static_cast<std::uint32_t>(n));
+  }
+  EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultLinkLost)) << osc::fault_name(a.faults);
+  EXPECT_TRUE(zero(exchange()));
 }
 
 TEST_F(Link, EncoderJumpFaultsInTheSameTick) {
