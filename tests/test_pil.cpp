@@ -9,6 +9,7 @@
 #include "experiment.hpp"
 #include "osc/control/params.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
 #include "pil_client.hpp"
 
@@ -113,6 +114,82 @@ TEST(PilClientErrors, CorruptedOrShortFramesAreReported) {
   std::snprintf(cmd, sizeof cmd, "printf '\\245\\132\\002\\%03oabc'; exec sleep 30", pil::kActuatorPayload);
   EXPECT_FALSE(d.start({"sh", "-c", cmd}, err, 0.3));
   EXPECT_NE(err.find("short frame"), std::string::npos) << err;
+}
+
+// ---------------------------------------------------------------- the host applies only valid, in-range codes
+/// A scripted peer: writes the given actuator frames (after its hello) and then stays silent.
+struct ScriptedPeer {
+  std::string path = ::testing::TempDir() + "pil_scripted_peer.bin";
+  std::vector<std::uint8_t> bytes;
+  void add(const pil::ActuatorFrame& a) {
+    std::uint8_t buf[pil::kMaxFrame];
+    bytes.insert(bytes.end(), buf, buf + pil::encode(a, buf));
+  }
+  std::vector<std::string> command() {
+    FILE* f = std::fopen(path.c_str(), "wb");
+    EXPECT_TRUE(f && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size());
+    if (f) std::fclose(f);
+    return {"sh", "-c", "cat \"$0\"; exec sleep 30", path};
+  }
+  static pil::ActuatorFrame answer(std::uint32_t seq, std::int32_t code) {
+    pil::ActuatorFrame a;
+    a.seq = seq;
+    for (std::int32_t& c : a.codes) c = code;
+    return a;
+  }
+  ScriptedPeer() { add(answer(pil::kHelloSeq, 0)); }
+};
+
+TEST(PilClientAmplifiers, OnlyAValidInRangeAnswerToTheTickIsApplied) {
+  using X = PilClient::Exchange;
+  const std::int32_t max = static_cast<std::int32_t>(osc::kDacMaxCode);
+  ScriptedPeer peer;
+  peer.add(ScriptedPeer::answer(0, -max));      // tick 0: at the range limit, applied
+  peer.add(ScriptedPeer::answer(1, max));
+  peer.bytes.back() ^= 0x01;                    // tick 1: corrupt (CRC)
+  pil::ActuatorFrame big = ScriptedPeer::answer(2, 100);
+  big.codes[3] = max + 1;                       // tick 2: one code out of range
+  peer.add(big);
+  peer.bytes.insert(peer.bytes.end(), {0x00, 0xA5, 0x01});  // junk
+  peer.add(ScriptedPeer::answer(2, 7));         // a stale answer (to tick 2), skipped
+  peer.add(ScriptedPeer::answer(3, 300));       // tick 3: applied
+  peer.add(ScriptedPeer::answer(5, 400));       // tick 4: answered as tick 5: not this tick's
+  PilClient c;
+  std::string err;
+  ASSERT_TRUE(c.start(peer.command(), err, 5.0)) << err;
+  struct Want {
+    X x;
+    std::int32_t code0;
+  } want[] = {{X::kApplied, -max}, {X::kZeroed, 0}, {X::kZeroed, 0}, {X::kApplied, 300}, {X::kZeroed, 0}, {X::kLost, 0}};
+  for (std::uint32_t k = 0; k < 6; ++k) {
+    pil::SensorFrame s;
+    s.seq = k;
+    pil::ActuatorFrame a = ScriptedPeer::answer(99, 55);  // whatever the caller held before
+    const X x = c.exchange(s, a, 0.3, err);
+    EXPECT_EQ(x, want[k].x) << "tick " << k << ": " << err;
+    for (std::int32_t code : a.codes) EXPECT_EQ(code, x == X::kApplied ? want[k].code0 : 0) << "tick " << k;
+  }
+  EXPECT_EQ(c.code_range_errors(), 1u);
+  EXPECT_EQ(c.link_counters()[pil::kErrCrc], 1u);
+  EXPECT_EQ(c.link_counters()[pil::kErrJunk], 3u);
+  EXPECT_EQ(c.link_counters()[pil::kErrSeq], 2u);  // the stale answer and the one from the future
+  EXPECT_EQ(c.link_counters()[pil::kErrSilence], 1u);
+  EXPECT_FALSE(PilClient::codes_in_range(big));
+}
+
+TEST(PilClientAmplifiers, TheRunnerZeroesTheTickAndReportsIt) {
+  ScriptedPeer peer;
+  for (std::uint32_t k = 0; k < 4; ++k) peer.add(ScriptedPeer::answer(k, k == 2 ? -2000000 : 0));
+  ExperimentConfig c;
+  c.duration = 0.004;  // four ticks
+  c.scalar = Scalar::kFloat;
+  c.pil_command = peer.command();
+  const ExperimentResult r = run_experiment(c);
+  EXPECT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.link.zeroed_ticks, 1u);
+  EXPECT_EQ(r.link.host_code_range, 1u);
+  EXPECT_NE(r.link.first_zeroed.find("tick 2: "), std::string::npos) << r.link.first_zeroed;
+  EXPECT_FALSE(r.link.clean());
 }
 
 // ---------------------------------------------------------------- link with a live peer
@@ -295,6 +372,11 @@ TEST(PilClosedLoop, TracksLikeTheInProcessFloatController) {
   }
   std::printf("firmware step: max %u, mean %u cycles; stack used %u bytes\n", remote.max_step_cycles,
               remote.mean_step_cycles, remote.stack_used);
+  std::printf("link: longest gap between bytes received by the firmware %u cycles, %u gaps over %d periods; "
+              "link errors: firmware %u, host %u\n",
+              remote.link.rx_gap_max, remote.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
+              remote.link.firmware.total(), remote.link.host.total());
+  EXPECT_TRUE(remote.link.clean());
   // Same float code on both sides; on the target the compiler and libm differ, so allow a
   // tolerance of one encoder quantum (0.069 mm) and 0.01 deg on the max errors.
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.069) << i;
