@@ -73,23 +73,27 @@ class RemoteController {
     ok_ = link_.start(cfg.pil_command, err);
   }
   bool ok() const { return ok_; }
+  /// One exchange. The simulated amplifiers apply the codes of a valid, in-range answer to this
+  /// tick's sensor frame, and zero on anything else (counted, the first such error kept); a lost
+  /// link (no answer in time, the peer gone) also ends the run.
   bool tick(PlantHal& hal, TickReport& r, std::string& err) {
     pil::SensorFrame s;
     s.seq = seq_++;
     hal.read_encoders(s.counts);
     if (s.seq == 0) s.inject = config_;
-    pil::ActuatorFrame a;
-    if (!link_.send(s, err) || !link_.receive(a, timeout_, err)) return false;
-    if (a.seq != s.seq) {
-      err = "actuator frame for tick " + std::to_string(a.seq) + " answered tick " + std::to_string(s.seq) +
-            " (faults " + std::to_string(a.faults) + ")";
-      return false;
-    }
+    pil::ActuatorFrame a = last_;
+    std::string why;
+    const PilClient::Exchange x = link_.exchange(s, a, timeout_, why);
     hal.write_dacs(a.codes);
+    if (x == PilClient::Exchange::kLost) return err = why, false;
+    if (x == PilClient::Exchange::kZeroed) {
+      ++zeroed_ticks_;
+      if (first_zeroed_.empty()) first_zeroed_ = "tick " + std::to_string(s.seq) + ": " + why;
+    }
+    last_ = a;
     r.faults = a.faults;
     for (int i = 0; i < 6; ++i) r.tau_f_hat[i] = a.tau_f_hat[i];
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = a.theta_hat[i];
-    last_ = a;
     return true;
   }
   void finish(ExperimentResult& res) {
@@ -97,6 +101,13 @@ class RemoteController {
     res.mean_step_cycles = last_.mean_cycles;
     res.max_tick_cycles = last_.tick_max_cycles;
     res.stack_used = last_.stack_used;
+    res.link.firmware = last_.link;
+    res.link.host = link_.link_counters();
+    res.link.host_code_range = link_.code_range_errors();
+    res.link.zeroed_ticks = zeroed_ticks_;
+    res.link.first_zeroed = first_zeroed_;
+    res.link.rx_gap_max = last_.rx_gap_max;
+    res.link.rx_long_gaps = last_.rx_long_gaps;
     link_.stop();
   }
 
@@ -107,6 +118,8 @@ class RemoteController {
   bool ok_ = false;
   std::uint32_t seq_ = 0;
   pil::ActuatorFrame last_;
+  std::uint32_t zeroed_ticks_ = 0;
+  std::string first_zeroed_;
 };
 
 template <class Controller>

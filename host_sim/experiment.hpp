@@ -10,6 +10,7 @@
 #include "osc/control/controller.hpp"
 #include "injection.hpp"
 #include "osc/control/gains.hpp"
+#include "osc/link/frames.hpp"
 #include "plant.hpp"
 
 namespace sim {
@@ -63,6 +64,19 @@ struct InjectionResult {
   int max_torque_joint = -1;   ///< its joint (0-based)
 };
 
+/// Link health of a processor-in-the-loop run.
+struct LinkReport {
+  pil::LinkCounters firmware;         // errors the firmware counted on the sensor frames
+  pil::LinkCounters host;             // errors the host counted on the actuator frames
+  std::uint32_t host_code_range = 0;  // answers with a DAC code out of range (applied as zero)
+  std::uint32_t zeroed_ticks = 0;     // ticks whose amplifiers got zero because of a link error
+  std::string first_zeroed;           // why the first of them was zeroed
+  /// The firmware's longest gap between received bytes [cycles = instructions under QEMU -icount
+  /// shift=0 = ns of its virtual time], and the gaps longer than params::kLinkSilenceTicks periods.
+  std::uint32_t rx_gap_max = 0, rx_long_gaps = 0;
+  bool clean() const { return firmware.total() == 0 && host.total() == 0 && host_code_range == 0 && zeroed_ticks == 0; }
+};
+
 struct ExperimentResult {
   std::string mode;
   std::string friction_preset;
@@ -88,6 +102,7 @@ struct ExperimentResult {
   InjectionResult injection;         // when cfg.injection.enabled
   std::string error;                 // link error (PIL), empty when the run completed
   std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
+  LinkReport link;                   // PIL only
   double wall_seconds = 0;
   std::vector<LogRow> log;
 };

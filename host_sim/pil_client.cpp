@@ -6,9 +6,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+
+#include "osc/runtime/io.hpp"
 
 namespace sim {
 
@@ -77,43 +80,105 @@ bool PilClient::send(const pil::SensorFrame& f, std::string& err) {
 }
 
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
+  return receive_frame(f, timeout_s, err) == Rx::kFrame;
+}
+
+PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
   using clock = std::chrono::steady_clock;
   const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
     while (rx_pos_ < rx_len_) {
-      switch (parser_.feed(rx_[rx_pos_++])) {
+      const pil::Parser::Result r = parser_.feed(rx_[rx_pos_++]);
+      switch (r) {
         case pil::Parser::kPending:
           break;
+        case pil::Parser::kJunk:
+          counters_[pil::kErrJunk] += static_cast<std::uint32_t>(parser_.junk());
+          break;
         case pil::Parser::kFrame:
-          if (!parser_.decode(f)) return err = "unexpected frame type from the firmware", false;
-          return true;
+          if (parser_.decode(f)) return Rx::kFrame;
+          ++counters_[pil::kErrHeader];
+          return err = "unexpected frame type from the firmware", Rx::kCorrupt;
         case pil::Parser::kBadChecksum:
-          return err = "corrupted actuator frame (checksum mismatch)", false;
         case pil::Parser::kBadHeader:
-          return err = "corrupted actuator frame (bad header)", false;
+        case pil::Parser::kBadLength:
+          ++counters_[pil::Parser::error_of(r)];
+          return err = r == pil::Parser::kBadChecksum ? "corrupted actuator frame (checksum mismatch)"
+                       : r == pil::Parser::kBadHeader ? "corrupted actuator frame (bad header: unknown type)"
+                                                      : "corrupted actuator frame (bad header: wrong length)",
+                 Rx::kCorrupt;
       }
     }
     const double left = std::chrono::duration<double>(deadline - clock::now()).count();
     if (left <= 0) {
+      const bool short_frame = parser_.in_frame();
+      ++counters_[short_frame ? pil::kErrShortFrame : pil::kErrSilence];
       return err = std::string("no actuator frame from the firmware within ") + std::to_string(timeout_s) + " s" +
-                   (parser_.in_frame() ? " (a frame started but did not complete: short frame)" : ""),
-             false;
+                   (short_frame ? " (a frame started but did not complete: short frame)" : ""),
+             Rx::kSilent;
     }
     pollfd p{from_child_, POLLIN, 0};
     const int r = poll(&p, 1, static_cast<int>(left * 1000) + 1);
     if (r < 0 && errno == EINTR) continue;
-    if (r < 0) return err = std::string("poll: ") + std::strerror(errno), false;
+    if (r < 0) return err = std::string("poll: ") + std::strerror(errno), Rx::kGone;
     if (r == 0) continue;
     const ssize_t n = read(from_child_, rx_, sizeof rx_);
-    if (n == 0) return err = "the firmware closed the link (exited)", false;
+    if (n == 0) return err = "the firmware closed the link (exited)", Rx::kGone;
     if (n < 0) {
       if (errno == EINTR) continue;
-      return err = std::string("link read failed: ") + std::strerror(errno), false;
+      return err = std::string("link read failed: ") + std::strerror(errno), Rx::kGone;
     }
     rx_len_ = static_cast<int>(n);
     rx_pos_ = 0;
   }
+}
+
+bool PilClient::codes_in_range(const pil::ActuatorFrame& a) {
+  for (std::int32_t c : a.codes)
+    if (c < -osc::kDacMaxCode || c > osc::kDacMaxCode) return false;
+  return true;
+}
+
+PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::ActuatorFrame& a, double timeout_s,
+                                        std::string& err) {
+  using clock = std::chrono::steady_clock;
+  const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
+  Exchange x = Exchange::kLost;
+  if (send(s, err)) {
+    for (;;) {
+      pil::ActuatorFrame f;
+      const double left = std::chrono::duration<double>(deadline - clock::now()).count();
+      const Rx r = receive_frame(f, std::max(left, 0.0), err);
+      if (r != Rx::kFrame) {
+        x = r == Rx::kCorrupt ? Exchange::kZeroed : Exchange::kLost;
+        break;
+      }
+      a = f;
+      // An answer to an earlier frame (e.g. the firmware's answer to a silence): not this one's.
+      const std::int32_t behind = static_cast<std::int32_t>(s.seq - f.seq);
+      if (behind > 0) {
+        ++counters_[pil::kErrSeq];
+        continue;
+      }
+      if (behind < 0) {
+        ++counters_[pil::kErrSeq];
+        err = "actuator frame " + std::to_string(f.seq) + " answered sensor frame " + std::to_string(s.seq);
+        x = Exchange::kZeroed;
+      } else if (!codes_in_range(f)) {
+        ++code_range_errors_;
+        err = "actuator frame " + std::to_string(f.seq) + " has a DAC code outside +-" +
+              std::to_string(osc::kDacMaxCode);
+        x = Exchange::kZeroed;
+      } else {
+        x = Exchange::kApplied;
+      }
+      break;
+    }
+  }
+  if (x != Exchange::kApplied)
+    for (std::int32_t& c : a.codes) c = 0;
+  return x;
 }
 
 int PilClient::stop() {

@@ -1,6 +1,8 @@
 // Host side of the processor-in-the-loop link: starts the firmware (qemu-system-arm with the
-// image, or any program speaking osc/pil.hpp on its standard input/output), and exchanges one
-// sensor frame and one actuator frame per tick. Every wait is bounded; errors are reported as text.
+// image, or any program speaking osc/link/frames.hpp on its standard input/output), and exchanges
+// one sensor frame and one actuator frame per tick. Every wait is bounded; errors are reported as
+// text and counted by kind. exchange() is the amplifiers' input: the codes it returns are those of
+// a valid, in-range answer to the tick's sensor frame, or all zero.
 #pragma once
 
 #include <string>
@@ -25,8 +27,27 @@ class PilClient {
 
   bool send(const pil::SensorFrame& f, std::string& err);
   bool send_raw(const std::uint8_t* p, int n, std::string& err);
-  /// Waits up to timeout_s (wall clock) for one actuator frame.
+  /// Waits up to timeout_s (wall clock) for one actuator frame; false on a corrupt frame (bad CRC,
+  /// header or length), on silence and when the peer is gone. Junk between frames is skipped.
   bool receive(pil::ActuatorFrame& f, double timeout_s, std::string& err);
+
+  enum class Exchange {
+    kApplied,  ///< a valid answer to the sensor frame, every code within the DAC range
+    kZeroed,   ///< a corrupt, out-of-sequence or out-of-range answer: zero codes, the link goes on
+    kLost,     ///< no answer in time or the peer is gone: zero codes, the link is down
+  };
+  /// One tick: sends s and waits up to timeout_s for its answer; earlier answers still in the pipe
+  /// (e.g. to a silence) are skipped. a.codes are what the amplifiers apply: the answer's if it is
+  /// kApplied, otherwise all zero (err says why; the counters count it). The rest of a is the
+  /// answer's telemetry when a readable answer came, else untouched.
+  Exchange exchange(const pil::SensorFrame& s, pil::ActuatorFrame& a, double timeout_s, std::string& err);
+  /// Every code of a within the DAC range [-kDacMaxCode, kDacMaxCode].
+  static bool codes_in_range(const pil::ActuatorFrame& a);
+
+  /// Errors on the actuator frames received so far, by kind.
+  const pil::LinkCounters& link_counters() const { return counters_; }
+  /// Answers whose codes were out of the DAC range (applied as zero).
+  std::uint32_t code_range_errors() const { return code_range_errors_; }
   /// Stops the peer (SIGKILL after a grace period) and returns its exit status (-1 if killed).
   int stop();
   bool running() const { return pid_ > 0; }
@@ -34,7 +55,12 @@ class PilClient {
  private:
   int pid_ = -1;
   int to_child_ = -1, from_child_ = -1;
+  enum class Rx { kFrame, kCorrupt, kSilent, kGone };
+  Rx receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err);
+
   pil::Parser parser_;
+  pil::LinkCounters counters_;
+  std::uint32_t code_range_errors_ = 0;
   std::uint8_t rx_[512];
   int rx_len_ = 0, rx_pos_ = 0;  // bytes read from the peer but not parsed yet
 };

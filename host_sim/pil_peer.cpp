@@ -1,4 +1,4 @@
-// pil_peer: the firmware's PIL node (osc/pil_node.hpp, float) built for the host, speaking the link
+// pil_peer: the firmware's PIL node (osc/link/node.hpp, float) built for the host, speaking the link
 // on stdin/stdout. It stands in for the QEMU image in tests of the host side and of the protocol,
 // and runs exactly the firmware's board-independent code.
 #include <poll.h>

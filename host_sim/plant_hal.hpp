@@ -43,8 +43,9 @@ class PlantHal {
   }
   bool injection_active() const { return active_; }
 
-  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad).
-  void read_encoders(std::int32_t counts[hal::kJoints]) {
+  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad). Every
+  /// tick has a sample.
+  bool read_encoders(std::int32_t counts[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) {
       counts[i] = static_cast<std::int32_t>(std::floor((plant_.q()(i) - q_start_(i)) * counts_per_rad_[i]));
       if (!active_ || !inj_.hits(i)) continue;
@@ -69,6 +70,7 @@ class PlantHal {
           break;
       }
     }
+    return true;
   }
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i)

@@ -157,6 +157,14 @@ void print_windows(const sim::ExperimentResult& r) {
   }
 }
 
+/// "none", or the nonzero link error counters as "name n, ...".
+std::string counters_text(const pil::LinkCounters& c) {
+  std::string s;
+  for (int k = 0; k < pil::kLinkErrorKinds; ++k)
+    if (c.count[k]) s += (s.empty() ? "" : ", ") + std::string(pil::kLinkErrorNames[k]) + " " + std::to_string(c.count[k]);
+  return s.empty() ? "none" : s;
+}
+
 void print_tables(const std::vector<sim::ExperimentResult>& runs) {
   std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')\n", runs[0].duration,
               runs[0].friction_preset.c_str());
@@ -199,6 +207,13 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
       std::printf("[%s] firmware control step (observer + controller + adaptation, float): max %u, mean %u "
                   "instructions (QEMU -icount shift=0); whole tick incl. link I/O max %u; stack used %u bytes\n",
                   r.mode.c_str(), r.max_step_cycles, r.mean_step_cycles, r.max_tick_cycles, r.stack_used);
+    if (r.max_step_cycles) {
+      std::printf("[%s] link: longest gap between received bytes %u cycles (ns of target time in QEMU), %u over %d periods; "
+                  "errors counted by the firmware: %s; by the host: %s, codes out of range %u; ticks zeroed %u%s%s\n",
+                  r.mode.c_str(), r.link.rx_gap_max, r.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
+                  counters_text(r.link.firmware).c_str(), counters_text(r.link.host).c_str(), r.link.host_code_range,
+                  r.link.zeroed_ticks, r.link.first_zeroed.empty() ? "" : ", the first: ", r.link.first_zeroed.c_str());
+    }
     std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time)\n", r.mode.c_str(), r.duration,
                 r.wall_seconds, r.duration / r.wall_seconds);
     if (r.status) {
@@ -293,6 +308,19 @@ void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* inde
     os << ",\n" << indent << "\"firmware_step_instructions_mean\": " << r.mean_step_cycles;
     os << ",\n" << indent << "\"firmware_tick_instructions_max\": " << r.max_tick_cycles;
     os << ",\n" << indent << "\"firmware_stack_used_bytes\": " << r.stack_used;
+    os << ",\n" << indent << "\"link\": {";
+    const pil::LinkCounters* sides[2] = {&r.link.firmware, &r.link.host};
+    for (int s = 0; s < 2; ++s) {
+      os << (s ? ", \"host\": {" : "\"firmware\": {");
+      for (int k = 0; k < pil::kLinkErrorKinds; ++k)
+        os << (k ? ", " : "") << "\"" << pil::kLinkErrorNames[k] << "\": " << sides[s]->count[k];
+      if (s) os << ", \"code_range\": " << r.link.host_code_range;
+      os << "}";
+    }
+    os << ", \"zeroed_ticks\": " << r.link.zeroed_ticks << ", \"rx_gap_max_instructions\": " << r.link.rx_gap_max
+       << ", \"rx_long_gaps\": " << r.link.rx_long_gaps;
+    if (!r.link.first_zeroed.empty()) os << ", \"first_zeroed\": " << json_string(r.link.first_zeroed);
+    os << "}";
   }
   os << ",\n" << indent << "\"stuck_monitor_peak_counts\": ";
   json_array(os, r.stuck_peak, 6);
@@ -472,6 +500,6 @@ int main(int argc, char** argv) {
   }
   // A fault is a failed run, unless a fault was injected on purpose (then the JSON tells how it went).
   for (const auto& r : runs)
-    if ((r.status && !o.base.injection.enabled) || !r.error.empty()) return 1;
+    if ((r.status && !o.base.injection.enabled) || !r.error.empty() || !r.link.clean()) return 1;
   return 0;
 }

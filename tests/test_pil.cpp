@@ -7,8 +7,10 @@
 #include <memory>
 
 #include "experiment.hpp"
+#include "osc/control/params.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
 #include "pil_client.hpp"
 
@@ -115,7 +117,88 @@ TEST(PilClientErrors, CorruptedOrShortFramesAreReported) {
   EXPECT_NE(err.find("short frame"), std::string::npos) << err;
 }
 
+// ---------------------------------------------------------------- the host applies only valid, in-range codes
+/// A scripted peer: writes the given actuator frames (after its hello) and then stays silent.
+struct ScriptedPeer {
+  std::string path = ::testing::TempDir() + "pil_scripted_peer.bin";
+  std::vector<std::uint8_t> bytes;
+  void add(const pil::ActuatorFrame& a) {
+    std::uint8_t buf[pil::kMaxFrame];
+    bytes.insert(bytes.end(), buf, buf + pil::encode(a, buf));
+  }
+  std::vector<std::string> command() {
+    FILE* f = std::fopen(path.c_str(), "wb");
+    EXPECT_TRUE(f && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size());
+    if (f) std::fclose(f);
+    return {"sh", "-c", "cat \"$0\"; exec sleep 30", path};
+  }
+  static pil::ActuatorFrame answer(std::uint32_t seq, std::int32_t code) {
+    pil::ActuatorFrame a;
+    a.seq = seq;
+    for (std::int32_t& c : a.codes) c = code;
+    return a;
+  }
+  ScriptedPeer() { add(answer(pil::kHelloSeq, 0)); }
+};
+
+TEST(PilClientAmplifiers, OnlyAValidInRangeAnswerToTheTickIsApplied) {
+  using X = PilClient::Exchange;
+  const std::int32_t max = static_cast<std::int32_t>(osc::kDacMaxCode);
+  ScriptedPeer peer;
+  peer.add(ScriptedPeer::answer(0, -max));      // tick 0: at the range limit, applied
+  peer.add(ScriptedPeer::answer(1, max));
+  peer.bytes.back() ^= 0x01;                    // tick 1: corrupt (CRC)
+  pil::ActuatorFrame big = ScriptedPeer::answer(2, 100);
+  big.codes[3] = max + 1;                       // tick 2: one code out of range
+  peer.add(big);
+  peer.bytes.insert(peer.bytes.end(), {0x00, 0xA5, 0x01});  // junk
+  peer.add(ScriptedPeer::answer(2, 7));         // a stale answer (to tick 2), skipped
+  peer.add(ScriptedPeer::answer(3, 300));       // tick 3: applied
+  peer.add(ScriptedPeer::answer(5, 400));       // tick 4: answered as tick 5: not this tick's
+  PilClient c;
+  std::string err;
+  ASSERT_TRUE(c.start(peer.command(), err, 5.0)) << err;
+  struct Want {
+    X x;
+    std::int32_t code0;
+  } want[] = {{X::kApplied, -max}, {X::kZeroed, 0}, {X::kZeroed, 0}, {X::kApplied, 300}, {X::kZeroed, 0}, {X::kLost, 0}};
+  for (std::uint32_t k = 0; k < 6; ++k) {
+    pil::SensorFrame s;
+    s.seq = k;
+    pil::ActuatorFrame a = ScriptedPeer::answer(99, 55);  // whatever the caller held before
+    const X x = c.exchange(s, a, 0.3, err);
+    EXPECT_EQ(x, want[k].x) << "tick " << k << ": " << err;
+    for (std::int32_t code : a.codes) EXPECT_EQ(code, x == X::kApplied ? want[k].code0 : 0) << "tick " << k;
+  }
+  EXPECT_EQ(c.code_range_errors(), 1u);
+  EXPECT_EQ(c.link_counters()[pil::kErrCrc], 1u);
+  EXPECT_EQ(c.link_counters()[pil::kErrJunk], 3u);
+  EXPECT_EQ(c.link_counters()[pil::kErrSeq], 2u);  // the stale answer and the one from the future
+  EXPECT_EQ(c.link_counters()[pil::kErrSilence], 1u);
+  EXPECT_FALSE(PilClient::codes_in_range(big));
+}
+
+TEST(PilClientAmplifiers, TheRunnerZeroesTheTickAndReportsIt) {
+  ScriptedPeer peer;
+  for (std::uint32_t k = 0; k < 4; ++k) peer.add(ScriptedPeer::answer(k, k == 2 ? -2000000 : 0));
+  ExperimentConfig c;
+  c.duration = 0.004;  // four ticks
+  c.scalar = Scalar::kFloat;
+  c.pil_command = peer.command();
+  const ExperimentResult r = run_experiment(c);
+  EXPECT_TRUE(r.error.empty()) << r.error;
+  EXPECT_EQ(r.link.zeroed_ticks, 1u);
+  EXPECT_EQ(r.link.host_code_range, 1u);
+  EXPECT_NE(r.link.first_zeroed.find("tick 2: "), std::string::npos) << r.link.first_zeroed;
+  EXPECT_FALSE(r.link.clean());
+}
+
 // ---------------------------------------------------------------- link with a live peer
+std::vector<std::uint8_t> with(std::vector<std::uint8_t> b, std::size_t at, std::uint8_t xor_mask) {
+  b[at] ^= xor_mask;
+  return b;
+}
+
 struct Link : ::testing::Test {
   PilClient link;
   std::uint32_t seq = 0;
@@ -123,16 +206,25 @@ struct Link : ::testing::Test {
   std::string err;
   void SetUp() override { ASSERT_TRUE(link.start(peer_command(), err)) << err; }
   void TearDown() override { link.stop(); }
-  pil::ActuatorFrame exchange(std::uint8_t inject = 0) {
+  pil::ActuatorFrame last;  // the latest answer
+  /// The next sensor frame's bytes.
+  std::vector<std::uint8_t> frame(std::uint8_t inject = 0) {
     pil::SensorFrame s;
     s.seq = seq++;
     for (int i = 0; i < 6; ++i) s.counts[i] = counts[i];
     s.inject = inject;
-    pil::ActuatorFrame a;
-    EXPECT_TRUE(link.send(s, err)) << err;
-    EXPECT_TRUE(link.receive(a, 10.0, err)) << err;
-    return a;
+    std::vector<std::uint8_t> b(pil::kMaxFrame);
+    b.resize(static_cast<std::size_t>(pil::encode(s, b.data())));
+    return b;
   }
+  /// Sends bytes and returns the one answer.
+  pil::ActuatorFrame answer(const std::vector<std::uint8_t>& b) {
+    pil::ActuatorFrame a;
+    EXPECT_TRUE(link.send_raw(b.data(), static_cast<int>(b.size()), err)) << err;
+    EXPECT_TRUE(link.receive(a, 10.0, err)) << err;
+    return last = a;
+  }
+  pil::ActuatorFrame exchange(std::uint8_t inject = 0) { return answer(frame(inject)); }
   static bool zero(const pil::ActuatorFrame& a) {
     for (int c : a.codes)
       if (c != 0) return false;
@@ -147,6 +239,16 @@ struct Link : ::testing::Test {
     EXPECT_TRUE(b.faults & bit);
     EXPECT_TRUE(zero(b));
   }
+  /// A link error's answer: zero codes for the tick the host waits for (a lost frame's answer carries
+  /// its number), counted, not latched; then torque again with healthy frames.
+  void expect_zeroed_once(const pil::ActuatorFrame& a, pil::LinkError kind, std::uint32_t count = 1) {
+    EXPECT_TRUE(zero(a));
+    EXPECT_EQ(a.seq, seq - 1);
+    EXPECT_EQ(a.link[kind], count) << pil::kLinkErrorNames[kind];
+    EXPECT_EQ(a.faults, 0u);
+    EXPECT_EQ(a.state, static_cast<std::uint8_t>(osc::SupervisorState::kRun));
+    healthy(2);
+  }
   void healthy(int n) {
     for (int k = 0; k < n; ++k) {
       const pil::ActuatorFrame a = exchange();
@@ -159,44 +261,56 @@ struct Link : ::testing::Test {
 
 TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) { healthy(20); }
 
-TEST_F(Link, CorruptedFrameIsALinkFaultWithZeroTorque) {
+// Link errors (the firmware's side; every kind in detail: tests/test_link.cpp): the answer carries
+// zero codes at once and counts the error, a single error does not latch, repeated errors do.
+TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
   healthy(5);
-  pil::SensorFrame s;
-  s.seq = seq++;
-  std::uint8_t buf[pil::kMaxFrame];
-  const int n = pil::encode(s, buf);
-  buf[10] ^= 0x40;  // flip a payload bit
-  ASSERT_TRUE(link.send_raw(buf, n, err)) << err;
-  pil::ActuatorFrame a;
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
+  for (std::uint32_t n = 1; n < static_cast<std::uint32_t>(osc::params::kLinkErrorLimit); ++n)
+    expect_zeroed_once(answer(with(frame(), 10, 0x40)), pil::kErrCrc, n);  // a payload bit flipped
+  const pil::ActuatorFrame a = answer(with(frame(), 10, 0x40));
+  EXPECT_EQ(a.link[pil::kErrCrc], static_cast<std::uint32_t>(osc::params::kLinkErrorLimit));
   expect_fault_now(a, osc::kFaultLinkCorrupt);
 }
 
-TEST_F(Link, SequenceGapIsALinkFault) {
+TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
+  healthy(5);
+  expect_zeroed_once(answer(with(frame(), 2, 0x07)), pil::kErrHeader);  // unknown frame type
+  EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
+}
+
+TEST_F(Link, JunkBetweenFramesZeroesTheNextTick) {
+  healthy(5);
+  std::vector<std::uint8_t> b = {0x00, 0x13, 0xA5, 0x77, 0xFF};
+  const std::vector<std::uint8_t> f = frame();
+  b.insert(b.end(), f.begin(), f.end());
+  expect_zeroed_once(answer(b), pil::kErrJunk, 5);
+}
+
+TEST_F(Link, SequenceGapZeroesTheTick) {
   healthy(5);
   ++seq;  // skip one
-  expect_fault_now(exchange(), osc::kFaultLinkCorrupt);
+  expect_zeroed_once(exchange(), pil::kErrSeq);
 }
 
-TEST_F(Link, ShortFrameTimesOutAsALinkFault) {
+TEST_F(Link, ShortFrameTimesOutWithZeroCodes) {
   healthy(5);
-  pil::SensorFrame s;
-  s.seq = seq++;
-  std::uint8_t buf[pil::kMaxFrame];
-  pil::encode(s, buf);
-  ASSERT_TRUE(link.send_raw(buf, 12, err)) << err;  // then silence
+  std::vector<std::uint8_t> b = frame();
+  b.resize(12);  // then silence: the firmware answers after its link timeout
+  expect_zeroed_once(answer(b), pil::kErrShortFrame);
+}
+
+TEST_F(Link, SilenceGetsZeroCodesRepeatedSilenceLatchesLinkLost) {
+  healthy(5);
   pil::ActuatorFrame a;
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;  // the firmware answers after its link timeout
-  EXPECT_TRUE(a.faults & osc::kFaultLinkCorrupt) << a.faults;
-  EXPECT_TRUE(zero(a));
-}
-
-TEST_F(Link, MissingFrameIsLinkLostWithZeroTorque) {
-  healthy(5);
-  pil::ActuatorFrame a;  // send nothing: the firmware reports on its own after the timeout
-  ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
-  EXPECT_TRUE(a.faults & osc::kFaultLinkLost) << "faults " << a.faults << " seq " << a.seq << " state " << int(a.state);
-  EXPECT_TRUE(zero(a));
+  for (int n = 1; n <= osc::params::kLinkErrorLimit; ++n) {
+    // Send nothing: the firmware answers on its own after its link timeout.
+    ASSERT_TRUE(link.receive(a, 10.0, err)) << err;
+    EXPECT_TRUE(zero(a));
+    EXPECT_EQ(a.seq, seq - 1);  // no frame was lost: the number of the last one
+    EXPECT_EQ(a.link[pil::kErrSilence], static_cast<std::uint32_t>(n));
+  }
+  EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultLinkLost)) << osc::fault_name(a.faults);
+  EXPECT_TRUE(zero(exchange()));
 }
 
 TEST_F(Link, EncoderJumpFaultsInTheSameTick) {
@@ -256,6 +370,11 @@ TEST(PilClosedLoop, TracksLikeTheInProcessFloatController) {
   }
   std::printf("firmware step: max %u, mean %u cycles; stack used %u bytes\n", remote.max_step_cycles,
               remote.mean_step_cycles, remote.stack_used);
+  std::printf("link: longest gap between bytes received by the firmware %u cycles, %u gaps over %d periods; "
+              "link errors: firmware %u, host %u\n",
+              remote.link.rx_gap_max, remote.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
+              remote.link.firmware.total(), remote.link.host.total());
+  EXPECT_TRUE(remote.link.clean());
   // Same float code on both sides; on the target the compiler and libm differ, so allow a
   // tolerance of one encoder quantum (0.069 mm) and 0.01 deg on the max errors.
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.069) << i;

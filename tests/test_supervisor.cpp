@@ -1,6 +1,7 @@
 // The supervisor (exhaustively) and the control task's fault handling with a scripted HAL.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <memory>
 
 #include "osc/runtime/control_task.hpp"
@@ -55,9 +56,11 @@ struct ScriptedHal {
   std::uint32_t clock = 0, clock_step = 10, faults = 0;
   int writes = 0;
   bool fault_line = false;
+  bool sample = true;  // the tick has a valid sample
   void fault_output(bool a) { fault_line = a; }
-  void read_encoders(std::int32_t c[kDof]) {
+  bool read_encoders(std::int32_t c[kDof]) {
     for (int i = 0; i < kDof; ++i) c[i] = counts[i];
+    return sample;
   }
   void write_dacs(const std::int32_t c[kDof]) {
     for (int i = 0; i < kDof; ++i) written[i] = c[i];
@@ -78,7 +81,7 @@ struct ScriptedHal {
 static_assert(hal::ControlHal<ScriptedHal>);
 // The concept is a real check: a binding that lacks one function, or returns the wrong type, fails it.
 struct HalWithoutFaultLine {
-  void read_encoders(std::int32_t*) {}
+  bool read_encoders(std::int32_t*) { return true; }
   void write_dacs(const std::int32_t*) {}
   std::uint32_t cycles() { return 0; }
   std::uint32_t io_faults() { return 0; }
@@ -87,6 +90,11 @@ struct HalWithFloatCycles : HalWithoutFaultLine {
   float cycles() { return 0; }
   void fault_output(bool) {}
 };
+struct HalWithVoidEncoders : HalWithFloatCycles {
+  std::uint32_t cycles() { return 0; }
+  void read_encoders(std::int32_t*) {}  // cannot say that a tick has no sample
+};
+static_assert(hal::ControlHal<HalWithVoidEncoders> == false);
 static_assert(!hal::ControlHal<HalWithoutFaultLine>);
 static_assert(!hal::ControlHal<HalWithFloatCycles>);
 
@@ -259,6 +267,50 @@ TEST_F(TaskFixture, OverrunFaults) {
   hal.clock_step = 2000;  // the step now takes longer than the period
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultOverrun));
   expect_latched(kFaultOverrun);
+}
+
+TEST_F(TaskFixture, ATickWithoutASampleCommandsZeroTorqueWithoutAFault) {
+  run(5);
+  ASSERT_FALSE(hal.all_zero());
+  const std::uint64_t tick = task->tick;
+  const std::uint32_t steps = task->step_timing.count;
+  hal.sample = false;
+  EXPECT_EQ(run(1), 0u);
+  EXPECT_TRUE(hal.all_zero());                      // zero codes in this tick
+  EXPECT_EQ(task->step_timing.count, steps);        // no control step
+  EXPECT_EQ(task->sup.state, SupervisorState::kRun);  // and no latch
+  EXPECT_FALSE(hal.fault_line);
+  EXPECT_EQ(task->tick, tick + 1);                  // the sample clock runs on
+  hal.sample = true;
+  EXPECT_EQ(run(1), 0u);
+  EXPECT_FALSE(hal.all_zero());                     // torque again with the next sample
+}
+
+TEST_F(TaskFixture, TheEncoderJumpLimitSpansTheTicksWithoutASample) {
+  run(3);
+  hal.sample = false;
+  run(2);  // two ticks without a sample: the next one is three ticks after the last
+  hal.sample = true;
+  hal.counts[1] += 3 * task->max_count_step[1];
+  EXPECT_EQ(run(1) & kFaultEncoderJump, 0u);  // no jump (the stuck and tracking monitors see it, though)
+  hal.sample = false;
+  run(1);
+  hal.sample = true;
+  hal.counts[1] += 2 * task->max_count_step[1] + 1;  // beyond two ticks' worth
+  EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
+}
+
+TEST_F(TaskFixture, HoldTickRepeatsTheCodesAndRunsTheClocks) {
+  run(4);
+  std::int32_t before[kDof];
+  std::copy(hal.written, hal.written + kDof, before);
+  const int writes = hal.writes;
+  const std::uint64_t tick = task->tick;
+  hold_tick(*task, hal);
+  EXPECT_EQ(hal.writes, writes + 1);
+  EXPECT_TRUE(std::equal(before, before + kDof, hal.written));
+  EXPECT_EQ(task->tick, tick + 1);
+  EXPECT_EQ(task->prev_counts_age, 1u);
 }
 
 TEST_F(TaskFixture, LinkFaultsFromTheIoLayer) {

@@ -1,8 +1,10 @@
-// The processor-in-the-loop firmware for mps2-an386: UART0 carries the link (osc/pil.hpp) to the
-// simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector) runs the control task;
-// here it is pended by the arrival of each sensor frame, so the host's plant sets the sample
-// clock (lockstep) and the run is deterministic under -icount. The link watchdog in the main loop
-// reports a missing or short frame as a fault with zero torque.
+// The processor-in-the-loop firmware for mps2-an386: UART0 carries the link (osc/link/frames.hpp)
+// to the simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector) runs the control
+// task; here it is pended whenever a frame ends (valid or not), so the host's plant sets the sample
+// clock (lockstep) and the run is deterministic under -icount. Every link error is answered at once
+// with zero codes (osc/link/node.hpp). The link watchdog in the main loop answers a missing or short
+// frame the same way after params::kLinkTimeout of virtual time: in lockstep the host paces the
+// ticks, so the node's tick-based silence rule (params::kLinkSilenceTicks) has no ticks to count.
 //
 // The CMSDK watchdog (board.hpp) starts with the link (the first received byte). Its PIL policy
 // (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop
@@ -68,9 +70,10 @@ int main() {
   board::control_irq_enable();
   g_node.hello();  // bytes the host sent before this point may have been dropped
   // The main loop polls the UART (under -icount, polling makes virtual time advance with the
-  // instructions executed, so the link timeout is measured deterministically; a WFI-idle loop
-  // lets QEMU warp virtual time). The link watchdog and the CMSDK watchdog are armed by the first
-  // byte.
+  // instructions executed; a WFI-idle loop lets QEMU warp virtual time). The link watchdog and the
+  // CMSDK watchdog are armed by the first byte. Virtual time also runs on while the host computes
+  // its next frame, so the time between frames follows the host's wall-clock time (the frames carry
+  // the longest gap seen).
   bool link_up = false;
   std::uint32_t last = board::cycles(), last_feed = last;
   for (;;) {

@@ -16,8 +16,9 @@ namespace {
 
 struct StillHal {
   std::int32_t codes[osc::kDof] = {};
-  void read_encoders(std::int32_t c[osc::kDof]) {
+  bool read_encoders(std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) c[i] = 0;
+    return true;
   }
   void write_dacs(const std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];

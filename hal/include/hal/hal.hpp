@@ -23,13 +23,15 @@ constexpr int kJoints = osc::kDof;
 template <class H>
 concept ControlHal = requires(H& h, std::int32_t* counts, const std::int32_t* codes, bool active) {
   /// Accumulated signed counts per joint since start-up, wrap-around of the hardware counters
-  /// already extended (see EncoderUnwrap).
-  { h.read_encoders(counts) } -> std::same_as<void>;
+  /// already extended (see EncoderUnwrap). Returns false when there is no valid sample this tick
+  /// (e.g. its link frame was lost or corrupt): the tick then commands zero torque and skips the
+  /// control step, without a fault; io_faults() decides when such ticks become one.
+  { h.read_encoders(counts) } -> std::same_as<bool>;
   /// Signed DAC codes in [-kDacMaxCode, kDacMaxCode] (osc/runtime/io.hpp).
   { h.write_dacs(codes) } -> std::same_as<void>;
   /// A free-running 32-bit counter for step timing (0 where there is none).
   { h.cycles() } -> std::same_as<std::uint32_t>;
-  /// osc::Fault bits the I/O layer detected since the last tick (lost or corrupt link).
+  /// osc::Fault bits the I/O layer detected since the last tick (e.g. a lost or corrupt link).
   { h.io_faults() } -> std::same_as<std::uint32_t>;
   /// The hardware fault line (e.g. an amplifier-enable interlock or a LED), driven every tick.
   { h.fault_output(active) } -> std::same_as<void>;

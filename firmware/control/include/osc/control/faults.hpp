@@ -15,8 +15,8 @@ namespace osc {
   X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")      \
   X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                   \
   X(Overrun, "overrun", "the next tick arrived before this one ended")                           \
-  X(LinkLost, "link_lost", "no sensor frame within the link timeout")                            \
-  X(LinkCorrupt, "link_corrupt", "a frame with a bad checksum, length or sequence number")         \
+  X(LinkLost, "link_lost", "repeated link errors, the last a silence alone (no frame, no byte)")   \
+  X(LinkCorrupt, "link_corrupt", "repeated link errors, the last a bad, cut short or stray frame")  \
   X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")          \
   X(EncoderStuck, "encoder_stuck", "an encoder stood still while the reference moved its joint by more than the bound") \
   X(Tracking, "tracking", "the measured tracking error exceeded its bound")                               \

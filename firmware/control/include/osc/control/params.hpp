@@ -62,7 +62,27 @@ constexpr double kTrackingLimitOrientation = 0.02;
 /// widened by theta_max on each side, [-theta_max, 2 theta_max]. The robust law never leaves
 /// [0, theta_max]; (67), which has no bounds, faults when it drifts that far.
 constexpr double kThetaFaultBand = 1.0;
-/// Sensor-frame timeout of the processor-in-the-loop link [s] (virtual time of the target).
+
+/// Link supervision (osc/link/node.hpp; docs/firmware.md, "Link supervision"). Every link error
+/// (bad CRC, header or length, junk or lost-sync bytes, a frame cut short, a wrong sequence number,
+/// silence) zeroes the DAC codes of the next tick without latching; repeated errors latch.
+/// Silence on a board whose timer paces the ticks: the DACs keep their codes over at most this many
+/// ticks without a sensor frame; the next tick without one is a silence error (zero codes).
+constexpr int kLinkSilenceTicks = 2;
+/// Silence when the host paces the ticks (lockstep processor in the loop, as in QEMU): no byte for
+/// this long [s of the target's virtual time] is a silence error (or a short frame, if one had
+/// started). Not kLinkSilenceTicks periods: in lockstep the target's clock runs on while it polls
+/// for the host's next frame, and that wait is the host's wall-clock time (the plant's step, the pipe,
+/// the scheduler of a shared machine) turned into target time: gaps of up to 1.7 ms measured in
+/// healthy runs (docs/firmware.md), too close to 2 ms. The plant is frozen meanwhile, so the wait
+/// costs it no torque.
 constexpr double kLinkTimeout = 0.1;
+/// Error ticks (ticks with at least one link error) that latch a link fault when they fall within
+/// kLinkErrorWindow ticks: link_lost when the last was a silence, link_corrupt otherwise. Fewer cost
+/// one tick of zero torque each (at most 0.2 % of the ticks) and are counted; three in a second is
+/// a link that loses more than one frame in 333, no longer one with rare bit errors, and a CRC-16
+/// passes 1 in 65 536 corrupted frames, so the latch also bounds the rate of undetected ones.
+constexpr int kLinkErrorLimit = 3;
+constexpr int kLinkErrorWindow = 1000;
 
 }  // namespace osc::params

@@ -4,7 +4,8 @@
 // Frame:  0xA5 0x5A | type (1) | length (1) | payload (length bytes) | CRC-16/CCITT-FALSE (2, LE)
 // The CRC covers type, length and payload. Sensor frames carry the tick's sequence number, the six
 // encoder counts and fault-injection requests (test builds); actuator frames carry the DAC codes,
-// the supervisor state and fault bits, step timing, stack use and the friction estimates.
+// the supervisor state and fault bits, step timing, stack use, the friction estimates and the
+// firmware's link error counters.
 #pragma once
 
 #include <cstdint>
@@ -47,6 +48,33 @@ struct SensorFrame {
   std::uint8_t inject = 0;
 };
 
+/// The kinds of link error a receiver tells apart, each counted (LinkCounters) in telemetry.
+enum LinkError : std::uint8_t {
+  kErrCrc,       ///< a complete frame whose CRC does not match
+  kErrHeader,    ///< the sync pair, then an unknown frame type (or a frame of the wrong type)
+  kErrLength,    ///< the sync pair and a known type, with the wrong length
+  kErrJunk,      ///< bytes discarded while hunting for the sync pair (junk, lost sync)
+  kErrShortFrame,///< a frame that started and was cut short (silence before its end)
+  kErrSeq,       ///< a valid frame with an unexpected sequence number
+  kErrSilence,   ///< no frame within the silence limit
+  kLinkErrorKinds
+};
+/// Names in telemetry (JSON, logs), in LinkError order.
+constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {"bad_crc",      "bad_header", "bad_length", "junk_bytes",
+                                                          "short_frames", "seq_errors", "timeouts"};
+
+/// Link errors counted by kind since start (32-bit counters that wrap; compare differences).
+struct LinkCounters {
+  std::uint32_t count[kLinkErrorKinds] = {};
+  std::uint32_t& operator[](LinkError e) { return count[e]; }
+  std::uint32_t operator[](LinkError e) const { return count[e]; }
+  std::uint32_t total() const {
+    std::uint32_t n = 0;
+    for (std::uint32_t c : count) n += c;
+    return n;
+  }
+};
+
 struct ActuatorFrame {
   std::uint32_t seq = 0;
   std::int32_t codes[kJoints] = {};
@@ -58,13 +86,19 @@ struct ActuatorFrame {
   std::uint32_t stack_used = 0;  ///< bytes, high-water mark
   float theta_hat[3 * kJoints] = {};
   float tau_f_hat[kJoints] = {};
+  LinkCounters link;             ///< the firmware's link errors by kind, since start
+  /// The longest gap between two received bytes, in cycles, and how many gaps were longer than
+  /// params::kLinkSilenceTicks control periods (what a tick-based silence watchdog would have seen).
+  std::uint32_t rx_gap_max = 0, rx_long_gaps = 0;
 };
 
 constexpr int kSensorPayload = 4 + 4 * kJoints + 1;
-constexpr int kActuatorPayload = 4 + 4 * kJoints + 4 + 1 + 4 * 5 + 4 * 3 * kJoints + 4 * kJoints;
+constexpr int kActuatorPayload =
+    4 + 4 * kJoints + 4 + 1 + 4 * 5 + 4 * 3 * kJoints + 4 * kJoints + 4 * kLinkErrorKinds + 4 * 2;
 constexpr int kOverhead = 6;
 constexpr int kMaxFrame = kActuatorPayload + kOverhead;
-static_assert(kActuatorPayload < 256, "length fits a byte");
+static_assert(kActuatorPayload < 256 && kSensorPayload < 256, "length fits a byte");
+static_assert(kActuatorPayload == 185, "the actuator frame's layout (encode/decode below) changed: update the docs");
 
 /// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), bitwise.
 inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
@@ -140,36 +174,52 @@ inline int encode(const ActuatorFrame& f, std::uint8_t* buf) {
   w.u32(f.stack_used);
   for (float v : f.theta_hat) w.f32(v);
   for (float v : f.tau_f_hat) w.f32(v);
+  for (std::uint32_t c : f.link.count) w.u32(c);
+  w.u32(f.rx_gap_max);
+  w.u32(f.rx_long_gaps);
   return detail::finish(buf, kActuatorFrame, kActuatorPayload);
 }
 
-/// Streaming frame parser: feed bytes one at a time.
+/// Payload length of a frame type, -1 for an unknown type.
+constexpr int payload_length(std::uint8_t type) {
+  return type == kSensorFrame ? kSensorPayload : type == kActuatorFrame ? kActuatorPayload : -1;
+}
+
+/// Streaming frame parser: feed bytes one at a time. Every byte is accounted for: part of a frame
+/// (kPending, then kFrame, kBadChecksum, kBadHeader or kBadLength when the frame ends), or junk
+/// (kJunk: junk() bytes discarded while hunting for the sync pair).
 class Parser {
  public:
-  enum Result : std::uint8_t { kPending, kFrame, kBadChecksum, kBadHeader };
+  enum Result : std::uint8_t { kPending, kFrame, kJunk, kBadHeader, kBadLength, kBadChecksum };
 
   Result feed(std::uint8_t b) {
     switch (stage_) {
-      case 0:  // hunting for the first sync byte; anything else is skipped
-        if (b == kSync0) stage_ = 1;
-        return kPending;
+      case 0:  // hunting for the first sync byte; anything else is junk
+        if (b == kSync0) {
+          stage_ = 1;
+          return kPending;
+        }
+        junk_ = 1;
+        return kJunk;
       case 1:
         if (b == kSync1) {
           stage_ = 2;
           return kPending;
         }
+        // Lost sync: the sync byte before was junk, and so is this one unless it starts a frame.
         stage_ = b == kSync0 ? 1 : 0;
-        return kBadHeader;
+        junk_ = b == kSync0 ? 1 : 2;
+        return kJunk;
       case 2:
         buf_[0] = b;
         stage_ = 3;
         return kPending;
       case 3: {
         buf_[1] = b;
-        const int expect = buf_[0] == kSensorFrame ? kSensorPayload : buf_[0] == kActuatorFrame ? kActuatorPayload : -1;
+        const int expect = payload_length(buf_[0]);
         if (expect < 0 || b != expect) {
           stage_ = 0;
-          return kBadHeader;
+          return expect < 0 ? kBadHeader : kBadLength;
         }
         need_ = b + 2;  // payload and CRC
         have_ = 0;
@@ -185,6 +235,12 @@ class Parser {
         return crc16(buf_, n + 2) == crc ? kFrame : kBadChecksum;
       }
     }
+  }
+  /// Bytes the last kJunk result discarded (1 or 2).
+  int junk() const { return junk_; }
+  /// The error kind of a result other than kPending and kFrame.
+  static constexpr LinkError error_of(Result r) {
+    return r == kJunk ? kErrJunk : r == kBadHeader ? kErrHeader : r == kBadLength ? kErrLength : kErrCrc;
   }
   /// True while a frame has started but not completed (a timeout here is a short frame).
   bool in_frame() const { return stage_ != 0; }
@@ -213,12 +269,15 @@ class Parser {
     f.stack_used = r.u32();
     for (float& v : f.theta_hat) v = r.f32();
     for (float& v : f.tau_f_hat) v = r.f32();
+    for (std::uint32_t& c : f.link.count) c = r.u32();
+    f.rx_gap_max = r.u32();
+    f.rx_long_gaps = r.u32();
     return true;
   }
 
  private:
   std::uint8_t buf_[kMaxFrame] = {};
-  int stage_ = 0, need_ = 0, have_ = 0;
+  int stage_ = 0, need_ = 0, have_ = 0, junk_ = 0;
 };
 
 }  // namespace pil

@@ -1,8 +1,21 @@
 // The firmware side of the processor-in-the-loop link: a HAL binding (hal::ControlHal) of the
 // control task whose encoders and DACs are the frames of osc/link/frames.hpp. Board-independent; a
-// board supplies the static functions of the concept PilBoard below, and runs: on_byte() for every received byte, and tick() from the control interrupt when
-// on_byte() asked for it or after on_timeout(), which it calls when no complete frame arrived
-// within the link timeout.
+// board supplies the static functions of the concept PilBoard below, calls on_byte() for every
+// received byte, and runs tick() from the control interrupt, paced in one of two ways:
+//
+//   lockstep (the host paces the ticks; pil_firmware under QEMU, pil_peer): a tick whenever
+//     on_byte() returns true (a frame ended, valid or not: each sensor frame is answered by exactly
+//     one actuator frame), and after on_timeout(), which the board calls when no byte came for
+//     params::kLinkTimeout of its time;
+//   timer-paced (a board's control timer): a tick every period, whatever arrived; a tick with no
+//     frame and no error since the last one keeps the previous codes, for at most
+//     params::kLinkSilenceTicks ticks in a row; the next such tick is a silence error.
+//
+// Link supervision (both ways): any link error since the last tick (bad CRC, header or length, junk
+// or lost-sync bytes, a frame cut short, a wrong sequence number, silence) makes the tick one
+// without a sample: zero codes, no control step, no latch. params::kLinkErrorLimit such error ticks
+// within params::kLinkErrorWindow ticks latch link_corrupt (link_lost if the last was a silence).
+// Every error is counted by kind in the actuator frame's telemetry.
 #pragma once
 
 #include <cstdint>
@@ -29,66 +42,99 @@ class PilNode {
 
   void init(const Vec6In<S>& q_start, FrictionMode mode, std::uint32_t period_cycles) {
     task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), mode, q_start, period_cycles);
-    expected_seq_ = 0;
-    pending_faults_ = 0;
-    configured_ = false;
     parser_.reset();
+    frame_ = {};
+    counters_ = {};
+    expected_seq_ = 0;
+    answer_seq_ = pil::kHelloSeq;
+    errors_ = 0;
+    fresh_ = synced_ = sample_ = false;
+    configured_ = false;
+    silent_ticks_ = 0;
+    latch_ = 0;
+    error_count_ = error_next_ = 0;
+    have_rx_ = false;
+    rx_last_ = rx_gap_max_ = rx_long_gaps_ = 0;
   }
 
   /// Announces that the receiver is ready (call once, after enabling reception).
   void hello() {
-    const std::uint32_t seq = frame_.seq;
-    frame_.seq = pil::kHelloSeq;
+    const std::uint32_t seq = answer_seq_;
+    answer_seq_ = pil::kHelloSeq;
     const std::int32_t zero[kDof] = {0, 0, 0, 0, 0, 0};
     write_dacs(zero);
-    frame_.seq = seq;
+    answer_seq_ = seq;
   }
 
-  /// Feeds one received byte. Returns true when a tick is due (a sensor frame, valid or not, must
-  /// be answered by exactly one actuator frame).
+  /// Feeds one received byte. Returns true when a frame ended here, valid or not (in lockstep a
+  /// tick follows and answers it).
   bool on_byte(std::uint8_t b) {
+    note_rx_gap();
     const pil::Parser::Result r = parser_.feed(b);
     if (r == pil::Parser::kPending) return false;
-    if (r == pil::Parser::kFrame) {
-      pil::SensorFrame f;
-      if (!parser_.decode(f)) {
-        pending_faults_ |= kFaultLinkCorrupt;
-        return true;
-      }
-      if (f.seq != expected_seq_) pending_faults_ |= kFaultLinkCorrupt;
-      if (!configured_) configure(f.inject);  // the first valid frame configures, once
-      expected_seq_ = f.seq + 1;
-      frame_ = f;
-      return true;
+    if (r == pil::Parser::kJunk) {
+      counters_[pil::kErrJunk] += static_cast<std::uint32_t>(parser_.junk());
+      // Junk after a valid frame is a new error; junk after an error (the rest of a frame whose
+      // header or length was bad, or that lost sync) belongs to that error and is only counted.
+      if (synced_) errors_ |= 1u << pil::kErrJunk;
+      synced_ = false;
+      return false;
     }
-    // Bad checksum or header: the link is corrupt; answer so the host sees the fault at once.
-    pending_faults_ |= kFaultLinkCorrupt;
-    return r == pil::Parser::kBadChecksum;
+    pil::SensorFrame f;
+    if (r != pil::Parser::kFrame) return lost_frame(pil::Parser::error_of(r));
+    if (!parser_.decode(f)) return lost_frame(pil::kErrHeader);  // a valid frame of the wrong type
+    if (f.seq != expected_seq_) error(pil::kErrSeq);
+    if (!configured_) configure(f.inject);  // the first valid frame configures, once
+    expected_seq_ = f.seq + 1;
+    answer_seq_ = f.seq;
+    frame_ = f;
+    fresh_ = synced_ = true;
+    return true;
   }
 
-  /// Link timeout: no complete sensor frame in time (missing or short frame). A tick must follow,
-  /// so that the fault and zero torque go out at once.
+  /// Lockstep: no byte for params::kLinkTimeout. A frame had started (or junk came instead of
+  /// one): it is lost (a short frame); otherwise a silence. A tick must follow.
   void on_timeout() {
-    pending_faults_ |= parser_.in_frame() ? kFaultLinkCorrupt : kFaultLinkLost;
-    parser_.reset();
-    frame_.inject = 0;
+    if (parser_.in_frame()) {
+      lost_frame(pil::kErrShortFrame);
+    } else if (errors_ & (1u << pil::kErrJunk)) {
+      lost_frame(pil::kErrSilence);  // a frame whose sync was destroyed: junk, then nothing
+    } else {
+      error(pil::kErrSilence);
+    }
   }
 
   /// One control tick on the latest sensor frame (runs in the control interrupt).
   void tick() {
-    if (frame_.inject & pil::kInjectNonFinite) task.inject_nonfinite();
+    if (fresh_) silent_ticks_ = 0;
+    if (!fresh_ && errors_ == 0) {  // timer-paced: nothing arrived since the last tick
+      if (++silent_ticks_ <= params::kLinkSilenceTicks) {
+        hold_tick(task, *this);  // the DACs keep their codes (sent again)
+        return;
+      }
+      on_timeout();
+    }
+    sample_ = fresh_ && errors_ == 0;
+    if (!sample_) latch_ |= count_error_tick();
+    if (sample_ && (frame_.inject & pil::kInjectNonFinite)) task.inject_nonfinite();
     control_tick(task, *this);
     frame_.inject = 0;
+    fresh_ = false;
+    errors_ = 0;
   }
 
+  /// The link errors counted so far, by kind.
+  const pil::LinkCounters& link_counters() const { return counters_; }
+
   // HAL binding used by control_tick.
-  void read_encoders(std::int32_t counts[kDof]) {
+  bool read_encoders(std::int32_t counts[kDof]) {
     for (int i = 0; i < kDof; ++i) counts[i] = frame_.counts[i];
-    if (frame_.inject & pil::kInjectOverrun) Board::burn(2 * task.period_cycles + 1);
+    if (sample_ && (frame_.inject & pil::kInjectOverrun)) Board::burn(2 * task.period_cycles + 1);
+    return sample_;
   }
   void write_dacs(const std::int32_t codes[kDof]) {
     pil::ActuatorFrame a;
-    a.seq = frame_.seq;
+    a.seq = answer_seq_;
     for (int i = 0; i < kDof; ++i) a.codes[i] = codes[i];
     a.faults = task.sup.latched;
     a.state = static_cast<std::uint8_t>(task.sup.state);
@@ -99,19 +145,22 @@ class PilNode {
     a.stack_used = Board::stack_used();
     for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.adapt.theta_hat(i));
     for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
+    a.link = counters_;
+    a.rx_gap_max = rx_gap_max_;
+    a.rx_long_gaps = rx_long_gaps_;
     std::uint8_t buf[pil::kMaxFrame];
     Board::uart_write(buf, pil::encode(a, buf));
   }
   std::uint32_t cycles() const { return Board::cycles(); }
   void fault_output(bool active) { Board::fault_output(active); }
   std::uint32_t io_faults() {
-    const std::uint32_t f = pending_faults_;
-    pending_faults_ = 0;
+    const std::uint32_t f = latch_;
+    latch_ = 0;
     return f;
   }
 
  private:
-  /// The configuration bits of the first sensor frame.
+  /// The first sensor frame's configuration bits.
   void configure(std::uint8_t config) {
     configured_ = true;
     if (config & pil::kConfigNoCompensation) task.mode = FrictionMode::kNone;
@@ -120,11 +169,60 @@ class PilNode {
       task.gains.adaptation = static_cast<AdaptationLaw>(law - 1);
   }
 
+  void error(pil::LinkError e) {
+    ++counters_[e];
+    errors_ |= 1u << e;
+  }
+  /// A frame ended unreadable (or never ended): presumed to be the expected one, so that its answer
+  /// carries the sequence number the host is waiting for. Returns true (a tick is due).
+  bool lost_frame(pil::LinkError e) {
+    error(e);
+    parser_.reset();
+    synced_ = false;
+    answer_seq_ = expected_seq_++;
+    return true;
+  }
+
+  /// Records a tick with link errors; returns the link fault to latch when it is the
+  /// params::kLinkErrorLimit-th within params::kLinkErrorWindow ticks.
+  std::uint32_t count_error_tick() {
+    constexpr int kLimit = params::kLinkErrorLimit;
+    error_ticks_[error_next_] = task.tick;
+    error_next_ = (error_next_ + 1) % kLimit;
+    if (error_count_ < kLimit) ++error_count_;
+    const std::uint64_t oldest = error_ticks_[error_next_];  // when full, the slot after the newest
+    if (error_count_ < kLimit || task.tick - oldest >= static_cast<std::uint64_t>(params::kLinkErrorWindow)) return 0;
+    return errors_ == (1u << pil::kErrSilence) ? kFaultLinkLost : kFaultLinkCorrupt;
+  }
+
+  /// The longest gap between received bytes, and the gaps a tick-based silence watchdog would flag.
+  void note_rx_gap() {
+    const std::uint32_t now = Board::cycles();
+    if (have_rx_) {
+      const std::uint32_t gap = now - rx_last_;
+      if (gap > rx_gap_max_) rx_gap_max_ = gap;
+      if (task.period_cycles != 0 && gap > params::kLinkSilenceTicks * task.period_cycles) ++rx_long_gaps_;
+    }
+    have_rx_ = true;
+    rx_last_ = now;
+  }
+
   pil::Parser parser_;
-  pil::SensorFrame frame_;
+  pil::SensorFrame frame_;      // the latest valid sensor frame
+  pil::LinkCounters counters_;
   std::uint32_t expected_seq_ = 0;
-  std::uint32_t pending_faults_ = 0;
+  std::uint32_t answer_seq_ = pil::kHelloSeq;  // sequence number of the next actuator frame
+  std::uint32_t errors_ = 0;    // 1 << pil::LinkError of the errors since the last tick
+  bool fresh_ = false;          // a valid sensor frame arrived since the last tick
+  bool synced_ = false;         // the last thing received was a valid frame (junk now is a new error)
+  bool sample_ = false;         // this tick has a valid sample
   bool configured_ = false;
+  int silent_ticks_ = 0;        // timer-paced: ticks in a row without a frame
+  std::uint32_t latch_ = 0;     // link fault for io_faults()
+  std::uint64_t error_ticks_[params::kLinkErrorLimit] = {};  // ticks of the latest error ticks
+  int error_count_ = 0, error_next_ = 0;
+  bool have_rx_ = false;
+  std::uint32_t rx_last_ = 0, rx_gap_max_ = 0, rx_long_gaps_ = 0;
 };
 
 }  // namespace osc

@@ -48,6 +48,7 @@ struct ControlTask {
   StepOutput<S> last;         // the most recent step, for telemetry
   std::int32_t codes[kDof];   // the most recent DAC codes
   std::int32_t prev_counts[kDof];
+  std::uint32_t prev_counts_age;      // ticks since prev_counts were sampled
   std::int32_t max_count_step[kDof];  // largest plausible encoder change per tick
   std::int64_t min_counts[kDof], max_counts[kDof];  // plausible readings: joint limits plus a margin
   std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
@@ -70,6 +71,7 @@ struct ControlTask {
     q_start = q0;
     tick = 0;
     have_counts = false;
+    prev_counts_age = 0;
     controller_init(model, state, q0);
     for (int i = 0; i < kDof; ++i) {
       codes[i] = 0;
@@ -161,34 +163,40 @@ std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) 
   return faults;
 }
 
-/// One tick. Returns the fault bits detected in this tick. On any fault, and whenever the
-/// supervisor is not in kRun, every DAC gets code 0 in this same tick.
+/// One tick. Returns the fault bits detected in this tick. On any fault, whenever the supervisor is
+/// not in kRun, and in a tick without a valid sample (read_encoders() false: no control step), every
+/// DAC gets code 0 in this same tick.
 template <class S, hal::ControlHal Hal>
 std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const std::uint32_t c0 = hal.cycles();
   std::uint32_t faults = hal.io_faults();
   std::int32_t counts[kDof];
-  hal.read_encoders(counts);
-  // Every reading, the first included, must lie within the joint limits plus the margin.
-  for (int i = 0; i < kDof; ++i)
-    if (counts[i] < task.min_counts[i] || counts[i] > task.max_counts[i]) faults |= kFaultEncoderRange;
-  // An encoder change beyond the physical joint speed (comparison written so that it cannot wrap).
+  const bool sampled = hal.read_encoders(counts);
   bool moved[kDof] = {};
-  if (task.have_counts) {
-    for (int i = 0; i < kDof; ++i) {
-      const std::int64_t d = static_cast<std::int64_t>(counts[i]) - task.prev_counts[i];
-      if (d > task.max_count_step[i] || d < -static_cast<std::int64_t>(task.max_count_step[i]))
-        faults |= kFaultEncoderJump;
-      moved[i] = d != 0;
-      task.prev_counts[i] = counts[i];
+  ++task.prev_counts_age;
+  if (sampled) {
+    // Every reading, the first included, must lie within the joint limits plus the margin.
+    for (int i = 0; i < kDof; ++i)
+      if (counts[i] < task.min_counts[i] || counts[i] > task.max_counts[i]) faults |= kFaultEncoderRange;
+    // An encoder change beyond the physical joint speed over the ticks since the last sample
+    // (comparison written so that it cannot wrap).
+    if (task.have_counts) {
+      for (int i = 0; i < kDof; ++i) {
+        const std::int64_t d = static_cast<std::int64_t>(counts[i]) - task.prev_counts[i];
+        const std::int64_t lim = static_cast<std::int64_t>(task.max_count_step[i]) * task.prev_counts_age;
+        if (d > lim || d < -lim) faults |= kFaultEncoderJump;
+        moved[i] = d != 0;
+        task.prev_counts[i] = counts[i];
+      }
+    } else {
+      for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i], moved[i] = true;  // the monitors start here
+      task.have_counts = true;
     }
-  } else {
-    for (int i = 0; i < kDof; ++i) task.prev_counts[i] = counts[i], moved[i] = true;  // the monitors start here
-    task.have_counts = true;
+    task.prev_counts_age = 0;
   }
 
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
-  if (task.sup.state != SupervisorState::kFault && faults == 0) {
+  if (sampled && task.sup.state != SupervisorState::kFault && faults == 0) {
     const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
     const S t = trajectory_time<S>(task.tick, task.gains.dt);
     const std::uint32_t s0 = hal.cycles();
@@ -206,7 +214,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const std::uint32_t elapsed = hal.cycles() - c0;
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
-  task.sup = supervisor_next(task.sup, {faults, true});
+  task.sup = supervisor_next(task.sup, {faults, task.have_counts});
   if (!torque_enabled(task.sup))
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   hal.write_dacs(task.codes);
@@ -214,6 +222,16 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   task.timing.add(hal.cycles() - c0);
   ++task.tick;
   return faults;
+}
+
+/// A tick without a new sample in which the I/O layer keeps the outputs (a short, bounded gap, e.g.
+/// a sensor frame not yet in on a timer-paced link): no control step, the DACs get the previous codes
+/// again, the sample clock and the age of the last encoder sample run on.
+template <class S, hal::ControlHal Hal>
+void hold_tick(ControlTask<S>& task, Hal& hal) {
+  ++task.prev_counts_age;
+  hal.write_dacs(task.codes);
+  ++task.tick;
 }
 
 }  // namespace osc
