@@ -312,3 +312,26 @@ TEST(Injection, ParserRejectsBadSpecifications) {
 }
 
 }  // namespace
+
+namespace {
+
+// The monitors never trip on the fault-free experiment, with or without compensation, and keep a
+// margin below their thresholds (4 h of both modes: docs/safety.md; CI runs 600 s of each).
+TEST(Monitors, NoFalseFaultWithOrWithoutCompensation) {
+  for (const osc::FrictionMode mode : {osc::FrictionMode::kAdaptive, osc::FrictionMode::kNone}) {
+    ExperimentConfig c = config(600, mode, osc::robot::kFrictionPaper);
+    const ExperimentResult r = run_experiment(c);
+    EXPECT_EQ(r.status, 0u) << osc::fault_name(r.status) << " at " << r.fault_time << " s";
+    std::printf("%-8s 600 s: stuck monitor peaks (counts / N m):", r.mode.c_str());
+    for (int j = 0; j < 6; ++j) {
+      std::printf(" J%d %.1f/%.1f", j + 1, r.stuck_peak[j], r.stuck_dtau_peak[j]);
+      EXPECT_LT(r.stuck_peak[j], 0.9 * osc::params::kStuckMotionCounts) << "J" << j + 1;
+      EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << "J" << j + 1;
+    }
+    const double pos = std::max({r.max_error[0], r.max_error[1], r.max_error[2]});
+    std::printf("; worst position error %.2f mm\n", pos);
+    EXPECT_LT(pos, 0.5 * osc::params::kTrackingLimitPosition * 1e3);
+  }
+}
+
+}  // namespace

@@ -49,9 +49,10 @@ __attribute__((section(".noinit"))) volatile Record g_rec;
 struct StillHal {
   std::int32_t codes[osc::kDof] = {};
   std::int32_t jump = 0;
-  void read_encoders(std::int32_t c[osc::kDof]) {
+  bool read_encoders(std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) c[i] = 0;
     c[0] = jump;
+    return true;
   }
   void write_dacs(const std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];
