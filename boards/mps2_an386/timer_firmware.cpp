@@ -1,5 +1,5 @@
-// The control task in the 1 kHz TIMER0 interrupt, standalone: a HAL with the encoders held at the
-// start pose (no plant) and the DAC codes kept in memory. The CMSDK watchdog runs and is fed at the
+// The control task in the 1 kHz TIMER0 interrupt, standalone (still_hal.hpp: the encoders held at the
+// start pose, no plant, and the DAC codes kept in memory). The CMSDK watchdog runs and is fed at the
 // end of every healthy tick (osc::supervisor_healthy); its first expiry (the NMI) would drop the
 // fault line and wait for the reset. Runs 200 ticks, then stops the watchdog and checks that the
 // ticks came 1 ms apart in virtual time, that no tick overran or faulted, that every tick fed the
@@ -8,29 +8,14 @@
 #include <cstdint>
 
 #include "board.hpp"
+#include "still_hal.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "osc/robot.hpp"
 #include "text.hpp"
 
 namespace {
 
-struct StillHal {
-  std::int32_t codes[osc::kDof] = {};
-  bool read_encoders(std::int32_t c[osc::kDof]) {
-    for (int i = 0; i < osc::kDof; ++i) c[i] = 0;
-    return true;
-  }
-  void write_dacs(const std::int32_t c[osc::kDof]) {
-    for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];
-  }
-  std::uint32_t cycles() { return board::cycles(); }
-  void fault_output(bool active) { board::fault_output(active); }
-  std::uint32_t io_faults() {
-    // The next tick already pending when this one starts: the previous one overran.
-    return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;
-  }
-};
-static_assert(hal::ControlHal<StillHal>);
+using board::StillHal;
 
 constexpr int kTicks = 200;
 constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;

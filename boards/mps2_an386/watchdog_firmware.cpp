@@ -16,6 +16,7 @@
 #include <cstdint>
 
 #include "board.hpp"
+#include "still_hal.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "text.hpp"
@@ -45,30 +46,7 @@ struct Record {
 constexpr std::uint32_t kRecordMagic = 0x57444F47u;
 __attribute__((section(".noinit"))) volatile Record g_rec;
 
-/// Encoders held at the start pose; `jump` counts added to joint 1 (an encoder jump).
-struct StillHal {
-  std::int32_t codes[osc::kDof] = {};
-  std::int32_t jump = 0;
-  bool read_encoders(std::int32_t c[osc::kDof]) {
-    for (int i = 0; i < osc::kDof; ++i) c[i] = 0;
-    c[0] = jump;
-    return true;
-  }
-  void write_dacs(const std::int32_t c[osc::kDof]) {
-    for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];
-  }
-  std::uint32_t cycles() { return board::cycles(); }
-  void fault_output(bool active) { board::fault_output(active); }
-  std::uint32_t io_faults() {
-    return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;
-  }
-  bool codes_zero() const {
-    for (int c : codes)
-      if (c != 0) return false;
-    return true;
-  }
-};
-static_assert(hal::ControlHal<StillHal>);
+using board::StillHal;
 
 osc::ControlTask<float> g_task;
 StillHal g_hal;

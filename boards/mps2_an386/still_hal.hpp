@@ -1,0 +1,41 @@
+// A HAL for the standalone mps2-an386 images that run the control task in the real 1 kHz TIMER0
+// interrupt without a plant: the encoders held at the start pose (joint 1 offset by `jump` counts,
+// to inject an encoder jump), the DAC codes kept in memory, the overrun seen as the next timer
+// interrupt already pending when a tick starts.
+#pragma once
+
+#include <cstdint>
+
+#include "board.hpp"
+#include "hal/hal.hpp"
+#include "osc/control/faults.hpp"
+#include "osc/robots/arm.hpp"
+
+namespace board {
+
+struct StillHal {
+  std::int32_t codes[osc::kDof] = {};
+  std::int32_t jump = 0;
+  bool read_encoders(std::int32_t c[osc::kDof]) {
+    for (int i = 0; i < osc::kDof; ++i) c[i] = 0;
+    c[0] = jump;
+    return true;
+  }
+  void write_dacs(const std::int32_t c[osc::kDof]) {
+    for (int i = 0; i < osc::kDof; ++i) codes[i] = c[i];
+  }
+  std::uint32_t cycles() { return board::cycles(); }
+  void fault_output(bool active) { board::fault_output(active); }
+  std::uint32_t io_faults() {
+    // The next tick already pending when this one starts: the previous one overran.
+    return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;
+  }
+  bool codes_zero() const {
+    for (int c : codes)
+      if (c != 0) return false;
+    return true;
+  }
+};
+static_assert(hal::ControlHal<StillHal>);
+
+}  // namespace board
