@@ -12,6 +12,24 @@
 
 namespace sim {
 
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
+                              pil::ActuatorFrame& f, std::string& err) {
+  while (pos < len) {
+    switch (parser.feed(bytes[pos++])) {
+      case pil::Parser::kPending:
+        break;
+      case pil::Parser::kFrame:
+        if (!parser.decode(f)) return err = "unexpected frame type from the firmware", RxResult::kError;
+        return RxResult::kFrame;
+      case pil::Parser::kBadChecksum:
+        return err = "corrupted actuator frame (checksum mismatch)", RxResult::kError;
+      case pil::Parser::kBadHeader:
+        return err = "corrupted actuator frame (bad header)", RxResult::kError;
+    }
+  }
+  return RxResult::kNeedMore;
+}
+
 PilClient::~PilClient() { stop(); }
 
 std::vector<std::string> PilClient::qemu_command(const std::string& qemu, const std::string& elf) {
@@ -81,18 +99,13 @@ bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& er
   const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
-    while (rx_pos_ < rx_len_) {
-      switch (parser_.feed(rx_[rx_pos_++])) {
-        case pil::Parser::kPending:
-          break;
-        case pil::Parser::kFrame:
-          if (!parser_.decode(f)) return err = "unexpected frame type from the firmware", false;
-          return true;
-        case pil::Parser::kBadChecksum:
-          return err = "corrupted actuator frame (checksum mismatch)", false;
-        case pil::Parser::kBadHeader:
-          return err = "corrupted actuator frame (bad header)", false;
-      }
+    switch (parse_actuator_bytes(parser_, rx_, rx_len_, rx_pos_, f, err)) {
+      case RxResult::kFrame:
+        return true;
+      case RxResult::kError:
+        return false;
+      case RxResult::kNeedMore:
+        break;
     }
     const double left = std::chrono::duration<double>(deadline - clock::now()).count();
     if (left <= 0) {

@@ -10,6 +10,14 @@
 
 namespace sim {
 
+enum class RxResult { kNeedMore, kFrame, kError };
+
+/// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until an actuator
+/// frame completes (kFrame, decoded into f) or the link is corrupt (kError, message in err); pos
+/// advances past the bytes consumed, so bytes after a frame stay for the next call.
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
+                              pil::ActuatorFrame& f, std::string& err);
+
 class PilClient {
  public:
   PilClient() = default;
