@@ -15,6 +15,33 @@
 
 namespace sim {
 
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
+                              pil::ActuatorFrame& f, pil::LinkCounters& counters, std::string& err) {
+  while (pos < len) {
+    const pil::Parser::Result r = parser.feed(bytes[pos++]);
+    switch (r) {
+      case pil::Parser::kPending:
+        break;
+      case pil::Parser::kJunk:
+        counters[pil::kErrJunk] += static_cast<std::uint32_t>(parser.junk());
+        break;
+      case pil::Parser::kFrame:
+        if (parser.decode(f)) return RxResult::kFrame;
+        ++counters[pil::kErrHeader];
+        return err = "unexpected frame type from the firmware", RxResult::kError;
+      case pil::Parser::kBadChecksum:
+      case pil::Parser::kBadHeader:
+      case pil::Parser::kBadLength:
+        ++counters[pil::Parser::error_of(r)];
+        return err = r == pil::Parser::kBadChecksum ? "corrupted actuator frame (checksum mismatch)"
+                     : r == pil::Parser::kBadHeader ? "corrupted actuator frame (bad header: unknown type)"
+                                                    : "corrupted actuator frame (bad header: wrong length)",
+               RxResult::kError;
+    }
+  }
+  return RxResult::kNeedMore;
+}
+
 PilClient::~PilClient() { stop(); }
 
 std::vector<std::string> PilClient::qemu_command(const std::string& qemu, const std::string& elf) {
@@ -88,27 +115,13 @@ PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, 
   const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
-    while (rx_pos_ < rx_len_) {
-      const pil::Parser::Result r = parser_.feed(rx_[rx_pos_++]);
-      switch (r) {
-        case pil::Parser::kPending:
-          break;
-        case pil::Parser::kJunk:
-          counters_[pil::kErrJunk] += static_cast<std::uint32_t>(parser_.junk());
-          break;
-        case pil::Parser::kFrame:
-          if (parser_.decode(f)) return Rx::kFrame;
-          ++counters_[pil::kErrHeader];
-          return err = "unexpected frame type from the firmware", Rx::kCorrupt;
-        case pil::Parser::kBadChecksum:
-        case pil::Parser::kBadHeader:
-        case pil::Parser::kBadLength:
-          ++counters_[pil::Parser::error_of(r)];
-          return err = r == pil::Parser::kBadChecksum ? "corrupted actuator frame (checksum mismatch)"
-                       : r == pil::Parser::kBadHeader ? "corrupted actuator frame (bad header: unknown type)"
-                                                      : "corrupted actuator frame (bad header: wrong length)",
-                 Rx::kCorrupt;
-      }
+    switch (parse_actuator_bytes(parser_, rx_, rx_len_, rx_pos_, f, counters_, err)) {
+      case RxResult::kFrame:
+        return Rx::kFrame;
+      case RxResult::kError:
+        return Rx::kCorrupt;
+      case RxResult::kNeedMore:
+        break;
     }
     const double left = std::chrono::duration<double>(deadline - clock::now()).count();
     if (left <= 0) {

@@ -12,6 +12,15 @@
 
 namespace sim {
 
+enum class RxResult { kNeedMore, kFrame, kError };
+
+/// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until an actuator
+/// frame completes (kFrame, decoded into f) or the link is corrupt (kError, message in err); pos
+/// advances past the bytes consumed, so bytes after a frame stay for the next call. Every error and
+/// every junk byte is counted in counters, by kind.
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
+                              pil::ActuatorFrame& f, pil::LinkCounters& counters, std::string& err);
+
 class PilClient {
  public:
   PilClient() = default;

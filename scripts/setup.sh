@@ -3,7 +3,9 @@
 set -euo pipefail
 pkgs=(cmake make g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib binutils-arm-none-eabi
-      qemu-system-arm python3 python3-matplotlib)
+      qemu-system-arm python3 python3-matplotlib
+      clang libclang-rt-14-dev llvm-14)  # the fuzz preset: clang 14 (Debian 12), its sanitizer and
+                                         # libFuzzer runtimes, llvm-symbolizer for the reports
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Sets up, builds and runs every test: host (kernels, simulator, experiment) and the Cortex-M4F
-# cross build (image checks and firmware tests under QEMU).
+# Sets up, builds and runs every test: host (kernels, simulator, experiment), the Cortex-M4F
+# cross build (image checks and firmware tests under QEMU), and the sanitizer build (the host tests
+# under ASan + UBSan, and each libFuzzer target for a fixed time: docs/fuzzing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -12,3 +13,6 @@ if [ -f boards/CMakeLists.txt ]; then
   cmake --build --preset m4f
   ctest --preset m4f
 fi
+cmake --preset fuzz >/dev/null
+cmake --build --preset fuzz
+ctest --preset fuzz

@@ -22,13 +22,14 @@ struct Supervisor {
 };
 
 /// Transition table:
-///   any state, faults != 0       -> kFault (faults latched)
+///   any state, faults != 0       -> kFault (faults latched; a bit outside the catalogue too: a
+///                                   fault the firmware cannot name still stops the torque)
 ///   kInit, ready                 -> kRun
 ///   kInit, !ready                -> kInit
 ///   kRun                         -> kRun
 ///   kFault                       -> kFault (sticky)
 constexpr Supervisor supervisor_next(Supervisor s, SupervisorInput in) {
-  const std::uint32_t latched = s.latched | (in.faults & kAllFaults);
+  const std::uint32_t latched = s.latched | in.faults;
   if (latched != 0 || s.state == SupervisorState::kFault) return {SupervisorState::kFault, latched};
   if (s.state == SupervisorState::kInit) return {in.ready ? SupervisorState::kRun : SupervisorState::kInit, 0};
   return {SupervisorState::kRun, 0};

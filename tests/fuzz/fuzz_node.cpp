@@ -1,0 +1,166 @@
+// Fuzz target: the firmware's PIL node (osc/link/node.hpp), osc::PilNode<double, FakeBoard>, driven
+// by fuzzed link traffic: raw bytes, well-formed sensor frames with fuzzed encoder counts, sequence
+// numbers and fault-injection bits, and link timeouts. FakeBoard captures what the node writes.
+//
+// Invariants:
+//  - hello() writes one actuator frame: sequence kHelloSeq, zero codes, state kInit;
+//  - on_byte() asks for a tick exactly when a frame ends (valid, or with a bad checksum), as an
+//    independent parser fed the same bytes sees it; every tick writes exactly one actuator frame,
+//    nothing else, and it parses with a valid checksum;
+//  - every code written is within [-kDacMaxCode, kDacMaxCode]; the frame's state and fault bits are
+//    the node's supervisor's; whenever that state is not kRun every code is 0, and the board's fault
+//    line is on exactly in kFault;
+//  - a corrupt header or checksum, a sequence gap or a link timeout is a latched link fault (zero
+//    torque) in the very next actuator frame; once in kFault the node never leaves it;
+//  - the actuator frame answering a valid sensor frame carries its sequence number.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "fuzz_util.hpp"
+#include "osc/link/node.hpp"
+#include "osc/robot.hpp"
+
+namespace {
+
+struct FakeBoard {
+  static inline std::vector<std::uint8_t> out;
+  static inline std::uint32_t clock = 0;
+  static inline bool fault_line = false;
+  static void uart_write(const std::uint8_t* p, int n) { out.insert(out.end(), p, p + n); }
+  static std::uint32_t cycles() { return clock += 1000; }
+  static std::uint32_t stack_used() { return 0; }
+  static void burn(std::uint32_t c) { clock += c; }
+  static void fault_output(bool active) { fault_line = active; }
+};
+static_assert(osc::PilBoard<FakeBoard>);
+
+using Node = osc::PilNode<double, FakeBoard>;
+constexpr std::uint32_t kPeriod = 1000000;
+constexpr int kMaxTicks = 100;
+
+/// The one actuator frame the board received since the last call (aborts otherwise).
+pil::ActuatorFrame take_frame() {
+  pil::Parser p;
+  pil::ActuatorFrame a;
+  int frames = 0;
+  for (std::uint8_t b : FakeBoard::out) {
+    const pil::Parser::Result r = p.feed(b);
+    FUZZ_CHECK(r == pil::Parser::kPending || r == pil::Parser::kFrame);
+    if (r == pil::Parser::kFrame) {
+      FUZZ_CHECK(p.decode(a));
+      ++frames;
+    }
+  }
+  FUZZ_CHECK(frames == 1);
+  FUZZ_CHECK(!p.in_frame());
+  FakeBoard::out.clear();
+  return a;
+}
+
+struct Driver {
+  explicit Driver(Node& n) : node(n) {}
+  Node& node;
+  pil::Parser shadow;               // the specification's view of the byte stream
+  std::uint32_t expected_seq = 0;   // the sequence number the node expects next
+  std::uint32_t last_seq = 0;       // sequence number of the latest valid sensor frame
+  bool link_fault_due = false;      // a link fault the next actuator frame must show
+  bool faulted = false;             // kFault seen
+  int ticks = 0;
+
+  void check_tick() {
+    const pil::ActuatorFrame a = take_frame();
+    const osc::Supervisor& sup = node.task.sup;
+    FUZZ_CHECK(a.state == static_cast<std::uint8_t>(sup.state));
+    FUZZ_CHECK(a.faults == sup.latched);
+    FUZZ_CHECK(a.seq == last_seq);
+    for (std::int32_t c : a.codes) FUZZ_CHECK(c >= -osc::kDacMaxCode && c <= osc::kDacMaxCode);
+    if (sup.state != osc::SupervisorState::kRun)
+      for (std::int32_t c : a.codes) FUZZ_CHECK(c == 0);
+    FUZZ_CHECK(FakeBoard::fault_line == (sup.state == osc::SupervisorState::kFault));
+    if (faulted) FUZZ_CHECK(sup.state == osc::SupervisorState::kFault);
+    if (link_fault_due) {
+      FUZZ_CHECK(sup.state == osc::SupervisorState::kFault);
+      FUZZ_CHECK(sup.latched & (osc::kFaultLinkCorrupt | osc::kFaultLinkLost));
+      link_fault_due = false;
+    }
+    faulted = sup.state == osc::SupervisorState::kFault;
+    ++ticks;
+  }
+
+  void byte(std::uint8_t b) {
+    const pil::Parser::Result r = shadow.feed(b);
+    const bool due = node.on_byte(b);
+    FUZZ_CHECK(due == (r == pil::Parser::kFrame || r == pil::Parser::kBadChecksum));
+    FUZZ_CHECK(FakeBoard::out.empty());
+    if (r == pil::Parser::kBadChecksum || r == pil::Parser::kBadHeader) link_fault_due = true;
+    if (r == pil::Parser::kFrame) {
+      pil::SensorFrame f;
+      if (!shadow.decode(f)) {
+        link_fault_due = true;  // an actuator frame sent to the firmware
+      } else {
+        if (f.seq != expected_seq) link_fault_due = true;
+        expected_seq = f.seq + 1;
+        last_seq = f.seq;
+      }
+    }
+    if (due) {
+      node.tick();
+      check_tick();
+    }
+  }
+
+  void timeout() {
+    node.on_timeout();
+    shadow.reset();
+    link_fault_due = true;
+    node.tick();
+    check_tick();
+  }
+};
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  fuzz::Input in(data, size);
+  FakeBoard::out.clear();
+  FakeBoard::clock = 0;
+  FakeBoard::fault_line = false;
+  auto node = std::make_unique<Node>();
+  node->init(osc::joint_vector<double>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriod);
+  node->hello();
+  {
+    const pil::ActuatorFrame h = take_frame();
+    FUZZ_CHECK(h.seq == pil::kHelloSeq);
+    FUZZ_CHECK(h.state == static_cast<std::uint8_t>(osc::SupervisorState::kInit));
+    for (std::int32_t c : h.codes) FUZZ_CHECK(c == 0);
+  }
+  Driver d(*node);
+  std::int32_t counts[osc::kDof] = {};
+  while (!in.empty() && d.ticks < kMaxTicks) {
+    const std::uint8_t op = in.u8();
+    switch (op & 3) {
+      case 0: {  // raw bytes
+        for (int k = in.u8() & 63; k > 0; --k) d.byte(in.u8());
+        break;
+      }
+      case 1:
+      case 2: {  // a well-formed sensor frame: small encoder steps, or (op & 4) any counts
+        pil::SensorFrame f;
+        f.seq = (op & 8) ? in.u32() : d.expected_seq;
+        for (int i = 0; i < osc::kDof; ++i)
+          counts[i] = (op & 4) ? in.i32() : fuzz::wrap_add(counts[i], static_cast<std::int8_t>(in.u8()) / 4);
+        for (int i = 0; i < osc::kDof; ++i) f.counts[i] = counts[i];
+        f.inject = (op & 16) ? in.u8() : 0;
+        std::uint8_t buf[pil::kMaxFrame];
+        const int n = pil::encode(f, buf);
+        for (int i = 0; i < n; ++i) d.byte(buf[i]);
+        break;
+      }
+      case 3:  // no complete frame within the link timeout
+        d.timeout();
+        break;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,225 @@
+// Writes the seed corpora of the fuzz targets: fuzz_make_corpus DIR writes DIR/<target>/<seed>.
+// The seeds are small, valid inputs in each target's input format (see the target's comment),
+// chosen to start the fuzzer where the interesting code runs: well-formed frames, a controller
+// running in kRun, each command-line option. Regenerate after a change of the link protocol or of
+// a target's input format, and commit the result (docs/fuzzing.md).
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "osc/link/frames.hpp"
+
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+std::filesystem::path g_root;
+
+void put(const std::string& target, const std::string& name, const Bytes& b) {
+  const auto dir = g_root / target;
+  std::filesystem::create_directories(dir);
+  std::ofstream f(dir / name, std::ios::binary);
+  f.write(reinterpret_cast<const char*>(b.data()), static_cast<std::streamsize>(b.size()));
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", (dir / name).c_str());
+    std::exit(1);
+  }
+}
+
+void u32(Bytes& b, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) b.push_back(static_cast<std::uint8_t>(v >> (8 * i)));
+}
+void append(Bytes& b, const Bytes& x) { b.insert(b.end(), x.begin(), x.end()); }
+
+Bytes sensor(std::uint32_t seq, std::int32_t c, std::uint8_t inject = 0) {
+  pil::SensorFrame f;
+  f.seq = seq;
+  for (int i = 0; i < pil::kJoints; ++i) f.counts[i] = c * (i + 1);
+  f.inject = inject;
+  std::uint8_t buf[pil::kMaxFrame];
+  return Bytes(buf, buf + pil::encode(f, buf));
+}
+
+Bytes actuator(std::uint32_t seq, std::uint8_t state, std::uint32_t faults) {
+  pil::ActuatorFrame a;
+  a.seq = seq;
+  for (int i = 0; i < pil::kJoints; ++i) a.codes[i] = (i % 2 ? -1 : 1) * 100 * (i + 1);
+  a.state = state;
+  a.faults = faults;
+  a.step_cycles = 22000;
+  a.max_cycles = 23000;
+  a.mean_cycles = 21000;
+  a.tick_max_cycles = 30000;
+  a.stack_used = 1234;
+  for (int i = 0; i < 3 * pil::kJoints; ++i) a.theta_hat[i] = 0.5f * static_cast<float>(i);
+  for (int i = 0; i < pil::kJoints; ++i) a.tau_f_hat[i] = -0.25f * static_cast<float>(i);
+  std::uint8_t buf[pil::kMaxFrame];
+  return Bytes(buf, buf + pil::encode(a, buf));
+}
+
+Bytes args(const std::vector<std::string>& a) {
+  Bytes b;
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (i) b.push_back(0);
+    b.insert(b.end(), a[i].begin(), a[i].end());
+  }
+  return b;
+}
+
+void frames() {
+  // Raw mode (first byte even): frames as they travel.
+  Bytes b{0};
+  append(b, sensor(0, 5));
+  put("fuzz_frames", "raw_sensor", b);
+  b = {0};
+  append(b, actuator(7, 1, 0));
+  put("fuzz_frames", "raw_actuator", b);
+  b = {0, 0x12, pil::kSync0, 0x00, pil::kSync0, pil::kSync0};
+  append(b, sensor(1, -3));
+  Bytes bad = sensor(2, 4);
+  bad[10] ^= 0x10;  // checksum mismatch
+  append(b, bad);
+  append(b, sensor(3, 9));
+  put("fuzz_frames", "raw_garbage_between", b);
+  // Structured mode (first byte odd): op, garbage, fields.
+  b = {1, 0x02, 0xA5, 0x5A};
+  for (int i = 0; i < 29; ++i) b.push_back(static_cast<std::uint8_t>(i));
+  b.push_back(0x18);  // actuator frame, one bit flipped
+  for (int i = 0; i < 137; ++i) b.push_back(static_cast<std::uint8_t>(3 * i));
+  put("fuzz_frames", "structured", b);
+}
+
+void node() {
+  // ops: 1 = well-formed sensor frame with the expected sequence number and six small steps,
+  // 3 = link timeout, 0 = raw bytes.
+  Bytes b;
+  for (int t = 0; t < 30; ++t) {
+    b.push_back(1);
+    for (int i = 0; i < 6; ++i) b.push_back(static_cast<std::uint8_t>(t % 3 == 0 ? 4 : 0xFC));
+  }
+  put("fuzz_node", "steady_run", b);
+  Bytes c = b;
+  c.resize(7 * 5);
+  c.push_back(1 | 16);  // inject field from the input: overrun
+  for (int i = 0; i < 6; ++i) c.push_back(0);
+  c.push_back(pil::kInjectOverrun);
+  put("fuzz_node", "overrun", c);
+  c.resize(7 * 5);
+  c.push_back(1 | 8);  // sequence number from the input: a gap
+  u32(c, 99);
+  for (int i = 0; i < 6; ++i) c.push_back(0);
+  put("fuzz_node", "sequence_gap", c);
+  c.resize(7 * 5);
+  c.push_back(3);
+  put("fuzz_node", "timeout", c);
+  c.resize(7 * 5);
+  const Bytes raw = sensor(5, 0, static_cast<std::uint8_t>(pil::kConfigNoCompensation));
+  c.push_back(0);
+  c.push_back(static_cast<std::uint8_t>(raw.size()));
+  append(c, raw);
+  put("fuzz_node", "raw_frame", c);
+  Bytes first;
+  const Bytes cfg = sensor(0, 0, static_cast<std::uint8_t>(pil::config_adaptation(osc::AdaptationLaw{})));
+  first.push_back(0);
+  first.push_back(static_cast<std::uint8_t>(cfg.size()));
+  append(first, cfg);
+  append(first, b);
+  put("fuzz_node", "configured_run", first);
+}
+
+void encoder() {
+  // Byte 0 even: the robot's encoder resolution. Then per tick: a mode byte and six small steps
+  // (mode 1), and its extra bytes for the other modes.
+  Bytes b{0};
+  for (int t = 0; t < 40; ++t) {
+    b.push_back(1);
+    for (int i = 0; i < 6; ++i) b.push_back(static_cast<std::uint8_t>(t % 2 ? 8 : 0xF8));
+  }
+  put("fuzz_encoder", "steady_run", b);
+  Bytes c = b;
+  c.resize(1 + 7 * 10);
+  c.push_back(3 | (2 << 2) | (2 << 5));  // joint 3 at the plausible step + 1
+  for (int i = 0; i < 6; ++i) c.push_back(0);
+  c.push_back(2);
+  put("fuzz_encoder", "edge_step", c);
+  Bytes r{0};
+  for (std::uint8_t off : {1, 2}) {  // joint 2 at the plausible maximum, then one count beyond
+    r.push_back(3 | (1 << 2) | (1 << 5));
+    for (int i = 0; i < 6; ++i) r.push_back(0);
+    r.push_back(off);
+  }
+  put("fuzz_encoder", "edge_range", r);
+  Bytes d{0, 2};  // INT32_MAX on joint 1 at the first sample
+  for (int i = 0; i < 6; ++i) d.push_back(0);
+  u32(d, 0x7FFFFFFF);
+  put("fuzz_encoder", "int32_max_first", d);
+  Bytes e{1};  // another resolution: 4096 counts per motor revolution
+  u32(e, 4096 - 100);
+  for (int t = 0; t < 20; ++t) {
+    e.push_back(1);
+    for (int i = 0; i < 6; ++i) e.push_back(static_cast<std::uint8_t>(t % 2 ? 16 : 0xF0));
+  }
+  put("fuzz_encoder", "resolution_4096", e);
+}
+
+void supervisor() {
+  // Two bytes a step: flags (bit 7 ready; bits 0-1 fault form), argument.
+  put("fuzz_supervisor", "init_run", {0x00, 0, 0x80, 0, 0x80, 0, 0x80, 0});
+  put("fuzz_supervisor", "run_then_fault", {0x80, 0, 0x80, 0, 0x81, 3, 0x80, 0, 0x81, 5});
+  put("fuzz_supervisor", "word_faults", {0x80, 0, 0x83, 0, 0x00, 0x01, 0x00, 0x80, 0x80, 0});
+  // Regression: bit 20 is outside the fault catalogue; it used to be masked off (torque stayed on).
+  put("fuzz_supervisor", "unknown_fault_bit", {0x80, 0, 0x80, 0, 0x81, 20, 0x80, 0});
+}
+
+void pil_client() {
+  // Byte 0 even: raw stream after 8 bytes of read sizes.
+  Bytes b{0, 1, 7, 30, 255, 2, 64, 9, 100};
+  append(b, actuator(pil::kHelloSeq, 0, 0));
+  append(b, actuator(0, 1, 0));
+  append(b, actuator(1, 2, 1u << 6));
+  put("fuzz_pil_client", "raw_actuators", b);
+  Bytes c{0, 3, 3, 3, 3, 3, 3, 3, 3, 0x11};
+  append(c, actuator(4, 1, 0));
+  append(c, sensor(5, 1));
+  Bytes bad = actuator(6, 1, 0);
+  bad[20] ^= 1;
+  append(c, bad);
+  put("fuzz_pil_client", "raw_errors", c);
+  // Byte 0 odd: frames built from the input (op, garbage, fields).
+  Bytes d{1, 255, 255, 255, 255, 255, 255, 255, 255, 0x01, 0x5A};
+  for (int i = 0; i < 137; ++i) d.push_back(static_cast<std::uint8_t>(i));
+  d.push_back(0x08);
+  for (int i = 0; i < 29; ++i) d.push_back(static_cast<std::uint8_t>(7 * i));
+  put("fuzz_pil_client", "structured", d);
+}
+
+void cli() {
+  put("fuzz_cli", "none", {});
+  put("fuzz_cli", "help", args({"--help"}));
+  put("fuzz_cli", "numbers", args({"--duration", "30", "--model-error", "-0.1", "--encoder-cpr", "4096", "--substep",
+                                   "5e-5", "--delay", "0", "--final-window", "60"}));
+  put("fuzz_cli", "words", args({"--mode", "adaptive", "--friction", "corke", "--scalar", "float", "--adaptation",
+                                 "paper", "--no-csv", "--no-progress"}));
+  put("fuzz_cli", "files", args({"--qemu", "--elf", "fw.elf", "--json", "s.json", "--csv-dir", "out dir"}));
+  put("fuzz_cli", "bad_value", args({"--duration", "1e999"}));
+  put("fuzz_cli", "missing_value", args({"--mode"}));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    std::fprintf(stderr, "usage: fuzz_make_corpus DIR (e.g. tests/fuzz/corpus)\n");
+    return 2;
+  }
+  g_root = argv[1];
+  frames();
+  node();
+  encoder();
+  supervisor();
+  pil_client();
+  cli();
+  return 0;
+}
