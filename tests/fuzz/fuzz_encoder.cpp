@@ -29,8 +29,9 @@ struct FuzzHal {
   int writes = 0;
   bool fault_line = false;
   std::uint32_t clock = 0;
-  void read_encoders(std::int32_t c[osc::kDof]) {
+  bool read_encoders(std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) c[i] = next[i];
+    return true;  // a sample every tick (ticks without one: tests/test_supervisor.cpp)
   }
   void write_dacs(const std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) written[i] = c[i];

@@ -38,6 +38,13 @@ struct Checked {
         if (was_in) FUZZ_CHECK(p.in_frame());
         else FUZZ_CHECK(p.in_frame() == (b == pil::kSync0));
         break;
+      case pil::Parser::kJunk:  // bytes discarded while hunting for the sync pair
+        FUZZ_CHECK(p.junk() == 1 || p.junk() == 2);
+        break;
+      case pil::Parser::kBadLength:  // a known type with another length: the frame is dropped
+        FUZZ_CHECK(was_in);
+        FUZZ_CHECK(!p.in_frame());
+        break;
       case pil::Parser::kBadHeader:
         FUZZ_CHECK(was_in);
         if (p.in_frame()) FUZZ_CHECK(b == pil::kSync0);
