@@ -68,14 +68,31 @@ def main(argv):
         print("usage: plot_experiment.py OUT_DIR", file=sys.stderr)
         return 2
     out = argv[1]
+    # The runs of this experiment are those of its summary.json: a CSV left in the folder by an
+    # earlier run (another mode, another duration) is not plotted beside them.
+    summary = {}
+    sp = os.path.join(out, "summary.json")
+    if os.path.exists(sp):
+        with open(sp) as f:
+            summary = {r["mode"]: r for r in json.load(f).get("runs", [])}
     runs = {}
     for mode in ("adaptive", "none"):
         p = os.path.join(out, f"timeseries_{mode}.csv")
-        if os.path.exists(p):
-            runs[mode] = load(p)
+        if not os.path.exists(p) or (summary and mode not in summary):
+            continue
+        d = load(p)
+        if mode in summary and abs(d["t"][-1] - summary[mode]["duration_s"]) > 1.0:
+            print(f"plot_experiment.py: {p} ends at {d['t'][-1]:.1f} s, but the run in summary.json lasted "
+                  f"{summary[mode]['duration_s']:.1f} s: a stale file, not plotted", file=sys.stderr)
+            continue
+        runs[mode] = d
     if not runs:
-        print(f"plot_experiment.py: no timeseries_*.csv in {out}", file=sys.stderr)
+        print(f"plot_experiment.py: no timeseries_*.csv of this run in {out}", file=sys.stderr)
         return 1
+    print(f"plotted runs: {' '.join(runs)}")
+    first = summary.get("adaptive") or summary.get("none") or {}
+    what = (f"{first.get('duration_s', 0):.0f} s, plant friction '{first.get('friction_preset', '?')}'"
+            if first else "")
 
     fig, axs = plt.subplots(6, 1, figsize=(9, 11), sharex=True)
     for mode, d in runs.items():
@@ -87,7 +104,7 @@ def main(argv):
         axs[i].grid(True, lw=0.3)
     axs[0].legend(loc="upper right", fontsize=8)
     axs[-1].set_xlabel("t [s]")
-    fig.suptitle("Tracking errors on the simulated PUMA 560 (cf. Fig. 1 of the paper)")
+    fig.suptitle(f"Tracking errors on the simulated PUMA 560 (cf. Fig. 1 of the paper){', ' + what if what else ''}")
     fig.tight_layout()
     p1 = os.path.join(out, "fig1_tracking_errors.png")
     fig.savefig(p1, dpi=110)
@@ -98,12 +115,18 @@ def main(argv):
         fig, axs = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
         for k in range(3):
             for j in range(6):
-                axs[k].plot(d["t"], d[f"theta_hat_{6 * k + j}"], lw=0.8, label=f"J{j + 1}")
+                line, = axs[k].plot(d["t"], d[f"theta_hat_{('vis', 'cou', 'sti')[k]}_J{j + 1}"], lw=0.8,
+                                    label=f"J{j + 1}")
+                if "adaptive" in summary:  # the plant's true value, dashed, same colour
+                    axs[k].axhline(summary["adaptive"]["theta_true"][6 * k + j], color=line.get_color(), lw=0.6,
+                                   ls="--")
             axs[k].set_ylabel(PARAMS[k] + (" [N m s/rad]" if k == 0 else " [N m]"))
             axs[k].grid(True, lw=0.3)
         axs[0].legend(ncol=6, fontsize=8)
         axs[-1].set_xlabel("t [s]")
-        fig.suptitle("Friction coefficient estimates θ̂ (adaptation law (67))")
+        law = summary.get("adaptive", {}).get("adaptation", "")
+        fig.suptitle(f"Friction coefficient estimates θ̂ ({law + ' law; ' if law else ''}dashed: the plant's true "
+                     f"values){', ' + what if what else ''}")
         fig.tight_layout()
         p2 = os.path.join(out, "friction_estimates.png")
         fig.savefig(p2, dpi=110)

@@ -302,7 +302,9 @@ bool write_csv(const std::string& dir, const sim::ExperimentResult& r, std::stri
   const std::string path = dir + "/timeseries_" + r.mode + ".csv";
   std::ostringstream f;
   f << "t,e_x_mm,e_y_mm,e_z_mm,e_phx_deg,e_phy_deg,e_phz_deg,xt_x_mm,xt_y_mm,xt_z_mm,xt_phx_deg,xt_phy_deg,xt_phz_deg";
-  for (int i = 0; i < 18; ++i) f << ",theta_hat_" << i;
+  // theta^ = [vis; cou; sti], six joints each (model (2)): named by coefficient and joint.
+  static const char* const kCoeff[3] = {"vis", "cou", "sti"};
+  for (int i = 0; i < 18; ++i) f << ",theta_hat_" << kCoeff[i / 6] << "_J" << i % 6 + 1;
   for (int i = 0; i < 6; ++i) f << ",tau_f_" << i;
   for (int i = 0; i < 6; ++i) f << ",tau_f_hat_" << i;
   f << "\n";

@@ -6,7 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake --preset host >/dev/null
-cmake --build --preset host --target puma_experiment
+cmake --build --preset host --target puma_experiment osc_model_info
 # --qemu runs the controller as the Cortex-M4F firmware image in QEMU: build it first.
 for a in "$@"; do
   if [ "$a" = "--qemu" ]; then
@@ -22,5 +22,11 @@ for a in "$@"; do
   prev=$a
 done
 mkdir -p "$dir"
-./build/host/host_sim/puma_experiment --json "$dir/summary.json" --csv-dir "$dir" "$@"
-/usr/bin/python3 host_sim/plot_experiment.py "$dir"
+# The figures are made whatever the run's status (a faulted run is when they are needed most);
+# the script then exits with the run's status.
+status=0
+./build/host/host_sim/puma_experiment --json "$dir/summary.json" --csv-dir "$dir" "$@" || status=$?
+if [ -f "$dir/summary.json" ]; then
+  /usr/bin/python3 host_sim/plot_experiment.py "$dir" || true
+fi
+exit "$status"
