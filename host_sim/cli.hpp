@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -25,7 +26,9 @@ inline bool parse_number(const std::string& flag, const char* text, double lo, d
     return false;
   }
   if (v < lo || v > hi) {
-    err = flag + ": " + text + " is out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    char range[64];
+    std::snprintf(range, sizeof range, "[%g, %g]", lo, hi);
+    err = flag + ": " + text + " is out of range " + range;
     return false;
   }
   out = v;

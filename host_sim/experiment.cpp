@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "osc/runtime/control_task.hpp"
@@ -184,7 +185,10 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     }
 
     double xt[6];
-    for (int i = 0; i < 6; ++i) xt[i] = rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg);
+    // The observer's error is known only for the in-process controller; over the link it is not
+    // sent, and the time series says so (nan) rather than showing zeros.
+    for (int i = 0; i < 6; ++i)
+      xt[i] = rep.has_observer ? rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg) : std::numeric_limits<double>::quiet_NaN();
     if (k % window_ticks == 0) {
       res.window_max.push_back({0, 0, 0, 0, 0, 0});
       res.window_theta_range.push_back({rep.theta_hat[0], rep.theta_hat[0]});
@@ -202,7 +206,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
       if (t >= t_final) {
         res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
-        res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
+        if (rep.has_observer) res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
       }
     }
     const Vec6 tau_f = plant.friction(plant.qd());

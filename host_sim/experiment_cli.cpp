@@ -32,10 +32,20 @@ const char* const kExperimentUsage =
 
 bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::string& err) {
   for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const char* v = i + 1 < argc ? argv[i + 1] : nullptr;
+    std::string a = argv[i];
+    // --flag=value is --flag value.
+    std::string inline_value;
+    const auto eq = a.find('=');
+    const bool has_inline = a.rfind("--", 0) == 0 && eq != std::string::npos;
+    if (has_inline) {
+      inline_value = a.substr(eq + 1);
+      a.resize(eq);
+    }
+    const char* v = has_inline ? inline_value.c_str() : i + 1 < argc ? argv[i + 1] : nullptr;
+    bool took = false;
     auto take = [&]() -> const char* {
-      ++i;
+      took = true;
+      if (!has_inline) ++i;
       return v;
     };
     if (a == "--help" || a == "-h") {
@@ -105,6 +115,7 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
     } else {
       return err = "unknown option '" + a + "'", false;
     }
+    if (has_inline && !took) return err = a + " takes no value", false;
   }
   return true;
 }

@@ -59,7 +59,9 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
   std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')\n", runs[0].duration,
               runs[0].friction_preset.c_str());
   std::printf("%-12s", "axis");
-  for (const auto& r : runs) std::printf(" %14s %14s", (r.mode + " all").c_str(), (r.mode + " last20s").c_str());
+  char last[32];
+  std::snprintf(last, sizeof last, " last%gs", runs[0].final_window);  // the "last" window, as long as the run at most
+  for (const auto& r : runs) std::printf(" %14s %14s", (r.mode + " all").c_str(), (r.mode + last).c_str());
   std::printf(" %10s %10s\n", "paper T.I", "paper T.III");
   for (int i = 0; i < 6; ++i) {
     std::printf("%-12s", kAxes[i]);
