@@ -22,7 +22,7 @@ namespace {
 using Options = sim::ExperimentOptions;
 
 int fail(const std::string& msg) {
-  std::cerr << "puma_experiment: " << msg << "\n" << sim::kExperimentUsage;
+  std::cerr << "puma_experiment: " << msg << "\n(puma_experiment --help lists the options)\n";
   return 2;
 }
 
