@@ -28,8 +28,8 @@ class PlantHal {
       : plant_(plant), q_start_(q_start), inj_(inj) {
     for (int i = 0; i < hal::kJoints; ++i) {
       counts_per_rad_[i] = osc::counts_per_rad(i, counts_per_motor_rev);
-      // The largest plausible change per tick (the firmware's bound, osc::ControlTask).
-      step_[i] = osc::robot::kDrives.max_joint_speed[i] * osc::params::kDt * counts_per_rad_[i];
+      // The encoder change per tick at the joint's maximum speed (the firmware's bound, less one count).
+      step_[i] = osc::counts_per_tick_at_max_speed(i, counts_per_rad_[i]);
     }
   }
 

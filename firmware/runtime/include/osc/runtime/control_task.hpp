@@ -99,7 +99,7 @@ struct ControlTask {
       const double c = osc::counts_per_rad(i, counts_per_motor_rev);
       counts_per_rad(i) = lit<S>(c);
       // Speed limit times the sample, in counts, plus one count of quantisation.
-      max_count_step[i] = static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * params::kDt * c) + 1;
+      max_count_step[i] = static_cast<std::int32_t>(counts_per_tick_at_max_speed(i, c)) + 1;
       // The joint limits plus the margin, relative to the start pose, in counts (rounded outwards).
       const double q0 = static_cast<double>(q_start(i));
       min_counts[i] = static_cast<std::int64_t>((robot::kArm.q_min[i] - params::kJointLimitMargin - q0) * c) - 1;

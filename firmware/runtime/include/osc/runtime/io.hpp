@@ -4,6 +4,7 @@
 
 #include <cstdint>
 
+#include "osc/control/params.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/robot.hpp"
 
@@ -14,6 +15,11 @@ namespace osc {
 constexpr double counts_per_rad(int joint,
                                 double counts_per_motor_rev = robot::kDrives.encoder_counts_per_motor_rev) {
   return counts_per_motor_rev * abs_of(robot::kArm.links[joint].gear_ratio) / (2 * kPi);
+}
+/// The encoder change of one control period at the joint's maximum speed [counts] (the plausible
+/// step per tick is this plus one count of quantisation).
+constexpr double counts_per_tick_at_max_speed(int joint, double counts_per_rad) {
+  return robot::kDrives.max_joint_speed[joint] * params::kDt * counts_per_rad;
 }
 /// Largest DAC code magnitude of the robot's drives.
 constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
