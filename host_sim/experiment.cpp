@@ -23,6 +23,7 @@ struct TickReport {
   std::uint32_t faults = 0;
   bool has_observer = false;  // x_tilde is available (in-process controller only)
   double x_tilde[6] = {};
+  double xd_hat[6] = {};      // the observer's velocity estimate: m/s, rad/s (in-process only)
   double tau_f_hat[6] = {};
   double theta_hat[18] = {};
 };
@@ -32,9 +33,7 @@ template <class S>
 class LocalController {
  public:
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
-    osc::Gains<S> gains = osc::Gains<S>::paper();
-    gains.adaptation = cfg.adaptation;
-    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), gains, cfg.mode, q0.cast<S>(),
+    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode, q0.cast<S>(),
                 PlantHal::kPeriodNs);
     task_->set_encoder_resolution(cfg.encoder_counts_per_motor_rev);
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
@@ -49,6 +48,7 @@ class LocalController {
     r.has_observer = true;
     for (int i = 0; i < 6; ++i) {
       r.x_tilde[i] = static_cast<double>(out.x_tilde(i));
+      r.xd_hat[i] = static_cast<double>(out.xd_hat(i));
       r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
     }
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
@@ -70,7 +70,7 @@ class RemoteController {
   RemoteController(const ExperimentConfig& cfg, std::string& err)
       : timeout_(cfg.pil_timeout),
         config_(static_cast<std::uint8_t>((cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
-                                          pil::config_adaptation(cfg.adaptation))) {
+                                          pil::config_adaptation(cfg.gains.adaptation))) {
     ok_ = link_.start(cfg.pil_command, err);
   }
   bool ok() const { return ok_; }
@@ -153,10 +153,11 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   TickReport rep;
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
-    const double t_ref = osc::trajectory_time<double>(static_cast<std::uint64_t>(k), dt);  // as the controller
+    const osc::TrajectorySpec<double>& spec = cfg.gains.trajectory;
+    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k), dt);  // as the controller
     // Errors of the true plant at the sample instant.
     osc::forward_kinematics(truth, tdata, plant.q());
-    const osc::Desired<double> d = osc::trajectory(p0, t_ref);
+    const osc::Desired<double> d = osc::trajectory(spec, p0, t_ref);
     const Vec3 phi = osc::orientation_coordinates(tdata.R[6], R_ref);
     double e[6];
     for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - tdata.o[6](i)) * 1e3;
@@ -171,7 +172,16 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.error = "tick " + std::to_string(k) + ": " + res.error;
       break;
     }
-    if (rep.faults != 0 && res.status == 0) res.status = rep.faults, res.fault_time = t;
+    if (rep.faults != 0 && res.status == 0) {
+      res.status = rep.faults, res.fault_time = t;
+      FaultState& fs = res.fault;
+      fs.tick = k, fs.t = t, fs.faults = rep.faults;
+      for (int i = 0; i < 6; ++i) fs.q[i] = plant.q()(i), fs.qd[i] = plant.qd()(i), fs.tau[i] = tau_old(i), fs.e[i] = e[i];
+      for (int i = 0; i < 18; ++i) fs.theta_hat[i] = rep.theta_hat[i];
+    }
+    // Statistics stop at a fault: after it the amplifiers are off and the robot falls.
+    const bool counting = res.status == 0;
+    if (counting) res.stats_until = t + dt;
     const Vec6 tau_new = hal.torque();
     if (hal.injection_active()) {
       if (rep.faults != 0 && ir.detected < 0) ir.detected = t, ir.faults = rep.faults;
@@ -184,15 +194,30 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
           if (std::abs(tau_new(i)) > ir.max_torque_after) ir.max_torque_after = std::abs(tau_new(i)), ir.max_torque_joint = i;
     }
 
-    double xt[6];
-    // The observer's error is known only for the in-process controller; over the link it is not
-    // sent, and the time series says so (nan) rather than showing zeros.
-    for (int i = 0; i < 6; ++i)
-      xt[i] = rep.has_observer ? rep.x_tilde[i] * (i < 3 ? 1e3 : kRadToDeg) : std::numeric_limits<double>::quiet_NaN();
-    if (k % window_ticks == 0) {
+    double xt[6], xdt[6];
+    // The observer's errors are known only for the in-process controller; over the link they are
+    // not sent, and the time series leaves their columns out rather than showing zeros.
+    res.has_observer = rep.has_observer;
+    if (rep.has_observer) {
+      // The true operational velocity: the analytic Jacobian of the plant's pose times its joint speeds.
+      osc::geometric_jacobian(tdata);
+      const Mat6 Ja = osc::analytic_jacobian(tdata.J, phi);
+      const Vec6 xd_true = Ja * plant.qd();
+      for (int i = 0; i < 6; ++i) {
+        const double scale = i < 3 ? 1e3 : kRadToDeg;
+        xt[i] = rep.x_tilde[i] * scale;
+        xdt[i] = (rep.xd_hat[i] - xd_true(i)) * scale;
+      }
+    } else {
+      for (int i = 0; i < 6; ++i) xt[i] = xdt[i] = std::numeric_limits<double>::quiet_NaN();
+    }
+    if (!counting) {
+      // Only the time series goes on after a fault (the figures show what the robot did).
+    } else if (k % window_ticks == 0) {
       res.window_max.push_back({0, 0, 0, 0, 0, 0});
       res.window_theta_range.push_back({rep.theta_hat[0], rep.theta_hat[0]});
     }
+    if (counting) {
     auto& wmax = res.window_max.back();
     auto& wth = res.window_theta_range.back();
     for (int i = 0; i < 18; ++i) {
@@ -206,11 +231,15 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
       if (t >= t_final) {
         res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
-        if (rep.has_observer) res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
+        if (rep.has_observer) {
+          res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
+          res.max_observer_velocity_error[i] = std::max(res.max_observer_velocity_error[i], std::abs(xdt[i]));
+        }
       }
     }
+    }
     const Vec6 tau_f = plant.friction(plant.qd());
-    if (t >= t_final) {
+    if (counting && t >= t_final) {
       for (int i = 0; i < 6; ++i) {
         const double df = rep.tau_f_hat[i] - tau_f(i);
         fr_err2 += df * df;
@@ -224,6 +253,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       for (int i = 0; i < 6; ++i) {
         r.e[i] = e[i];
         r.x_tilde[i] = xt[i];
+        r.xd_tilde[i] = xdt[i];
+        r.tau[i] = tau_new(i);
         r.tau_f[i] = tau_f(i);
         r.tau_f_hat[i] = rep.tau_f_hat[i];
       }
@@ -234,7 +265,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     tau_old = tau_new;
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);
   }
-  for (int i = 0; i < 18; ++i) res.theta_hat[i] = rep.theta_hat[i];
+  for (int i = 0; i < 18; ++i) res.theta_hat[i] = res.status ? res.fault.theta_hat[i] : rep.theta_hat[i];
   if (fr_n > 0) {
     res.friction_rms_error = std::sqrt(fr_err2 / (6.0 * fr_n));
     res.friction_rms = std::sqrt(fr2 / (6.0 * fr_n));
@@ -250,14 +281,14 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   ExperimentResult res;
   res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
   res.duration = cfg.duration;
-  res.adaptation = osc::adaptation_law_name(cfg.adaptation);
+  res.adaptation = osc::adaptation_law_name(cfg.gains.adaptation);
   res.friction_preset = cfg.plant.friction.name;
   for (int i = 0; i < 6; ++i) {
     res.theta_true[i] = cfg.plant.friction.vis[i];
     res.theta_true[6 + i] = cfg.plant.friction.cou[i];
     res.theta_true[12 + i] = cfg.plant.friction.sti[i];
   }
-  const Vec6 q0 = osc::joint_vector<double>(osc::robot::kQStart);
+  const Vec6 q0 = cfg.q_start;
   if (!cfg.pil_command.empty()) {
     RemoteController ctrl(cfg, res.error);
     if (ctrl.ok()) run(cfg, q0, ctrl, res);

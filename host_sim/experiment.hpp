@@ -28,7 +28,11 @@ struct ExperimentConfig {
   double log_period = 0.01;                         ///< time-series decimation [s]
   double final_window = 20.0;                       ///< "last 20 s" statistics [s]
   double window = 60.0;                             ///< length of the per-window maxima [s]
-  osc::AdaptationLaw adaptation = osc::Gains<double>::paper().adaptation;  ///< the firmware's default
+  /// The controller's gains (69), K_ad, tau_dec, adaptation law and trajectory (68), in double; the
+  /// in-process controller casts them to its scalar. The firmware's defaults (params.hpp); a PIL
+  /// image uses its own compiled-in values (only the adaptation law and mode go over the link).
+  osc::Gains<double> gains = osc::Gains<double>::paper();
+  Vec6 q_start = osc::joint_vector<double>(osc::robot::kQStart);  ///< start pose of the task [rad]
   double observer_offset[6] = {0, 0, 0, 0, 0, 0};    ///< x^(0) - x(0), to test observer convergence
   /// Uptime test (in-process controller only): at jump_at [s] the controller's sample counter
   /// advances by jump_ticks, as if it had been running that much longer (a multiple of the
@@ -48,6 +52,8 @@ struct LogRow {
   double t;
   double e[6];          // tracking error of the true plant: mm (x, y, z), deg (about X, Y, Z)
   double x_tilde[6];    // observer position error: mm, deg
+  double xd_tilde[6];   // observer velocity error x^dot - x dot (true): mm/s, deg/s
+  double tau[6];        // joint torque the amplifiers applied [N m]
   double theta_hat[18];
   double tau_f[6];      // true plant friction [N m]
   double tau_f_hat[6];  // estimated friction (30) [N m]
@@ -77,6 +83,17 @@ struct LinkReport {
   bool clean() const { return firmware.total() == 0 && host.total() == 0 && host_code_range == 0 && zeroed_ticks == 0; }
 };
 
+/// The state of the plant and the controller at the tick a fault latched.
+struct FaultState {
+  long tick = -1;                    ///< sample index (-1: no fault)
+  double t = -1;                     ///< [s]
+  std::uint32_t faults = 0;          ///< the fault bits of that tick
+  double q[6] = {}, qd[6] = {};      ///< plant joint angles [rad] and speeds [rad/s]
+  double tau[6] = {};                ///< torque the amplifiers applied in the sample before [N m]
+  double e[6] = {};                  ///< tracking error: mm, deg
+  double theta_hat[18] = {};         ///< the friction estimates
+};
+
 struct ExperimentResult {
   std::string mode;
   std::string friction_preset;
@@ -84,6 +101,11 @@ struct ExperimentResult {
   double max_error[6] = {};          // over the whole run: mm, mm, mm, deg, deg, deg
   double final_max_error[6] = {};    // over the last final_window seconds
   double max_observer_error[6] = {}; // |x~| over the last final_window seconds: mm, deg
+  double max_observer_velocity_error[6] = {};  // |x^dot - x dot| over the last final_window seconds: mm/s, deg/s
+  bool has_observer = false;         // the observer's errors are known (in-process controller)
+  /// The statistics (errors, windows, theta^) cover the run up to the fault's tick only, when one
+  /// latched: after it the amplifiers are off and the robot falls, which is no result.
+  double stats_until = 0;            // [s]
   double theta_hat[18] = {};
   double theta_true[18] = {};
   double final_window = 0;                        // [s] of the "last" statistics
@@ -99,6 +121,7 @@ struct ExperimentResult {
   double stuck_dtau_peak[6] = {};          // the stuck-encoder monitor's largest value per joint [counts] (in process)
   std::uint32_t status = 0;          // first fault bits reported (0: none)
   double fault_time = -1;            // [s] of the first fault (-1: none)
+  FaultState fault;                  // where and how the first fault latched
   InjectionResult injection;         // when cfg.injection.enabled
   std::string error;                 // link error (PIL), empty when the run completed
   std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)

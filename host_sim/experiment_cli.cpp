@@ -1,121 +1,152 @@
-// puma_experiment's command line (see experiment_cli.hpp).
+// puma_experiment's command line (see experiment_cli.hpp), parsed by CLI11.
 #include "experiment_cli.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <fstream>
+#include <sstream>
+#include <utility>
+#include <vector>
 
 #include "injection.hpp"
 
-#include "cli.hpp"
-
 namespace sim {
+namespace {
 
-const char* const kExperimentUsage =
-    "usage: puma_experiment [options]\n"
-    "  --duration S        simulated seconds per run (default 120; 1..86400)\n"
-    "  --mode M            both | adaptive | none (default both)\n"
-    "  --friction P        plant friction preset: paper | corke | none (default paper)\n"
-    "  --scalar T          controller arithmetic: double | float (default double)\n"
-    "  --adaptation L      friction adaptation law: paper (default: the firmware's)\n"
-    "  --model-error F     controller link mass/inertia relative error (default 0; -0.5..0.5)\n"
-    "  --encoder-cpr C     encoder counts per motor revolution, plant and controller (default 1000; 100..1e7)\n"
-    "  --substep S         plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)\n"
-    "  --delay S           computation delay inside the sample (default 2e-4; 0..1e-3)\n"
-    "  --qemu              run the controller as the firmware image in qemu-system-arm (PIL)\n"
-    "  --elf FILE          firmware image for --qemu (default: the m4f build's pil_firmware.elf)\n"
-    "  --json FILE         write the summary as JSON\n"
-    "  --csv-dir DIR       write time series CSV files there (default: out)\n"
-    "  --inject KIND[:J]@S inject a fault into the simulated hardware at S seconds, on joint J (1..6;\n"
-    "                      default every joint): encoder-stuck | encoder-jump | encoder-garbage |\n"
-    "                      encoder-noise | dac-stuck | overrun | estop (docs/safety.md)\n"
-    "  --final-window S    length of the \"last\" statistics at the end of the run (default 20; 1..3600)\n"
-    "  --no-csv            do not write time series\n"
-    "  --no-progress       no progress bar\n"
-    "  --help              this text\n";
+/// A named option that stands for a configuration key (--duration 30 is --set run.duration=30).
+struct Shorthand {
+  const char* flag;
+  const char* key;
+  const char* help;
+};
+constexpr Shorthand kShorthands[] = {
+    {"--duration", "run.duration", "simulated seconds per run (default 120; 1..86400)"},
+    {"--mode", "run.modes", "both | adaptive | none (default both)"},
+    {"--scalar", "run.scalar", "the controller's arithmetic: double | float (default double)"},
+    {"--adaptation", "run.adaptation", "friction adaptation law: paper | robust (default robust)"},
+    {"--final-window", "run.final_window", "length of the \"last\" statistics in seconds (default 20; 1..3600)"},
+    {"--friction", "plant.friction.preset", "plant friction preset: paper | corke | none (default paper)"},
+    {"--model-error", "controller.model_error", "controller link mass/inertia relative error (default 0; -0.5..0.5)"},
+    {"--encoder-cpr", "plant.encoder_cpr", "encoder counts per motor revolution, plant and controller (default 1000)"},
+    {"--substep", "plant.substep", "plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)"},
+    {"--delay", "plant.delay", "computation delay inside the sample in seconds (default 2e-4; 0..1e-3)"},
+};
+
+/// Keys the firmware image compiles in: with --qemu they must keep their defaults.
+constexpr const char* kHostOnlyKeys[] = {"controller.knd",    "controller.k",       "controller.ks",
+                                         "controller.ki",     "controller.k_ad",    "controller.tau_dec",
+                                         "controller.leakage", "controller.model_error", "trajectory.amplitude",
+                                         "trajectory.period", "trajectory.envelope", "start_pose",
+                                         "plant.encoder_cpr"};
+
+struct Parsed {
+  std::vector<std::pair<const Shorthand*, std::string>> shorthands;
+  std::vector<std::string> sets;
+  std::string inject;
+};
+
+void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::string>& values) {
+  app.description(
+      "The paper's experiment (Section VI) on the simulated PUMA 560, with adaptive friction compensation and "
+      "without. The configuration's defaults are the paper's set-up; --print-config shows every key.");
+  app.set_help_flag("-h,--help", "this text");
+  app.option_defaults()->disable_flag_override();
+  app.add_option("--config", o.config_file, "read the configuration from this YAML file (see --print-config)")
+      ->type_name("FILE");
+  app.add_option("--set", p.sets, "set one configuration key, after --config and the options below "
+                                  "(e.g. --set trajectory.amplitude=0.1); repeatable")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_flag("--print-config", o.print_config, "print the effective configuration as YAML and exit");
+  values.resize(std::size(kShorthands));
+  for (size_t i = 0; i < std::size(kShorthands); ++i)
+    app.add_option(kShorthands[i].flag, values[i], std::string(kShorthands[i].help) + "; sets " + kShorthands[i].key)
+        ->type_name("V");
+  app.add_flag("--qemu", o.qemu, "run the controller as the firmware image in qemu-system-arm (PIL)");
+  app.add_option("--elf", o.elf, "firmware image for --qemu (default: the m4f build's pil_firmware.elf)")
+      ->type_name("FILE");
+  app.add_option("--json", o.json, "write the summary as JSON")->type_name("FILE");
+  app.add_option("--csv-dir", o.csv_dir, "write time series CSV files and config.yaml there (default: out)")
+      ->type_name("DIR");
+  app.add_option("--inject", p.inject,
+                 "inject a fault into the simulated hardware at S seconds, on joint J (1..6; default every joint): "
+                 "encoder-stuck | encoder-jump | encoder-garbage | encoder-noise | dac-stuck | overrun | estop "
+                 "(docs/safety.md)")
+      ->type_name("KIND[:J]@S");
+  app.add_flag("--no-csv", [&o](std::int64_t) { o.csv = false; }, "do not write time series");
+  app.add_flag("--no-progress", [&o](std::int64_t) { o.progress = false; }, "no progress bar");
+}
+
+bool read_file(const std::string& path, std::string& text, std::string& err) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return err = "cannot read configuration file " + path, false;
+  std::ostringstream ss;
+  ss << f.rdbuf();
+  if (f.bad()) return err = "cannot read configuration file " + path, false;
+  text = ss.str();
+  return true;
+}
+
+}  // namespace
+
+std::string experiment_usage() {
+  CLI::App app("", "puma_experiment");
+  ExperimentOptions o;
+  Parsed p;
+  std::vector<std::string> values;
+  build(app, o, p, values);
+  return app.help();
+}
 
 bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::string& err) {
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    // --flag=value is --flag value.
-    std::string inline_value;
-    const auto eq = a.find('=');
-    const bool has_inline = a.rfind("--", 0) == 0 && eq != std::string::npos;
-    if (has_inline) {
-      inline_value = a.substr(eq + 1);
-      a.resize(eq);
+  CLI::App app("", "puma_experiment");
+  Parsed p;
+  std::vector<std::string> values;
+  build(app, o, p, values);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    o.help = true;
+    return true;
+  } catch (const CLI::ParseError& e) {
+    return err = e.what(), false;
+  }
+  for (size_t i = 0; i < values.size(); ++i)
+    if (app.get_option(kShorthands[i].flag)->count() > 0) p.shorthands.emplace_back(&kShorthands[i], values[i]);
+
+  if (!o.config_file.empty()) {
+    std::string text;
+    if (!read_file(o.config_file, text, err)) return false;
+    if (!apply_config(text, o.config_file, o, err)) return false;
+  }
+  for (const auto& [s, v] : p.shorthands)
+    if (!set_key(s->key, v, o, err)) {
+      // "run.duration: 0 is out of range" reads "--duration: 0 is out of range (run.duration)".
+      const std::string key = s->key;
+      if (err.rfind(key + ":", 0) == 0) err = std::string(s->flag) + err.substr(key.size()) + " (" + key + ")";
+      return false;
     }
-    const char* v = has_inline ? inline_value.c_str() : i + 1 < argc ? argv[i + 1] : nullptr;
-    bool took = false;
-    auto take = [&]() -> const char* {
-      took = true;
-      if (!has_inline) ++i;
-      return v;
-    };
-    if (a == "--help" || a == "-h") {
-      o.help = true;
-      return true;
-    } else if (a == "--duration") {
-      if (!parse_number(a, take(), 1, 86400, o.duration, err)) return false;
-    } else if (a == "--mode") {
-      const char* m = take();
-      const std::string s = m ? m : "";
-      if (s == "both") o.run_adaptive = o.run_none = true;
-      else if (s == "adaptive") o.run_adaptive = true, o.run_none = false;
-      else if (s == "none") o.run_adaptive = false, o.run_none = true;
-      else return err = "--mode: expected both, adaptive or none, got '" + s + "'", false;
-    } else if (a == "--friction") {
-      const char* m = take();
-      const std::string s = m ? m : "";
-      if (s == "paper") o.base.plant.friction = osc::robot::kFrictionPaper;
-      else if (s == "corke") o.base.plant.friction = osc::robot::kFrictionCorke;
-      else if (s == "none") o.base.plant.friction = osc::kFrictionNone;
-      else return err = "--friction: expected paper, corke or none, got '" + s + "'", false;
-    } else if (a == "--scalar") {
-      const char* m = take();
-      const std::string s = m ? m : "";
-      if (s == "double") o.base.scalar = Scalar::kDouble;
-      else if (s == "float") o.base.scalar = Scalar::kFloat;
-      else return err = "--scalar: expected double or float, got '" + s + "'", false;
-    } else if (a == "--adaptation") {
-      const char* m = take();
-      const std::string s = m ? m : "";
-      if (!osc::adaptation_law_from_name(s, o.base.adaptation)) {
-        err = "--adaptation: expected";
-        for (int k = 0; k < osc::kAdaptationLawCount; ++k) err += std::string(k ? " or " : " ") + osc::kAdaptationLawNames[k];
-        return err += ", got '" + s + "'", false;
-      }
-    } else if (a == "--encoder-cpr") {
-      if (!parse_number(a, take(), 100, 1e7, o.base.encoder_counts_per_motor_rev, err)) return false;
-    } else if (a == "--model-error") {
-      if (!parse_number(a, take(), -0.5, 0.5, o.base.model_error, err)) return false;
-    } else if (a == "--substep") {
-      if (!parse_number(a, take(), 1e-6, 1e-3, o.base.plant.substep, err)) return false;
-    } else if (a == "--delay") {
-      if (!parse_number(a, take(), 0, osc::params::kDt, o.base.plant.compute_delay, err)) return false;
-    } else if (a == "--qemu") {
-      o.qemu = true;
-    } else if (a == "--elf") {
-      const char* f = take();
-      if (!f || !*f) return err = "--elf needs a file name", false;
-      o.elf = f;
-    } else if (a == "--json") {
-      const char* f = take();
-      if (!f || !*f) return err = "--json needs a file name", false;
-      o.json = f;
-    } else if (a == "--csv-dir") {
-      const char* f = take();
-      if (!f || !*f) return err = "--csv-dir needs a directory", false;
-      o.csv_dir = f;
-    } else if (a == "--final-window") {
-      if (!parse_number(a, take(), 1, 3600, o.base.final_window, err)) return false;
-    } else if (a == "--inject") {
-      const char* f = take();
-      if (!parse_injection(f ? f : "", o.base.injection, err)) return false;
-    } else if (a == "--no-csv") {
-      o.csv = false;
-    } else if (a == "--no-progress") {
-      o.progress = false;
-    } else {
-      return err = "unknown option '" + a + "'", false;
-    }
-    if (has_inline && !took) return err = a + " takes no value", false;
+  for (const std::string& a : p.sets)
+    if (!apply_setting(a, o, err)) return err = "--set: " + err, false;
+  if (!validate_settings(o, err)) return false;
+
+  if (!p.inject.empty() || app.get_option("--inject")->count() > 0)
+    if (!parse_injection(p.inject, o.base.injection, err)) return false;
+  if (o.elf.empty()) return err = "--elf needs a file name", false;
+  if (app.get_option("--json")->count() > 0 && o.json.empty()) return err = "--json needs a file name", false;
+  if (o.csv_dir.empty()) return err = "--csv-dir needs a directory", false;
+
+  if (o.qemu) {
+    // The image's controller is compiled in: only the mode and the adaptation law go over the link.
+    const std::vector<std::string> changed = differences_from_paper(o);
+    for (const char* key : kHostOnlyKeys)
+      for (const std::string& d : changed)
+        if (d == key)
+          return err = d + " applies to the host-built controller only, not with --qemu (the firmware image "
+                           "compiles in its defaults)", false;
+    if (o.base.injection.enabled && !info(o.base.injection.kind).per_joint)
+      return err = std::string("--inject ") + info(o.base.injection.kind).name +
+                   " applies to the host-built controller only, not with --qemu", false;
   }
   return true;
 }

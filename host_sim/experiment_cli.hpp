@@ -1,27 +1,29 @@
-// puma_experiment's command line: the options and their parser, apart from main() so that the
-// parser can be tested and fuzzed (tests/fuzz/fuzz_cli.cpp) without running an experiment.
+// puma_experiment's command line (CLI11) and configuration (config.hpp), apart from main() so that
+// the parser can be tested and fuzzed (tests/fuzz/fuzz_cli.cpp) without running an experiment.
 #pragma once
 
 #include <string>
 
-#include "experiment.hpp"
+#include "config.hpp"
 
 namespace sim {
 
-extern const char* const kExperimentUsage;
-
-struct ExperimentOptions {
-  double duration = 120;
-  bool run_adaptive = true, run_none = true;
-  ExperimentConfig base;
+struct ExperimentOptions : Settings {
+  std::string config_file;   ///< --config (empty: the defaults)
+  bool print_config = false; ///< --print-config: print the effective configuration and exit 0
   std::string json, csv_dir = "out";
   bool csv = true, progress = true;
   bool qemu = false;
-  bool help = false;  ///< --help or -h: print kExperimentUsage and exit 0 (later arguments unread)
+  bool help = false;  ///< --help or -h: print usage() and exit 0
   std::string elf = OSC_DEFAULT_PIL_ELF;
 };
 
-/// Parses argv[1..argc-1] into o. Returns false with a message in err on the first bad argument.
+/// The generated help text.
+std::string experiment_usage();
+
+/// Parses argv[1..argc-1] into o: the configuration file, then the named options (--duration,
+/// --mode, ...), then every --set, each checked with the key it sets. Returns false with one short
+/// message in err on the first bad argument, key or value; nothing has run yet.
 bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::string& err);
 
 }  // namespace sim

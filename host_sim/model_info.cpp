@@ -1,18 +1,14 @@
 // osc_model_info: prints the PUMA 560 model quantities at a named pose or given joint angles.
-#include <cstdio>
-#include <cstring>
-#include <iostream>
-#include <string>
+#include <CLI/CLI.hpp>
 
-#include "cli.hpp"
+#include <cstdio>
+#include <string>
+#include <vector>
+
 #include "osc/kernels/opspace.hpp"
 #include "osc/robot.hpp"
 
 namespace {
-
-const char* kUsage =
-    "usage: osc_model_info [--pose qn|qz|qr|qs | --q q1,q2,q3,q4,q5,q6] [--qd v1,...,v6]\n"
-    "  prints forward kinematics, Jacobians, A(q), g(q), c(q,qd), Lambda and the Jacobian condition\n";
 
 template <class M>
 void print(const char* name, const M& m) {
@@ -23,55 +19,35 @@ void print(const char* name, const M& m) {
   }
 }
 
-bool parse_vec(const std::string& flag, const char* text, osc::Vec6<double>& v, std::string& err) {
-  if (!text) return err = flag + " needs six comma-separated numbers", false;
-  std::string s = text;
-  for (int i = 0; i < 6; ++i) {
-    const size_t comma = s.find(',');
-    const std::string item = s.substr(0, comma);
-    if (!sim::parse_number(flag, item.c_str(), -100, 100, v(i), err)) return false;
-    if ((comma == std::string::npos) != (i == 5)) return err = flag + " needs exactly six comma-separated numbers", false;
-    s = comma == std::string::npos ? "" : s.substr(comma + 1);
-  }
-  return true;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   using namespace osc;
-  Vec6<double> q = joint_vector<double>(puma560::kQn), qd = Vec6<double>::Zero();
-  std::string name = "qn", err;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    const char* v = i + 1 < argc ? argv[++i] : nullptr;
-    if (a == "--help" || a == "-h") {
-      std::cout << kUsage;
-      return 0;
-    } else if (a == "--pose") {
-      const std::string p = v ? v : "";
-      const double* src = p == "qn" ? puma560::kQn : p == "qz" ? puma560::kQz : p == "qr" ? puma560::kQr
-                        : p == "qs" ? puma560::kQs : nullptr;
-      if (!src) {
-        std::cerr << "osc_model_info: --pose: unknown pose '" << p << "' (qn, qz, qr, qs)\n" << kUsage;
-        return 2;
-      }
-      for (int k = 0; k < kDof; ++k) q(k) = src[k];
-      name = p;
-    } else if (a == "--q") {
-      if (!parse_vec(a, v, q, err)) break;
-      name = "given q";
-    } else if (a == "--qd") {
-      if (!parse_vec(a, v, qd, err)) break;
-    } else {
-      err = "unknown option '" + a + "'";
-      break;
-    }
-  }
-  if (!err.empty()) {
-    std::cerr << "osc_model_info: " << err << "\n" << kUsage;
+  CLI::App app("Prints forward kinematics, Jacobians, A(q), g(q), c(q, qd), Lambda and the Jacobian condition "
+               "of the PUMA 560 model at a named pose or given joint angles.",
+               "osc_model_info");
+  std::string pose = "qn";
+  std::vector<double> qv, qdv;
+  auto* pose_opt = app.add_option("--pose", pose, "named pose (default qn)")->check(CLI::IsMember({"qn", "qz", "qr", "qs"}));
+  app.add_option("--q", qv, "joint angles q1,...,q6 [rad]")
+      ->delimiter(',')->expected(6)->check(CLI::Range(-100.0, 100.0))->excludes(pose_opt);
+  app.add_option("--qd", qdv, "joint speeds [rad/s] for c(q, qd) (default 0)")
+      ->delimiter(',')->expected(6)->check(CLI::Range(-100.0, 100.0));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::printf("%s", app.help().c_str());
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "osc_model_info: %s\n(osc_model_info --help lists the options)\n", e.what());
     return 2;
   }
+  const double* named = pose == "qz" ? puma560::kQz : pose == "qr" ? puma560::kQr : pose == "qs" ? puma560::kQs
+                                                                                  : puma560::kQn;
+  Vec6<double> q = Eigen::Map<const Vec6<double>>(named), qd = Vec6<double>::Zero();
+  std::string name = pose;
+  if (!qv.empty()) q = Eigen::Map<const Vec6<double>>(qv.data()), name = "given q";
+  if (!qdv.empty()) qd = Eigen::Map<const Vec6<double>>(qdv.data());
 
   const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;

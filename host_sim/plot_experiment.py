@@ -19,7 +19,7 @@ PARAMS = ["τ_vis", "τ_cou", "τ_sti"]
 
 def load(path):
     with open(path, newline="") as f:
-        rows = list(csv.DictReader(f))
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
     if not rows:
         raise ValueError(f"{path}: no rows")
     return {k: [float(r[k]) for r in rows] for k in rows[0]}
@@ -115,7 +115,7 @@ def main(argv):
         fig, axs = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
         for k in range(3):
             for j in range(6):
-                line, = axs[k].plot(d["t"], d[f"theta_hat_{('vis', 'cou', 'sti')[k]}_J{j + 1}"], lw=0.8,
+                line, = axs[k].plot(d["t"], d[f"theta_{('vis', 'cou', 'sti')[k]}_j{j + 1}"], lw=0.8,
                                     label=f"J{j + 1}")
                 if "adaptive" in summary:  # the plant's true value, dashed, same colour
                     axs[k].axhline(summary["adaptive"]["theta_true"][6 * k + j], color=line.get_color(), lw=0.6,

@@ -1,6 +1,10 @@
 // puma_experiment: the paper's experiment (Section VI) on the simulated PUMA 560, with adaptive
-// friction compensation and without, printed side by side with the paper's Tables I-III.
+// friction compensation and without, printed side by side with the paper's Tables I-III. The
+// configuration (config.hpp) and its provenance go with every output: console, JSON (nlohmann-json),
+// CSV header, and the config.yaml written beside the time series.
 #include <unistd.h>
+
+#include <nlohmann/json.hpp>
 
 #include <atomic>
 #include <filesystem>
@@ -12,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "config.hpp"
 #include "experiment.hpp"
 #include "experiment_cli.hpp"
 #include "injection.hpp"
@@ -55,33 +60,94 @@ std::string counters_text(const pil::LinkCounters& c) {
   return s.empty() ? "none" : s;
 }
 
-void print_tables(const std::vector<sim::ExperimentResult>& runs) {
-  std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')\n", runs[0].duration,
-              runs[0].friction_preset.c_str());
+/// What every output records about the run's origin: program revision, configuration (hash and
+/// full text) and how it differs from the paper's set-up.
+struct Provenance {
+  std::string revision, config_text, config_hash, config_file;
+  std::vector<std::string> differs;  // keys that differ from the paper's set-up
+  std::string line() const {
+    std::string s = "puma_experiment " + revision + ", configuration " + config_hash;
+    if (!config_file.empty()) s += " (" + config_file + ")";
+    return s;
+  }
+  std::string setup() const {
+    if (differs.empty()) return "the paper's set-up";
+    std::string s = "differs from the paper's set-up in";
+    for (size_t i = 0; i < differs.size(); ++i) s += (i ? ", " : " ") + differs[i];
+    return s;
+  }
+};
+
+/// The fault of a run in words: names, tick, time and the state at that moment.
+void print_fault(const sim::ExperimentResult& r) {
+  const sim::FaultState& f = r.fault;
+  std::printf("[%s] FAULT %s at tick %ld, t = %.3f s (latched; zero torque from that tick on)\n", r.mode.c_str(),
+              osc::fault_name(f.faults), f.tick, f.t);
+  std::printf("[%s]   every fault bit:", r.mode.c_str());
+  for (int i = 0; i < osc::kFaultCount; ++i)
+    if (f.faults & (1u << i)) std::printf(" %s", osc::kFaultNames[i]);
+  std::printf("\n[%s]   q [deg]:      ", r.mode.c_str());
+  for (double v : f.q) std::printf(" %9.3f", v * 180 / osc::kPi);
+  std::printf("\n[%s]   qdot [deg/s]: ", r.mode.c_str());
+  for (double v : f.qd) std::printf(" %9.3f", v * 180 / osc::kPi);
+  std::printf("\n[%s]   tau [N m]:    ", r.mode.c_str());
+  for (double v : f.tau) std::printf(" %9.3f", v);
+  std::printf("\n[%s]   error:         %.3f %.3f %.3f mm  %.4f %.4f %.4f deg\n", r.mode.c_str(), f.e[0], f.e[1], f.e[2],
+              f.e[3], f.e[4], f.e[5]);
+  std::printf("[%s]   the statistics below cover 0..%.3f s; the robot after the fault is no result\n", r.mode.c_str(),
+              r.stats_until);
+}
+
+void print_tables(const std::vector<sim::ExperimentResult>& runs, const Provenance& prov) {
+  std::printf("%s\nset-up: %s\n", prov.line().c_str(), prov.setup().c_str());
+  for (const auto& r : runs)
+    if (r.status) print_fault(r);
+  const bool paper = prov.differs.empty();
+  // The paper's tables are compared with only when the set-up is the paper's.
+  const char* t1 = paper ? "paper T.I" : "(T.I)";
+  const char* t3 = paper ? "paper T.III" : "(T.III)";
+  std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')%s\n", runs[0].duration,
+              runs[0].friction_preset.c_str(),
+              paper ? "" : "\n  (the set-up differs from the paper's: its tables, in brackets, are not comparable)");
   std::printf("%-12s", "axis");
   char last[32];
   std::snprintf(last, sizeof last, " last%gs", runs[0].final_window);  // the "last" window, as long as the run at most
   for (const auto& r : runs) std::printf(" %14s %14s", (r.mode + " all").c_str(), (r.mode + last).c_str());
-  std::printf(" %10s %10s\n", "paper T.I", "paper T.III");
+  std::printf(" %10s %10s\n", t1, t3);
   for (int i = 0; i < 6; ++i) {
     std::printf("%-12s", kAxes[i]);
-    for (const auto& r : runs) std::printf(" %14.3f %14.3f", r.max_error[i], r.final_max_error[i]);
+    for (const auto& r : runs) {
+      std::printf(" %14.3f", r.max_error[i]);
+      // A run that faulted before the end has no "last" window.
+      if (r.status) std::printf(" %14s", "(faulted)");
+      else std::printf(" %14.3f", r.final_max_error[i]);
+    }
     std::printf(" %10.2f %10.2f\n", sim::kPaperTable1[i], sim::kPaperTable3[i]);
   }
+  for (const auto& r : runs)
+    if (r.status) std::printf("  [%s] faulted at %.3f s: its 'all' column covers the run up to the fault only\n",
+                              r.mode.c_str(), r.fault_time);
   const sim::ExperimentResult* ad = nullptr;
   const sim::ExperimentResult* no = nullptr;
   for (const auto& r : runs) (r.mode == "adaptive" ? ad : no) = &r;
-  if (ad && no) {
-    std::printf("\nRatio without / with friction compensation (whole run, last 20 s; paper Table III / Table I)\n");
-    for (int i = 0; i < 6; ++i)
-      std::printf("  %-12s %6.1fx %6.1fx   paper %4.1fx\n", kAxes[i], no->max_error[i] / ad->max_error[i],
-                  no->final_max_error[i] / ad->final_max_error[i], sim::kPaperTable3[i] / sim::kPaperTable1[i]);
+  if (ad && no && !ad->status && !no->status) {
+    std::printf("\nRatio without / with friction compensation (whole run, last %gs; %s)\n", ad->final_window,
+                paper ? "paper Table III / Table I" : "the paper's ratio is for its set-up only");
+    for (int i = 0; i < 6; ++i) {
+      std::printf("  %-12s %6.1fx %6.1fx", kAxes[i], no->max_error[i] / ad->max_error[i],
+                  no->final_max_error[i] / ad->final_max_error[i]);
+      if (paper) std::printf("   paper %4.1fx", sim::kPaperTable3[i] / sim::kPaperTable1[i]);
+      std::printf("\n");
+    }
   }
   if (ad) {
     static const char* names[3] = {"tau_vis [N m s/rad]", "tau_cou [N m]", "tau_sti [N m]"};
-    std::printf("\nIdentified friction coefficients after %.0f s (estimate / plant's true value; paper Table II is "
-                "the plant's default)\n%-20s",
-                ad->duration, "");
+    if (ad->status)
+      std::printf("\nFriction estimates at the fault (t = %.3f s): not identified values (estimate / plant's true "
+                  "value)\n%-20s", ad->fault_time, "");
+    else
+      std::printf("\nIdentified friction coefficients after %.0f s (estimate / plant's true value, preset '%s')\n%-20s",
+                  ad->duration, ad->friction_preset.c_str(), "");
     for (int j = 0; j < 6; ++j) std::printf("      J%d       ", j + 1);
     std::printf("\n");
     for (int k = 0; k < 3; ++k) {
@@ -89,9 +155,18 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
       for (int j = 0; j < 6; ++j) std::printf(" %6.2f / %5.2f", ad->theta_hat[6 * k + j], ad->theta_true[6 * k + j]);
       std::printf("\n");
     }
-    std::printf("estimated vs true joint friction over the last 20 s: rms error %.3f N m (rms friction %.3f N m)\n",
-                ad->friction_rms_error, ad->friction_rms);
+    if (!ad->status)
+      std::printf("estimated vs true joint friction over the last %gs: rms error %.3f N m (rms friction %.3f N m)\n",
+                  ad->final_window, ad->friction_rms_error, ad->friction_rms);
   }
+  for (const auto& r : runs)
+    if (r.has_observer && !r.status)
+      std::printf("[%s] observer error over the last %gs: |x~| max %.4f %.4f %.4f mm  %.5f %.5f %.5f deg; velocity "
+                  "%.2f %.2f %.2f mm/s  %.3f %.3f %.3f deg/s\n",
+                  r.mode.c_str(), r.final_window, r.max_observer_error[0], r.max_observer_error[1],
+                  r.max_observer_error[2], r.max_observer_error[3], r.max_observer_error[4], r.max_observer_error[5],
+                  r.max_observer_velocity_error[0], r.max_observer_velocity_error[1], r.max_observer_velocity_error[2],
+                  r.max_observer_velocity_error[3], r.max_observer_velocity_error[4], r.max_observer_velocity_error[5]);
   for (const auto& r : runs) print_windows(r);
   for (const auto& r : runs) {
     if (!r.error.empty()) std::printf("[%s] LINK ERROR: %s\n", r.mode.c_str(), r.error.c_str());
@@ -108,12 +183,6 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
     }
     std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time)\n", r.mode.c_str(), r.duration,
                 r.wall_seconds, r.duration / r.wall_seconds);
-    if (r.status) {
-      std::printf("[%s] FAULT at t = %.3f s:", r.mode.c_str(), r.fault_time);
-      for (int i = 0; i < osc::kFaultCount; ++i)
-        if (r.status & (1u << i)) std::printf(" %s", osc::kFaultNames[i]);
-      std::printf(" (latched; zero torque from that tick on)\n");
-    }
     if (r.injection.injection.enabled) {
       const sim::InjectionResult& ir = r.injection;
       std::printf("[%s] injected %s: ", r.mode.c_str(), sim::to_string(ir.injection).c_str());
@@ -125,118 +194,111 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs) {
                   ir.max_torque_after);
     }
   }
+  for (const auto& r : runs)
+    if (r.status)
+      std::printf("[%s] FAULT %s at t = %.3f s (tick %ld)\n", r.mode.c_str(), osc::fault_name(r.fault.faults),
+                  r.fault_time, r.fault.tick);
 }
 
-std::string json_string(const std::string& s) {
-  std::string out = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
-    else out += c;
-  }
-  return out + "\"";
-}
-
-void json_array(std::ostream& os, const double* v, int n, double scale = 1) {
-  os << "[";
-  for (int i = 0; i < n; ++i) os << (i ? ", " : "") << v[i] * scale;
-  os << "]";
-}
+using json = nlohmann::ordered_json;
 
 /// A time in seconds, or null for "never" (negative).
-std::string json_time(double t) {
-  if (t < 0) return "null";
-  std::ostringstream os;
-  os.precision(9);
-  os << t;
-  return os.str();
-}
+json json_time(double t) { return t < 0 ? json(nullptr) : json(t); }
 
-/// The names of the fault bits, as a JSON array.
-std::string json_faults(std::uint32_t bits) {
-  std::string s = "[";
+json json_array(const double* v, int n) { return json(std::vector<double>(v, v + n)); }
+
+/// The names of the fault bits.
+json json_faults(std::uint32_t bits) {
+  json a = json::array();
   for (int i = 0; i < osc::kFaultCount; ++i)
-    if (bits & (1u << i)) s += (s.size() > 1 ? ", " : "") + json_string(osc::kFaultNames[i]);
-  return s + "]";
+    if (bits & (1u << i)) a.push_back(osc::kFaultNames[i]);
+  return a;
 }
 
-void json_run(std::ostream& os, const sim::ExperimentResult& r, const char* indent) {
-  os << indent << "\"mode\": \"" << r.mode << "\",\n";
-  os << indent << "\"duration_s\": " << r.duration << ",\n";
-  os << indent << "\"friction_preset\": \"" << r.friction_preset << "\",\n";
-  os << indent << "\"adaptation\": \"" << r.adaptation << "\",\n";
-  os << indent << "\"window_s\": " << r.window << ",\n";
-  os << indent << "\"window_max_error\": [";
-  for (size_t w = 0; w < r.window_max.size(); ++w) {
-    os << (w ? ", " : "");
-    json_array(os, r.window_max[w].data(), 6);
+/// The CSV file of a run (relative to the CSV directory).
+std::string csv_name(const sim::ExperimentResult& r) { return "timeseries_" + r.mode + ".csv"; }
+
+json json_run(const sim::ExperimentResult& r, bool csv) {
+  json j;
+  j["mode"] = r.mode;
+  j["duration_s"] = r.duration;
+  j["friction_preset"] = r.friction_preset;
+  j["adaptation"] = r.adaptation;
+  if (csv) j["timeseries"] = csv_name(r);
+  // Statistics cover the run up to its first fault (the whole run without one).
+  j["stats_until_s"] = r.stats_until;
+  j["faults"] = json_faults(r.status);
+  j["fault_time_s"] = json_time(r.fault_time);
+  if (r.status) {
+    const sim::FaultState& f = r.fault;
+    j["fault"] = {{"names", json_faults(f.faults)},
+                  {"tick", f.tick},
+                  {"time_s", f.t},
+                  {"q_rad", json_array(f.q, 6)},
+                  {"qd_rad_s", json_array(f.qd, 6)},
+                  {"tau_Nm", json_array(f.tau, 6)},
+                  {"error_mm_deg", json_array(f.e, 6)},
+                  {"theta_hat", json_array(f.theta_hat, 18)}};
+  } else {
+    j["fault"] = nullptr;
   }
-  os << "],\n" << indent << "\"window_theta_range\": [";
-  for (size_t w = 0; w < r.window_theta_range.size(); ++w) {
-    os << (w ? ", " : "");
-    json_array(os, r.window_theta_range[w].data(), 2);
+  j["final_window_s"] = r.final_window;
+  j["max_error_mm"] = json_array(r.max_error, 3);
+  j["max_error_deg"] = json_array(r.max_error + 3, 3);
+  j["final_max_error_mm"] = json_array(r.final_max_error, 3);
+  j["final_max_error_deg"] = json_array(r.final_max_error + 3, 3);
+  if (r.has_observer) {
+    j["final_max_observer_error_mm_deg"] = json_array(r.max_observer_error, 6);
+    j["final_max_observer_velocity_error_mm_s_deg_s"] = json_array(r.max_observer_velocity_error, 6);
   }
-  os << "],\n" << indent << "\"theta_min_seen\": ";
-  json_array(os, r.theta_min_seen, 18);
-  os << ",\n" << indent << "\"theta_max_seen\": ";
-  json_array(os, r.theta_max_seen, 18);
-  os << ",\n" << indent << "\"final_window_s\": " << r.final_window << ",\n";
-  os << indent << "\"max_error_mm\": ";
-  json_array(os, r.max_error, 3);
-  os << ",\n" << indent << "\"max_error_deg\": ";
-  json_array(os, r.max_error + 3, 3);
-  os << ",\n" << indent << "\"final20s_max_error_mm\": ";
-  json_array(os, r.final_max_error, 3);
-  os << ",\n" << indent << "\"final20s_max_error_deg\": ";
-  json_array(os, r.final_max_error + 3, 3);
-  os << ",\n" << indent << "\"theta_hat\": ";
-  json_array(os, r.theta_hat, 18);
-  os << ",\n" << indent << "\"theta_true\": ";
-  json_array(os, r.theta_true, 18);
-  os << ",\n" << indent << "\"friction_rms_error_Nm\": " << r.friction_rms_error;
-  os << ",\n" << indent << "\"fault_status\": " << r.status;
+  j["window_s"] = r.window;
+  json w = json::array(), wt = json::array();
+  for (const auto& m : r.window_max) w.push_back(json_array(m.data(), 6));
+  for (const auto& m : r.window_theta_range) wt.push_back(json_array(m.data(), 2));
+  j["window_max_error"] = w;
+  j["window_theta_range"] = wt;
+  j["theta_hat"] = json_array(r.theta_hat, 18);
+  j["theta_true"] = json_array(r.theta_true, 18);
+  j["theta_min_seen"] = json_array(r.theta_min_seen, 18);
+  j["theta_max_seen"] = json_array(r.theta_max_seen, 18);
+  j["friction_rms_error_Nm"] = r.friction_rms_error;
+  j["friction_rms_Nm"] = r.friction_rms;
+  j["stuck_monitor_peak_counts"] = json_array(r.stuck_peak, 6);
+  j["stuck_monitor_peak_dtau_Nm"] = json_array(r.stuck_dtau_peak, 6);
   if (r.max_step_cycles) {
-    os << ",\n" << indent << "\"firmware_step_instructions_max\": " << r.max_step_cycles;
-    os << ",\n" << indent << "\"firmware_step_instructions_mean\": " << r.mean_step_cycles;
-    os << ",\n" << indent << "\"firmware_tick_instructions_max\": " << r.max_tick_cycles;
-    os << ",\n" << indent << "\"firmware_stack_used_bytes\": " << r.stack_used;
-    os << ",\n" << indent << "\"link\": {";
+    j["firmware_step_instructions_max"] = r.max_step_cycles;
+    j["firmware_step_instructions_mean"] = r.mean_step_cycles;
+    j["firmware_tick_instructions_max"] = r.max_tick_cycles;
+    j["firmware_stack_used_bytes"] = r.stack_used;
+    json link;
     const pil::LinkCounters* sides[2] = {&r.link.firmware, &r.link.host};
     for (int s = 0; s < 2; ++s) {
-      os << (s ? ", \"host\": {" : "\"firmware\": {");
-      for (int k = 0; k < pil::kLinkErrorKinds; ++k)
-        os << (k ? ", " : "") << "\"" << pil::kLinkErrorNames[k] << "\": " << sides[s]->count[k];
-      if (s) os << ", \"code_range\": " << r.link.host_code_range;
-      os << "}";
+      json c;
+      for (int k = 0; k < pil::kLinkErrorKinds; ++k) c[pil::kLinkErrorNames[k]] = sides[s]->count[k];
+      if (s) c["code_range"] = r.link.host_code_range;
+      link[s ? "host" : "firmware"] = c;
     }
-    os << ", \"zeroed_ticks\": " << r.link.zeroed_ticks << ", \"rx_gap_max_instructions\": " << r.link.rx_gap_max
-       << ", \"rx_long_gaps\": " << r.link.rx_long_gaps;
-    if (!r.link.first_zeroed.empty()) os << ", \"first_zeroed\": " << json_string(r.link.first_zeroed);
-    os << "}";
+    link["zeroed_ticks"] = r.link.zeroed_ticks;
+    link["rx_gap_max_instructions"] = r.link.rx_gap_max;
+    link["rx_long_gaps"] = r.link.rx_long_gaps;
+    if (!r.link.first_zeroed.empty()) link["first_zeroed"] = r.link.first_zeroed;
+    j["link"] = link;
   }
-  os << ",\n" << indent << "\"stuck_monitor_peak_counts\": ";
-  json_array(os, r.stuck_peak, 6);
-  os << ",\n" << indent << "\"stuck_monitor_peak_dtau_Nm\": ";
-  json_array(os, r.stuck_dtau_peak, 6);
-  os << ",\n" << indent << "\"faults\": " << json_faults(r.status);
-  os << ",\n" << indent << "\"fault_time_s\": " << json_time(r.fault_time);
   if (r.injection.injection.enabled) {
     const sim::InjectionResult& ir = r.injection;
-    const std::string in2 = std::string(indent) + "  ";
-    os << ",\n" << indent << "\"injection\": {\n";
-    os << in2 << "\"kind\": \"" << sim::info(ir.injection.kind).name << "\",\n";
-    os << in2 << "\"joint\": " << (ir.injection.joint < 0 ? "null" : std::to_string(ir.injection.joint + 1)) << ",\n";
-    os << in2 << "\"at_s\": " << ir.injection.at << ",\n";
-    os << in2 << "\"detected_s\": " << json_time(ir.detected) << ",\n";
-    os << in2 << "\"fault\": " << (ir.detected < 0 ? "null" : json_string(osc::fault_name(ir.faults))) << ",\n";
-    os << in2 << "\"faults\": " << json_faults(ir.faults) << ",\n";
-    os << in2 << "\"zero_torque_s\": " << json_time(ir.zero_torque) << ",\n";
-    os << in2 << "\"excursion_mm\": " << ir.excursion_mm << ",\n";
-    os << in2 << "\"max_torque_after_detection_Nm\": " << ir.max_torque_after << "\n";
-    os << indent << "}";
+    j["injection"] = {{"kind", sim::info(ir.injection.kind).name},
+                      {"joint", ir.injection.joint < 0 ? json(nullptr) : json(ir.injection.joint + 1)},
+                      {"at_s", ir.injection.at},
+                      {"detected_s", json_time(ir.detected)},
+                      {"fault", ir.detected < 0 ? json(nullptr) : json(osc::fault_name(ir.faults))},
+                      {"faults", json_faults(ir.faults)},
+                      {"zero_torque_s", json_time(ir.zero_torque)},
+                      {"excursion_mm", ir.excursion_mm},
+                      {"max_torque_after_detection_Nm", ir.max_torque_after}};
   }
-  if (!r.error.empty()) os << ",\n" << indent << "\"error\": " << json_string(r.error);
-  os << ",\n" << indent << "\"wall_s\": " << r.wall_seconds << "\n";
+  if (!r.error.empty()) j["error"] = r.error;
+  j["wall_s"] = r.wall_seconds;
+  return j;
 }
 
 /// Writes a temporary file beside path, then renames it: an existing file is never left
@@ -284,39 +346,62 @@ bool check_arm_elf(const std::string& path, std::string& err) {
   return true;
 }
 
-bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, std::string& err) {
-  std::ostringstream os;
-  os.precision(9);
-  os << "{\n";
-  json_run(os, runs[0], "  ");  // the primary run (adaptive when it ran)
-  os.seekp(-1, std::ios_base::end);
-  os << ",\n  \"runs\": [\n";
-  for (size_t i = 0; i < runs.size(); ++i) {
-    os << "    {\n";
-    json_run(os, runs[i], "      ");
-    os << "    }" << (i + 1 < runs.size() ? "," : "") << "\n";
-  }
-  os << "  ]\n}\n";
-  return write_atomically(path, os.str(), err);
+bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, const sim::Settings& cfg,
+                const Provenance& prov, bool csv, std::string& err) {
+  json root;
+  root["program"] = "puma_experiment";
+  root["git_revision"] = prov.revision;
+  root["config_hash"] = prov.config_hash;
+  if (!prov.config_file.empty()) root["config_file"] = prov.config_file;
+  root["config"] = sim::config_json(cfg);
+  root["paper_setup"] = prov.differs.empty();
+  root["differs_from_paper"] = prov.differs;
+  root["paper"] = {{"table1_max_error_mm_deg", json_array(sim::kPaperTable1, 6)},
+                   {"table3_max_error_mm_deg", json_array(sim::kPaperTable3, 6)}};
+  json a = json::array();
+  for (const auto& r : runs) a.push_back(json_run(r, csv));
+  root["runs"] = a;
+  return write_atomically(path, root.dump(2) + "\n", err);
 }
 
-bool write_csv(const std::string& dir, const sim::ExperimentResult& r, std::string& err) {
-  const std::string path = dir + "/timeseries_" + r.mode + ".csv";
+/// The time series of a run. The first line is a comment with the provenance; a column that the
+/// run does not have (the observer over the link, the friction estimates without compensation)
+/// is left out.
+bool write_csv(const std::string& dir, const sim::ExperimentResult& r, const Provenance& prov, std::string& err) {
+  const std::string path = dir + "/" + csv_name(r);
+  const bool adaptive = r.mode == "adaptive";
   std::ostringstream f;
-  f << "t,e_x_mm,e_y_mm,e_z_mm,e_phx_deg,e_phy_deg,e_phz_deg,xt_x_mm,xt_y_mm,xt_z_mm,xt_phx_deg,xt_phy_deg,xt_phz_deg";
+  f.precision(9);
+  f << "# " << prov.line() << "; mode " << r.mode << "; " << prov.setup() << "\n";
+  f << "t,e_x_mm,e_y_mm,e_z_mm,e_phx_deg,e_phy_deg,e_phz_deg";
+  static const char* const kAx[6] = {"x_mm", "y_mm", "z_mm", "phx_deg", "phy_deg", "phz_deg"};
+  static const char* const kVel[6] = {"x_mm_s", "y_mm_s", "z_mm_s", "phx_deg_s", "phy_deg_s", "phz_deg_s"};
+  if (r.has_observer) {
+    for (int i = 0; i < 6; ++i) f << ",xt_" << kAx[i];
+    for (int i = 0; i < 6; ++i) f << ",xdt_" << kVel[i];
+  }
   // theta^ = [vis; cou; sti], six joints each (model (2)): named by coefficient and joint.
   static const char* const kCoeff[3] = {"vis", "cou", "sti"};
-  for (int i = 0; i < 18; ++i) f << ",theta_hat_" << kCoeff[i / 6] << "_J" << i % 6 + 1;
-  for (int i = 0; i < 6; ++i) f << ",tau_f_" << i;
-  for (int i = 0; i < 6; ++i) f << ",tau_f_hat_" << i;
+  if (adaptive)
+    for (int i = 0; i < 18; ++i) f << ",theta_" << kCoeff[i / 6] << "_j" << i % 6 + 1;
+  for (int i = 0; i < 6; ++i) f << ",tau_j" << i + 1 << "_Nm";
+  for (int i = 0; i < 6; ++i) f << ",tau_f_j" << i + 1 << "_Nm";
+  if (adaptive)
+    for (int i = 0; i < 6; ++i) f << ",tau_f_hat_j" << i + 1 << "_Nm";
   f << "\n";
   for (const auto& row : r.log) {
     f << row.t;
     for (double v : row.e) f << "," << v;
-    for (double v : row.x_tilde) f << "," << v;
-    for (double v : row.theta_hat) f << "," << v;
+    if (r.has_observer) {
+      for (double v : row.x_tilde) f << "," << v;
+      for (double v : row.xd_tilde) f << "," << v;
+    }
+    if (adaptive)
+      for (double v : row.theta_hat) f << "," << v;
+    for (double v : row.tau) f << "," << v;
     for (double v : row.tau_f) f << "," << v;
-    for (double v : row.tau_f_hat) f << "," << v;
+    if (adaptive)
+      for (double v : row.tau_f_hat) f << "," << v;
     f << "\n";
   }
   return write_atomically(path, f.str(), err);
@@ -329,39 +414,45 @@ int main(int argc, char** argv) {
   std::string err;
   if (!sim::parse_experiment_args(argc, argv, o, err)) return fail(err);
   if (o.help) {
-    std::cout << sim::kExperimentUsage;
+    std::cout << sim::experiment_usage();
     return 0;
   }
-  o.base.duration = o.duration;
+  if (o.print_config) {
+    std::cout << sim::config_yaml(o);
+    return 0;
+  }
   if (o.qemu) {
-    if (o.base.model_error != 0) return fail("--model-error applies to the host-built controller only, not with --qemu");
-    if (o.base.encoder_counts_per_motor_rev != osc::robot::kDrives.encoder_counts_per_motor_rev)
-      return fail("--encoder-cpr applies to the host-built controller only, not with --qemu");
-    if (o.base.injection.enabled && !sim::info(o.base.injection.kind).per_joint)
-      return fail(std::string("--inject ") + sim::info(o.base.injection.kind).name +
-                  " applies to the host-built controller only, not with --qemu");
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
     if (!check_arm_elf(o.elf, err)) return fail(err);
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
   }
-  if (o.csv && !o.csv_dir.empty()) {
+  if (o.csv) {
     // No shell: the name is a path, never a command.
     std::error_code ec;
     std::filesystem::create_directories(o.csv_dir, ec);
     if (ec || !std::filesystem::is_directory(o.csv_dir))
       return fail("cannot create directory " + o.csv_dir + (ec ? ": " + ec.message() : ""));
   }
-
   if (!o.json.empty() && !check_writable(o.json, err)) return fail(err);
+
+  Provenance prov;
+  prov.revision = sim::git_revision();
+  prov.config_text = sim::config_yaml(o);
+  prov.config_hash = sim::text_hash(prov.config_text);
+  prov.differs = sim::differences_from_paper(o);
+  if (o.csv) {
+    prov.config_file = o.csv_dir + "/config.yaml";
+    if (!write_atomically(prov.config_file, prov.config_text, err)) return fail(err);
+  }
 
   std::vector<sim::ExperimentConfig> cfgs;
   if (o.run_adaptive) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kAdaptive;
   if (o.run_none) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kNone;
 
   // Progress bar on a terminal only, for runs longer than a second.
-  const bool bar = o.progress && isatty(STDERR_FILENO) && o.duration > 1.0;
+  const bool bar = o.progress && isatty(STDERR_FILENO) && o.base.duration > 1.0;
   std::vector<std::atomic<double>> frac(cfgs.size());
   for (auto& f : frac) f = 0;
   for (size_t i = 0; i < cfgs.size(); ++i)
@@ -386,14 +477,14 @@ int main(int argc, char** argv) {
   }
   for (auto& t : threads) t.join();
 
-  print_tables(runs);
+  print_tables(runs, prov);
   if (o.csv) {
     for (const auto& r : runs)
-      if (!write_csv(o.csv_dir, r, err)) return fail(err);
-    std::printf("time series: %s/timeseries_*.csv\n", o.csv_dir.c_str());
+      if (!write_csv(o.csv_dir, r, prov, err)) return fail(err);
+    std::printf("time series: %s/timeseries_*.csv, configuration: %s\n", o.csv_dir.c_str(), prov.config_file.c_str());
   }
   if (!o.json.empty()) {
-    if (!write_json(o.json, runs, err)) return fail(err);
+    if (!write_json(o.json, runs, o, prov, o.csv, err)) return fail(err);
     std::printf("summary: %s\n", o.json.c_str());
   }
   // A fault is a failed run, unless a fault was injected on purpose (then the JSON tells how it went).

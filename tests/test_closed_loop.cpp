@@ -159,7 +159,7 @@ TEST(ClosedLoop, AdaptationDoesNotDriftOnAFrictionlessPlant) {
   auto drift = [](osc::AdaptationLaw law) {
     ExperimentConfig c = config(300, osc::FrictionMode::kAdaptive, osc::kFrictionNone);
     c.final_window = 60;
-    c.adaptation = law;
+    c.gains.adaptation = law;
     const ExperimentResult r = run_experiment(c);
     bool in_bounds = true;
     for (int i = 0; i < 18; ++i)
@@ -187,7 +187,7 @@ TEST(ClosedLoop, AdaptationDoesNotDriftOnAFrictionlessPlant) {
 TEST(ClosedLoop, PaperLawDriftScalesWithTheSquareOfTheEncoderQuantum) {
   auto vis_j1 = [](osc::AdaptationLaw law, double cpr) {
     ExperimentConfig c = config(200, osc::FrictionMode::kAdaptive, osc::kFrictionNone);
-    c.adaptation = law;
+    c.gains.adaptation = law;
     c.encoder_counts_per_motor_rev = cpr;
     const ExperimentResult r = run_experiment(c);
     EXPECT_EQ(r.status, 0u);

@@ -397,7 +397,7 @@ TEST(PilClosedLoop, TheAdaptationLawIsConfiguredOverTheLink) {
   ExperimentResult remote_of[2];
   const osc::AdaptationLaw laws[2] = {osc::AdaptationLaw::kPaper, osc::AdaptationLaw::kRobust};
   for (int l = 0; l < 2; ++l) {
-    c.adaptation = laws[l];
+    c.gains.adaptation = laws[l];
     c.pil_command.clear();
     const ExperimentResult local = run_experiment(c);
     c.pil_command = peer_command();

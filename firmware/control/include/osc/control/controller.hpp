@@ -114,7 +114,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   const ObserverOutput<S> ob = observer_output(G, os, st.obs.x_hat, st.obs.y);
   const Vec6<S> tau_f_hat = adaptive ? friction_estimate(G, theta_hat, ob.qd_hat) : Vec6<S>(Vec6<S>::Zero());
   const Vec6<S> f_hat = operational_friction(os, tau_f_hat);
-  const Desired<S> d = trajectory(st.p0, t);
+  const Desired<S> d = trajectory(G.trajectory, st.p0, t);
   const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, f_hat);
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.h_xd, c.p, f_hat);

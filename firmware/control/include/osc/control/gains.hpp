@@ -1,5 +1,5 @@
-// The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, and the choices
-// a caller makes (friction mode, adaptation law). Defaults from params.hpp; the adaptation law
+// The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, the task's
+// trajectory (68), and the choices a caller makes (friction mode, adaptation law). Defaults from params.hpp; the adaptation law
 // defaults to the robust one (docs/adaptation.md); AdaptationLaw::kPaper gives (67) exactly.
 #pragma once
 
@@ -7,6 +7,7 @@
 #include <string_view>
 
 #include "osc/control/params.hpp"
+#include "osc/control/trajectory.hpp"
 #include "osc/kernels/model.hpp"
 
 namespace osc {
@@ -46,6 +47,7 @@ struct Gains {
   AdaptationLaw adaptation;
   Vec18<S> theta_max;  // projection bounds of the robust law (lower bounds 0)
   S leakage;           // sigma of the robust law [1/s]
+  TrajectorySpec<S> trajectory;  // the task (68)
 
   static Gains paper() {
     Gains g;
@@ -62,6 +64,26 @@ struct Gains {
     g.adaptation = AdaptationLaw::kRobust;
     for (int i = 0; i < 3 * kDof; ++i) g.theta_max(i) = lit<S>(params::kThetaMax[i]);
     g.leakage = lit<S>(params::kAdaptationLeakage);
+    g.trajectory = TrajectorySpec<S>::paper();
+    return g;
+  }
+
+  /// The same parameters in another scalar (the host's experiment configures them in double).
+  template <class T>
+  Gains<T> cast() const {
+    Gains<T> g;
+    g.knd = knd.template cast<T>();
+    g.k = k.template cast<T>();
+    g.ks = ks.template cast<T>();
+    g.ki = ki.template cast<T>();
+    g.kad = static_cast<T>(kad);
+    g.tau_dec = tau_dec.template cast<T>();
+    g.dt = static_cast<T>(dt);
+    g.min_rcond = static_cast<T>(min_rcond);
+    g.adaptation = adaptation;
+    g.theta_max = theta_max.template cast<T>();
+    g.leakage = static_cast<T>(leakage);
+    g.trajectory = trajectory.template cast<T>();
     return g;
   }
 };

@@ -1,5 +1,6 @@
 // Desired trajectory (68): +-50 mm on each axis about the start position p0, period 5 s,
-// envelope 1 - exp(-0.05 t^3) so that the desired velocity and acceleration start at zero.
+// envelope 1 - exp(-0.05 t^3) so that the desired velocity and acceleration start at zero
+// (the paper's shape; TrajectorySpec holds another).
 // The orientation is held at its start value (phi_d = 0 relative to the start orientation).
 #pragma once
 
@@ -18,14 +19,46 @@ static_assert(abs_of(params::kOmega * kTrajectoryPeriodTicks * params::kDt - 2 *
               "the period in samples is a whole number of the trajectory's periods");
 static_assert(params::kEnvelope * 20.0 * 20.0 * 20.0 >= 400.0, "the envelope has settled by then");
 
-/// The trajectory's time at sample n, from the integer sample count: n dt while the envelope rises,
-/// then 20 s plus the phase within the period. Its precision therefore does not depend on uptime
-/// (a float n dt advances in 1.5 ms steps after 2.3 h and stops after 4.6 h), and a 64-bit count
-/// never wraps in service.
+/// The shape of (68): amplitude, angular frequency and envelope rate, with the two sample counts
+/// that keep its phase exact over any uptime. The firmware uses paper() (params.hpp); the host's
+/// experiment may configure another (host_sim/config.cpp checks it with trajectory_spec_valid).
 template <class S>
-S trajectory_time(std::uint64_t n, S dt) {
-  if (n < kEnvelopeSettledTicks) return static_cast<S>(n) * dt;
-  return static_cast<S>(kEnvelopeSettledTicks + (n - kEnvelopeSettledTicks) % kTrajectoryPeriodTicks) * dt;
+struct TrajectorySpec {
+  S amplitude;                  ///< [m]
+  S omega;                      ///< [rad/s], 2 pi / (period_ticks dt)
+  S envelope;                   ///< c in 1 - exp(-c t^3) [1/s^3]
+  std::uint64_t period_ticks;   ///< one period of the sinusoids, in samples (a whole number)
+  std::uint64_t settled_ticks;  ///< a whole number of periods after which c t^3 >= 400
+
+  static constexpr TrajectorySpec paper() {
+    return {lit<S>(params::kAmplitude), lit<S>(params::kOmega), lit<S>(params::kEnvelope), kTrajectoryPeriodTicks,
+            kEnvelopeSettledTicks};
+  }
+  /// The same shape in another scalar.
+  template <class T>
+  TrajectorySpec<T> cast() const {
+    return {static_cast<T>(amplitude), static_cast<T>(omega), static_cast<T>(envelope), period_ticks, settled_ticks};
+  }
+};
+
+/// The spec of a trajectory with the given amplitude [m], period (a whole number of samples) and
+/// envelope rate c [1/s^3]: settled_ticks is the first whole number of periods with c t^3 >= 400.
+inline TrajectorySpec<double> trajectory_spec(double amplitude, std::uint64_t period_ticks, double envelope, double dt) {
+  TrajectorySpec<double> s{amplitude, 2 * kPi / (static_cast<double>(period_ticks) * dt), envelope, period_ticks, 0};
+  std::uint64_t n = 1;
+  while (envelope * (n * period_ticks * dt) * (n * period_ticks * dt) * (n * period_ticks * dt) < 400.0) ++n;
+  s.settled_ticks = n * period_ticks;
+  return s;
+}
+
+/// The trajectory's time at sample n, from the integer sample count: n dt while the envelope rises,
+/// then the settling time plus the phase within the period. Its precision therefore does not depend
+/// on uptime (a float n dt advances in 1.5 ms steps after 2.3 h and stops after 4.6 h), and a 64-bit
+/// count never wraps in service.
+template <class S>
+S trajectory_time(const TrajectorySpec<S>& spec, std::uint64_t n, S dt) {
+  if (n < spec.settled_ticks) return static_cast<S>(n) * dt;
+  return static_cast<S>(spec.settled_ticks + (n - spec.settled_ticks) % spec.period_ticks) * dt;
 }
 
 template <class S>
@@ -33,10 +66,10 @@ struct Desired {
   Vec6<S> x, xd, xdd;  // x_d, x_d dot, x_d double dot
 };
 
-/// Evaluates (68) and its analytic derivatives at time t (f = 1, see NOTES.md).
+/// Evaluates (68) and its analytic derivatives at time t (f = 1, see docs/paper_notes.md).
 template <class S>
-Desired<S> trajectory(const Vec3<S>& p0, S t) {
-  const S A = lit<S>(params::kAmplitude), w = lit<S>(params::kOmega), c = lit<S>(params::kEnvelope);
+Desired<S> trajectory(const TrajectorySpec<S>& spec, const Vec3<S>& p0, S t) {
+  const S A = spec.amplitude, w = spec.omega, c = spec.envelope;
   // Envelope s(t) and its derivatives.
   const S ex = math::exp(-c * t * t * t);
   const S s = S(1) - ex;

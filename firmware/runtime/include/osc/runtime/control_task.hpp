@@ -198,7 +198,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (sampled && task.sup.state != SupervisorState::kFault && faults == 0) {
     const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
-    const S t = trajectory_time<S>(task.tick, task.gains.dt);
+    const S t = trajectory_time<S>(task.gains.trajectory, task.tick, task.gains.dt);
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
     task.step_timing.add(hal.cycles() - s0);

@@ -1,0 +1,509 @@
+// The experiment's configuration (see config.hpp): one table of entries, read and written with
+// yaml-cpp.
+#include "config.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <sstream>
+
+#include "osc_git_revision.hpp"
+
+namespace sim {
+namespace {
+
+using json = nlohmann::ordered_json;
+
+constexpr double kDeg = osc::kPi / 180.0;
+
+/// Shortest text that reads back as the same double ("0.05", "120", "0.0001").
+std::string number_text(double v) {
+  char buf[32];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+std::string range_text(double lo, double hi) {
+  return "[" + number_text(lo) + ", " + number_text(hi) + "]";
+}
+
+enum class Kind { kNumber, kList, kName };
+
+/// One entry of the configuration. Values travel as JSON values in the file's units (numbers, lists
+/// of numbers, names); `get` reads one from the settings and `put` stores a checked one, returning
+/// an error text for what only it can check (empty: fine).
+struct Entry {
+  const char* key;
+  const char* doc;                    // unit and meaning: the YAML comment and --help
+  Kind kind;
+  double lo = 0, hi = 0;              // kNumber, and each element of a kList
+  std::vector<std::string> names;     // kName: the values allowed
+  bool paper = true;                  // part of the paper's set-up (differences_from_paper)
+  std::function<json(const Settings&)> get;
+  std::function<std::string(Settings&, const json&)> put;
+  std::function<bool(const Settings&)> shown;  // printed only when true (null: always)
+  std::function<void(const Settings&, double& lo, double& hi, int element)> element_range;  // per-element bounds
+};
+
+json vec_json(const double* v, int n, double scale = 1) {
+  json a = json::array();
+  for (int i = 0; i < n; ++i) a.push_back(v[i] * scale);
+  return a;
+}
+json vec_json(const Vec6& v, double scale = 1) { return vec_json(v.data(), 6, scale); }
+
+std::string mode_name(const Settings& s) {
+  return s.run_adaptive && s.run_none ? "both" : s.run_adaptive ? "adaptive" : "none";
+}
+
+const osc::FrictionCoefficients* friction_preset(const std::string& name) {
+  static const osc::FrictionCoefficients* const kPresets[] = {&osc::robot::kFrictionPaper,
+                                                               &osc::robot::kFrictionCorke, &osc::kFrictionNone};
+  for (const auto* p : kPresets)
+    if (name == p->name) return p;
+  return nullptr;
+}
+
+/// Sets one coefficient list of the plant's friction (0 vis, 1 cou, 2 sti): the friction is then custom.
+std::function<std::string(Settings&, const json&)> put_friction(int which) {
+  return [which](Settings& s, const json& v) {
+    osc::FrictionCoefficients& f = s.base.plant.friction;
+    double* dst = which == 0 ? f.vis : which == 1 ? f.cou : f.sti;
+    for (int i = 0; i < 6; ++i) dst[i] = v[i].get<double>();
+    f.name = "custom";
+    return std::string();
+  };
+}
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> kEntries = [] {
+    std::vector<Entry> t;
+    auto number = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
+                       std::function<double&(Settings&)> ref) {
+      Entry e{key, doc, Kind::kNumber, lo, hi, {}, paper, nullptr, nullptr, nullptr, nullptr};
+      e.get = [ref](const Settings& s) { return json(ref(const_cast<Settings&>(s))); };
+      e.put = [ref](Settings& s, const json& v) {
+        ref(s) = v.get<double>();
+        return std::string();
+      };
+      t.push_back(e);
+    };
+    // A list of six numbers, each in [lo, hi], stored scaled by `scale` into the settings.
+    auto list6 = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
+                      std::function<Vec6&(Settings&)> ref, double scale = 1) {
+      Entry e{key, doc, Kind::kList, lo, hi, {}, paper, nullptr, nullptr, nullptr, nullptr};
+      e.get = [ref, scale](const Settings& s) { return vec_json(ref(const_cast<Settings&>(s)), 1 / scale); };
+      e.put = [ref, scale](Settings& s, const json& v) {
+        for (int i = 0; i < 6; ++i) ref(s)(i) = v[i].get<double>() * scale;
+        return std::string();
+      };
+      t.push_back(e);
+    };
+    auto name = [&t](const char* key, const char* doc, std::vector<std::string> names, bool paper,
+                     std::function<std::string(const Settings&)> get,
+                     std::function<void(Settings&, const std::string&)> put) {
+      Entry e{key, doc, Kind::kName, 0, 0, std::move(names), paper, nullptr, nullptr, nullptr, nullptr};
+      e.get = [get](const Settings& s) { return json(get(s)); };
+      e.put = [put](Settings& s, const json& v) {
+        put(s, v.get<std::string>());
+        return std::string();
+      };
+      t.push_back(e);
+    };
+
+    // run
+    number("run.duration", "simulated seconds per run [s]", 1, 86400, true,
+           [](Settings& s) -> double& { return s.base.duration; });
+    name("run.modes", "with friction compensation (Table I), without (Table III), or both", {"both", "adaptive", "none"},
+         false, mode_name, [](Settings& s, const std::string& m) {
+           s.run_adaptive = m != "none";
+           s.run_none = m != "adaptive";
+         });
+    name("run.scalar", "the controller's arithmetic", {"double", "float"}, false,
+         [](const Settings& s) { return std::string(s.base.scalar == Scalar::kFloat ? "float" : "double"); },
+         [](Settings& s, const std::string& m) { s.base.scalar = m == "float" ? Scalar::kFloat : Scalar::kDouble; });
+    {
+      std::vector<std::string> laws(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount);
+      name("run.adaptation", "friction adaptation law: paper is (67) exactly, robust adds projection and leakage "
+           "(docs/adaptation.md)", laws, false,
+           [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
+           [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
+    }
+    number("run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
+           true, [](Settings& s) -> double& { return s.base.final_window; });
+    number("run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,
+           [](Settings& s) -> double& { return s.base.window; });
+
+    // controller: gains (69), diagonal, axes x, y, z, then the rotations about X, Y, Z.
+    list6("controller.knd", "observer gain k_nd of (69), per axis x y z rx ry rz", 1e-3, 1e5, true,
+          [](Settings& s) -> Vec6& { return s.base.gains.knd; });
+    list6("controller.k", "observer gain k of (69)", 1e-3, 1e5, true,
+          [](Settings& s) -> Vec6& { return s.base.gains.k; });
+    list6("controller.ks", "controller gain k_s of (69)", 1e-3, 1e5, true,
+          [](Settings& s) -> Vec6& { return s.base.gains.ks; });
+    list6("controller.ki", "controller gain k_i of (69)", 1e-3, 1e6, true,
+          [](Settings& s) -> Vec6& { return s.base.gains.ki; });
+    {
+      Entry e{"controller.k_ad", "adaptation gain: every diagonal entry of K_ad", Kind::kNumber, 0, 1e5, {}, true,
+              nullptr, nullptr, nullptr, nullptr};
+      e.get = [](const Settings& s) { return json(s.base.gains.kad); };
+      e.put = [](Settings& s, const json& v) {
+        s.base.gains.kad = v.get<double>();
+        return std::string();
+      };
+      t.push_back(e);
+      Entry d{"controller.tau_dec", "the controller's Stribeck decay tau_dec of model (2), every joint [s^2/rad^2]",
+              Kind::kNumber, 0.01, 100, {}, true, nullptr, nullptr, nullptr, nullptr};
+      d.get = [](const Settings& s) { return json(s.base.gains.tau_dec(0)); };
+      d.put = [](Settings& s, const json& v) {
+        s.base.gains.tau_dec.setConstant(v.get<double>());
+        return std::string();
+      };
+      t.push_back(d);
+    }
+    number("controller.leakage", "leakage sigma of the robust law [1/s]", 0, 1, true,
+           [](Settings& s) -> double& { return s.base.gains.leakage; });
+    number("controller.model_error", "relative error of the controller's link masses and inertias", -0.5, 0.5, true,
+           [](Settings& s) -> double& { return s.base.model_error; });
+
+    // trajectory (68). omega keeps the exact value of params.hpp for the paper's period.
+    auto reshape = [](Settings& s, double amplitude, std::uint64_t period_ticks, double envelope) {
+      osc::TrajectorySpec<double>& spec = s.base.gains.trajectory;
+      const osc::TrajectorySpec<double> old = spec;
+      spec = osc::trajectory_spec(amplitude, period_ticks, envelope, osc::params::kDt);
+      if (period_ticks == old.period_ticks) spec.omega = old.omega;
+      if (period_ticks == osc::kTrajectoryPeriodTicks) spec.omega = osc::params::kOmega;
+    };
+    {
+      Entry a{"trajectory.amplitude", "of each sinusoid about the start position [m]", Kind::kNumber, 0, 0.2, {}, true,
+              nullptr, nullptr, nullptr, nullptr};
+      a.get = [](const Settings& s) { return json(s.base.gains.trajectory.amplitude); };
+      a.put = [reshape](Settings& s, const json& v) {
+        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+        reshape(s, v.get<double>(), o.period_ticks, o.envelope);
+        return std::string();
+      };
+      t.push_back(a);
+      Entry p{"trajectory.period", "of the sinusoids [s], a whole number of samples (1 ms)", Kind::kNumber, 0.5, 60, {},
+              true, nullptr, nullptr, nullptr, nullptr};
+      p.get = [](const Settings& s) {
+        return json(static_cast<double>(s.base.gains.trajectory.period_ticks) * osc::params::kDt);
+      };
+      p.put = [reshape](Settings& s, const json& v) {
+        const double period = v.get<double>();
+        const double ticks = std::round(period / osc::params::kDt);
+        if (std::abs(ticks * osc::params::kDt - period) > 1e-9)
+          return number_text(period) + " s is not a whole number of samples of " + number_text(osc::params::kDt) + " s";
+        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+        reshape(s, o.amplitude, static_cast<std::uint64_t>(ticks), o.envelope);
+        return std::string();
+      };
+      t.push_back(p);
+      Entry c{"trajectory.envelope", "rate c of the envelope 1 - exp(-c t^3) [1/s^3]", Kind::kNumber, 1e-3, 10, {},
+              true, nullptr, nullptr, nullptr, nullptr};
+      c.get = [](const Settings& s) { return json(s.base.gains.trajectory.envelope); };
+      c.put = [reshape](Settings& s, const json& v) {
+        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+        reshape(s, o.amplitude, o.period_ticks, v.get<double>());
+        return std::string();
+      };
+      t.push_back(c);
+    }
+
+    // start pose, in degrees within the joint limits
+    {
+      Entry q{"start_pose", "joint angles q1..q6 at the start [deg], within the joint limits", Kind::kList, -360, 360,
+              {}, true, nullptr, nullptr, nullptr, nullptr};
+      q.get = [](const Settings& s) { return vec_json(s.base.q_start, 1 / kDeg); };
+      q.put = [](Settings& s, const json& v) {
+        for (int i = 0; i < 6; ++i) {
+          double rad = v[i].get<double>() * kDeg;
+          // The printed degrees read back as the description's radians exactly.
+          if (std::abs(rad - osc::robot::kQStart[i]) < 1e-12) rad = osc::robot::kQStart[i];
+          s.base.q_start(i) = rad;
+        }
+        return std::string();
+      };
+      q.element_range = [](const Settings&, double& lo, double& hi, int i) {
+        lo = std::round(osc::robot::kArm.q_min[i] / kDeg * 1e6) / 1e6;
+        hi = std::round(osc::robot::kArm.q_max[i] / kDeg * 1e6) / 1e6;
+      };
+      t.push_back(q);
+    }
+
+    // plant
+    {
+      Entry f{"plant.friction.preset",
+              "the simulated robot's friction: paper (Table II), corke (toolbox), none, or custom (vis, cou, sti "
+              "below; setting any of them makes it custom)",
+              Kind::kName, 0, 0, {"paper", "corke", "none", "custom"}, true, nullptr, nullptr, nullptr, nullptr};
+      f.get = [](const Settings& s) { return json(std::string(s.base.plant.friction.name)); };
+      f.put = [](Settings& s, const json& v) {
+        const std::string n = v.get<std::string>();
+        if (const osc::FrictionCoefficients* p = friction_preset(n)) s.base.plant.friction = *p;
+        else s.base.plant.friction.name = "custom";  // keeps the coefficients it has
+        return std::string();
+      };
+      t.push_back(f);
+      const char* const kCoef[3][2] = {{"plant.friction.vis", "viscous coefficients per joint [N m s/rad]"},
+                                       {"plant.friction.cou", "Coulomb levels per joint [N m]"},
+                                       {"plant.friction.sti", "Stribeck excess per joint [N m]"}};
+      for (int k = 0; k < 3; ++k) {
+        Entry c{kCoef[k][0], kCoef[k][1], Kind::kList, 0, 200, {}, true, nullptr, nullptr, nullptr, nullptr};
+        c.get = [k](const Settings& s) {
+          const osc::FrictionCoefficients& fr = s.base.plant.friction;
+          return vec_json(k == 0 ? fr.vis : k == 1 ? fr.cou : fr.sti, 6);
+        };
+        c.put = put_friction(k);
+        c.shown = [](const Settings& s) { return std::string(s.base.plant.friction.name) == "custom"; };
+        t.push_back(c);
+      }
+    }
+    number("plant.tau_dec", "the simulated robot's Stribeck decay tau_dec [s^2/rad^2]", 0.01, 100, true,
+           [](Settings& s) -> double& { return s.base.plant.tau_dec; });
+    number("plant.encoder_cpr", "encoder counts per motor revolution, plant and controller alike", 100, 1e7, true,
+           [](Settings& s) -> double& { return s.base.encoder_counts_per_motor_rev; });
+    number("plant.delay", "computation delay from the encoder sample to the DAC update [s]", 0, osc::params::kDt, true,
+           [](Settings& s) -> double& { return s.base.plant.compute_delay; });
+    number("plant.substep", "the plant's RK4 step [s]", 1e-6, 1e-3, false,
+           [](Settings& s) -> double& { return s.base.plant.substep; });
+    return t;
+  }();
+  return kEntries;
+}
+
+const Entry* find_entry(const std::string& key) {
+  for (const Entry& e : entries())
+    if (key == e.key) return &e;
+  return nullptr;
+}
+
+std::string allowed_names(const Entry& e) {
+  std::string s;
+  for (size_t i = 0; i < e.names.size(); ++i) s += (i ? (i + 1 == e.names.size() ? " or " : ", ") : "") + e.names[i];
+  return s;
+}
+
+/// The scalar text of a node, for messages.
+std::string node_text(const YAML::Node& n) {
+  if (n.IsScalar()) return "'" + n.Scalar() + "'";
+  YAML::Emitter out;
+  out << YAML::Flow << n;
+  return out.c_str();
+}
+
+bool read_number(const YAML::Node& n, double& v) {
+  if (!n.IsScalar()) return false;
+  const std::string& t = n.Scalar();
+  const auto r = std::from_chars(t.data(), t.data() + t.size(), v);
+  return r.ec == std::errc() && r.ptr == t.data() + t.size();
+}
+
+/// Checks a node against the entry and stores it; err names the key.
+bool set_entry(const Entry& e, const YAML::Node& n, Settings& s, std::string& err) {
+  const std::string key = e.key;
+  json v;
+  switch (e.kind) {
+    case Kind::kNumber: {
+      double x;
+      if (!read_number(n, x)) return err = key + ": expected a number, got " + node_text(n), false;
+      if (!std::isfinite(x)) return err = key + ": the value must be finite", false;
+      if (x < e.lo || x > e.hi)
+        return err = key + ": " + number_text(x) + " is out of range " + range_text(e.lo, e.hi), false;
+      v = x;
+      break;
+    }
+    case Kind::kList: {
+      if (!n.IsSequence() || n.size() != 6)
+        return err = key + ": expected a list of 6 numbers like [1, 2, 3, 4, 5, 6], got " + node_text(n), false;
+      v = json::array();
+      for (int i = 0; i < 6; ++i) {
+        double x, lo = e.lo, hi = e.hi;
+        if (e.element_range) e.element_range(s, lo, hi, i);
+        const std::string where = key + "[" + std::to_string(i + 1) + "]";
+        if (!read_number(n[i], x)) return err = where + ": expected a number, got " + node_text(n[i]), false;
+        if (!std::isfinite(x)) return err = where + ": the value must be finite", false;
+        if (x < lo || x > hi) return err = where + ": " + number_text(x) + " is out of range " + range_text(lo, hi), false;
+        v.push_back(x);
+      }
+      break;
+    }
+    case Kind::kName: {
+      const std::string t = n.IsScalar() ? n.Scalar() : "";
+      bool ok = false;
+      for (const auto& name : e.names) ok = ok || t == name;
+      if (!ok) return err = key + ": expected " + allowed_names(e) + ", got " + node_text(n), false;
+      v = t;
+      break;
+    }
+  }
+  const std::string why = e.put(s, v);
+  if (!why.empty()) return err = key + ": " + why, false;
+  return true;
+}
+
+/// Walks a mapping; every leaf must be an entry of the table.
+bool apply_node(const YAML::Node& map, const std::string& prefix, const std::string& source, Settings& s,
+                std::string& err) {
+  for (const auto& kv : map) {
+    const std::string key = prefix + kv.first.as<std::string>();
+    const Entry* e = find_entry(key);
+    if (e) {
+      if (!set_entry(*e, kv.second, s, err)) return err = source + ": " + err, false;
+    } else if (kv.second.IsMap()) {
+      bool known_section = false;
+      for (const Entry& x : entries()) known_section = known_section || std::string(x.key).rfind(key + ".", 0) == 0;
+      if (!known_section) return err = source + ": unknown key '" + key + "' (--print-config lists the keys)", false;
+      if (!apply_node(kv.second, key + ".", source, s, err)) return false;
+    } else {
+      return err = source + ": unknown key '" + key + "' (--print-config lists the keys)", false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+bool apply_config(const std::string& text, const std::string& source, Settings& s, std::string& err) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& x) {
+    return err = source + ": not valid YAML: " + x.what(), false;
+  }
+  if (root.IsNull()) return true;  // an empty file changes nothing
+  if (!root.IsMap()) return err = source + ": expected a mapping of keys (like 'run:' and 'trajectory:')", false;
+  try {
+    return apply_node(root, "", source, s, err);
+  } catch (const YAML::Exception& x) {
+    return err = source + ": " + x.what(), false;
+  }
+}
+
+bool set_key(const std::string& key, const std::string& value, Settings& s, std::string& err) {
+  const Entry* e = find_entry(key);
+  if (!e) return err = "unknown key '" + key + "' (--print-config lists the keys)", false;
+  YAML::Node n;
+  try {
+    n = YAML::Load(value);
+  } catch (const YAML::Exception& x) {
+    return err = key + ": '" + value + "' is not a YAML value: " + x.msg, false;
+  }
+  try {
+    return set_entry(*e, n, s, err);
+  } catch (const YAML::Exception& x) {
+    return err = key + ": " + x.what(), false;
+  }
+}
+
+bool apply_setting(const std::string& assignment, Settings& s, std::string& err) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    return err = "--set: expected key=value (like trajectory.amplitude=0.1), got '" + assignment + "'", false;
+  return set_key(assignment.substr(0, eq), assignment.substr(eq + 1), s, err);
+}
+
+bool validate_settings(const Settings& s, std::string& err) {
+  // The controller refuses a Jacobian whose reciprocal condition is below min_rcond (the singular
+  // fault): a start pose there would fault at the first tick.
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
+  osc::Data<double> data;
+  osc::OpSpace<double> os;
+  osc::forward_kinematics(model, data, Vec6(s.base.q_start));
+  const Mat3 R = data.R[osc::kDof];
+  osc::opspace_update(model, data, os, Vec6(s.base.q_start), R);
+  if (!(os.Jf.rcond >= 2 * s.base.gains.min_rcond)) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "start_pose: too close to a singularity (Jacobian reciprocal condition %.2g, the "
+                  "controller needs %.2g or more)", static_cast<double>(os.Jf.rcond), 2 * s.base.gains.min_rcond);
+    return err = buf, false;
+  }
+  return true;
+}
+
+std::string config_yaml(const Settings& s) {
+  YAML::Emitter out;
+  out.SetIndent(2);
+  out << YAML::BeginMap;
+  std::vector<std::string> open;  // the sections open now
+  for (const Entry& e : entries()) {
+    if (e.shown && !e.shown(s)) continue;
+    std::vector<std::string> parts;
+    std::stringstream ks(e.key);
+    for (std::string p; std::getline(ks, p, '.');) parts.push_back(p);
+    size_t common = 0;
+    while (common < open.size() && common + 1 < parts.size() && open[common] == parts[common]) ++common;
+    while (open.size() > common) out << YAML::EndMap, open.pop_back();
+    for (size_t j = open.size(); j + 1 < parts.size(); ++j) {
+      out << YAML::Key << parts[j] << YAML::Value << YAML::BeginMap;
+      open.push_back(parts[j]);
+    }
+    out << YAML::Key << parts.back() << YAML::Value;
+    const json v = e.get(s);
+    std::string range;
+    if (v.is_array()) {
+      out << YAML::Flow << YAML::BeginSeq;
+      for (const auto& x : v) out << number_text(x.get<double>());
+      out << YAML::EndSeq;
+    } else if (v.is_number()) {
+      out << number_text(v.get<double>());
+    } else {
+      out << v.get<std::string>();
+    }
+    if (e.kind == Kind::kName) range = allowed_names(e);
+    else if (!e.element_range) range = range_text(e.lo, e.hi);
+    out << YAML::Comment(std::string(e.doc) + (range.empty() ? "" : "; " + range));
+  }
+  while (!open.empty()) out << YAML::EndMap, open.pop_back();
+  out << YAML::EndMap;
+  std::string text = "# puma_experiment configuration: feed it back with --config FILE, change one entry with\n"
+                     "# --set key=value. The defaults are the paper's set-up (Section VI), from the firmware's\n"
+                     "# headers (params.hpp, the robot description).\n";
+  return text + out.c_str() + "\n";
+}
+
+json config_json(const Settings& s) {
+  json root = json::object();
+  for (const Entry& e : entries()) {
+    if (e.shown && !e.shown(s)) continue;
+    json* node = &root;
+    std::stringstream ks(e.key);
+    std::vector<std::string> parts;
+    for (std::string p; std::getline(ks, p, '.');) parts.push_back(p);
+    for (size_t j = 0; j + 1 < parts.size(); ++j) node = &(*node)[parts[j]];
+    (*node)[parts.back()] = e.get(s);
+  }
+  return root;
+}
+
+std::vector<std::string> differences_from_paper(const Settings& s) {
+  const Settings paper;
+  std::vector<std::string> keys;
+  for (const Entry& e : entries()) {
+    if (!e.paper) continue;
+    const json a = e.get(s), b = e.get(paper);
+    bool same = a == b;
+    if (!same && a.is_array() && b.is_array() && a.size() == b.size()) {  // degrees of the same radians
+      same = true;
+      for (size_t i = 0; i < a.size(); ++i)
+        same = same && std::abs(a[i].get<double>() - b[i].get<double>()) <= 1e-9 * (1 + std::abs(b[i].get<double>()));
+    }
+    if (!same) keys.push_back(e.key);
+  }
+  return keys;
+}
+
+std::string text_hash(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : text) h = (h ^ c) * 1099511628211ull;
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
+  return buf;
+}
+
+const char* git_revision() { return OSC_GIT_REVISION; }
+
+}  // namespace sim
