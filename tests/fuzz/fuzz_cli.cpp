@@ -85,7 +85,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const bool ok = sim::parse_experiment_args(argc, argv.data(), o, err);
   if (ok) {
     FUZZ_CHECK(err.empty());
-    check_options(o);
+    if (!o.help) check_options(o);  // with --help nothing else is read (the program prints the help and exits)
   } else {
     FUZZ_CHECK(!err.empty());
   }
