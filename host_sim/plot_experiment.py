@@ -292,6 +292,8 @@ def main(argv):
     if not runs:
         return fail(f"no time series of this run in {out}")
     print(f"plotted runs: {' '.join(r['mode'] for r, _ in runs)}")
+    print(f"titles: config {summary.get('config_hash', '?')}, rev {summary.get('git_revision', '?')}; "
+          f"{setup_text(summary)}")
     for r, _ in runs:
         if r.get("fault"):
             f = r["fault"]
