@@ -154,7 +154,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
     const osc::TrajectorySpec<double>& spec = cfg.gains.trajectory;
-    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k), dt);  // as the controller
+    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k), osc::params::kControlHz);  // as the controller
     // Errors of the true plant at the sample instant.
     osc::forward_kinematics(truth, tdata, plant.q());
     const osc::Desired<double> d = osc::trajectory(spec, p0, t_ref);
@@ -295,6 +295,7 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   } else if (cfg.scalar == Scalar::kFloat) {
     LocalController<float> ctrl(cfg, q0);
     run(cfg, q0, ctrl, res);
+
   } else {
     LocalController<double> ctrl(cfg, q0);
     run(cfg, q0, ctrl, res);

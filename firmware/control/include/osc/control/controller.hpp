@@ -42,7 +42,7 @@ struct StepOutput {
   Vec6<S> tau_f_hat;  // estimated friction (30)
   Vec6<S> qd_ref;     // joint velocity the reference commands, J^{-1} x_d dot (stuck-encoder monitor)
   S rcond;
-  std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular (then tau = 0)
+  std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular / kFaultOverflow (then tau = 0)
 };
 
 /// Starts the observer at the measured pose: x^(0) = x(0), y(0) = -k x~(0) = 0; theta^(0) = 0.
@@ -106,6 +106,9 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.rcond = os.Jf.rcond;
   out.x = os.x;
   if (!(os.Jf.rcond >= G.min_rcond)) {
+    // Factoring a singular J divides by near-zeros: in fixed point those saturations are this
+    // fault, not another one.
+    math::take_arithmetic_fault<S>();
     out.status = kFaultSingular;
     return out;
   }
@@ -121,6 +124,11 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat) ||
       !math::all_finite(theta_hat)) {
     out.status = kFaultNonFinite;
+    return out;
+  }
+  // A fixed-point result that saturated anywhere in the step (math::take_arithmetic_fault).
+  if (math::take_arithmetic_fault<S>()) {
+    out.status = kFaultOverflow;
     return out;
   }
   st.obs = next;

@@ -1,7 +1,7 @@
 // The firmware's fault catalogue: one list, from which the bits, their names and the mask of all
 // faults are generated. Every fault latches in the supervisor (osc/runtime/supervisor.hpp) and
-// commands zero torque in the tick that detects it. The control step itself raises two of them
-// (non_finite, singular); the runtime and the link raise the rest.
+// commands zero torque in the tick that detects it. The control step itself raises three of them
+// (non_finite, singular, overflow); the runtime and the link raise the rest.
 #pragma once
 
 #include <cstdint>
@@ -21,7 +21,8 @@ namespace osc {
   X(EncoderStuck, "encoder_stuck", "an encoder stood still while the reference moved its joint by more than the bound") \
   X(Tracking, "tracking", "the measured tracking error exceeded its bound")                               \
   X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                    \
-  X(Estop, "estop", "the emergency-stop input is active")
+  X(Estop, "estop", "the emergency-stop input is active")                                                 \
+  X(Overflow, "overflow", "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain")
 
 namespace detail {
 enum FaultBit : unsigned {

@@ -51,14 +51,16 @@ inline TrajectorySpec<double> trajectory_spec(double amplitude, std::uint64_t pe
   return s;
 }
 
-/// The trajectory's time at sample n, from the integer sample count: n dt while the envelope rises,
-/// then the settling time plus the phase within the period. Its precision therefore does not depend
-/// on uptime (a float n dt advances in 1.5 ms steps after 2.3 h and stops after 4.6 h), and a 64-bit
-/// count never wraps in service.
+/// The trajectory's time at sample n of a rate of rate_hz samples per second, from the integer
+/// sample count: n / rate_hz while the envelope rises, then the settling time plus the phase within
+/// the period. Its precision therefore does not depend on uptime (a float n dt advances in 1.5 ms
+/// steps after 2.3 h and stops after 4.6 h), and a 64-bit count never wraps in service. The count
+/// is divided by the integer rate, not multiplied by a rounded sample time: exact to the scalar's
+/// rounding in fixed point too (math::ratio).
 template <class S>
-S trajectory_time(const TrajectorySpec<S>& spec, std::uint64_t n, S dt) {
-  if (n < spec.settled_ticks) return static_cast<S>(n) * dt;
-  return static_cast<S>(spec.settled_ticks + (n - spec.settled_ticks) % spec.period_ticks) * dt;
+S trajectory_time(const TrajectorySpec<S>& spec, std::uint64_t n, std::uint32_t rate_hz) {
+  if (n < spec.settled_ticks) return math::ratio<S>(n, rate_hz);
+  return math::ratio<S>(spec.settled_ticks + (n - spec.settled_ticks) % spec.period_ticks, rate_hz);
 }
 
 template <class S>
@@ -70,11 +72,15 @@ struct Desired {
 template <class S>
 Desired<S> trajectory(const TrajectorySpec<S>& spec, const Vec3<S>& p0, S t) {
   const S A = spec.amplitude, w = spec.omega, c = spec.envelope;
-  // Envelope s(t) and its derivatives.
-  const S ex = math::exp(-c * t * t * t);
+  // Envelope s(t) and its derivatives. The factor e^{-c t^3} is applied before the powers of t grow
+  // (c^2 t^4 reaches 8800 at t = 25 s; c t^2 e^{-c t^3} stays below 0.4), so that no intermediate
+  // leaves the range of a fixed-point scalar.
+  const S ct = c * t, ct2 = ct * t;
+  const S ex = math::exp(-(ct2 * t));
   const S s = S(1) - ex;
-  const S sd = lit<S>(3) * c * t * t * ex;
-  const S sdd = (lit<S>(6) * c * t - lit<S>(9) * c * c * t * t * t * t) * ex;
+  const S ct2_ex = ct2 * ex;
+  const S sd = lit<S>(3) * ct2_ex;
+  const S sdd = lit<S>(6) * ct * ex - lit<S>(9) * ct2_ex * ct2;
   const S sn = math::sin(w * t), cs = math::cos(w * t);
   // x: A sin(wt) s;  y, z: A cos(wt) s.
   const S px = A * sn * s, pxd = A * (w * cs * s + sn * sd), pxdd = A * (-w * w * sn * s + lit<S>(2) * w * cs * sd + sn * sdd);

@@ -1,10 +1,13 @@
 // The one place the kernels touch elementary functions and literals.
-// double and float forward to <cmath>; a fixed-point type adds its own overloads
-// of these functions to osc::math (the kernels call them qualified) and a
+// double and float forward to <cmath>; the fixed-point scalars (osc/kernels/fixed.hpp) bring their
+// own overloads of these functions into osc::math (the kernels call them qualified) and a
 // constructor from double for literals (lit<S>).
 #pragma once
 
 #include <cmath>
+#include <cstdint>
+
+#include "osc/kernels/fixed.hpp"
 
 namespace osc {
 
@@ -29,6 +32,14 @@ inline double abs(double v) { return std::fabs(v); }
 inline double atan2(double y, double x) { return std::atan2(y, x); }
 inline double asin(double v) { return std::asin(v); }
 inline bool isfinite(double v) { return std::isfinite(v); }
+using fixed::sin;
+using fixed::cos;
+using fixed::sqrt;
+using fixed::exp;
+using fixed::abs;
+using fixed::atan2;
+using fixed::asin;
+using fixed::isfinite;
 
 /// sgn with sgn(0) = 0, eq. (3).
 template <class S>
@@ -41,6 +52,37 @@ bool all_finite(const Derived& m) {
     for (int i = 0; i < m.rows(); ++i)
       if (!isfinite(m(i, j))) return false;
   return true;
+}
+
+/// Reads and clears the scalar's sticky arithmetic flags (fixed point: a saturated overflow, a
+/// division by a near-zero, a function outside its domain). Always false for float and double,
+/// whose overflows show as non-finite values instead.
+template <class S>
+bool take_arithmetic_fault() {
+  if constexpr (fixed::is_q_v<S>) return fixed::take_flags() != 0;
+  else return false;
+}
+
+/// The scalar of hardware units at the I/O boundary (encoder counts, counts per radian, DAC
+/// codes), whose magnitudes reach 10^5: the scalar itself for float and double, FixedIo for the
+/// fixed-point kernels.
+template <class S> struct IoScalar { using type = S; };
+template <int F> struct IoScalar<fixed::Q<F>> { using type = FixedIo; };
+template <class S> using io_scalar_t = typename IoScalar<S>::type;
+
+/// n / d of two integers (sample counts to seconds): n (1/d) for float and double (the same bits
+/// as n times a sample time 1/d), rounded once in fixed point.
+template <class S>
+S ratio(std::uint64_t n, std::uint32_t d) {
+  if constexpr (fixed::is_q_v<S>) return fixed::ratio<S::kFractionBits>(static_cast<std::int64_t>(n), d);
+  else return static_cast<S>(n) * (S(1) / static_cast<S>(d));
+}
+
+/// An integer n (encoder counts) divided by a scale of the I/O scalar (counts per radian).
+template <class S>
+S quotient(std::int32_t n, io_scalar_t<S> d) {
+  if constexpr (fixed::is_q_v<S>) return fixed::quotient<S::kFractionBits>(n, d);
+  else return static_cast<S>(n) / d;
 }
 }  // namespace math
 }  // namespace osc

@@ -34,6 +34,9 @@ struct StepTiming {
 
 /// Longest interval between encoder changes the stuck-encoder monitor keeps [ticks].
 constexpr std::uint32_t kStuckIntervalCap = 1u << 20;
+/// The stuck-encoder monitor's accumulated reference motion is held at this bound [counts]: ten
+/// times its threshold, so no decision changes, and within the range of every scalar.
+constexpr double kStuckMotionBound = 10 * params::kStuckMotionCounts;
 
 template <class S>
 struct ControlTask {
@@ -41,7 +44,7 @@ struct ControlTask {
   Gains<S> gains;
   FrictionMode mode;
   Vec6<S> q_start;            // joint angles at which the encoders read zero
-  Vec6<S> counts_per_rad;     // encoder counts per joint radian (the robot's drives by default)
+  Vec6<math::io_scalar_t<S>> counts_per_rad;  // encoder counts per joint radian (the robot's drives by default)
   std::uint64_t tick;         // samples since start (64 bits: never wraps in service)
   bool have_counts;           // a first encoder sample has been taken
   ControllerState<S> state;
@@ -97,7 +100,7 @@ struct ControlTask {
   void set_encoder_resolution(double counts_per_motor_rev) {
     for (int i = 0; i < kDof; ++i) {
       const double c = osc::counts_per_rad(i, counts_per_motor_rev);
-      counts_per_rad(i) = lit<S>(c);
+      counts_per_rad(i) = lit<math::io_scalar_t<S>>(c);
       // Speed limit times the sample, in counts, plus one count of quantisation.
       max_count_step[i] = static_cast<std::int32_t>(counts_per_tick_at_max_speed(i, c)) + 1;
       // The joint limits plus the margin, relative to the start pose, in counts (rounded outwards).
@@ -112,7 +115,8 @@ struct ControlTask {
 
 /// Encoder counts to joint angles.
 template <class S>
-Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<S>& counts_per_rad, const std::int32_t counts[kDof]) {
+Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<math::io_scalar_t<S>>& counts_per_rad,
+                           const std::int32_t counts[kDof]) {
   Vec6<S> q;
   for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(counts[i], counts_per_rad(i), q_start(i));
   return q;
@@ -141,6 +145,7 @@ std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) 
     if (dtau > task.stuck_dtau_peak(i)) task.stuck_dtau_peak(i) = dtau;
     if (dtau > lit<S>(params::kStuckTorque[i])) faults |= kFaultEncoderStuck;
     m += math::abs(out.qd_ref(i)) * task.gains.dt * task.counts_per_rad(i);
+    if (m > lit<S>(kStuckMotionBound)) m = lit<S>(kStuckMotionBound);
     // Stuck: the reference has moved the joint far, and the encoder has been silent for many times
     // its recent interval between counts (a joint that was slowing down, as at a reversal held by
     // static friction, had long intervals already).
@@ -198,7 +203,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (sampled && task.sup.state != SupervisorState::kFault && faults == 0) {
     const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
-    const S t = trajectory_time<S>(task.gains.trajectory, task.tick, task.gains.dt);
+    const S t = trajectory_time<S>(task.gains.trajectory, task.tick, params::kControlHz);
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
     task.step_timing.add(hal.cycles() - s0);
@@ -210,6 +215,8 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
       if (task.sat_ticks[i] >= params::kSaturationTicks) faults |= kFaultSaturation;
     }
   }
+  // A fixed-point saturation in the monitors or the torque conversion (the step reports its own).
+  if (math::take_arithmetic_fault<S>()) faults |= kFaultOverflow;
   // The step's own duration against the period (the next tick would have arrived).
   const std::uint32_t elapsed = hal.cycles() - c0;
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;

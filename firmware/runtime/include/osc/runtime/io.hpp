@@ -24,37 +24,41 @@ constexpr double counts_per_tick_at_max_speed(int joint, double counts_per_rad) 
 /// Largest DAC code magnitude of the robot's drives.
 constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
 
-/// Joint angle [rad] of an encoder count, relative to the count taken at the start pose.
+/// Joint angle [rad] of an encoder count, relative to the count taken at the start pose. Counts
+/// and counts per radian reach 10^5: they are of the I/O scalar (math::io_scalar_t).
 template <class S>
-S counts_to_angle(std::int32_t counts, S counts_per_rad, S q_at_zero) {
-  return q_at_zero + static_cast<S>(counts) / counts_per_rad;
+S counts_to_angle(std::int32_t counts, math::io_scalar_t<S> counts_per_rad, S q_at_zero) {
+  return q_at_zero + math::quotient<S>(counts, counts_per_rad);
 }
 /// The same with the robot's drives.
 template <class S>
 S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
-  return counts_to_angle<S>(counts, lit<S>(counts_per_rad(joint)), q_at_zero);
+  return counts_to_angle<S>(counts, lit<math::io_scalar_t<S>>(counts_per_rad(joint)), q_at_zero);
 }
 
-/// DAC code of a joint torque, saturated at the code range. Returns true when it saturated.
+/// DAC code of a joint torque, saturated at the code range. Returns true when it saturated. The
+/// code is computed in the I/O scalar (it reaches 32767).
 template <class S>
 bool torque_to_code(int joint, S tau, std::int32_t& code) {
-  const S scale = lit<S>(static_cast<double>(kDacMaxCode) / robot::kDrives.torque_limit[joint]);
-  const S c = tau * scale;
-  const S max = lit<S>(static_cast<double>(kDacMaxCode));
-  if (!math::isfinite(c)) {
+  using W = math::io_scalar_t<S>;
+  const W scale = lit<W>(static_cast<double>(kDacMaxCode) / robot::kDrives.torque_limit[joint]);
+  const W t = static_cast<W>(tau);
+  const W limit = lit<W>(robot::kDrives.torque_limit[joint]);
+  if (!math::isfinite(t)) {
     code = 0;
     return true;
   }
-  if (c >= max) {
+  if (t >= limit) {
     code = static_cast<std::int32_t>(kDacMaxCode);
     return true;
   }
-  if (c <= -max) {
+  if (t <= -limit) {
     code = -static_cast<std::int32_t>(kDacMaxCode);
     return true;
   }
-  // Round to nearest.
-  code = static_cast<std::int32_t>(c >= S(0) ? c + lit<S>(0.5) : c - lit<S>(0.5));
+  // Below the limit the code lies within the range; round to nearest.
+  const W c = t * scale;
+  code = static_cast<std::int32_t>(c >= W(0) ? c + lit<W>(0.5) : c - lit<W>(0.5));
   return false;
 }
 
