@@ -111,13 +111,16 @@ Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpa
   return analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
 }
 
-/// h(v) = Psi(x, v) v = J^{-T} c(q, qd_v) - Lambda Jdot(q, qd_v) qd_v, with qd_v = J^{-1} v.
+/// h(v) = Psi(x, v) v = J^{-T} c(q, qd_v) - Lambda Jdot(q, qd_v) qd_v, with qd_v = J^{-1} v,
+/// evaluated as J^{-T} [c - A J^{-1} Jdot qd_v] (Lambda = J^{-T} A J^{-1}): the bracket is a joint
+/// torque, whereas Lambda times the operational acceleration Jdot qd_v has entries many times h's
+/// own near the edges of the workspace (beyond the range of a fixed-point scalar first).
 template <class S>
 Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& v) {
   const Vec6<S> qd = os.Jf.solve(v);
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
   const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
-  return os.Jf.solve_transpose(vp.c) - os.Lambda * jdqd;
+  return os.Jf.solve_transpose(Vec6<S>(vp.c - data.A * os.Jf.solve(jdqd)));
 }
 
 /// Psi(x, y) z, the symmetric bilinear form of (8), by polarisation: (h(y+z) - h(y-z)) / 4.
