@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <iterator>
 #include <sstream>
 
 #include "osc_git_revision.hpp"
@@ -122,9 +123,13 @@ const std::vector<Entry>& entries() {
            s.run_adaptive = m != "none";
            s.run_none = m != "adaptive";
          });
-    name("run.scalar", "the controller's arithmetic", {"double", "float"}, false,
-         [](const Settings& s) { return std::string(s.base.scalar == Scalar::kFloat ? "float" : "double"); },
-         [](Settings& s, const std::string& m) { s.base.scalar = m == "float" ? Scalar::kFloat : Scalar::kDouble; });
+    name("run.scalar", "the controller's arithmetic (fixed: Q12.19 fixed point, docs/fixed_point.md)",
+         std::vector<std::string>(std::begin(kScalarNames), std::end(kScalarNames)), false,
+         [](const Settings& s) { return std::string(kScalarNames[static_cast<int>(s.base.scalar)]); },
+         [](Settings& s, const std::string& m) {
+           for (int i = 0; i < static_cast<int>(std::size(kScalarNames)); ++i)
+             if (m == kScalarNames[i]) s.base.scalar = static_cast<Scalar>(i);
+         });
     {
       std::vector<std::string> laws(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount);
       name("run.adaptation", "friction adaptation law: paper is (67) exactly, robust adds projection and leakage "

@@ -295,7 +295,9 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   } else if (cfg.scalar == Scalar::kFloat) {
     LocalController<float> ctrl(cfg, q0);
     run(cfg, q0, ctrl, res);
-
+  } else if (cfg.scalar == Scalar::kFixed) {
+    LocalController<osc::Fixed> ctrl(cfg, q0);
+    run(cfg, q0, ctrl, res);
   } else {
     LocalController<double> ctrl(cfg, q0);
     run(cfg, q0, ctrl, res);

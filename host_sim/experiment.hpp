@@ -15,7 +15,11 @@
 
 namespace sim {
 
-enum class Scalar { kDouble, kFloat };
+/// The in-process controller's arithmetic: double, float, or the fixed-point Q12.19 of
+/// osc/kernels/fixed.hpp.
+enum class Scalar { kDouble, kFloat, kFixed };
+/// Names of the scalars, in enum order (configuration, command lines).
+constexpr const char* kScalarNames[] = {"double", "float", "fixed"};
 
 struct ExperimentConfig {
   double duration = 120.0;                          ///< [s]

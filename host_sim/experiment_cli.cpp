@@ -22,7 +22,7 @@ struct Shorthand {
 constexpr Shorthand kShorthands[] = {
     {"--duration", "run.duration", "simulated seconds per run (default 120; 1..86400)"},
     {"--mode", "run.modes", "both | adaptive | none (default both)"},
-    {"--scalar", "run.scalar", "the controller's arithmetic: double | float (default double)"},
+    {"--scalar", "run.scalar", "the controller's arithmetic: double | float | fixed (default double)"},
     {"--adaptation", "run.adaptation", "friction adaptation law: paper | robust (default robust)"},
     {"--final-window", "run.final_window", "length of the \"last\" statistics in seconds (default 20; 1..3600)"},
     {"--friction", "plant.friction.preset", "plant friction preset: paper | corke | none (default paper)"},

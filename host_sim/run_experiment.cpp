@@ -254,7 +254,8 @@ int main(int argc, char** argv) {
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
     if (!check_arm_elf(o.elf, err)) return fail(err);
-    if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;  // the firmware computes in float
+    // The M4F firmware computes in float (the M3 image in fixed point: --scalar fixed says so).
+    if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
   }
   if (o.csv) {

@@ -132,6 +132,29 @@ TEST(ClosedLoop, FloatControllerTracksLikeDouble) {
   for (int i = 0; i < 3; ++i) EXPECT_LT(f.final_max_error[i], 1.5 * d.final_max_error[i] + 0.02) << i;
 }
 
+// Issue 10: the fixed-point (Q12.19) controller against the float one, with and without
+// compensation. 30 s: the envelope has settled at 20 s, the statistics cover the last 10 s (the
+// runner's 120 s experiment: docs/fixed_point.md).
+TEST(ClosedLoop, FixedPointControllerTracksLikeFloatAndCompensationHalvesTheErrors) {
+  ExperimentConfig c = config(30, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
+  c.scalar = Scalar::kFloat;
+  const ExperimentResult f = run_experiment(c);
+  c.scalar = Scalar::kFixed;
+  const ExperimentResult x = run_experiment(c);
+  c.mode = osc::FrictionMode::kNone;
+  const ExperimentResult n = run_experiment(c);
+  print("float controller", f);
+  print("fixed-point controller", x);
+  print("fixed-point, no comp.", n);
+  ASSERT_EQ(f.status, 0u);
+  ASSERT_EQ(x.status, 0u) << osc::fault_name(x.status);
+  ASSERT_EQ(n.status, 0u) << osc::fault_name(n.status);
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_LE(x.final_max_error[i], 1.5 * f.final_max_error[i]) << "axis " << i;
+    EXPECT_GE(n.final_max_error[i], 2.0 * x.final_max_error[i]) << "axis " << i;
+  }
+}
+
 TEST(Windows, PerWindowMaximaCoverTheRunAndAgreeWithTheWholeRunMaximum) {
   ExperimentConfig c = config(7, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
   c.window = 2.0;
@@ -204,10 +227,10 @@ TEST(ClosedLoop, PaperLawDriftScalesWithTheSquareOfTheEncoderQuantum) {
 
 // Time that never runs out: after 25 s the controller's sample counter jumps to 2^31, 2^32 - 10,
 // 240 h and 50 days of uptime (rounded to the trajectory's period, so the reference is the same).
-// The tracking errors from then on must equal those of the run without the jump exactly, in double
-// and in float (a float n dt had stopped advancing after 4.6 h).
+// The tracking errors from then on must equal those of the run without the jump exactly, in double,
+// in float (a float n dt had stopped advancing after 4.6 h) and in fixed point.
 TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
-  for (const Scalar scalar : {Scalar::kDouble, Scalar::kFloat}) {
+  for (const Scalar scalar : {Scalar::kDouble, Scalar::kFloat, Scalar::kFixed}) {
     ExperimentConfig c = config(35, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
     c.scalar = scalar;
     c.final_window = 10;
@@ -224,7 +247,7 @@ TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
       for (int i = 0; i < 6; ++i)
         EXPECT_EQ(r.final_max_error[i], base.final_max_error[i]) << "uptime " << target << " axis " << i;
       std::printf("%s controller, counter jumps to %llu at 25 s: last 10 s max |e| %.4f %.4f %.4f mm (without: %.4f %.4f %.4f)\n",
-                  scalar == Scalar::kFloat ? "float " : "double", static_cast<unsigned long long>(jump_at_tick + c.jump_ticks),
+                  kScalarNames[static_cast<int>(scalar)], static_cast<unsigned long long>(jump_at_tick + c.jump_ticks),
                   r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], base.final_max_error[0],
                   base.final_max_error[1], base.final_max_error[2]);
     }

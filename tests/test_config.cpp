@@ -122,6 +122,20 @@ TEST(Config, DifferencesFromThePaperListTheSetUpKeysOnly) {
   EXPECT_EQ(d[1], "trajectory.amplitude");
 }
 
+TEST(Config, EveryScalarIsANameOfRunScalarAndReadsBack) {
+  for (int i = 0; i < static_cast<int>(std::size(sim::kScalarNames)); ++i) {
+    Settings s;
+    std::string err;
+    ASSERT_TRUE(sim::apply_setting(std::string("run.scalar=") + sim::kScalarNames[i], s, err)) << err;
+    EXPECT_EQ(static_cast<int>(s.base.scalar), i);
+    EXPECT_NE(sim::config_yaml(s).find(std::string("scalar: ") + sim::kScalarNames[i]), std::string::npos);
+  }
+  Settings s;
+  std::string err;
+  EXPECT_FALSE(sim::apply_setting("run.scalar=q15", s, err));
+  EXPECT_NE(err.find("fixed"), std::string::npos) << err;  // the message lists the names
+}
+
 TEST(Config, CommandLineAppliesFileThenOptionsThenSet) {
   char prog[] = "puma_experiment", a1[] = "--duration=30", a2[] = "--set", a3[] = "run.duration=40", a4[] = "--mode",
        a5[] = "none";
