@@ -18,6 +18,14 @@ using namespace sim;
 
 namespace {
 
+/// The arithmetic of the peer's controller: float (the host peer, the M4F image) or fixed (the M3
+/// image: PIL_SCALAR=fixed).
+bool peer_is_fixed() {
+  const char* s = std::getenv("PIL_SCALAR");
+  return s != nullptr && std::string(s) == "fixed";
+}
+Scalar peer_scalar() { return peer_is_fixed() ? Scalar::kFixed : Scalar::kFloat; }
+
 std::vector<std::string> peer_command() {
   if (const char* elf = std::getenv("PIL_FIRMWARE_ELF")) {
     const char* qemu = std::getenv("QEMU");
@@ -321,7 +329,8 @@ TEST_F(Link, EncoderJumpFaultsInTheSameTick) {
 
 TEST_F(Link, NonFiniteValueFaultsInTheSameTick) {
   healthy(5);
-  expect_fault_now(exchange(pil::kInjectNonFinite), osc::kFaultNonFinite);
+  // In fixed point the injected 0/0 saturates with the arithmetic flag raised: the overflow fault.
+  expect_fault_now(exchange(pil::kInjectNonFinite), peer_is_fixed() ? osc::kFaultOverflow : osc::kFaultNonFinite);
 }
 
 TEST_F(Link, OverrunFaultsInTheSameTick) {
@@ -351,12 +360,12 @@ TEST_F(Link, FrozenEncodersFaultAsStuck) {
   EXPECT_TRUE(zero(a));
 }
 
-TEST(PilClosedLoop, TracksLikeTheInProcessFloatController) {
+TEST(PilClosedLoop, TracksLikeTheInProcessController) {
   ExperimentConfig c;
   c.duration = std::getenv("PIL_FIRMWARE_ELF") ? 10.0 : 3.0;
   c.final_window = c.duration / 2;
   c.log_period = 0.01;
-  c.scalar = Scalar::kFloat;
+  c.scalar = peer_scalar();
   const ExperimentResult local = run_experiment(c);
   c.pil_command = peer_command();
   const ExperimentResult remote = run_experiment(c);
@@ -379,8 +388,18 @@ TEST(PilClosedLoop, TracksLikeTheInProcessFloatController) {
   // tolerance of one encoder quantum (0.069 mm) and 0.01 deg on the max errors.
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.069) << i;
   for (int i = 3; i < 6; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.01) << i;
-  if (!std::getenv("PIL_FIRMWARE_ELF")) {
-    EXPECT_EQ(worst, 0.0);  // host peer: bit-identical
+  // The host peer runs the same code with the same compiler; fixed point is integer arithmetic, the
+  // same on every core: both agree with the in-process controller bit for bit, every torque of the
+  // run included.
+  if (!std::getenv("PIL_FIRMWARE_ELF") || peer_is_fixed()) {
+    EXPECT_EQ(worst, 0.0);
+    ASSERT_EQ(remote.log.size(), local.log.size());
+    std::size_t differ = 0;
+    for (std::size_t k = 0; k < local.log.size(); ++k)
+      for (int i = 0; i < 6; ++i)
+        differ += remote.log[k].tau[i] != local.log[k].tau[i] || remote.log[k].e[i] != local.log[k].e[i];
+    EXPECT_EQ(differ, 0u) << "of " << local.log.size() << " logged samples";
+    std::printf("bit for bit: %zu logged samples of torques and errors, %zu differ\n", local.log.size(), differ);
   }
 }
 
@@ -392,7 +411,7 @@ TEST(PilClosedLoop, TheAdaptationLawIsConfiguredOverTheLink) {
   ExperimentConfig c;
   c.duration = 3.0;
   c.final_window = 1.0;
-  c.scalar = Scalar::kFloat;
+  c.scalar = peer_scalar();
   double spread[2] = {0, 0};
   ExperimentResult remote_of[2];
   const osc::AdaptationLaw laws[2] = {osc::AdaptationLaw::kPaper, osc::AdaptationLaw::kRobust};
@@ -413,8 +432,8 @@ TEST(PilClosedLoop, TheAdaptationLawIsConfiguredOverTheLink) {
   for (int l = 0; l < 2; ++l)
     for (int i = 0; i < 18; ++i) lowest[l] = std::min(lowest[l], remote_of[l].theta_min_seen[i]);
   std::printf("lowest theta^ over the link: paper %.3g, robust %.3g\n", lowest[0], lowest[1]);
-  if (!qemu) {
-    EXPECT_EQ(spread[0], 0.0);  // host peer: bit-identical
+  if (!qemu || peer_is_fixed()) {
+    EXPECT_EQ(spread[0], 0.0);  // host peer or fixed point: bit-identical
     EXPECT_EQ(spread[1], 0.0);
     EXPECT_GT(between, 0.1);
   }

@@ -79,10 +79,23 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
   data.A.diagonal() += model.armature;
 }
 
-/// Gravity torques g(q).
+/// Gravity torques g(q), from the composite bodies (what rnea with gravity and no motion gives, in
+/// O(n) products instead of a full pass): joint j holds the weight of links j..6, whose mass M_j
+/// and first moment h_j = sum m_i c_i the backward loop accumulates, so
+/// g_j = z_{j-1} . ((h_j - M_j o_{j-1}) x (0, 0, gravity)).
 template <class S>
 Vec6<S> gravity_torques(const Model<S>& model, const Data<S>& data) {
-  return rnea(model, data, Vec6<S>::Zero(), Vec6<S>::Zero(), true).tau;
+  S m = S(0);
+  Vec3<S> h = Vec3<S>::Zero();
+  Vec6<S> g;
+  for (int j = kDof; j >= 1; --j) {
+    m += model.link[j - 1].mass;
+    h += model.link[j - 1].mass * data.com[j];
+    const Vec3<S> r = h - m * data.o[j - 1];  // first moment of links j..6 about o_{j-1}
+    const Vec3<S> z = data.R[j - 1].col(2);
+    g(j - 1) = model.gravity * (z(0) * r(1) - z(1) * r(0));  // z . (r x g e_z)
+  }
+  return g;
 }
 
 /// Velocity products c(q,qd) = B(q,qd) qd (no gravity, no acceleration), and in the same pass

@@ -65,6 +65,43 @@ constexpr std::int32_t narrow(std::int64_t v, std::uint32_t why = kOverflow) {
   return static_cast<std::int32_t>(v);
 }
 
+/// The end of the range in the direction of `positive`, with the flag `why` raised: the slow path
+/// of every operation, out of line so that the fast path stays a few instructions.
+[[gnu::cold, gnu::noinline]] inline std::int32_t saturated(bool positive, std::uint32_t why) {
+  raise_flag(why);
+  return positive ? kRawMax : kRawMin;
+}
+
+/// a + b, a - b, -a, saturating.
+[[gnu::always_inline]] inline std::int32_t add(std::int32_t a, std::int32_t b) {
+  std::int32_t r;
+  if (__builtin_add_overflow(a, b, &r)) [[unlikely]]
+    return saturated(a >= 0, kOverflow);  // both of a's sign
+  return r;
+}
+[[gnu::always_inline]] inline std::int32_t sub(std::int32_t a, std::int32_t b) {
+  std::int32_t r;
+  if (__builtin_sub_overflow(a, b, &r)) [[unlikely]]
+    return saturated(a >= 0, kOverflow);  // a and -b of one sign
+  return r;
+}
+[[gnu::always_inline]] inline std::int32_t neg(std::int32_t a) {
+  if (a == kRawMin) [[unlikely]]
+    return saturated(true, kOverflow);
+  return -a;
+}
+/// round(a b / 2^s) (half up), saturating: one 32x32 -> 64-bit multiply, the rounding constant, a
+/// range check on the high word (the result fits when it lies in [-2^(s-1), 2^(s-1))), and the
+/// middle 32 bits.
+template <int S>
+[[gnu::always_inline]] inline std::int32_t mul_shift(std::int32_t a, std::int32_t b) {
+  const std::int64_t p = static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b) + (std::int64_t{1} << (S - 1));
+  const std::int32_t hi = static_cast<std::int32_t>(p >> 32);
+  if (static_cast<std::uint32_t>(hi) + (1u << (S - 1)) >= (1u << S)) [[unlikely]]
+    return saturated(hi >= 0, kOverflow);
+  return static_cast<std::int32_t>((static_cast<std::uint32_t>(p) >> S) | (static_cast<std::uint32_t>(hi) << (32 - S)));
+}
+
 /// Rounding arithmetic right shift by s >= 1 (round half up).
 constexpr std::int64_t shift_round(std::int64_t v, int s) { return (v + (std::int64_t{1} << (s - 1))) >> s; }
 
@@ -252,10 +289,16 @@ class Q {
   static constexpr int kFractionBits = F;
   static constexpr int kIntegerBits = 31 - F;
 
-  /// Zero. (Eigen's condition estimator compares a vector that it assigns only in an earlier loop
-  /// iteration; GCC cannot follow that and warns of an uninitialised read. The stores are dead and
-  /// optimised away wherever a value is assigned anyway.)
+#if defined(__arm__) && !defined(__linux__)
+  /// Uninitialised, like float: Eigen's fixed-size temporaries stay free.
+  Q() = default;
+#else
+  /// Zero on the host: Eigen's condition estimator compares a vector that it assigns only in an
+  /// earlier loop iteration, which the host compiler cannot follow (-Wmaybe-uninitialized, an error
+  /// here). On the target the same code compiles without it, and zeroing every temporary would cost
+  /// memsets in the control step. No kernel reads a default-constructed value before writing it.
   constexpr Q() : r_(0) {}
+#endif
 
   /// From an integer: implicit, as for float (Eigen's generic code writes `return 0;`).
   template <std::integral I>
@@ -288,21 +331,19 @@ class Q {
   friend constexpr bool operator==(Q a, Q b) { return a.r_ == b.r_; }
   friend constexpr auto operator<=>(Q a, Q b) { return a.r_ <=> b.r_; }
 
-  friend constexpr Q operator+(Q a, Q b) { return from_raw(detail::narrow(static_cast<std::int64_t>(a.r_) + b.r_)); }
-  friend constexpr Q operator-(Q a, Q b) { return from_raw(detail::narrow(static_cast<std::int64_t>(a.r_) - b.r_)); }
-  friend constexpr Q operator-(Q a) { return from_raw(detail::narrow(-static_cast<std::int64_t>(a.r_))); }
+  [[gnu::always_inline]] friend Q operator+(Q a, Q b) { return from_raw(detail::add(a.r_, b.r_)); }
+  [[gnu::always_inline]] friend Q operator-(Q a, Q b) { return from_raw(detail::sub(a.r_, b.r_)); }
+  [[gnu::always_inline]] friend Q operator-(Q a) { return from_raw(detail::neg(a.r_)); }
   friend constexpr Q operator+(Q a) { return a; }
   /// Rounded to nearest (half up).
-  friend constexpr Q operator*(Q a, Q b) {
-    return from_raw(detail::narrow(detail::shift_round(static_cast<std::int64_t>(a.r_) * b.r_, F)));
-  }
+  [[gnu::always_inline]] friend Q operator*(Q a, Q b) { return from_raw(detail::mul_shift<F>(a.r_, b.r_)); }
   /// Rounded to nearest (half away from zero); b == 0 or a quotient beyond the range saturates.
   friend Q operator/(Q a, Q b) { return from_raw(detail::div_shifted(a.r_, F, b.r_)); }
   /// A product with another format, in this one (e.g. a quantity times a hardware scale).
   template <int G>
     requires(G != F)
-  friend constexpr Q operator*(Q a, Q<G> b) {
-    return from_raw(detail::narrow(detail::shift_round(static_cast<std::int64_t>(a.r_) * b.raw(), G)));
+  friend Q operator*(Q a, Q<G> b) {
+    return from_raw(detail::mul_shift<G>(a.r_, b.raw()));
   }
   template <std::integral I>
   friend constexpr Q operator*(I i, Q a) {
@@ -313,9 +354,9 @@ class Q {
     return i * a;
   }
 
-  constexpr Q& operator+=(Q b) { return *this = *this + b; }
-  constexpr Q& operator-=(Q b) { return *this = *this - b; }
-  constexpr Q& operator*=(Q b) { return *this = *this * b; }
+  Q& operator+=(Q b) { return *this = *this + b; }
+  Q& operator-=(Q b) { return *this = *this - b; }
+  Q& operator*=(Q b) { return *this = *this * b; }
   Q& operator/=(Q b) { return *this = *this / b; }
 
  private:
@@ -366,7 +407,7 @@ template <class T> inline constexpr bool is_q_v = IsQ<T>::value;
 // range, in units of the result's last bit (LSB = 2^-F); tests/test_fixed.cpp measures them.
 
 template <int F>
-constexpr Q<F> abs(Q<F> v) { return v.raw() < 0 ? -v : v; }
+[[gnu::always_inline]] inline Q<F> abs(Q<F> v) { return v.raw() < 0 ? -v : v; }
 template <int F>
 constexpr bool isfinite(Q<F>) { return true; }
 template <int F>

@@ -2,13 +2,14 @@
 //
 // For an arm with a spherical wrist whose centre is the frame-6 origin (has_spherical_wrist(), in
 // osc/robots/arm.hpp; the PUMA 560 is one), the linear-velocity rows of J do not depend on joints
-// 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian).
-// J is therefore factored as two 3x3 LU decompositions; det J = det J11 det J22, and every
-// solve with J or J^T is two 3x3 solves. No 6x6 matrix is ever inverted.
+// 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian), and
+// J^{-1} = [J11^{-1} 0; -J22^{-1} J21 J11^{-1} J22^{-1}]. The factor keeps the inverses of the two
+// 3x3 blocks (by cofactors: one division each); every solve with J or J^T is then three 3x3 products
+// and no division, det J = det J11 det J22, and the reciprocal condition numbers are exact (1-norm).
+// No 6x6 matrix is ever inverted.
 #pragma once
 
 #include <Eigen/Cholesky>
-#include <Eigen/LU>
 
 #include "osc/kernels/dynamics.hpp"
 
@@ -18,35 +19,51 @@ namespace osc {
 /// when has_spherical_wrist(arm) holds (the runtime checks it at compile time for the built robot).
 template <class S>
 struct SphericalWristJacobianFactor {
-  Eigen::PartialPivLU<Mat3<S>> arm;    // J11: position rows, joints 1-3
-  Eigen::PartialPivLU<Mat3<S>> wrist;  // J22: orientation rows, joints 4-6
+  Mat3<S> arm_inv;    // J11^{-1}: position rows, joints 1-3
+  Mat3<S> wrist_inv;  // J22^{-1}: orientation rows, joints 4-6
   Mat3<S> J21;
-  /// Reciprocal condition estimate (1-norm) of the worse of the two blocks; 0 when singular.
+  /// Reciprocal condition number (1-norm) of the worse of the two blocks; 0 when one is singular.
   /// Callers refuse to act when it falls below their threshold.
   S rcond = S(0);
 
   void compute(const Mat6<S>& J) {
-    arm.compute(J.template topLeftCorner<3, 3>());
-    wrist.compute(J.template bottomRightCorner<3, 3>());
     J21 = J.template bottomLeftCorner<3, 3>();
-    const S r1 = arm.rcond(), r2 = wrist.rcond();
+    const S r1 = invert(J.template topLeftCorner<3, 3>(), arm_inv);
+    const S r2 = invert(J.template bottomRightCorner<3, 3>(), wrist_inv);
     rcond = r1 < r2 ? r1 : r2;
     if (!math::isfinite(rcond)) rcond = S(0);
   }
   /// J^{-1} b.
   Vec6<S> solve(const Vec6In<S>& b) const {
     Vec6<S> x;
-    x.template head<3>() = arm.solve(b.template head<3>());
-    x.template tail<3>() = wrist.solve(b.template tail<3>() - J21 * x.template head<3>());
+    x.template head<3>() = arm_inv * b.template head<3>();
+    x.template tail<3>() = wrist_inv * (b.template tail<3>() - J21 * x.template head<3>());
     return x;
   }
   /// J^{-T} b.
   Vec6<S> solve_transpose(const Vec6In<S>& b) const {
     Vec6<S> x;
-    x.template tail<3>() = wrist.transpose().solve(b.template tail<3>());
-    x.template head<3>() = arm.transpose().solve(b.template head<3>() - J21.transpose() * x.template tail<3>());
+    x.template tail<3>() = wrist_inv.transpose() * b.template tail<3>();
+    x.template head<3>() = arm_inv.transpose() * (b.template head<3>() - J21.transpose() * x.template tail<3>());
     return x;
   }
+
+ private:
+  /// M^{-1} by cofactors (its columns are cross products of M's rows, over det M) and the reciprocal
+  /// condition number of M in the 1-norm; a zero inverse and 0 when M is singular.
+  static S invert(const Mat3<S>& M, Mat3<S>& inv) {
+    const Vec3<S> r0 = M.row(0).transpose(), r1 = M.row(1).transpose(), r2 = M.row(2).transpose();
+    Mat3<S> adj;
+    adj << r1.cross(r2), r2.cross(r0), r0.cross(r1);
+    const S det = r0.dot(adj.col(0));
+    if (det == S(0)) {
+      inv.setZero();
+      return S(0);
+    }
+    inv = (S(1) / det) * adj;
+    return S(1) / (norm1(M) * norm1(inv));
+  }
+  static S norm1(const Mat3<S>& M) { return M.cwiseAbs().colwise().sum().maxCoeff(); }
 };
 
 /// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised.

@@ -48,7 +48,7 @@ __attribute__((section(".noinit"))) volatile Record g_rec;
 
 using board::StillHal;
 
-osc::ControlTask<float> g_task;
+osc::ControlTask<board::Scalar> g_task;
 StillHal g_hal;
 volatile std::uint32_t g_scenario = kDone;
 volatile std::uint32_t g_ticks = 0, g_feeds = 0, g_last_feed = 0;
@@ -124,8 +124,8 @@ int main() {
   const cortex_m::ResetCause cause = board::reset_cause();
   Line().str("boot: reset cause ").str(board::reset_cause_name(cause)).str(", watchdog resets ")
       .u32(cortex_m::watchdog_resets()).emit();
-  g_task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
-              osc::joint_vector<float>(osc::robot::kQStart), kPeriodNs);
+  g_task.init(osc::Model<board::Scalar>::of(osc::robot::kArm), osc::Gains<board::Scalar>::paper(),
+              osc::FrictionMode::kAdaptive, osc::joint_vector<board::Scalar>(osc::robot::kQStart), kPeriodNs);
   // Up with zero torque: every DAC code 0, the supervisor starting, the fault line released.
   const bool outputs_ok = g_hal.codes_zero() && g_task.sup.state == osc::SupervisorState::kInit &&
                           g_task.sup.latched == 0 && !board::g_fault_line;

@@ -1,5 +1,6 @@
-// mps2-an386 external interrupts 0..31 (CMSDK peripherals), placed right after the common system
-// vectors (boards/common/cortex_m/startup.cpp). Only the timers are used; the rest trap.
+// MPS2 external interrupts 0..31 (CMSDK peripherals; the same numbers on AN385 and AN386), placed
+// right after the common system vectors (boards/common/cortex_m/startup.cpp). Only the timers are
+// used; the rest trap.
 extern "C" {
 void Default_Handler();  // boards/common/cortex_m/startup.cpp: reports and exits
 void Unused_Irq_Handler() { Default_Handler(); }

@@ -1,4 +1,4 @@
-// A HAL for the standalone mps2-an386 images that run the control task in the real 1 kHz TIMER0
+// A HAL for the standalone MPS2 images that run the control task in the real 1 kHz TIMER0
 // interrupt without a plant: the encoders held at the start pose (joint 1 offset by `jump` counts,
 // to inject an encoder jump), the DAC codes kept in memory, the overrun seen as the next timer
 // interrupt already pending when a tick starts.

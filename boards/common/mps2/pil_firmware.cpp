@@ -1,4 +1,5 @@
-// The processor-in-the-loop firmware for mps2-an386: UART0 carries the link (osc/link/frames.hpp)
+// The processor-in-the-loop firmware for the MPS2 boards, in the board's scalar (board::Scalar: float
+// on the AN386's Cortex-M4F, Q12.19 fixed point on the AN385's Cortex-M3): UART0 carries the link (osc/link/frames.hpp)
 // to the simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector) runs the control
 // task; here it is pended whenever a frame ends (valid or not), so the host's plant sets the sample
 // clock (lockstep) and the run is deterministic under -icount. Every link error is answered at once
@@ -31,9 +32,9 @@ struct Mps2Board {
   static void fault_output(bool active) { board::fault_output(active); }
 };
 static_assert(osc::PilBoard<Mps2Board>);
-static_assert(hal::ControlHal<osc::PilNode<float, Mps2Board>>);
+static_assert(hal::ControlHal<osc::PilNode<board::Scalar, Mps2Board>>);
 
-osc::PilNode<float, Mps2Board> g_node;  // a few kB: static, never on the stack
+osc::PilNode<board::Scalar, Mps2Board> g_node;  // a few kB: static, never on the stack
 
 /// Overrun budget: one control period in virtual ns (= instructions under -icount shift=0).
 constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;
@@ -66,7 +67,7 @@ extern "C" void NMI_Handler() {
 int main() {
   board::cycle_counter_init();
   board::uart_init();
-  g_node.init(osc::joint_vector<float>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
+  g_node.init(osc::joint_vector<board::Scalar>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
   g_node.hello();  // bytes the host sent before this point may have been dropped
   // The main loop polls the UART (under -icount, polling makes virtual time advance with the

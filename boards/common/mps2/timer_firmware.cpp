@@ -20,7 +20,7 @@ using board::StillHal;
 constexpr int kTicks = 200;
 constexpr std::uint32_t kPeriodNs = 1000000000u / board::kControlHz;
 
-osc::ControlTask<float> g_task;
+osc::ControlTask<board::Scalar> g_task;
 StillHal g_hal;
 volatile int g_ticks = 0;
 volatile int g_feeds = 0;
@@ -53,8 +53,8 @@ extern "C" void NMI_Handler() {
 int main() {
   board::cycle_counter_init();
   const cortex_m::ResetCause cause = board::reset_cause();
-  g_task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
-              osc::joint_vector<float>(osc::robot::kQStart), kPeriodNs);
+  g_task.init(osc::Model<board::Scalar>::of(osc::robot::kArm), osc::Gains<board::Scalar>::paper(),
+              osc::FrictionMode::kAdaptive, osc::joint_vector<board::Scalar>(osc::robot::kQStart), kPeriodNs);
   board::watchdog_start();
   board::control_timer_start(board::kControlHz);
   while (g_ticks < kTicks) {

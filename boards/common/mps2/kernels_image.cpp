@@ -1,0 +1,222 @@
+// Exercises every kernel in the board's scalar (board::Scalar: float on the M4F's FPU, Q12.19 fixed
+// point on the M3, or float in soft-float routines on the M3 for comparison), checks them against
+// the published PUMA 560 vectors, and reports the instructions each takes (QEMU -icount shift=0).
+// In fixed point it also compares every kernel with the host's results bit for bit
+// (tests/fixed_reference.hpp) and requires the arithmetic flag clear. Exit status 0 = pass.
+#include <cstdint>
+
+#include "board.hpp"
+#include "osc/runtime/control_task.hpp"
+#include "fixed_reference.hpp"
+#include "osc/robot.hpp"
+#include "text.hpp"
+
+namespace {
+
+using namespace osc;
+using F = board::Scalar;
+constexpr bool kFixed = fixed::is_q_v<F>;
+
+int g_failures = 0;
+
+template <class T>
+double d(T v) { return static_cast<double>(v); }
+
+void check(const char* what, double got, double want, double tol) {
+  const double err = got > want ? got - want : want - got;
+  if (!(err <= tol)) {
+    cortex_m::text::Line().str("FAIL ").str(what).str(" got ").fix(static_cast<float>(got), 5).str(" want ")
+        .fix(static_cast<float>(want), 5).emit();
+    ++g_failures;
+  }
+}
+
+struct Timer {
+  const char* name;
+  std::uint32_t t0 = board::cycles();
+  explicit Timer(const char* n) : name(n) {}
+  ~Timer() {
+    const std::uint32_t dt = board::cycles() - t0;
+    cortex_m::text::Line().str("  ").str(name).str(": ").u32(dt).str(" instructions").emit();
+  }
+};
+
+// Kept out of the stack: Data, OpSpace and the controller state are a few kB each.
+Model<F> g_model;
+Data<F> g_data;
+OpSpace<F> g_os;
+ControllerState<F> g_state;
+
+}  // namespace
+
+int main() {
+  board::cycle_counter_init();
+  cortex_m::text::Line().str("kernels_image: PUMA 560 kernels in ").str(board::kScalarName).str(" on ").str(board::kCore)
+      .emit();
+  g_model = Model<F>::of(robot::kArm);
+  const Vec6<F> qn = joint_vector<F>(puma560::kQn), q0 = joint_vector<F>(robot::kQStart);
+  Vec6<F> qd, one;
+  qd << 1, 2, 3, 1, 2, 3;
+  one.setOnes();
+  Vec6<F> g, c, tau;
+  Mat6<F> B;
+  {
+    Timer t("forward_kinematics");
+    forward_kinematics(g_model, g_data, qn);
+  }
+  {
+    Timer t("geometric_jacobian");
+    geometric_jacobian(g_data);
+  }
+  {
+    Timer t("joint_inertia (CRBA)");
+    joint_inertia(g_model, g_data);
+  }
+  {
+    Timer t("gravity_torques");
+    g = gravity_torques(g_model, g_data);
+  }
+  {
+    Timer t("rnea (qd = qdd = 1)");
+    tau = rnea(g_model, g_data, one, one, true).tau;
+  }
+  {
+    Timer t("velocity_products (c, Jdot qd)");
+    c = velocity_products(g_model, g_data, qd).c;
+  }
+  {
+    Timer t("coriolis_matrix (Christoffel)");
+    B = coriolis_matrix(g_model, g_data, qd);
+  }
+  const double tol = 2e-3;
+  check("g2", d(g(1)), 31.6399, tol * 31.6399);
+  check("g3", d(g(2)), 6.0351, tol * 6.0351);
+  check("g5", d(g(4)), 0.0283, 2e-4);
+  const double Mdiag[6] = {3.6594, 4.4137, 0.9378, 0.1925, 0.1713, 0.1941};
+  for (int i = 0; i < 6; ++i) check("M_ii", d(g_data.A(i, i)), Mdiag[i], 1e-3 * Mdiag[i] + 1e-4);
+  // rne(qn, 1, 1) without the toolbox's friction: published value minus that friction.
+  check("B(1,2)", d(B(0, 1)), -2.0494, 2e-3);
+  check("B(2,3)", d(B(1, 2)), 1.9287, 2e-3);
+  check("c = B qd", d((B * qd - c).norm()), 0.0, 1e-3);
+  (void)tau;
+
+  Vec6<F> fr;
+  Regressor<F> W;
+  const FrictionParams<F> fp = FrictionParams<F>::from(robot::kFrictionPaper, 1.0);
+  {
+    Timer t("friction_torque (2)");
+    fr = friction_torque(fp, qd);
+  }
+  {
+    Timer t("friction_regressor (19)");
+    W = friction_regressor(qd, fp.dec);
+  }
+  check("W theta = tau_f", d((W * fp.theta() - fr).norm()), 0.0, 1e-4);
+
+  forward_kinematics(g_model, g_data, q0);
+  const Mat3<F> R_ref = g_data.R[kDof];
+  {
+    Timer t("opspace_update (FK, J, A, g, Ja, LU, LLT, Lambda)");
+    opspace_update(g_model, g_data, g_os, q0, R_ref);
+  }
+  SphericalWristJacobianFactor<F> Jg;
+  Mat6<F> Lg;
+  forward_kinematics(g_model, g_data, qn);
+  geometric_jacobian(g_data);
+  joint_inertia(g_model, g_data);
+  {
+    Timer t("SphericalWristJacobianFactor::compute");
+    Jg.compute(g_data.J);
+  }
+  {
+    Timer t("operational_inertia (Lambda)");
+    Lg = operational_inertia(g_data.A, Jg);
+  }
+  check("Lambda(1,1)", d(Lg(0, 0)), 17.2954, 0.05);
+  check("Lambda(3,3)", d(Lg(2, 2)), 13.3348, 0.05);
+  check("Lambda(6,6)", d(Lg(5, 5)), 0.5791, 2e-3);
+  check("rcond(qn) > 1e-3", d(Jg.rcond) > 1e-3 ? 1.0 : 0.0, 1.0, 0.0);
+
+  opspace_update(g_model, g_data, g_os, q0, R_ref);
+  Vec6<F> v, h, hb, p, f, G, l, jd;
+  v << lit<F>(0.05), lit<F>(-0.02), lit<F>(0.03), lit<F>(0.01), lit<F>(0.02), lit<F>(-0.01);
+  {
+    Timer t("psi_quadratic h(v)");
+    h = psi_quadratic(g_model, g_data, g_os, v);
+  }
+  {
+    Timer t("psi_bilinear Psi(x,y)z");
+    hb = psi_bilinear(g_model, g_data, g_os, v, v);
+  }
+  check("Psi(v)v = h(v)", d((h - hb).norm()), 0.0, 1e-3 * (1 + d(h.norm())));
+  {
+    Timer t("operational_gravity p");
+    p = operational_gravity(g_os);
+  }
+  {
+    Timer t("operational_friction f");
+    f = operational_friction(g_os, fr);
+  }
+  {
+    Timer t("joint_torques J^T F");
+    G = joint_torques(g_os, p);
+  }
+  check("J^T p = g", d((G - g_os.g).norm()), 0.0, 1e-3 * d(g_os.g.norm()));
+  {
+    Timer t("lambda_solve");
+    l = lambda_solve(g_os, v);
+  }
+  check("Lambda Lambda^-1 v = v", d((g_os.Lambda * l - v).norm()), 0.0, 1e-3);
+  {
+    Timer t("analytic_jdot_qd");
+    jd = analytic_jdot_qd(g_model, g_data, g_os, qd);
+  }
+  (void)f;
+
+  // The full control step (observer, controller, adaptation), a few samples.
+  const Gains<F> gains = Gains<F>::paper();
+  controller_init(g_model, g_state, q0);
+  std::uint32_t worst = 0, sum = 0;
+  for (int k = 0; k < 20; ++k) {
+    Vec6<F> q = q0;
+    q(1) += lit<F>(1e-5) * F(k);
+    const std::uint32_t t0 = board::cycles();
+    const StepOutput<F> out = control_step(g_model, gains, FrictionMode::kAdaptive, g_state, q, lit<F>(1e-3) * F(k));
+    const std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst) worst = dt;
+    sum += dt;
+    check("control_step status", static_cast<double>(out.status), 0.0, 0.0);
+  }
+  cortex_m::text::Line().str("  control_step (observer + controller + adaptation), worst of 20: ").u32(worst)
+      .str(", mean ").u32(sum / 20).str(" instructions").emit();
+  check("control_step holds gravity at rest", d((g_state.obs.x_hat - g_os.x).norm()) < 1.0 ? 1.0 : 0.0, 1.0, 0.0);
+
+  if constexpr (kFixed) {
+    // Every kernel against the host's Q12.19 results, bit for bit.
+    int n = 0, mismatches = 0;
+    const int count = static_cast<int>(sizeof(reference::kValues) / sizeof(reference::kValues[0]));
+    auto emit = [&](const char* name, const auto& m) {
+      for (int j = 0; j < m.cols(); ++j)
+        for (int i = 0; i < m.rows(); ++i, ++n) {
+          const std::int32_t want = n < count ? reference::kValues[n] : 0;
+          if (m(i, j).raw() == want) continue;
+          if (++mismatches <= 5)
+            cortex_m::text::Line().str("FAIL reference ").str(name).str(" word ").i32(n).str(": got ").i32(m(i, j).raw())
+                .str(" want ").i32(want).emit();
+        }
+    };
+    fixed::take_flags();
+    for (const reference::Case& rc : reference::kCases) reference::kernel_outputs(rc, g_model, g_data, g_os, emit);
+    reference::step_outputs(g_model, g_state, emit);
+    const std::uint32_t flags = fixed::take_flags();
+    cortex_m::text::Line().str("reference values (host, Q12.19): ").i32(n).str(" words, ").i32(mismatches)
+        .str(" differ; arithmetic flags ").u32(flags).emit();
+    if (n != count) ++g_failures;
+    if (flags != 0) ++g_failures;
+    g_failures += mismatches;
+  }
+
+  cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
+  cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
+  return g_failures ? 1 : 0;
+}

@@ -1,0 +1,62 @@
+# The boards/<board>/CMakeLists.txt of an MPS2 board built from CMSDK parts (mps2-an385, mps2-an386):
+# one call of osc_add_mps2_board(NAME CPU QEMU_MACHINE). The wiring, the interrupt table, the linker
+# script and the images are shared (boards/common/mps2, linker/mps2.ld); the board's own folder has
+# its board.hpp (the core and the scalar of its images, board::Scalar) and this call. Defines the
+# images kernels_image, heap_probe, pil_firmware, timer_firmware and watchdog_firmware with their
+# tests; sets OSC_BOARD_ENABLED in the caller (false when CPU is not this toolchain's).
+set(OSC_MPS2_DIR ${CMAKE_CURRENT_LIST_DIR})
+
+function(osc_add_mps2_board)
+  cmake_parse_arguments(B "" "NAME;CPU;QEMU_MACHINE" "" ${ARGN})
+  osc_add_board(NAME ${B_NAME} CPU ${B_CPU} LINKER_SCRIPT ${PROJECT_SOURCE_DIR}/linker/mps2.ld
+                QEMU_MACHINE ${B_QEMU_MACHINE} SOURCES ${OSC_MPS2_DIR}/vectors.cpp)
+  set(OSC_BOARD_ENABLED ${OSC_BOARD_ENABLED} PARENT_SCOPE)
+  if(NOT OSC_BOARD_ENABLED)
+    return()
+  endif()
+  target_include_directories(board_${B_NAME} PUBLIC ${OSC_MPS2_DIR})
+  target_link_libraries(board_${B_NAME} PUBLIC cmsdk)  # the CMSDK watchdog driver
+
+  # Every kernel in the board's scalar against the published vectors (and, in fixed point, the
+  # host's results bit for bit: tests/fixed_reference.hpp), with per-kernel instruction counts.
+  osc_board_image(${B_NAME} kernels_image ${OSC_MPS2_DIR}/kernels_image.cpp)
+  target_include_directories(kernels_image PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  add_test(NAME kernels_image_qemu COMMAND kernels_image)
+  osc_image_checks(kernels_image)
+
+  # The link-time heap ban: an image that calls malloc must fail to link.
+  osc_board_image(${B_NAME} heap_probe ${OSC_CORTEX_M_DIR}/heap_probe.cpp)
+  set_target_properties(heap_probe PROPERTIES EXCLUDE_FROM_ALL TRUE)
+  add_test(NAME heap_use_fails_link COMMAND ${CMAKE_COMMAND} --build ${CMAKE_BINARY_DIR} --target heap_probe)
+  # Passes only on the linker script's heap assertion (not on any other build failure).
+  set_tests_properties(heap_use_fails_link PROPERTIES PASS_REGULAR_EXPRESSION "heap use is forbidden")
+
+  # Processor-in-the-loop firmware: the control task over the UART0 link to host_sim.
+  osc_board_image(${B_NAME} pil_firmware ${OSC_MPS2_DIR}/pil_firmware.cpp)
+  osc_image_checks(pil_firmware)
+
+  # The control task in the real 1 kHz timer interrupt (no plant).
+  osc_board_image(${B_NAME} timer_firmware ${OSC_MPS2_DIR}/timer_firmware.cpp)
+  add_test(NAME timer_firmware_qemu COMMAND timer_firmware)
+  # The image feeds the watchdog; under -no-reboot a watchdog reset would end QEMU with status 0,
+  # so the test also needs the image's own verdict.
+  set_tests_properties(timer_firmware_qemu PROPERTIES PASS_REGULAR_EXPRESSION "timer_firmware: pass")
+
+  # The watchdog end to end: healthy ticks feed it; a hung tick, a latched fault and a disabled
+  # control interrupt each let it reset the board (QEMU reboots the image; a record in .noinit RAM
+  # carries the scenario across the resets).
+  osc_board_image(${B_NAME} watchdog_firmware ${OSC_MPS2_DIR}/watchdog_firmware.cpp)
+  osc_add_reboot_test(watchdog_reset_qemu watchdog_firmware)
+  set_tests_properties(watchdog_reset_qemu PROPERTIES PASS_REGULAR_EXPRESSION "watchdog_firmware: pass")
+endfunction()
+
+# osc_add_pil_test(NAME SCALAR [ARGS...]): the host's PIL tests (build/host/tests/test_pil, so the
+# host preset must be built first; scripts/test.sh does) against this build's pil_firmware in QEMU:
+# fault injection through the link and the closed loop against the host-built controller in SCALAR
+# (float or fixed).
+function(osc_add_pil_test name scalar)
+  add_test(NAME ${name} COMMAND ${PROJECT_SOURCE_DIR}/build/host/tests/test_pil ${ARGN})
+  set_tests_properties(${name} PROPERTIES
+    ENVIRONMENT "PIL_FIRMWARE_ELF=$<TARGET_FILE:pil_firmware>;QEMU=${QEMU_SYSTEM_ARM};PIL_SCALAR=${scalar}"
+    DEPENDS pil_firmware_checks TIMEOUT 900)
+endfunction()

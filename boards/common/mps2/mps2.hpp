@@ -1,0 +1,149 @@
+// What every QEMU MPS2 board built from Arm's CMSDK parts shares (mps2-an385: Cortex-M3;
+// mps2-an386: Cortex-M4F): the 25 MHz system clock, the memory map (linker/mps2.ld), the CMSDK APB
+// UARTs, timers and watchdog at the same addresses, the same interrupt numbers (vectors.cpp). One
+// header of wiring over the shared Cortex-M code (boards/common/cortex_m): clock, register blocks,
+// drivers as static functions; no virtual calls, no heap. A board's board.hpp includes it and adds
+// what differs: its core and the scalar its images compute in (board::Scalar).
+//
+// Under QEMU with -icount shift=0 one instruction takes 1 ns of virtual time and the 25 MHz
+// peripherals tick every 40 instructions; Board::cycles() therefore counts instructions, with a
+// resolution of 40.
+//
+// UARTs: the n-th -serial option of QEMU is UART n (UART0 at 0x40004000 is the first).
+#pragma once
+
+#include <cstdint>
+
+#include "cmsdk_watchdog.hpp"
+#include "cortex_m.hpp"
+#include "osc/control/params.hpp"
+
+namespace board {
+
+constexpr std::uint32_t kSysClockHz = 25000000;
+/// The control rate is the controller's (one source: osc::params::kControlHz).
+constexpr std::uint32_t kControlHz = osc::params::kControlHz;
+static_assert(kSysClockHz % kControlHz == 0, "the control timer divides the clock exactly");
+/// Virtual-time nanoseconds (= instructions under -icount shift=0) per processor clock cycle.
+constexpr std::uint32_t kNsPerTick = 1000000000u / kSysClockHz;
+
+namespace semihost = cortex_m::semihost;
+
+struct CmsdkUart {
+  volatile std::uint32_t DATA, STATE, CTRL, INTSTATUS, BAUDDIV;
+  static constexpr std::uint32_t kTxFull = 1u << 0, kRxFull = 1u << 1;
+  static constexpr std::uint32_t kTxEnable = 1u << 0, kRxEnable = 1u << 1;
+};
+struct CmsdkTimer {
+  volatile std::uint32_t CTRL, VALUE, RELOAD, INTSTATUS;
+  static constexpr std::uint32_t kEnable = 1u << 0, kIrqEnable = 1u << 3;
+};
+
+inline CmsdkUart& uart0() { return *reinterpret_cast<CmsdkUart*>(0x40004000u); }
+inline CmsdkTimer& timer0() { return *reinterpret_cast<CmsdkTimer*>(0x40000000u); }
+
+constexpr int kTimer0Irq = 8;
+
+// ---------------------------------------------------------------- UART0 (polling)
+inline void uart_init() {
+  uart0().BAUDDIV = 16;  // QEMU does not model the baud rate but wants a valid divider
+  uart0().CTRL = CmsdkUart::kTxEnable | CmsdkUart::kRxEnable;
+}
+inline void uart_write(const std::uint8_t* p, int n) {
+  for (int i = 0; i < n; ++i) {
+    while (uart0().STATE & CmsdkUart::kTxFull) {
+    }
+    uart0().DATA = p[i];
+  }
+}
+inline bool uart_rx_ready() { return (uart0().STATE & CmsdkUart::kRxFull) != 0; }
+inline std::uint8_t uart_read() { return static_cast<std::uint8_t>(uart0().DATA); }
+
+// ---------------------------------------------------------------- timing
+/// Starts the cycle counter (SysTick, free-running).
+inline void cycle_counter_init() { cortex_m::systick_free_run(); }
+/// Monotonic virtual nanoseconds (instructions under -icount shift=0).
+/// Must be called at least every 0.67 s to follow the 24-bit SysTick wrap.
+inline std::uint32_t cycles() { return cortex_m::systick_cycles() * kNsPerTick; }
+inline void busy_wait(std::uint32_t ns) {
+  const std::uint32_t t0 = cycles();
+  while (cycles() - t0 < ns) {
+  }
+}
+
+// ---------------------------------------------------------------- control timer (TIMER0, IRQ 8)
+/// Periodic TIMER0 interrupt at hz.
+inline void control_timer_start(std::uint32_t hz) {
+  timer0().CTRL = 0;
+  timer0().RELOAD = kSysClockHz / hz - 1;
+  timer0().VALUE = kSysClockHz / hz - 1;
+  timer0().INTSTATUS = 1;
+  timer0().CTRL = CmsdkTimer::kEnable | CmsdkTimer::kIrqEnable;
+  cortex_m::irq_enable(kTimer0Irq);
+}
+/// Enables the control interrupt without the hardware timer: software pends it (PIL mode).
+inline void control_irq_enable() { cortex_m::irq_enable(kTimer0Irq); }
+/// Pends the control interrupt: it is taken right after this call.
+inline void control_irq_pend() { cortex_m::irq_pend(kTimer0Irq); }
+inline void control_timer_ack() { timer0().INTSTATUS = 1; }
+inline bool control_timer_pending() { return (timer0().INTSTATUS & 1u) != 0; }
+/// Stops the control interrupt (NVIC): no tick is taken after this call.
+inline void control_irq_disable() { cortex_m::irq_disable(kTimer0Irq); }
+
+// ---------------------------------------------------------------- fault line
+/// QEMU's MPS2 boards model no free output pin for an interlock; the binding keeps the level here
+/// (a real board drives its amplifier-enable line). The link frames carry the state to the host.
+inline volatile bool g_fault_line = false;
+inline void fault_output(bool active) { g_fault_line = active; }
+
+// ---------------------------------------------------------------- watchdog (CMSDK APB watchdog)
+// At 0x40008000 on WDOGCLK = the 25 MHz system clock; its interrupt is the NMI (AN385 and AN386;
+// QEMU's hw/arm/mps2.c wires it the same way on every MPS2 machine). The reset output resets the whole board.
+using Watchdog = cmsdk::Watchdog<0x40008000u>;
+/// The first expiry (the NMI) comes kWatchdogPeriods control periods after the last feed, the
+/// reset as many again after it: a healthy tick feeds every period, so three late or missing feeds
+/// are tolerated, a stale torque command is held for at most 4 ms before the NMI drops the fault
+/// line, and the board resets 8 ms after the last healthy tick (docs/firmware.md, "Watchdog").
+constexpr std::uint32_t kWatchdogPeriods = 4;
+constexpr std::uint32_t kWatchdogExpiryNs = kWatchdogPeriods * (1000000000u / kControlHz);
+constexpr std::uint32_t kWatchdogLoad = cmsdk::watchdog_load(kSysClockHz, kWatchdogExpiryNs / 1000u);
+static_assert(kWatchdogLoad == 100000u, "4 ms at 25 MHz");
+
+/// Starts the watchdog (counting from a full timeout).
+inline void watchdog_start() { Watchdog::start(kWatchdogLoad); }
+/// Restarts the count. Call only at the end of a healthy tick (osc::supervisor_healthy), or
+/// where an image documents another rule (pil_firmware.cpp).
+inline void watchdog_feed() { Watchdog::feed(); }
+/// Stops the watchdog (test images, once their run is over).
+inline void watchdog_stop() { Watchdog::stop(); }
+/// The board's reaction to the first expiry, for the image's NMI_Handler: the fault line goes
+/// active (on a real board: amplifier enable off, so no stale torque stays applied) and the reset
+/// record notes that the reset to come is the watchdog's, with `faults` (the supervisor's latched
+/// bits). The image then waits for the reset (await_reset()).
+inline void watchdog_expired(std::uint32_t faults) {
+  fault_output(true);
+  cortex_m::note_watchdog_expiry(faults);
+}
+/// Waits for the watchdog's reset (one timeout after its first expiry).
+[[noreturn]] inline void await_reset() {
+  for (;;) {
+  }
+}
+
+// ---------------------------------------------------------------- reset cause
+/// The board has no reset-cause register (nor does QEMU's model); the cause comes from the reset
+/// record in .noinit RAM (cortex_m.hpp).
+inline cortex_m::ResetCause reset_cause() { return cortex_m::reset_cause(); }
+inline const char* reset_cause_name(cortex_m::ResetCause c) {
+  switch (c) {
+    case cortex_m::ResetCause::kPowerOn: return "power-on";
+    case cortex_m::ResetCause::kWatchdog: return "watchdog";
+    case cortex_m::ResetCause::kOther: return "other";
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------- stack
+inline std::uint32_t stack_used() { return cortex_m::stack_used(); }
+
+}  // namespace board
