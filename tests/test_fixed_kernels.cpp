@@ -17,11 +17,12 @@
 // Budgets: absolute, in the kernel's units, the largest error over every entry, about twice the
 // worst error measured (printed). The Q12.19 resolution (1.9e-6) explains them: FK and J are sums of
 // a few rounded products of lengths < 1 m (a few LSB); A, g, c accumulate through the six links
-// (tens of LSB times the masses and lengths); Lambda, p and Psi add two solves with the 3x3 blocks of
-// J (8e-5 of the largest entry). The control step's torque amplifies the few-LSB error of x through
-// the gains (k (k_s + k_nd) + k_s Lambda k, about 3e5 N/m at Lambda = 30): a torque error of up to a
-// few N m, which is at most half of what one encoder count (50 um at the tip) does to the same
-// controller in double at the same state (that relative budget is checked state by state).
+// (tens of LSB times the masses and lengths); Lambda, p and Psi multiply by the inverses of the 3x3
+// blocks of J, whose cofactors are rounded before the division by det (3.5e-4 of the largest entry).
+// The control step's torque amplifies the few-LSB error of x through the gains (k (k_s + k_nd) +
+// k_s Lambda k, about 3e5 N/m at Lambda = 30): a torque error of up to a few N m, which is at most
+// half of what one encoder count (50 um at the tip) does to the same controller in double at the
+// same state (that relative budget is checked state by state).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -45,19 +46,19 @@ constexpr double kDomainRcond = 0.1;
 constexpr double kOutsideRelative = 2e-2;
 
 // The budgets (absolute; units of each kernel).
-constexpr double kBudgetPosition = 1.2e-5;     // FK: frame-6 origin [m]
-constexpr double kBudgetRotation = 1.4e-5;     // FK: R6 entries [1]
-constexpr double kBudgetPhi = 1.4e-5;          // FK: orientation coordinates [rad] (atan2, asin)
-constexpr double kBudgetJacobian = 1.4e-5;     // J, geometric [m/rad, 1]
-constexpr double kBudgetInertia = 1.6e-4;      // A [kg m^2]
-constexpr double kBudgetGravity = 2e-3;      // g [N m]
-constexpr double kBudgetVelocity = 1.4e-4;     // c [N m], |qd_i| <= 1 rad/s
-constexpr double kBudgetLambda = 8e-2;       // Lambda [kg, kg m, kg m^2]
-constexpr double kBudgetOpGravity = 1.2e-2;    // p [N, N m]
-constexpr double kBudgetPsi = 5e-2;          // h(v) = Psi(x, v) v [N, N m], |v| <= 0.2
-constexpr double kBudgetRegressor = 4e-6;    // W_j [rad/s, 1]
-constexpr double kBudgetTau = 3.0;           // control_step tau [N m]
-constexpr double kBudgetTauPerCount = 0.5;  // ... and at most this fraction of one encoder count's effect
+constexpr double kBudgetPosition = 1.2e-5;    // FK: frame-6 origin [m]
+constexpr double kBudgetRotation = 1.4e-5;    // FK: R6 entries [1]
+constexpr double kBudgetPhi = 1.4e-5;         // FK: orientation coordinates [rad] (atan2, asin)
+constexpr double kBudgetJacobian = 1.4e-5;    // J, geometric [m/rad, 1]
+constexpr double kBudgetInertia = 1.6e-4;     // A [kg m^2]
+constexpr double kBudgetGravity = 2e-3;       // g [N m]
+constexpr double kBudgetVelocity = 1.4e-4;    // c [N m], |qd_i| <= 1 rad/s
+constexpr double kBudgetLambda = 0.3;         // Lambda [kg, kg m, kg m^2]
+constexpr double kBudgetOpGravity = 3e-2;     // p [N, N m]
+constexpr double kBudgetPsi = 0.12;           // h(v) = Psi(x, v) v [N, N m], |v| <= 0.2
+constexpr double kBudgetRegressor = 4e-6;     // W_j [rad/s, 1]
+constexpr double kBudgetTau = 3.0;            // control_step tau [N m]
+constexpr double kBudgetTauPerCount = 0.5;    // ... and at most this fraction of one encoder count's effect
 
 /// Largest absolute difference between a fixed-point and a double Eigen object.
 template <class A, class B>
