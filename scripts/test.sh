@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Sets up, builds and runs every test: host (kernels, simulator, experiment), the Cortex-M4F
-# cross build (image checks and firmware tests under QEMU), and the sanitizer build (the host tests
-# under ASan + UBSan, and each libFuzzer target for a fixed time: docs/fuzzing.md).
+# Sets up, builds and runs every test: host (kernels, simulator, experiment), the Cortex-M4F and
+# Cortex-M3 cross builds (image checks and firmware tests under QEMU; the M3 runs the fixed-point
+# controller), and the sanitizer build (the host tests under ASan + UBSan, and each libFuzzer target
+# for a fixed time: docs/fuzzing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -9,9 +10,11 @@ cmake --preset host >/dev/null
 cmake --build --preset host
 ctest --preset host
 if [ -f boards/CMakeLists.txt ]; then
-  cmake --preset m4f >/dev/null
-  cmake --build --preset m4f
-  ctest --preset m4f
+  for preset in m4f m3; do
+    cmake --preset $preset >/dev/null
+    cmake --build --preset $preset
+    ctest --preset $preset
+  done
 fi
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz

@@ -1,5 +1,6 @@
-// Google Benchmark: every kernel in double and float, the full control step, the plant, and KDL
-// computing the same quantities. Not a test: run build/host/tests/osc_bench.
+// Google Benchmark: every kernel in double, float and Q12.19 fixed point (osc::Fixed), the full
+// control step, the plant, and KDL computing the same quantities. Not a test: run
+// build/host/tests/osc_bench.
 #include <benchmark/benchmark.h>
 
 #include <kdl/chaindynparam.hpp>
@@ -107,7 +108,8 @@ template <class S> void BM_control_step(benchmark::State& st) {
 
 #define OSC_BENCH(name) \
   BENCHMARK_TEMPLATE(name, double); \
-  BENCHMARK_TEMPLATE(name, float)
+  BENCHMARK_TEMPLATE(name, float); \
+  BENCHMARK_TEMPLATE(name, Fixed)
 OSC_BENCH(BM_forward_kinematics);
 OSC_BENCH(BM_geometric_jacobian);
 OSC_BENCH(BM_joint_inertia);

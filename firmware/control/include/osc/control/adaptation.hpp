@@ -16,9 +16,8 @@
 //   - projection onto 0 <= theta^ <= theta_max per coefficient (K_ad is diagonal, so clipping is the
 //     exact projection in the K_ad^-1 metric and never makes the Lyapunov function grow).
 // Everything is +, *, compare (and the regressor's exp and sgn): it runs in float, double and fixed
-// point alike. The products are ordered for fixed point: K_ad Dq before the regressor (Dq is a few
-// quantisation steps, W_j^T Dq alone would be one or two LSB), sigma (dt theta^) rather than
-// (sigma dt) theta^ (sigma dt = 1e-6 is half an LSB of Q12.19).
+// point alike. The leakage is applied as sigma (dt theta^), not (sigma dt) theta^: sigma dt = 1e-6
+// is half an LSB of Q12.19 and would round to twice the rate.
 #pragma once
 
 #include "osc/control/gains.hpp"
@@ -48,7 +47,7 @@ Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Ve
 template <class S>
 Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   const Vec6<S> Dq = increment_error(G, a, q);
-  return a.theta_hat - friction_regressor(a.qd_hat_prev, G.tau_dec).transpose() * (G.kad * Dq);
+  return a.theta_hat - G.kad * (friction_regressor(a.qd_hat_prev, G.tau_dec).transpose() * Dq);
 }
 
 /// The robust law: (67)'s error Dq, the regressor at q^dot(t-2dt), leakage, projection.
@@ -56,7 +55,7 @@ template <class S>
 Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   const Vec6<S> Dq = increment_error(G, a, q);
   Vec18<S> theta = a.theta_hat - G.leakage * (G.dt * a.theta_hat);
-  theta -= friction_regressor(a.qd_hat_prev2, G.tau_dec).transpose() * (G.kad * Dq);
+  theta -= G.kad * (friction_regressor(a.qd_hat_prev2, G.tau_dec).transpose() * Dq);
   for (int i = 0; i < 3 * kDof; ++i) {
     if (theta(i) < S(0)) theta(i) = S(0);
     if (theta(i) > G.theta_max(i)) theta(i) = G.theta_max(i);
