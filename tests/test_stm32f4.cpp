@@ -121,7 +121,7 @@ TEST(Stm32Clock, ReachesThePllAt168MHzWithFiveWaitStates) {
 
 TEST(Stm32Clock, EveryBootFaultHasAName) {
   for (BootFault b : {BootFault::kHseTimeout, BootFault::kPllTimeout, BootFault::kFlashLatency,
-                      BootFault::kSwitchTimeout, BootFault::kWatchdogSetup})
+                      BootFault::kSwitchTimeout, BootFault::kWatchdogSetup, BootFault::kDacSetup})
     EXPECT_STRNE(boot_fault_name(b), "?");
 }
 

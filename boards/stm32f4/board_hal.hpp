@@ -54,12 +54,14 @@ class BoardHal {
   }
 
   /// One control tick: the control task, then the amplifier enable (on only in kRun with torque
-  /// permitted and no E-stop) and the fault LED, then the watchdog, fed only when the supervisor is
-  /// healthy (osc::supervisor_healthy). Returns the faults detected in the tick.
+  /// permitted and no E-stop) and the fault LED (a latched fault or a boot fault), then the watchdog,
+  /// fed only when the supervisor is healthy (osc::supervisor_healthy). Returns the faults detected
+  /// in the tick.
   template <class S>
   std::uint32_t tick(osc::ControlTask<S>& task) {
     const std::uint32_t faults = osc::control_tick(task, *this);
-    safety_.set_outputs(permitted_ && osc::torque_enabled(task.sup), task.sup.state == osc::SupervisorState::kFault);
+    safety_.set_outputs(permitted_ && osc::torque_enabled(task.sup),
+                        task.sup.state == osc::SupervisorState::kFault || !permitted_);
     if (osc::supervisor_healthy(task.sup)) {
       safety_.watchdog_feed();
       ++feeds_;

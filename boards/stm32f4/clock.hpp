@@ -23,6 +23,7 @@ enum class BootFault : std::uint8_t {
   kFlashLatency,   ///< the flash did not take the wait states (ACR read back)
   kSwitchTimeout,  ///< the system clock never switched to the PLL (SWS)
   kWatchdogSetup,  ///< the independent watchdog never took its prescaler and reload (IWDG_SR)
+  kDacSetup,       ///< a DAC set-up frame did not complete on the SPI bus
 };
 constexpr const char* boot_fault_name(BootFault f) {
   switch (f) {
@@ -32,6 +33,7 @@ constexpr const char* boot_fault_name(BootFault f) {
     case BootFault::kFlashLatency: return "flash_latency";
     case BootFault::kSwitchTimeout: return "clock_switch_timeout";
     case BootFault::kWatchdogSetup: return "watchdog_setup";
+    case BootFault::kDacSetup: return "dac_setup";
   }
   return "?";
 }

@@ -18,15 +18,24 @@ constexpr TimerDivider control_divider(std::uint32_t timer_clock_hz, std::uint32
   return {timer_clock_hz / 1000000u - 1u, 1000000u / hz - 1u};
 }
 static_assert(control_divider(84000000, 1000).psc == 83 && control_divider(84000000, 1000).arr == 999, "1 kHz");
+/// No prescaler, the reload counts the timer clock itself: for a 32-bit timer (TIM2, TIM5).
+constexpr TimerDivider control_divider_32bit(std::uint32_t timer_clock_hz, std::uint32_t hz) {
+  return {0, timer_clock_hz / hz - 1u};
+}
 
+/// Starts the periodic update interrupt. A prescaler other than 0 is loaded at once by an update
+/// event (UG; the prescaler register is buffered), with the counter restarted from 0; with prescaler
+/// 0 neither is needed (both are at their reset values), and neither is written.
 inline void control_timer_start(TimRegs& t, TimerDivider d) {
   t.CR1 = 0;
   t.DIER = 0;
   t.PSC = d.psc;
   t.ARR = d.arr;
   t.CR1 = TimRegs::kUrs;
-  t.EGR = TimRegs::kUg;  // loads PSC and ARR now
-  t.CNT = 0;
+  if (d.psc != 0) {
+    t.EGR = TimRegs::kUg;
+    t.CNT = 0;
+  }
   t.SR = 0;
   t.DIER = TimRegs::kUie;
   t.CR1 = TimRegs::kUrs | TimRegs::kCen;
