@@ -439,6 +439,15 @@ TEST(Stm32Board, AnEstopDuringTheBurstClearsTheOutputs) {
   EXPECT_EQ(dac.clears, 1) << "CLR pulsed: the codes of that burst never reach the joints";
 }
 
+TEST(Stm32Board, TheSafeStateBeforeInitIsHarmless) {
+  // A fault handler may run before the drivers are set up: nothing to switch yet, and no crash.
+  Safety safety;
+  SpiDacBus bus;
+  safety.force_safe();
+  bus.clear_pulse();
+  EXPECT_FALSE(safety.amplifier_enabled());
+}
+
 TEST(Stm32Board, TheWatchdogIsFedOnlyByHealthyTicks) {
   BoardRig r;
   EXPECT_EQ(r.safety.watchdog_start(), BootFault::kNone);

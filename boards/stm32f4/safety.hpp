@@ -73,9 +73,11 @@ class Safety {
   /// The E-stop as the control task's fault bit.
   std::uint32_t io_faults() { return estop() ? static_cast<std::uint32_t>(osc::kFaultEstop) : 0u; }
 
-  /// Amplifier off, fault LED on. Register writes only: callable from any interrupt or fault handler.
+  /// Amplifier off, fault LED on. Register writes only: callable from any interrupt or fault handler
+  /// (before init() there is nothing to switch off: the pin is still an input, held low externally).
   void force_safe() {
     amplifier_ = false;
+    if (chip_.exti == nullptr) return;
     write(pins::kAmpEnable, false);
     write(pins::kFaultLed, true);
   }

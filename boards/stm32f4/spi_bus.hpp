@@ -65,7 +65,10 @@ class SpiDacBus {
   /// LDAC low for at least the part's minimum pulse width (20 ns: the write and two read-backs of
   /// the port take longer at 168 MHz), then high.
   void ldac_pulse() { pulse(*ldac_, pins::kDacLdac.pin.n); }
-  void clear_pulse() { pulse(*clr_, pins::kDacClr.pin.n); }
+  /// CLR low then high (a no-op before init(): a fault handler may call it that early).
+  void clear_pulse() {
+    if (clr_ != nullptr) pulse(*clr_, pins::kDacClr.pin.n);
+  }
   /// Frames that failed since start.
   std::uint32_t errors() const { return errors_; }
 
