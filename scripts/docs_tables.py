@@ -104,11 +104,14 @@ QEMU = ["qemu-system-arm", "-M", "mps2-an386", "-display", "none", "-monitor", "
 _images = {}
 
 
-def image_output(image):
-    """What an mps2-an386 image prints when it runs in QEMU (cached)."""
+def image_output(image, board="mps2_an386", machine="mps2-an386"):
+    """What an image prints when it runs in its board's QEMU (cached)."""
     if image not in _images:
-        elf = os.path.join(M4F, "boards/mps2_an386", image + ".elf")
-        p = subprocess.run(["timeout", "120", *QEMU, elf], capture_output=True, text=True)
+        elf = os.path.join(M4F, "boards", board, image + ".elf")
+        qemu = [a if a != "mps2-an386" else machine for a in QEMU]
+        if board == "stm32f4":  # its USART2 (the second serial port) carries the telemetry frames
+            qemu = qemu[:-1] + ["-serial", "null", "-kernel"]
+        p = subprocess.run(["timeout", "120", *qemu, elf], capture_output=True, text=True)
         if p.returncode != 0:
             raise RuntimeError(f"{image} failed in QEMU ({p.returncode}):\n{p.stdout[-3000:]}{p.stderr[-2000:]}")
         _images[image] = p.stdout + p.stderr  # semihosting output goes to QEMU's stderr
@@ -229,9 +232,9 @@ IMAGES = [("kernels_image", "every kernel in float, checked against the publishe
           ("watchdog_firmware", "the watchdog's resets (hung tick, latched fault, control interrupt off)")]
 
 
-def image_size(image):
+def image_size(image, board="mps2_an386"):
     out = subprocess.run([os.path.join(ROOT, "boards/common/cortex_m/check_image.sh"),
-                          os.path.join(M4F, "boards/mps2_an386", image + ".elf")], capture_output=True, text=True)
+                          os.path.join(M4F, "boards", board, image + ".elf")], capture_output=True, text=True)
     m = re.search(r"flash \(text\+data\): (\d+) bytes; RAM: .* = (\d+) bytes", out.stdout)
     if not m:
         raise RuntimeError(f"check_image.sh {image}: {out.stdout}{out.stderr}")
@@ -250,6 +253,18 @@ def firmware_images():
         flash, ram = image_size(image)
         s = f"{thousands(stack[image])} B" if stack.get(image) else ""
         lines.append(f"| `{image}` | {what} | {thousands(flash)} B | {thousands(ram)} B | {s} |")
+    return "\n".join(lines)
+
+
+@table("stm32f4_images", "docs/stm32f4.md", "m4f")
+def stm32f4_images():
+    m = re.search(r"stack used (\d+) bytes", image_output("stm32f4_qemu", "stm32f4", "netduinoplus2"))
+    lines = ["| image | flash | RAM (data + bss + .noinit + 16 KiB stack) | stack high-water |", "|---|---|---|---|"]
+    for image, note in (("stm32f4_firmware", ""), ("stm32f4_qemu", "")):
+        flash, ram = image_size(image, "stm32f4")
+        stack = f"{thousands(int(m.group(1)))} B (300 ticks in QEMU)" if m and image == "stm32f4_qemu" else ""
+        lines.append(f"| `{image}` | {thousands(flash)} B ({100 * flash / 1048576:.0f} % of 1 MiB) | "
+                     f"{thousands(ram)} B ({100 * ram / 131072:.0f} % of 128 KiB) | {stack} |")
     return "\n".join(lines)
 
 
