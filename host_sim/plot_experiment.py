@@ -223,11 +223,12 @@ def plot_windows(out, summary, runs):
         w = r["window_s"]
         t = [w * (k + 1) for k in range(len(r["window_max_error"]))]
         c = MODE_COLOR[r["mode"]]
+        mk = "o" if len(t) < 30 else None  # a few windows: points, not a trend
         for i, ls in zip(range(3), ("-", "--", ":")):
-            axs[0].semilogy(t, [m[i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c,
+            axs[0].semilogy(t, [m[i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c, marker=mk, ms=3,
                             label=f"{r['mode']} e_{'xyz'[i]}")
-            axs[1].semilogy(t, [m[3 + i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c,
-                            label=f"{r['mode']} e_φ{'xyz'[i]}")
+            axs[1].semilogy(t, [m[3 + i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c, marker=mk,
+                            ms=3, label=f"{r['mode']} e_φ{'xyz'[i]}")
         if r["mode"] == "adaptive":
             axs[2].plot(t, [m[0] for m in r["window_theta_range"]], color=c, lw=0.9, label="smallest θ̂")
             axs[2].plot(t, [m[1] for m in r["window_theta_range"]], color=c, lw=0.9, ls="--", label="largest θ̂")
