@@ -58,6 +58,7 @@ class LocalController {
   void finish(ExperimentResult& res) {
     for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck_peak(i));
     for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck_dtau_peak(i));
+    for (int i = 0; i < 6; ++i) res.stuck_dtau_silent_peak[i] = static_cast<double>(task_->stuck_dtau_gated_peak(i));
   }
 
  private:

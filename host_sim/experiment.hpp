@@ -122,7 +122,8 @@ struct ExperimentResult {
   double friction_rms_error = 0;     // rms of tau_f_hat - tau_f over the last window [N m]
   double friction_rms = 0;           // rms of tau_f over the last window [N m]
   double stuck_peak[6] = {};
-  double stuck_dtau_peak[6] = {};          // the stuck-encoder monitor's largest value per joint [counts] (in process)
+  double stuck_dtau_peak[6] = {};          // the stuck-encoder monitor's largest torque change [N m] (in process)
+  double stuck_dtau_silent_peak[6] = {};   // ... while the encoder was also silent (kStuckTorqueSilent) [N m]
   std::uint32_t status = 0;          // first fault bits reported (0: none)
   double fault_time = -1;            // [s] of the first fault (-1: none)
   FaultState fault;                  // where and how the first fault latched

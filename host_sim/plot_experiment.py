@@ -149,18 +149,24 @@ def plot_tracking(out, summary, runs):
         axs[i][1].axhline(t3[i], ls=":", **style)
         for j in range(2):
             mark_faults(axs[i][j], runs, label=(i == 0 and j == 0))
-    fit_limits(axs.flat)
-    axs[0][0].set_title("whole run")
-    axs[0][1].set_title("|e|, log scale (black: paper Table I --, III ··)")
     fw = runs[0][0]["final_window_s"]
-    axs[0][2].set_title(f"last {fw:g} s" + ("" if paper else " (paper bounds: its set-up, not this one)"))
-    axs[0][0].legend(loc="upper right", fontsize=7)
     axs[0][2].legend(loc="upper right", fontsize=7)
-    for j in range(3):
+    return finish_grid(fig, axs, ["whole run", "|e|, log scale (black: paper Table I --, III ··)",
+                                  f"last {fw:g} s" + ("" if paper else " (paper bounds: its set-up, not this one)")],
+                       title(summary, runs, "Tracking errors of the simulated PUMA 560 (cf. the paper's Fig. 1)"),
+                       out, "fig1_tracking_errors.png")
+
+
+def finish_grid(fig, axs, column_titles, suptitle, out, name):
+    """Common end of the per-axis grids: limits, column titles, legend, labels, title, file."""
+    fit_limits(axs.flat)
+    for j, t in enumerate(column_titles):
+        axs[0][j].set_title(t)
         axs[-1][j].set_xlabel("t [s]")
-    fig.suptitle(title(summary, runs, "Tracking errors of the simulated PUMA 560 (cf. the paper's Fig. 1)"), fontsize=10)
+    axs[0][0].legend(loc="upper right", fontsize=7)
+    fig.suptitle(suptitle, fontsize=10)
     fig.tight_layout()
-    return save(fig, out, "fig1_tracking_errors.png")
+    return save(fig, out, name)
 
 
 def plot_theta(out, summary, runs):
@@ -202,15 +208,9 @@ def plot_observer(out, summary, runs):
         for j in range(2):
             axs[i][j].grid(True, lw=0.3)
             mark_faults(axs[i][j], obs)
-    fit_limits(axs.flat)
-    axs[0][0].set_title("position error x̂ − x (x from the encoders)")
-    axs[0][1].set_title("velocity error x̂̇ − ẋ (ẋ: the plant's true velocity)")
-    axs[0][0].legend(loc="upper right", fontsize=7)
-    for j in range(2):
-        axs[-1][j].set_xlabel("t [s]")
-    fig.suptitle(title(summary, obs, "The velocity observer's errors"), fontsize=10)
-    fig.tight_layout()
-    return save(fig, out, "observer_errors.png")
+    return finish_grid(fig, axs, ["position error x̂ − x (x from the encoders)",
+                                  "velocity error x̂̇ − ẋ (ẋ: the plant's true velocity)"],
+                       title(summary, obs, "The velocity observer's errors"), out, "observer_errors.png")
 
 
 def plot_windows(out, summary, runs):
@@ -223,11 +223,12 @@ def plot_windows(out, summary, runs):
         w = r["window_s"]
         t = [w * (k + 1) for k in range(len(r["window_max_error"]))]
         c = MODE_COLOR[r["mode"]]
+        mk = "o" if len(t) < 30 else None  # a few windows: points, not a trend
         for i, ls in zip(range(3), ("-", "--", ":")):
-            axs[0].semilogy(t, [m[i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c,
+            axs[0].semilogy(t, [m[i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c, marker=mk, ms=3,
                             label=f"{r['mode']} e_{'xyz'[i]}")
-            axs[1].semilogy(t, [m[3 + i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c,
-                            label=f"{r['mode']} e_φ{'xyz'[i]}")
+            axs[1].semilogy(t, [m[3 + i] for m in r["window_max_error"]], lw=0.9, ls=ls, color=c, marker=mk,
+                            ms=3, label=f"{r['mode']} e_φ{'xyz'[i]}")
         if r["mode"] == "adaptive":
             axs[2].plot(t, [m[0] for m in r["window_theta_range"]], color=c, lw=0.9, label="smallest θ̂")
             axs[2].plot(t, [m[1] for m in r["window_theta_range"]], color=c, lw=0.9, ls="--", label="largest θ̂")

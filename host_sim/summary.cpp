@@ -70,6 +70,7 @@ json json_run(const ExperimentResult& r, bool csv) {
   j["friction_rms_Nm"] = r.friction_rms;
   j["stuck_monitor_peak_counts"] = json_array(r.stuck_peak, 6);
   j["stuck_monitor_peak_dtau_Nm"] = json_array(r.stuck_dtau_peak, 6);
+  j["stuck_monitor_peak_dtau_silent_Nm"] = json_array(r.stuck_dtau_silent_peak, 6);
   if (r.max_step_cycles) {
     j["firmware_step_instructions_max"] = r.max_step_cycles;
     j["firmware_step_instructions_mean"] = r.mean_step_cycles;

@@ -51,7 +51,8 @@ def row(name, run, tmax):
         hi_all = max(r[1] for r in run["window_theta_range"])
         rng = f"{'yes' if lo_all >= 0 else 'NO'} [{lo_all:.2f}, {hi_all:.2f}] (all coefficients)"
     wa = worst(after)
-    return (f"| {name} | {run['fault_status']} | {rng} | {run['friction_rms_error_Nm']:.3f} "
+    faults = ", ".join(run["faults"]) if run.get("faults") else "0"
+    return (f"| {name} | {faults} | {rng} | {run['friction_rms_error_Nm']:.3f} "
             f"({run.get('final_window_s', 20):.0f} s) | {fmt(wa[:3])} mm, {fmt(wa[3:], 4)}° | "
             f"{fmt(worst(first)[:3])} → {fmt(worst(last)[:3])} | {over}/{len(after)} |")
 

@@ -41,6 +41,8 @@ def main():
     ap.add_argument("--mode", default="adaptive", choices=["adaptive", "none"])
     ap.add_argument("--out", default="out/injection")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--summary", action="store_true", help="print the table by kind (docs/safety.md)")
+    ap.add_argument("--full", help="write the table of every run into this Markdown file")
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     jobs = []
@@ -51,13 +53,37 @@ def main():
                 jobs.append((kind, joint, at))
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
         results = list(ex.map(lambda j: run(a.exe, a.mode, *j, a.out), jobs))
-    print(f"| injection ({a.mode}) | detected after [ms] | fault | zero torque after [ms] | excursion [mm] |"
-          " largest torque after detection [N m] |")
-    print("|---|---:|---|---:|---:|---:|")
+    lines = [f"| injection ({a.mode}) | detected after [ms] | fault | zero torque after [ms] | excursion [mm] |"
+             " largest torque after detection [N m] |", "|---|---:|---|---:|---:|---:|"]
     for spec, r in results:
         at = r["at_s"]
-        print(f"| `{spec}` | {ms(r['detected_s'], at)} | {r['fault'] or '-'} | {ms(r['zero_torque_s'], at)} | "
-              f"{r['excursion_mm']:.2f} | {r['max_torque_after_detection_Nm']:.2f} |")
+        lines.append(f"| `{spec}` | {ms(r['detected_s'], at)} | {r['fault'] or '-'} | {ms(r['zero_torque_s'], at)} | "
+                     f"{r['excursion_mm']:.2f} | {r['max_torque_after_detection_Nm']:.2f} |")
+    if a.full:
+        with open(a.full, "w") as f:
+            f.write(f"# Fault injection, every run ({a.mode})\n\nWritten by `python3 scripts/injection_table.py "
+                    f"--mode {a.mode} --full {a.full}` (or `scripts/docs_tables.py --kind long --only injection`)."
+                    "\n\n" + "\n".join(lines) + "\n")
+    if not a.summary:
+        print("\n".join(lines))
+        return
+    # By kind: worst detection, how many within 50 ms and 5 mm, the faults raised.
+    print("| kind | runs | worst detection [ms] | detected ≤ 50 ms | faults raised | worst excursion [mm] | "
+          "excursion ≤ 5 mm | largest torque after detection [N m] |")
+    print("|---|---:|---:|---:|---|---:|---:|---:|")
+    groups = {}
+    for spec, r in results:
+        kind = spec.split("@")[0].split(":")[0]
+        label = f"`{kind}` at t = 0" if r["at_s"] == 0 else f"`{kind}`"
+        groups.setdefault(label, []).append(r)
+    for label, rs in groups.items():
+        det = [None if r["detected_s"] is None else (r["detected_s"] - r["at_s"]) * 1e3 for r in rs]
+        worst = "never" if any(d is None for d in det) else f"{max(det):.0f}"
+        fast = sum(1 for d in det if d is not None and d <= 50)
+        faults = sorted({f for r in rs for f in r["faults"]})
+        exc = [r["excursion_mm"] for r in rs]
+        print(f"| {label} | {len(rs)} | {worst} | {fast}/{len(rs)} | {', '.join(faults)} | {max(exc):.2f} | "
+              f"{sum(1 for e in exc if e <= 5)}/{len(rs)} | {max(r['max_torque_after_detection_Nm'] for r in rs):.2f} |")
 
 
 if __name__ == "__main__":

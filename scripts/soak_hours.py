@@ -24,7 +24,7 @@ def main(argv):
         print(f"| {h + 1}{' (from 120 s)' if h == 0 else ''} | {f(worst)} | {f(mean)} |")
     th = run["theta_hat"]
     print(f"\nθ̂ J1 at the end: vis {th[0]:.2f}, cou {th[6]:.2f}, sti {th[12]:.2f}; friction rms error "
-          f"{run['friction_rms_error_Nm']:.3f} N·m; faults {run['fault_status']}")
+          f"{run['friction_rms_error_Nm']:.3f} N·m; faults {', '.join(run['faults']) or 'none'}")
     return 0
 
 

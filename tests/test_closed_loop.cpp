@@ -313,7 +313,8 @@ TEST(Injection, StuckAmplifierIsCaughtAndDisabledByTheFaultLine) {
   ASSERT_GE(r.injection.detected, 0);
   EXPECT_LE(r.injection.detected - 3.5, 0.6);
   EXPECT_EQ(r.injection.zero_torque, r.injection.detected);
-  EXPECT_LE(r.injection.excursion_mm, 11.0);
+  // The tracking bound trips first: the excursion is that bound plus what one tick adds.
+  EXPECT_LE(r.injection.excursion_mm, osc::params::kTrackingLimitPosition * 1e3 + 1.0);
   EXPECT_EQ(r.injection.max_torque_after, 0.0);
 }
 
@@ -338,18 +339,22 @@ TEST(Injection, ParserRejectsBadSpecifications) {
 
 namespace {
 
-// The monitors never trip on the fault-free experiment, with or without compensation, and keep a
-// margin below their thresholds (4 h of both modes: docs/safety.md; CI runs 600 s of each).
+// The monitors never trip on the fault-free experiment, with or without compensation, on either
+// friction preset of the robot description (the Corke/Armstrong-Helouvry one holds joint 1 with
+// 26 N m of static friction), and keep a margin below their thresholds (an hour of each:
+// docs/safety.md; CI runs 300 s of each).
 TEST(Monitors, NoFalseFaultWithOrWithoutCompensation) {
+  for (const osc::FrictionCoefficients* fr : {&osc::robot::kFrictionPaper, &osc::robot::kFrictionCorke})
   for (const osc::FrictionMode mode : {osc::FrictionMode::kAdaptive, osc::FrictionMode::kNone}) {
-    ExperimentConfig c = config(600, mode, osc::robot::kFrictionPaper);
+    ExperimentConfig c = config(300, mode, *fr);
     const ExperimentResult r = run_experiment(c);
-    EXPECT_EQ(r.status, 0u) << osc::fault_name(r.status) << " at " << r.fault_time << " s";
-    std::printf("%-8s 600 s: stuck monitor peaks (counts / N m):", r.mode.c_str());
+    EXPECT_EQ(r.status, 0u) << fr->name << ": " << osc::fault_name(r.status) << " at " << r.fault_time << " s";
+    std::printf("%-6s %-8s 300 s: stuck monitor peaks (counts / N m / N m while silent):", fr->name, r.mode.c_str());
     for (int j = 0; j < 6; ++j) {
-      std::printf(" J%d %.1f/%.1f", j + 1, r.stuck_peak[j], r.stuck_dtau_peak[j]);
-      EXPECT_LT(r.stuck_peak[j], 0.9 * osc::params::kStuckMotionCounts) << "J" << j + 1;
-      EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << "J" << j + 1;
+      std::printf(" J%d %.1f/%.1f/%.1f", j + 1, r.stuck_peak[j], r.stuck_dtau_peak[j], r.stuck_dtau_silent_peak[j]);
+      EXPECT_LT(r.stuck_peak[j], 0.9 * osc::params::kStuckMotionCounts) << fr->name << " J" << j + 1;
+      EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << fr->name << " J" << j + 1;
+      EXPECT_LT(r.stuck_dtau_silent_peak[j], 0.8 * osc::params::kStuckTorqueSilent[j]) << fr->name << " J" << j + 1;
     }
     const double pos = std::max({r.max_error[0], r.max_error[1], r.max_error[2]});
     std::printf("; worst position error %.2f mm\n", pos);

@@ -1,5 +1,6 @@
-// Code shared by every Cortex-M3/M4 board: core registers (SCB, NVIC, SysTick), semihosting, the
-// SysTick-based cycle counter, the main-stack high-water mark and the reset record. A board adds
+// Code shared by every Cortex-M3/M4 board: core registers (SCB, NVIC, SysTick, DWT), semihosting,
+// the SysTick- and DWT-based cycle counters, the main-stack high-water mark, the reset record and
+// the safe-state hook of the fault handlers. A board adds
 // its own clock, peripherals and interrupt table (boards/<board>/board.hpp, vectors.cpp).
 #pragma once
 
@@ -11,25 +12,52 @@ struct SysTickRegs {
   volatile std::uint32_t CSR, RVR, CVR, CALIB;
 };
 inline SysTickRegs& systick() { return *reinterpret_cast<SysTickRegs*>(0xE000E010u); }
-inline volatile std::uint32_t& nvic_iser0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E100u); }
-inline volatile std::uint32_t& nvic_icer0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E180u); }
-inline volatile std::uint32_t& nvic_ispr0() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000E200u); }
+/// NVIC set-enable, clear-enable and set-pending registers: word n covers interrupts 32n..32n+31.
+inline volatile std::uint32_t& nvic_iser(int n) { return reinterpret_cast<volatile std::uint32_t*>(0xE000E100u)[n]; }
+inline volatile std::uint32_t& nvic_icer(int n) { return reinterpret_cast<volatile std::uint32_t*>(0xE000E180u)[n]; }
+inline volatile std::uint32_t& nvic_ispr(int n) { return reinterpret_cast<volatile std::uint32_t*>(0xE000E200u)[n]; }
+/// NVIC interrupt priority registers: one byte per interrupt (ARMv7-M ARM, B3.4.9).
+inline volatile std::uint8_t& nvic_ipr(int irq) { return reinterpret_cast<volatile std::uint8_t*>(0xE000E400u)[irq]; }
 inline volatile std::uint32_t& scb_cpacr() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000ED88u); }
 
-/// Enables external interrupt irq (0..31).
-inline void irq_enable(int irq) { nvic_iser0() = 1u << irq; }
-/// Disables external interrupt irq (0..31); it is not taken after this call returns.
+/// Enables external interrupt irq.
+inline void irq_enable(int irq) { nvic_iser(irq >> 5) = 1u << (irq & 31); }
+/// Disables external interrupt irq; it is not taken after this call returns.
 inline void irq_disable(int irq) {
-  nvic_icer0() = 1u << irq;
+  nvic_icer(irq >> 5) = 1u << (irq & 31);
   __asm__ volatile("dsb\n isb" ::: "memory");
 }
 /// Pends external interrupt irq. The barriers make every store made before the call (e.g. fault
 /// flags the interrupt reads) visible to it: the interrupt is taken right after the write.
 inline void irq_pend(int irq) {
   __asm__ volatile("dsb" ::: "memory");
-  nvic_ispr0() = 1u << irq;
+  nvic_ispr(irq >> 5) = 1u << (irq & 31);
   __asm__ volatile("dsb\n isb" ::: "memory");
 }
+/// Sets the priority of external interrupt irq: `level` 0 is the most urgent; the device implements
+/// the top `prio_bits` bits of each priority byte (a board constant: 4 on the STM32F4).
+inline void irq_priority(int irq, unsigned level, int prio_bits) {
+  nvic_ipr(irq) = static_cast<std::uint8_t>(level << (8 - prio_bits));
+}
+
+// ---------------------------------------------------------------- DWT cycle counter
+// ARMv7-M ARM C1.8: DWT_CTRL (0xE0001000) bit 0 CYCCNTENA, DWT_CYCCNT (0xE0001004) counts processor
+// clock cycles; the DWT is enabled by DEMCR (0xE000EDFC) bit 24 TRCENA. Optional: DWT_CTRL bit 25
+// NOCYCCNT reads 1 where there is no cycle counter (and an emulator may have no DWT at all).
+inline volatile std::uint32_t& dwt_ctrl() { return *reinterpret_cast<volatile std::uint32_t*>(0xE0001000u); }
+inline volatile std::uint32_t& dwt_cyccnt() { return *reinterpret_cast<volatile std::uint32_t*>(0xE0001004u); }
+inline volatile std::uint32_t& demcr() { return *reinterpret_cast<volatile std::uint32_t*>(0xE000EDFCu); }
+/// Starts the DWT cycle counter. Returns false when it does not count (no DWT, or no CYCCNT).
+inline bool dwt_start() {
+  demcr() = demcr() | (1u << 24);
+  dwt_cyccnt() = 0;
+  dwt_ctrl() = dwt_ctrl() | 1u;
+  const std::uint32_t a = dwt_cyccnt();
+  for (int i = 0; i < 8; ++i) __asm__ volatile("nop");
+  return dwt_cyccnt() != a;
+}
+/// Processor clock cycles (32 bits, wraps every 2^32 cycles: 25.6 s at 168 MHz).
+inline std::uint32_t dwt_cycles() { return dwt_cyccnt(); }
 
 // ---------------------------------------------------------------- semihosting
 namespace semihost {
@@ -64,6 +92,13 @@ inline std::uint32_t systick_cycles() {
   last = v;
   return high + v;
 }
+
+// ---------------------------------------------------------------- fault handlers
+// The common fault handlers (startup.cpp: HardFault and its escalations, any unexpected interrupt)
+// first call osc_safe_state(), then report over semihosting and exit. The default does nothing; a
+// board with outputs that move the robot defines it to put them in their safe state (amplifiers
+// disabled, torque commands zero) with plain register writes: it runs in a fault handler.
+extern "C" void osc_safe_state();
 
 // ---------------------------------------------------------------- stack
 /// Bytes of the main stack ever used (painted at reset by the common startup code).

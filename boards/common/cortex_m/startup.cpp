@@ -1,8 +1,10 @@
 // Reset and system exceptions, shared by every Cortex-M board: FPU on (where there is one), .data
 // copied, .bss zeroed, the main stack painted for the high-water mark, the reset record read (the
-// cause of this reset), static constructors, main(), semihosting exit with main's status. The 16 system entries of the vector table are here, in
-// section .isr_vector; each board's vectors.cpp places its external interrupts right after them,
-// in .isr_vector.irq (the linker scripts keep the two in that order).
+// cause of this reset), static constructors, main(), semihosting exit with main's status. The fault
+// handlers first put the board's outputs in their safe state (osc_safe_state(), cortex_m.hpp). The
+// 16 system entries of the vector table are here, in section .isr_vector; each board's vectors.cpp
+// places its external interrupts right after them, in .isr_vector.irq (the linker scripts keep the
+// two in that order).
 #include <cstdint>
 
 #include "cortex_m.hpp"
@@ -25,7 +27,10 @@ void UsageFault_Handler() __attribute__((weak, alias("HardFault_Handler")));
 void SVC_Handler() __attribute__((weak, alias("Default_Handler")));
 void PendSV_Handler() __attribute__((weak, alias("Default_Handler")));
 void SysTick_Handler() __attribute__((weak, alias("Default_Handler")));
+void osc_safe_state() __attribute__((weak));
 }
+
+extern "C" void osc_safe_state() {}
 
 namespace {
 constexpr std::uint32_t kPaint = 0xC0FFEE11u;
@@ -90,11 +95,13 @@ __attribute__((section(".isr_vector"), used)) const Handler g_system_vectors[16]
 };
 
 extern "C" void Default_Handler() {
+  osc_safe_state();
   cortex_m::semihost::write("unexpected interrupt\n");
   cortex_m::semihost::exit(90);
 }
 
 extern "C" void HardFault_Handler() {
+  osc_safe_state();
   cortex_m::semihost::write("hard fault\n");
   cortex_m::semihost::exit(91);
 }

@@ -1,4 +1,5 @@
-// printf-free text output over semihosting (newlib's printf would bring in malloc).
+// printf-free text lines (newlib's printf would bring in malloc), emitted over semihosting or taken
+// as text for another output.
 #pragma once
 
 #include <cstdint>
@@ -47,6 +48,11 @@ class Line {
       buf_[n_ < kMax - 1 ? n_++ : n_] = static_cast<char>('0' + (d ? (f / d) % 10 : 0));
     }
     return *this;
+  }
+  /// The line so far (NUL-terminated, no newline), e.g. for a UART.
+  const char* text() {
+    buf_[n_] = 0;
+    return buf_;
   }
   void emit() {
     buf_[n_ < kMax - 1 ? n_++ : n_] = '\n';

@@ -45,18 +45,28 @@ constexpr double kJointLimitMargin = 0.1;
 constexpr int kSaturationTicks = 50;
 /// Stuck-encoder monitor: the joint motion the reference commands while an encoder stands still,
 /// accumulated from the last count change, beyond which the encoder is stuck [counts]
-/// (docs/safety.md derives it from the fault-free peaks).
-constexpr double kStuckMotionCounts = 100;
+/// (docs/safety.md derives it and kStuckTorque from the fault-free peaks, 1.5 times the largest over
+/// both friction presets of the robot description, paper and corke, with and without compensation:
+/// the heavier the static friction, the longer a joint sticks at a reversal).
+constexpr double kStuckMotionCounts = 165;
 /// ... or the commanded joint torque has changed by more than this since the encoder's last change
 /// [N m]: a joint held by static friction breaks away within a bounded torque change, a joint whose
 /// encoder is stuck while it moves makes the controller ramp its torque without bound.
-constexpr double kStuckTorque[6] = {27, 31, 12, 14, 6, 9};
+/// J1 of the corke preset (static friction 26 N m) needs 52 N m to reverse.
+constexpr double kStuckTorque[6] = {78, 34, 22, 19, 6, 10};
+/// ... or by more than this [N m] when the joint was moving (its last interval between counts at
+/// most kStuckFastInterval ticks) and its encoder has since been silent for kStuckIntervals of
+/// those intervals: a moving joint that should have counted, not one that slowed to a reversal and
+/// is held there by static friction.
+constexpr double kStuckTorqueSilent[6] = {33, 20, 12, 8, 4, 9};
+constexpr int kStuckFastInterval = 5;
 /// ... and the encoder has been silent for more than this many of its recent intervals between
 /// counts.
 constexpr int kStuckIntervals = 10;
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
-/// coordinate [rad]; about 2.5 times the worst fault-free error without friction compensation.
-constexpr double kTrackingLimitPosition = 0.010;
+/// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
+/// heavier (corke) friction preset (7.0 mm, 0.43 deg).
+constexpr double kTrackingLimitPosition = 0.015;
 constexpr double kTrackingLimitOrientation = 0.02;
 /// The supervisor's bounds on the friction estimates: the robust law's projection set [0, theta_max]
 /// widened by theta_max on each side, [-theta_max, 2 theta_max]. The robust law never leaves

@@ -22,6 +22,7 @@
 
 #include "osc/runtime/control_task.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/link/telemetry.hpp"
 
 namespace osc {
 
@@ -133,18 +134,7 @@ class PilNode {
     return sample_;
   }
   void write_dacs(const std::int32_t codes[kDof]) {
-    pil::ActuatorFrame a;
-    a.seq = answer_seq_;
-    for (int i = 0; i < kDof; ++i) a.codes[i] = codes[i];
-    a.faults = task.sup.latched;
-    a.state = static_cast<std::uint8_t>(task.sup.state);
-    a.step_cycles = task.step_timing.last;
-    a.max_cycles = task.step_timing.max;
-    a.mean_cycles = task.step_timing.mean();
-    a.tick_max_cycles = task.timing.max;
-    a.stack_used = Board::stack_used();
-    for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.adapt.theta_hat(i));
-    for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
+    pil::ActuatorFrame a = telemetry_frame(task, codes, answer_seq_, Board::stack_used());
     a.link = counters_;
     a.rx_gap_max = rx_gap_max_;
     a.rx_long_gaps = rx_long_gaps_;

@@ -60,6 +60,7 @@ struct ControlTask {
   std::uint32_t move_interval[kDof];   // ticks between its last two changes (its recent count rate)
   Vec6<S> tau_at_move;                // the torque commanded at each encoder's last change
   Vec6<S> stuck_dtau_peak;            // the largest torque change seen while an encoder stood still
+  Vec6<S> stuck_dtau_gated_peak;      // ... while it was silent for kStuckIntervals of its intervals
   Vec6<S> stuck_peak;                 // the largest stuck_motion seen (the monitor's headroom)
   Supervisor sup;
   std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
@@ -85,6 +86,7 @@ struct ControlTask {
     stuck_peak.setZero();
     tau_at_move.setZero();
     stuck_dtau_peak.setZero();
+    stuck_dtau_gated_peak.setZero();
     for (int i = 0; i < kDof; ++i) {
       last_move_tick[i] = 0;
       move_interval[i] = kStuckIntervalCap;
@@ -141,18 +143,24 @@ std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) 
       task.tau_at_move(i) = out.tau(i);
       continue;
     }
+    // The torque change since the encoder's last count: beyond the largest breakaway torque of
+    // static friction, stuck whatever the joint did before.
     const S dtau = math::abs(out.tau(i) - task.tau_at_move(i));
     if (dtau > task.stuck_dtau_peak(i)) task.stuck_dtau_peak(i) = dtau;
     if (dtau > lit<S>(params::kStuckTorque[i])) faults |= kFaultEncoderStuck;
     m += math::abs(out.qd_ref(i)) * task.gains.dt * task.counts_per_rad(i);
     if (m > lit<S>(kStuckMotionBound)) m = lit<S>(kStuckMotionBound);
-    // Stuck: the reference has moved the joint far, and the encoder has been silent for many times
-    // its recent interval between counts (a joint that was slowing down, as at a reversal held by
-    // static friction, had long intervals already).
+    // The encoder has been silent for many times its recent interval between counts: a joint that
+    // was moving should have counted (one that was slowing down, as at a reversal held by static
+    // friction, had long intervals already). Then a smaller torque change, or the reference having
+    // moved the joint far, is a stuck encoder.
     const std::uint64_t silent = task.tick - task.last_move_tick[i];
     if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * task.move_interval[i]) continue;
     if (m > task.stuck_peak(i)) task.stuck_peak(i) = m;
     if (m > lit<S>(params::kStuckMotionCounts)) faults |= kFaultEncoderStuck;
+    if (task.move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
+    if (dtau > task.stuck_dtau_gated_peak(i)) task.stuck_dtau_gated_peak(i) = dtau;
+    if (dtau > lit<S>(params::kStuckTorqueSilent[i])) faults |= kFaultEncoderStuck;
   }
   const S lp = lit<S>(params::kTrackingLimitPosition), lo = lit<S>(params::kTrackingLimitOrientation);
   if (out.e.template head<3>().squaredNorm() > lp * lp) faults |= kFaultTracking;

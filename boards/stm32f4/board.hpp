@@ -1,0 +1,187 @@
+// Board support for an STM32F407 controller board (Cortex-M4F, 168 MHz): the drivers of this folder
+// wired to the chip (stm32f4::Chip::hardware()), the boot sequence, the interrupts and their
+// priorities. Over the shared Cortex-M code (boards/common/cortex_m); no virtual calls, no heap.
+// docs/stm32f4.md describes the board; pins.hpp is its pin map.
+//
+// Build-time switch OSC_STM32F4_QEMU (the image stm32f4_qemu, for QEMU's netduinoplus2, an
+// STM32F405 with the same core and memory map): QEMU models TIM2..TIM5, the USARTs, SPI, SYSCFG and
+// EXTI, but not TIM6/TIM7, the RCC, GPIO, the IWDG nor encoder mode. With the switch
+//   - the control interrupt comes from TIM2 (IRQ 28) instead of TIM6 (IRQ 54), with QEMU's fixed
+//     48 MHz timer clock;
+//   - the encoders are a still robot (every count 0): TIM2 is the tick, and QEMU would run TIM3..5 as
+//     free counters, not in encoder mode;
+//   - the cycle counter's rate is QEMU's fixed 168 MHz CPU clock, whatever the RCC set-up reports.
+// Everything else is the board image's code: the bounded clock set-up (which falls back to HSI
+// there, the RCC reading zero), the DAC frames on SPI2, the safety I/O registers, the watchdog's
+// registers, the EXTI E-stop (driven by its software trigger in the smoke test) and the telemetry
+// USART.
+#pragma once
+
+#include <cstdint>
+#include <type_traits>
+
+#include "ad5754r.hpp"
+#include "board_hal.hpp"
+#include "clock.hpp"
+#include "control_timer.hpp"
+#include "cortex_m.hpp"
+#include "encoders.hpp"
+#include "osc/control/params.hpp"
+#include "safety.hpp"
+#include "spi_bus.hpp"
+#include "stm32f4_regs.hpp"
+#include "text.hpp"
+#include "usart.hpp"
+
+#if defined(OSC_STM32F4_QEMU)
+#define OSC_CONTROL_TIMER_HANDLER TIM2_Handler
+#else
+#define OSC_CONTROL_TIMER_HANDLER TIM6_DAC_Handler
+#endif
+
+namespace board {
+
+using stm32f4::BootFault;
+
+#if defined(OSC_STM32F4_QEMU)
+constexpr bool kQemu = true;
+#else
+constexpr bool kQemu = false;
+#endif
+
+/// The control rate is the controller's (one source: osc::params::kControlHz).
+constexpr std::uint32_t kControlHz = osc::params::kControlHz;
+
+// ---------------------------------------------------------------- interrupts
+// IRQ numbers: RM0090 table 61. Priorities: the STM32F4 implements 4 priority bits (16 levels, 0 the
+// most urgent); with the reset priority grouping all 4 are pre-emption bits. The E-stop pre-empts the
+// control tick, so that the amplifier falls within microseconds even in the middle of a step; the
+// tick pre-empts the main loop (telemetry transmission). The fault exceptions (HardFault, NMI) are
+// above all of them by the architecture.
+constexpr int kPriorityBits = 4;
+constexpr int kEstopIrq = 7;  // EXTI1
+constexpr int kTim2Irq = 28, kTim6DacIrq = 54;
+constexpr unsigned kEstopPriority = 1, kControlPriority = 2;
+constexpr stm32f4::Timer kControlTimer = kQemu ? stm32f4::Timer::kTim2 : stm32f4::Timer::kTim6;
+constexpr int kControlIrq = kQemu ? kTim2Irq : kTim6DacIrq;
+
+// ---------------------------------------------------------------- QEMU's timer and clock
+/// netduinoplus2's CPU clock (hw/arm/netduinoplus2.c: 168 MHz, whatever the RCC says) and the
+/// clock of its TIM2..TIM5 model: 1 GHz in QEMU 7.2, the version of Debian 12 (the property
+/// clock-frequency of stm32f2xx-timer, `info qtree`; later QEMU versions model 48 MHz).
+constexpr std::uint32_t kQemuTimerHz = 1000000000, kQemuCpuHz = 168000000;
+/// QEMU 7.2's timer model re-bases its count on every write to PSC, CNT or EGR.UG and then fires
+/// after ARR plus that base instead of ARR + 1 counts: the QEMU image runs TIM2 unprescaled with
+/// its 32-bit reload (999 999 at 1 GHz: 1 ms) and writes none of the three (control_timer_start).
+constexpr stm32f4::TimerDivider qemu_control_divider() { return stm32f4::control_divider_32bit(kQemuTimerHz, kControlHz); }
+
+// ---------------------------------------------------------------- telemetry
+constexpr std::uint32_t kTelemetryBaud = 460800;
+/// An actuator frame (191 bytes, 4.1 ms at 460 800 baud) every 10th tick: 100 frames a second.
+constexpr std::uint32_t kTelemetryEvery = 10;
+
+/// The QEMU image's encoders: a still robot.
+struct StillEncoders {
+  void init(const stm32f4::Chip&) {}
+  void read(std::int32_t counts[hal::kJoints]) {
+    for (int i = 0; i < hal::kJoints; ++i) counts[i] = 0;
+  }
+};
+using Encoders = std::conditional_t<kQemu, StillEncoders, stm32f4::EncoderBank>;
+
+/// Step timing: the DWT cycle counter, or SysTick where the DWT does not count (start() finds out).
+struct CycleCounter {
+  static inline bool dwt = false;
+  static void start() {
+    dwt = cortex_m::dwt_start();
+    if (!dwt) cortex_m::systick_free_run();
+  }
+  /// Processor clock cycles. With SysTick, call at least every 2^24 cycles (0.1 s): every tick does.
+  static std::uint32_t cycles() { return dwt ? cortex_m::dwt_cycles() : cortex_m::systick_cycles(); }
+};
+
+/// Why the MCU last reset (RCC_CSR's flags, read at boot and cleared).
+inline const char* reset_cause_name(std::uint32_t csr) {
+  using R = stm32f4::RccRegs;
+  if (csr & R::kIwdgRstf) return "watchdog";
+  if (csr & R::kSftRstf) return "software";
+  if (csr & R::kPorRstf) return "power-on";
+  if (csr & R::kPinRstf) return "reset pin";
+  return "unknown";
+}
+
+using Dac = ad5754r::DacPair<stm32f4::SpiDacBus>;
+using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter>;
+
+/// The board: its drivers and what the boot found.
+struct Board {
+  stm32f4::Chip chip = stm32f4::Chip::hardware();
+  stm32f4::Clocks clocks{};
+  BootFault boot = BootFault::kNone;  ///< the first boot fault (docs/stm32f4.md, "Boot faults")
+  std::uint32_t reset_flags = 0;
+  Encoders encoders;
+  stm32f4::SpiDacBus dac_bus;
+  Dac dac{dac_bus};
+  stm32f4::Safety safety;
+  stm32f4::TelemetryUart uart;
+  Hal hal{encoders, dac, safety, chip.timer(kControlTimer)};
+
+  /// Boot, with interrupts still off: clocks (bounded, HSI fallback), the reset cause, the cycle
+  /// counter, the safety outputs first (amplifier disabled), the DACs at 0 V, the encoders, the
+  /// telemetry USART. A boot fault keeps the torque off for good (Hal::permit_torque).
+  void init() {
+    clocks = stm32f4::clock_init(*chip.rcc, *chip.flash);
+    note(clocks.fault);
+    reset_flags = chip.rcc->CSR;
+    chip.rcc->CSR = chip.rcc->CSR | stm32f4::RccRegs::kRmvf;
+    CycleCounter::start();
+    chip.rcc->AHB1ENR = chip.rcc->AHB1ENR | 0x1Fu;  // GPIO ports A..E
+    stm32f4::read_back(chip.rcc->AHB1ENR);
+    safety.init(chip);
+    dac_bus.init(chip, clocks.pclk1);
+    if (!dac.init()) note(BootFault::kDacSetup);
+    encoders.init(chip);
+    uart.init(chip, clocks.pclk1, kTelemetryBaud);
+  }
+  /// The independent watchdog: from here on only healthy ticks keep the MCU out of reset.
+  void start_watchdog() { note(safety.watchdog_start()); }
+  /// The E-stop interrupt and the 1 kHz control interrupt, with their priorities.
+  void start_control() {
+    cortex_m::irq_priority(kEstopIrq, kEstopPriority, kPriorityBits);
+    cortex_m::irq_priority(kControlIrq, kControlPriority, kPriorityBits);
+    cortex_m::irq_enable(kEstopIrq);
+    if constexpr (!kQemu) {
+      chip.rcc->APB1ENR = chip.rcc->APB1ENR | stm32f4::RccRegs::kTim6En;
+      stm32f4::read_back(chip.rcc->APB1ENR);
+    }
+    stm32f4::control_timer_start(chip.timer(kControlTimer), kQemu ? qemu_control_divider()
+                                                                  : stm32f4::control_divider(timer_hz(), kControlHz));
+    cortex_m::irq_enable(kControlIrq);
+  }
+  /// The control timer's acknowledgement, first thing in its interrupt.
+  void control_ack() { stm32f4::control_timer_ack(chip.timer(kControlTimer)); }
+
+  /// The control timer's kernel clock (TIM6 and TIM2 are both on APB1).
+  std::uint32_t timer_hz() const { return kQemu ? kQemuTimerHz : clocks.tim_apb1; }
+  /// The cycle counter's rate.
+  std::uint32_t cycle_hz() const { return kQemu ? kQemuCpuHz : clocks.sysclk; }
+  /// The outputs to their safe state (fault handlers, E-stop): amplifier off, LED on, DACs to 0 V.
+  void safe_state() {
+    safety.force_safe();
+    dac.clear();
+  }
+  /// The boot report, one line: "<fault or ok>, sysclk, reset cause".
+  cortex_m::text::Line& describe(cortex_m::text::Line& l) const {
+    return l.str("boot ").str(stm32f4::boot_fault_name(boot)).str(", sysclk ").u32(clocks.sysclk)
+        .str(clocks.on_pll() ? " Hz (HSE, PLL)" : " Hz (HSI fallback)").str(", reset cause ")
+        .str(reset_cause_name(reset_flags)).str(", cycle counter ").str(CycleCounter::dwt ? "DWT" : "SysTick");
+  }
+
+ private:
+  void note(BootFault f) {
+    if (boot == BootFault::kNone) boot = f;
+    hal.permit_torque(boot == BootFault::kNone);
+  }
+};
+
+}  // namespace board

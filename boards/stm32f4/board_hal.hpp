@@ -1,0 +1,87 @@
+// The board's binding of the control task (hal::ControlHal): encoders from the timers, torque
+// commands to the DAC pair, the E-stop and the control timer's overrun as I/O faults, and a tick
+// (BoardHal::tick) that drives the safety outputs and feeds the watchdog after the control step.
+// Templates over the drivers (the board's, or fakes in tests/test_stm32f4.cpp): no virtual calls.
+#pragma once
+
+#include <cstdint>
+
+#include "control_timer.hpp"
+#include "hal/hal.hpp"
+#include "osc/control/faults.hpp"
+#include "osc/runtime/control_task.hpp"
+#include "safety.hpp"
+
+namespace stm32f4 {
+
+/// A board fault outside the firmware's catalogue (osc/control/faults.hpp), which the supervisor
+/// latches as it comes: a DAC frame did not complete on the SPI bus.
+constexpr std::uint32_t kFaultDacBus = 1u << 31;
+
+/// Encoders: read(counts). Dac: write(codes) -> bool, clear(). CycleClock: static cycles().
+template <class Encoders, class Dac, class CycleClock>
+class BoardHal {
+ public:
+  BoardHal(Encoders& encoders, Dac& dac, Safety& safety, TimRegs& control_timer)
+      : enc_(encoders), dac_(dac), safety_(safety), timer_(control_timer) {}
+
+  /// Whether torque may be commanded at all: false after a boot fault (docs/stm32f4.md, "Boot
+  /// faults"): zero codes and the amplifier disabled, whatever the supervisor says.
+  void permit_torque(bool permitted) { permitted_ = permitted; }
+
+  // hal::ControlHal
+  bool read_encoders(std::int32_t counts[hal::kJoints]) {
+    enc_.read(counts);
+    return true;
+  }
+  void write_dacs(const std::int32_t codes[hal::kJoints]) {
+    const bool zero = !permitted_ || safety_.estop();
+    for (int i = 0; i < hal::kJoints; ++i) written_[i] = zero ? 0 : codes[i];
+    if (!dac_.write(written_)) dac_fault_ = true;
+    // An E-stop that came during the burst: its codes may already be latched; clear them now.
+    if (!zero && safety_.estop()) dac_.clear();
+  }
+  std::uint32_t cycles() { return CycleClock::cycles(); }
+  std::uint32_t io_faults() {
+    std::uint32_t f = safety_.io_faults();
+    // The next update already pending when this tick starts (acknowledged on entry): overrun.
+    if (control_timer_pending(timer_)) f |= osc::kFaultOverrun;
+    if (dac_fault_) f |= kFaultDacBus;
+    return f;
+  }
+  void fault_output(bool active) {
+    if (active) safety_.force_safe();
+  }
+
+  /// One control tick: the control task, then the amplifier enable (on only in kRun with torque
+  /// permitted and no E-stop) and the fault LED (a latched fault or a boot fault), then the watchdog,
+  /// fed only when the supervisor is healthy (osc::supervisor_healthy). Returns the faults detected
+  /// in the tick.
+  template <class S>
+  std::uint32_t tick(osc::ControlTask<S>& task) {
+    const std::uint32_t faults = osc::control_tick(task, *this);
+    safety_.set_outputs(permitted_ && osc::torque_enabled(task.sup),
+                        task.sup.state == osc::SupervisorState::kFault || !permitted_);
+    if (osc::supervisor_healthy(task.sup)) {
+      safety_.watchdog_feed();
+      ++feeds_;
+    }
+    return faults;
+  }
+
+  /// The codes sent to the DACs in the last tick.
+  const std::int32_t* written() const { return written_; }
+  std::uint32_t feeds() const { return feeds_; }
+
+ private:
+  Encoders& enc_;
+  Dac& dac_;
+  Safety& safety_;
+  TimRegs& timer_;
+  bool permitted_ = true;
+  bool dac_fault_ = false;
+  std::int32_t written_[hal::kJoints] = {};
+  std::uint32_t feeds_ = 0;
+};
+
+}  // namespace stm32f4

@@ -1,0 +1,546 @@
+#!/usr/bin/env python3
+"""Regenerates the tables of measured figures in docs/ from runs and test output.
+
+usage: docs_tables.py [--check] [--kind host|m4f|long ...] [--only NAME ...] [--list]
+
+A generated table sits between two markers in a docs/*.md file:
+
+    <!-- generated: NAME (scripts/docs_tables.py; edit the script, not the table) -->
+    | ... |
+    <!-- end: NAME -->
+
+and is rewritten in place. Kinds:
+  host  short runs of the host build (puma_experiment): seconds; checked in CI (ctest docs_tables_host)
+  m4f   the Cortex-M4F images: sizes, stack and instruction counts from running them in QEMU;
+        checked in CI (ctest docs_tables_m4f in the m4f preset)
+  long  runs of minutes to hours (QEMU experiment, fault-injection matrix, benchmarks): regenerated
+        by hand with --kind long, never checked (wall-clock figures vary from run to run)
+
+--check regenerates the selected tables in memory and compares them with the docs: the same text,
+or numbers within 2 % (the simulated plant is compiled for the build machine's vector unit, so
+another machine may round its last bits differently); exit 1 listing the stale tables.
+By default every host and m4f table whose build exists is regenerated (and written).
+"""
+import argparse
+import concurrent.futures
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+HOST = os.path.join(ROOT, "build", "host")
+M4F = os.path.join(ROOT, "build", "m4f")
+EXPERIMENT = os.path.join(HOST, "host_sim", "puma_experiment")
+AXES = ["e_x mm", "e_y mm", "e_z mm", "e_φx °", "e_φy °", "e_φz °"]
+
+TABLES = {}
+
+
+def set_builds(host, m4f):
+    global HOST, M4F, EXPERIMENT
+    HOST, M4F = os.path.abspath(host), os.path.abspath(m4f)
+    EXPERIMENT = os.path.join(HOST, "host_sim", "puma_experiment")
+
+
+def table(name, doc, kind):
+    def wrap(fn):
+        TABLES[name] = (doc, kind, fn)
+        return fn
+    return wrap
+
+
+# ---------------------------------------------------------------- runs
+
+
+_runs = {}
+
+
+EXPECTED_FAULTS = set()  # argument lists whose runs may fault: the fault is the result
+
+
+def experiment(*args):
+    """Runs puma_experiment once per argument list (cached); returns its summary JSON."""
+    key = tuple(args)
+    if key not in _runs:
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "s.json")
+            cmd = [EXPERIMENT, "--no-csv", "--no-progress", "--json", path, *args]
+            p = subprocess.run(cmd, capture_output=True, text=True)
+            if not os.path.exists(path):
+                raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
+            with open(path) as f:
+                _runs[key] = json.load(f)
+            # A table is never made of a faulted run's numbers (that run is no result).
+            for r in _runs[key]["runs"]:
+                if r.get("faults") and "--inject" not in args and key not in EXPECTED_FAULTS:
+                    raise RuntimeError(f"{' '.join(cmd)}: run '{r['mode']}' faulted: {r['faults']} at "
+                                       f"{r['fault_time_s']} s\n{p.stdout}")
+    return _runs[key]
+
+
+def prefetch(arg_lists):
+    """Runs several experiments two at a time (the machine has two cores; each run is one mode
+    per thread, so this is at most two runs of one mode or one run of two)."""
+    with concurrent.futures.ThreadPoolExecutor(max_workers=2) as ex:
+        list(ex.map(lambda a: experiment(*a), arg_lists))
+
+
+def run_of(summary, mode):
+    return next(r for r in summary["runs"] if r["mode"] == mode)
+
+
+def errors(run, which):
+    """The six max |e| of a run: which = 'all' or 'last'."""
+    if which == "all":
+        return run["max_error_mm"] + run["max_error_deg"]
+    return run["final_max_error_mm"] + run["final_max_error_deg"]
+
+
+# The QEMU line of osc_add_board (boards/CMakeLists.txt) for the mps2-an386 images.
+QEMU = ["qemu-system-arm", "-M", "mps2-an386", "-display", "none", "-monitor", "none", "-serial", "null",
+        "-semihosting-config", "enable=on,target=native", "-icount", "shift=0", "-no-reboot", "-kernel"]
+
+_images = {}
+
+
+def image_output(image, board="mps2_an386", machine="mps2-an386"):
+    """What an image prints when it runs in its board's QEMU (cached)."""
+    if image not in _images:
+        elf = os.path.join(M4F, "boards", board, image + ".elf")
+        qemu = [a if a != "mps2-an386" else machine for a in QEMU]
+        if board == "stm32f4":  # its USART2 (the second serial port) carries the telemetry frames
+            qemu = qemu[:-1] + ["-serial", "null", "-kernel"]
+        p = subprocess.run(["timeout", "120", *qemu, elf], capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError(f"{image} failed in QEMU ({p.returncode}):\n{p.stdout[-3000:]}{p.stderr[-2000:]}")
+        _images[image] = p.stdout + p.stderr  # semihosting output goes to QEMU's stderr
+    return _images[image]
+
+
+# ---------------------------------------------------------------- formatting
+
+
+def fmt(v, digits=3):
+    return f"{v:.{digits}f}"
+
+
+def row(label, values, digits=3, bold=False):
+    cells = [fmt(v, digits) for v in values]
+    if bold:
+        cells = [f"**{c}**" for c in cells]
+    return "| " + label + " | " + " | ".join(cells) + " |"
+
+
+def thousands(n):
+    return f"{n:,}".replace(",", " ")
+
+
+# ---------------------------------------------------------------- host tables
+
+PAPER_RUNS = [("--duration", "120"), ("--duration", "120", "--mode", "adaptive", "--adaptation", "paper"),
+              ("--duration", "120", "--friction", "corke")]
+
+
+def paper_runs():
+    """The 120 s runs: robust law (adaptive, none), the paper's law (adaptive), and Table I, III."""
+    prefetch(PAPER_RUNS)
+    robust = experiment(*PAPER_RUNS[0])
+    paper = experiment(*PAPER_RUNS[1])
+    t1, t3 = robust["paper"]["table1_max_error_mm_deg"], robust["paper"]["table3_max_error_mm_deg"]
+    return run_of(robust, "adaptive"), run_of(robust, "none"), run_of(paper, "adaptive"), t1, t3
+
+
+@table("experiment_tracking", "docs/experiment.md", "host")
+def experiment_tracking():
+    ad, no, pa, t1, t3 = paper_runs()
+    lines = ["| | " + " | ".join(AXES) + " |", "|---|---|---|---|---|---|---|",
+             row("paper, with compensation (Table I)", t1, 2),
+             row("sim, adaptive (robust law), last 20 s", errors(ad, "last"), bold=True),
+             row("sim, adaptive (robust law), whole run", errors(ad, "all")),
+             row("sim, adaptive (paper's law (67)), last 20 s", errors(pa, "last")),
+             row("sim, adaptive (paper's law (67)), whole run", errors(pa, "all")),
+             row("paper, without compensation (Table III)", t3, 2),
+             row("sim, without compensation, last 20 s", errors(no, "last")),
+             row("sim, without compensation, whole run", errors(no, "all"))]
+    return "\n".join(lines)
+
+
+@table("experiment_ratio", "docs/experiment.md", "host")
+def experiment_ratio():
+    ad, no, pa, t1, t3 = paper_runs()
+
+    def ratio(a, b):
+        return [x / y for x, y in zip(a, b)]
+    lines = ["| without / with compensation | x | y | z | φx | φy | φz |", "|---|---|---|---|---|---|---|",
+             row("robust law, whole run", ratio(errors(no, "all"), errors(ad, "all")), 1),
+             row("robust law, last 20 s", ratio(errors(no, "last"), errors(ad, "last")), 1),
+             row("paper's law (67), whole run", ratio(errors(no, "all"), errors(pa, "all")), 1),
+             row("paper's law (67), last 20 s", ratio(errors(no, "last"), errors(pa, "last")), 1),
+             row("paper, Table III / Table I", ratio(t3, t1), 1)]
+    return "\n".join(lines)
+
+
+@table("experiment_corke", "docs/experiment.md", "host")
+def experiment_corke():
+    prefetch(PAPER_RUNS)
+    corke = experiment(*PAPER_RUNS[2])
+    ad, no = run_of(corke, "adaptive"), run_of(corke, "none")
+    lines = ["| `--friction corke`, max \\|e\\| | " + " | ".join(AXES) + " |", "|---|---|---|---|---|---|---|",
+             row("adaptive (robust law), last 20 s", errors(ad, "last")),
+             row("without compensation, last 20 s", errors(no, "last"))]
+    return "\n".join(lines)
+
+
+@table("experiment_identified", "docs/experiment.md", "host")
+def experiment_identified():
+    ro, _, pa, _, _ = paper_runs()
+    lines = ["| law, coefficient | J1 | J2 | J3 | J4 | J5 | J6 |", "|---|---|---|---|---|---|---|"]
+    for law, r in (("(67)", pa), ("robust", ro)):
+        for k, name in enumerate(("τ_vis", "τ_cou", "τ_sti")):
+            cells = [f"{r['theta_hat'][6 * k + j]:.2f} / {r['theta_true'][6 * k + j]:.1f}" for j in range(6)]
+            lines.append(f"| {law}, {name} estimate / true | " + " | ".join(cells) + " |")
+    lines.append("")
+    lines.append("| law | predicted friction, rms error over the last 20 s [N·m] | true friction, rms [N·m] |")
+    lines.append("|---|---|---|")
+    for law, r in (("(67)", pa), ("robust", ro)):
+        lines.append(f"| {law} | {r['friction_rms_error_Nm']:.3f} | {r['friction_rms_Nm']:.2f} |")
+    return "\n".join(lines)
+
+
+ROBUST_RUNS = [("--duration", "15", "--final-window", "5", "--mode", "adaptive", *extra)
+               for extra in ((), ("--scalar", "float"), ("--model-error", "-0.1"), ("--model-error", "0.1"))]
+
+
+@table("experiment_robustness", "docs/experiment.md", "host")
+def experiment_robustness():
+    prefetch(ROBUST_RUNS)
+    labels = ["exact model, double", "exact model, float", "all link masses and inertias −10 %",
+              "all link masses and inertias +10 %"]
+    lines = ["| controller (15 s, robust law, max \\|e\\| over the last 5 s) | e_x mm | e_y mm | e_z mm |",
+             "|---|---|---|---|"]
+    for label, args in zip(labels, ROBUST_RUNS):
+        lines.append(row(label, errors(run_of(experiment(*args), "adaptive"), "last")[:3]))
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------- m4f tables
+
+IMAGES = [("kernels_image", "every kernel in float, checked against the published vectors, instruction counts"),
+          ("timer_firmware", "the control task in the 1 kHz TIMER0 interrupt, 200 ticks, fed watchdog"),
+          ("pil_firmware", "the control task over the UART0 link to host_sim"),
+          ("watchdog_firmware", "the watchdog's resets (hung tick, latched fault, control interrupt off)")]
+
+
+def image_size(image, board="mps2_an386"):
+    out = subprocess.run([os.path.join(ROOT, "boards/common/cortex_m/check_image.sh"),
+                          os.path.join(M4F, "boards", board, image + ".elf")], capture_output=True, text=True)
+    m = re.search(r"flash \(text\+data\): (\d+) bytes; RAM: .* = (\d+) bytes", out.stdout)
+    if not m:
+        raise RuntimeError(f"check_image.sh {image}: {out.stdout}{out.stderr}")
+    return int(m.group(1)), int(m.group(2))
+
+
+@table("firmware_images", "docs/firmware.md", "m4f")
+def firmware_images():
+    stack = {}
+    for image in ("kernels_image", "timer_firmware"):
+        m = re.search(r"^stack used: (\d+) bytes", image_output(image), re.M)
+        stack[image] = int(m.group(1)) if m else None
+    lines = ["| image | what | flash | RAM (data + bss + .noinit + 16 KiB stack) | stack high-water |",
+             "|---|---|---|---|---|"]
+    for image, what in IMAGES:
+        flash, ram = image_size(image)
+        s = f"{thousands(stack[image])} B" if stack.get(image) else ""
+        lines.append(f"| `{image}` | {what} | {thousands(flash)} B | {thousands(ram)} B | {s} |")
+    return "\n".join(lines)
+
+
+@table("stm32f4_images", "docs/stm32f4.md", "m4f")
+def stm32f4_images():
+    m = re.search(r"stack used (\d+) bytes", image_output("stm32f4_qemu", "stm32f4", "netduinoplus2"))
+    lines = ["| image | flash | RAM (data + bss + .noinit + 16 KiB stack) | stack high-water |", "|---|---|---|---|"]
+    for image, note in (("stm32f4_firmware", ""), ("stm32f4_qemu", "")):
+        flash, ram = image_size(image, "stm32f4")
+        stack = f"{thousands(int(m.group(1)))} B (300 ticks in QEMU)" if m and image == "stm32f4_qemu" else ""
+        lines.append(f"| `{image}` | {thousands(flash)} B ({100 * flash / 1048576:.0f} % of 1 MiB) | "
+                     f"{thousands(ram)} B ({100 * ram / 131072:.0f} % of 128 KiB) | {stack} |")
+    return "\n".join(lines)
+
+
+@table("target_instructions", "docs/benchmarks.md", "m4f")
+def target_instructions():
+    out = image_output("kernels_image") + image_output("timer_firmware")
+    lines = ["| kernel (float) | instructions |", "|---|---|"]
+    for name, n in re.findall(r"^\s+(.+?): (\d+) instructions$", out, re.M):
+        label = f"**{name}**" if name.startswith("control_step") else name
+        count = f"**{thousands(int(n))}**" if name.startswith("control_step") else thousands(int(n))
+        lines.append(f"| {label} | {count} |")
+    m = re.search(r"control step: max (\d+), mean (\d+) instructions", out)
+    if m:
+        lines.append(f"| control step in the 1 kHz timer interrupt (`timer_firmware`, 200 ticks): max / mean | "
+                     f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))} |")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------- long tables
+
+
+@table("qemu_experiment", "docs/firmware.md", "long")
+def qemu_experiment():
+    q = experiment("--duration", "120", "--qemu")
+    h = experiment(*PAPER_RUNS[0])
+    fa, fn, ha = run_of(q, "adaptive"), run_of(q, "none"), run_of(h, "adaptive")
+    lines = ["| max \\|e\\| | " + " | ".join(AXES) + " |", "|---|---|---|---|---|---|---|",
+             row("firmware, adaptive (robust law), last 20 s", errors(fa, "last")),
+             row("firmware, adaptive (robust law), whole run", errors(fa, "all")),
+             row("firmware, without compensation, whole run", errors(fn, "all")),
+             row("host double controller, adaptive (robust law), last 20 s", errors(ha, "last")),
+             "",
+             "| firmware in QEMU, 120 s | adaptive | without compensation |",
+             "|---|---|---|",
+             f"| control step, max / mean [instructions] | {thousands(fa['firmware_step_instructions_max'])} / "
+             f"{thousands(fa['firmware_step_instructions_mean'])} | {thousands(fn['firmware_step_instructions_max'])} / "
+             f"{thousands(fn['firmware_step_instructions_mean'])} |",
+             f"| whole tick incl. link I/O, max [instructions] | {thousands(fa['firmware_tick_instructions_max'])} | "
+             f"{thousands(fn['firmware_tick_instructions_max'])} |",
+             f"| stack high-water [B] | {thousands(fa['firmware_stack_used_bytes'])} | "
+             f"{thousands(fn['firmware_stack_used_bytes'])} |",
+             f"| friction prediction error, last 20 s [N·m rms] | {fa['friction_rms_error_Nm']:.3f} (host "
+             f"{ha['friction_rms_error_Nm']:.3f}) | |",
+             f"| wall time [s] | {fa['wall_s']:.0f} | {fn['wall_s']:.0f} |"]
+    return "\n".join(lines)
+
+
+@table("injection", "docs/safety.md", "long")
+def injection():
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "scripts/injection_table.py"), "--exe", EXPERIMENT,
+                        "--summary", "--full", os.path.join(ROOT, "docs/safety/injection_adaptive.md"),
+                        "--out", tempfile.mkdtemp()], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(p.stderr)
+    return p.stdout.strip()
+
+
+def parse_params(name, n):
+    """A constant of firmware/control/include/osc/control/params.hpp (the single source)."""
+    text = open(os.path.join(ROOT, "firmware/control/include/osc/control/params.hpp")).read()
+    m = re.search(rf"constexpr double {name}(?:\[{n}\])?\s*=\s*\{{?([^;}}]*)\}}?;", text)
+    vals = [float(v) for v in re.sub(r"//[^\n]*", "", m.group(1)).split(",") if v.strip()]
+    return vals
+
+
+STUCK_RUNS = [("--duration", "300", "--friction", fr) for fr in ("paper", "corke")]
+
+
+@table("stuck_peaks", "docs/safety.md", "host")
+def stuck_peaks():
+    prefetch(STUCK_RUNS)
+    dtau_max, counts_max = parse_params("kStuckTorque", 6), parse_params("kStuckMotionCounts", 1)[0]
+    lines = ["| fault-free peak, 300 s | J1 | J2 | J3 | J4 | J5 | J6 |", "|---|---:|---:|---:|---:|---:|---:|"]
+    for args in STUCK_RUNS:
+        s = experiment(*args)
+        for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
+            r = run_of(s, mode)
+            lines.append(f"| torque change while still, {args[-1]} friction, {label} [N m] | "
+                         + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_Nm"]) + " |")
+    lines.append("| threshold `kStuckTorque` [N m] | " + " | ".join(f"{v:g}" for v in dtau_max) + " |")
+    for args in STUCK_RUNS:
+        s = experiment(*args)
+        for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
+            r = run_of(s, mode)
+            lines.append(f"| torque change, moving joint silent, {args[-1]} friction, {label} [N m] | "
+                         + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_silent_Nm"]) + " |")
+    lines.append("| threshold `kStuckTorqueSilent` [N m] | "
+                 + " | ".join(f"{v:g}" for v in parse_params("kStuckTorqueSilent", 6)) + " |")
+    for args in STUCK_RUNS:
+        s = experiment(*args)
+        for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
+            r = run_of(s, mode)
+            lines.append(f"| reference motion while still, gated, {args[-1]} friction, {label} [counts] | "
+                         + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_counts"]) + " |")
+    lines.append(f"| threshold `kStuckMotionCounts` [counts] | " + " | ".join([f"{counts_max:g}"] * 6) + " |")
+    return "\n".join(lines)
+
+
+HOUR = ("--mode", "adaptive", "--duration", "3600")
+HOUR_RUNS = [("paper friction (default)", HOUR), ("corke", HOUR + ("--friction", "corke")),
+             ("none (final window 60 s)", HOUR + ("--friction", "none", "--final-window", "60")),
+             ("model error −0.1", HOUR + ("--model-error", "-0.1")), ("model error +0.1", HOUR + ("--model-error", "0.1")),
+             ("float, default plant", HOUR + ("--scalar", "float"))]
+
+
+def adaptation_rows(runs):
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    import adaptation_table
+    tmax = adaptation_table.theta_max()
+    prefetch([a for _, a in runs])
+    lines = ["| run | faults | θ̂ in bounds [min, max/bound] | friction rms error N·m (final window) | worst 60 s "
+             "window after 120 s | first 20 min → last 20 min, x/y/z mm | windows over Table I |",
+             "|---|---|---|---|---|---|---|"]
+    for name, args in runs:
+        lines.append(adaptation_table.row(name, run_of(experiment(*args), "adaptive"), tmax))
+    return "\n".join(lines)
+
+
+@table("adaptation_hour", "docs/adaptation.md", "long")
+def adaptation_hour():
+    return adaptation_rows(HOUR_RUNS)
+
+
+@table("adaptation_hour_paper_law", "docs/adaptation.md", "long")
+def adaptation_hour_paper_law():
+    # (67) drifts; the supervisor's bound on the estimates (theta_bounds) stops it: that is the result.
+    EXPECTED_FAULTS.add(HOUR + ("--adaptation", "paper"))
+    return adaptation_rows([("paper's law (67), default plant", HOUR + ("--adaptation", "paper"))])
+
+
+@table("monitors_hour", "docs/safety.md", "long")
+def monitors_hour():
+    runs = [("--duration", "3600", "--friction", fr) for fr in ("paper", "corke")]
+    prefetch(runs)
+    dtau_max, counts_max = parse_params("kStuckTorque", 6), parse_params("kStuckMotionCounts", 1)[0]
+    pos, ori = parse_params("kTrackingLimitPosition", 1)[0] * 1e3, parse_params("kTrackingLimitOrientation", 1)[0]
+    lines = ["| one hour, fault-free: worst value (threshold) | " + " | ".join(
+        f"{fr} friction, {m}" for fr in ("paper", "corke") for m in ("compensated", "no compensation")) + " |",
+             "|---|---:|---:|---:|---:|"]
+    rs = [run_of(experiment(*a), m) for a in runs for m in ("adaptive", "none")]
+    lines.append("| faults | " + " | ".join(", ".join(r["faults"]) or "none" for r in rs) + " |")
+    lines.append(f"| reference motion while still, gated, J1..J6 [counts] ({counts_max:g}) | "
+                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_counts"]) for r in rs) + " |")
+    lines.append(f"| torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau_max)}) | "
+                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_Nm"]) for r in rs) + " |")
+    silent = parse_params("kStuckTorqueSilent", 6)
+    lines.append(f"| torque change, moving joint silent, J1..J6 [N m] ({', '.join(f'{v:g}' for v in silent)}) | "
+                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_silent_Nm"]) for r in rs)
+                 + " |")
+    lines.append(f"| tracking error, position [mm] ({pos:g}) | "
+                 + " | ".join(f"{max(r['max_error_mm']):.2f}" for r in rs) + " |")
+    lines.append(f"| tracking error, orientation [deg] ({math.degrees(ori):.2f}) | "
+                 + " | ".join(f"{max(r['max_error_deg']):.3f}" for r in rs) + " |")
+    lines.append("| friction estimates θ̂, min … max | "
+                 + " | ".join(f"{min(r['theta_min_seen']):.2f} … {max(r['theta_max_seen']):.2f}" if r["mode"] == "adaptive"
+                              else "(off)" for r in rs) + " |")
+    return "\n".join(lines)
+
+
+BENCH_ROWS = [("FK, all frames", "forward_kinematics", "kdl_forward_kinematics", "forward_kinematics"),
+              ("geometric Jacobian (after FK)", "geometric_jacobian", "kdl_jacobian", "jacobian"),
+              ("A(q), CRBA (after FK)", "joint_inertia", "kdl_mass", "mass"),
+              ("g(q)", "gravity", "kdl_gravity", "gravity"),
+              ("c(q,q̇) and J̇q̇, one RNEA pass", "velocity_products", "kdl_coriolis", "coriolis"),
+              ("W_j(q̇) (19)", "friction_regressor", None, None),
+              ("J factor (2× 3×3 LU) + solve", "jacobian_factor_solve", None, None),
+              ("Λ = J⁻ᵀAJ⁻¹", "operational_inertia", None, None),
+              ("opspace_update: FK, J, A, g, J_a, LU, LLT, Λ", "opspace_update", None, None),
+              ("h(v) = Ψ(x,v)v", "psi_quadratic", None, None),
+              ("full control step (observer + controller + adaptation)", "control_step", None, None),
+              ("plant forward dynamics (ABA, host_sim)", None, "kdl_forward_dynamics", "ChainFdSolver_RNE"),
+              ("J̇q̇", None, "kdl_jacdot", "jacdot")]
+
+
+@table("host_benchmarks", "docs/benchmarks.md", "long")
+def host_benchmarks():
+    """CPU time per call (Google Benchmark); wall-clock figures, so never checked."""
+    p = subprocess.run([os.path.join(HOST, "tests", "osc_bench"), "--benchmark_min_time=0.2",
+                        "--benchmark_format=json"], capture_output=True, text=True)
+    if p.returncode != 0:
+        raise RuntimeError(p.stderr)
+    ns = {b["name"]: b["cpu_time"] for b in json.loads(p.stdout)["benchmarks"]}
+    lines = ["| kernel | double [ns] | float [ns] | KDL (double) [ns] |", "|---|---|---|---|"]
+    for label, ours, kdl, kdl_name in BENCH_ROWS:
+        d = f"{ns[f'BM_{ours}<double>']:.0f}" if ours else ""
+        f = f"{ns[f'BM_{ours}<float>']:.0f}" if ours else ""
+        if label.startswith("plant"):
+            d = f"{ns['BM_plant_forward_dynamics']:.0f}"
+        k = f"{ns['BM_' + kdl]:.0f} ({kdl_name})" if kdl else ""
+        lines.append(f"| {label} | {d} | {f} | {k} |")
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------- docs
+
+
+def block_re(name):
+    return re.compile(r"(<!-- generated: " + re.escape(name) + r" [^\n]*-->\n)(.*?)(\n<!-- end: " + re.escape(name)
+                      + r" -->)", re.S)
+
+
+def numbers_close(a, b):
+    """The same table text, or the same words with numbers within 2 %."""
+    if a == b:
+        return True
+    ta, tb = re.split(r"(-?\d[\d ]*\.?\d*)", a), re.split(r"(-?\d[\d ]*\.?\d*)", b)
+    if len(ta) != len(tb):
+        return False
+    for x, y in zip(ta, tb):
+        if x == y:
+            continue
+        try:
+            fx, fy = float(x.replace(" ", "")), float(y.replace(" ", ""))
+        except ValueError:
+            return False
+        if abs(fx - fy) > 0.02 * max(abs(fx), abs(fy)) + 1e-3:
+            return False
+    return True
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="compare, do not write; exit 1 when a table is stale")
+    ap.add_argument("--kind", action="append", choices=["host", "m4f", "long"], help="the kinds of tables to do")
+    ap.add_argument("--only", action="append", help="only these tables")
+    ap.add_argument("--list", action="store_true", help="list the tables")
+    ap.add_argument("--host-build", default=HOST, help="the host preset's build directory")
+    ap.add_argument("--m4f-build", default=M4F, help="the m4f preset's build directory")
+    a = ap.parse_args(argv[1:])
+    set_builds(a.host_build, a.m4f_build)
+    if a.list:
+        for name, (doc, kind, _) in TABLES.items():
+            print(f"{name:24} {kind:5} {doc}")
+        return 0
+    kinds = a.kind or [k for k, build in (("host", HOST), ("m4f", M4F)) if os.path.isdir(build)]
+    names = [n for n, (_, kind, _) in TABLES.items() if kind in kinds and (not a.only or n in a.only)]
+    if a.only and len(names) != len(a.only):
+        print(f"docs_tables.py: unknown table or kind not selected: {set(a.only) - set(names)}", file=sys.stderr)
+        return 2
+    if "host" in kinds and not os.access(EXPERIMENT, os.X_OK):
+        print(f"docs_tables.py: {EXPERIMENT} is not built (cmake --build --preset host)", file=sys.stderr)
+        return 2
+    stale, done = [], 0
+    for name in names:
+        doc, kind, fn = TABLES[name]
+        path = os.path.join(ROOT, doc)
+        with open(path) as f:
+            if not block_re(name).search(f.read()):
+                print(f"docs_tables.py: {doc} has no markers for table '{name}'", file=sys.stderr)
+                return 2
+        new = fn()
+        with open(path) as f:  # read again after a long run: the file may have been edited meanwhile
+            text = f.read()
+        m = block_re(name).search(text)
+        if a.check:
+            ok = numbers_close(m.group(2).strip(), new.strip())
+            print(f"{'current' if ok else 'STALE  '} {name} ({doc})")
+            if not ok:
+                stale.append(name)
+                print("  in the docs:\n    " + m.group(2).strip().replace("\n", "\n    "))
+                print("  regenerated:\n    " + new.strip().replace("\n", "\n    "))
+        else:
+            text = text[:m.start(2)] + new.strip() + text[m.end(2):]
+            with open(path, "w") as f:
+                f.write(text)
+            print(f"wrote {name} ({doc})")
+        done += 1
+    if a.check:
+        print(f"{done - len(stale)} of {done} tables current" + (f"; stale: {', '.join(stale)}" if stale else "")
+              + ("; regenerate with: python3 scripts/docs_tables.py" if stale else ""))
+        return 1 if stale else 0
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,549 @@
+// The STM32F4 board's drivers (boards/stm32f4) on the host, each pointed at fake register blocks in
+// RAM (a Chip of zeroed structs the test presets and reads back): the bounded clock set-up and its
+// fallbacks, the encoder unwrap across the 16- and 32-bit counter wraps, the AD5754R frames and the
+// one LDAC per burst, the SPI bus and its bounded waits, the zero-on-fault path, the E-stop latch,
+// the amplifier enable, the watchdog fed only by healthy ticks, the control timer and the telemetry
+// UART. The control task runs for real (ControlTask<double>) over the board's HAL binding.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "ad5754r.hpp"
+#include "board_hal.hpp"
+#include "clock.hpp"
+#include "control_timer.hpp"
+#include "encoders.hpp"
+#include "osc/link/telemetry.hpp"
+#include "osc/robot.hpp"
+#include "pins.hpp"
+#include "safety.hpp"
+#include "spi_bus.hpp"
+#include "usart.hpp"
+
+using namespace stm32f4;
+
+namespace {
+
+/// Every register block of the board, in RAM, zeroed.
+struct FakeChip {
+  RccRegs rcc{};
+  FlashRegs flash{};
+  GpioRegs gpio[kPorts]{};
+  TimRegs tim[kTimers]{};
+  SpiRegs spi2{};
+  UsartRegs usart2{};
+  IwdgRegs iwdg{};
+  ExtiRegs exti{};
+  SyscfgRegs syscfg{};
+  DbgmcuRegs dbgmcu{};
+  Chip chip() {
+    Chip c{};
+    c.rcc = &rcc;
+    c.flash = &flash;
+    for (int i = 0; i < kPorts; ++i) c.gpio[i] = &gpio[i];
+    for (int i = 0; i < kTimers; ++i) c.tim[i] = &tim[i];
+    c.spi2 = &spi2;
+    c.usart2 = &usart2;
+    c.iwdg = &iwdg;
+    c.exti = &exti;
+    c.syscfg = &syscfg;
+    c.dbgmcu = &dbgmcu;
+    return c;
+  }
+  GpioRegs& port(Port p) { return gpio[static_cast<int>(p)]; }
+  TimRegs& timer(Timer t) { return tim[static_cast<int>(t)]; }
+};
+
+/// The last BSRR write to a pin's port drove that pin high (true) or low (false); fails if it did
+/// not touch the pin at all.
+::testing::AssertionResult drove(FakeChip& f, const PinConfig& p, bool high) {
+  const std::uint32_t bsrr = f.port(p.pin.port).BSRR;
+  const std::uint32_t bit = high ? 1u << p.pin.n : 1u << (p.pin.n + 16);
+  if (bsrr == bit) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "BSRR of the pin's port is 0x" << std::hex << bsrr << ", expected 0x" << bit;
+}
+
+// ------------------------------------------------------------------------------------------ clock
+
+TEST(Stm32Clock, FallsBackToHsiWhenTheCrystalNeverStarts) {
+  FakeChip f;  // the RCC reads zero, as under QEMU: HSERDY never comes
+  const Clocks c = clock_init(f.rcc, f.flash);
+  EXPECT_EQ(c.fault, BootFault::kHseTimeout);
+  EXPECT_STREQ(boot_fault_name(c.fault), "hse_timeout");
+  EXPECT_EQ(c.sysclk, 16000000u);
+  EXPECT_EQ(c.tim_apb1, 16000000u);
+  EXPECT_FALSE(c.on_pll());
+  EXPECT_EQ(f.rcc.CR & (RccRegs::kHseOn | RccRegs::kPllOn), 0u) << "HSE and PLL switched off again";
+  EXPECT_EQ(f.rcc.CFGR & RccRegs::kSwMask, RccRegs::kSwHsi);
+  EXPECT_EQ(f.rcc.PLLCFGR, 0u) << "the PLL was not touched";
+}
+
+TEST(Stm32Clock, FallsBackWhenThePllNeverLocks) {
+  FakeChip f;
+  f.rcc.CR = RccRegs::kHseRdy;  // the crystal runs, PLLRDY never comes
+  const Clocks c = clock_init(f.rcc, f.flash);
+  EXPECT_EQ(c.fault, BootFault::kPllTimeout);
+  EXPECT_EQ(c.sysclk, 16000000u);
+  // M = 8, N = 336, P = 2 (field 0), source HSE, Q = 7 (RM0090 7.3.2).
+  EXPECT_EQ(f.rcc.PLLCFGR, 8u | (336u << 6) | (0u << 16) | (1u << 22) | (7u << 24));
+  EXPECT_EQ(f.rcc.CR & (RccRegs::kHseOn | RccRegs::kPllOn), 0u);
+  EXPECT_EQ(f.flash.ACR, 0u) << "no wait states set before the PLL locked";
+}
+
+TEST(Stm32Clock, FallsBackWhenTheSwitchToThePllNeverHappens) {
+  FakeChip f;
+  f.rcc.CR = RccRegs::kHseRdy | RccRegs::kPllRdy;  // SWS stays at HSI
+  const Clocks c = clock_init(f.rcc, f.flash, ClockPolls{100, 100, 4, 50});
+  EXPECT_EQ(c.fault, BootFault::kSwitchTimeout);
+  EXPECT_EQ(c.pclk1, 16000000u);
+  EXPECT_EQ(f.rcc.CFGR & (RccRegs::kSwMask | RccRegs::kHpreMask | RccRegs::kPpre1Mask | RccRegs::kPpre2Mask), 0u)
+      << "back to HSI with every bus at /1";
+  EXPECT_EQ(f.rcc.CR & (RccRegs::kHseOn | RccRegs::kPllOn), 0u);
+}
+
+TEST(Stm32Clock, ReachesThePllAt168MHzWithFiveWaitStates) {
+  FakeChip f;
+  f.rcc.CR = RccRegs::kHseRdy | RccRegs::kPllRdy;
+  f.rcc.CFGR = RccRegs::kSwsPll;  // the switch status the hardware would show
+  const Clocks c = clock_init(f.rcc, f.flash);
+  EXPECT_EQ(c.fault, BootFault::kNone);
+  EXPECT_TRUE(c.on_pll());
+  EXPECT_EQ(c.sysclk, 168000000u);
+  EXPECT_EQ(c.pclk1, 42000000u);
+  EXPECT_EQ(c.tim_apb1, 84000000u);
+  EXPECT_EQ(c.tim_apb2, 168000000u);
+  EXPECT_EQ(f.flash.ACR, 5u | FlashRegs::kPrften | FlashRegs::kIcen | FlashRegs::kDcen);
+  EXPECT_EQ(f.rcc.CFGR & RccRegs::kSwMask, RccRegs::kSwPll);
+  EXPECT_EQ(f.rcc.CFGR & RccRegs::kPpre1Mask, RccRegs::kPpre1Div4);
+  EXPECT_EQ(f.rcc.CFGR & RccRegs::kPpre2Mask, RccRegs::kPpre2Div2);
+  EXPECT_NE(f.rcc.CR & (RccRegs::kHseOn | RccRegs::kPllOn), 0u);
+}
+
+TEST(Stm32Clock, EveryBootFaultHasAName) {
+  for (BootFault b : {BootFault::kHseTimeout, BootFault::kPllTimeout, BootFault::kFlashLatency,
+                      BootFault::kSwitchTimeout, BootFault::kWatchdogSetup, BootFault::kDacSetup})
+    EXPECT_STRNE(boot_fault_name(b), "?");
+}
+
+// --------------------------------------------------------------------------------------- encoders
+
+TEST(Stm32Encoders, InitPutsEveryTimerInEncoderModeWithItsPins) {
+  FakeChip f;
+  EncoderBank enc;
+  enc.init(f.chip());
+  for (const pins::EncoderChannel& e : pins::kEncoders) {
+    const TimRegs& t = f.timer(e.timer);
+    EXPECT_EQ(t.SMCR, 3u) << "encoder mode 3 (x4)";
+    EXPECT_EQ(t.CCMR1 & 0x0303u, 0x0101u) << "CC1S = TI1, CC2S = TI2";
+    EXPECT_EQ(t.ARR, e.bits == 32 ? 0xFFFFFFFFu : 0xFFFFu);
+    EXPECT_EQ(t.CR1 & TimRegs::kCen, TimRegs::kCen);
+    EXPECT_NE(f.rcc.*e.enable_register & e.enable_bit, 0u);
+    for (const PinConfig& p : {e.a, e.b}) {
+      const GpioRegs& g = f.port(p.pin.port);
+      EXPECT_EQ((g.MODER >> (2 * p.pin.n)) & 3u, 2u) << "alternate function";
+      EXPECT_EQ((g.AFR[p.pin.n / 8] >> (4 * (p.pin.n % 8))) & 0xFu, p.af);
+    }
+  }
+  // The table's widths are the hardware's: TIM2 and TIM5 are the 32-bit timers.
+  for (const pins::EncoderChannel& e : pins::kEncoders)
+    EXPECT_EQ(e.bits, e.timer == Timer::kTim2 || e.timer == Timer::kTim5 ? 32 : 16);
+}
+
+TEST(Stm32Encoders, SixteenBitCountersUnwrapAcrossBothWraps) {
+  FakeChip f;
+  EncoderBank enc;
+  enc.init(f.chip());
+  TimRegs& t = f.timer(Timer::kTim1);  // joint 1, 16-bit
+  std::int32_t c[hal::kJoints];
+  // Steps of up to 30000 counts between ticks (below the 32768 limit), through 0 and 65535 both ways.
+  const std::vector<std::pair<std::uint32_t, std::int32_t>> steps = {
+      {65530u, -6},      // backwards through 0
+      {30000u, 30000},   // forwards through 0 again (+30006)
+      {60000u, 60000},   // forwards
+      {24464u, 90000},   // forwards through 65535 (+30000)
+      {60000u, 60000},   // backwards through 65535 (-30000)
+      {35536u, 35536},   // backwards
+      {5536u, 5536},
+      {45536u, -20000},  // backwards through 0 (-25536)
+  };
+  for (const auto& [raw, want] : steps) {
+    t.CNT = raw;
+    enc.read(c);
+    EXPECT_EQ(c[0], want) << "raw " << raw;
+  }
+}
+
+TEST(Stm32Encoders, ThirtyTwoBitCountersUnwrapAcrossBothWraps) {
+  FakeChip f;
+  EncoderBank enc;
+  enc.init(f.chip());
+  EXPECT_EQ(f.timer(Timer::kTim2).CNT, 0u) << "init zeroes the counters";
+  f.timer(Timer::kTim2).CNT = 0xFFFFFF00u;  // counts from here on (restart) near the 32-bit wrap
+  f.timer(Timer::kTim5).CNT = 0x7FFFFFF0u;  // and near the signed boundary
+  enc.restart();
+  std::int32_t c[hal::kJoints];
+  enc.read(c);
+  EXPECT_EQ(c[1], 0);
+  EXPECT_EQ(c[4], 0);
+  f.timer(Timer::kTim2).CNT = 0x00000100u;  // forwards through 0xFFFFFFFF: +512
+  f.timer(Timer::kTim5).CNT = 0x80000010u;  // forwards through the signed boundary: +32
+  enc.read(c);
+  EXPECT_EQ(c[1], 512);
+  EXPECT_EQ(c[4], 32);
+  f.timer(Timer::kTim2).CNT = 0xFFFFFFFEu;  // backwards through 0: -258
+  f.timer(Timer::kTim5).CNT = 0x7FFFFFFFu;  // backwards: -17
+  enc.read(c);
+  EXPECT_EQ(c[1], 512 - 258);
+  EXPECT_EQ(c[4], 32 - 17);
+}
+
+TEST(Stm32Encoders, EveryJointReadsItsOwnTimer) {
+  FakeChip f;
+  EncoderBank enc;
+  enc.init(f.chip());
+  for (int j = 0; j < hal::kJoints; ++j) f.timer(pins::kEncoders[j].timer).CNT = static_cast<std::uint32_t>(10 * (j + 1));
+  std::int32_t c[hal::kJoints];
+  enc.read(c);
+  for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(c[j], 10 * (j + 1));
+}
+
+// -------------------------------------------------------------------------------------------- DAC
+
+/// A DAC bus that records what the chips would see.
+struct RecordingBus {
+  struct Event {
+    enum Kind { kFrame, kLdac, kClear } kind;
+    int chip;
+    ad5754r::Frame frame;
+  };
+  std::vector<Event> events;
+  bool fail = false;
+  bool write(int chip, const ad5754r::Frame& fr) {
+    events.push_back({Event::kFrame, chip, fr});
+    return !fail;
+  }
+  void ldac_pulse() { events.push_back({Event::kLdac, -1, {}}); }
+  void clear_pulse() { events.push_back({Event::kClear, -1, {}}); }
+};
+static_assert(ad5754r::Bus<RecordingBus>);
+
+TEST(Stm32Dac, FramesOfKnownCodes) {
+  using namespace ad5754r;
+  // Register bits 21-19, channel 18-16, data 15-0, MSB first.
+  EXPECT_EQ(frame(kDacRegister, 0, code_word(32767)), (Frame{{0x00, 0x7F, 0xFF}}));
+  EXPECT_EQ(frame(kDacRegister, 2, code_word(-1)), (Frame{{0x02, 0xFF, 0xFF}}));
+  EXPECT_EQ(frame(kDacRegister, 1, code_word(-32767)), (Frame{{0x01, 0x80, 0x01}}));
+  EXPECT_EQ(frame(kDacRegister, 1, code_word(0)), (Frame{{0x01, 0x00, 0x00}})) << "0 V in two's complement";
+  EXPECT_EQ(frame(kOutputRange, kAllChannels, kRangeBipolar10V), (Frame{{0x0C, 0x00, 0x04}}));
+  EXPECT_EQ(frame(kPowerControl, 0, kPowerUpABC | kPowerUpReference), (Frame{{0x10, 0x00, 0x17}}));
+  EXPECT_EQ(frame(kControl, kControlFunctionSet, kTsdEnable | kClampEnable | kSdoDisable), (Frame{{0x19, 0x00, 0x0D}}));
+  EXPECT_EQ(code_word(40000), 0x7FFFu) << "saturated";
+  EXPECT_EQ(code_word(-40000), 0x8000u);
+}
+
+TEST(Stm32Dac, OneBurstOfSixFramesThenOneLatchForAllJoints) {
+  RecordingBus bus;
+  ad5754r::DacPair<RecordingBus> dac(bus);
+  const std::int32_t codes[hal::kJoints] = {1000, -2000, 32767, -32767, 0, 12345};
+  ASSERT_TRUE(dac.write(codes));
+  ASSERT_EQ(bus.events.size(), 7u) << "six frames and one LDAC pulse";
+  const int chip[hal::kJoints] = {0, 0, 0, 1, 1, 1};
+  const std::uint8_t channel[hal::kJoints] = {0, 1, 2, 0, 1, 2};
+  for (int j = 0; j < hal::kJoints; ++j) {
+    SCOPED_TRACE(j);
+    EXPECT_EQ(bus.events[j].kind, RecordingBus::Event::kFrame) << "no latch before every joint's code is in";
+    EXPECT_EQ(bus.events[j].chip, chip[j]);
+    const std::uint16_t w = ad5754r::code_word(codes[j]);
+    EXPECT_EQ(bus.events[j].frame,
+              (ad5754r::Frame{{channel[j], static_cast<std::uint8_t>(w >> 8), static_cast<std::uint8_t>(w & 0xFF)}}));
+  }
+  EXPECT_EQ(bus.events[6].kind, RecordingBus::Event::kLdac);
+}
+
+TEST(Stm32Dac, InitSetsTheRangeAndZeroBeforePoweringUp) {
+  RecordingBus bus;
+  ad5754r::DacPair<RecordingBus> dac(bus);
+  ASSERT_TRUE(dac.init());
+  using E = RecordingBus::Event;
+  std::vector<E::Kind> kinds;
+  for (const E& e : bus.events) kinds.push_back(e.kind);
+  const std::vector<E::Kind> want = {E::kFrame, E::kFrame, E::kFrame, E::kFrame, E::kFrame, E::kFrame,
+                                     E::kLdac,  E::kFrame, E::kFrame};
+  ASSERT_EQ(kinds, want);
+  for (int c = 0; c < 2; ++c) {
+    EXPECT_EQ(bus.events[3 * c].frame, (ad5754r::Frame{{0x0C, 0x00, 0x04}})) << "±10 V, all channels";
+    EXPECT_EQ(bus.events[3 * c + 2].frame, (ad5754r::Frame{{0x04, 0x00, 0x00}})) << "0 V, all channels";
+    EXPECT_EQ(bus.events[7 + c].frame, (ad5754r::Frame{{0x10, 0x00, 0x17}})) << "A-C and reference up last";
+    EXPECT_EQ(bus.events[7 + c].chip, c);
+  }
+  bus.fail = true;
+  EXPECT_FALSE(dac.init());
+}
+
+TEST(Stm32SpiBus, ConfiguresMode2MasterAndSendsAFrameUnderSync) {
+  FakeChip f;
+  SpiDacBus bus;
+  bus.init(f.chip(), 42000000);
+  EXPECT_EQ(f.spi2.CR1, SpiRegs::kMstr | SpiRegs::kCpol | SpiRegs::kSsm | SpiRegs::kSsi | SpiRegs::kSpe)
+      << "master, CPOL 1 CPHA 0, 21 MHz (BR 0), 8-bit";
+  EXPECT_TRUE(drove(f, pins::kDacClr, true)) << "outputs idle high";
+  f.spi2.SR = SpiRegs::kTxe | SpiRegs::kRxne;  // every byte goes at once, BSY low
+  EXPECT_TRUE(bus.write(1, {{0x02, 0xAB, 0xCD}}));
+  EXPECT_EQ(f.spi2.DR, 0xCDu) << "the last byte written";
+  EXPECT_TRUE(drove(f, pins::kDacSync[1], true)) << "SYNC of chip 1 back high";
+  bus.ldac_pulse();
+  EXPECT_TRUE(drove(f, pins::kDacLdac, true));
+  EXPECT_EQ(bus.errors(), 0u);
+}
+
+TEST(Stm32SpiBus, ATransmitterThatNeverEmptiesFailsTheFrameBoundedly) {
+  FakeChip f;
+  SpiDacBus bus;
+  bus.init(f.chip(), 42000000);
+  f.spi2.SR = 0;  // TXE never set
+  EXPECT_FALSE(bus.write(0, {{0x00, 0x12, 0x34}}));
+  EXPECT_EQ(f.spi2.DR, 0u) << "nothing written";
+  EXPECT_TRUE(drove(f, pins::kDacSync[0], true)) << "SYNC released: the chip drops the frame";
+  f.spi2.SR = SpiRegs::kTxe | SpiRegs::kRxne | SpiRegs::kBsy;  // busy forever
+  EXPECT_FALSE(bus.write(0, {{0x00, 0x12, 0x34}}));
+  EXPECT_EQ(bus.errors(), 2u);
+}
+
+// ------------------------------------------------------------- the board's HAL and the control task
+
+/// A DAC that records the codes of every burst.
+struct RecordingDac {
+  std::vector<std::vector<std::int32_t>> bursts;
+  int clears = 0;
+  bool ok = true;
+  bool write(const std::int32_t c[hal::kJoints]) {
+    bursts.emplace_back(c, c + hal::kJoints);
+    return ok;
+  }
+  void clear() { ++clears; }
+  bool last_zero() const {
+    for (std::int32_t c : bursts.back())
+      if (c != 0) return false;
+    return true;
+  }
+};
+struct FakeCycles {
+  static inline std::uint32_t now = 0;
+  static std::uint32_t cycles() { return now += 100; }
+};
+
+struct BoardRig {
+  FakeChip f;
+  EncoderBank enc;
+  RecordingDac dac;
+  Safety safety;
+  BoardHal<EncoderBank, RecordingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  osc::ControlTask<double> task;
+  BoardRig() {
+    const Chip c = f.chip();
+    enc.init(c);
+    safety.init(c);
+    task.init(osc::Model<double>::of(osc::robot::kArm), osc::Gains<double>::paper(), osc::FrictionMode::kAdaptive,
+              osc::joint_vector<double>(osc::robot::kQStart), 168000);
+  }
+  /// A tick as the control interrupt runs it.
+  std::uint32_t tick() {
+    control_timer_ack(f.timer(Timer::kTim6));
+    return hal.tick(task);
+  }
+};
+static_assert(hal::ControlHal<BoardHal<EncoderBank, RecordingDac, FakeCycles>>);
+
+TEST(Stm32Board, AmplifierOffUntilTheSupervisorRunsHealthy) {
+  BoardRig r;
+  EXPECT_TRUE(r.f.port(pins::kAmpEnable.pin.port).MODER & (1u << (2 * pins::kAmpEnable.pin.n)));
+  EXPECT_TRUE(drove(r.f, pins::kFaultLed, false)) << "init: LED off, set before the pin became an output";
+  EXPECT_FALSE(r.safety.amplifier_enabled());
+  ASSERT_EQ(r.tick(), 0u);
+  EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kRun);
+  EXPECT_TRUE(r.safety.amplifier_enabled());
+  EXPECT_TRUE(drove(r.f, pins::kAmpEnable, true));
+  EXPECT_NE(r.dac.bursts.back()[1], 0) << "the controller holds joint 2 against gravity";
+}
+
+TEST(Stm32Board, ABootFaultKeepsTheAmplifierOffAndTheCodesZero) {
+  BoardRig r;
+  r.hal.permit_torque(false);
+  for (int k = 0; k < 5; ++k) ASSERT_EQ(r.tick(), 0u);
+  EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kRun) << "the control task itself runs";
+  EXPECT_NE(r.task.codes[1], 0);
+  EXPECT_TRUE(r.dac.last_zero());
+  EXPECT_FALSE(r.safety.amplifier_enabled());
+  EXPECT_TRUE(drove(r.f, pins::kAmpEnable, false));
+}
+
+TEST(Stm32Board, AnyFaultZeroesTheCodesAndDropsTheAmplifierInTheSameTick) {
+  BoardRig r;
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(r.tick(), 0u);
+  ASSERT_FALSE(r.dac.last_zero());
+  r.f.timer(pins::kEncoders[0].timer).CNT = 5000;  // an encoder jump
+  EXPECT_NE(r.tick() & osc::kFaultEncoderJump, 0u);
+  EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kFault);
+  EXPECT_TRUE(r.dac.last_zero());
+  EXPECT_FALSE(r.safety.amplifier_enabled());
+  EXPECT_TRUE(drove(r.f, pins::kAmpEnable, false));
+  r.tick();
+  EXPECT_TRUE(r.dac.last_zero()) << "and every tick after";
+}
+
+TEST(Stm32Board, TheEstopInterruptLatchesTheFaultWithinOneTick) {
+  BoardRig r;
+  EXPECT_EQ(r.f.syscfg.EXTICR[0], 3u << 4) << "EXTI line 1 from port D";
+  EXPECT_EQ(r.f.exti.RTSR, 1u << 1);
+  EXPECT_EQ(r.f.exti.IMR, 1u << 1);
+  for (int k = 0; k < 3; ++k) ASSERT_EQ(r.tick(), 0u);
+  ASSERT_TRUE(r.safety.amplifier_enabled());
+  r.f.exti.PR = 0;
+  r.safety.on_estop_interrupt();  // the EXTI1 handler
+  EXPECT_EQ(r.f.exti.PR, 1u << 1) << "pending bit cleared";
+  EXPECT_FALSE(r.safety.amplifier_enabled()) << "amplifier off in the interrupt itself";
+  EXPECT_TRUE(drove(r.f, pins::kFaultLed, true));
+  EXPECT_NE(r.tick() & osc::kFaultEstop, 0u) << "the next tick";
+  EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kFault);
+  EXPECT_NE(r.task.sup.latched & osc::kFaultEstop, 0u);
+  EXPECT_TRUE(r.dac.last_zero());
+  EXPECT_FALSE(r.safety.amplifier_enabled());
+}
+
+TEST(Stm32Board, AnEstopHeldBeforeBootFaultsTheFirstTick) {
+  BoardRig r;
+  r.f.port(pins::kEstop.pin.port).IDR = 1u << pins::kEstop.pin.n;  // open chain: no edge ever comes
+  EXPECT_NE(r.tick() & osc::kFaultEstop, 0u);
+  EXPECT_FALSE(r.safety.amplifier_enabled());
+  EXPECT_TRUE(r.dac.last_zero());
+}
+
+TEST(Stm32Board, AnEstopDuringTheBurstClearsTheOutputs) {
+  struct RacingDac : RecordingDac {
+    Safety* s = nullptr;
+    bool write(const std::int32_t c[hal::kJoints]) {
+      s->on_estop_interrupt();  // the E-stop interrupt preempts the burst
+      return RecordingDac::write(c);
+    }
+  };
+  FakeChip f;
+  EncoderBank enc;
+  RacingDac dac;
+  Safety safety;
+  enc.init(f.chip());
+  safety.init(f.chip());
+  dac.s = &safety;
+  BoardHal<EncoderBank, RacingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  const std::int32_t codes[hal::kJoints] = {1, 2, 3, 4, 5, 6};
+  hal.write_dacs(codes);
+  EXPECT_EQ(dac.clears, 1) << "CLR pulsed: the codes of that burst never reach the joints";
+}
+
+TEST(Stm32Board, TheSafeStateBeforeInitIsHarmless) {
+  // A fault handler may run before the drivers are set up: nothing to switch yet, and no crash.
+  Safety safety;
+  SpiDacBus bus;
+  safety.force_safe();
+  bus.clear_pulse();
+  EXPECT_FALSE(safety.amplifier_enabled());
+}
+
+TEST(Stm32Board, TheWatchdogIsFedOnlyByHealthyTicks) {
+  BoardRig r;
+  EXPECT_EQ(r.safety.watchdog_start(), BootFault::kNone);
+  EXPECT_EQ(r.f.iwdg.PR, 0u);
+  EXPECT_EQ(r.f.iwdg.RLR, 40u);
+  EXPECT_EQ(r.f.iwdg.KR, IwdgRegs::kReload);
+  EXPECT_NE(r.f.dbgmcu.APB1_FZ & DbgmcuRegs::kIwdgStop, 0u) << "paused while a debugger halts the core";
+  for (int k = 0; k < 3; ++k) {
+    r.f.iwdg.KR = 0;
+    ASSERT_EQ(r.tick(), 0u);
+    EXPECT_EQ(r.f.iwdg.KR, IwdgRegs::kReload) << "healthy tick " << k;
+  }
+  r.f.timer(pins::kEncoders[2].timer).CNT = 60000;  // encoder jump: the fault latches
+  r.f.iwdg.KR = 0;
+  r.tick();
+  EXPECT_EQ(r.f.iwdg.KR, 0u) << "the faulted tick does not feed";
+  for (int k = 0; k < 3; ++k) {
+    r.tick();
+    EXPECT_EQ(r.f.iwdg.KR, 0u) << "nor any tick after it";
+  }
+  EXPECT_EQ(r.hal.feeds(), 3u);
+}
+
+TEST(Stm32Board, AWatchdogThatNeverTakesItsSettingsIsABootFault) {
+  BoardRig r;
+  r.f.iwdg.SR = IwdgRegs::kRvu;  // the reload update never completes (no LSI)
+  EXPECT_EQ(r.safety.watchdog_start(), BootFault::kWatchdogSetup);
+}
+
+TEST(Stm32Board, ATickThatFindsTheNextOnePendingIsAnOverrun) {
+  BoardRig r;
+  ASSERT_EQ(r.tick(), 0u);
+  r.f.timer(Timer::kTim6).SR = TimRegs::kUif;  // set again right after the acknowledgement
+  EXPECT_NE(r.hal.tick(r.task) & osc::kFaultOverrun, 0u);
+}
+
+TEST(Stm32Board, ADacBusFaultLatchesOnTheNextTick) {
+  BoardRig r;
+  ASSERT_EQ(r.tick(), 0u);
+  r.dac.ok = false;
+  EXPECT_EQ(r.tick(), 0u);
+  EXPECT_NE(r.tick() & kFaultDacBus, 0u);
+  EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kFault);
+  EXPECT_TRUE(r.dac.last_zero());
+}
+
+// ---------------------------------------------------------------------- control timer, telemetry
+
+TEST(Stm32ControlTimer, OneKilohertzFromEachTimerClock) {
+  FakeChip f;
+  TimRegs& t = f.timer(Timer::kTim6);
+  control_timer_start(t, control_divider(84000000, 1000));
+  EXPECT_EQ(t.PSC, 83u);
+  EXPECT_EQ(t.ARR, 999u);
+  EXPECT_EQ(t.DIER, TimRegs::kUie);
+  EXPECT_EQ(t.CR1, TimRegs::kUrs | TimRegs::kCen);
+  EXPECT_EQ(control_divider(16000000, 1000).psc, 15u) << "HSI fallback";
+  EXPECT_EQ(control_divider(48000000, 1000).psc, 47u) << "QEMU's timer clock";
+  t.SR = TimRegs::kUif;
+  EXPECT_TRUE(control_timer_pending(t));
+  control_timer_ack(t);
+  EXPECT_FALSE(control_timer_pending(t));
+}
+
+TEST(Stm32Telemetry, AFrameGoesOutWhileTheTransmitterIsEmptyAndTheNextWaits) {
+  FakeChip f;
+  TelemetryUart u;
+  u.init(f.chip(), 42000000, 460800);
+  EXPECT_EQ(f.usart2.BRR, 91u);
+  EXPECT_EQ(f.usart2.CR1, UsartRegs::kUe | UsartRegs::kTe | UsartRegs::kRe);
+  osc::ControlTask<float> task;
+  task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
+            osc::joint_vector<float>(osc::robot::kQStart));
+  const std::int32_t codes[hal::kJoints] = {1, -2, 3, -4, 5, -6};
+  std::uint8_t buf[pil::kMaxFrame];
+  const int n = pil::encode(osc::telemetry_frame(task, codes, 7, 1234), buf);
+  ASSERT_EQ(n, pil::kMaxFrame);
+  ASSERT_TRUE(u.offer(buf, n));
+  EXPECT_EQ(u.pump(), 0) << "transmitter full: nothing goes";
+  EXPECT_FALSE(u.offer(buf, n)) << "still busy: the next frame is refused";
+  EXPECT_EQ(u.dropped(), 1u);
+  f.usart2.SR = UsartRegs::kTxe;
+  EXPECT_EQ(u.pump(10), 10);
+  EXPECT_EQ(u.pump(), n - 10);
+  EXPECT_EQ(f.usart2.DR, buf[n - 1]);
+  EXPECT_FALSE(u.busy());
+  // The bytes are the PIL's actuator frame: the host's parser reads them back.
+  pil::Parser p;
+  pil::Parser::Result res = pil::Parser::kPending;
+  for (int i = 0; i < n; ++i) res = p.feed(buf[i]);
+  ASSERT_EQ(res, pil::Parser::kFrame);
+  pil::ActuatorFrame a;
+  ASSERT_TRUE(p.decode(a));
+  EXPECT_EQ(a.seq, 7u);
+  EXPECT_EQ(a.codes[3], -4);
+  EXPECT_EQ(a.stack_used, 1234u);
+}
+
+}  // namespace
