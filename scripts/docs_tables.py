@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the tables of measured figures in docs/ from runs and test output.
 
-usage: docs_tables.py [--check] [--kind host|m4f|long ...] [--only NAME ...] [--list]
+usage: docs_tables.py [--check] [--kind host|m4f|m3|long ...] [--only NAME ...] [--list]
 
 A generated table sits between two markers in a docs/*.md file:
 
@@ -13,6 +13,8 @@ and is rewritten in place. Kinds:
   host  short runs of the host build (puma_experiment): seconds; checked in CI (ctest docs_tables_host)
   m4f   the Cortex-M4F images: sizes, stack and instruction counts from running them in QEMU;
         checked in CI (ctest docs_tables_m4f in the m4f preset)
+  m3    the Cortex-M3 images (fixed point, and the soft-float alternative): the same figures;
+        checked in CI (ctest docs_tables_m3 in the m3 preset)
   long  runs of minutes to hours (QEMU experiment, fault-injection matrix, benchmarks): regenerated
         by hand with --kind long, never checked (wall-clock figures vary from run to run)
 
@@ -34,15 +36,16 @@ import tempfile
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 HOST = os.path.join(ROOT, "build", "host")
 M4F = os.path.join(ROOT, "build", "m4f")
+M3 = os.path.join(ROOT, "build", "m3")
 EXPERIMENT = os.path.join(HOST, "host_sim", "puma_experiment")
 AXES = ["e_x mm", "e_y mm", "e_z mm", "e_φx °", "e_φy °", "e_φz °"]
 
 TABLES = {}
 
 
-def set_builds(host, m4f):
-    global HOST, M4F, EXPERIMENT
-    HOST, M4F = os.path.abspath(host), os.path.abspath(m4f)
+def set_builds(host, m4f, m3):
+    global HOST, M4F, M3, EXPERIMENT
+    HOST, M4F, M3 = os.path.abspath(host), os.path.abspath(m4f), os.path.abspath(m3)
     EXPERIMENT = os.path.join(HOST, "host_sim", "puma_experiment")
 
 
@@ -107,18 +110,20 @@ QEMU = ["qemu-system-arm", "-M", "mps2-an386", "-display", "none", "-monitor", "
 _images = {}
 
 
-def image_output(image, board="mps2_an386", machine="mps2-an386"):
-    """What an image prints when it runs in its board's QEMU (cached)."""
-    if image not in _images:
-        elf = os.path.join(M4F, "boards", board, image + ".elf")
+def image_output(image, board="mps2_an386", machine="mps2-an386", build=None):
+    """What an image prints when it runs in its board's QEMU (cached); build: M4F by default."""
+    build = build or M4F
+    key = (build, board, image)
+    if key not in _images:
+        elf = os.path.join(build, "boards", board, image + ".elf")
         qemu = [a if a != "mps2-an386" else machine for a in QEMU]
         if board == "stm32f4":  # its USART2 (the second serial port) carries the telemetry frames
             qemu = qemu[:-1] + ["-serial", "null", "-kernel"]
         p = subprocess.run(["timeout", "120", *qemu, elf], capture_output=True, text=True)
         if p.returncode != 0:
             raise RuntimeError(f"{image} failed in QEMU ({p.returncode}):\n{p.stdout[-3000:]}{p.stderr[-2000:]}")
-        _images[image] = p.stdout + p.stderr  # semihosting output goes to QEMU's stderr
-    return _images[image]
+        _images[key] = p.stdout + p.stderr  # semihosting output goes to QEMU's stderr
+    return _images[key]
 
 
 # ---------------------------------------------------------------- formatting
@@ -227,6 +232,90 @@ def experiment_robustness():
     return "\n".join(lines)
 
 
+@table("fixed_closed_loop", "docs/fixed_point.md", "host")
+def fixed_closed_loop():
+    runs = [("--duration", "120", "--scalar", s) for s in ("double", "float", "fixed")]
+    prefetch(runs)
+    res = {a[-1]: experiment(*a) for a in runs}
+    fl_ad = errors(run_of(res["float"], "adaptive"), "last")
+    fx_ad, fx_no = errors(run_of(res["fixed"], "adaptive"), "last"), errors(run_of(res["fixed"], "none"), "last")
+    lines = ["| 120 s, max \\|e\\| over the last 20 s | " + " | ".join(AXES) + " |", "|---|---|---|---|---|---|---|"]
+    for sc in ("double", "float", "fixed"):
+        lines.append(row(f"{sc}, adaptive (robust law)", errors(run_of(res[sc], "adaptive"), "last"), bold=sc == "fixed"))
+    for sc in ("float", "fixed"):
+        lines.append(row(f"{sc}, without compensation", errors(run_of(res[sc], "none"), "last")))
+    lines.append(row("fixed / float, adaptive (criterion ≤ 1.5)", [a / b for a, b in zip(fx_ad, fl_ad)], 2))
+    lines.append(row("fixed: without / with (criterion ≥ 2)", [a / b for a, b in zip(fx_no, fx_ad)], 1))
+    return "\n".join(lines)
+
+
+_tests = {}
+
+
+def test_output(name):
+    """What a host test binary prints (cached)."""
+    if name not in _tests:
+        exe = os.path.join(HOST, "tests", name)
+        p = subprocess.run([exe], capture_output=True, text=True)
+        if p.returncode != 0:
+            raise RuntimeError(f"{exe} failed:\n{p.stdout[-3000:]}")
+        _tests[name] = p.stdout
+    return _tests[name]
+
+
+@table("fixed_accuracy", "docs/fixed_point.md", "host")
+def fixed_accuracy():
+    out = test_output("test_fixed_kernels")
+    units = {"FK position": "m", "R": "", "phi": "rad", "J": "m/rad, 1", "A": "kg m²", "g": "N m", "c": "N m",
+             "Lambda": "kg, kg m, kg m²", "p": "N, N m", "Psi": "N, N m", "W": "rad/s, 1"}
+    lines = ["| kernel (1000 random states in the domain) | worst \\|fixed − double\\| | budget (tested) | unit |",
+             "|---|---|---|---|"]
+    for name, unit in units.items():
+        m = re.search(r"(?:^|, |  )" + re.escape(name) + r" ([0-9.e+-]+)(?: \w[^(]*)? \(([0-9.e+-]+)", out, re.M)
+        if not m:
+            raise RuntimeError(f"test_fixed_kernels: no line for {name}:\n{out}")
+        lines.append(f"| {name} | {float(m.group(1)):.2e} | {float(m.group(2)):.1e} | {unit} |")
+    m = re.search(r"control_step tau: worst \|error\| ([0-9.e+-]+) N m \(budget ([0-9.]+)\).*?"
+                  r"worst error / effect of one encoder count ([0-9.]+) \(budget ([0-9.]+)\)", out, re.S)
+    lines.append(f"| control_step τ | {float(m.group(1)):.2e} | {float(m.group(2)):.1f} | N m |")
+    lines.append(f"| control_step τ error / τ change of one encoder count | {float(m.group(3)):.3f} | "
+                 f"{float(m.group(4)):.2f} | |")
+    return "\n".join(lines)
+
+
+@table("fixed_functions", "docs/fixed_point.md", "host")
+def fixed_functions():
+    out = test_output("test_fixed")
+    lines = ["| function (Q12.19 in and out) | method | stated max error (tested) | measured worst |", "|---|---|---|---|"]
+    methods = {"sin": ("x = k π/2 + r (π/2 to 61 bits), Taylor to r¹¹ in Q30", "0.51 LSB"),
+               "cos": ("the same reduction, Taylor to r¹²", "0.51 LSB"),
+               "exp": ("x = k ln 2 + r, Taylor to r⁸ in Q30, times 2^k", "0.51 LSB + 4·10⁻⁹ eˣ"),
+               "sqrt": ("integer square root of the 64-bit r·2¹⁹, rounded", "0.5 LSB (correctly rounded)"),
+               "atan2": ("octant, atan(i/8) table + 7th-order series in Q30", "0.51 LSB"),
+               "asin": ("atan2(x, √(1 − x²)) with 1 − x² exact", "0.51 LSB")}
+    for name, (method, stated) in methods.items():
+        m = re.search(r"\b" + name + r": worst (?:\|error\| - [0-9e.+-]+ e\^x = )?([0-9.]+) LSB", out)
+        if not m:
+            raise RuntimeError(f"test_fixed: no line for {name}")
+        lines.append(f"| {name} | {method} | {stated} | {float(m.group(1)):.4f} LSB |")
+    return "\n".join(lines)
+
+
+@table("fixed_headroom", "docs/fixed_point.md", "host")
+def fixed_headroom():
+    out = test_output("test_fixed_headroom")
+    rows = re.findall(r"^\| (the paper's task.*|joint-limit corners.*) \|$", out, re.M)
+    lines = ["| largest \\|value\\| | A kg m² | Λ | g N m | p | h = Ψ(x, ẋ)ẋ | bracket of h, c N m | F | τ N m | "
+             "spare bits (no flag down to) |", "|---|---|---|---|---|---|---|---|---|---|"]
+    task = [r for r in rows if r.startswith("the paper")][0]
+    corners = [r for r in rows if r.startswith("joint-limit")][0]
+    tb = re.search(r"along the task: the chain runs without a flag down to Q<(\d+)> .*?: (\d+) spare bits", out)
+    cb = re.search(r"at the corners in the domain: no flag down to Q<(\d+)> .*?: (\d+) spare bits", out)
+    lines.append(f"| {task} | {tb.group(2)} (Q<{tb.group(1)}>) |")
+    lines.append(f"| {corners} | {cb.group(2)} (Q<{cb.group(1)}>) |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- m4f tables
 
 IMAGES = [("kernels_image", "every kernel in float, checked against the published vectors, instruction counts"),
@@ -235,9 +324,9 @@ IMAGES = [("kernels_image", "every kernel in float, checked against the publishe
           ("watchdog_firmware", "the watchdog's resets (hung tick, latched fault, control interrupt off)")]
 
 
-def image_size(image, board="mps2_an386"):
+def image_size(image, board="mps2_an386", build=None):
     out = subprocess.run([os.path.join(ROOT, "boards/common/cortex_m/check_image.sh"),
-                          os.path.join(M4F, "boards", board, image + ".elf")], capture_output=True, text=True)
+                          os.path.join(build or M4F, "boards", board, image + ".elf")], capture_output=True, text=True)
     m = re.search(r"flash \(text\+data\): (\d+) bytes; RAM: .* = (\d+) bytes", out.stdout)
     if not m:
         raise RuntimeError(f"check_image.sh {image}: {out.stdout}{out.stderr}")
@@ -271,18 +360,63 @@ def stm32f4_images():
     return "\n".join(lines)
 
 
+def kernel_instructions(out):
+    """The per-kernel instruction counts a kernels_image printed: [(name, count)]; the control step
+    as (name, "worst / mean")."""
+    rows = []
+    for name, n in re.findall(r"^\s+(.+?): (\d+) instructions$", out, re.M):
+        rows.append((name, thousands(int(n))))
+    m = re.search(r"^\s+(control_step .*?), worst of (\d+): (\d+), mean (\d+) instructions$", out, re.M)
+    if m:
+        rows.append((f"**{m.group(1)}, {m.group(2)} steps: worst / mean**",
+                     f"**{thousands(int(m.group(3)))}** / {thousands(int(m.group(4)))}"))
+    return rows
+
+
+def timer_step(out, what="control step in the 1 kHz timer interrupt (`timer_firmware`, 200 ticks): max / mean"):
+    m = re.search(r"control step: max (\d+), mean (\d+) instructions", out)
+    return [(what, f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))}")] if m else []
+
+
 @table("target_instructions", "docs/benchmarks.md", "m4f")
 def target_instructions():
-    out = image_output("kernels_image") + image_output("timer_firmware")
-    lines = ["| kernel (float) | instructions |", "|---|---|"]
-    for name, n in re.findall(r"^\s+(.+?): (\d+) instructions$", out, re.M):
-        label = f"**{name}**" if name.startswith("control_step") else name
-        count = f"**{thousands(int(n))}**" if name.startswith("control_step") else thousands(int(n))
-        lines.append(f"| {label} | {count} |")
-    m = re.search(r"control step: max (\d+), mean (\d+) instructions", out)
-    if m:
-        lines.append(f"| control step in the 1 kHz timer interrupt (`timer_firmware`, 200 ticks): max / mean | "
-                     f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))} |")
+    rows = kernel_instructions(image_output("kernels_image")) + timer_step(image_output("timer_firmware"))
+    return "\n".join(["| kernel (float) | instructions |", "|---|---|"] + [f"| {a} | {b} |" for a, b in rows])
+
+
+# ---------------------------------------------------------------- m3 tables (docs/fixed_point.md)
+
+M3_IMAGES = [("kernels_image", "every kernel in Q12.19, checked against the host's values bit for bit"),
+             ("kernels_image_softfloat", "the same kernels in float through the soft-float routines"),
+             ("timer_firmware", "the control task in the 1 kHz TIMER0 interrupt, 200 ticks"),
+             ("pil_firmware", "the control task over the UART0 link to host_sim"),
+             ("watchdog_firmware", "the watchdog's resets")]
+
+
+def m3_output(image):
+    return image_output(image, "mps2_an385", "mps2-an385", M3)
+
+
+@table("m3_images", "docs/fixed_point.md", "m3")
+def m3_images():
+    lines = ["| image (Cortex-M3) | what | flash | RAM (data + bss + .noinit + 16 KiB stack) | stack high-water |",
+             "|---|---|---|---|---|"]
+    for image, what in M3_IMAGES:
+        flash, ram = image_size(image, "mps2_an385", M3)
+        runs = image.startswith("kernels_image") or image == "timer_firmware"  # they print their stack
+        m = re.search(r"^stack used: (\d+) bytes", m3_output(image), re.M) if runs else None
+        s = f"{thousands(int(m.group(1)))} B" if m else ""
+        lines.append(f"| `{image}` | {what} | {thousands(flash)} B | {thousands(ram)} B | {s} |")
+    return "\n".join(lines)
+
+
+@table("m3_instructions", "docs/fixed_point.md", "m3")
+def m3_instructions():
+    fixed = kernel_instructions(m3_output("kernels_image")) + timer_step(m3_output("timer_firmware"))
+    soft = dict(kernel_instructions(m3_output("kernels_image_softfloat")))
+    lines = ["| kernel (Cortex-M3, no FPU) | Q12.19 fixed point | float, soft-float routines |", "|---|---|---|"]
+    for name, n in fixed:
+        lines.append(f"| {name} | {n} | {soft.get(name, '')} |")
     return "\n".join(lines)
 
 
@@ -491,18 +625,19 @@ def numbers_close(a, b):
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--check", action="store_true", help="compare, do not write; exit 1 when a table is stale")
-    ap.add_argument("--kind", action="append", choices=["host", "m4f", "long"], help="the kinds of tables to do")
+    ap.add_argument("--kind", action="append", choices=["host", "m4f", "m3", "long"], help="the kinds of tables to do")
     ap.add_argument("--only", action="append", help="only these tables")
     ap.add_argument("--list", action="store_true", help="list the tables")
     ap.add_argument("--host-build", default=HOST, help="the host preset's build directory")
     ap.add_argument("--m4f-build", default=M4F, help="the m4f preset's build directory")
+    ap.add_argument("--m3-build", default=M3, help="the m3 preset's build directory")
     a = ap.parse_args(argv[1:])
-    set_builds(a.host_build, a.m4f_build)
+    set_builds(a.host_build, a.m4f_build, a.m3_build)
     if a.list:
         for name, (doc, kind, _) in TABLES.items():
             print(f"{name:24} {kind:5} {doc}")
         return 0
-    kinds = a.kind or [k for k, build in (("host", HOST), ("m4f", M4F)) if os.path.isdir(build)]
+    kinds = a.kind or [k for k, build in (("host", HOST), ("m4f", M4F), ("m3", M3)) if os.path.isdir(build)]
     names = [n for n, (_, kind, _) in TABLES.items() if kind in kinds and (not a.only or n in a.only)]
     if a.only and len(names) != len(a.only):
         print(f"docs_tables.py: unknown table or kind not selected: {set(a.only) - set(names)}", file=sys.stderr)

@@ -134,6 +134,19 @@ TEST(FixedArithmetic, ConversionsToFloatAndDoubleAreExactOrCorrectlyRounded) {
     EXPECT_EQ(d * (1 << 19), static_cast<double>(x.raw()));
     EXPECT_EQ(static_cast<float>(x), static_cast<float>(d));
   }
+  // The edges, and the ties of the rounding to 24 bits (even down, odd up), in three formats.
+  for (std::int32_t raw : {1, -1, 2, INT32_MAX, INT32_MIN, INT32_MIN + 1, (1 << 24) - 1, 1 << 24, (1 << 24) + 1,
+                           (1 << 24) + 3, -((1 << 24) + 1), -((1 << 24) + 3), (1 << 30) + 64, (1 << 30) + 192,
+                           0x7FFFFFC0, 0x7FFFFF40}) {
+    EXPECT_EQ(static_cast<float>(Fixed::from_raw(raw)), static_cast<float>(static_cast<double>(Fixed::from_raw(raw))))
+        << raw;
+    EXPECT_EQ(static_cast<float>(FixedIo::from_raw(raw)), static_cast<float>(static_cast<double>(FixedIo::from_raw(raw))))
+        << raw;
+    EXPECT_EQ(static_cast<float>(fixed::Q<30>::from_raw(raw)),
+              static_cast<float>(static_cast<double>(fixed::Q<30>::from_raw(raw))))
+        << raw;
+  }
+  EXPECT_EQ(static_cast<float>(Fixed::from_raw(0)), 0.0f);
 }
 
 TEST(FixedArithmetic, MixedFormatProductAndIntegerQuotient) {

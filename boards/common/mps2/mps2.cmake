@@ -3,11 +3,11 @@
 # script and the images are shared (boards/common/mps2, linker/mps2.ld); the board's own folder has
 # its board.hpp (the core and the scalar of its images, board::Scalar) and this call. Defines the
 # images kernels_image, heap_probe, pil_firmware, timer_firmware and watchdog_firmware with their
-# tests; sets OSC_BOARD_ENABLED in the caller (false when CPU is not this toolchain's).
+# tests (FORBIDDEN_ON_CONTROL_PATH: a regular expression of routines the control path must not call); sets OSC_BOARD_ENABLED in the caller (false when CPU is not this toolchain's).
 set(OSC_MPS2_DIR ${CMAKE_CURRENT_LIST_DIR})
 
 function(osc_add_mps2_board)
-  cmake_parse_arguments(B "" "NAME;CPU;QEMU_MACHINE" "" ${ARGN})
+  cmake_parse_arguments(B "" "NAME;CPU;QEMU_MACHINE;FORBIDDEN_ON_CONTROL_PATH" "" ${ARGN})
   osc_add_board(NAME ${B_NAME} CPU ${B_CPU} LINKER_SCRIPT ${PROJECT_SOURCE_DIR}/linker/mps2.ld
                 QEMU_MACHINE ${B_QEMU_MACHINE} SOURCES ${OSC_MPS2_DIR}/vectors.cpp)
   set(OSC_BOARD_ENABLED ${OSC_BOARD_ENABLED} PARENT_SCOPE)
@@ -34,6 +34,16 @@ function(osc_add_mps2_board)
   # Processor-in-the-loop firmware: the control task over the UART0 link to host_sim.
   osc_board_image(${B_NAME} pil_firmware ${OSC_MPS2_DIR}/pil_firmware.cpp)
   osc_image_checks(pil_firmware)
+
+  # The control path (the timer interrupt, the tick, the step) calls no routine the board's scalar
+  # must not need: FORBIDDEN_ON_CONTROL_PATH, e.g. the soft double-precision routines.
+  find_program(OSC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  foreach(image pil_firmware timer_firmware)
+    add_test(NAME ${image}_control_path_calls
+             COMMAND ${OSC_SYSTEM_PYTHON} ${OSC_CORTEX_M_DIR}/control_path_calls.py $<TARGET_FILE:${image}>
+                     "^TIMER0_Handler$|control_tick|control_step" "${B_FORBIDDEN_ON_CONTROL_PATH}"
+                     --objdump ${CMAKE_OBJDUMP})
+  endforeach()
 
   # The control task in the real 1 kHz timer interrupt (no plant).
   osc_board_image(${B_NAME} timer_firmware ${OSC_MPS2_DIR}/timer_firmware.cpp)

@@ -22,6 +22,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <bit>
 #include <climits>
 #include <concepts>
 #include <cstdint>
@@ -321,8 +322,28 @@ class Q {
   static constexpr Q lsb() { return from_raw(1); }
 
   explicit constexpr operator double() const { return static_cast<double>(r_) / static_cast<double>(std::int64_t{1} << F); }
-  /// Correctly rounded (the integer rounds once, the power of two scales exactly).
-  explicit constexpr operator float() const { return static_cast<float>(r_) * (1.0f / static_cast<float>(1u << F)); }
+  /// Correctly rounded (to nearest, ties to even), assembled from the integer's bits: no floating-point
+  /// operation, so a core without an FPU converts without a soft-float routine (telemetry frames).
+  explicit constexpr operator float() const {
+    if (r_ == 0) return 0.0f;
+    const std::uint32_t sign = r_ < 0 ? 0x80000000u : 0u;
+    std::uint32_t m = r_ < 0 ? 0u - static_cast<std::uint32_t>(r_) : static_cast<std::uint32_t>(r_);
+    int top = 31 - std::countl_zero(m);  // value = m 2^-F = 1.f 2^(top - F)
+    if (top > 23) {                      // keep 24 significant bits, rounded to nearest even
+      const int sh = top - 23;
+      const std::uint32_t rest = m & ((1u << sh) - 1u), half = 1u << (sh - 1);
+      m >>= sh;
+      if (rest > half || (rest == half && (m & 1u))) ++m;
+      if (m == (1u << 24)) {
+        m >>= 1;
+        ++top;
+      }
+    } else {
+      m <<= 23 - top;
+    }
+    const std::uint32_t exponent = static_cast<std::uint32_t>(top - F + 127);  // a normal float for F <= 30
+    return std::bit_cast<float>(sign | (exponent << 23) | (m & 0x7FFFFFu));
+  }
   /// Truncated towards zero, as a float converts.
   explicit constexpr operator std::int32_t() const {
     return r_ >= 0 ? (r_ >> F) : -static_cast<std::int32_t>((-static_cast<std::int64_t>(r_)) >> F);

@@ -4,7 +4,9 @@
 // constructor from double for literals (lit<S>).
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 #include "osc/kernels/fixed.hpp"
@@ -14,6 +16,16 @@ namespace osc {
 /// Literal of the kernel's scalar type (evaluated at compile time for float/double).
 template <class S>
 constexpr S lit(double v) { return static_cast<S>(v); }
+
+/// A table of literals (per-joint limits) in the kernel's scalar. Bound to a constexpr variable it is
+/// converted at compile time: indexing it at run time then costs no conversion from double (on a
+/// core without a double-precision FPU, each would be a library call).
+template <class S, std::size_t N>
+constexpr std::array<S, N> lit_array(const double (&a)[N]) {
+  std::array<S, N> r{};
+  for (std::size_t i = 0; i < N; ++i) r[i] = lit<S>(a[i]);
+  return r;
+}
 
 namespace math {
 inline float sin(float v) { return std::sin(v); }

@@ -131,6 +131,13 @@ Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<math::io_scalar_t<
 ///  - theta_bounds: a friction estimate outside [-band theta_max, (1 + band) theta_max].
 template <class S>
 std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) {
+  // The thresholds in S, converted at compile time.
+  static constexpr std::array<S, kDof> kStuckTorque = lit_array<S>(params::kStuckTorque);
+  static constexpr std::array<S, kDof> kStuckTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
+  static constexpr S kMotionBound = lit<S>(kStuckMotionBound), kMotionCounts = lit<S>(params::kStuckMotionCounts);
+  static constexpr S kLimitPosition = lit<S>(params::kTrackingLimitPosition);
+  static constexpr S kLimitOrientation = lit<S>(params::kTrackingLimitOrientation);
+  static constexpr S kBand = lit<S>(params::kThetaFaultBand);
   std::uint32_t faults = 0;
   const StepOutput<S>& out = task.last;
   for (int i = 0; i < kDof; ++i) {
@@ -147,9 +154,9 @@ std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) 
     // static friction, stuck whatever the joint did before.
     const S dtau = math::abs(out.tau(i) - task.tau_at_move(i));
     if (dtau > task.stuck_dtau_peak(i)) task.stuck_dtau_peak(i) = dtau;
-    if (dtau > lit<S>(params::kStuckTorque[i])) faults |= kFaultEncoderStuck;
+    if (dtau > kStuckTorque[i]) faults |= kFaultEncoderStuck;
     m += math::abs(out.qd_ref(i)) * task.gains.dt * task.counts_per_rad(i);
-    if (m > lit<S>(kStuckMotionBound)) m = lit<S>(kStuckMotionBound);
+    if (m > kMotionBound) m = kMotionBound;
     // The encoder has been silent for many times its recent interval between counts: a joint that
     // was moving should have counted (one that was slowing down, as at a reversal held by static
     // friction, had long intervals already). Then a smaller torque change, or the reference having
@@ -157,17 +164,17 @@ std::uint32_t plausibility_faults(ControlTask<S>& task, const bool moved[kDof]) 
     const std::uint64_t silent = task.tick - task.last_move_tick[i];
     if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * task.move_interval[i]) continue;
     if (m > task.stuck_peak(i)) task.stuck_peak(i) = m;
-    if (m > lit<S>(params::kStuckMotionCounts)) faults |= kFaultEncoderStuck;
+    if (m > kMotionCounts) faults |= kFaultEncoderStuck;
     if (task.move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
     if (dtau > task.stuck_dtau_gated_peak(i)) task.stuck_dtau_gated_peak(i) = dtau;
-    if (dtau > lit<S>(params::kStuckTorqueSilent[i])) faults |= kFaultEncoderStuck;
+    if (dtau > kStuckTorqueSilent[i]) faults |= kFaultEncoderStuck;
   }
-  const S lp = lit<S>(params::kTrackingLimitPosition), lo = lit<S>(params::kTrackingLimitOrientation);
+  const S lp = kLimitPosition, lo = kLimitOrientation;
   if (out.e.template head<3>().squaredNorm() > lp * lp) faults |= kFaultTracking;
   for (int i = 3; i < 6; ++i)
     if (math::abs(out.e(i)) > lo) faults |= kFaultTracking;
   if (task.mode == FrictionMode::kAdaptive) {
-    const S band = lit<S>(params::kThetaFaultBand);
+    const S band = kBand;
     for (int i = 0; i < 3 * kDof; ++i) {
       const S th = task.state.adapt.theta_hat(i), mx = task.gains.theta_max(i);
       if (!(th >= -band * mx && th <= (S(1) + band) * mx)) faults |= kFaultThetaBounds;

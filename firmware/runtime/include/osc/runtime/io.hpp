@@ -36,14 +36,30 @@ S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
   return counts_to_angle<S>(counts, lit<math::io_scalar_t<S>>(counts_per_rad(joint)), q_at_zero);
 }
 
+/// The DAC scale [codes per N m] and torque limit [N m] of each joint in the scalar W, built at
+/// compile time: the conversion in the tick then calls no double-precision routine (on a core
+/// without a double-precision FPU each would be a library call).
+template <class W>
+struct DacTable {
+  W scale[kDof], limit[kDof];
+  constexpr DacTable() : scale{}, limit{} {
+    for (int i = 0; i < kDof; ++i) {
+      scale[i] = lit<W>(static_cast<double>(kDacMaxCode) / robot::kDrives.torque_limit[i]);
+      limit[i] = lit<W>(robot::kDrives.torque_limit[i]);
+    }
+  }
+};
+template <class W> inline constexpr DacTable<W> kDacTable{};
+
 /// DAC code of a joint torque, saturated at the code range. Returns true when it saturated. The
 /// code is computed in the I/O scalar (it reaches 32767).
 template <class S>
 bool torque_to_code(int joint, S tau, std::int32_t& code) {
   using W = math::io_scalar_t<S>;
-  const W scale = lit<W>(static_cast<double>(kDacMaxCode) / robot::kDrives.torque_limit[joint]);
+  constexpr W kHalf = lit<W>(0.5);
+  const W scale = kDacTable<W>.scale[joint];
+  const W limit = kDacTable<W>.limit[joint];
   const W t = static_cast<W>(tau);
-  const W limit = lit<W>(robot::kDrives.torque_limit[joint]);
   if (!math::isfinite(t)) {
     code = 0;
     return true;
@@ -58,7 +74,7 @@ bool torque_to_code(int joint, S tau, std::int32_t& code) {
   }
   // Below the limit the code lies within the range; round to nearest.
   const W c = t * scale;
-  code = static_cast<std::int32_t>(c >= W(0) ? c + lit<W>(0.5) : c - lit<W>(0.5));
+  code = static_cast<std::int32_t>(c >= W(0) ? c + kHalf : c - kHalf);
   return false;
 }
 
