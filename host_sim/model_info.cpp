@@ -68,7 +68,7 @@ int main(int argc, char** argv) {
     SphericalWristJacobianFactor<double> Jg;
     Jg.compute(data.J);
     print("Lambda with the geometric Jacobian", operational_inertia(data.A, Jg));
-    print("Lambda with the analytic Jacobian (orientation relative to this pose)", os.Lambda);
+    print("Lambda with the analytic Jacobian (orientation relative to this pose)", operational_inertia(data, os));
     print("p(x) = J^-T g", operational_gravity(os).transpose());
   }
   return 0;

@@ -38,7 +38,7 @@ void kernel_outputs(const Case& c, const Model<S>& model, Data<S>& data, OpSpace
   emit("J", data.J);
   emit("A", data.A);
   emit("g", os.g);
-  emit("Lambda", os.Lambda);
+  emit("Lambda", Mat6<S>(operational_inertia(data, os)));
   emit("p", operational_gravity(os));
   emit("c", velocity_products(model, data, qd).c);
   emit("Psi h(v)", psi_quadratic(model, data, os, v));

@@ -128,8 +128,8 @@ TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
     q(1) += 0.08 * s;
     q(2) -= 0.1 * s;
     opspace_update(model, data, os, q, R_ref);
-    worst_semi = std::max(worst_semi, spectral_radius(os.Lambda, true));
-    worst_explicit = std::max(worst_explicit, spectral_radius(os.Lambda, false));
+    worst_semi = std::max(worst_semi, spectral_radius(operational_inertia(data, os), true));
+    worst_explicit = std::max(worst_explicit, spectral_radius(operational_inertia(data, os), false));
   }
   RecordProperty("spectral_radius_semi_implicit", std::to_string(worst_semi));
   RecordProperty("spectral_radius_explicit", std::to_string(worst_explicit));
@@ -236,7 +236,7 @@ TEST_F(Stages, ObserverUpdateIsEquation22) {
   const ObserverState<double> n = observer_update(G, os, x_hat, y, xt, F, h, p, f);
   // Lambda (y' - y) / dt = F - h - p - f + k_i x~, solved densely here.
   const Vec6<double> rhs = F - h - p - f + G.ki.cwiseProduct(xt);
-  const Vec6<double> y_expect = y + G.dt * os.Lambda.partialPivLu().solve(rhs);
+  const Vec6<double> y_expect = y + G.dt * operational_inertia(data, os).partialPivLu().solve(rhs);
   EXPECT_LT((n.y - y_expect).norm(), 1e-9 * (1 + y_expect.norm()));
   EXPECT_LT((n.x_hat - (x_hat + G.dt * (n.y + G.k.cwiseProduct(xt)))).norm(), 1e-15);
 }
@@ -260,6 +260,8 @@ TEST_F(Stages, AdaptationWaitsForItsFirstSampleThenFollowsEquation67) {
   a.q_prev = q;
   a.qd_hat_prev = v6(0.1, -0.2, 0.3, 0.0, 0.5, -0.6);
   a.qd_hat_prev2 = v6(9, 9, 9, 9, 9, 9);  // not used by (67)
+  a.w_prev = friction_regressor_diagonals(a.qd_hat_prev, G.tau_dec);  // what the last sample recorded
+  a.w_prev2 = friction_regressor_diagonals(a.qd_hat_prev2, G.tau_dec);
   a.samples = 0;
   const Vec6<double> q1 = q + v6(1e-4, -2e-4, 3e-4, 0, 5e-4, -6e-4);
   EXPECT_EQ(adaptation_step(G, a, q1), a.theta_hat);
@@ -283,6 +285,8 @@ TEST_F(Stages, RobustLawUsesTheOlderRegressorLeaksAndProjects) {
   a.q_prev = q;
   a.qd_hat_prev = v6(0.1, -0.2, 0.3, 0.0, 0.5, -0.6);
   a.qd_hat_prev2 = v6(-0.2, 0.1, 0.3, 0.05, -0.5, 0.4);
+  a.w_prev = friction_regressor_diagonals(a.qd_hat_prev, G.tau_dec);  // what the last samples recorded
+  a.w_prev2 = friction_regressor_diagonals(a.qd_hat_prev2, G.tau_dec);
   const Vec6<double> q1 = q + v6(1e-3, 2e-3, 3e-4, 1e-4, 5e-4, -6e-4);
   a.samples = 1;
   EXPECT_EQ(adaptation_step(G, a, q1), a.theta_hat);  // needs two samples
@@ -320,7 +324,7 @@ TEST_F(Stages, ForceCommandIsEquations32_36) {
   const Vec6<double> v = d.xd + G.ks.cwiseProduct(e);
   const Vec6<double> psi_v = psi_bilinear(model, data, os, ob.xd_hat, v);  // Psi(x, x^dot) v
   const Vec6<double> p = operational_gravity(os);
-  const Vec6<double> w_e = os.Lambda * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + p + f_hat;  // (35)
+  const Vec6<double> w_e = operational_inertia(data, os) * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + p + f_hat;  // (35)
   const Vec6<double> F = (G.ks + G.knd).cwiseProduct(v - ob.xd_hat) + w_e - G.ki.cwiseProduct(ob.x_tilde);  // (32), (34)
   EXPECT_LT((c.e - e).norm(), 1e-15);
   EXPECT_LT((c.F - F).norm(), 1e-10 * (1 + F.norm()));

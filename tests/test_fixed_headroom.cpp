@@ -52,7 +52,8 @@ Peaks chain(const Vec6<double>& q, const Mat3<double>& R_ref, const Vec6<double>
   const Vec6<S> vs = v.cast<S>(), as = a.cast<S>();
   const Vec6<S> h = psi_quadratic(model, *data, *os, vs);
   const Vec6<S> p = operational_gravity(*os);
-  const Vec6<S> F = os->Lambda * as + h + p;
+  const Mat6<S> Lambda = operational_inertia(*data, *os);
+  const Vec6<S> F = Lambda * as + h + p;
   const Vec6<S> tau = joint_torques(*os, F);
   // psi_quadratic's bracket c - A J^{-1} Jdot qd_v (a joint torque), its largest intermediate.
   const Vec6<S> qd = os->Jf.solve(vs);
@@ -60,7 +61,7 @@ Peaks chain(const Vec6<double>& q, const Mat3<double>& R_ref, const Vec6<double>
   const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os->x.template tail<3>()));
   const Vec6<S> bracket = data->A * os->Jf.solve(jdqd);
   Peaks pk;
-  pk.A = amax(data->A), pk.Lambda = amax(os->Lambda), pk.g = amax(os->g), pk.p = amax(p), pk.h = amax(h);
+  pk.A = amax(data->A), pk.Lambda = amax(Lambda), pk.g = amax(os->g), pk.p = amax(p), pk.h = amax(h);
   pk.bracket = std::max(amax(bracket), amax(vp.c)), pk.F = amax(F), pk.tau = amax(tau);
   return pk;
 }

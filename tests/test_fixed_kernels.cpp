@@ -119,13 +119,15 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
       W = friction_regressor(qdq, Vec6<double>(Vec6<double>::Constant(params::kTauDec)));
       Wf = friction_regressor(qdf, dec);
     }
+    const Mat6<double> Ld = operational_inertia(*dd, *od);
+    const Mat6<Fixed> Lf = operational_inertia(*df, *of);
     const bool flagged = fixed::take_flags() != 0;
-    if (largest(od->Lambda, pg, h, c, od->g) > kDomain || od->Jf.rcond < kDomainRcond) {
+    if (largest(Ld, pg, h, c, od->g) > kDomain || od->Jf.rcond < kDomainRcond) {
       ++outside;
       if (flagged) {
         ++outside_flagged;
       } else {
-        const double rel = std::max({err(of->Lambda, od->Lambda) / largest(od->Lambda), err(hf, h) / largest(h),
+        const double rel = std::max({err(Lf, Ld) / largest(Ld), err(hf, h) / largest(h),
                                      err(pgf, pg) / largest(pg)});
         outside_rel(rel);
         EXPECT_LE(rel, kOutsideRelative) << "an unflagged, inaccurate result at state " << k;
@@ -140,11 +142,11 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
     wJ(err(df->J, dd->J));
     wA(err(df->A, dd->A));
     wg(err(of->g, od->g));
-    wL(err(of->Lambda, od->Lambda));
-    wLr(err(of->Lambda, od->Lambda) / largest(od->Lambda));
+    wL(err(Lf, Ld));
+    wLr(err(Lf, Ld) / largest(Ld));
     whr(err(hf, h) / largest(h));
     wpgr(err(pgf, pg) / largest(pg));
-    max_lambda = std::max(max_lambda, largest(od->Lambda));
+    max_lambda = std::max(max_lambda, largest(Ld));
     wc(err(cf, c));
     wpg(err(pgf, pg));
     wh(err(hf, h));
@@ -186,6 +188,10 @@ void set_state(ControllerState<S>& st, const Vec3<double>& p0, const Mat3<double
   st.adapt.q_prev = q_prev.cast<S>();
   st.adapt.qd_hat_prev = qd1.cast<S>();
   st.adapt.qd_hat_prev2 = qd2.cast<S>();
+  // The regressors the two previous samples recorded, at the kernel's own rounding of q^dot.
+  const Vec6<S> dec = Vec6<S>::Constant(lit<S>(params::kTauDec));
+  st.adapt.w_prev = friction_regressor_diagonals(st.adapt.qd_hat_prev, dec);
+  st.adapt.w_prev2 = friction_regressor_diagonals(st.adapt.qd_hat_prev2, dec);
   st.adapt.samples = 2;
 }
 
@@ -262,7 +268,7 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
     }
     bool within_drives = true;  // the torques within the amplifiers' limits (beyond, the DACs clip)
     for (int i = 0; i < kDof; ++i) within_drives = within_drives && std::abs(od.tau(i)) <= robot::kDrives.torque_limit[i];
-    if (largest(sd->os.Lambda, h) > kDomain || sd->os.Jf.rcond < kDomainRcond || !within_drives) {
+    if (largest(operational_inertia(sd->data, sd->os), h) > kDomain || sd->os.Jf.rcond < kDomainRcond || !within_drives) {
       ++outside;
       if (of.status == kFaultOverflow) {
         ++outside_flagged;

@@ -33,6 +33,9 @@ struct AdaptationState {
   Vec6<S> q_prev;        // q(t - dt)
   Vec6<S> qd_hat_prev;   // q^dot(t - dt)
   Vec6<S> qd_hat_prev2;  // q^dot(t - 2 dt)
+  // The regressor at q^dot(t - dt) and q^dot(t - 2 dt): friction_estimate computed them in those
+  // samples (each costs six exponentials).
+  RegressorDiagonals<S> w_prev, w_prev2;
   int samples;           // samples recorded so far (saturates at 2)
 };
 
@@ -47,7 +50,7 @@ Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Ve
 template <class S>
 Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   const Vec6<S> Dq = increment_error(G, a, q);
-  return a.theta_hat - G.kad * (friction_regressor(a.qd_hat_prev, G.tau_dec).transpose() * Dq);
+  return a.theta_hat - G.kad * a.w_prev.transpose_times(Dq);
 }
 
 /// The robust law: (67)'s error Dq, the regressor at q^dot(t-2dt), leakage, projection.
@@ -55,7 +58,7 @@ template <class S>
 Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   const Vec6<S> Dq = increment_error(G, a, q);
   Vec18<S> theta = a.theta_hat - G.leakage * (G.dt * a.theta_hat);
-  theta -= G.kad * (friction_regressor(a.qd_hat_prev2, G.tau_dec).transpose() * Dq);
+  theta -= G.kad * a.w_prev2.transpose_times(Dq);
   for (int i = 0; i < 3 * kDof; ++i) {
     if (theta(i) < S(0)) theta(i) = S(0);
     if (theta(i) > G.theta_max(i)) theta(i) = G.theta_max(i);
@@ -77,23 +80,36 @@ void adaptation_init(AdaptationState<S>& a, const Vec6<S>& q0) {
   a.q_prev = q0;
   a.qd_hat_prev.setZero();
   a.qd_hat_prev2.setZero();
+  a.w_prev.vis.setZero(), a.w_prev.cou.setZero(), a.w_prev.sti.setZero();  // the regressor at rest
+  a.w_prev2 = a.w_prev;
   a.samples = 0;
 }
 
-/// Records the sample t for the next update: theta^(t), q(t), q^dot(t).
+/// Records the sample t for the next update: theta^(t), q(t), q^dot(t) and the regressor at q^dot(t).
 template <class S>
-void adaptation_record(AdaptationState<S>& a, const Vec18<S>& theta_hat, const Vec6<S>& q, const Vec6<S>& qd_hat) {
+void adaptation_record(AdaptationState<S>& a, const Vec18<S>& theta_hat, const Vec6<S>& q, const Vec6<S>& qd_hat,
+                       const RegressorDiagonals<S>& w) {
   a.theta_hat = theta_hat;
   a.q_prev = q;
   a.qd_hat_prev2 = a.qd_hat_prev;
   a.qd_hat_prev = qd_hat;
+  a.w_prev2 = a.w_prev;
+  a.w_prev = w;
   if (a.samples < 2) ++a.samples;
+}
+/// The same, computing the regressor at q^dot(t).
+template <class S>
+void adaptation_record(const Gains<S>& G, AdaptationState<S>& a, const Vec18<S>& theta_hat, const Vec6<S>& q,
+                       const Vec6<S>& qd_hat) {
+  adaptation_record(a, theta_hat, q, qd_hat, friction_regressor_diagonals(qd_hat, G.tau_dec));
 }
 
 /// Estimated joint friction (30): tau_f^ = W_j(q^dot) theta^.
 template <class S>
+Vec6<S> friction_estimate(const RegressorDiagonals<S>& w, const Vec18<S>& theta_hat) { return w.times(theta_hat); }
+template <class S>
 Vec6<S> friction_estimate(const Gains<S>& G, const Vec18<S>& theta_hat, const Vec6<S>& qd_hat) {
-  return friction_regressor(qd_hat, G.tau_dec) * theta_hat;
+  return friction_estimate(friction_regressor_diagonals(qd_hat, G.tau_dec), theta_hat);
 }
 
 }  // namespace osc

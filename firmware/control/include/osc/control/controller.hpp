@@ -73,12 +73,12 @@ ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Da
   c.e = d.x - os.x;                                   // (36)
   const Vec6<S> v = d.xd + G.ks.cwiseProduct(c.e);
   const Vec6<S> eta_p = v - ob.xd_hat;                // (34)
-  // Psi(x, x^dot) x^dot and Psi(x, x^dot)(x_d dot + k_s e) by polarisation of h(v) = Psi(x,v) v.
-  c.h_xd = psi_quadratic(model, data, os, ob.xd_hat);
-  const Vec6<S> psi_v = lit<S>(0.5) * (psi_quadratic(model, data, os, ob.xd_hat + v) - c.h_xd -
-                                       psi_quadratic(model, data, os, v));
+  // Psi(x, x^dot) x^dot and Psi(x, x^dot)(x_d dot + k_s e), in one pass.
+  const PsiPair<S> psi = psi_pair(model, data, os, ob.xd_hat, v);
+  c.h_xd = psi.yy;
+  const Vec6<S> psi_v = psi.yz;
   c.p = operational_gravity(os);
-  const Vec6<S> w_e = os.Lambda * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + c.p + f_hat;  // (35)
+  const Vec6<S> w_e = lambda_times(data, os, Vec6<S>(d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat))) + psi_v + c.p + f_hat;  // (35)
   c.F = (G.ks + G.knd).cwiseProduct(eta_p) + w_e - G.ki.cwiseProduct(ob.x_tilde);                     // (32)
   return c;
 }
@@ -115,7 +115,9 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   const bool adaptive = mode == FrictionMode::kAdaptive;
   const Vec18<S> theta_hat = adaptive ? adaptation_step(G, st.adapt, q) : st.adapt.theta_hat;
   const ObserverOutput<S> ob = observer_output(G, os, st.obs.x_hat, st.obs.y);
-  const Vec6<S> tau_f_hat = adaptive ? friction_estimate(G, theta_hat, ob.qd_hat) : Vec6<S>(Vec6<S>::Zero());
+  // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
+  const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
+  const Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
   const Vec6<S> f_hat = operational_friction(os, tau_f_hat);
   const Desired<S> d = trajectory(G.trajectory, st.p0, t);
   const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, f_hat);
@@ -132,7 +134,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
     return out;
   }
   st.obs = next;
-  adaptation_record(st.adapt, theta_hat, Vec6<S>(q), ob.qd_hat);
+  adaptation_record(st.adapt, theta_hat, Vec6<S>(q), ob.qd_hat, w);
   out.tau = tau;
   out.e = c.e;
   out.x_tilde = ob.x_tilde;

@@ -56,6 +56,10 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
 /// rotational inertia I_O.
 template <class S>
 void joint_inertia(const Model<S>& model, Data<S>& data) {
+  // Unit rotation about axis z_i through o_{i-1}: angular velocity z_i, base-origin velocity
+  // vO_i = o_{i-1} x z_i. A_ij = z_i . (L_j - o_{i-1} x p_j) = z_i . L_j + vO_i . p_j.
+  Vec3<S> vO[kDof];
+  for (int i = 0; i < kDof; ++i) vO[i] = data.o[i].cross(data.R[i].col(2));
   S m = S(0);
   Vec3<S> h = Vec3<S>::Zero();
   Mat3<S> IO = Mat3<S>::Zero();
@@ -65,14 +69,11 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
     m += mj;
     h += mj * c;
     IO += data.Ic[j] + mj * (c.squaredNorm() * Mat3<S>::Identity() - c * c.transpose());
-    // Unit rotation about axis z through o_{j-1}: angular velocity z, origin velocity o x z.
     const Vec3<S> z = data.R[j - 1].col(2);
-    const Vec3<S> vO = data.o[j - 1].cross(z);
-    const Vec3<S> p = m * vO + z.cross(h);      // linear momentum
-    const Vec3<S> L = IO * z + h.cross(vO);     // angular momentum about the base origin
+    const Vec3<S> p = m * vO[j - 1] + z.cross(h);  // linear momentum
+    const Vec3<S> L = IO * z + h.cross(vO[j - 1]);  // angular momentum about the base origin
     for (int i = 1; i <= j; ++i) {
-      const Vec3<S> zi = data.R[i - 1].col(2);
-      data.A(i - 1, j - 1) = zi.dot(L - data.o[i - 1].cross(p));
+      data.A(i - 1, j - 1) = data.R[i - 1].col(2).dot(L) + vO[i - 1].dot(p);
       data.A(j - 1, i - 1) = data.A(i - 1, j - 1);
     }
   }
@@ -114,6 +115,64 @@ VelocityProducts<S> velocity_products(const Model<S>& model, const Data<S>& data
   out.c = r.tau;
   out.jdot_qd << r.acc6, r.alpha6;
   out.w6 = r.w6;
+  return out;
+}
+
+/// The velocity products of one velocity y and their symmetric bilinear form with a second velocity
+/// v, in one pass: quad = c(q, y) = B(q, y) y with the geometric Jdot y of the frame-6 origin, and
+/// bilinear = B(q, y) v (property 2: = B(q, v) y) with the bilinear form of Jdot, i.e. the
+/// polarisation (c(y + v) - c(y - v)) / 4 without its two passes. Every product that is quadratic in
+/// the velocity in rnea (w x (z qd), w x (w x r), w x (I w)) becomes half the sum of its two
+/// mixed products; the linear parts (the angular velocities of y and v) are shared.
+template <class S>
+struct VelocityProductPair {
+  VelocityProducts<S> quad;      // c(q, y), Jdot y, w6(y)
+  VelocityProducts<S> bilinear;  // B(q, y) v, bilinear Jdot, w6(v)
+};
+
+template <class S>
+VelocityProductPair<S> velocity_product_pair(const Model<S>& model, const Data<S>& data, const Vec6In<S>& y,
+                                             const Vec6In<S>& v) {
+  const S h = lit<S>(0.5);
+  Vec3<S> wy = Vec3<S>::Zero(), wv = Vec3<S>::Zero();
+  Vec3<S> wdq = Vec3<S>::Zero(), wdb = Vec3<S>::Zero(), aq = Vec3<S>::Zero(), ab = Vec3<S>::Zero();
+  Vec3<S> fq[kDof + 1], nq[kDof + 1], fb[kDof + 1], nb[kDof + 1];
+  for (int i = 1; i <= kDof; ++i) {
+    const Vec3<S> z = data.R[i - 1].col(2);
+    const Vec3<S> zy = z * y(i - 1), zv = z * v(i - 1);
+    wdq += wy.cross(zy);
+    wdb += h * (wy.cross(zv) + wv.cross(zy));
+    wy += zy;
+    wv += zv;
+    const Vec3<S> r = data.o[i] - data.o[i - 1], rc = data.com[i] - data.o[i];
+    const Vec3<S> wyr = wy.cross(r), wvr = wv.cross(r), wyrc = wy.cross(rc), wvrc = wv.cross(rc);
+    aq += wdq.cross(r) + wy.cross(wyr);
+    ab += wdb.cross(r) + h * (wy.cross(wvr) + wv.cross(wyr));
+    const S m = model.link[i - 1].mass;
+    fq[i] = m * (aq + wdq.cross(rc) + wy.cross(wyrc));
+    fb[i] = m * (ab + wdb.cross(rc) + h * (wy.cross(wvrc) + wv.cross(wyrc)));
+    const Vec3<S> Iwy = data.Ic[i] * wy, Iwv = data.Ic[i] * wv;
+    nq[i] = data.Ic[i] * wdq + wy.cross(Iwy);
+    nb[i] = data.Ic[i] * wdb + h * (wy.cross(Iwv) + wv.cross(Iwy));
+  }
+  VelocityProductPair<S> out;
+  out.quad.jdot_qd.template head<3>() = aq;
+  out.quad.jdot_qd.template tail<3>() = wdq;
+  out.quad.w6 = wy;
+  out.bilinear.jdot_qd.template head<3>() = ab;
+  out.bilinear.jdot_qd.template tail<3>() = wdb;
+  out.bilinear.w6 = wv;
+  Vec3<S> Fq = Vec3<S>::Zero(), Nq = Vec3<S>::Zero(), Fb = Vec3<S>::Zero(), Nb = Vec3<S>::Zero();
+  for (int i = kDof; i >= 1; --i) {
+    const Vec3<S> rc = data.com[i] - data.o[i - 1], r = data.o[i] - data.o[i - 1];
+    Nq = nq[i] + Nq + rc.cross(fq[i]) + r.cross(Fq);
+    Nb = nb[i] + Nb + rc.cross(fb[i]) + r.cross(Fb);
+    Fq += fq[i];
+    Fb += fb[i];
+    const Vec3<S> z = data.R[i - 1].col(2);
+    out.quad.c(i - 1) = z.dot(Nq);
+    out.bilinear.c(i - 1) = z.dot(Nb);
+  }
   return out;
 }
 

@@ -476,6 +476,15 @@ Q<F> cos(Q<F> x) {
   return detail::from_q30<F>(c);
 }
 
+/// sin x and cos x with one argument reduction; each as sin and cos above.
+template <int F>
+void sincos(Q<F> x, Q<F>& s, Q<F>& c) {
+  std::int32_t sr, cr;
+  detail::sincos_q30(x, &sr, &cr);
+  s = detail::from_q30<F>(sr);
+  c = detail::from_q30<F>(cr);
+}
+
 /// e^x: x = k ln 2 + r, |r| <= ln 2 / 2, Taylor to r^8 in Q30 (truncation 2e-10), scaled by 2^k.
 /// |error| <= 0.51 LSB + 4e-9 e^x; e^x beyond the range saturates (kOverflow), far below it is 0.
 template <int F>

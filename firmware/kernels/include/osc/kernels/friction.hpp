@@ -40,15 +40,47 @@ Vec6<S> friction_torque(const FrictionParams<S>& p, const Vec6In<S>& qd) {
   return tau;
 }
 
-/// Regressor W_j(qd) of (19): [diag(qd), diag(sgn qd), diag(sgn(qd) exp(-dec qd^2))].
+/// The three diagonals of the regressor W_j(qd) of (19), [diag(qd), diag(sgn qd),
+/// diag(sgn(qd) exp(-dec qd^2))]: all of its nonzeros. Products with W and W^T take 18 multiplications
+/// this way instead of 108, with the same sums (the dense product only adds zeros).
 template <class S>
-Regressor<S> friction_regressor(const Vec6<S>& qd, const Vec6<S>& dec) {
-  Regressor<S> W = Regressor<S>::Zero();
+struct RegressorDiagonals {
+  Vec6<S> vis, cou, sti;
+
+  /// W theta (theta = [vis; cou; sti], 18 entries).
+  Vec6<S> times(const Vec18<S>& theta) const {
+    return vis.cwiseProduct(theta.template segment<kDof>(0)) + cou.cwiseProduct(theta.template segment<kDof>(kDof)) +
+           sti.cwiseProduct(theta.template segment<kDof>(2 * kDof));
+  }
+  /// W^T v.
+  Vec18<S> transpose_times(const Vec6<S>& v) const {
+    Vec18<S> r;
+    r << vis.cwiseProduct(v), cou.cwiseProduct(v), sti.cwiseProduct(v);
+    return r;
+  }
+};
+
+template <class S>
+RegressorDiagonals<S> friction_regressor_diagonals(const Vec6<S>& qd, const Vec6<S>& dec) {
+  RegressorDiagonals<S> w;
   for (int i = 0; i < kDof; ++i) {
     const S s = math::sgn(qd(i));
-    W(i, i) = qd(i);
-    W(i, kDof + i) = s;
-    W(i, 2 * kDof + i) = s * math::exp(-dec(i) * qd(i) * qd(i));
+    w.vis(i) = qd(i);
+    w.cou(i) = s;
+    w.sti(i) = s * math::exp(-dec(i) * qd(i) * qd(i));
+  }
+  return w;
+}
+
+/// Regressor W_j(qd) of (19) as a dense 6x18 matrix.
+template <class S>
+Regressor<S> friction_regressor(const Vec6<S>& qd, const Vec6<S>& dec) {
+  const RegressorDiagonals<S> w = friction_regressor_diagonals(qd, dec);
+  Regressor<S> W = Regressor<S>::Zero();
+  for (int i = 0; i < kDof; ++i) {
+    W(i, i) = w.vis(i);
+    W(i, kDof + i) = w.cou(i);
+    W(i, 2 * kDof + i) = w.sti(i);
   }
   return W;
 }

@@ -20,7 +20,8 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
   data.o[0].setZero();
   for (int i = 0; i < kDof; ++i) {
     const auto& l = model.link[i];
-    const S c = math::cos(q(i)), s = math::sin(q(i));
+    S s, c;
+    math::sincos(q(i), s, c);
     Mat3<S> Ai;  // Rz(q) Rx(alpha)
     Ai << c, -s * l.cos_alpha, s * l.sin_alpha,
           s, c * l.cos_alpha, -c * l.sin_alpha,
@@ -61,39 +62,73 @@ Vec6<S> operational_coordinates(const Data<S>& data, const Mat3<S>& R_ref) {
   return x;
 }
 
+/// The map between the base angular velocity w and the orientation rates phi_dot at phi:
+/// E(phi) phi_dot = w. Computed once per sample (opspace_update) with the sines and cosines of pitch
+/// and yaw that its derivative needs too.
+template <class S>
+struct PhiRate {
+  Mat3<S> Einv;  // E^{-1}(phi): phi_dot = E^{-1} w
+  S cb, sb, cg, sg;  // cos, sin of pitch (phi_2) and yaw (phi_3)
+};
+
+template <class S>
+PhiRate<S> phi_rate(const Vec3<S>& phi) {
+  PhiRate<S> E;
+  math::sincos(phi(1), E.sb, E.cb);
+  math::sincos(phi(2), E.sg, E.cg);
+  const S cg_cb = E.cg / E.cb, sg_cb = E.sg / E.cb;
+  E.Einv << cg_cb, sg_cb, S(0),
+            -E.sg, E.cg, S(0),
+            E.sb * cg_cb, E.sb * sg_cb, S(1);
+  return E;
+}
+
 /// E^{-1}(phi): maps the base angular velocity w to phi_dot (E(phi) phi_dot = w).
 template <class S>
-Mat3<S> angular_to_phi_rate(const Vec3<S>& phi) {
-  const S cb = math::cos(phi(1)), sb = math::sin(phi(1));
-  const S cg = math::cos(phi(2)), sg = math::sin(phi(2));
-  Mat3<S> Einv;
-  Einv << cg / cb, sg / cb, S(0),
-          -sg, cg, S(0),
-          cg * sb / cb, sg * sb / cb, S(1);
-  return Einv;
-}
+Mat3<S> angular_to_phi_rate(const Vec3<S>& phi) { return phi_rate(phi).Einv; }
 
 /// Analytic Jacobian Ja = blockdiag(I, E^{-1}(phi)) J, so that x_dot = Ja q_dot.
 template <class S>
-Mat6<S> analytic_jacobian(const Mat6<S>& J, const Vec3<S>& phi) {
+Mat6<S> analytic_jacobian(const Mat6<S>& J, const PhiRate<S>& E) {
   Mat6<S> Ja = J;
-  Ja.template bottomRows<3>() = angular_to_phi_rate(phi) * J.template bottomRows<3>();
+  Ja.template bottomRows<3>() = E.Einv * J.template bottomRows<3>();
   return Ja;
+}
+template <class S>
+Mat6<S> analytic_jacobian(const Mat6<S>& J, const Vec3<S>& phi) { return analytic_jacobian(J, phi_rate(phi)); }
+
+/// Edot phi_dot for the products of the rates p01 = phi_dot_1 phi_dot_2, p20 = phi_dot_3 phi_dot_1,
+/// p21 = phi_dot_3 phi_dot_2 (symmetrised products for the bilinear form).
+template <class S>
+Vec3<S> edot_products(const PhiRate<S>& E, S p01, S p20, S p21) {
+  return p01 * Vec3<S>(-E.cg * E.sb, -E.sg * E.sb, -E.cb) + p20 * Vec3<S>(-E.sg * E.cb, E.cg * E.cb, S(0)) +
+         p21 * Vec3<S>(-E.cg, -E.sg, S(0));
+}
+/// Edot(phi, phi_dot) phi_dot.
+template <class S>
+Vec3<S> edot_rates(const PhiRate<S>& E, const Vec3<S>& a) {
+  return edot_products(E, a(0) * a(1), a(2) * a(0), a(2) * a(1));
+}
+/// The symmetric bilinear form of Edot(phi, phi_dot) phi_dot at the rates a and b.
+template <class S>
+Vec3<S> edot_rates(const PhiRate<S>& E, const Vec3<S>& a, const Vec3<S>& b) {
+  const S h = lit<S>(0.5);
+  return edot_products(E, h * (a(0) * b(1) + a(1) * b(0)), h * (a(2) * b(0) + a(0) * b(2)),
+                       h * (a(2) * b(1) + a(1) * b(2)));
 }
 
 /// Converts the geometric Jdot*qd = [a6; alpha6] (q_ddot = 0) into the analytic one:
 /// d/dt(E^{-1} w) = E^{-1} (alpha - Edot phi_dot), with w = J_w qd.
 template <class S>
-Vec6<S> analytic_jdot_qd(const Vec6<S>& jdot_qd_geometric, const Vec3<S>& w, const Vec3<S>& phi) {
-  const Mat3<S> Einv = angular_to_phi_rate(phi);
-  const Vec3<S> pd = Einv * w;  // (roll, pitch, yaw) rates
-  const S cb = math::cos(phi(1)), sb = math::sin(phi(1));
-  const S cg = math::cos(phi(2)), sg = math::sin(phi(2));
-  const Vec3<S> Edot_pd = pd(0) * pd(1) * Vec3<S>(-cg * sb, -sg * sb, -cb) +
-                          pd(2) * (pd(0) * Vec3<S>(-sg * cb, cg * cb, S(0)) + pd(1) * Vec3<S>(-cg, -sg, S(0)));
+Vec6<S> analytic_jdot_qd(const Vec6<S>& jdot_qd_geometric, const Vec3<S>& w, const PhiRate<S>& E) {
+  const Vec3<S> pd = E.Einv * w;  // (roll, pitch, yaw) rates
   Vec6<S> out;
-  out << jdot_qd_geometric.template head<3>(), Einv * (jdot_qd_geometric.template tail<3>() - Edot_pd);
+  out << jdot_qd_geometric.template head<3>(), E.Einv * (jdot_qd_geometric.template tail<3>() - edot_rates(E, pd));
   return out;
+}
+template <class S>
+Vec6<S> analytic_jdot_qd(const Vec6<S>& jdot_qd_geometric, const Vec3<S>& w, const Vec3<S>& phi) {
+  return analytic_jdot_qd(jdot_qd_geometric, w, phi_rate(phi));
 }
 
 }  // namespace osc

@@ -66,7 +66,8 @@ struct SphericalWristJacobianFactor {
   static S norm1(const Mat3<S>& M) { return M.cwiseAbs().colwise().sum().maxCoeff(); }
 };
 
-/// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised.
+/// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised. The control step never forms it: it
+/// needs only products Lambda u (lambda_times) and solves Lambda^{-1} w (lambda_solve).
 template <class S>
 Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor<S>& Jf) {
   Mat6<S> Y;  // Y = J^{-T} A
@@ -81,14 +82,14 @@ Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor
 template <class S>
 struct OpSpace {
   Vec6<S> x;               // [p; phi]
+  PhiRate<S> E;            // E^{-1}(phi) and the trig of phi
   Mat6<S> Ja;              // analytic Jacobian
   SphericalWristJacobianFactor<S> Jf;    // factorisation of Ja
   Eigen::LLT<Mat6<S>> A_llt;
-  Mat6<S> Lambda;
   Vec6<S> g;               // joint gravity torques
 };
 
-/// Computes kinematics, A(q), g(q), Ja, its factorisation and Lambda at q.
+/// Computes kinematics, A(q), g(q), Ja, its factorisation and the Cholesky factor of A at q.
 template <class S>
 void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q,
                     const Mat3<S>& R_ref) {
@@ -96,11 +97,22 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
   geometric_jacobian(data);
   joint_inertia(model, data);
   os.x = operational_coordinates(data, R_ref);
-  os.Ja = analytic_jacobian(data.J, Vec3<S>(os.x.template tail<3>()));
+  os.E = phi_rate(Vec3<S>(os.x.template tail<3>()));
+  os.Ja = analytic_jacobian(data.J, os.E);
   os.Jf.compute(os.Ja);
   os.A_llt.compute(data.A);
-  os.Lambda = operational_inertia(data.A, os.Jf);
   os.g = gravity_torques(model, data);
+}
+
+/// Lambda of the current state (opspace_update must have run).
+template <class S>
+Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S>& os) { return operational_inertia(data.A, os.Jf); }
+
+/// Lambda u = J^{-T} (A (J^{-1} u)): two block-triangular solves and one 6x6 product, without forming
+/// Lambda (which would take twelve solves).
+template <class S>
+Vec6<S> lambda_times(const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& u) {
+  return os.Jf.solve_transpose(Vec6<S>(data.A * os.Jf.solve(u)));
 }
 
 /// p(x) = J^{-T} g(q) (5).
@@ -125,7 +137,7 @@ Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
 template <class S>
 Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qd) {
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
-  return analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
+  return analytic_jdot_qd(vp.jdot_qd, vp.w6, os.E);
 }
 
 /// h(v) = Psi(x, v) v = J^{-T} c(q, qd_v) - Lambda Jdot(q, qd_v) qd_v, with qd_v = J^{-1} v,
@@ -136,15 +148,40 @@ template <class S>
 Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& v) {
   const Vec6<S> qd = os.Jf.solve(v);
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
-  const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os.x.template tail<3>()));
+  const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, os.E);
   return os.Jf.solve_transpose(Vec6<S>(vp.c - data.A * os.Jf.solve(jdqd)));
 }
 
-/// Psi(x, y) z, the symmetric bilinear form of (8), by polarisation: (h(y+z) - h(y-z)) / 4.
+/// Psi(x, y) y and Psi(x, y) z together (z enters linearly; Psi(x, y) z is the symmetric bilinear
+/// form of (8)): one pass of velocity_product_pair, the bracket of psi_quadratic for each.
+template <class S>
+struct PsiPair {
+  Vec6<S> yy;  // Psi(x, y) y
+  Vec6<S> yz;  // Psi(x, y) z
+};
+
+template <class S>
+PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+                    const Vec6In<S>& z) {
+  const Vec6<S> qy = os.Jf.solve(y), qz = os.Jf.solve(z);
+  const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
+  const Vec3<S> pdy = os.E.Einv * vp.quad.w6, pdz = os.E.Einv * vp.bilinear.w6;  // orientation rates
+  Vec6<S> jq, jb;  // analytic Jdot: quadratic and bilinear
+  jq << vp.quad.jdot_qd.template head<3>(),
+      os.E.Einv * (vp.quad.jdot_qd.template tail<3>() - edot_rates(os.E, pdy));
+  jb << vp.bilinear.jdot_qd.template head<3>(),
+      os.E.Einv * (vp.bilinear.jdot_qd.template tail<3>() - edot_rates(os.E, pdy, pdz));
+  PsiPair<S> out;
+  out.yy = os.Jf.solve_transpose(Vec6<S>(vp.quad.c - data.A * os.Jf.solve(jq)));
+  out.yz = os.Jf.solve_transpose(Vec6<S>(vp.bilinear.c - data.A * os.Jf.solve(jb)));
+  return out;
+}
+
+/// Psi(x, y) z, the symmetric bilinear form of (8).
 template <class S>
 Vec6<S> psi_bilinear(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
                      const Vec6In<S>& z) {
-  return lit<S>(0.25) * (psi_quadratic(model, data, os, y + z) - psi_quadratic(model, data, os, y - z));
+  return psi_pair(model, data, os, y, z).yz;
 }
 
 }  // namespace osc

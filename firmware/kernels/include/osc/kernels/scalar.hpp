@@ -44,8 +44,12 @@ inline double abs(double v) { return std::fabs(v); }
 inline double atan2(double y, double x) { return std::atan2(y, x); }
 inline double asin(double v) { return std::asin(v); }
 inline bool isfinite(double v) { return std::isfinite(v); }
+/// sin v and cos v together (one argument reduction in fixed point).
+inline void sincos(float v, float& s, float& c) { s = std::sin(v), c = std::cos(v); }
+inline void sincos(double v, double& s, double& c) { s = std::sin(v), c = std::cos(v); }
 using fixed::sin;
 using fixed::cos;
+using fixed::sincos;
 using fixed::sqrt;
 using fixed::exp;
 using fixed::abs;
