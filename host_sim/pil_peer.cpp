@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 
 #include "osc/control/params.hpp"
@@ -36,7 +37,11 @@ int main() {
   auto node = std::make_unique<osc::PilNode<float, StdioBoard>>();
   node->init(osc::joint_vector<float>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, 1000000);
   node->hello();
-  const int timeout_ms = static_cast<int>(osc::params::kLinkTimeout * 1000);
+  // The firmware's silence timeout, in wall-clock time here. OSC_PIL_PEER_TIMEOUT_MS overrides it for
+  // tests that do not exercise silence (the closed loop): on a loaded machine a scheduling stall of
+  // the host process would otherwise read as a silent link and zero a tick.
+  int timeout_ms = static_cast<int>(osc::params::kLinkTimeout * 1000);
+  if (const char* t = std::getenv("OSC_PIL_PEER_TIMEOUT_MS")) timeout_ms = std::atoi(t) > 0 ? std::atoi(t) : timeout_ms;
   for (;;) {
     pollfd p{STDIN_FILENO, POLLIN, 0};
     const int r = poll(&p, 1, timeout_ms);
