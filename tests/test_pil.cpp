@@ -394,10 +394,19 @@ TEST(PilClosedLoop, TracksLikeTheInProcessController) {
               remote.link.rx_gap_max, remote.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
               remote.link.firmware.total(), remote.link.host.total());
   EXPECT_TRUE(remote.link.clean());
-  // Same float code on both sides; on the target the compiler and libm differ, so allow a
-  // tolerance of one encoder quantum (0.069 mm) and 0.01 deg on the max errors.
+  // Same float code on both sides; on the target the compiler (contracted multiply-adds) and libm
+  // (sinf, cosf, expf, atan2f) differ in the last bits. After the start transient (the second half
+  // of the run) the two track alike to one encoder quantum (0.069 mm) and 0.01 deg. The peak of the
+  // transient itself, at the first stick-slip of the joints, moves by up to 0.02 deg between equally
+  // valid roundings of the same law (on this 10 s run: double 0.078, host float 0.077, target float
+  // 0.063, fixed point 0.059 deg about z), so the whole run's peaks are held to 0.03 deg.
+  for (int i = 0; i < 6; ++i)
+    std::printf("axis %d, second half: max |e| in process %.4f, over the link %.4f\n", i, local.final_max_error[i],
+                remote.final_max_error[i]);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(remote.final_max_error[i], local.final_max_error[i], 0.069) << i;
+  for (int i = 3; i < 6; ++i) EXPECT_NEAR(remote.final_max_error[i], local.final_max_error[i], 0.01) << i;
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.069) << i;
-  for (int i = 3; i < 6; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.01) << i;
+  for (int i = 3; i < 6; ++i) EXPECT_NEAR(remote.max_error[i], local.max_error[i], 0.03) << i;
   // The host peer runs the same code with the same compiler; fixed point is integer arithmetic, the
   // same on every core: both agree with the in-process controller bit for bit, every torque of the
   // run included.
