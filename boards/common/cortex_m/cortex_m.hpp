@@ -34,6 +34,16 @@ inline void irq_pend(int irq) {
   nvic_ispr(irq >> 5) = 1u << (irq & 31);
   __asm__ volatile("dsb\n isb" ::: "memory");
 }
+/// Sleeps until an interrupt is pending, without a window for a lost wake-up: interrupts are masked
+/// (PRIMASK) while `idle()` is evaluated and during the WFI, which still returns on a pending one;
+/// the pending interrupts are taken when the mask is cleared, before this function returns. Does
+/// not sleep when idle() is false.
+template <class Idle>
+inline void sleep_while(Idle idle) {
+  __asm__ volatile("cpsid i" ::: "memory");
+  if (idle()) __asm__ volatile("dsb\n wfi" ::: "memory");
+  __asm__ volatile("cpsie i\n isb" ::: "memory");
+}
 /// Sets the priority of external interrupt irq: `level` 0 is the most urgent; the device implements
 /// the top `prio_bits` bits of each priority byte (a board constant: 4 on the STM32F4).
 inline void irq_priority(int irq, unsigned level, int prio_bits) {

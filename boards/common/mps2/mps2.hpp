@@ -32,7 +32,8 @@ namespace semihost = cortex_m::semihost;
 struct CmsdkUart {
   volatile std::uint32_t DATA, STATE, CTRL, INTSTATUS, BAUDDIV;
   static constexpr std::uint32_t kTxFull = 1u << 0, kRxFull = 1u << 1;
-  static constexpr std::uint32_t kTxEnable = 1u << 0, kRxEnable = 1u << 1;
+  static constexpr std::uint32_t kTxEnable = 1u << 0, kRxEnable = 1u << 1, kRxIrqEnable = 1u << 3;
+  static constexpr std::uint32_t kRxIrq = 1u << 1;  // INTSTATUS (write 1 to clear)
 };
 struct CmsdkTimer {
   volatile std::uint32_t CTRL, VALUE, RELOAD, INTSTATUS;
@@ -41,8 +42,11 @@ struct CmsdkTimer {
 
 inline CmsdkUart& uart0() { return *reinterpret_cast<CmsdkUart*>(0x40004000u); }
 inline CmsdkTimer& timer0() { return *reinterpret_cast<CmsdkTimer*>(0x40000000u); }
+inline CmsdkTimer& timer1() { return *reinterpret_cast<CmsdkTimer*>(0x40001000u); }
 
+constexpr int kUart0RxIrq = 0;
 constexpr int kTimer0Irq = 8;
+constexpr int kTimer1Irq = 9;
 
 // ---------------------------------------------------------------- UART0 (polling)
 inline void uart_init() {
@@ -58,6 +62,14 @@ inline void uart_write(const std::uint8_t* p, int n) {
 }
 inline bool uart_rx_ready() { return (uart0().STATE & CmsdkUart::kRxFull) != 0; }
 inline std::uint8_t uart_read() { return static_cast<std::uint8_t>(uart0().DATA); }
+/// UART0's receive interrupt (UART0RX_Handler), raised by every received byte: it only wakes the
+/// core from WFI (sleep_until_rx_or_irq); the handler acknowledges it, the byte stays for uart_read().
+inline void uart_rx_irq_enable() {
+  uart0().INTSTATUS = CmsdkUart::kRxIrq;
+  uart0().CTRL = uart0().CTRL | CmsdkUart::kRxIrqEnable;
+  cortex_m::irq_enable(kUart0RxIrq);
+}
+inline void uart_rx_irq_ack() { uart0().INTSTATUS = CmsdkUart::kRxIrq; }
 
 // ---------------------------------------------------------------- timing
 /// Starts the cycle counter (SysTick, free-running).
@@ -89,6 +101,24 @@ inline void control_timer_ack() { timer0().INTSTATUS = 1; }
 inline bool control_timer_pending() { return (timer0().INTSTATUS & 1u) != 0; }
 /// Stops the control interrupt (NVIC): no tick is taken after this call.
 inline void control_irq_disable() { cortex_m::irq_disable(kTimer0Irq); }
+
+// ---------------------------------------------------------------- wake-up timer (TIMER1, IRQ 9)
+/// Periodic TIMER1 interrupt at hz, whose only job is to end a WFI (TIMER1_Handler acknowledges
+/// it): a main loop that sleeps until the next byte still runs its time-based checks.
+inline void wake_timer_start(std::uint32_t hz) {
+  timer1().CTRL = 0;
+  timer1().RELOAD = kSysClockHz / hz - 1;
+  timer1().VALUE = kSysClockHz / hz - 1;
+  timer1().INTSTATUS = 1;
+  timer1().CTRL = CmsdkTimer::kEnable | CmsdkTimer::kIrqEnable;
+  cortex_m::irq_enable(kTimer1Irq);
+}
+inline void wake_timer_ack() { timer1().INTSTATUS = 1; }
+/// Sleeps (WFI) unless a byte is waiting in UART0; returns after any interrupt (a received byte
+/// with uart_rx_irq_enable(), the wake-up timer), its handler run.
+inline void sleep_until_rx_or_irq() {
+  cortex_m::sleep_while([] { return !uart_rx_ready(); });
+}
 
 // ---------------------------------------------------------------- fault line
 /// QEMU's MPS2 boards model no free output pin for an interlock; the binding keeps the level here

@@ -11,9 +11,12 @@
 // (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop
 // while it waits for the host's next frame, once per control period, provided every tick it pended
 // has run. The host sets the pace and may take far longer than the 8 ms to the reset between two
-// frames (virtual time advances while the main loop polls), so ticks alone cannot feed it here. A
+// frames (virtual time advances while the main loop waits), so ticks alone cannot feed it here. A
 // hung or disabled control interrupt or a hung main loop lets it expire; a latched fault does not:
 // the link keeps answering every frame with zero torque and the latched bits, which the host needs.
+// While the main loop sleeps (WFI) for the next byte with every pended tick done, the watchdog is
+// stopped, and restarted from a full count after the sleep: under -icount (sleep=on) virtual time
+// follows wall-clock time while the core sleeps, including any time QEMU itself is descheduled.
 // Feeding never changes what a tick computes, so the lockstep run stays deterministic.
 #include <cstdint>
 
@@ -64,17 +67,26 @@ extern "C" void NMI_Handler() {
   board::await_reset();
 }
 
+// Wake-ups from WFI: a received byte, and the wake-up timer (the main loop's time-based checks).
+extern "C" void UART0RX_Handler() { board::uart_rx_irq_ack(); }
+extern "C" void TIMER1_Handler() { board::wake_timer_ack(); }
+
 int main() {
   board::cycle_counter_init();
   board::uart_init();
   g_node.init(osc::joint_vector<board::Scalar>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
+  board::uart_rx_irq_enable();
+  board::wake_timer_start(board::kControlHz);
   g_node.hello();  // bytes the host sent before this point may have been dropped
-  // The main loop polls the UART (under -icount, polling makes virtual time advance with the
-  // instructions executed; a WFI-idle loop lets QEMU warp virtual time). The link watchdog and the
-  // CMSDK watchdog are armed by the first byte. Virtual time also runs on while the host computes
-  // its next frame, so the time between frames follows the host's wall-clock time (the frames carry
-  // the longest gap seen).
+  // The main loop sleeps (WFI) until a byte comes or the wake-up timer ticks (once per control
+  // period), and then handles every byte that is there. Under -icount (sleep=on, QEMU's default)
+  // virtual time follows the host's wall-clock time while the core sleeps, as it did while it
+  // polled; the sleep hands the CPU to QEMU's I/O thread at once, which delivers the next byte (a
+  // polling loop keeps it waiting: docs/benchmarks.md). The link watchdog and the CMSDK watchdog
+  // are armed by the first byte. Virtual time runs on while the host computes its next frame, so
+  // the time between frames follows the host's wall-clock time (the frames carry the longest gap
+  // seen).
   bool link_up = false;
   std::uint32_t last = board::cycles(), last_feed = last;
   for (;;) {
@@ -86,16 +98,30 @@ int main() {
       }
       if (g_node.on_byte(board::uart_read())) pend_tick();
       last = board::cycles();
-    } else if (link_up) {
+      continue;
+    }
+    if (link_up) {
       const std::uint32_t now = board::cycles();
       if (now - last > kLinkTimeoutNs) {
         g_node.on_timeout();
         pend_tick();
         last = board::cycles();
-      } else if (now - last_feed >= kPeriodNs && g_ticks_run == g_ticks_pended) {
+        continue;
+      }
+      if (now - last_feed >= kPeriodNs && g_ticks_run == g_ticks_pended) {
         board::watchdog_feed();  // waiting for the host, every pended tick done
         last_feed = now;
       }
+    }
+    // Waiting for the host with every pended tick done, the watchdog pauses during the sleep and
+    // restarts from a full count after it: virtual time jumps while QEMU itself is descheduled,
+    // and such a jump must not read as a hung firmware. A tick still pending keeps it counting.
+    const bool pause = link_up && g_ticks_run == g_ticks_pended;
+    if (pause) board::watchdog_stop();
+    board::sleep_until_rx_or_irq();
+    if (pause) {
+      board::watchdog_start();
+      last_feed = board::cycles();
     }
   }
 }
