@@ -273,8 +273,21 @@ const std::vector<Entry>& entries() {
            [](Settings& s) -> double& { return s.base.encoder_counts_per_motor_rev; });
     number("plant.delay", "computation delay from the encoder sample to the DAC update [s]", 0, osc::params::kDt, true,
            [](Settings& s) -> double& { return s.base.plant.compute_delay; });
-    number("plant.substep", "the plant's RK4 step [s]", 1e-6, 1e-3, false,
+    number("plant.substep", "the plant's RK4 step [s] (through velocity reversals)", 1e-6, 1e-3, false,
            [](Settings& s) -> double& { return s.base.plant.substep; });
+    {
+      Entry e{"plant.smooth_steps",
+              "substeps the plant's RK4 takes at once while no joint velocity changes sign (1: fixed step)",
+              Kind::kNumber, 1, 16, {}, false, nullptr, nullptr, nullptr, nullptr};
+      e.get = [](const Settings& s) { return json(s.base.plant.smooth_steps); };
+      e.put = [](Settings& s, const json& v) {
+        const double n = v.get<double>();
+        if (n != std::floor(n)) return number_text(n) + " is not a whole number";
+        s.base.plant.smooth_steps = static_cast<int>(n);
+        return std::string();
+      };
+      t.push_back(e);
+    }
     return t;
   }();
   return kEntries;

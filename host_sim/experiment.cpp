@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <memory>
 
@@ -263,6 +264,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.log.push_back(r);
     }
     plant.advance_sample(tau_old, tau_new, dt);
+    res.plant_evaluations = plant.evaluations();
     tau_old = tau_new;
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);
   }
@@ -279,6 +281,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
 
 ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   const auto wall0 = std::chrono::steady_clock::now();
+  timespec cpu0{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu0);
   ExperimentResult res;
   res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
   res.duration = cfg.duration;
@@ -304,6 +308,9 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
     run(cfg, q0, ctrl, res);
   }
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  timespec cpu1{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu1);
+  res.cpu_seconds = static_cast<double>(cpu1.tv_sec - cpu0.tv_sec) + 1e-9 * static_cast<double>(cpu1.tv_nsec - cpu0.tv_nsec);
   return res;
 }
 

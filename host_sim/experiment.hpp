@@ -132,6 +132,8 @@ struct ExperimentResult {
   std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0, stack_used = 0;  // firmware telemetry (PIL)
   LinkReport link;                   // PIL only
   double wall_seconds = 0;
+  double cpu_seconds = 0;            // CPU time of the thread that ran it (wall time counts other jobs too)
+  long plant_evaluations = 0;        // articulated-body evaluations of the plant over the run
   std::vector<LogRow> log;
 };
 

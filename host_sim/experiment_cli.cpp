@@ -29,6 +29,7 @@ constexpr Shorthand kShorthands[] = {
     {"--model-error", "controller.model_error", "controller link mass/inertia relative error (default 0; -0.5..0.5)"},
     {"--encoder-cpr", "plant.encoder_cpr", "encoder counts per motor revolution, plant and controller (default 1000)"},
     {"--substep", "plant.substep", "plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)"},
+    {"--smooth-steps", "plant.smooth_steps", "plant RK4 substeps taken at once away from velocity reversals (default 8; 1..16)"},
     {"--delay", "plant.delay", "computation delay inside the sample in seconds (default 2e-4; 0..1e-3)"},
 };
 

@@ -122,6 +122,7 @@ void Plant::reset(const Vec6& q0, const Vec6& qd0) {
 Vec6 Plant::friction(const Vec6& qd) const { return osc::friction_torque(friction_, qd); }
 
 Vec6 Plant::acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const {
+  ++evaluations_;
   return body_.forward_dynamics(q, qd, tau - friction(qd));
 }
 
@@ -135,11 +136,39 @@ void Plant::rk4(const Vec6& tau, double h) {
   t_ += h;
 }
 
+bool Plant::rk4_smooth(const Vec6& tau, double h) {
+  const Vec6 k1q = qd_, k1v = acceleration(q_, qd_, tau);
+  const Vec6 k2q = qd_ + 0.5 * h * k1v, k2v = acceleration(q_ + 0.5 * h * k1q, k2q, tau);
+  const Vec6 k3q = qd_ + 0.5 * h * k2v, k3v = acceleration(q_ + 0.5 * h * k2q, k3q, tau);
+  const Vec6 k4q = qd_ + h * k3v, k4v = acceleration(q_ + h * k3q, k4q, tau);
+  const Vec6 qd1 = qd_ + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  // Friction (2) is smooth along the step only if every velocity it was evaluated at, and the
+  // end velocity, has the start's strict sign.
+  for (int i = 0; i < 6; ++i) {
+    const double v = qd_(i);
+    if (v == 0) return false;
+    if (v > 0 ? (k2q(i) <= 0 || k3q(i) <= 0 || k4q(i) <= 0 || qd1(i) <= 0)
+              : (k2q(i) >= 0 || k3q(i) >= 0 || k4q(i) >= 0 || qd1(i) >= 0))
+      return false;
+  }
+  q_ += h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q);
+  qd_ = qd1;
+  t_ += h;
+  return true;
+}
+
 void Plant::integrate(const Vec6& tau, double duration) {
   if (duration <= 0) return;
   const int n = static_cast<int>(std::ceil(duration / cfg_.substep - 1e-9));
   const double h = duration / n;
-  for (int k = 0; k < n; ++k) rk4(tau, h);
+  // Chunks of up to smooth_steps substeps: one RK4 step over the chunk where the friction is
+  // smooth, the fixed substep through a velocity reversal (where sgn() makes RK4 first order).
+  for (int k = 0; k < n;) {
+    const int m = std::min(cfg_.smooth_steps, n - k);
+    if (m < 2 || !rk4_smooth(tau, m * h))
+      for (int j = 0; j < m; ++j) rk4(tau, h);
+    k += m;
+  }
 }
 
 void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) {

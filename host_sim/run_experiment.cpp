@@ -163,8 +163,10 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
                   counters_text(r.link.firmware).c_str(), counters_text(r.link.host).c_str(), r.link.host_code_range,
                   r.link.zeroed_ticks, r.link.first_zeroed.empty() ? "" : ", the first: ", r.link.first_zeroed.c_str());
     }
-    std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time)\n", r.mode.c_str(), r.duration,
-                r.wall_seconds, r.duration / r.wall_seconds);
+    std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time); %.2f s CPU (%.3gx real time); "
+                "%.1f plant evaluations per sample\n",
+                r.mode.c_str(), r.duration, r.wall_seconds, r.duration / r.wall_seconds, r.cpu_seconds,
+                r.duration / r.cpu_seconds, static_cast<double>(r.plant_evaluations) / (r.duration / osc::params::kDt));
     if (r.injection.injection.enabled) {
       const sim::InjectionResult& ir = r.injection;
       std::printf("[%s] injected %s: ", r.mode.c_str(), sim::to_string(ir.injection).c_str());

@@ -104,6 +104,8 @@ json json_run(const ExperimentResult& r, bool csv) {
   }
   if (!r.error.empty()) j["error"] = r.error;
   j["wall_s"] = r.wall_seconds;
+  j["cpu_s"] = r.cpu_seconds;
+  j["plant_evaluations"] = r.plant_evaluations;
   return j;
 }
 

@@ -127,6 +127,70 @@ TEST(Plant, HalvingTheStepChangesA10sClosedLoopRunByLessThanTolerance) {
   EXPECT_LT(dpos, 0.15);  // samples: about two encoder quanta
 }
 
+TEST(Plant, SmoothStepsAgreeWithTheFixedStep) {
+  // Away from velocity reversals the plant takes smooth_steps substeps in one RK4 step; through a
+  // reversal it falls back to the fixed substep. Open loop (the sinusoidal torque of the halving
+  // test, every joint reversing): without friction the result matches the fixed step to round-off
+  // of RK4's error, with friction to the order of the halving difference. Closed loop: the run's
+  // statistics agree within the halving test's tolerances, at under half the evaluations.
+  auto run = [](int smooth, const osc::FrictionCoefficients& friction, long* evaluations) {
+    PlantConfig cfg;
+    cfg.smooth_steps = smooth;
+    cfg.friction = friction;
+    Plant plant(cfg);
+    plant.reset(q_start());
+    osc::Data<double> data;
+    const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
+    for (int k = 0; k < 2000; ++k) {
+      osc::forward_kinematics(model, data, plant.q());
+      Vec6 tau = osc::gravity_torques(model, data);
+      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::kPi * (0.7 + 0.2 * i) * k * 1e-3);
+      plant.advance_sample(tau, tau, 1e-3);
+    }
+    if (evaluations) *evaluations = plant.evaluations();
+    return Vec6(plant.q());
+  };
+  const int s = PlantConfig{}.smooth_steps;
+  ASSERT_GT(s, 1);
+  long n_fixed = 0, n_smooth = 0;
+  const double smooth = (run(1, osc::kFrictionNone, &n_fixed) - run(s, osc::kFrictionNone, &n_smooth)).cwiseAbs().maxCoeff();
+  const double rough = (run(1, osc::robot::kFrictionPaper, nullptr) - run(s, osc::robot::kFrictionPaper, nullptr)).cwiseAbs().maxCoeff();
+  std::printf("open loop, %d substeps at once vs fixed: max joint-angle difference after 2 s %.2e rad without friction, "
+              "%.2e rad with the paper's friction; %.1f vs %.1f evaluations per sample\n",
+              s, smooth, rough, n_smooth / 2000.0, n_fixed / 2000.0);
+  EXPECT_LT(smooth, 1e-9);
+  EXPECT_LT(rough, 5e-4);
+  EXPECT_EQ(n_fixed, 2000 * 40);
+  EXPECT_LT(n_smooth, n_fixed / 2);
+
+  ExperimentConfig a;
+  a.duration = 10;
+  a.final_window = 5;
+  a.log_period = 0.001;
+  a.plant.smooth_steps = 1;
+  ExperimentConfig b = a;
+  b.plant.smooth_steps = s;
+  const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
+  ASSERT_EQ(ra.log.size(), rb.log.size());
+  double dpos = 0, dang = 0;
+  for (size_t k = 0; k < ra.log.size(); ++k) {
+    for (int i = 0; i < 3; ++i) dpos = std::max(dpos, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
+    for (int i = 3; i < 6; ++i) dang = std::max(dang, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
+  }
+  double dmax_pos = 0, dmax_ang = 0;
+  for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
+  for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
+  const double per_sample_a = static_cast<double>(ra.plant_evaluations) / 10000, per_sample_b = static_cast<double>(rb.plant_evaluations) / 10000;
+  std::printf("closed loop, %d substeps at once vs fixed: max sample difference %.3f mm %.4f deg; max-error statistics "
+              "differ by %.4f mm %.5f deg; %.1f vs %.1f evaluations per sample\n",
+              s, dpos, dang, dmax_pos, dmax_ang, per_sample_b, per_sample_a);
+  EXPECT_LT(dmax_pos, 0.069);
+  EXPECT_LT(dmax_ang, 0.01);
+  EXPECT_LT(dpos, 0.15);
+  EXPECT_NEAR(per_sample_a, 40.0, 1e-9);
+  EXPECT_LT(per_sample_b, per_sample_a / 2);
+}
+
 TEST(PlantHal, EncodersQuantiseAndDacsScaleAndSaturate) {
   Plant plant;
   const Vec6 q0 = q_start();

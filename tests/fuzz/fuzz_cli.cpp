@@ -4,7 +4,7 @@
 // Invariants: the parser never crashes (CLI11 and yaml-cpp exceptions are caught inside) and either
 //  - succeeds with an empty error and every value within its documented range: duration [1, 86400],
 //    encoder counts per motor revolution [100, 1e7], model error [-0.5, 0.5], RK4 substep
-//    [1e-6, 1e-3], delay [0, dt], final window [1, 3600], all finite; a known friction preset,
+//    [1e-6, 1e-3], whole RK4 substeps at once [1, 16], delay [0, dt], final window [1, 3600], all finite; a known friction preset,
 //    scalar and adaptation law; at least one mode to run; non-empty file names; trajectory within
 //    its ranges with a whole period; and its effective configuration, printed and read back into
 //    the defaults, prints the same again (--print-config is a fixed point); or
@@ -34,6 +34,7 @@ void check_options(const sim::ExperimentOptions& o) {
   FUZZ_CHECK(in_range(o.base.encoder_counts_per_motor_rev, 100, 1e7));
   FUZZ_CHECK(in_range(o.base.model_error, -0.5, 0.5));
   FUZZ_CHECK(in_range(o.base.plant.substep, 1e-6, 1e-3));
+  FUZZ_CHECK(o.base.plant.smooth_steps >= 1 && o.base.plant.smooth_steps <= 16);
   FUZZ_CHECK(in_range(o.base.plant.compute_delay, 0, osc::params::kDt));
   FUZZ_CHECK(in_range(o.base.final_window, 1, 3600));
   const auto& fr = o.base.plant.friction;
