@@ -70,3 +70,14 @@ function(osc_add_pil_test name scalar)
     ENVIRONMENT "PIL_FIRMWARE_ELF=$<TARGET_FILE:pil_firmware>;QEMU=${QEMU_SYSTEM_ARM};PIL_SCALAR=${scalar}"
     DEPENDS pil_firmware_checks TIMEOUT 900)
 endfunction()
+
+# osc_add_docs_tables_test(KIND): ctest docs_tables_KIND checks that the generated tables of that
+# kind in docs/ (scripts/docs_tables.py --kind KIND) are current for this build's images.
+function(osc_add_docs_tables_test kind)
+  find_program(OSC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  if(OSC_SYSTEM_PYTHON)
+    add_test(NAME docs_tables_${kind}
+             COMMAND ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/scripts/docs_tables.py --check --kind ${kind}
+                     --${kind}-build ${CMAKE_BINARY_DIR})
+  endif()
+endfunction()
