@@ -81,7 +81,7 @@ constexpr double kThetaFaultBand = 1.0;
 constexpr int kLinkSilenceTicks = 2;
 /// Silence when the host paces the ticks (lockstep processor in the loop, as in QEMU): no byte for
 /// this long [s of the target's virtual time] is a silence error (or a short frame, if one had
-/// started). Not kLinkSilenceTicks periods: in lockstep the target's clock runs on while it polls
+/// started). Not kLinkSilenceTicks periods: in lockstep the target's clock runs on while it waits (polls, or sleeps in WFI)
 /// for the host's next frame, and that wait is the host's wall-clock time (the plant's step, the pipe,
 /// the scheduler of a shared machine) turned into target time: gaps of up to 1.7 ms measured in
 /// healthy runs (docs/firmware.md), too close to 2 ms. The plant is frozen meanwhile, so the wait
