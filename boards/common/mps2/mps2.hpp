@@ -83,16 +83,19 @@ inline void busy_wait(std::uint32_t ns) {
   }
 }
 
+/// A CMSDK timer interrupting periodically at hz on irq.
+inline void periodic_timer_start(CmsdkTimer& t, int irq, std::uint32_t hz) {
+  t.CTRL = 0;
+  t.RELOAD = kSysClockHz / hz - 1;
+  t.VALUE = kSysClockHz / hz - 1;
+  t.INTSTATUS = 1;
+  t.CTRL = CmsdkTimer::kEnable | CmsdkTimer::kIrqEnable;
+  cortex_m::irq_enable(irq);
+}
+
 // ---------------------------------------------------------------- control timer (TIMER0, IRQ 8)
 /// Periodic TIMER0 interrupt at hz.
-inline void control_timer_start(std::uint32_t hz) {
-  timer0().CTRL = 0;
-  timer0().RELOAD = kSysClockHz / hz - 1;
-  timer0().VALUE = kSysClockHz / hz - 1;
-  timer0().INTSTATUS = 1;
-  timer0().CTRL = CmsdkTimer::kEnable | CmsdkTimer::kIrqEnable;
-  cortex_m::irq_enable(kTimer0Irq);
-}
+inline void control_timer_start(std::uint32_t hz) { periodic_timer_start(timer0(), kTimer0Irq, hz); }
 /// Enables the control interrupt without the hardware timer: software pends it (PIL mode).
 inline void control_irq_enable() { cortex_m::irq_enable(kTimer0Irq); }
 /// Pends the control interrupt: it is taken right after this call.
@@ -105,14 +108,7 @@ inline void control_irq_disable() { cortex_m::irq_disable(kTimer0Irq); }
 // ---------------------------------------------------------------- wake-up timer (TIMER1, IRQ 9)
 /// Periodic TIMER1 interrupt at hz, whose only job is to end a WFI (TIMER1_Handler acknowledges
 /// it): a main loop that sleeps until the next byte still runs its time-based checks.
-inline void wake_timer_start(std::uint32_t hz) {
-  timer1().CTRL = 0;
-  timer1().RELOAD = kSysClockHz / hz - 1;
-  timer1().VALUE = kSysClockHz / hz - 1;
-  timer1().INTSTATUS = 1;
-  timer1().CTRL = CmsdkTimer::kEnable | CmsdkTimer::kIrqEnable;
-  cortex_m::irq_enable(kTimer1Irq);
-}
+inline void wake_timer_start(std::uint32_t hz) { periodic_timer_start(timer1(), kTimer1Irq, hz); }
 inline void wake_timer_ack() { timer1().INTSTATUS = 1; }
 /// Sleeps (WFI) unless a byte is waiting in UART0; returns after any interrupt (a received byte
 /// with uart_rx_irq_enable(), the wake-up timer), its handler run.

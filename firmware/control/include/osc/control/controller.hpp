@@ -74,7 +74,7 @@ ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Da
   const Vec6<S> v = d.xd + G.ks.cwiseProduct(c.e);
   const Vec6<S> eta_p = v - ob.xd_hat;                // (34)
   // Psi(x, x^dot) x^dot and Psi(x, x^dot)(x_d dot + k_s e), in one pass.
-  const PsiPair<S> psi = psi_pair(model, data, os, ob.xd_hat, v);
+  const PsiPair<S> psi = psi_pair_from_joint_rate(model, data, os, ob.qd_hat, v);  // q^dot = J^{-1} x^dot
   c.h_xd = psi.yy;
   const Vec6<S> psi_v = psi.yz;
   c.p = operational_gravity(os);

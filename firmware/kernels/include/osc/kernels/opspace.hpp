@@ -160,10 +160,11 @@ struct PsiPair {
   Vec6<S> yz;  // Psi(x, y) z
 };
 
+/// The same from qy = J^{-1} y, which the caller may already have (the observer's q^dot).
 template <class S>
-PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
-                    const Vec6In<S>& z) {
-  const Vec6<S> qy = os.Jf.solve(y), qz = os.Jf.solve(z);
+PsiPair<S> psi_pair_from_joint_rate(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os,
+                                    const Vec6In<S>& qy, const Vec6In<S>& z) {
+  const Vec6<S> qz = os.Jf.solve(z);
   const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
   const Vec3<S> pdy = os.E.Einv * vp.quad.w6, pdz = os.E.Einv * vp.bilinear.w6;  // orientation rates
   Vec6<S> jq, jb;  // analytic Jdot: quadratic and bilinear
@@ -175,6 +176,12 @@ PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>
   out.yy = os.Jf.solve_transpose(Vec6<S>(vp.quad.c - data.A * os.Jf.solve(jq)));
   out.yz = os.Jf.solve_transpose(Vec6<S>(vp.bilinear.c - data.A * os.Jf.solve(jb)));
   return out;
+}
+
+template <class S>
+PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+                    const Vec6In<S>& z) {
+  return psi_pair_from_joint_rate(model, data, os, Vec6<S>(os.Jf.solve(y)), z);
 }
 
 /// Psi(x, y) z, the symmetric bilinear form of (8).
