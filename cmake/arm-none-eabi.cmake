@@ -24,8 +24,11 @@ else()
 endif()
 set(CMAKE_C_FLAGS_INIT "${OSC_CPU_FLAGS} -ffunction-sections -fdata-sections")
 set(CMAKE_CXX_FLAGS_INIT "${OSC_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-exceptions -fno-rtti -fno-threadsafe-statics -fno-use-cxa-atexit -fno-unwind-tables -fno-asynchronous-unwind-tables")
-set(CMAKE_CXX_FLAGS_RELEASE_INIT "-O2 -DNDEBUG")
-set(CMAKE_C_FLAGS_RELEASE_INIT "-O2 -DNDEBUG")
+# -O3: measured against -O2 and -Os on both cores (docs/benchmarks.md, "Optimisation level"). CMake
+# appends its own Release default (-O3 -DNDEBUG) to these, so that is what every image has been
+# built with; -O2 here before was overridden by it.
+set(CMAKE_CXX_FLAGS_RELEASE_INIT "-O3 -DNDEBUG")
+set(CMAKE_C_FLAGS_RELEASE_INIT "-O3 -DNDEBUG")
 # Own startup code; newlib-nano for the few libc/libm functions used; no syscall stubs (libnosys
 # would provide _sbrk, i.e. a heap).
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${OSC_CPU_FLAGS} -nostartfiles --specs=nano.specs -Wl,--gc-sections")

@@ -85,7 +85,7 @@ template <class S> void BM_opspace_update(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) {
     opspace_update(f.model, f.data, f.os, f.q, f.R_ref);
-    benchmark::DoNotOptimize(f.os.A_llt);
+    benchmark::DoNotOptimize(f.os.A_ldlt);
   }
 }
 template <class S> void BM_psi_quadratic(benchmark::State& st) {

@@ -116,7 +116,7 @@ int main() {
   forward_kinematics(g_model, g_data, q0);
   const Mat3<F> R_ref = g_data.R[kDof];
   {
-    Timer t("opspace_update (FK, J, A, g, Ja, J factor, LLT of A)");
+    Timer t("opspace_update (FK, J, A, g, Ja, J factor, LDLT of A)");
     opspace_update(g_model, g_data, g_os, q0, R_ref);
   }
   SphericalWristJacobianFactor<F> Jg;

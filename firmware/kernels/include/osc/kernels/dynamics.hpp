@@ -28,13 +28,13 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
     const Vec3<S> z = data.R[i - 1].col(2);
     const Vec3<S> w_prev = w;
     w = w_prev + z * qd(i - 1);
-    wd = wd + z * qdd(i - 1) + w_prev.cross(z * qd(i - 1));
+    wd = wd + z * qdd(i - 1) + cross(w_prev, z * qd(i - 1));
     const Vec3<S> r = data.o[i] - data.o[i - 1];
-    a = a + wd.cross(r) + w.cross(w.cross(r));
+    a = a + cross(wd, r) + cross(w, cross(w, r));
     const Vec3<S> rc = data.com[i] - data.o[i];
-    const Vec3<S> ac = a + wd.cross(rc) + w.cross(w.cross(rc));
+    const Vec3<S> ac = a + cross(wd, rc) + cross(w, cross(w, rc));
     f[i] = model.link[i - 1].mass * ac;
-    n[i] = data.Ic[i] * wd + w.cross(data.Ic[i] * w);
+    n[i] = data.Ic[i] * wd + cross(w, data.Ic[i] * w);
   }
   RneaOut<S> out;
   out.acc6 = a;
@@ -43,7 +43,7 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
   // Backward pass: force F and moment N about o_{i-1} transmitted through joint i.
   Vec3<S> F = Vec3<S>::Zero(), N = Vec3<S>::Zero();
   for (int i = kDof; i >= 1; --i) {
-    N = n[i] + N + (data.com[i] - data.o[i - 1]).cross(f[i]) + (data.o[i] - data.o[i - 1]).cross(F);
+    N = n[i] + N + cross(data.com[i] - data.o[i - 1], f[i]) + cross(data.o[i] - data.o[i - 1], F);
     F = f[i] + F;
     out.tau(i - 1) = data.R[i - 1].col(2).dot(N) + model.armature(i - 1) * qdd(i - 1);
   }
@@ -59,21 +59,31 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
   // Unit rotation about axis z_i through o_{i-1}: angular velocity z_i, base-origin velocity
   // vO_i = o_{i-1} x z_i. A_ij = z_i . (L_j - o_{i-1} x p_j) = z_i . L_j + vO_i . p_j.
   Vec3<S> vO[kDof];
-  for (int i = 0; i < kDof; ++i) vO[i] = data.o[i].cross(data.R[i].col(2));
+  for (int i = 0; i < kDof; ++i) vO[i] = cross(data.o[i], data.R[i].col(2));
   S m = S(0);
   Vec3<S> h = Vec3<S>::Zero();
-  Mat3<S> IO = Mat3<S>::Zero();
+  Mat3<S> IO = Mat3<S>::Zero();  // symmetric
   for (int j = kDof; j >= 1; --j) {
     const S mj = model.link[j - 1].mass;
     const Vec3<S>& c = data.com[j];
+    const Vec3<S> mc = mj * c;
     m += mj;
-    h += mj * c;
-    IO += data.Ic[j] + mj * (c.squaredNorm() * Mat3<S>::Identity() - c * c.transpose());
+    h += mc;
+    // IO += Ic + mj (|c|^2 I - c c^T): the diagonal entry r is sum_{k != r} mc_k c_k, an off-diagonal
+    // one -mc_r c_s; six entries, IO and Ic being symmetric.
+    const Mat3<S>& Ic = data.Ic[j];
+    IO(0, 0) += Ic(0, 0) + math::dot2(mc(1), c(1), mc(2), c(2));
+    IO(1, 1) += Ic(1, 1) + math::dot2(mc(0), c(0), mc(2), c(2));
+    IO(2, 2) += Ic(2, 2) + math::dot2(mc(0), c(0), mc(1), c(1));
+    IO(0, 1) += Ic(0, 1) - mc(0) * c(1);
+    IO(0, 2) += Ic(0, 2) - mc(0) * c(2);
+    IO(1, 2) += Ic(1, 2) - mc(1) * c(2);
+    IO(1, 0) = IO(0, 1), IO(2, 0) = IO(0, 2), IO(2, 1) = IO(1, 2);
     const Vec3<S> z = data.R[j - 1].col(2);
-    const Vec3<S> p = m * vO[j - 1] + z.cross(h);  // linear momentum
-    const Vec3<S> L = IO * z + h.cross(vO[j - 1]);  // angular momentum about the base origin
+    const Vec3<S> p = m * vO[j - 1] + cross(z, h);  // linear momentum
+    const Vec3<S> L = IO * z + cross(h, vO[j - 1]);  // angular momentum about the base origin
     for (int i = 1; i <= j; ++i) {
-      data.A(i - 1, j - 1) = data.R[i - 1].col(2).dot(L) + vO[i - 1].dot(p);
+      data.A(i - 1, j - 1) = dot_sum(Vec3<S>(data.R[i - 1].col(2)), L, vO[i - 1], p);
       data.A(j - 1, i - 1) = data.A(i - 1, j - 1);
     }
   }
@@ -133,45 +143,47 @@ struct VelocityProductPair {
 template <class S>
 VelocityProductPair<S> velocity_product_pair(const Model<S>& model, const Data<S>& data, const Vec6In<S>& y,
                                              const Vec6In<S>& v) {
-  const S h = lit<S>(0.5);
+  // The bilinear quantities (wdb, ab, fb, nb, Fb, Nb) are carried doubled: each mixed product is
+  // then a plain sum of its two halves, and the one factor 1/2 is applied to the outputs.
   Vec3<S> wy = Vec3<S>::Zero(), wv = Vec3<S>::Zero();
   Vec3<S> wdq = Vec3<S>::Zero(), wdb = Vec3<S>::Zero(), aq = Vec3<S>::Zero(), ab = Vec3<S>::Zero();
   Vec3<S> fq[kDof + 1], nq[kDof + 1], fb[kDof + 1], nb[kDof + 1];
   for (int i = 1; i <= kDof; ++i) {
     const Vec3<S> z = data.R[i - 1].col(2);
     const Vec3<S> zy = z * y(i - 1), zv = z * v(i - 1);
-    wdq += wy.cross(zy);
-    wdb += h * (wy.cross(zv) + wv.cross(zy));
+    wdq += cross(wy, zy);
+    wdb += cross(wy, zv) + cross(wv, zy);
     wy += zy;
     wv += zv;
     const Vec3<S> r = data.o[i] - data.o[i - 1], rc = data.com[i] - data.o[i];
-    const Vec3<S> wyr = wy.cross(r), wvr = wv.cross(r), wyrc = wy.cross(rc), wvrc = wv.cross(rc);
-    aq += wdq.cross(r) + wy.cross(wyr);
-    ab += wdb.cross(r) + h * (wy.cross(wvr) + wv.cross(wyr));
+    const Vec3<S> wyr = cross(wy, r), wvr = cross(wv, r), wyrc = cross(wy, rc), wvrc = cross(wv, rc);
+    aq += cross(wdq, r) + cross(wy, wyr);
+    ab += cross(wdb, r) + cross(wy, wvr) + cross(wv, wyr);
     const S m = model.link[i - 1].mass;
-    fq[i] = m * (aq + wdq.cross(rc) + wy.cross(wyrc));
-    fb[i] = m * (ab + wdb.cross(rc) + h * (wy.cross(wvrc) + wv.cross(wyrc)));
+    fq[i] = m * (aq + cross(wdq, rc) + cross(wy, wyrc));
+    fb[i] = m * (ab + cross(wdb, rc) + cross(wy, wvrc) + cross(wv, wyrc));
     const Vec3<S> Iwy = data.Ic[i] * wy, Iwv = data.Ic[i] * wv;
-    nq[i] = data.Ic[i] * wdq + wy.cross(Iwy);
-    nb[i] = data.Ic[i] * wdb + h * (wy.cross(Iwv) + wv.cross(Iwy));
+    nq[i] = data.Ic[i] * wdq + cross(wy, Iwy);
+    nb[i] = data.Ic[i] * wdb + cross(wy, Iwv) + cross(wv, Iwy);
   }
+  const S h = lit<S>(0.5);
   VelocityProductPair<S> out;
   out.quad.jdot_qd.template head<3>() = aq;
   out.quad.jdot_qd.template tail<3>() = wdq;
   out.quad.w6 = wy;
-  out.bilinear.jdot_qd.template head<3>() = ab;
-  out.bilinear.jdot_qd.template tail<3>() = wdb;
+  out.bilinear.jdot_qd.template head<3>() = h * ab;
+  out.bilinear.jdot_qd.template tail<3>() = h * wdb;
   out.bilinear.w6 = wv;
   Vec3<S> Fq = Vec3<S>::Zero(), Nq = Vec3<S>::Zero(), Fb = Vec3<S>::Zero(), Nb = Vec3<S>::Zero();
   for (int i = kDof; i >= 1; --i) {
     const Vec3<S> rc = data.com[i] - data.o[i - 1], r = data.o[i] - data.o[i - 1];
-    Nq = nq[i] + Nq + rc.cross(fq[i]) + r.cross(Fq);
-    Nb = nb[i] + Nb + rc.cross(fb[i]) + r.cross(Fb);
+    Nq = nq[i] + Nq + cross(rc, fq[i]) + cross(r, Fq);
+    Nb = nb[i] + Nb + cross(rc, fb[i]) + cross(r, Fb);
     Fq += fq[i];
     Fb += fb[i];
     const Vec3<S> z = data.R[i - 1].col(2);
     out.quad.c(i - 1) = z.dot(Nq);
-    out.bilinear.c(i - 1) = z.dot(Nb);
+    out.bilinear.c(i - 1) = h * z.dot(Nb);
   }
   return out;
 }

@@ -27,6 +27,7 @@
 #include <concepts>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 namespace osc::fixed {
 
@@ -94,13 +95,80 @@ constexpr std::int32_t narrow(std::int64_t v, std::uint32_t why = kOverflow) {
 /// round(a b / 2^s) (half up), saturating: one 32x32 -> 64-bit multiply, the rounding constant, a
 /// range check on the high word (the result fits when it lies in [-2^(s-1), 2^(s-1))), and the
 /// middle 32 bits.
+/// round(v / 2^S) (half up), saturating. The rounding constant is added modulo 2^64 (a v within
+/// 2^(S-1) of the top of the 64-bit range wraps to a negative high word, which is out of range too);
+/// the direction of a saturation is v's sign.
 template <int S>
-[[gnu::always_inline]] inline std::int32_t mul_shift(std::int32_t a, std::int32_t b) {
-  const std::int64_t p = static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b) + (std::int64_t{1} << (S - 1));
+[[gnu::always_inline]] inline std::int32_t round_shift(std::int64_t v) {
+  const std::int64_t p = static_cast<std::int64_t>(static_cast<std::uint64_t>(v) + (std::uint64_t{1} << (S - 1)));
   const std::int32_t hi = static_cast<std::int32_t>(p >> 32);
   if (static_cast<std::uint32_t>(hi) + (1u << (S - 1)) >= (1u << S)) [[unlikely]]
-    return saturated(hi >= 0, kOverflow);
+    return saturated(v >= 0, kOverflow);
   return static_cast<std::int32_t>((static_cast<std::uint32_t>(p) >> S) | (static_cast<std::uint32_t>(hi) << (32 - S)));
+}
+template <int S>
+[[gnu::always_inline]] inline std::int32_t mul_shift(std::int32_t a, std::int32_t b) {
+  return round_shift<S>(static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b));
+}
+
+/// A sum of products a_k b_k of Q<S> numbers, held exactly in 64 bits (Q<2S>) and rounded once at
+/// the end: a dot product in fixed point has the error of one rounding, not one per product, and a
+/// term costs a multiply-accumulate (SMLAL) instead of a rounded, range-checked product and a
+/// saturating sum.
+///
+/// Why no term needs its own overflow check: each product is at most 2^62 in magnitude. A sum of up
+/// to three of them that wraps around the 64-bit range lands at least 2^64 - 3 2^62 = 2^62 away
+/// from zero, far beyond the 2^(31+S) that the final rounding accepts, so the rounding saturates
+/// and raises kOverflow. From then on the running sum is checked after every second term to stay
+/// below 2^62 (checkpoint(): a sum that passed cannot have wrapped, and two more terms cannot wrap
+/// it unnoticed); a partial sum beyond 2^62, i.e. 2^(62-2S) in real units (2^24 for Q12.19),
+/// raises kOverflow too. Nothing wraps silently.
+template <int S>
+struct ProductSum {
+  std::int64_t acc = 0;
+  /// acc + a b modulo 2^64 (the argument above says when that is exact).
+  [[gnu::always_inline]] void mac(std::int32_t a, std::int32_t b) {
+    acc = static_cast<std::int64_t>(static_cast<std::uint64_t>(acc) +
+                                    static_cast<std::uint64_t>(static_cast<std::int64_t>(a) * b));
+  }
+  /// The term with index k (0, 1, 2, ...; a constant where the sum is unrolled): a checkpoint after
+  /// terms 3, 5, 7, ...
+  [[gnu::always_inline]] void add(int k, std::int32_t a, std::int32_t b) {
+    mac(a, b);
+    if (k >= 2 && (k & 1) == 0) checkpoint();
+  }
+  /// The same with - a b.
+  [[gnu::always_inline]] void sub(int k, std::int32_t a, std::int32_t b) {
+    acc = static_cast<std::int64_t>(static_cast<std::uint64_t>(acc) -
+                                    static_cast<std::uint64_t>(static_cast<std::int64_t>(a) * b));
+    if (k >= 2 && (k & 1) == 0) checkpoint();
+  }
+  /// |acc| < 2^62, or kOverflow and acc held at 2^62 of its sign.
+  [[gnu::always_inline]] void checkpoint() {
+    const std::int32_t hi = static_cast<std::int32_t>(acc >> 32);
+    if (static_cast<std::uint32_t>(hi) + (1u << 30) >= (1u << 31)) [[unlikely]]
+      acc = overflowed(hi >= 0);
+  }
+  /// round(sum / 2^S), saturated (kOverflow) when it does not fit.
+  [[gnu::always_inline]] std::int32_t rounded() const { return round_shift<S>(acc); }
+
+ private:
+  [[gnu::cold, gnu::noinline]] static std::int64_t overflowed(bool positive) {
+    raise_flag(kOverflow);
+    return positive ? (std::int64_t{1} << 62) : -(std::int64_t{1} << 62);
+  }
+};
+
+/// a0 b0 + a1 b1 (+ a2 b2 ...) of Q<S> raw values with one rounding.
+template <int S, class... P>
+[[gnu::always_inline]] inline std::int32_t dot_raw(P... ab) {
+  static_assert(sizeof...(P) % 2 == 0);
+  ProductSum<S> s;
+  const std::int32_t v[] = {ab...};
+  [&]<int... K>(std::integer_sequence<int, K...>) {
+    (s.add(K, v[2 * K], v[2 * K + 1]), ...);
+  }(std::make_integer_sequence<int, sizeof...(P) / 2>{});
+  return s.rounded();
 }
 
 /// Rounding arithmetic right shift by s >= 1 (round half up).
@@ -605,3 +673,76 @@ struct NumTraits<osc::fixed::Q<F>> {
   static constexpr int max_exponent() { return 31 - F; }
 };
 }  // namespace Eigen
+
+namespace Eigen::internal {
+// Dot products of Q<F> numbers with one rounding. Every sum of products that Eigen forms (a.dot(b),
+// the coefficients of a fixed-size matrix product, the steps of its triangular solves and of LLT,
+// squaredNorm) is a redux of scalar_sum_op over a coefficient-wise product; for Q<F> these reduxes
+// accumulate the exact products in 64 bits and round once (osc::fixed::detail::ProductSum) instead
+// of rounding and saturating at every product and sum. The result is the correctly rounded sum
+// (when it fits), and a multiply-accumulate costs a fraction of a rounded product on a core
+// without an FPU. Nothing else of Eigen changes: float and double take Eigen's own paths.
+template <class Op> struct OscQProductOp : std::false_type {};
+template <int F> struct OscQProductOp<scalar_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
+template <int F> struct OscQProductOp<scalar_conj_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
+
+template <int F>
+struct OscQDotRedux {
+  /// fn(k, i, j) for every coefficient (i, j) of xpr, k counting them: unrolled with a compile-time
+  /// k (std::integral_constant) at compile-time sizes (the 3- and 6-term dot products of the
+  /// kernels), a loop for the run-time blocks of LLT.
+  template <class Xpr, class Fn>
+  [[gnu::always_inline]] static void for_each_coeff(const Xpr& xpr, Fn&& fn) {
+    constexpr int R = Xpr::RowsAtCompileTime, C = Xpr::ColsAtCompileTime;
+    if constexpr (R != Dynamic && C != Dynamic) {
+      [&]<int... K>(std::integer_sequence<int, K...>) {
+        (fn(std::integral_constant<int, K>{}, K % R, K / R), ...);
+      }(std::make_integer_sequence<int, R * C>{});
+    } else {
+      int k = 0;
+      for (Index j = 0; j < xpr.cols(); ++j)
+        for (Index i = 0; i < xpr.rows(); ++i) fn(k++, i, j);
+    }
+  }
+  /// sum_ij lhs(i, j) rhs(i, j) of a coefficient-wise product.
+  template <class Op, class L, class R>
+  static osc::fixed::Q<F> run(const CwiseBinaryOp<Op, L, R>& xpr) {
+    const evaluator<L> le(xpr.lhs());
+    const evaluator<R> re(xpr.rhs());
+    osc::fixed::detail::ProductSum<F> s;
+    for_each_coeff(xpr, [&](auto k, Index i, Index j) { s.add(k, le.coeff(i, j).raw(), re.coeff(i, j).raw()); });
+    return osc::fixed::Q<F>::from_raw(s.rounded());
+  }
+  /// sum_ij x(i, j)^2 (squaredNorm).
+  template <class X>
+  static osc::fixed::Q<F> run(const CwiseUnaryOp<scalar_abs2_op<osc::fixed::Q<F>>, X>& xpr) {
+    const evaluator<X> e(xpr.nestedExpression());
+    osc::fixed::detail::ProductSum<F> s;
+    for_each_coeff(xpr, [&](auto k, Index i, Index j) {
+      const std::int32_t v = e.coeff(i, j).raw();
+      s.add(k, v, v);
+    });
+    return osc::fixed::Q<F>::from_raw(s.rounded());
+  }
+};
+
+// Eigen picks its redux by traversal and unrolling; a Q<F> scalar never vectorises
+// (DefaultTraversal), and small fixed sizes unroll completely: both cases take the one-rounding sum.
+#define OSC_Q_DOT_REDUX(UNROLLING)                                                                          \
+  template <int F, class Op, class L, class R>                                                            \
+    requires OscQProductOp<Op>::value                                                                     \
+  struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>, redux_evaluator<CwiseBinaryOp<Op, L, R>>, \
+                    DefaultTraversal, UNROLLING> {                                                        \
+    template <class Ev, class Func, class Xpr>                                                            \
+    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) { return OscQDotRedux<F>::run(xpr); } \
+  };                                                                                                      \
+  template <int F, class X>                                                                               \
+  struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>,                                    \
+                    redux_evaluator<CwiseUnaryOp<scalar_abs2_op<osc::fixed::Q<F>>, X>>, DefaultTraversal, UNROLLING> { \
+    template <class Ev, class Func, class Xpr>                                                            \
+    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) { return OscQDotRedux<F>::run(xpr); } \
+  };
+OSC_Q_DOT_REDUX(NoUnrolling)
+OSC_Q_DOT_REDUX(CompleteUnrolling)
+#undef OSC_Q_DOT_REDUX
+}  // namespace Eigen::internal

@@ -14,6 +14,10 @@
 namespace osc {
 
 /// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic.
+/// R_{i+1} = R_i Rz(q_i) Rx(alpha_i): Rz turns the first two columns of R_i by q_i (x, y below),
+/// and Rx(alpha) mixes y with the third column, a permutation with a sign for the twists 0 and
+/// +-pi/2 that the robot table states (Model::Link::twist). o_{i+1} = o_i + R_i (a c, a s, d) =
+/// o_i + a x + d z.
 template <class S>
 void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q) {
   data.R[0].setIdentity();
@@ -22,14 +26,28 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
     const auto& l = model.link[i];
     S s, c;
     math::sincos(q(i), s, c);
-    Mat3<S> Ai;  // Rz(q) Rx(alpha)
-    Ai << c, -s * l.cos_alpha, s * l.sin_alpha,
-          s, c * l.cos_alpha, -c * l.sin_alpha,
-          S(0), l.sin_alpha, l.cos_alpha;
-    data.o[i + 1] = data.o[i] + data.R[i] * Vec3<S>(l.a * c, l.a * s, l.d);
-    data.R[i + 1] = data.R[i] * Ai;
-    data.com[i + 1] = data.o[i + 1] + data.R[i + 1] * l.com;
-    data.Ic[i + 1] = data.R[i + 1] * l.inertia.asDiagonal() * data.R[i + 1].transpose();
+    const Mat3<S>& R = data.R[i];
+    Mat3<S>& Rn = data.R[i + 1];
+    const Vec3<S> x = combine(c, R.col(0), s, R.col(1));   // R Rz(q) e_x
+    const Vec3<S> y = combine(c, R.col(1), -s, R.col(0));  // R Rz(q) e_y
+    const Vec3<S> z = R.col(2);
+    Rn.col(0) = x;
+    switch (l.twist) {
+      case Twist::kZero: Rn.col(1) = y, Rn.col(2) = z; break;
+      case Twist::kPlusHalfPi: Rn.col(1) = z, Rn.col(2) = -y; break;
+      case Twist::kMinusHalfPi: Rn.col(1) = -z, Rn.col(2) = y; break;
+      case Twist::kGeneral:
+        Rn.col(1) = combine(l.cos_alpha, y, l.sin_alpha, z);
+        Rn.col(2) = combine(l.cos_alpha, z, S(-l.sin_alpha), y);
+        break;
+    }
+    data.o[i + 1] = data.o[i] + combine(l.a, x, l.d, z);
+    data.com[i + 1] = data.o[i + 1] + Rn * l.com;
+    // Ic = Rn diag(I) Rn^T, symmetric: six of its entries.
+    const Mat3<S> M = Rn * l.inertia.asDiagonal();
+    Mat3<S>& Ic = data.Ic[i + 1];
+    for (int r = 0; r < 3; ++r)
+      for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));
   }
 }
 
@@ -39,7 +57,7 @@ template <class S>
 void geometric_jacobian(Data<S>& data) {
   for (int j = 0; j < kDof; ++j) {
     const Vec3<S> z = data.R[j].col(2);
-    data.J.template block<3, 1>(0, j) = z.cross(data.o[kDof] - data.o[j]);
+    data.J.template block<3, 1>(0, j) = cross(z, data.o[kDof] - data.o[j]);
     data.J.template block<3, 1>(3, j) = z;
   }
 }

@@ -28,11 +28,72 @@ Vec6<S> joint_vector(const double (&a)[kDof]) {
   return v;
 }
 
+/// a x b, each component a_i b_j - a_j b_i by math::dot2_minus (one rounding in fixed point).
+template <class A, class B>
+[[gnu::always_inline]] inline Vec3<typename A::Scalar> cross(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b) {
+  using S = typename A::Scalar;
+  if constexpr (fixed::is_q_v<S>) {
+    const Vec3<S> u = a, v = b;
+    return Vec3<S>(math::dot2_minus(u(1), v(2), u(2), v(1)), math::dot2_minus(u(2), v(0), u(0), v(2)),
+                   math::dot2_minus(u(0), v(1), u(1), v(0)));
+  } else {
+    return a.cross(b);
+  }
+}
+
+/// a x b + c x d, each component rounded once in fixed point (a four-term fixed::detail::ProductSum).
+template <class A, class B, class C, class D>
+[[gnu::always_inline]] inline Vec3<typename A::Scalar> cross_sum(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b,
+                                                                const Eigen::MatrixBase<C>& c, const Eigen::MatrixBase<D>& d) {
+  using S = typename A::Scalar;
+  if constexpr (fixed::is_q_v<S>) {
+    const Vec3<S> u = a, v = b, w = c, x = d;
+    const auto component = [&](int i, int j) {
+      fixed::detail::ProductSum<S::kFractionBits> sum;
+      sum.add(0, u(i).raw(), v(j).raw());
+      sum.sub(1, u(j).raw(), v(i).raw());
+      sum.add(2, w(i).raw(), x(j).raw());
+      sum.sub(3, w(j).raw(), x(i).raw());
+      return S::from_raw(sum.rounded());
+    };
+    return Vec3<S>(component(1, 2), component(2, 0), component(0, 1));
+  } else {
+    return a.cross(b) + c.cross(d);
+  }
+}
+
+/// u . v + w . x of 3-vectors, rounded once in fixed point (a six-term math::sum_of_products).
+template <class S>
+[[gnu::always_inline]] inline S dot_sum(const Vec3<S>& u, const Vec3<S>& v, const Vec3<S>& w, const Vec3<S>& x) {
+  if constexpr (fixed::is_q_v<S>) return math::sum_of_products(u(0), v(0), u(1), v(1), u(2), v(2), w(0), x(0), w(1), x(1), w(2), x(2));
+  else return u.dot(v) + w.dot(x);
+}
+
+/// a u + b v of two 3-vectors, each component by math::dot2 (one rounding in fixed point).
+template <class S, class U, class V>
+[[gnu::always_inline]] inline Vec3<S> combine(S a, const Eigen::MatrixBase<U>& u, S b, const Eigen::MatrixBase<V>& v) {
+  return Vec3<S>(math::dot2(a, S(u(0)), b, S(v(0))), math::dot2(a, S(u(1)), b, S(v(1))), math::dot2(a, S(u(2)), b, S(v(2))));
+}
+
+/// The twist alpha of a DH link as the structure it gives the frames: 0 and +-pi/2 (every PUMA 560
+/// link) turn the rotation Rx(alpha) into a permutation of columns with a sign, which
+/// forward_kinematics applies without a product; any other angle is kGeneral.
+enum class Twist : unsigned char { kZero, kPlusHalfPi, kMinusHalfPi, kGeneral };
+
+constexpr Twist twist_of(double alpha) {
+  constexpr double kTol = 1e-12;
+  if (alpha > -kTol && alpha < kTol) return Twist::kZero;
+  if (alpha - kPi / 2 > -kTol && alpha - kPi / 2 < kTol) return Twist::kPlusHalfPi;
+  if (alpha + kPi / 2 > -kTol && alpha + kPi / 2 < kTol) return Twist::kMinusHalfPi;
+  return Twist::kGeneral;
+}
+
 /// Constant parameters of a 6-joint standard-DH arm, in the kernel's scalar.
 template <class S>
 struct Model {
   struct Link {
     S a, d, cos_alpha, sin_alpha;
+    Twist twist;          // the structure of alpha (kGeneral: use cos_alpha, sin_alpha)
     S mass;
     Vec3<S> com;          // COM in frame i
     Vec3<S> inertia;      // principal moments about the COM, axes of frame i
@@ -55,6 +116,7 @@ struct Model {
       l.sin_alpha = lit<S>(std::sin(p.alpha));
       // Snap cos/sin of +-pi/2 to exact zeros so the DH structure is exact.
       if (std::fabs(std::cos(p.alpha)) < 1e-12) l.cos_alpha = S(0);
+      l.twist = twist_of(p.alpha);
       l.mass = lit<S>(p.mass * s);
       l.com = Vec3<S>(lit<S>(p.com[0]), lit<S>(p.com[1]), lit<S>(p.com[2]));
       l.inertia = Vec3<S>(lit<S>(p.inertia[0] * s), lit<S>(p.inertia[1] * s), lit<S>(p.inertia[2] * s));
@@ -71,7 +133,7 @@ struct Data {
   Mat3<S> R[kDof + 1];
   Vec3<S> o[kDof + 1];
   Vec3<S> com[kDof + 1];   // COM of link i in the base frame (index 0 unused)
-  Mat3<S> Ic[kDof + 1];    // inertia of link i about its COM, base axes
+  Mat3<S> Ic[kDof + 1];    // inertia of link i about its COM, base axes (symmetric)
   Mat6<S> J;               // geometric Jacobian [v; w] of the frame-6 origin, base frame
   Mat6<S> A;               // joint-space inertia, armature included
 };

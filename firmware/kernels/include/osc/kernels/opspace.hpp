@@ -54,7 +54,7 @@ struct SphericalWristJacobianFactor {
   static S invert(const Mat3<S>& M, Mat3<S>& inv) {
     const Vec3<S> r0 = M.row(0).transpose(), r1 = M.row(1).transpose(), r2 = M.row(2).transpose();
     Mat3<S> adj;
-    adj << r1.cross(r2), r2.cross(r0), r0.cross(r1);
+    adj << cross(r1, r2), cross(r2, r0), cross(r0, r1);
     const S det = r0.dot(adj.col(0));
     if (det == S(0)) {
       inv.setZero();
@@ -64,6 +64,38 @@ struct SphericalWristJacobianFactor {
     return S(1) / (norm1(M) * norm1(inv));
   }
   static S norm1(const Mat3<S>& M) { return M.cwiseAbs().colwise().sum().maxCoeff(); }
+};
+
+/// A = L D L^T of a symmetric positive definite N x N matrix (unit lower-triangular L, diagonal D):
+/// no pivoting (not needed for A(q)), no square root, and the reciprocals 1/D kept, so that a
+/// factorisation takes N divisions and a solve none (Eigen's LLT takes N square roots and N(N-1)/2
+/// divisions, and N divisions per triangular solve). positive is false when a pivot is not positive
+/// (A not positive definite); the solve is then meaningless and callers treat it as a fault.
+template <class S, int N>
+struct LdltFactor {
+  Eigen::Matrix<S, N, N> L;  // strictly lower part: L; the rest unused
+  Eigen::Matrix<S, N, 1> d, d_inv;
+  bool positive = false;
+
+  void compute(const Eigen::Matrix<S, N, N>& A) {
+    positive = true;
+    Eigen::Matrix<S, N, 1> t;  // t_k = L(j, k) d_k of the current row j
+    for (int j = 0; j < N; ++j) {
+      for (int k = 0; k < j; ++k) t(k) = L(j, k) * d(k);
+      d(j) = A(j, j) - L.row(j).head(j).dot(t.head(j));
+      if (!(d(j) > S(0))) positive = false;
+      d_inv(j) = S(1) / d(j);
+      for (int i = j + 1; i < N; ++i) L(i, j) = (A(i, j) - L.row(i).head(j).dot(t.head(j))) * d_inv(j);
+    }
+  }
+  /// A^{-1} b: L y = b, then L^T x = D^{-1} y.
+  Eigen::Matrix<S, N, 1> solve(const Eigen::Matrix<S, N, 1>& b) const {
+    Eigen::Matrix<S, N, 1> x;
+    for (int i = 0; i < N; ++i) x(i) = b(i) - L.row(i).head(i).dot(x.head(i));
+    for (int i = N - 1; i >= 0; --i)
+      x(i) = x(i) * d_inv(i) - L.col(i).tail(N - 1 - i).dot(x.tail(N - 1 - i));
+    return x;
+  }
 };
 
 /// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised. The control step never forms it: it
@@ -85,11 +117,11 @@ struct OpSpace {
   PhiRate<S> E;            // E^{-1}(phi) and the trig of phi
   Mat6<S> Ja;              // analytic Jacobian
   SphericalWristJacobianFactor<S> Jf;    // factorisation of Ja
-  Eigen::LLT<Mat6<S>> A_llt;
+  LdltFactor<S, kDof> A_ldlt;  // A = L D L^T
   Vec6<S> g;               // joint gravity torques
 };
 
-/// Computes kinematics, A(q), g(q), Ja, its factorisation and the Cholesky factor of A at q.
+/// Computes kinematics, A(q), g(q), Ja, its factorisation and the L D L^T factors of A at q.
 template <class S>
 void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q,
                     const Mat3<S>& R_ref) {
@@ -100,7 +132,7 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
   os.E = phi_rate(Vec3<S>(os.x.template tail<3>()));
   os.Ja = analytic_jacobian(data.J, os.E);
   os.Jf.compute(os.Ja);
-  os.A_llt.compute(data.A);
+  os.A_ldlt.compute(data.A);
   os.g = gravity_torques(model, data);
 }
 
@@ -127,10 +159,10 @@ Vec6<S> operational_friction(const OpSpace<S>& os, const Vec6In<S>& tau_f) { ret
 template <class S>
 Vec6<S> joint_torques(const OpSpace<S>& os, const Vec6In<S>& F) { return os.Ja.transpose() * F; }
 
-/// Lambda^{-1} w = J A^{-1} J^T w, by the Cholesky factor of A.
+/// Lambda^{-1} w = J A^{-1} J^T w, by the L D L^T factors of A.
 template <class S>
 Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
-  return os.Ja * os.A_llt.solve(os.Ja.transpose() * w);
+  return os.Ja * os.A_ldlt.solve(Vec6<S>(os.Ja.transpose() * w));
 }
 
 /// Analytic Jdot(q, qd) qd.

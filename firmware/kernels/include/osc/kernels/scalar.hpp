@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -28,10 +29,71 @@ constexpr std::array<S, N> lit_array(const double (&a)[N]) {
 }
 
 namespace math {
-inline float sin(float v) { return std::sin(v); }
-inline float cos(float v) { return std::cos(v); }
+namespace detail {
+/// sin v and cos v in float, for the FPU targets (newlib's sinf and cosf each reduce the argument
+/// again and take several times as many instructions). v = k pi/2 + r, |r| <= pi/4, with pi/2 split
+/// into three floats whose first two have 12 significant bits, so that k times them is exact for
+/// |k| < 2^12 (|v| < 6400); the rounding of r is kept as r_lo (TwoSum), and the one of 1 - r^2/2
+/// too (as fdlibm's cosine kernel does). Taylor polynomials of sin to r^9 and of cos to r^10
+/// (truncation below 2e-9 at pi/4), each result rounded once from r or 1 - r^2/2 and a small sum.
+/// |error| <= 6e-8 (one float ulp of 1) for |v| <= 6400, tested
+/// against double (tests/test_properties.cpp, FloatFunctions).
+[[gnu::always_inline]] inline void sincos_float(float v, float& s, float& c) {
+  const float kf = v * 0.636619772f;
+  const int k = static_cast<int>(kf >= 0.0f ? kf + 0.5f : kf - 0.5f);
+  const float fk = static_cast<float>(k);
+  const float a = v - fk * 1.57080078125f;  // exact
+  const float b = fk * -4.453584551811218e-06f;  // exact
+  const float r = a - b, bv = r - a;  // TwoSum: r + e = a - b exactly
+  const float r_lo = ((a - (r - bv)) - (b + bv)) - fk * -8.705516307827565e-10f;  // r + r_lo = v - k pi/2
+  const float z = r * r;
+  const float sr_lo = r * z * (-1.66666667e-1f + z * (8.33333333e-3f + z * (-1.98412698e-4f + z * 2.75573192e-6f)));
+  const float sr = r + sr_lo;
+  const float hz = 0.5f * z, w = 1.0f - hz;
+  const float cr_lo = ((1.0f - w) - hz) + z * z * (4.16666667e-2f + z * (-1.38888889e-3f + z * (2.48015873e-5f + z * -2.75573192e-7f)));
+  const float cr = w + cr_lo;
+  // sin(r + r_lo) = sin r + r_lo cos r, cos(r + r_lo) = cos r - r_lo sin r (r_lo^2 is below 2^-40).
+  const float ps = r + (sr_lo + r_lo * cr);
+  const float pc = w + (cr_lo - r_lo * sr);
+  switch (static_cast<unsigned>(k) & 3u) {
+    case 0: s = ps, c = pc; break;
+    case 1: s = pc, c = -ps; break;
+    case 2: s = -ps, c = -pc; break;
+    default: s = -pc, c = ps; break;
+  }
+}
+/// e^v in float: v = k ln 2 + r, |r| <= ln 2 / 2 (ln 2 in two floats, the first with 12 significant
+/// bits), Taylor polynomial to r^7 (truncation below 6e-9 relative), times 2^k from the exponent bits.
+/// Relative error <= 2.4e-7 (two float ulps) where e^v is a normal float; 0 below, +inf above.
+[[gnu::always_inline]] inline float exp_float(float v) {
+  if (!(v >= -87.3f)) return v != v ? v : 0.0f;  // NaN stays NaN; e^v below the normal range: 0
+  if (v > 88.5f) return HUGE_VALF;
+  const float kf = v * 1.44269502f;
+  const int k = static_cast<int>(kf >= 0.0f ? kf + 0.5f : kf - 0.5f);
+  const float fk = static_cast<float>(k);
+  const float r = (v - fk * 0.693115234375f) - fk * 3.194618329871446e-05f;
+  const float p = 1.0f + r * (1.0f + r * (0.5f + r * (1.66666667e-1f + r * (4.16666667e-2f + r * (8.33333333e-3f +
+                                       r * (1.38888889e-3f + r * 1.98412698e-4f))))));
+  // 2^k as two factors: each is a normal float for k in [-126, 128] (k = 128 only just below 88.72).
+  const int k1 = k / 2, k2 = k - k1;
+  const float s1 = std::bit_cast<float>(static_cast<std::uint32_t>(k1 + 127) << 23);
+  const float s2 = std::bit_cast<float>(static_cast<std::uint32_t>(k2 + 127) << 23);
+  return p * s1 * s2;
+}
+}  // namespace detail
+
+inline float sin(float v) {
+  float s, c;
+  detail::sincos_float(v, s, c);
+  return s;
+}
+inline float cos(float v) {
+  float s, c;
+  detail::sincos_float(v, s, c);
+  return c;
+}
 inline float sqrt(float v) { return std::sqrt(v); }
-inline float exp(float v) { return std::exp(v); }
+inline float exp(float v) { return detail::exp_float(v); }
 inline float abs(float v) { return std::fabs(v); }
 inline float atan2(float y, float x) { return std::atan2(y, x); }
 inline float asin(float v) { return std::asin(v); }
@@ -45,7 +107,7 @@ inline double atan2(double y, double x) { return std::atan2(y, x); }
 inline double asin(double v) { return std::asin(v); }
 inline bool isfinite(double v) { return std::isfinite(v); }
 /// sin v and cos v together (one argument reduction in fixed point).
-inline void sincos(float v, float& s, float& c) { s = std::sin(v), c = std::cos(v); }
+inline void sincos(float v, float& s, float& c) { detail::sincos_float(v, s, c); }
 inline void sincos(double v, double& s, double& c) { s = std::sin(v), c = std::cos(v); }
 using fixed::sin;
 using fixed::cos;
@@ -56,6 +118,34 @@ using fixed::abs;
 using fixed::atan2;
 using fixed::asin;
 using fixed::isfinite;
+
+/// a b + c d: the component of a cross product or of a plane rotation. Fixed point rounds it once
+/// (the exact products summed in 64 bits, fixed::detail::ProductSum), not once per product and sum.
+template <class S>
+[[gnu::always_inline]] inline S dot2(S a, S b, S c, S d) {
+  if constexpr (fixed::is_q_v<S>) return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), c.raw(), d.raw()));
+  else return a * b + c * d;
+}
+/// a0 b0 + a1 b1 + ...: a dot product written out, rounded once in fixed point. A negated factor
+/// (-a) costs a saturating negation there, exact but for the most negative number.
+template <class S, class... R>
+[[gnu::always_inline]] inline S sum_of_products(S a, S b, R... rest) {
+  if constexpr (fixed::is_q_v<S>) return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), rest.raw()...));
+  else if constexpr (sizeof...(R) == 0) return a * b;
+  else return a * b + sum_of_products(rest...);
+}
+/// a b - c d, likewise.
+template <class S>
+[[gnu::always_inline]] inline S dot2_minus(S a, S b, S c, S d) {
+  if constexpr (fixed::is_q_v<S>) {
+    fixed::detail::ProductSum<S::kFractionBits> sum;
+    sum.add(0, a.raw(), b.raw());
+    sum.sub(1, c.raw(), d.raw());
+    return S::from_raw(sum.rounded());
+  } else {
+    return a * b - c * d;
+  }
+}
 
 /// sgn with sgn(0) = 0, eq. (3).
 template <class S>
