@@ -81,7 +81,8 @@ Desired<S> trajectory(const TrajectorySpec<S>& spec, const Vec3<S>& p0, S t) {
   const S ct2_ex = ct2 * ex;
   const S sd = lit<S>(3) * ct2_ex;
   const S sdd = lit<S>(6) * ct * ex - lit<S>(9) * ct2_ex * ct2;
-  const S sn = math::sin(w * t), cs = math::cos(w * t);
+  S sn, cs;
+  math::sincos(w * t, sn, cs);
   // x: A sin(wt) s;  y, z: A cos(wt) s.
   const S px = A * sn * s, pxd = A * (w * cs * s + sn * sd), pxdd = A * (-w * w * sn * s + lit<S>(2) * w * cs * sd + sn * sdd);
   const S py = A * cs * s, pyd = A * (-w * sn * s + cs * sd), pydd = A * (-w * w * cs * s - lit<S>(2) * w * sn * sd + cs * sdd);

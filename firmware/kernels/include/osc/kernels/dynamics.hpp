@@ -72,9 +72,9 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
     // IO += Ic + mj (|c|^2 I - c c^T): the diagonal entry r is sum_{k != r} mc_k c_k, an off-diagonal
     // one -mc_r c_s; six entries, IO and Ic being symmetric.
     const Mat3<S>& Ic = data.Ic[j];
-    IO(0, 0) += Ic(0, 0) + math::dot2(mc(1), c(1), mc(2), c(2));
-    IO(1, 1) += Ic(1, 1) + math::dot2(mc(0), c(0), mc(2), c(2));
-    IO(2, 2) += Ic(2, 2) + math::dot2(mc(0), c(0), mc(1), c(1));
+    IO(0, 0) += Ic(0, 0) + math::sum_of_products(mc(1), c(1), mc(2), c(2));
+    IO(1, 1) += Ic(1, 1) + math::sum_of_products(mc(0), c(0), mc(2), c(2));
+    IO(2, 2) += Ic(2, 2) + math::sum_of_products(mc(0), c(0), mc(1), c(1));
     IO(0, 1) += Ic(0, 1) - mc(0) * c(1);
     IO(0, 2) += Ic(0, 2) - mc(0) * c(2);
     IO(1, 2) += Ic(1, 2) - mc(1) * c(2);

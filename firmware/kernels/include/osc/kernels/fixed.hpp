@@ -92,12 +92,10 @@ constexpr std::int32_t narrow(std::int64_t v, std::uint32_t why = kOverflow) {
     return saturated(true, kOverflow);
   return -a;
 }
-/// round(a b / 2^s) (half up), saturating: one 32x32 -> 64-bit multiply, the rounding constant, a
-/// range check on the high word (the result fits when it lies in [-2^(s-1), 2^(s-1))), and the
-/// middle 32 bits.
-/// round(v / 2^S) (half up), saturating. The rounding constant is added modulo 2^64 (a v within
-/// 2^(S-1) of the top of the 64-bit range wraps to a negative high word, which is out of range too);
-/// the direction of a saturation is v's sign.
+/// round(v / 2^S) (half up), saturating: the rounding constant, a range check on the high word (the
+/// result fits when it lies in [-2^(S-1), 2^(S-1))), and the middle 32 bits. The constant is added
+/// modulo 2^64 (a v within 2^(S-1) of the top of the 64-bit range wraps to a negative high word,
+/// which is out of range too); the direction of a saturation is v's sign.
 template <int S>
 [[gnu::always_inline]] inline std::int32_t round_shift(std::int64_t v) {
   const std::int64_t p = static_cast<std::int64_t>(static_cast<std::uint64_t>(v) + (std::uint64_t{1} << (S - 1)));
@@ -106,6 +104,7 @@ template <int S>
     return saturated(v >= 0, kOverflow);
   return static_cast<std::int32_t>((static_cast<std::uint32_t>(p) >> S) | (static_cast<std::uint32_t>(hi) << (32 - S)));
 }
+/// round(a b / 2^S), saturating: one 32x32 -> 64-bit multiply, then round_shift.
 template <int S>
 [[gnu::always_inline]] inline std::int32_t mul_shift(std::int32_t a, std::int32_t b) {
   return round_shift<S>(static_cast<std::int64_t>(a) * static_cast<std::int64_t>(b));
@@ -135,12 +134,16 @@ struct ProductSum {
   /// terms 3, 5, 7, ...
   [[gnu::always_inline]] void add(int k, std::int32_t a, std::int32_t b) {
     mac(a, b);
-    if (k >= 2 && (k & 1) == 0) checkpoint();
+    after_term(k);
   }
   /// The same with - a b.
   [[gnu::always_inline]] void sub(int k, std::int32_t a, std::int32_t b) {
     acc = static_cast<std::int64_t>(static_cast<std::uint64_t>(acc) -
                                     static_cast<std::uint64_t>(static_cast<std::int64_t>(a) * b));
+    after_term(k);
+  }
+  /// The checkpoint schedule: after terms 3, 5, 7, ... (index k = 2, 4, 6, ...).
+  [[gnu::always_inline]] void after_term(int k) {
     if (k >= 2 && (k & 1) == 0) checkpoint();
   }
   /// |acc| < 2^62, or kOverflow and acc held at 2^62 of its sign.

@@ -41,27 +41,6 @@ template <class A, class B>
   }
 }
 
-/// a x b + c x d, each component rounded once in fixed point (a four-term fixed::detail::ProductSum).
-template <class A, class B, class C, class D>
-[[gnu::always_inline]] inline Vec3<typename A::Scalar> cross_sum(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b,
-                                                                const Eigen::MatrixBase<C>& c, const Eigen::MatrixBase<D>& d) {
-  using S = typename A::Scalar;
-  if constexpr (fixed::is_q_v<S>) {
-    const Vec3<S> u = a, v = b, w = c, x = d;
-    const auto component = [&](int i, int j) {
-      fixed::detail::ProductSum<S::kFractionBits> sum;
-      sum.add(0, u(i).raw(), v(j).raw());
-      sum.sub(1, u(j).raw(), v(i).raw());
-      sum.add(2, w(i).raw(), x(j).raw());
-      sum.sub(3, w(j).raw(), x(i).raw());
-      return S::from_raw(sum.rounded());
-    };
-    return Vec3<S>(component(1, 2), component(2, 0), component(0, 1));
-  } else {
-    return a.cross(b) + c.cross(d);
-  }
-}
-
 /// u . v + w . x of 3-vectors, rounded once in fixed point (a six-term math::sum_of_products).
 template <class S>
 [[gnu::always_inline]] inline S dot_sum(const Vec3<S>& u, const Vec3<S>& v, const Vec3<S>& w, const Vec3<S>& x) {
@@ -69,10 +48,12 @@ template <class S>
   else return u.dot(v) + w.dot(x);
 }
 
-/// a u + b v of two 3-vectors, each component by math::dot2 (one rounding in fixed point).
+/// a u + b v of two 3-vectors, each component by math::sum_of_products (one rounding in fixed point).
 template <class S, class U, class V>
 [[gnu::always_inline]] inline Vec3<S> combine(S a, const Eigen::MatrixBase<U>& u, S b, const Eigen::MatrixBase<V>& v) {
-  return Vec3<S>(math::dot2(a, S(u(0)), b, S(v(0))), math::dot2(a, S(u(1)), b, S(v(1))), math::dot2(a, S(u(2)), b, S(v(2))));
+  using math::sum_of_products;
+  return Vec3<S>(sum_of_products(a, S(u(0)), b, S(v(0))), sum_of_products(a, S(u(1)), b, S(v(1))),
+                 sum_of_products(a, S(u(2)), b, S(v(2))));
 }
 
 /// The twist alpha of a DH link as the structure it gives the frames: 0 and +-pi/2 (every PUMA 560

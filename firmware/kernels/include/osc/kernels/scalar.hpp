@@ -30,6 +30,9 @@ constexpr std::array<S, N> lit_array(const double (&a)[N]) {
 
 namespace math {
 namespace detail {
+/// v rounded to the nearest integer (half away from zero), for the range reductions below.
+[[gnu::always_inline]] inline int round_to_int(float v) { return static_cast<int>(v >= 0.0f ? v + 0.5f : v - 0.5f); }
+
 /// sin v and cos v in float, for the FPU targets (newlib's sinf and cosf each reduce the argument
 /// again and take several times as many instructions). v = k pi/2 + r, |r| <= pi/4, with pi/2 split
 /// into three floats whose first two have 12 significant bits, so that k times them is exact for
@@ -39,8 +42,7 @@ namespace detail {
 /// |error| <= 6e-8 (one float ulp of 1) for |v| <= 6400, tested
 /// against double (tests/test_properties.cpp, FloatFunctions).
 [[gnu::always_inline]] inline void sincos_float(float v, float& s, float& c) {
-  const float kf = v * 0.636619772f;
-  const int k = static_cast<int>(kf >= 0.0f ? kf + 0.5f : kf - 0.5f);
+  const int k = round_to_int(v * 0.636619772f);
   const float fk = static_cast<float>(k);
   const float a = v - fk * 1.57080078125f;  // exact
   const float b = fk * -4.453584551811218e-06f;  // exact
@@ -68,8 +70,7 @@ namespace detail {
 [[gnu::always_inline]] inline float exp_float(float v) {
   if (!(v >= -87.3f)) return v != v ? v : 0.0f;  // NaN stays NaN; e^v below the normal range: 0
   if (v > 88.5f) return HUGE_VALF;
-  const float kf = v * 1.44269502f;
-  const int k = static_cast<int>(kf >= 0.0f ? kf + 0.5f : kf - 0.5f);
+  const int k = round_to_int(v * 1.44269502f);
   const float fk = static_cast<float>(k);
   const float r = (v - fk * 0.693115234375f) - fk * 3.194618329871446e-05f;
   const float p = 1.0f + r * (1.0f + r * (0.5f + r * (1.66666667e-1f + r * (4.16666667e-2f + r * (8.33333333e-3f +
@@ -119,22 +120,16 @@ using fixed::atan2;
 using fixed::asin;
 using fixed::isfinite;
 
-/// a b + c d: the component of a cross product or of a plane rotation. Fixed point rounds it once
-/// (the exact products summed in 64 bits, fixed::detail::ProductSum), not once per product and sum.
-template <class S>
-[[gnu::always_inline]] inline S dot2(S a, S b, S c, S d) {
-  if constexpr (fixed::is_q_v<S>) return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), c.raw(), d.raw()));
-  else return a * b + c * d;
-}
-/// a0 b0 + a1 b1 + ...: a dot product written out, rounded once in fixed point. A negated factor
-/// (-a) costs a saturating negation there, exact but for the most negative number.
+/// a0 b0 + a1 b1 + ...: a dot product written out (a plane rotation, an entry of an inertia). Fixed
+/// point rounds it once (the exact products summed in 64 bits, fixed::detail::ProductSum), not once
+/// per product and sum.
 template <class S, class... R>
 [[gnu::always_inline]] inline S sum_of_products(S a, S b, R... rest) {
   if constexpr (fixed::is_q_v<S>) return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), rest.raw()...));
   else if constexpr (sizeof...(R) == 0) return a * b;
   else return a * b + sum_of_products(rest...);
 }
-/// a b - c d, likewise.
+/// a b - c d, likewise (the component of a cross product).
 template <class S>
 [[gnu::always_inline]] inline S dot2_minus(S a, S b, S c, S d) {
   if constexpr (fixed::is_q_v<S>) {
