@@ -305,7 +305,7 @@ def fixed_functions():
 def fixed_headroom():
     out = test_output("test_fixed_headroom")
     rows = re.findall(r"^\| (the paper's task.*|joint-limit corners.*) \|$", out, re.M)
-    lines = ["| largest \\|value\\| | A kg m² | Λ | g N m | p | h = Ψ(x, ẋ)ẋ | bracket of h, c N m | F | τ N m | "
+    lines = ["| largest \\|value\\| | A kg m² | Λ | g N m | p | h = Ψ(x, ẋ)ẋ | bracket, c N m | F | τ N m | "
              "spare bits (no flag down to) |", "|---|---|---|---|---|---|---|---|---|---|"]
     task = [r for r in rows if r.startswith("the paper")][0]
     corners = [r for r in rows if r.startswith("joint-limit")][0]

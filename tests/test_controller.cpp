@@ -230,13 +230,17 @@ TEST_F(Stages, ObserverOutputIsEquations21_23_28) {
 TEST_F(Stages, ObserverUpdateIsEquation22) {
   const Vec6<double> x_hat = os.x + v6(1e-3, -2e-3, 5e-4, 1e-3, 0, -1e-3);
   const Vec6<double> y = v6(0.02, -0.01, 0.03, 0.1, -0.05, 0.02);
-  const Vec6<double> F = v6(10, -20, 35, 1, -2, 0.5), h = v6(0.1, 0.2, -0.3, 0.01, 0, 0.02);
-  const Vec6<double> p = operational_gravity(os), f = v6(1, -1, 2, 0.1, 0.2, -0.1);
+  const Vec6<double> F = v6(10, -20, 35, 1, -2, 0.5);
+  BiasForce<double> bias;  // h + p + f = J^-T tau - Lambda a
+  bias.tau = v6(3, -40, 12, 0.5, -0.3, 0.1);
+  bias.a = v6(0.2, -0.1, 0.3, 1.0, -2.0, 0.5);
   const Vec6<double> xt = os.x - x_hat;
-  const ObserverState<double> n = observer_update(G, os, x_hat, y, xt, F, h, p, f);
-  // Lambda (y' - y) / dt = F - h - p - f + k_i x~, solved densely here.
-  const Vec6<double> rhs = F - h - p - f + G.ki.cwiseProduct(xt);
-  const Vec6<double> y_expect = y + G.dt * operational_inertia(data, os).partialPivLu().solve(rhs);
+  const ObserverState<double> n = observer_update(G, os, x_hat, y, xt, F, bias);
+  // Lambda (y' - y) / dt = F - (h + p + f) + k_i x~, with Lambda formed and everything solved densely here.
+  const Mat6<double> Lambda = operational_inertia(data, os);
+  const Vec6<double> hpf = os.Ja.transpose().partialPivLu().solve(bias.tau) - Lambda * bias.a;
+  const Vec6<double> rhs = F - hpf + G.ki.cwiseProduct(xt);
+  const Vec6<double> y_expect = y + G.dt * Lambda.partialPivLu().solve(rhs);
   EXPECT_LT((n.y - y_expect).norm(), 1e-9 * (1 + y_expect.norm()));
   EXPECT_LT((n.x_hat - (x_hat + G.dt * (n.y + G.k.cwiseProduct(xt)))).norm(), 1e-15);
 }
@@ -311,25 +315,31 @@ TEST_F(Stages, RobustLawUsesTheOlderRegressorLeaksAndProjects) {
   EXPECT_GT(clipped_lo, 0);
 }
 
-TEST_F(Stages, ForceCommandIsEquations32_36) {
+TEST_F(Stages, ForceCommandIsEquations31_36) {
   const Vec3<double> p0 = data.o[kDof] + Vec3<double>(0.01, -0.02, 0.005);
   const Desired<double> d = trajectory(kPaperTrajectory, p0, 3.3);
   ObserverOutput<double> ob;
   ob.x_tilde = v6(1e-4, -2e-4, 1e-4, 1e-4, 0, -1e-4);
   ob.xd_hat = v6(0.02, -0.01, 0.03, 0.01, -0.02, 0.01);
   ob.qd_hat = os.Jf.solve(ob.xd_hat);
-  const Vec6<double> f_hat = v6(1, -1, 2, 0.1, 0.2, -0.1);
-  const ForceCommand<double> c = force_command(model, G, data, os, d, ob, f_hat);
+  const Vec6<double> tau_f_hat = v6(1, -1, 2, 0.1, 0.2, -0.1);
+  const ForceCommand<double> c = force_command(model, G, data, os, d, ob, tau_f_hat);
+  // Each operational force on its own, as the paper writes (35), with Lambda formed.
   const Vec6<double> e = d.x - os.x;                               // (36)
   const Vec6<double> v = d.xd + G.ks.cwiseProduct(e);
   const Vec6<double> psi_v = psi_bilinear(model, data, os, ob.xd_hat, v);  // Psi(x, x^dot) v
   const Vec6<double> p = operational_gravity(os);
-  const Vec6<double> w_e = operational_inertia(data, os) * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + p + f_hat;  // (35)
+  const Vec6<double> f_hat = operational_friction(os, tau_f_hat);  // (31)
+  const Mat6<double> Lambda = operational_inertia(data, os);
+  const Vec6<double> w_e = Lambda * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + p + f_hat;  // (35)
   const Vec6<double> F = (G.ks + G.knd).cwiseProduct(v - ob.xd_hat) + w_e - G.ki.cwiseProduct(ob.x_tilde);  // (32), (34)
   EXPECT_LT((c.e - e).norm(), 1e-15);
   EXPECT_LT((c.F - F).norm(), 1e-10 * (1 + F.norm()));
-  EXPECT_LT((c.h_xd - psi_bilinear(model, data, os, ob.xd_hat, ob.xd_hat)).norm(), 1e-10);
-  EXPECT_LT((c.p - p).norm(), 1e-15);
+  // The bias force the observer reuses: h(x, x^dot) + p + f^.
+  const Vec6<double> hpf = psi_quadratic(model, data, os, ob.xd_hat) + p + f_hat;
+  const Vec6<double> bias = os.Ja.transpose().partialPivLu().solve(c.bias.tau) - Lambda * c.bias.a;
+  EXPECT_LT((bias - hpf).norm(), 1e-10 * (1 + hpf.norm()));
+  EXPECT_GT(c.bias.a.norm(), 0.0);  // the Jdot part is not empty at this velocity
 }
 
 }  // namespace

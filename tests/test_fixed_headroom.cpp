@@ -3,10 +3,12 @@
 // limits, and how many integer bits the whole chain could lose before anything saturates.
 //
 // Two measurements:
-//  - the named quantities (A, Lambda, g, p, h = Psi(x, xd) xd, F, tau, and the bracket of
-//    psi_quadratic, the largest intermediate) in double, as their largest magnitude;
-//  - the kernel chain of one control step (opspace_update, psi_quadratic, operational_gravity,
-//    F = Lambda xdd + h + p, tau = J^T F) run in Q<19 + k> for k = 0, 1, 2, ...: Q<19 + k> has 2^k
+//  - the named quantities (A, Lambda, g, p, h = Psi(x, xd) xd, F, tau, and the joint-space bracket
+//    A J^{-1}(xdd - Jdot qd) of operational_force, the largest intermediate) in double, as their
+//    largest magnitude;
+//  - the kernel chain of one control step (opspace_update, the velocity products, F = Lambda xdd +
+//    h + p formed as the control step forms it, tau = J^T F, and psi_quadratic, operational_gravity
+//    and Lambda on their own) run in Q<19 + k> for k = 0, 1, 2, ...: Q<19 + k> has 2^k
 //    times less range than Q12.19, so the largest k whose chain leaves the overflow flag clear says
 //    that every intermediate of that chain (each product, sum and solve) stays below 4096 / 2^k.
 // The task's states come from inverse kinematics of the reference (68), sampled every 10 ms over
@@ -53,13 +55,15 @@ Peaks chain(const Vec6<double>& q, const Mat3<double>& R_ref, const Vec6<double>
   const Vec6<S> h = psi_quadratic(model, *data, *os, vs);
   const Vec6<S> p = operational_gravity(*os);
   const Mat6<S> Lambda = operational_inertia(*data, *os);
-  const Vec6<S> F = Lambda * as + h + p;
-  const Vec6<S> tau = joint_torques(*os, F);
-  // psi_quadratic's bracket c - A J^{-1} Jdot qd_v (a joint torque), its largest intermediate.
+  // F = Lambda a + h + p as the control step forms it: one operational_force of the joint-space
+  // parts, J^{-T}[A J^{-1}(a - Jdot qd_v) + c + g]. Its bracket A J^{-1}(a - Jdot qd_v) (a joint
+  // torque) and c are the largest intermediates.
   const Vec6<S> qd = os->Jf.solve(vs);
   const VelocityProducts<S> vp = velocity_products(model, *data, qd);
   const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, Vec3<S>(os->x.template tail<3>()));
-  const Vec6<S> bracket = data->A * os->Jf.solve(jdqd);
+  const Vec6<S> F = operational_force(*data, *os, Vec6<S>(as - jdqd), Vec6<S>(vp.c + os->g));
+  const Vec6<S> tau = joint_torques(*os, F);
+  const Vec6<S> bracket = data->A * os->Jf.solve(Vec6<S>(as - jdqd));
   Peaks pk;
   pk.A = amax(data->A), pk.Lambda = amax(Lambda), pk.g = amax(os->g), pk.p = amax(p), pk.h = amax(h);
   pk.bracket = std::max(amax(bracket), amax(vp.c)), pk.F = amax(F), pk.tau = amax(tau);

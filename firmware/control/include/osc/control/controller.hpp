@@ -3,12 +3,15 @@
 //   kinematics and dynamics at q           opspace_update          (4), (5)
 //   friction adaptation                    adaptation_step         (67) or robust   adaptation.hpp
 //   observer output                        observer_output         (21), (23), (28)  observer.hpp
-//   friction estimate                      friction_estimate       (30), (31)
+//   friction estimate                      friction_estimate       (30)
 //   desired trajectory                     trajectory              (68)      trajectory.hpp
-//   force command                          force_command           (32)-(36)
+//   force command                          force_command           (31)-(36)
 //   joint torques                          joint_torques           (5)
 //   observer update                        observer_update         (22)      observer.hpp
-// All state lives in ControllerState; nothing is allocated.
+// The operational forces of (35) and (22) (Lambda a, Psi, p, f) are summed in their joint-space form,
+// J^{-T} tau + Lambda a, and each sum costs one solve with J^T (operational_force) or one L D L^T solve
+// with A (operational_acceleration), not one per term. All state lives in ControllerState; nothing is
+// allocated.
 #pragma once
 
 #include <cstdint>
@@ -58,28 +61,31 @@ void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In
 
 template <class S>
 struct ForceCommand {
-  Vec6<S> F;     // operational force (32)
-  Vec6<S> e;     // tracking error (36)
-  Vec6<S> h_xd;  // Psi(x, x^dot) x^dot, which the observer update (22) reuses
-  Vec6<S> p;     // operational gravity p(x) (5)
+  Vec6<S> F;             // operational force (32)
+  Vec6<S> e;             // tracking error (36)
+  BiasForce<S> bias;     // h(x, x^dot) + p + f^, which the observer update (22) reuses
 };
 
 /// The force command (32) with w_e (35), the tracking error (36) and the observed filtered
-/// tracking error (34), at the measured x and the observed velocity x^dot.
+/// tracking error (34), at the measured x and the observed velocity x^dot, with the estimated joint
+/// friction tau_f^ (30).
 template <class S>
 ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Data<S>& data, const OpSpace<S>& os,
-                              const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& f_hat) {
+                              const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& tau_f_hat) {
   ForceCommand<S> c;
   c.e = d.x - os.x;                                   // (36)
   const Vec6<S> v = d.xd + G.ks.cwiseProduct(c.e);
   const Vec6<S> eta_p = v - ob.xd_hat;                // (34)
-  // Psi(x, x^dot) x^dot and Psi(x, x^dot)(x_d dot + k_s e), in one pass.
-  const PsiPair<S> psi = psi_pair_from_joint_rate(model, data, os, ob.qd_hat, v);  // q^dot = J^{-1} x^dot
-  c.h_xd = psi.yy;
-  const Vec6<S> psi_v = psi.yz;
-  c.p = operational_gravity(os);
-  const Vec6<S> w_e = lambda_times(data, os, Vec6<S>(d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat))) + psi_v + c.p + f_hat;  // (35)
-  c.F = (G.ks + G.knd).cwiseProduct(eta_p) + w_e - G.ki.cwiseProduct(ob.x_tilde);                     // (32)
+  // Psi(x, x^dot) x^dot and Psi(x, x^dot) v in their joint-space parts, from one pass (q^dot = J^{-1} x^dot).
+  const PsiTerms<S> psi = psi_terms(model, data, os, ob.qd_hat, v);
+  // (35): w_e = Lambda a_r + Psi(x, x^dot) v + p + f^, a_r = x_d ddot + k_s (x_d dot - x^dot). Each term
+  // is an operational_force, so their sum is one: J^{-T}[A J^{-1}(a_r - Jdot_a(q^dot, q_v)) + B(q, q^dot) q_v
+  // + g + tau_f^], with f^ = J^{-T} tau_f^ (31).
+  const Vec6<S> a_r = d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat);
+  const Vec6<S> w_e = operational_force(data, os, Vec6<S>(a_r - psi.jdot_yz), Vec6<S>(psi.c_yz + os.g + tau_f_hat));
+  c.F = (G.ks + G.knd).cwiseProduct(eta_p) + w_e - G.ki.cwiseProduct(ob.x_tilde);  // (32)
+  c.bias.tau = psi.c_yy + os.g + tau_f_hat;
+  c.bias.a = psi.jdot_yy;
   return c;
 }
 
@@ -118,11 +124,10 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
   const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
   const Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
-  const Vec6<S> f_hat = operational_friction(os, tau_f_hat);
   const Desired<S> d = trajectory(G.trajectory, st.p0, t);
-  const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, f_hat);
+  const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat);
   const Vec6<S> tau = joint_torques(os, c.F);
-  const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.h_xd, c.p, f_hat);
+  const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);
   if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat) ||
       !math::all_finite(theta_hat)) {
     out.status = kFaultNonFinite;

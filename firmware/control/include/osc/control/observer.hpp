@@ -40,13 +40,26 @@ struct ObserverState {
   Vec6<S> x_hat, y;
 };
 
+/// h + p + f^ of (22), the model's velocity, gravity and friction forces at the observed velocity, in
+/// the joint-space form psi_terms gives them: h + p + f^ = J^{-T} tau - Lambda a, with
+/// tau = B(q, q^dot) q^dot + g + tau_f^ and a = Jdot_a(q^dot) q^dot (Psi(x, y) y = J^{-T} B(q, q_y) q_y
+/// - Lambda Jdot_a q_y, p = J^{-T} g, f^ = J^{-T} tau_f^). operational_force(data, os, -a, tau) is the
+/// force itself.
+template <class S>
+struct BiasForce {
+  Vec6<S> tau;  // joint torque part
+  Vec6<S> a;    // operational acceleration part
+};
+
 /// The observer update (22) over one sample, driven by the force F the controller commands in it;
-/// h_xd = Psi(x, x^dot) x^dot, p the operational gravity, f_hat the estimated friction (31).
+/// bias = h(x, x^dot) + p + f^. Mapped to joint space, Lambda^{-1}(F - bias + k_i x~) is the
+/// operational acceleration J A^{-1}(J^T (F + k_i x~) - bias.tau) + bias.a: one product with J^T,
+/// one L D L^T solve with A and one product with J.
 template <class S>
 ObserverState<S> observer_update(const Gains<S>& G, const OpSpace<S>& os, const Vec6<S>& x_hat, const Vec6<S>& y,
-                                 const Vec6<S>& x_tilde, const Vec6<S>& F, const Vec6<S>& h_xd, const Vec6<S>& p,
-                                 const Vec6<S>& f_hat) {
-  const Vec6<S> y_dot = lambda_solve(os, F - h_xd - p - f_hat + G.ki.cwiseProduct(x_tilde));
+                                 const Vec6<S>& x_tilde, const Vec6<S>& F, const BiasForce<S>& bias) {
+  const Vec6<S> tau = os.Ja.transpose() * (F + G.ki.cwiseProduct(x_tilde)) - bias.tau;
+  const Vec6<S> y_dot = operational_acceleration(os, tau, bias.a);
   ObserverState<S> n;
   n.y = y + G.dt * y_dot;
   n.x_hat = x_hat + G.dt * (n.y + G.k.cwiseProduct(x_tilde));

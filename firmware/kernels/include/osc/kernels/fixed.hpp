@@ -434,7 +434,7 @@ class Q {
   /// A product with another format, in this one (e.g. a quantity times a hardware scale).
   template <int G>
     requires(G != F)
-  friend Q operator*(Q a, Q<G> b) {
+  [[gnu::always_inline]] friend Q operator*(Q a, Q<G> b) {
     return from_raw(detail::mul_shift<G>(a.r_, b.raw()));
   }
   template <std::integral I>
@@ -446,9 +446,9 @@ class Q {
     return i * a;
   }
 
-  Q& operator+=(Q b) { return *this = *this + b; }
-  Q& operator-=(Q b) { return *this = *this - b; }
-  Q& operator*=(Q b) { return *this = *this * b; }
+  [[gnu::always_inline]] Q& operator+=(Q b) { return *this = *this + b; }
+  [[gnu::always_inline]] Q& operator-=(Q b) { return *this = *this - b; }
+  [[gnu::always_inline]] Q& operator*=(Q b) { return *this = *this * b; }
   Q& operator/=(Q b) { return *this = *this / b; }
 
  private:

@@ -165,6 +165,25 @@ Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
   return os.Ja * os.A_ldlt.solve(Vec6<S>(os.Ja.transpose() * w));
 }
 
+/// Lambda a + J^{-T} tau = J^{-T} (A J^{-1} a + tau): the operational force that a joint torque tau
+/// and an operational acceleration a call for together, with one solve with J and one with J^T
+/// (Lambda = J^{-T} A J^{-1}). Every operational force of (35) is of this form: Lambda a, p = J^{-T} g,
+/// f = J^{-T} tau_f and Psi(x, y) z (psi_terms).
+template <class S>
+Vec6<S> operational_force(const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& a, const Vec6In<S>& tau) {
+  return os.Jf.solve_transpose(Vec6<S>(data.A * os.Jf.solve(a) + tau));
+}
+
+/// J A^{-1} tau + a = Lambda^{-1} J^{-T} tau + a: the operational acceleration x_dd = J q_dd + Jdot q_dot
+/// of the arm under joint torque tau (q_dd = A^{-1} tau), a being Jdot q_dot; the inverse of
+/// operational_force: the acceleration a force F = Lambda a + J^{-T} tau gives is
+/// operational_acceleration(J^T F - tau, 0) = a. Lambda^{-1} w is operational_acceleration(J^T w, 0)
+/// (lambda_solve).
+template <class S>
+Vec6<S> operational_acceleration(const OpSpace<S>& os, const Vec6In<S>& tau, const Vec6In<S>& a) {
+  return os.Ja * os.A_ldlt.solve(tau) + a;
+}
+
 /// Analytic Jdot(q, qd) qd.
 template <class S>
 Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qd) {
@@ -173,40 +192,61 @@ Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpa
 }
 
 /// h(v) = Psi(x, v) v = J^{-T} c(q, qd_v) - Lambda Jdot(q, qd_v) qd_v, with qd_v = J^{-1} v,
-/// evaluated as J^{-T} [c - A J^{-1} Jdot qd_v] (Lambda = J^{-T} A J^{-1}): the bracket is a joint
-/// torque, whereas Lambda times the operational acceleration Jdot qd_v has entries many times h's
+/// evaluated as J^{-T} [c - A J^{-1} Jdot qd_v] (operational_force): the bracket is a joint torque,
+/// whereas Lambda times the operational acceleration Jdot qd_v has entries many times h's
 /// own near the edges of the workspace (beyond the range of a fixed-point scalar first).
 template <class S>
 Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& v) {
   const Vec6<S> qd = os.Jf.solve(v);
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
   const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, os.E);
-  return os.Jf.solve_transpose(Vec6<S>(vp.c - data.A * os.Jf.solve(jdqd)));
+  return operational_force(data, os, Vec6<S>(-jdqd), vp.c);
+}
+
+/// The joint-space parts of Psi(x, y) y and Psi(x, y) z (8), from one pass of velocity_product_pair:
+///   J^T Psi(x, y) z = B(q, q_y) q_z - A J^{-1} Jdot_a(q_y, q_z),   q_y = J^{-1} y, q_z = J^{-1} z,
+/// with Jdot_a(q_y, q_z) the symmetric bilinear form of the analytic Jdot(q, q_y) q_y (and z = y the
+/// quadratic one). The control step adds them to other joint-space terms before the one solve with
+/// J^T they all need (operational_force, operational_acceleration); psi_pair finishes them alone.
+template <class S>
+struct PsiTerms {
+  Vec6<S> c_yy, jdot_yy;  // B(q, q_y) q_y and Jdot_a(q_y, q_y)
+  Vec6<S> c_yz, jdot_yz;  // B(q, q_y) q_z and Jdot_a(q_y, q_z)
+};
+
+/// The same from qy = J^{-1} y, which the caller may already have (the observer's q^dot).
+template <class S>
+PsiTerms<S> psi_terms(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qy,
+                      const Vec6In<S>& z) {
+  const Vec6<S> qz = os.Jf.solve(z);
+  const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
+  const Vec3<S> pdy = os.E.Einv * vp.quad.w6, pdz = os.E.Einv * vp.bilinear.w6;  // orientation rates
+  PsiTerms<S> t;
+  t.c_yy = vp.quad.c;
+  t.c_yz = vp.bilinear.c;
+  t.jdot_yy << vp.quad.jdot_qd.template head<3>(),
+      os.E.Einv * (vp.quad.jdot_qd.template tail<3>() - edot_rates(os.E, pdy));
+  t.jdot_yz << vp.bilinear.jdot_qd.template head<3>(),
+      os.E.Einv * (vp.bilinear.jdot_qd.template tail<3>() - edot_rates(os.E, pdy, pdz));
+  return t;
 }
 
 /// Psi(x, y) y and Psi(x, y) z together (z enters linearly; Psi(x, y) z is the symmetric bilinear
-/// form of (8)): one pass of velocity_product_pair, the bracket of psi_quadratic for each.
+/// form of (8)): one pass of velocity_product_pair.
 template <class S>
 struct PsiPair {
   Vec6<S> yy;  // Psi(x, y) y
   Vec6<S> yz;  // Psi(x, y) z
 };
 
-/// The same from qy = J^{-1} y, which the caller may already have (the observer's q^dot).
+/// The same from qy = J^{-1} y.
 template <class S>
 PsiPair<S> psi_pair_from_joint_rate(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os,
                                     const Vec6In<S>& qy, const Vec6In<S>& z) {
-  const Vec6<S> qz = os.Jf.solve(z);
-  const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
-  const Vec3<S> pdy = os.E.Einv * vp.quad.w6, pdz = os.E.Einv * vp.bilinear.w6;  // orientation rates
-  Vec6<S> jq, jb;  // analytic Jdot: quadratic and bilinear
-  jq << vp.quad.jdot_qd.template head<3>(),
-      os.E.Einv * (vp.quad.jdot_qd.template tail<3>() - edot_rates(os.E, pdy));
-  jb << vp.bilinear.jdot_qd.template head<3>(),
-      os.E.Einv * (vp.bilinear.jdot_qd.template tail<3>() - edot_rates(os.E, pdy, pdz));
+  const PsiTerms<S> t = psi_terms(model, data, os, qy, z);
   PsiPair<S> out;
-  out.yy = os.Jf.solve_transpose(Vec6<S>(vp.quad.c - data.A * os.Jf.solve(jq)));
-  out.yz = os.Jf.solve_transpose(Vec6<S>(vp.bilinear.c - data.A * os.Jf.solve(jb)));
+  out.yy = operational_force(data, os, Vec6<S>(-t.jdot_yy), t.c_yy);
+  out.yz = operational_force(data, os, Vec6<S>(-t.jdot_yz), t.c_yz);
   return out;
 }
 
