@@ -9,6 +9,9 @@
 // No 6x6 matrix is ever inverted.
 #pragma once
 
+#include <type_traits>
+#include <utility>
+
 #include <Eigen/Cholesky>
 
 #include "osc/kernels/dynamics.hpp"
@@ -80,21 +83,43 @@ struct LdltFactor {
   void compute(const Eigen::Matrix<S, N, N>& A) {
     positive = true;
     Eigen::Matrix<S, N, 1> t;  // t_k = L(j, k) d_k of the current row j
-    for (int j = 0; j < N; ++j) {
-      for (int k = 0; k < j; ++k) t(k) = L(j, k) * d(k);
-      d(j) = A(j, j) - L.row(j).head(j).dot(t.head(j));
-      if (!(d(j) > S(0))) positive = false;
-      d_inv(j) = S(1) / d(j);
-      for (int i = j + 1; i < N; ++i) L(i, j) = (A(i, j) - L.row(i).head(j).dot(t.head(j))) * d_inv(j);
-    }
+    // Row j at compile time, so that every partial row is a fixed-size segment (unrolled sums).
+    for_each_index([&]<int J>(std::integral_constant<int, J>) {
+      if constexpr (J == 0) {
+        d(0) = A(0, 0);
+      } else {
+        t.template head<J>() = L.row(J).template head<J>().transpose().cwiseProduct(d.template head<J>());
+        d(J) = A(J, J) - L.row(J).template head<J>().dot(t.template head<J>());
+      }
+      if (!(d(J) > S(0))) positive = false;
+      d_inv(J) = S(1) / d(J);
+      for (int i = J + 1; i < N; ++i) {
+        if constexpr (J == 0) L(i, 0) = A(i, 0) * d_inv(0);
+        else L(i, J) = (A(i, J) - L.row(i).template head<J>().dot(t.template head<J>())) * d_inv(J);
+      }
+    });
   }
   /// A^{-1} b: L y = b, then L^T x = D^{-1} y.
   Eigen::Matrix<S, N, 1> solve(const Eigen::Matrix<S, N, 1>& b) const {
     Eigen::Matrix<S, N, 1> x;
-    for (int i = 0; i < N; ++i) x(i) = b(i) - L.row(i).head(i).dot(x.head(i));
-    for (int i = N - 1; i >= 0; --i)
-      x(i) = x(i) * d_inv(i) - L.col(i).tail(N - 1 - i).dot(x.tail(N - 1 - i));
+    x(0) = b(0);
+    for_each_index([&]<int I>(std::integral_constant<int, I>) {
+      if constexpr (I > 0) x(I) = b(I) - L.row(I).template head<I>().dot(x.template head<I>());
+    });
+    x(N - 1) *= d_inv(N - 1);
+    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+      constexpr int I = N - 2 - K, M = N - 1 - I;  // rows N-2 .. 0, each with the M entries below it
+      if constexpr (I >= 0) x(I) = x(I) * d_inv(I) - L.col(I).template tail<M>().dot(x.template tail<M>());
+    });
     return x;
+  }
+
+ private:
+  /// f(std::integral_constant<int, I>{}) for I = 0, 1, ..., N - 1 in order.
+  template <class Fn>
+  static void for_each_index(Fn&& f) {
+    [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }(
+        std::make_integer_sequence<int, N>{});
   }
 };
 
