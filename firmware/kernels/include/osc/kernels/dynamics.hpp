@@ -40,12 +40,14 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
   out.acc6 = a;
   out.alpha6 = wd;
   out.w6 = w;
-  // Backward pass: force F and moment N about o_{i-1} transmitted through joint i.
+  // Backward pass: force F and moment N about the base origin of links i..6, which joint i
+  // transmits. Its torque is z_{i-1} . (N - o_{i-1} x F) = z_{i-1} . N + vO_{i-1} . F: no moment arm
+  // changes from link to link.
   Vec3<S> F = Vec3<S>::Zero(), N = Vec3<S>::Zero();
   for (int i = kDof; i >= 1; --i) {
-    N = n[i] + N + cross(data.com[i] - data.o[i - 1], f[i]) + cross(data.o[i] - data.o[i - 1], F);
+    N = n[i] + N + cross(data.com[i], f[i]);
     F = f[i] + F;
-    out.tau(i - 1) = data.R[i - 1].col(2).dot(N) + model.armature(i - 1) * qdd(i - 1);
+    out.tau(i - 1) = dot_sum(Vec3<S>(data.R[i - 1].col(2)), N, data.vO[i - 1], F) + model.armature(i - 1) * qdd(i - 1);
   }
   return out;
 }
@@ -57,9 +59,8 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
 template <class S>
 void joint_inertia(const Model<S>& model, Data<S>& data) {
   // Unit rotation about axis z_i through o_{i-1}: angular velocity z_i, base-origin velocity
-  // vO_i = o_{i-1} x z_i. A_ij = z_i . (L_j - o_{i-1} x p_j) = z_i . L_j + vO_i . p_j.
-  Vec3<S> vO[kDof];
-  for (int i = 0; i < kDof; ++i) vO[i] = cross(data.o[i], data.R[i].col(2));
+  // vO_i = o_{i-1} x z_i (data.vO). A_ij = z_i . (L_j - o_{i-1} x p_j) = z_i . L_j + vO_i . p_j.
+  const Vec3<S>* vO = data.vO;
   S m = S(0);
   Vec3<S> h = Vec3<S>::Zero();
   Mat3<S> IO = Mat3<S>::Zero();  // symmetric
@@ -174,16 +175,16 @@ VelocityProductPair<S> velocity_product_pair(const Model<S>& model, const Data<S
   out.bilinear.jdot_qd.template head<3>() = h * ab;
   out.bilinear.jdot_qd.template tail<3>() = h * wdb;
   out.bilinear.w6 = wv;
+  // Forces and moments about the base origin, as in rnea.
   Vec3<S> Fq = Vec3<S>::Zero(), Nq = Vec3<S>::Zero(), Fb = Vec3<S>::Zero(), Nb = Vec3<S>::Zero();
   for (int i = kDof; i >= 1; --i) {
-    const Vec3<S> rc = data.com[i] - data.o[i - 1], r = data.o[i] - data.o[i - 1];
-    Nq = nq[i] + Nq + cross(rc, fq[i]) + cross(r, Fq);
-    Nb = nb[i] + Nb + cross(rc, fb[i]) + cross(r, Fb);
+    Nq = nq[i] + Nq + cross(data.com[i], fq[i]);
+    Nb = nb[i] + Nb + cross(data.com[i], fb[i]);
     Fq += fq[i];
     Fb += fb[i];
     const Vec3<S> z = data.R[i - 1].col(2);
-    out.quad.c(i - 1) = z.dot(Nq);
-    out.bilinear.c(i - 1) = h * z.dot(Nb);
+    out.quad.c(i - 1) = dot_sum(z, Nq, data.vO[i - 1], Fq);
+    out.bilinear.c(i - 1) = h * dot_sum(z, Nb, data.vO[i - 1], Fb);
   }
   return out;
 }

@@ -13,7 +13,8 @@
 
 namespace osc {
 
-/// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic.
+/// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic; the
+/// joint axes' moments o_i x z_i into data.vO (the CRBA's and the RNEA passes' joint projections).
 /// R_{i+1} = R_i Rz(q_i) Rx(alpha_i): Rz turns the first two columns of R_i by q_i (x, y below),
 /// and Rx(alpha) mixes y with the third column, a permutation with a sign for the twists 0 and
 /// +-pi/2 that the robot table states (Model::Link::twist). o_{i+1} = o_i + R_i (a c, a s, d) =
@@ -22,10 +23,12 @@ template <class S>
 void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q) {
   data.R[0].setIdentity();
   data.o[0].setZero();
+  // The joints' sines and cosines first: independent of each other, unlike the frames below.
+  S sq[kDof], cq[kDof];
+  for (int i = 0; i < kDof; ++i) math::sincos(q(i), sq[i], cq[i]);
   for (int i = 0; i < kDof; ++i) {
     const auto& l = model.link[i];
-    S s, c;
-    math::sincos(q(i), s, c);
+    const S s = sq[i], c = cq[i];
     const Mat3<S>& R = data.R[i];
     Mat3<S>& Rn = data.R[i + 1];
     const Vec3<S> x = combine(c, R.col(0), s, R.col(1));   // R Rz(q) e_x
@@ -49,6 +52,7 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
     for (int r = 0; r < 3; ++r)
       for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));
   }
+  for (int i = 0; i < kDof; ++i) data.vO[i] = cross(data.o[i], data.R[i].col(2));
 }
 
 /// Geometric Jacobian of the frame-6 origin, base frame: column j = [z_{j-1} x (o6 - o_{j-1}); z_{j-1}].

@@ -115,6 +115,7 @@ struct Data {
   Vec3<S> o[kDof + 1];
   Vec3<S> com[kDof + 1];   // COM of link i in the base frame (index 0 unused)
   Mat3<S> Ic[kDof + 1];    // inertia of link i about its COM, base axes (symmetric)
+  Vec3<S> vO[kDof];        // o_i x z_i: velocity of the point at the base origin under a unit rate of joint i + 1
   Mat6<S> J;               // geometric Jacobian [v; w] of the frame-6 origin, base frame
   Mat6<S> A;               // joint-space inertia, armature included
 };
