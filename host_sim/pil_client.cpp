@@ -79,6 +79,7 @@ bool PilClient::start(const std::vector<std::string>& argv, std::string& err, do
   to_child_ = in[1];
   from_child_ = out[0];
   pid_ = pid;
+  reaped_ = false;
   signal(SIGPIPE, SIG_IGN);  // a dead peer is an error return, not a signal
   parser_.reset();
   rx_len_ = rx_pos_ = 0;
@@ -137,7 +138,7 @@ PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, 
     if (r < 0) return err = std::string("poll: ") + std::strerror(errno), Rx::kGone;
     if (r == 0) continue;
     const ssize_t n = read(from_child_, rx_, sizeof rx_);
-    if (n == 0) return err = "the firmware closed the link (exited)", Rx::kGone;
+    if (n == 0) return err = "the firmware closed the link (" + exit_description() + ")", Rx::kGone;
     if (n < 0) {
       if (errno == EINTR) continue;
       return err = std::string("link read failed: ") + std::strerror(errno), Rx::kGone;
@@ -194,10 +195,32 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
   return x;
 }
 
+std::string PilClient::exit_description() {
+  for (int i = 0; i < 100 && !reaped_; ++i) {
+    if (waitpid(pid_, &wait_status_, WNOHANG) == pid_) reaped_ = true;
+    else usleep(10000);
+  }
+  if (!reaped_) return "exited; still running after 1 s";
+  if (WIFSIGNALED(wait_status_)) return "killed by signal " + std::to_string(WTERMSIG(wait_status_));
+  const int code = WEXITSTATUS(wait_status_);
+  // The firmware's own exits (boards/common/cortex_m/startup.cpp); QEMU ends with 0 on the reset
+  // that -no-reboot turns into an exit (e.g. the watchdog's).
+  const char* what = code == 91 ? ": hard fault" : code == 90 ? ": unexpected interrupt"
+                     : code == 0 ? ": a normal end, or a reset under -no-reboot" : "";
+  return "exited, status " + std::to_string(code) + what;
+}
+
 int PilClient::stop() {
   if (pid_ <= 0) return -1;
   if (to_child_ >= 0) close(to_child_);
   to_child_ = -1;
+  if (reaped_) {
+    pid_ = -1;
+    reaped_ = false;
+    close(from_child_);
+    from_child_ = -1;
+    return WIFEXITED(wait_status_) ? WEXITSTATUS(wait_status_) : -1;
+  }
   int status = 0;
   // Give the peer a moment to exit on its own (end of input), then kill it.
   for (int i = 0; i < 20; ++i) {

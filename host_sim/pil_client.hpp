@@ -59,10 +59,16 @@ class PilClient {
   std::uint32_t code_range_errors() const { return code_range_errors_; }
   /// Stops the peer (SIGKILL after a grace period) and returns its exit status (-1 if killed).
   int stop();
-  bool running() const { return pid_ > 0; }
+  bool running() const { return pid_ > 0 && !reaped_; }
 
  private:
+  /// Once the peer has closed the link: waits up to a second for it to end and says how it ended
+  /// ("exit status N", with the firmware's meaning where it has one, or "killed by signal N").
+  std::string exit_description();
+
   int pid_ = -1;
+  bool reaped_ = false;  // the peer ended and was waited for (exit_description); stop() only tidies up
+  int wait_status_ = 0;
   int to_child_ = -1, from_child_ = -1;
   enum class Rx { kFrame, kCorrupt, kSilent, kGone };
   Rx receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err);

@@ -106,6 +106,14 @@ TEST(PilClientErrors, PeerThatExitsIsReported) {
   std::string err;
   EXPECT_FALSE(c.start({"true"}, err, 5.0));
   EXPECT_NE(err.find("closed the link"), std::string::npos) << err;
+  EXPECT_NE(err.find("exited, status 0"), std::string::npos) << err;
+  EXPECT_EQ(c.stop(), 0);
+  PilClient h;  // a firmware image's own exit code is reported with its meaning
+  EXPECT_FALSE(h.start({"sh", "-c", "exit 91"}, err, 5.0));
+  EXPECT_NE(err.find("exited, status 91: hard fault"), std::string::npos) << err;
+  PilClient k;
+  EXPECT_FALSE(k.start({"sh", "-c", "kill -9 $$"}, err, 5.0));
+  EXPECT_NE(err.find("killed by signal 9"), std::string::npos) << err;
   PilClient d;
   EXPECT_FALSE(d.start({"/nonexistent/firmware-runner"}, err, 5.0));
   EXPECT_NE(err.find("closed the link"), std::string::npos) << err;
