@@ -12,8 +12,6 @@
 #include <type_traits>
 #include <utility>
 
-#include <Eigen/Cholesky>
-
 #include "osc/kernels/dynamics.hpp"
 
 namespace osc {
@@ -73,7 +71,8 @@ struct SphericalWristJacobianFactor {
 /// no pivoting (not needed for A(q)), no square root, and the reciprocals 1/D kept, so that a
 /// factorisation takes N divisions and a solve none (Eigen's LLT takes N square roots and N(N-1)/2
 /// divisions, and N divisions per triangular solve). positive is false when a pivot is not positive
-/// (A not positive definite); the solve is then meaningless and callers treat it as a fault.
+/// (A not positive definite); the solve is then meaningless. A(q) with its armature is positive
+/// definite by construction, so the control step does not test it (tests/test_properties.cpp does).
 template <class S, int N>
 struct LdltFactor {
   Eigen::Matrix<S, N, N> L;  // strictly lower part: L; the rest unused
@@ -124,7 +123,7 @@ struct LdltFactor {
 };
 
 /// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised. The control step never forms it: it
-/// needs only products Lambda u (lambda_times) and solves Lambda^{-1} w (lambda_solve).
+/// needs only products Lambda u (operational_force) and solves Lambda^{-1} w (operational_acceleration).
 template <class S>
 Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor<S>& Jf) {
   Mat6<S> Y;  // Y = J^{-T} A
@@ -164,13 +163,6 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
 /// Lambda of the current state (opspace_update must have run).
 template <class S>
 Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S>& os) { return operational_inertia(data.A, os.Jf); }
-
-/// Lambda u = J^{-T} (A (J^{-1} u)): two block-triangular solves and one 6x6 product, without forming
-/// Lambda (which would take twelve solves).
-template <class S>
-Vec6<S> lambda_times(const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& u) {
-  return os.Jf.solve_transpose(Vec6<S>(data.A * os.Jf.solve(u)));
-}
 
 /// p(x) = J^{-T} g(q) (5).
 template <class S>
@@ -264,21 +256,14 @@ struct PsiPair {
   Vec6<S> yz;  // Psi(x, y) z
 };
 
-/// The same from qy = J^{-1} y.
 template <class S>
-PsiPair<S> psi_pair_from_joint_rate(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os,
-                                    const Vec6In<S>& qy, const Vec6In<S>& z) {
-  const PsiTerms<S> t = psi_terms(model, data, os, qy, z);
+PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+                    const Vec6In<S>& z) {
+  const PsiTerms<S> t = psi_terms(model, data, os, Vec6<S>(os.Jf.solve(y)), z);
   PsiPair<S> out;
   out.yy = operational_force(data, os, Vec6<S>(-t.jdot_yy), t.c_yy);
   out.yz = operational_force(data, os, Vec6<S>(-t.jdot_yz), t.c_yz);
   return out;
-}
-
-template <class S>
-PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
-                    const Vec6In<S>& z) {
-  return psi_pair_from_joint_rate(model, data, os, Vec6<S>(os.Jf.solve(y)), z);
 }
 
 /// Psi(x, y) z, the symmetric bilinear form of (8).
