@@ -44,6 +44,7 @@ struct Parsed {
   std::vector<std::pair<const Shorthand*, std::string>> shorthands;
   std::vector<std::string> sets;
   std::string inject;
+  std::string pil_link;
 };
 
 void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::string>& values) {
@@ -66,6 +67,10 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::stri
   app.add_flag("--qemu", o.qemu, "run the controller as the firmware image in qemu-system-arm (PIL)");
   app.add_option("--elf", o.elf, "firmware image for --qemu (default: the m4f build's pil_firmware.elf)")
       ->type_name("FILE");
+  app.add_option("--pil-link", p.pil_link,
+                 "how the frames reach the image with --qemu: semihosting (QEMU's semihosting console, a frame "
+                 "per read or write; default) | uart (the board's UART0, a byte at a time, as on a board)")
+      ->type_name("LINK");
   app.add_option("--json", o.json, "write the summary as JSON")->type_name("FILE");
   app.add_option("--csv-dir", o.csv_dir, "write time series CSV files and config.yaml there (default: out)")
       ->type_name("DIR");
@@ -134,6 +139,11 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
   if (!p.inject.empty() || app.get_option("--inject")->count() > 0)
     if (!parse_injection(p.inject, o.base.injection, err)) return false;
   if (o.elf.empty()) return err = "--elf needs a file name", false;
+  if (app.get_option("--pil-link")->count() > 0) {
+    if (!parse_pil_link(p.pil_link, o.pil_link))
+      return err = "--pil-link: '" + p.pil_link + "' is not a link: semihosting | uart", false;
+    if (!o.qemu) return err = "--pil-link applies with --qemu only", false;
+  }
   if (app.get_option("--json")->count() > 0 && o.json.empty()) return err = "--json needs a file name", false;
   if (o.csv_dir.empty()) return err = "--csv-dir needs a directory", false;
 

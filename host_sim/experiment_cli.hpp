@@ -5,6 +5,7 @@
 #include <string>
 
 #include "config.hpp"
+#include "pil_client.hpp"
 
 namespace sim {
 
@@ -14,6 +15,7 @@ struct ExperimentOptions : Settings {
   std::string json, csv_dir = "out";
   bool csv = true, progress = true;
   bool qemu = false;
+  PilLink pil_link = PilLink::kSemihosting;  ///< --pil-link: how the frames reach the image in QEMU
   bool help = false;  ///< --help or -h: print usage() and exit 0
   std::string elf = OSC_DEFAULT_PIL_ELF;
 };

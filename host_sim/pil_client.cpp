@@ -10,6 +10,8 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <fstream>
+#include <iterator>
 
 #include "osc/runtime/io.hpp"
 
@@ -44,15 +46,128 @@ RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
 
 PilClient::~PilClient() { stop(); }
 
-std::vector<std::string> PilClient::qemu_command(const std::string& qemu, const std::string& elf) {
-  // UART0 of the board is the first -serial: here the process's stdin/stdout. -icount shift=0:
-  // one instruction = 1 ns of virtual time, so the firmware's timing is an instruction count.
-  return {qemu,      "-M",           "mps2-an386",
-          "-display", "none",        "-monitor",
-          "none",     "-serial",     "stdio",
-          "-semihosting-config",     "enable=on,target=native",
-          "-icount",  "shift=0",     "-no-reboot",
-          "-kernel",  elf};
+const char* name(PilLink link) { return link == PilLink::kUart ? "uart" : "semihosting"; }
+
+bool parse_pil_link(const std::string& text, PilLink& link) {
+  if (text == "uart") link = PilLink::kUart;
+  else if (text == "semihosting") link = PilLink::kSemihosting;
+  else return false;
+  return true;
+}
+
+namespace {
+
+std::uint32_t le32(const std::string& b, std::size_t at) {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 2])) << 16 |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 3])) << 24;
+}
+std::uint32_t le16(const std::string& b, std::size_t at) {
+  return static_cast<std::uint32_t>(static_cast<unsigned char>(b[at])) |
+         static_cast<std::uint32_t>(static_cast<unsigned char>(b[at + 1])) << 8;
+}
+
+/// Tag_CPU_arch of the "aeabi" file attributes in an .ARM.attributes section (ARM IHI 0045), or -1.
+/// Tags 4, 5, 65, 67 and odd tags from 32 on are NUL-terminated strings; the rest are ULEB128,
+/// except Tag_compatibility (32: a ULEB128, then a string).
+int cpu_arch(const std::string& a) {
+  if (a.empty() || a[0] != 'A') return -1;
+  std::size_t pos = 1;
+  while (pos + 4 <= a.size()) {
+    const std::size_t len = le32(a, pos);
+    if (len < 4 || pos + len > a.size()) return -1;
+    const std::size_t end = pos + len;
+    std::size_t p = pos + 4;
+    const std::size_t vendor_end = a.find('\0', p);
+    if (vendor_end == std::string::npos || vendor_end >= end) return -1;
+    const bool aeabi = a.compare(p, vendor_end - p, "aeabi") == 0;
+    p = vendor_end + 1;
+    while (aeabi && p + 5 <= end) {
+      const int kind = static_cast<unsigned char>(a[p]);
+      const std::size_t sub_len = le32(a, p + 1);
+      if (sub_len < 5 || p + sub_len > end) return -1;
+      const std::size_t sub_end = p + sub_len;
+      std::size_t q = p + 5;
+      auto uleb = [&](std::uint64_t& v) {
+        v = 0;
+        for (int shift = 0; q < sub_end && shift < 64; shift += 7) {
+          const auto byte = static_cast<unsigned char>(a[q++]);
+          v |= static_cast<std::uint64_t>(byte & 0x7F) << shift;
+          if ((byte & 0x80) == 0) return true;
+        }
+        return false;
+      };
+      auto skip_string = [&] {
+        const std::size_t z = a.find('\0', q);
+        if (z == std::string::npos || z >= sub_end) return false;
+        q = z + 1;
+        return true;
+      };
+      while (kind == 1 && q < sub_end) {  // Tag_File: the attributes of the whole file
+        std::uint64_t tag = 0, value = 0;
+        if (!uleb(tag)) return -1;
+        if (tag == 4 || tag == 5 || tag == 65 || tag == 67 || (tag > 32 && tag % 2 == 1)) {
+          if (!skip_string()) return -1;
+        } else if (tag == 32) {
+          if (!uleb(value) || !skip_string()) return -1;
+        } else {
+          if (!uleb(value)) return -1;
+          if (tag == 6) return static_cast<int>(value);
+        }
+      }
+      p = sub_end;
+    }
+    pos = end;
+  }
+  return -1;
+}
+
+}  // namespace
+
+std::string qemu_machine(const std::string& elf, std::string& err) {
+  std::ifstream f(elf, std::ios::binary);
+  if (!f) return err = "cannot read firmware image " + elf, "";
+  std::string b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  if (b.size() < 52 || b.compare(0, 4, "\x7F" "ELF") != 0)
+    return err = "firmware image " + elf + " is not an ELF file", "";
+  if (b[4] != 1 || b[5] != 1 || le16(b, 18) != 40)
+    return err = "firmware image " + elf + " is not a 32-bit little-endian ARM ELF file", "";
+  const std::size_t shoff = le32(b, 0x20), shentsize = le16(b, 0x2E), shnum = le16(b, 0x30);
+  int arch = -1;
+  for (std::size_t i = 0; i < shnum && shentsize >= 40; ++i) {
+    const std::size_t h = shoff + i * shentsize;
+    if (h + 40 > b.size()) break;
+    if (le32(b, h + 4) != 0x70000003u) continue;  // SHT_ARM_ATTRIBUTES
+    const std::size_t off = le32(b, h + 16), size = le32(b, h + 20);
+    if (off > b.size() || size > b.size() - off) break;
+    arch = cpu_arch(b.substr(off, size));
+    break;
+  }
+  if (arch == 10) return "mps2-an385";  // ARMv7 (with the M profile: ARMv7-M, the Cortex-M3)
+  if (arch == 13) return "mps2-an386";  // ARMv7E-M (Cortex-M4F)
+  return err = "firmware image " + elf + (arch < 0 ? " names no ARM architecture (no build attributes)"
+                                                   : " is for ARM architecture " + std::to_string(arch) +
+                                                         ", not ARMv7-M or ARMv7E-M (no MPS2 machine here)"),
+         "";
+}
+
+std::vector<std::string> PilClient::qemu_command(const std::string& qemu, const std::string& elf, PilLink link,
+                                                 std::string& err) {
+  const std::string machine = qemu_machine(elf, err);
+  if (machine.empty()) return {};
+  // -icount shift=0: one instruction = 1 ns of virtual time, so the firmware's timing is an
+  // instruction count. The link is the process's stdin/stdout: UART0 (the first -serial), or the
+  // semihosting console.
+  std::vector<std::string> argv = {qemu, "-M", machine, "-display", "none", "-monitor", "none"};
+  if (link == PilLink::kUart) {
+    argv.insert(argv.end(), {"-serial", "stdio", "-semihosting-config", "enable=on,target=native"});
+  } else {
+    // The image's semihosting command line (arg=) asks it for the console transport.
+    argv.insert(argv.end(), {"-serial", "null", "-semihosting-config", "enable=on,target=native,arg=link=semihosting"});
+  }
+  argv.insert(argv.end(), {"-icount", "shift=0", "-no-reboot", "-kernel", elf});
+  return argv;
 }
 
 bool PilClient::start(const std::vector<std::string>& argv, std::string& err, double ready_timeout_s) {

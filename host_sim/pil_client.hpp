@@ -14,6 +14,19 @@ namespace sim {
 
 enum class RxResult { kNeedMore, kFrame, kError };
 
+/// How the frames reach a PIL firmware image in QEMU (PilClient::qemu_command).
+enum class PilLink {
+  kSemihosting,  ///< QEMU's semihosting console: a frame per read or write
+  kUart,         ///< the board's UART0 through QEMU's UART model: a byte at a time, as on a board
+};
+const char* name(PilLink link);
+bool parse_pil_link(const std::string& text, PilLink& link);
+
+/// The QEMU machine for an ARM ELF image, from its build attributes (Tag_CPU_arch): mps2-an385
+/// (Cortex-M3) for ARMv7-M, mps2-an386 (Cortex-M4F) for ARMv7E-M. Empty, with err, for a file that
+/// is not a 32-bit little-endian ARM ELF image, or an architecture with no machine here.
+std::string qemu_machine(const std::string& elf, std::string& err);
+
 /// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until an actuator
 /// frame completes (kFrame, decoded into f) or the link is corrupt (kError, message in err); pos
 /// advances past the bytes consumed, so bytes after a frame stay for the next call. Every error and
@@ -31,8 +44,13 @@ class PilClient {
   /// Starts argv[0] with the given arguments (its stdin/stdout carry the link) and waits up to
   /// ready_timeout_s for the peer's hello frame.
   bool start(const std::vector<std::string>& argv, std::string& err, double ready_timeout_s = 30.0);
-  /// The QEMU command line that runs a firmware image on mps2-an386, deterministically (-icount).
-  static std::vector<std::string> qemu_command(const std::string& qemu, const std::string& elf);
+  /// The QEMU command line that runs a PIL firmware image deterministically (-icount shift=0) on the
+  /// MPS2 machine of its core (qemu_machine), over the given transport (the image's
+  /// boards/common/mps2/pil_firmware.cpp): UART0 on the process's stdin/stdout, or the semihosting
+  /// console there (semihosting argument link=semihosting), which moves whole frames, not bytes.
+  /// Empty, with err, when elf is not an ARM image of a core with a machine here.
+  static std::vector<std::string> qemu_command(const std::string& qemu, const std::string& elf, PilLink link,
+                                               std::string& err);
 
   bool send(const pil::SensorFrame& f, std::string& err);
   bool send_raw(const std::uint8_t* p, int n, std::string& err);

@@ -16,7 +16,7 @@ namespace {
 
 struct StdioBoard {
   static inline std::uint32_t clock = 0;
-  static void uart_write(const std::uint8_t* p, int n) {
+  static void link_write(const std::uint8_t* p, int n) {
     while (n > 0) {
       const ssize_t w = write(STDOUT_FILENO, p, static_cast<size_t>(n));
       if (w <= 0) _exit(3);

@@ -80,7 +80,7 @@ void print_fault(const sim::ExperimentResult& r) {
               r.stats_until);
 }
 
-void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Provenance& prov) {
+void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Provenance& prov, sim::Scalar scalar) {
   std::printf("%s\nset-up: %s\n", prov.line().c_str(), prov.setup().c_str());
   for (const auto& r : runs)
     if (r.status) print_fault(r);
@@ -153,9 +153,9 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
   for (const auto& r : runs) {
     if (!r.error.empty()) std::printf("[%s] LINK ERROR: %s\n", r.mode.c_str(), r.error.c_str());
     if (r.max_step_cycles)
-      std::printf("[%s] firmware control step (observer + controller + adaptation, float): max %u, mean %u "
+      std::printf("[%s] firmware control step (observer + controller + adaptation, %s): max %u, mean %u "
                   "instructions (QEMU -icount shift=0); whole tick incl. link I/O max %u; stack used %u bytes\n",
-                  r.mode.c_str(), r.max_step_cycles, r.mean_step_cycles, r.max_tick_cycles, r.stack_used);
+                  r.mode.c_str(), sim::kScalarNames[static_cast<int>(scalar)], r.max_step_cycles, r.mean_step_cycles, r.max_tick_cycles, r.stack_used);
     if (r.max_step_cycles) {
       std::printf("[%s] link: longest gap between received bytes %u cycles (ns of target time in QEMU), %u over %d periods; "
                   "errors counted by the firmware: %s; by the host: %s, codes out of range %u; ticks zeroed %u%s%s\n",
@@ -216,19 +216,6 @@ bool check_writable(const std::string& path, std::string& err) {
   return true;
 }
 
-/// The --qemu image must be a 32-bit little-endian ARM ELF file.
-bool check_arm_elf(const std::string& path, std::string& err) {
-  std::ifstream f(path, std::ios::binary);
-  unsigned char h[20] = {};
-  if (!f.read(reinterpret_cast<char*>(h), sizeof h))
-    return err = "firmware image " + path + " is not an ELF file (too short or unreadable)", false;
-  if (h[0] != 0x7F || h[1] != 'E' || h[2] != 'L' || h[3] != 'F')
-    return err = "firmware image " + path + " is not an ELF file; pass the .elf the m4f build makes", false;
-  if (h[4] != 1 || h[5] != 1 || (h[18] | (h[19] << 8)) != 40)
-    return err = "firmware image " + path + " is not a 32-bit little-endian ARM ELF file", false;
-  return true;
-}
-
 bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, const sim::Settings& cfg,
                 const sim::Provenance& prov, bool csv, std::string& err) {
   return write_atomically(path, sim::summary_json(runs, cfg, prov, csv).dump(2) + "\n", err);
@@ -255,10 +242,10 @@ int main(int argc, char** argv) {
   if (o.qemu) {
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
-    if (!check_arm_elf(o.elf, err)) return fail(err);
     // The M4F firmware computes in float (the M3 image in fixed point: --scalar fixed says so).
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;
-    o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf);
+    o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf, o.pil_link, err);
+    if (o.base.pil_command.empty()) return fail(err);
   }
   if (o.csv) {
     // No shell: the name is a path, never a command.
@@ -309,7 +296,7 @@ int main(int argc, char** argv) {
   }
   for (auto& t : threads) t.join();
 
-  print_tables(runs, prov);
+  print_tables(runs, prov, o.base.scalar);
   if (o.csv) {
     for (const auto& r : runs)
       if (!write_csv(o.csv_dir, r, prov, err)) return fail(err);

@@ -320,7 +320,7 @@ def fixed_headroom():
 
 IMAGES = [("kernels_image", "every kernel in float, checked against the published vectors, instruction counts"),
           ("timer_firmware", "the control task in the 1 kHz TIMER0 interrupt, 200 ticks, fed watchdog"),
-          ("pil_firmware", "the control task over the UART0 link to host_sim"),
+          ("pil_firmware", "the control task over the link to host_sim (semihosting console or UART0)"),
           ("watchdog_firmware", "the watchdog's resets (hung tick, latched fault, control interrupt off)")]
 
 
@@ -389,7 +389,7 @@ def target_instructions():
 M3_IMAGES = [("kernels_image", "every kernel in Q12.19, checked against the host's values bit for bit"),
              ("kernels_image_softfloat", "the same kernels in float through the soft-float routines"),
              ("timer_firmware", "the control task in the 1 kHz TIMER0 interrupt, 200 ticks"),
-             ("pil_firmware", "the control task over the UART0 link to host_sim"),
+             ("pil_firmware", "the control task over the link to host_sim (semihosting console or UART0)"),
              ("watchdog_firmware", "the watchdog's resets")]
 
 

@@ -158,6 +158,28 @@ TEST(Config, CommandLineAppliesFileThenOptionsThenSet) {
   EXPECT_NE(err.find("trajectory.amplitude applies to the host-built controller only"), std::string::npos) << err;
 }
 
+// --pil-link names the transport to the image in QEMU; semihosting unless it says uart.
+TEST(Config, PilLinkIsSemihostingOrUartAndNeedsQemu) {
+  char prog[] = "puma_experiment", q[] = "--qemu", l[] = "--pil-link", uart[] = "uart", spi[] = "spi";
+  std::string err;
+  sim::ExperimentOptions o;
+  char* plain[] = {prog, q};
+  ASSERT_TRUE(sim::parse_experiment_args(2, plain, o, err)) << err;
+  EXPECT_EQ(o.pil_link, sim::PilLink::kSemihosting);
+  sim::ExperimentOptions o2;
+  char* by_uart[] = {prog, q, l, uart};
+  ASSERT_TRUE(sim::parse_experiment_args(4, by_uart, o2, err)) << err;
+  EXPECT_EQ(o2.pil_link, sim::PilLink::kUart);
+  sim::ExperimentOptions o3;
+  char* unknown[] = {prog, q, l, spi};
+  EXPECT_FALSE(sim::parse_experiment_args(4, unknown, o3, err));
+  EXPECT_EQ(err, "--pil-link: 'spi' is not a link: semihosting | uart");
+  sim::ExperimentOptions o4;
+  char* without_qemu[] = {prog, l, uart};
+  EXPECT_FALSE(sim::parse_experiment_args(3, without_qemu, o4, err));
+  EXPECT_EQ(err, "--pil-link applies with --qemu only");
+}
+
 TEST(Config, StartPoseAtASingularityIsRefused) {
   Settings s;
   std::string err;

@@ -30,7 +30,7 @@ struct FakeBoard {
     rx.reset();
     bad_bytes = 0;
   }
-  static void uart_write(const std::uint8_t* p, int n) {
+  static void link_write(const std::uint8_t* p, int n) {
     for (int i = 0; i < n; ++i) {
       const pil::Parser::Result r = rx.feed(p[i]);
       if (r == pil::Parser::kFrame) {

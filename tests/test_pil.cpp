@@ -26,10 +26,21 @@ bool peer_is_fixed() {
 }
 Scalar peer_scalar() { return peer_is_fixed() ? Scalar::kFixed : Scalar::kFloat; }
 
+/// The transport to the image in QEMU: PIL_LINK=uart or semihosting (the default).
+PilLink peer_link() {
+  PilLink link = PilLink::kSemihosting;
+  const char* s = std::getenv("PIL_LINK");
+  if (s != nullptr && !parse_pil_link(s, link)) ADD_FAILURE() << "PIL_LINK=" << s << " is not a link";
+  return link;
+}
+
 std::vector<std::string> peer_command() {
   if (const char* elf = std::getenv("PIL_FIRMWARE_ELF")) {
     const char* qemu = std::getenv("QEMU");
-    return PilClient::qemu_command(qemu ? qemu : "qemu-system-arm", elf);
+    std::string err;
+    std::vector<std::string> argv = PilClient::qemu_command(qemu ? qemu : "qemu-system-arm", elf, peer_link(), err);
+    if (argv.empty()) ADD_FAILURE() << err;
+    return argv;
   }
   return {PIL_PEER_PATH};
 }
@@ -428,6 +439,65 @@ TEST(PilClosedLoop, TracksLikeTheInProcessController) {
     EXPECT_EQ(differ, 0u) << "of " << local.log.size() << " logged samples";
     std::printf("bit for bit: %zu logged samples of torques and errors, %zu differ\n", local.log.size(), differ);
   }
+}
+
+// QEMU only (PIL_FIRMWARE_ELF): the image's two transports (boards/common/mps2/pil_firmware.cpp)
+// carry the same bytes, so the same run gives the same result bit for bit: every tick's torques,
+// errors, theta^ and friction estimate, and the statistics. Only the link's timing differs (the
+// UART's bytes arrive one by one). The host preset's test_pil, whose peer is a host program, leaves
+// this suite out.
+TEST(PilQemu, TheUartAndTheSemihostingLinkRunTheSameLoopBitForBit) {
+  const PatientPeer patient;
+  const char* elf = std::getenv("PIL_FIRMWARE_ELF");
+  if (elf == nullptr) GTEST_SKIP() << "needs PIL_FIRMWARE_ELF, the image (ctest --preset m4f or m3 runs it)";
+  const char* qemu = std::getenv("QEMU");
+  ExperimentConfig c;
+  c.duration = 3.0;
+  c.final_window = 1.0;
+  c.log_period = 0.001;  // every tick
+  c.scalar = peer_scalar();
+  ExperimentResult r[2];
+  const PilLink links[2] = {PilLink::kUart, PilLink::kSemihosting};
+  for (int l = 0; l < 2; ++l) {
+    std::string err;
+    c.pil_command = PilClient::qemu_command(qemu ? qemu : "qemu-system-arm", elf, links[l], err);
+    ASSERT_FALSE(c.pil_command.empty()) << err;
+    r[l] = run_experiment(c);
+    ASSERT_TRUE(r[l].error.empty()) << name(links[l]) << ": " << r[l].error;
+    EXPECT_TRUE(r[l].link.clean()) << name(links[l]);
+    std::printf("%s: %.2f s wall for %.0f s; longest gap between received bytes %u cycles\n", name(links[l]),
+                r[l].wall_seconds, c.duration, r[l].link.rx_gap_max);
+  }
+  EXPECT_EQ(r[0].status, 0u);
+  EXPECT_EQ(r[1].status, r[0].status);
+  ASSERT_EQ(r[1].log.size(), r[0].log.size());
+  ASSERT_GE(r[0].log.size(), 2999u);
+  std::size_t differ = 0;
+  for (std::size_t k = 0; k < r[0].log.size(); ++k) {
+    const LogRow &u = r[0].log[k], &v = r[1].log[k];
+    bool same = u.t == v.t;
+    for (int i = 0; i < 6; ++i) same = same && u.tau[i] == v.tau[i] && u.e[i] == v.e[i] && u.tau_f_hat[i] == v.tau_f_hat[i];
+    for (int i = 0; i < 18; ++i) same = same && u.theta_hat[i] == v.theta_hat[i];
+    differ += !same;
+  }
+  EXPECT_EQ(differ, 0u) << "of " << r[0].log.size() << " ticks";
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(r[1].max_error[i], r[0].max_error[i]) << i;
+  for (int i = 0; i < 18; ++i) EXPECT_EQ(r[1].theta_hat[i], r[0].theta_hat[i]) << i;
+  EXPECT_EQ(r[1].friction_rms_error, r[0].friction_rms_error);
+  std::printf("bit for bit: %zu ticks of torques, errors, theta^ and friction estimates, %zu differ\n",
+              r[0].log.size(), differ);
+}
+
+// The machine comes from the image's build attributes; anything else is refused with a reason.
+TEST(PilQemu, TheMachineIsTheImagesCore) {
+  const char* elf = std::getenv("PIL_FIRMWARE_ELF");
+  if (elf == nullptr) GTEST_SKIP() << "needs PIL_FIRMWARE_ELF, the image (ctest --preset m4f or m3 runs it)";
+  std::string err;
+  EXPECT_EQ(qemu_machine(elf, err), peer_is_fixed() ? "mps2-an385" : "mps2-an386") << err;
+  EXPECT_EQ(qemu_machine(PIL_PEER_PATH, err), "");  // a host program: not a 32-bit ARM image
+  EXPECT_NE(err.find("not a 32-bit little-endian ARM ELF"), std::string::npos) << err;
+  EXPECT_EQ(qemu_machine("/nonexistent.elf", err), "");
+  EXPECT_NE(err.find("cannot read"), std::string::npos) << err;
 }
 
 // The adaptation law chosen on the host reaches the controller over the link (first frame's

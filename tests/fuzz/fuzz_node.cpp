@@ -28,7 +28,7 @@ struct FakeBoard {
   static inline std::vector<std::uint8_t> out;
   static inline std::uint32_t clock = 0;
   static inline bool fault_line = false;
-  static void uart_write(const std::uint8_t* p, int n) { out.insert(out.end(), p, p + n); }
+  static void link_write(const std::uint8_t* p, int n) { out.insert(out.end(), p, p + n); }
   static std::uint32_t cycles() { return clock += 1000; }
   static std::uint32_t stack_used() { return 0; }
   static void burn(std::uint32_t c) { clock += c; }

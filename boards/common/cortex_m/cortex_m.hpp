@@ -78,6 +78,30 @@ inline int call(int op, const void* arg) {
   return r0;
 }
 inline void write(const char* s) { call(0x04, s); }  // SYS_WRITE0
+/// SYS_OPEN: a handle for `path` (":tt" is the debugger's console) in `mode` (0 "r", 4 "w"), or -1.
+inline int open(const char* path, std::uint32_t length, std::uint32_t mode) {
+  const std::uint32_t block[3] = {reinterpret_cast<std::uint32_t>(path), mode, length};
+  return call(0x01, block);
+}
+/// SYS_WRITE: writes n bytes; returns how many were NOT written (0 on success).
+inline int write(int handle, const void* p, int n) {
+  const std::uint32_t block[3] = {static_cast<std::uint32_t>(handle), reinterpret_cast<std::uint32_t>(p),
+                                  static_cast<std::uint32_t>(n)};
+  return call(0x05, block);
+}
+/// SYS_READ: reads up to n bytes, waiting for at least one; returns how many of the n were NOT read
+/// (n at the end of the input).
+inline int read(int handle, void* p, int n) {
+  const std::uint32_t block[3] = {static_cast<std::uint32_t>(handle), reinterpret_cast<std::uint32_t>(p),
+                                  static_cast<std::uint32_t>(n)};
+  return call(0x06, block);
+}
+/// SYS_GET_CMDLINE: the command line the debugger passes (QEMU: the -kernel file and -append
+/// text), NUL-terminated, into buf[0..n); its length, or -1 when it does not fit.
+inline int command_line(char* buf, int n) {
+  std::uint32_t block[2] = {reinterpret_cast<std::uint32_t>(buf), static_cast<std::uint32_t>(n)};
+  return call(0x15, block) == 0 ? static_cast<int>(block[1]) : -1;
+}
 [[noreturn]] inline void exit(int code) {
   const std::uint32_t block[2] = {0x20026u, static_cast<std::uint32_t>(code)};  // ApplicationExit
   call(0x20, block);  // SYS_EXIT_EXTENDED

@@ -60,15 +60,26 @@ function(osc_add_mps2_board)
   set_tests_properties(watchdog_reset_qemu PROPERTIES PASS_REGULAR_EXPRESSION "watchdog_firmware: pass")
 endfunction()
 
-# osc_add_pil_test(NAME SCALAR [ARGS...]): the host's PIL tests (build/host/tests/test_pil, so the
-# host preset must be built first; scripts/test.sh does) against this build's pil_firmware in QEMU:
-# fault injection through the link and the closed loop against the host-built controller in SCALAR
-# (float or fixed).
-function(osc_add_pil_test name scalar)
+# osc_add_pil_test(NAME SCALAR LINK [ARGS...]): the host's PIL tests (build/host/tests/test_pil, so
+# the host preset must be built first; scripts/test.sh does) against this build's pil_firmware in
+# QEMU over LINK (semihosting or uart, host_sim/pil_client.hpp): fault injection through the link
+# and the closed loop against the host-built controller in SCALAR (float or fixed).
+function(osc_add_pil_test name scalar link)
   add_test(NAME ${name} COMMAND ${PROJECT_SOURCE_DIR}/build/host/tests/test_pil ${ARGN})
   set_tests_properties(${name} PROPERTIES
-    ENVIRONMENT "PIL_FIRMWARE_ELF=$<TARGET_FILE:pil_firmware>;QEMU=${QEMU_SYSTEM_ARM};PIL_SCALAR=${scalar}"
+    ENVIRONMENT "PIL_FIRMWARE_ELF=$<TARGET_FILE:pil_firmware>;QEMU=${QEMU_SYSTEM_ARM};PIL_SCALAR=${scalar};PIL_LINK=${link}"
     DEPENDS pil_firmware_checks TIMEOUT 900)
+endfunction()
+
+# osc_add_pil_tests(SCALAR): every PIL test, each over the transport it needs. Over the
+# semihosting console (the experiment's default): all but the link's timeouts, which that transport
+# does not have (the firmware blocks in its read, and virtual time with it); PilQemu compares it
+# with the UART bit for bit. Over the UART, byte by byte as on a board: the link tests, timeouts
+# included.
+function(osc_add_pil_tests scalar)
+  osc_add_pil_test(pil_qemu ${scalar} semihosting
+                   --gtest_filter=-Link.ShortFrameTimesOutWithZeroCodes:Link.SilenceGetsZeroCodesRepeatedSilenceLatchesLinkLost)
+  osc_add_pil_test(pil_qemu_uart ${scalar} uart --gtest_filter=Link.*)
 endfunction()
 
 # osc_add_docs_tables_test(KIND): ctest docs_tables_KIND checks that the generated tables of that

@@ -1,11 +1,26 @@
 // The processor-in-the-loop firmware for the MPS2 boards, in the board's scalar (board::Scalar: float
-// on the AN386's Cortex-M4F, Q12.19 fixed point on the AN385's Cortex-M3): UART0 carries the link (osc/link/frames.hpp)
-// to the simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector) runs the control
-// task; here it is pended whenever a frame ends (valid or not), so the host's plant sets the sample
-// clock (lockstep) and the run is deterministic under -icount. Every link error is answered at once
-// with zero codes (osc/link/node.hpp). The link watchdog in the main loop answers a missing or short
+// on the AN386's Cortex-M4F, Q12.19 fixed point on the AN385's Cortex-M3): a link (osc/link/frames.hpp)
+// carries the frames to the simulated PUMA 560 in host_sim. The control interrupt (TIMER0's vector)
+// runs the control task; here it is pended whenever a frame ends (valid or not), so the host's plant
+// sets the sample clock (lockstep) and the run is deterministic under -icount. Every link error is
+// answered at once with zero codes (osc/link/node.hpp). The link watchdog answers a missing or short
 // frame the same way after params::kLinkTimeout of virtual time: in lockstep the host paces the
 // ticks, so the node's tick-based silence rule (params::kLinkSilenceTicks) has no ticks to count.
+//
+// Two transports for the same bytes, chosen at start from the command line QEMU passes over
+// semihosting (-semihosting-config ...,arg=link=semihosting):
+//   UART0 (the default): the board's serial port, a byte at a time through QEMU's CMSDK UART model,
+//     as on a board. The main loop sleeps (WFI) until a byte comes or the wake-up timer ticks, and
+//     checks the link timeout.
+//   "link=semihosting": whole reads and writes of the semihosting console (":tt", QEMU's own
+//     stdin and stdout), for speed: QEMU's UART model costs a host system call or two per byte, this
+//     one a call per read or write (docs/benchmarks.md, "QEMU"). The main loop blocks in the read,
+//     and so does virtual time (the core executes nothing and is not idle): nothing can time out
+//     while the host computes, so this transport has no link timeout. A frame that never completes
+//     leaves the firmware waiting; the host's own timeout reports it. The link's timeouts are tested
+//     over the UART.
+// The node, the frames, the ticks and what they compute are the same on both: the same run gives
+// the same torques, bit for bit (tests/test_pil.cpp, PilQemu).
 //
 // The CMSDK watchdog (board.hpp) starts with the link (the first received byte). Its PIL policy
 // (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop
@@ -14,8 +29,8 @@
 // frames (virtual time advances while the main loop waits), so ticks alone cannot feed it here. A
 // hung or disabled control interrupt or a hung main loop lets it expire; a latched fault does not:
 // the link keeps answering every frame with zero torque and the latched bits, which the host needs.
-// While the main loop sleeps (WFI) for the next byte with every pended tick done, the watchdog is
-// stopped, and restarted from a full count after the sleep: under -icount (sleep=on) virtual time
+// While the main loop waits for the next byte with every pended tick done, the watchdog is
+// stopped, and restarted from a full count after the wait: under -icount (sleep=on) virtual time
 // follows wall-clock time while the core sleeps, including any time QEMU itself is descheduled.
 // Feeding never changes what a tick computes, so the lockstep run stays deterministic.
 #include <cstdint>
@@ -27,8 +42,15 @@
 
 namespace {
 
+enum class Transport : std::uint8_t { kUart, kSemihosting };
+Transport g_transport = Transport::kUart;
+int g_console_in = -1, g_console_out = -1;  // semihosting handles (kSemihosting)
+
 struct Mps2Board {
-  static void uart_write(const std::uint8_t* p, int n) { board::uart_write(p, n); }
+  static void link_write(const std::uint8_t* p, int n) {
+    if (g_transport == Transport::kSemihosting) board::semihost::write(g_console_out, p, n);
+    else board::uart_write(p, n);
+  }
   static std::uint32_t cycles() { return board::cycles(); }
   static std::uint32_t stack_used() { return board::stack_used(); }
   static void burn(std::uint32_t ns) { board::busy_wait(ns); }
@@ -49,6 +71,50 @@ volatile std::uint32_t g_ticks_pended = 0, g_ticks_run = 0;
 void pend_tick() {
   g_ticks_pended = g_ticks_pended + 1;
   board::control_irq_pend();  // the tick runs now
+}
+
+/// "link=semihosting" is a word of the semihosting command line (QEMU: -semihosting-config arg=...).
+bool semihosting_link_requested() {
+  char line[96];
+  const int n = board::semihost::command_line(line, sizeof line);
+  constexpr char kWord[] = "link=semihosting";
+  constexpr int kLen = sizeof kWord - 1;
+  for (int i = 0; i + kLen <= n; ++i) {
+    if (i > 0 && line[i - 1] != ' ') continue;
+    int k = 0;
+    while (k < kLen && line[i + k] == kWord[k]) ++k;
+    if (k == kLen && (i + kLen == n || line[i + kLen] == ' ')) return true;
+  }
+  return false;
+}
+
+/// The received bytes of the semihosting transport: one read's worth at a time.
+struct ConsoleRx {
+  std::uint8_t buf[64];
+  int len = 0, pos = 0;
+  bool ready() const { return pos < len; }
+  std::uint8_t read() { return buf[pos++]; }
+  /// Blocks until the host writes. At the end of the input the host has gone: the run ends.
+  void wait() {
+    const int left = board::semihost::read(g_console_in, buf, static_cast<int>(sizeof buf));
+    len = static_cast<int>(sizeof buf) - left;
+    pos = 0;
+    if (len <= 0) board::semihost::exit(0);
+  }
+};
+ConsoleRx g_console_rx;
+
+bool rx_ready() {
+  return g_transport == Transport::kSemihosting ? g_console_rx.ready() : board::uart_rx_ready();
+}
+std::uint8_t rx_read() {
+  return g_transport == Transport::kSemihosting ? g_console_rx.read() : board::uart_read();
+}
+/// Waits for the next byte: the UART sleeps until a byte or an interrupt; the console blocks until
+/// bytes come.
+void rx_wait() {
+  if (g_transport == Transport::kSemihosting) g_console_rx.wait();
+  else board::sleep_until_rx_or_irq();
 }
 
 }  // namespace
@@ -73,13 +139,20 @@ extern "C" void TIMER1_Handler() { board::wake_timer_ack(); }
 
 int main() {
   board::cycle_counter_init();
-  board::uart_init();
+  if (semihosting_link_requested()) {
+    g_console_in = board::semihost::open(":tt", 3, 0);
+    g_console_out = board::semihost::open(":tt", 3, 4);
+    if (g_console_in < 0 || g_console_out < 0) board::semihost::exit(2);
+    g_transport = Transport::kSemihosting;
+  } else {
+    board::uart_init();
+  }
   g_node.init(osc::joint_vector<board::Scalar>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
-  board::uart_rx_irq_enable();
+  if (g_transport == Transport::kUart) board::uart_rx_irq_enable();
   board::wake_timer_start(board::kControlHz);
   g_node.hello();  // bytes the host sent before this point may have been dropped
-  // The main loop sleeps (WFI) until a byte comes or the wake-up timer ticks (once per control
+  // The main loop waits (rx_wait) until a byte comes or the wake-up timer ticks (once per control
   // period), and then handles every byte that is there. Under -icount (sleep=on, QEMU's default)
   // virtual time follows the host's wall-clock time while the core sleeps, as it did while it
   // polled; the sleep hands the CPU to QEMU's I/O thread at once, which delivers the next byte (a
@@ -90,13 +163,13 @@ int main() {
   bool link_up = false;
   std::uint32_t last = board::cycles(), last_feed = last;
   for (;;) {
-    if (board::uart_rx_ready()) {
+    if (rx_ready()) {
       if (!link_up) {
         link_up = true;
         board::watchdog_start();
         last_feed = board::cycles();
       }
-      if (g_node.on_byte(board::uart_read())) pend_tick();
+      if (g_node.on_byte(rx_read())) pend_tick();
       last = board::cycles();
       continue;
     }
@@ -113,12 +186,12 @@ int main() {
         last_feed = now;
       }
     }
-    // Waiting for the host with every pended tick done, the watchdog pauses during the sleep and
+    // Waiting for the host with every pended tick done, the watchdog pauses during the wait and
     // restarts from a full count after it: virtual time jumps while QEMU itself is descheduled,
     // and such a jump must not read as a hung firmware. A tick still pending keeps it counting.
     const bool pause = link_up && g_ticks_run == g_ticks_pended;
     if (pause) board::watchdog_stop();
-    board::sleep_until_rx_or_irq();
+    rx_wait();
     if (pause) {
       board::watchdog_start();
       last_feed = board::cycles();

@@ -29,7 +29,7 @@ namespace osc {
 /// What the link node needs from a board (all static).
 template <class B>
 concept PilBoard = requires(const std::uint8_t* bytes, int n, std::uint32_t cycles, bool active) {
-  { B::uart_write(bytes, n) } -> std::same_as<void>;       // blocking write of n bytes
+  { B::link_write(bytes, n) } -> std::same_as<void>;       // blocking write of n bytes
   { B::cycles() } -> std::same_as<std::uint32_t>;          // free-running cycle counter
   { B::stack_used() } -> std::same_as<std::uint32_t>;      // main-stack high-water mark [bytes]
   { B::burn(cycles) } -> std::same_as<void>;               // busy-wait (fault injection only)
@@ -139,7 +139,7 @@ class PilNode {
     a.rx_gap_max = rx_gap_max_;
     a.rx_long_gaps = rx_long_gaps_;
     std::uint8_t buf[pil::kMaxFrame];
-    Board::uart_write(buf, pil::encode(a, buf));
+    Board::link_write(buf, pil::encode(a, buf));
   }
   std::uint32_t cycles() const { return Board::cycles(); }
   void fault_output(bool active) { Board::fault_output(active); }
