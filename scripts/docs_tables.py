@@ -561,6 +561,41 @@ def monitors_hour():
     return "\n".join(lines)
 
 
+MONITOR_PERTURBATIONS = [(), ("--delay", "1e-4"), ("--delay", "3e-4"), ("--model-error", "-0.05"),
+                         ("--model-error", "0.05"), ("--set", "plant.smooth_steps=1")]
+
+
+@table("monitor_margins", "docs/safety.md", "long")
+def monitor_margins():
+    """The stuck-encoder monitor's fault-free peaks against its thresholds: 300 s in every scalar,
+    on both presets, in both modes, nominal and perturbed (72 runs of 300 s)."""
+    criteria = [("reference motion while still", "stuck_monitor_peak_counts", [parse_params("kStuckMotionCounts", 1)[0]] * 6,
+                 "counts"),
+                ("torque change while still", "stuck_monitor_peak_dtau_Nm", parse_params("kStuckTorque", 6), "N m"),
+                ("torque change, moving joint silent", "stuck_monitor_peak_dtau_silent_Nm",
+                 parse_params("kStuckTorqueSilent", 6), "N m")]
+    sets = [(scalar, friction, pert) for scalar in ("double", "float", "fixed") for friction in ("paper", "corke")
+            for pert in MONITOR_PERTURBATIONS]
+    args = {k: ("--duration", "300", "--scalar", k[0], "--friction", k[1], *k[2]) for k in sets}
+    prefetch(list(args.values()))
+    runs = []
+    for (scalar, friction, pert) in sets:
+        for r in experiment(*args[(scalar, friction, pert)])["runs"]:
+            where = f"{scalar}, {friction}, {'compensated' if r['mode'] == 'adaptive' else 'no compensation'}"
+            runs.append((where + (f", `{' '.join(pert)}`" if pert else ""), r))
+    lines = ["| criterion | worst peak / threshold | where | per joint, worst of all runs (threshold) |",
+             "|---|---|---|---|"]
+    for label, key, limit, unit in criteria:
+        worst = max(((r[key][j] / limit[j], j, where, r[key][j]) for where, r in runs for j in range(6)))
+        per_joint = [max(r[key][j] for _, r in runs) for j in range(6)]
+        lines.append(f"| {label} | {worst[0]:.2f} | J{worst[1] + 1}, {worst[2]} ({worst[3]:.1f} of "
+                     f"{limit[worst[1]]:g} {unit}) | " + ", ".join(f"{v:.1f} ({t:g})" for v, t in zip(per_joint, limit))
+                     + " |")
+    lines.append("")
+    lines.append(f"{len(runs)} runs of 300 s, no fault (a fault-free run that faults stops the script).")
+    return "\n".join(lines)
+
+
 BENCH_ROWS = [("FK, all frames", "forward_kinematics", "kdl_forward_kinematics", "forward_kinematics"),
               ("geometric Jacobian (after FK)", "geometric_jacobian", "kdl_jacobian", "jacobian"),
               ("A(q), CRBA (after FK)", "joint_inertia", "kdl_mass", "mass"),
