@@ -60,7 +60,7 @@ extern "C" void OSC_CONTROL_TIMER_HANDLER() {
   }
   g_faults = g_faults | g_board.hal.tick(g_task);
   if (k % board::kTelemetryEvery == 0) {
-    const int n = pil::encode(osc::telemetry_frame(g_task, g_board.hal.written(), k, cortex_m::stack_used()), g_frame);
+    const int n = pil::encode(osc::telemetry_frame(g_task, g_board.hal.written(), k, cortex_m::stack_used_sweep()), g_frame);
     if (g_board.uart.offer(g_frame, n)) ++g_frames;
   }
   if constexpr (board::kQemu) {

@@ -135,8 +135,15 @@ inline std::uint32_t systick_cycles() {
 extern "C" void osc_safe_state();
 
 // ---------------------------------------------------------------- stack
-/// Bytes of the main stack ever used (painted at reset by the common startup code).
+/// Bytes of the main stack ever used (painted at reset by the common startup code): a scan of
+/// the unused part, up to a few thousand words.
 std::uint32_t stack_used();
+/// The same high-water mark for a periodic caller (the control interrupt's telemetry): each call
+/// examines at most kStackSweepWords words of an ongoing sweep and returns the deepest use found
+/// so far, so a new depth shows within (stack size / 4 / kStackSweepWords) calls. Never more than
+/// stack_used().
+std::uint32_t stack_used_sweep();
+constexpr int kStackSweepWords = 64;
 
 // ---------------------------------------------------------------- reset record
 // Neither the Cortex-M3/M4 core nor QEMU's MPS2 boards have a reset-cause register. The cause is

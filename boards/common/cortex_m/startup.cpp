@@ -130,6 +130,19 @@ std::uint32_t cortex_m::stack_used() {
                                     reinterpret_cast<std::uintptr_t>(p));
 }
 
+std::uint32_t cortex_m::stack_used_sweep() {
+  // `mark`: the lowest word found written, so far; `next`: the sweep's next word, from the limit
+  // up to the mark, then from the limit again. Any word below the mark that gets written is met
+  // by the next sweep.
+  static const std::uint32_t* mark = &__stack_top__;
+  static const std::uint32_t* next = &__stack_limit__;
+  for (int k = 0; k < kStackSweepWords && next < mark; ++k, ++next)
+    if (*next != kPaint) mark = next;
+  if (next >= mark) next = &__stack_limit__;
+  return static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&__stack_top__) -
+                                    reinterpret_cast<std::uintptr_t>(mark));
+}
+
 cortex_m::ResetCause cortex_m::reset_cause() { return g_reset_cause; }
 std::uint32_t cortex_m::watchdog_resets() { return g_reset_record.watchdog_resets; }
 std::uint32_t cortex_m::watchdog_faults() { return g_watchdog_faults; }

@@ -171,5 +171,6 @@ inline const char* reset_cause_name(cortex_m::ResetCause c) {
 
 // ---------------------------------------------------------------- stack
 inline std::uint32_t stack_used() { return cortex_m::stack_used(); }
+inline std::uint32_t stack_used_sweep() { return cortex_m::stack_used_sweep(); }
 
 }  // namespace board

@@ -52,7 +52,7 @@ struct Mps2Board {
     else board::uart_write(p, n);
   }
   static std::uint32_t cycles() { return board::cycles(); }
-  static std::uint32_t stack_used() { return board::stack_used(); }
+  static std::uint32_t stack_used() { return board::stack_used_sweep(); }  // every tick: a bounded sweep
   static void burn(std::uint32_t ns) { board::busy_wait(ns); }
   static void fault_output(bool active) { board::fault_output(active); }
 };

@@ -50,6 +50,34 @@ extern "C" void NMI_Handler() {
   board::await_reset();
 }
 
+/// Writes a stack frame deeper than anything before it (and keeps the compiler from removing it).
+[[gnu::noinline]] std::uint32_t use_stack_deeply() {
+  volatile std::uint32_t deep[1536];  // 6 KiB
+  for (std::uint32_t i = 0; i < 1536; ++i) deep[i] = i;
+  return deep[7];
+}
+
+/// The telemetry's bounded sweep (cortex_m::stack_used_sweep) against the full scan: never above
+/// it, equal once a sweep is through, and a new, deeper use found by the next sweep.
+bool stack_sweep_agrees() {
+  constexpr int kCalls = 4096 / cortex_m::kStackSweepWords + 2;  // a 16 KiB stack's sweep, and one more call
+  std::uint32_t swept = 0;
+  bool never_above = true;
+  for (int k = 0; k < kCalls; ++k) {
+    swept = board::stack_used_sweep();
+    never_above = never_above && swept <= board::stack_used();
+  }
+  const bool equal = swept == board::stack_used();
+  const std::uint32_t before = swept;
+  (void)use_stack_deeply();
+  for (int k = 0; k < kCalls; ++k) swept = board::stack_used_sweep();
+  const bool deeper_found = swept == board::stack_used() && swept > before && swept >= 6144;
+  cortex_m::text::Line().str("stack sweep: ").u32(before).str(" bytes, then ").u32(swept).str(" after a 6 KiB frame (")
+      .str(never_above && equal && deeper_found ? "agrees with the full scan" : "DISAGREES with the full scan").str(")")
+      .emit();
+  return never_above && equal && deeper_found;
+}
+
 int main() {
   board::cycle_counter_init();
   const cortex_m::ResetCause cause = board::reset_cause();
@@ -78,7 +106,8 @@ int main() {
       .str(watchdog_ok ? "never expired" : "EXPIRED or unfed").str("; reset cause ")
       .str(board::reset_cause_name(cause)).emit();
   const bool spacing_ok = lo + 100 >= kPeriodNs && hi <= kPeriodNs + 100;
-  const bool ok = spacing_ok && watchdog_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun &&
+  const bool sweep_ok = stack_sweep_agrees();
+  const bool ok = spacing_ok && watchdog_ok && sweep_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun &&
                   g_hal.codes[1] != 0;
   cortex_m::text::Line().str(ok ? "timer_firmware: pass" : "timer_firmware: FAIL").emit();
   return ok ? 0 : 1;

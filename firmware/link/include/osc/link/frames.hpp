@@ -100,8 +100,9 @@ constexpr int kMaxFrame = kActuatorPayload + kOverhead;
 static_assert(kActuatorPayload < 256 && kSensorPayload < 256, "length fits a byte");
 static_assert(kActuatorPayload == 185, "the actuator frame's layout (encode/decode below) changed: update the docs");
 
-/// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), bitwise.
-inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
+/// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), one bit at a time: the definition,
+/// which makes the table below and the tests' reference.
+constexpr std::uint16_t crc16_bitwise(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
   for (int i = 0; i < n; ++i) {
     crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(p[i]) << 8));
     for (int b = 0; b < 8; ++b)
@@ -109,6 +110,29 @@ inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xF
   }
   return crc;
 }
+
+namespace detail {
+/// The CRC register after one byte b with a zero register, for every b (512 bytes of flash).
+struct Crc16Table {
+  std::uint16_t v[256];
+  constexpr Crc16Table() : v{} {
+    for (int b = 0; b < 256; ++b) {
+      const auto byte = static_cast<std::uint8_t>(b);
+      v[b] = crc16_bitwise(&byte, 1, 0);
+    }
+  }
+};
+inline constexpr Crc16Table kCrc16Table{};
+}  // namespace detail
+
+/// The same CRC a byte at a time through the table: a frame's CRC in a few instructions per byte
+/// instead of about forty (the link runs in the control interrupt).
+inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
+  for (int i = 0; i < n; ++i)
+    crc = static_cast<std::uint16_t>((crc << 8) ^ detail::kCrc16Table.v[((crc >> 8) ^ p[i]) & 0xFF]);
+  return crc;
+}
+static_assert(detail::kCrc16Table.v[1] == 0x1021, "the table's first power of x is the polynomial");
 
 namespace detail {
 struct Writer {

@@ -31,7 +31,7 @@ template <class B>
 concept PilBoard = requires(const std::uint8_t* bytes, int n, std::uint32_t cycles, bool active) {
   { B::link_write(bytes, n) } -> std::same_as<void>;       // blocking write of n bytes
   { B::cycles() } -> std::same_as<std::uint32_t>;          // free-running cycle counter
-  { B::stack_used() } -> std::same_as<std::uint32_t>;      // main-stack high-water mark [bytes]
+  { B::stack_used() } -> std::same_as<std::uint32_t>;      // main-stack high-water mark [bytes], per tick
   { B::burn(cycles) } -> std::same_as<void>;               // busy-wait (fault injection only)
   { B::fault_output(active) } -> std::same_as<void>;       // the board's fault line
 };
