@@ -83,21 +83,20 @@ inline int open(const char* path, std::uint32_t length, std::uint32_t mode) {
   const std::uint32_t block[3] = {reinterpret_cast<std::uint32_t>(path), mode, length};
   return call(0x01, block);
 }
-/// SYS_WRITE: writes n bytes; returns how many were NOT written (0 on success).
-inline int write(int handle, const void* p, int n) {
+/// SYS_WRITE (op 0x05) or SYS_READ (op 0x06) of n bytes at p: the number NOT transferred.
+inline int transfer(int op, int handle, const void* p, int n) {
   const std::uint32_t block[3] = {static_cast<std::uint32_t>(handle), reinterpret_cast<std::uint32_t>(p),
                                   static_cast<std::uint32_t>(n)};
-  return call(0x05, block);
+  return call(op, block);
 }
+/// SYS_WRITE: writes n bytes; returns how many were NOT written (0 on success).
+inline int write(int handle, const void* p, int n) { return transfer(0x05, handle, p, n); }
 /// SYS_READ: reads up to n bytes, waiting for at least one; returns how many of the n were NOT read
 /// (n at the end of the input).
-inline int read(int handle, void* p, int n) {
-  const std::uint32_t block[3] = {static_cast<std::uint32_t>(handle), reinterpret_cast<std::uint32_t>(p),
-                                  static_cast<std::uint32_t>(n)};
-  return call(0x06, block);
-}
-/// SYS_GET_CMDLINE: the command line the debugger passes (QEMU: the -kernel file and -append
-/// text), NUL-terminated, into buf[0..n); its length, or -1 when it does not fit.
+inline int read(int handle, void* p, int n) { return transfer(0x06, handle, p, n); }
+/// SYS_GET_CMDLINE: the command line the debugger passes (QEMU: the -semihosting-config arg=
+/// values, else the -kernel file and the -append text), NUL-terminated, into buf[0..n); its length,
+/// or -1 when it does not fit.
 inline int command_line(char* buf, int n) {
   std::uint32_t block[2] = {reinterpret_cast<std::uint32_t>(buf), static_cast<std::uint32_t>(n)};
   return call(0x15, block) == 0 ? static_cast<int>(block[1]) : -1;

@@ -149,11 +149,13 @@ int main() {
   }
   g_node.init(osc::joint_vector<board::Scalar>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
   board::control_irq_enable();
-  if (g_transport == Transport::kUart) board::uart_rx_irq_enable();
-  board::wake_timer_start(board::kControlHz);
+  if (g_transport == Transport::kUart) {
+    board::uart_rx_irq_enable();
+    board::wake_timer_start(board::kControlHz);  // nothing can wake a core blocked in a console read
+  }
   g_node.hello();  // bytes the host sent before this point may have been dropped
-  // The main loop waits (rx_wait) until a byte comes or the wake-up timer ticks (once per control
-  // period), and then handles every byte that is there. Under -icount (sleep=on, QEMU's default)
+  // The main loop waits (rx_wait) until a byte comes or, on the UART, the wake-up timer ticks (once
+  // per control period), and then handles every byte that is there. Under -icount (sleep=on, QEMU's default)
   // virtual time follows the host's wall-clock time while the core sleeps, as it did while it
   // polled; the sleep hands the CPU to QEMU's I/O thread at once, which delivers the next byte (a
   // polling loop keeps it waiting: docs/benchmarks.md). The link watchdog and the CMSDK watchdog
