@@ -20,16 +20,20 @@ Mat3 rot_x(double a) {
   m << 1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a);
   return m;
 }
-/// Spatial cross products at a common point, ordering [angular; linear].
-Vec6 cross_motion(const Vec6& v, const Vec6& m) {
+/// [a; b]. (Not Eigen's comma initializer: GCC 12 under -march=native reads the initializer of a
+/// 6-vector from two 3-vectors as an AVX load past the end of the second, a false -Warray-bounds.)
+Vec6 join(const Vec3& a, const Vec3& b) {
   Vec6 out;
-  out << v.head<3>().cross(m.head<3>()), v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
+  out.head<3>() = a;
+  out.tail<3>() = b;
   return out;
 }
+/// Spatial cross products at a common point, ordering [angular; linear].
+Vec6 cross_motion(const Vec6& v, const Vec6& m) {
+  return join(v.head<3>().cross(m.head<3>()), v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>()));
+}
 Vec6 cross_force(const Vec6& v, const Vec6& f) {
-  Vec6 out;
-  out << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
-  return out;
+  return join(v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>()));
 }
 
 }  // namespace
@@ -72,7 +76,7 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
     Rz << cq, -sq, 0, sq, cq, 0, 0, 0, 1;
     W = W * rot_fixed_[i] * Rz;
     const Vec3 z = W.col(2);
-    S[i] << z, o.cross(z);
+    S[i] = join(z, o.cross(z));
     const Vec6 vJ = S[i] * qd(i);
     V += vJ;
     c[i] = cross_motion(V, vJ);
