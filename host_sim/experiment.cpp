@@ -284,7 +284,7 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   timespec cpu0{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu0);
   ExperimentResult res;
-  res.mode = cfg.mode == osc::FrictionMode::kAdaptive ? "adaptive" : "none";
+  res.mode = mode_name(cfg.mode);
   res.duration = cfg.duration;
   res.adaptation = osc::adaptation_law_name(cfg.gains.adaptation);
   res.friction_preset = cfg.plant.friction.name;

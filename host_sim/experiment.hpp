@@ -137,6 +137,9 @@ struct ExperimentResult {
   std::vector<LogRow> log;
 };
 
+/// A run's mode as the outputs name it: "adaptive" or "none".
+inline const char* mode_name(osc::FrictionMode m) { return m == osc::FrictionMode::kAdaptive ? "adaptive" : "none"; }
+
 ExperimentResult run_experiment(const ExperimentConfig& cfg);
 
 /// Paper tables (NOTES.md) for side-by-side printing.

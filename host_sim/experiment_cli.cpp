@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 #include <utility>
@@ -47,12 +48,12 @@ struct Parsed {
   std::string pil_link;
 };
 
-void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::string>& values) {
+void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vector<std::string>>& values) {
   app.description(
       "The paper's experiment (Section VI) on the simulated PUMA 560, with adaptive friction compensation and "
       "without. The configuration's defaults are the paper's set-up; --print-config shows every key.");
   app.set_help_flag("-h,--help", "this text");
-  app.option_defaults()->disable_flag_override();
+  app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--config", o.config_file, "read the configuration from this YAML file (see --print-config)")
       ->type_name("FILE");
   app.add_option("--set", p.sets, "set one configuration key, after --config and the options below "
@@ -63,7 +64,9 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::stri
   values.resize(std::size(kShorthands));
   for (size_t i = 0; i < std::size(kShorthands); ++i)
     app.add_option(kShorthands[i].flag, values[i], std::string(kShorthands[i].help) + "; sets " + kShorthands[i].key)
-        ->type_name("V");
+        ->type_name("V")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--qemu", o.qemu, "run the controller as the firmware image in qemu-system-arm (PIL)");
   app.add_option("--elf", o.elf, "firmware image for --qemu (default: the m4f build's pil_firmware.elf)")
       ->type_name("FILE");
@@ -83,13 +86,19 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::stri
   app.add_flag("--no-progress", [&o](std::int64_t) { o.progress = false; }, "no progress bar");
 }
 
+/// Reads a configuration file of at most kMaxConfigBytes (a device such as /dev/zero, or a file that
+/// is no configuration, would otherwise be read without end).
 bool read_file(const std::string& path, std::string& text, std::string& err) {
   std::ifstream f(path, std::ios::binary);
   if (!f) return err = "cannot read configuration file " + path, false;
-  std::ostringstream ss;
-  ss << f.rdbuf();
+  text.assign(kMaxConfigBytes + 1, '\0');
+  f.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (f.bad()) return err = "cannot read configuration file " + path, false;
-  text = ss.str();
+  text.resize(static_cast<std::size_t>(f.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    return err = "configuration file " + path + " is larger than " + std::to_string(kMaxConfigBytes >> 20) +
+                 " MiB: not a configuration (puma_experiment --print-config shows one)",
+           false;
   return true;
 }
 
@@ -99,7 +108,7 @@ std::string experiment_usage() {
   CLI::App app("", "puma_experiment");
   ExperimentOptions o;
   Parsed p;
-  std::vector<std::string> values;
+  std::vector<std::vector<std::string>> values;
   build(app, o, p, values);
   return app.help();
 }
@@ -107,7 +116,7 @@ std::string experiment_usage() {
 bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::string& err) {
   CLI::App app("", "puma_experiment");
   Parsed p;
-  std::vector<std::string> values;
+  std::vector<std::vector<std::string>> values;
   build(app, o, p, values);
   try {
     app.parse(argc, argv);
@@ -117,8 +126,14 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
   } catch (const CLI::ParseError& e) {
     return err = e.what(), false;
   }
-  for (size_t i = 0; i < values.size(); ++i)
-    if (app.get_option(kShorthands[i].flag)->count() > 0) p.shorthands.emplace_back(&kShorthands[i], values[i]);
+  // In the order given on the command line: the last of a repeated option wins, each one checked.
+  for (const CLI::Option* opt : app.parse_order())
+    for (size_t i = 0; i < values.size(); ++i)
+      if (opt == app.get_option(kShorthands[i].flag)) {
+        const std::size_t seen = std::count_if(p.shorthands.begin(), p.shorthands.end(),
+                                               [&](const auto& sv) { return sv.first == &kShorthands[i]; });
+        p.shorthands.emplace_back(&kShorthands[i], values[i].at(seen));
+      }
 
   if (!o.config_file.empty()) {
     std::string text;

@@ -2,6 +2,7 @@
 // the parser can be tested and fuzzed (tests/fuzz/fuzz_cli.cpp) without running an experiment.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 #include "config.hpp"
@@ -20,12 +21,17 @@ struct ExperimentOptions : Settings {
   std::string elf = OSC_DEFAULT_PIL_ELF;
 };
 
+/// The largest configuration file --config reads.
+constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
+
 /// The generated help text.
 std::string experiment_usage();
 
 /// Parses argv[1..argc-1] into o: the configuration file, then the named options (--duration,
-/// --mode, ...), then every --set, each checked with the key it sets. Returns false with one short
-/// message in err on the first bad argument, key or value; nothing has run yet.
+/// --mode, ...), then every --set, each checked with the key it sets. An option given more than once
+/// takes its last value (scripts/run.sh gives --json and --csv-dir before the user's own), each value
+/// checked. Returns false with one short message in err on the first bad argument, key or value;
+/// nothing has run yet.
 bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::string& err);
 
 }  // namespace sim

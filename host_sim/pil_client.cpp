@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 #include "osc/runtime/io.hpp"
 
@@ -323,6 +324,14 @@ std::string PilClient::exit_description() {
   const char* what = code == 91 ? ": hard fault" : code == 90 ? ": unexpected interrupt"
                      : code == 0 ? ": a normal end, or a reset under -no-reboot" : "";
   return "exited, status " + std::to_string(code) + what;
+}
+
+bool PilClient::freeze_peer(double seconds, std::string& err) {
+  if (!running()) return err = "no peer to freeze", false;
+  if (kill(pid_, SIGSTOP) != 0) return err = std::string("SIGSTOP: ") + std::strerror(errno), false;
+  std::this_thread::sleep_for(std::chrono::duration<double>(seconds));
+  if (kill(pid_, SIGCONT) != 0) return err = std::string("SIGCONT: ") + std::strerror(errno), false;
+  return true;
 }
 
 int PilClient::stop() {

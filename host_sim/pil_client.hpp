@@ -78,6 +78,9 @@ class PilClient {
   /// Stops the peer (SIGKILL after a grace period) and returns its exit status (-1 if killed).
   int stop();
   bool running() const { return pid_ > 0 && !reaped_; }
+  /// Stops the peer's process for `seconds` of wall-clock time (SIGSTOP, then SIGCONT), as a busy
+  /// machine's scheduler may: for tests of a peer that is descheduled while it waits.
+  bool freeze_peer(double seconds, std::string& err);
 
  private:
   /// Once the peer has closed the link: waits up to a second for it to end and says how it ended

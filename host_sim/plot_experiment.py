@@ -21,7 +21,9 @@ import csv
 import json
 import math
 import os
+import stat
 import sys
+import tempfile
 
 import matplotlib
 
@@ -250,10 +252,52 @@ def plot_windows(out, summary, runs):
     return save(fig, out, "window_max_errors.png")
 
 
+class OutputError(Exception):
+    pass
+
+
+def write_output(path, write):
+    """Writes a file as puma_experiment does (host_sim/output_file.hpp): a regular file or a new path
+    through a temporary file beside it, renamed over it when complete (a failed write leaves the old
+    one as it was; a replaced file keeps its mode); a symbolic link written through to its target; a
+    device or a FIFO written in place; a directory refused. write(f) writes to a binary file."""
+    if os.path.isdir(path):
+        raise OutputError(f"cannot write {path}: it is a directory")
+    if os.path.exists(path) and not stat.S_ISREG(os.stat(path).st_mode):
+        try:
+            with open(path, "wb") as f:
+                write(f)
+        except OSError as e:
+            raise OutputError(f"cannot write {path}: {e.strerror}") from e
+        return
+    target = os.path.realpath(path)  # through links, also to a file that does not exist yet
+    if os.path.exists(target):
+        mode = stat.S_IMODE(os.stat(target).st_mode)
+    else:
+        mask = os.umask(0)
+        os.umask(mask)
+        mode = 0o666 & ~mask
+    tmp = None
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(target) + ".", dir=os.path.dirname(target))
+        with os.fdopen(fd, "wb") as f:
+            write(f)
+            f.flush()
+            os.fsync(f.fileno())
+            os.fchmod(f.fileno(), mode)
+        os.replace(tmp, target)
+    except OSError as e:
+        if tmp and os.path.exists(tmp):
+            os.unlink(tmp)
+        raise OutputError(f"cannot write {path}: {e.strerror}") from e
+
+
 def save(fig, out, name):
     p = os.path.join(out, name)
-    fig.savefig(p, dpi=110)
-    plt.close(fig)
+    try:
+        write_output(p, lambda f: fig.savefig(f, dpi=110, format="png"))
+    finally:
+        plt.close(fig)
     print(f"wrote {p}")
     return p
 
@@ -299,10 +343,13 @@ def main(argv):
         if r.get("fault"):
             f = r["fault"]
             print(f"[{r['mode']}] fault {'+'.join(f['names'])} at t = {f['time_s']:.3f} s (tick {f['tick']}): marked")
-    plot_tracking(out, summary, runs)
-    plot_theta(out, summary, runs)
-    plot_observer(out, summary, runs)
-    plot_windows(out, summary, runs)
+    try:
+        plot_tracking(out, summary, runs)
+        plot_theta(out, summary, runs)
+        plot_observer(out, summary, runs)
+        plot_windows(out, summary, runs)
+    except OutputError as e:
+        return fail(str(e))
     return 0
 
 

@@ -6,9 +6,10 @@
 
 
 #include <atomic>
-#include <filesystem>
+#include <cerrno>
 #include <cstdio>
-#include <fstream>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -20,6 +21,7 @@
 #include "experiment_cli.hpp"
 #include "summary.hpp"
 #include "injection.hpp"
+#include "output_file.hpp"
 #include "pil_client.hpp"
 
 namespace {
@@ -28,6 +30,11 @@ using Options = sim::ExperimentOptions;
 
 int fail(const std::string& msg) {
   std::cerr << "puma_experiment: " << msg << "\n(puma_experiment --help lists the options)\n";
+  return 2;
+}
+/// An output that cannot be written (host_sim/output_file.hpp): the message alone.
+int fail_output(const std::string& msg) {
+  std::cerr << "puma_experiment: " << msg << "\n";
   return 2;
 }
 
@@ -184,45 +191,8 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
                   r.fault_time, r.fault.tick);
 }
 
-/// Writes a temporary file beside path, then renames it: an existing file is never left
-/// half-written, and nothing is left behind on failure.
-bool write_atomically(const std::string& path, const std::string& text, std::string& err) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp);
-    if (f) f << text;
-    f.close();
-    if (!f) {
-      std::remove(tmp.c_str());
-      return err = "cannot write " + path, false;
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return err = "cannot write " + path + " (rename failed)", false;
-  }
-  return true;
-}
-
-/// Before the run: an output file can be created there (the file itself is written at the end).
-bool check_writable(const std::string& path, std::string& err) {
-  if (std::filesystem::is_directory(path)) return err = "cannot write " + path + ": it is a directory", false;
-  const std::string tmp = path + ".tmp";
-  std::ofstream f(tmp);
-  const bool ok = static_cast<bool>(f);
-  f.close();
-  std::remove(tmp.c_str());
-  if (!ok) return err = "cannot write " + path + " (does its directory exist and is it writable?)", false;
-  return true;
-}
-
-bool write_json(const std::string& path, const std::vector<sim::ExperimentResult>& runs, const sim::Settings& cfg,
-                const sim::Provenance& prov, bool csv, std::string& err) {
-  return write_atomically(path, sim::summary_json(runs, cfg, prov, csv).dump(2) + "\n", err);
-}
-
 bool write_csv(const std::string& dir, const sim::ExperimentResult& r, const sim::Provenance& prov, std::string& err) {
-  return write_atomically(dir + "/" + sim::csv_name(r), sim::csv_text(r, prov), err);
+  return sim::write_output(dir + "/" + sim::csv_name(r), sim::csv_text(r, prov), err);
 }
 
 }  // namespace
@@ -252,9 +222,17 @@ int main(int argc, char** argv) {
     std::error_code ec;
     std::filesystem::create_directories(o.csv_dir, ec);
     if (ec || !std::filesystem::is_directory(o.csv_dir))
-      return fail("cannot create directory " + o.csv_dir + (ec ? ": " + ec.message() : ""));
+      return fail_output("cannot create directory " + o.csv_dir + (ec ? ": " + ec.message() : ""));
   }
-  if (!o.json.empty() && !check_writable(o.json, err)) return fail(err);
+  if (!o.json.empty() && !sim::check_output(o.json, err)) return fail_output(err);
+  // A summary on standard output ("--json -", or /dev/stdout) has it to itself: the tables go to
+  // standard error, so that "--json - | jq ." reads JSON only.
+  int json_fd = -1;
+  if (!o.json.empty() && sim::is_stdout(o.json)) {
+    std::fflush(stdout);
+    json_fd = dup(STDOUT_FILENO);
+    if (json_fd < 0 || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) return fail_output("cannot set up standard output for --json");
+  }
 
   sim::Provenance prov;
   prov.revision = sim::git_revision();
@@ -263,12 +241,18 @@ int main(int argc, char** argv) {
   prov.differs = sim::differences_from_paper(o);
   if (o.csv) {
     prov.config_file = o.csv_dir + "/config.yaml";
-    if (!write_atomically(prov.config_file, prov.config_text, err)) return fail(err);
+    if (!sim::write_output(prov.config_file, prov.config_text, err)) return fail_output(err);
   }
 
   std::vector<sim::ExperimentConfig> cfgs;
   if (o.run_adaptive) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kAdaptive;
   if (o.run_none) cfgs.push_back(o.base), cfgs.back().mode = osc::FrictionMode::kNone;
+  // The time series are written after the run: their paths are checked before it.
+  for (const auto& c : cfgs) {
+    sim::ExperimentResult named;
+    named.mode = sim::mode_name(c.mode);
+    if (o.csv && !sim::check_output(o.csv_dir + "/" + sim::csv_name(named), err)) return fail_output(err);
+  }
 
   // Progress bar on a terminal only, for runs longer than a second.
   const bool bar = o.progress && isatty(STDERR_FILENO) && o.base.duration > 1.0;
@@ -299,13 +283,18 @@ int main(int argc, char** argv) {
   print_tables(runs, prov, o.base.scalar);
   if (o.csv) {
     for (const auto& r : runs)
-      if (!write_csv(o.csv_dir, r, prov, err)) return fail(err);
+      if (!write_csv(o.csv_dir, r, prov, err)) return fail_output(err);
     std::printf("time series: %s/timeseries_*.csv, configuration: %s\n", o.csv_dir.c_str(), prov.config_file.c_str());
   }
   if (!o.json.empty()) {
-    if (!write_json(o.json, runs, o, prov, o.csv, err)) return fail(err);
+    const std::string text = sim::summary_json(runs, o, prov, o.csv).dump(2) + "\n";
+    std::fflush(stdout);
+    const bool ok = json_fd >= 0 ? sim::write_all(json_fd, text, "standard output", err) && close(json_fd) == 0
+                                 : sim::write_output(o.json, text, err);
+    if (!ok) return fail_output(err.empty() ? "cannot write standard output: " + std::string(std::strerror(errno)) : err);
     std::printf("summary: %s\n", o.json.c_str());
   }
+  if (std::fflush(stdout) != 0 || std::ferror(stdout)) return fail_output("cannot write standard output");
   // A fault is a failed run, unless a fault was injected on purpose (then the JSON tells how it went).
   for (const auto& r : runs)
     if ((r.status && !o.base.injection.enabled) || !r.error.empty() || !r.link.clean()) return 1;

@@ -3,12 +3,13 @@
 // it is the firmware image in qemu-system-arm (the m4f preset runs it that way).
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <memory>
+#include <thread>
 
 #include "experiment.hpp"
 #include "osc/control/params.hpp"
-#include "osc/runtime/io.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
@@ -301,6 +302,28 @@ struct Link : ::testing::Test {
 };
 
 TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) { healthy(20); }
+
+// A slow host, and an emulator descheduled by a busy machine. While the firmware waits for a byte,
+// QEMU's virtual time follows the wall clock (-icount sleep=on): a host that sends its next frame
+// 30 ms after the last answer, or a QEMU process stopped for 30 ms while it waits (SIGSTOP: what a
+// loaded machine's scheduler does to it), is 30 ms of waiting to the firmware, longer than its
+// watchdog (4 ms to the interrupt, 8 ms to the reset) and shorter than its link timeout
+// (params::kLinkTimeout): neither a fault nor a link error nor a reset. (QEMU 7.2's CMSDK watchdog
+// model keeps counting with its interrupt disabled and latches its reset on the second expiry; the
+// firmware's pause sets the longest count: board::watchdog_pause.)
+TEST_F(Link, SlowHostOrDescheduledEmulatorIsNeitherAFaultNorAReset) {
+  static_assert(osc::params::kLinkTimeout > 0.05, "the waits stay below the link timeout");
+  healthy(3);
+  for (int k = 0; k < 10; ++k) {
+    if (k % 2) std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    else ASSERT_TRUE(link.freeze_peer(0.03, err)) << err;
+    const pil::ActuatorFrame a = exchange();
+    ASSERT_EQ(a.faults, 0u) << osc::fault_name(a.faults);
+    ASSERT_EQ(a.seq, seq - 1);
+    ASSERT_FALSE(zero(a));
+    for (int e = 0; e < pil::kLinkErrorKinds; ++e) ASSERT_EQ(a.link.count[e], 0u) << pil::kLinkErrorNames[e];
+  }
+}
 
 // Link errors (the firmware's side; every kind in detail: tests/test_link.cpp): the answer carries
 // zero codes at once and counts the error, a single error does not latch, repeated errors do.

@@ -64,6 +64,20 @@ struct Watchdog {
     w.INTCLR = 1;
     w.LOCK = 0;
   }
+  /// Pauses the watchdog for a wait of unknown length; start() resumes it from a full count. The
+  /// part stops its counter when CTRL.INTEN goes low (DDI 0479). QEMU 7.2's model (Debian 12's;
+  /// later QEMU stops it as the part does) does not: its counter runs on, and its second expiry
+  /// latches the reset even with CTRL.RESEN low, to be asserted as soon as start() sets RESEN. So the count restarts from
+  /// the longest LOAD too: the two expiries are 2^33 clock cycles away (344 s at 25 MHz), where
+  /// stop() leaves them two LOADs away.
+  static void pause() {
+    WatchdogRegs& w = regs();
+    w.LOCK = WatchdogRegs::kUnlockKey;
+    w.CTRL = 0;
+    w.LOAD = 0xFFFFFFFFu;
+    w.INTCLR = 1;
+    w.LOCK = 0;
+  }
   /// The count has expired once since the last feed (the interrupt is raised).
   static bool expired_once() { return (regs().RIS & 1u) != 0; }
 };

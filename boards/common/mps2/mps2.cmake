@@ -64,8 +64,15 @@ endfunction()
 # the host preset must be built first; scripts/test.sh does) against this build's pil_firmware in
 # QEMU over LINK (semihosting or uart, host_sim/pil_client.hpp): fault injection through the link
 # and the closed loop against the host-built controller in SCALAR (float or fixed).
+# With LOADED N before the arguments, the test runs while N busy processes compete for the cores
+# (tests/run_under_load.sh).
 function(osc_add_pil_test name scalar link)
-  add_test(NAME ${name} COMMAND ${PROJECT_SOURCE_DIR}/build/host/tests/test_pil ${ARGN})
+  cmake_parse_arguments(PARSE_ARGV 3 PIL "" "LOADED" "")
+  set(cmd ${PROJECT_SOURCE_DIR}/build/host/tests/test_pil ${PIL_UNPARSED_ARGUMENTS})
+  if(PIL_LOADED)
+    set(cmd bash ${PROJECT_SOURCE_DIR}/tests/run_under_load.sh ${PIL_LOADED} ${cmd})
+  endif()
+  add_test(NAME ${name} COMMAND ${cmd})
   set_tests_properties(${name} PROPERTIES
     ENVIRONMENT "PIL_FIRMWARE_ELF=$<TARGET_FILE:pil_firmware>;QEMU=${QEMU_SYSTEM_ARM};PIL_SCALAR=${scalar};PIL_LINK=${link}"
     DEPENDS pil_firmware_checks TIMEOUT 900)
@@ -80,6 +87,9 @@ function(osc_add_pil_tests scalar)
   osc_add_pil_test(pil_qemu ${scalar} semihosting
                    --gtest_filter=-Link.ShortFrameTimesOutWithZeroCodes:Link.SilenceGetsZeroCodesRepeatedSilenceLatchesLinkLost)
   osc_add_pil_test(pil_qemu_uart ${scalar} uart --gtest_filter=Link.*)
+  # The same on a machine kept busy: QEMU's virtual time follows the wall clock while the firmware
+  # waits, so a descheduled emulator is a long wait to it (once a watchdog reset: pil_firmware.cpp).
+  osc_add_pil_test(pil_qemu_uart_loaded ${scalar} uart LOADED 2 --gtest_filter=Link.*)
 endfunction()
 
 # osc_add_docs_tables_test(KIND): ctest docs_tables_KIND checks that the generated tables of that

@@ -142,6 +142,9 @@ inline void watchdog_start() { Watchdog::start(kWatchdogLoad); }
 inline void watchdog_feed() { Watchdog::feed(); }
 /// Stops the watchdog (test images, once their run is over).
 inline void watchdog_stop() { Watchdog::stop(); }
+/// Pauses it for a wait of any length up to minutes, as QEMU's model too allows
+/// (cmsdk::Watchdog::pause); watchdog_start() resumes it from a full count.
+inline void watchdog_pause() { Watchdog::pause(); }
 /// The board's reaction to the first expiry, for the image's NMI_Handler: the fault line goes
 /// active (on a real board: amplifier enable off, so no stale torque stays applied) and the reset
 /// record notes that the reset to come is the watchdog's, with `faults` (the supervisor's latched
