@@ -16,6 +16,7 @@
 
 #include "osc/control/faults.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/runtime/supervisor.hpp"
 
 namespace {
 
@@ -29,7 +30,7 @@ std::string fault_names(std::uint32_t bits) {
   }
   return s;
 }
-const char* state_name(std::uint8_t s) { return s == 0 ? "init" : s == 1 ? "run" : s == 2 ? "fault" : "?"; }
+const char* state_name(std::uint8_t s) { return osc::supervisor_state_name(s); }
 
 /// Raw mode at `baud` for a serial device; false if the rate is not one of the usual ones.
 bool set_serial(int fd, int baud) {

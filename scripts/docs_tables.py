@@ -17,6 +17,8 @@ and is rewritten in place. Kinds:
         checked in CI (ctest docs_tables_m3 in the m3 preset)
   long  runs of minutes to hours (QEMU experiment, fault-injection matrix, benchmarks): regenerated
         by hand with --kind long, never checked (wall-clock figures vary from run to run)
+  protocol  the link protocol's tables in docs/protocol.md, from the host build's osc_protocol (the
+        firmware's field lists, constants and encoder); checked exactly in CI (ctest docs_tables_protocol)
 
 --check regenerates the selected tables in memory and compares them with the docs: the same text,
 or numbers within 2 % (the simulated plant is compiled for the build machine's vector unit, so
@@ -633,6 +635,156 @@ def host_benchmarks():
 # ---------------------------------------------------------------- docs
 
 
+# ---------------------------------------------------------------- the link protocol (docs/protocol.md)
+# From osc_protocol's JSON: the firmware's own field lists, constants and encoder. Checked exactly
+# (no tolerance): a changed field, bit or constant makes ctest docs_tables_protocol fail.
+
+_protocol = None
+
+
+def protocol():
+    global _protocol
+    if _protocol is None:
+        exe = os.path.join(HOST, "host_sim", "osc_protocol")
+        _protocol = json.loads(subprocess.run([exe], capture_output=True, text=True, check=True).stdout)
+    return _protocol
+
+
+def hexs(v, width=2):
+    return f"0x{v:0{width}X}"
+
+
+@table("protocol_frame", "docs/protocol.md", "protocol")
+def t_protocol_frame():
+    p = protocol()
+    s, a = p["types"]
+    rows = ["| offset | bytes | field | value |", "|---|---|---|---|",
+            f"| 0 | 1 | sync | `{hexs(p['sync'][0])}` |",
+            f"| 1 | 1 | sync | `{hexs(p['sync'][1])}` |",
+            f"| 2 | 1 | type | {s['code']} {s['name']} (host to firmware), {a['code']} {a['name']} (firmware to host) |",
+            f"| 3 | 1 | length | the payload's bytes: {s['payload']} ({s['name']}), {a['payload']} ({a['name']}) |",
+            "| 4 | length | payload | the fields of the type, in the order of its table below |",
+            "| 4 + length | 2 | CRC | CRC-16/CCITT-FALSE of bytes 2 to 3 + length (type, length, payload), "
+            "low byte first |"]
+    return "\n".join(rows) + (f"\n\nA {s['name']} frame is {s['payload'] + p['overhead']} bytes, an {a['name']} frame "
+                              f"{a['payload'] + p['overhead']} ({p['overhead']} bytes of framing each).")
+
+
+def field_rows(fields):
+    rows = ["| offset | type | bytes | field | unit | meaning |", "|---|---|---|---|---|---|"]
+    for f in fields:
+        t = f["type"] if f["count"] == 1 else f"{f['type']} × {f['count']}"
+        rows.append(f"| {f['offset']} | {t} | {f['bytes']} | `{f['name']}` | {f['unit']} | {f['doc']} |")
+    total = sum(f["bytes"] for f in fields)
+    rows.append(f"| | | **{total}** | | | |")
+    return "\n".join(rows)
+
+
+@table("protocol_sensor", "docs/protocol.md", "protocol")
+def t_protocol_sensor():
+    return field_rows(protocol()["sensor_fields"])
+
+
+@table("protocol_actuator", "docs/protocol.md", "protocol")
+def t_protocol_actuator():
+    return field_rows(protocol()["actuator_fields"])
+
+
+@table("protocol_flags", "docs/protocol.md", "protocol")
+def t_protocol_flags():
+    p = protocol()
+    i = p["inject"]
+    laws = p["adaptation_laws"]
+    shift, mask = i["adaptation_shift"], i["adaptation_mask"]
+    hi = shift + bin(mask >> shift).count("1") - 1
+    law_values = ", ".join(f"{k + 1} {name}" for k, name in enumerate(laws))
+    rows = ["| bits | mask | name | meaning |", "|---|---|---|---|",
+            f"| 0 | `{hexs(i['non_finite'])}` | non_finite | test builds: poison the observer state with a NaN in this "
+            "tick (the fault it must raise: non_finite, or overflow in fixed point) |",
+            f"| 1 | `{hexs(i['overrun'])}` | overrun | test builds: burn more than one control period inside this tick "
+            "(the overrun fault) |",
+            f"| {shift}-{hi} | `{hexs(mask)}` | adaptation | first frame only: the adaptation law + 1 ({law_values}); "
+            f"0 keeps the firmware's default ({p['default_adaptation']}) |",
+            f"| 7 | `{hexs(i['no_compensation'])}` | no_compensation | first frame only: run without friction "
+            "compensation (the paper's Table III baseline) |",
+            "| other | | | 0 |"]
+    return "\n".join(rows)
+
+
+@table("protocol_link_errors", "docs/protocol.md", "protocol")
+def t_protocol_link_errors():
+    p = protocol()
+    off = next(f["offset"] for f in p["actuator_fields"] if f["name"] == "link")
+    rows = ["| index | payload offset | name | counts |", "|---|---|---|---|"]
+    for k, e in enumerate(p["link_errors"]):
+        rows.append(f"| {k} | {off + 4 * k} | `{e['name']}` | {e['doc']} |")
+    return "\n".join(rows)
+
+
+@table("protocol_states", "docs/protocol.md", "protocol")
+def t_protocol_states():
+    meaning = {"init": "no valid sample yet: zero torque",
+               "run": "torque commanded",
+               "fault": "a fault latched: zero torque until a reset (no transition leaves it)"}
+    rows = ["| code | state | meaning |", "|---|---|---|"]
+    for k, name in enumerate(protocol()["states"]):
+        rows.append(f"| {k} | `{name}` | {meaning.get(name, '')} |")
+    return "\n".join(rows)
+
+
+@table("protocol_faults", "docs/protocol.md", "protocol")
+def t_protocol_faults():
+    rows = ["| bit | mask | name | meaning |", "|---|---|---|---|"]
+    for k, f in enumerate(protocol()["faults"]):
+        rows.append(f"| {k} | `{hexs(1 << k, 8)}` | `{f['name']}` | {f['doc']} |")
+    return "\n".join(rows)
+
+
+@table("protocol_joints", "docs/protocol.md", "protocol")
+def t_protocol_joints():
+    p = protocol()
+    full = p["dac_max_code"]
+    rows = ["| joint | counts per rad | q at count 0 [rad] | [deg] | torque at code ±" + f"{full} [N m]"
+            + " | codes per N m | top speed [rad/s] |",
+            "|---|---|---|---|---|---|---|"]
+    for k, j in enumerate(p["joints"]):
+        rows.append(f"| {k + 1} | {j['counts_per_rad']:.6f} | {j['q_start']:.6f} | {math.degrees(j['q_start']):.1f} | "
+                    f"{j['torque_limit']:g} | {full / j['torque_limit']:.4f} | {j['max_speed']:g} |")
+    return "\n".join(rows)
+
+
+@table("protocol_constants", "docs/protocol.md", "protocol")
+def t_protocol_constants():
+    p = protocol()
+    rows = ["| constant | value |", "|---|---|",
+            f"| hello frame's `seq` | `{hexs(p['hello_seq'], 8)}` |",
+            f"| largest frame | {p['max_frame']} bytes |",
+            f"| CRC-16/CCITT-FALSE | polynomial `{hexs(p['crc']['poly'], 4)}`, initial value `{hexs(p['crc']['init'], 4)}`, "
+            f"no reflection, no final XOR; check value (the CRC of the ASCII bytes `123456789`) `{hexs(p['crc']['check'], 4)}` |",
+            f"| control rate | {p['control_hz']} Hz (trajectory time = ticks / {p['control_hz']} s) |",
+            f"| DAC full scale | ±{p['dac_max_code']} |",
+            f"| encoder counts per motor revolution | {p['encoder_counts_per_motor_rev']:g} (after quadrature decoding) |",
+            f"| link timeout (lockstep) | {p['link_timeout_s'] * 1000:g} ms without a byte |",
+            f"| silence limit (timer-paced) | {p['link_silence_ticks']} ticks without a frame |",
+            f"| link fault latch | {p['link_error_limit']} ticks with link errors within {p['link_error_window']} ticks |"]
+    return "\n".join(rows)
+
+
+@table("protocol_examples", "docs/protocol.md", "protocol")
+def t_protocol_examples():
+    out = []
+    for e in protocol()["examples"]:
+        b = e["bytes"]
+        out.append(f"{e['what'][0].upper()}{e['what'][1:]} ({len(b)} bytes):\n\n```")
+        for row in range(0, len(b), 16):
+            out.append(f"{row:04x}  " + " ".join(f"{x:02X}" for x in b[row:row + 16]))
+        n = b[3]
+        crc = b[4 + n] | (b[5 + n] << 8)
+        out.append(f"```\n\nsync `A5 5A`, type {b[2]}, length {n}, payload bytes 4 to {3 + n}, CRC `{b[4 + n]:02X} "
+                   f"{b[5 + n]:02X}` = `{hexs(crc, 4)}`.\n")
+    return "\n".join(out)
+
+
 def block_re(name):
     return re.compile(r"(<!-- generated: " + re.escape(name) + r" [^\n]*-->\n)(.*?)(\n<!-- end: " + re.escape(name)
                       + r" -->)", re.S)
@@ -660,7 +812,8 @@ def numbers_close(a, b):
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--check", action="store_true", help="compare, do not write; exit 1 when a table is stale")
-    ap.add_argument("--kind", action="append", choices=["host", "m4f", "m3", "long"], help="the kinds of tables to do")
+    ap.add_argument("--kind", action="append", choices=["host", "m4f", "m3", "long", "protocol"],
+                    help="the kinds of tables to do")
     ap.add_argument("--only", action="append", help="only these tables")
     ap.add_argument("--list", action="store_true", help="list the tables")
     ap.add_argument("--host-build", default=HOST, help="the host preset's build directory")
@@ -672,7 +825,8 @@ def main(argv):
         for name, (doc, kind, _) in TABLES.items():
             print(f"{name:24} {kind:5} {doc}")
         return 0
-    kinds = a.kind or [k for k, build in (("host", HOST), ("m4f", M4F), ("m3", M3)) if os.path.isdir(build)]
+    kinds = a.kind or [k for k, build in (("host", HOST), ("protocol", HOST), ("m4f", M4F), ("m3", M3))
+                       if os.path.isdir(build)]
     names = [n for n, (_, kind, _) in TABLES.items() if kind in kinds and (not a.only or n in a.only)]
     if a.only and len(names) != len(a.only):
         print(f"docs_tables.py: unknown table or kind not selected: {set(a.only) - set(names)}", file=sys.stderr)
@@ -693,7 +847,8 @@ def main(argv):
             text = f.read()
         m = block_re(name).search(text)
         if a.check:
-            ok = numbers_close(m.group(2).strip(), new.strip())
+            exact = kind == "protocol"  # the protocol's tables are facts of the code: no tolerance
+            ok = m.group(2).strip() == new.strip() if exact else numbers_close(m.group(2).strip(), new.strip())
             print(f"{'current' if ok else 'STALE  '} {name} ({doc})")
             if not ok:
                 stale.append(name)

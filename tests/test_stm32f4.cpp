@@ -489,9 +489,12 @@ TEST(Stm32Board, ADacBusFaultLatchesOnTheNextTick) {
   ASSERT_EQ(r.tick(), 0u);
   r.dac.ok = false;
   EXPECT_EQ(r.tick(), 0u);
-  EXPECT_NE(r.tick() & kFaultDacBus, 0u);
+  EXPECT_NE(r.tick() & osc::kFaultDacBus, 0u);
   EXPECT_EQ(r.task.sup.state, osc::SupervisorState::kFault);
   EXPECT_TRUE(r.dac.last_zero());
+  // In the catalogue: named in the console, the JSON and the telemetry reader (it once read "none").
+  EXPECT_EQ(r.task.sup.latched & ~osc::kAllFaults, 0u);
+  EXPECT_STREQ(osc::fault_name(r.task.sup.latched), "dac_bus");
 }
 
 // ---------------------------------------------------------------------- control timer, telemetry

@@ -14,10 +14,6 @@
 
 namespace stm32f4 {
 
-/// A board fault outside the firmware's catalogue (osc/control/faults.hpp), which the supervisor
-/// latches as it comes: a DAC frame did not complete on the SPI bus.
-constexpr std::uint32_t kFaultDacBus = 1u << 31;
-
 /// Encoders: read(counts). Dac: write(codes) -> bool, clear(). CycleClock: static cycles().
 template <class Encoders, class Dac, class CycleClock>
 class BoardHal {
@@ -46,7 +42,7 @@ class BoardHal {
     std::uint32_t f = safety_.io_faults();
     // The next update already pending when this tick starts (acknowledged on entry): overrun.
     if (control_timer_pending(timer_)) f |= osc::kFaultOverrun;
-    if (dac_fault_) f |= kFaultDacBus;
+    if (dac_fault_) f |= osc::kFaultDacBus;  // a DAC frame did not complete on the SPI bus
     return f;
   }
   void fault_output(bool active) {

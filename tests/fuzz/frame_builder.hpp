@@ -9,35 +9,32 @@
 
 namespace fuzz {
 
-/// Encodes a sensor or actuator frame whose every field comes from the input (floats as raw bits,
-/// NaNs included) into buf (kMaxFrame bytes); returns its length.
+inline void fill(Input& in, std::uint8_t& v) { v = in.u8(); }
+inline void fill(Input& in, std::uint32_t& v) { v = in.u32(); }
+inline void fill(Input& in, std::int32_t& v) { v = in.i32(); }
+inline void fill(Input& in, float& v) {  // raw bits: NaNs and infinities included
+  const std::uint32_t u = in.u32();
+  std::memcpy(&v, &u, 4);
+}
+template <class T, int N>
+void fill(Input& in, T (&a)[N]) {
+  for (T& v : a) fill(in, v);
+}
+inline void fill(Input& in, pil::LinkCounters& c) { fill(in, c.count); }
+
+/// Encodes a sensor or actuator frame whose every field comes from the input, in the order of the
+/// frame's field list (osc/link/frames.hpp), into buf (kMaxFrame bytes); returns its length.
 inline int build_frame(fuzz::Input& in, bool actuator, std::uint8_t* buf) {
+#define OSC_FUZZ_FILL(type, name, extent, unit, doc) fill(in, f.name);
   if (!actuator) {
-    pil::SensorFrame s;
-    s.seq = in.u32();
-    for (auto& c : s.counts) c = in.i32();
-    s.inject = in.u8();
-    return pil::encode(s, buf);
+    pil::SensorFrame f;
+    OSC_SENSOR_FIELDS(OSC_FUZZ_FILL)
+    return pil::encode(f, buf);
   }
-  pil::ActuatorFrame a;
-  a.seq = in.u32();
-  for (auto& c : a.codes) c = in.i32();
-  a.faults = in.u32();
-  a.state = in.u8();
-  a.step_cycles = in.u32();
-  a.max_cycles = in.u32();
-  a.mean_cycles = in.u32();
-  a.tick_max_cycles = in.u32();
-  a.stack_used = in.u32();
-  auto f32 = [&] {
-    const std::uint32_t u = in.u32();
-    float v;
-    std::memcpy(&v, &u, 4);
-    return v;
-  };
-  for (float& v : a.theta_hat) v = f32();
-  for (float& v : a.tau_f_hat) v = f32();
-  return pil::encode(a, buf);
+  pil::ActuatorFrame f;
+  OSC_ACTUATOR_FIELDS(OSC_FUZZ_FILL)
+#undef OSC_FUZZ_FILL
+  return pil::encode(f, buf);
 }
 
 }  // namespace fuzz

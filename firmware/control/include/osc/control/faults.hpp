@@ -1,7 +1,8 @@
 // The firmware's fault catalogue: one list, from which the bits, their names and the mask of all
 // faults are generated. Every fault latches in the supervisor (osc/runtime/supervisor.hpp) and
 // commands zero torque in the tick that detects it. The control step itself raises three of them
-// (non_finite, singular, overflow); the runtime and the link raise the rest.
+// (non_finite, singular, overflow); the runtime, the link and the boards' HALs raise the rest
+// (dac_bus: the STM32F4 board). Every bit a board can latch is here, so that it has a name.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +23,8 @@ namespace osc {
   X(Tracking, "tracking", "the measured tracking error exceeded its bound")                               \
   X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                    \
   X(Estop, "estop", "the emergency-stop input is active")                                                 \
-  X(Overflow, "overflow", "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain")
+  X(Overflow, "overflow", "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \
+  X(DacBus, "dac_bus", "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")
 
 namespace detail {
 enum FaultBit : unsigned {
@@ -42,6 +44,7 @@ enum Fault : std::uint32_t {
 };
 
 constexpr int kFaultCount = detail::kFaultCount;
+static_assert(kFaultCount <= 32, "the fault bits fit the 32-bit fault word of the link and the supervisor");
 /// Every defined fault bit.
 constexpr std::uint32_t kAllFaults = (1u << kFaultCount) - 1u;
 /// Names of the fault bits, in bit order (for telemetry and logs).
@@ -49,6 +52,13 @@ constexpr const char* kFaultNames[kFaultCount] = {
 #define OSC_FAULT_NAME(Name, name, doc) name,
     OSC_FAULT_LIST(OSC_FAULT_NAME)
 #undef OSC_FAULT_NAME
+};
+
+/// What each fault means, in bit order.
+constexpr const char* kFaultDocs[kFaultCount] = {
+#define OSC_FAULT_DOC(Name, name, doc) doc,
+    OSC_FAULT_LIST(OSC_FAULT_DOC)
+#undef OSC_FAULT_DOC
 };
 
 /// Name of the lowest fault bit set in bits ("none" for 0).

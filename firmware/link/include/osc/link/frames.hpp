@@ -2,10 +2,10 @@
 // frame from the host and one actuator frame back per tick). Shared by the firmware and host_sim.
 //
 // Frame:  0xA5 0x5A | type (1) | length (1) | payload (length bytes) | CRC-16/CCITT-FALSE (2, LE)
-// The CRC covers type, length and payload. Sensor frames carry the tick's sequence number, the six
-// encoder counts and fault-injection requests (test builds); actuator frames carry the DAC codes,
-// the supervisor state and fault bits, step timing, stack use, the friction estimates and the
-// firmware's link error counters.
+// The CRC covers type, length and payload. Each payload is declared once, as a field list
+// (OSC_SENSOR_FIELDS, OSC_ACTUATOR_FIELDS): the frame structs, their encoding and decoding, the
+// payload lengths and the protocol document's tables (docs/protocol.md, checked by ctest
+// docs_tables_protocol) are all made from it. A field is added in its list, and nowhere else.
 #pragma once
 
 #include <cstdint>
@@ -42,26 +42,51 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
   return static_cast<std::uint8_t>((static_cast<unsigned>(law) + 1u) << kConfigAdaptationShift);
 }
 
+// X(type, name, extent, unit, meaning): one payload field, in wire order. `extent` is empty for one
+// value or [N] for N of them; the wire type follows the C++ type (detail::Wire): std::uint8_t u8,
+// std::uint32_t u32, std::int32_t i32, float f32 (IEEE 754 binary32), all little-endian.
+#define OSC_SENSOR_FIELDS(X)                                                                               \
+  X(std::uint32_t, seq, , "",                                                                             \
+    "sequence number: 0 in the first frame, one more in each next frame (wraps at 2^32)")                 \
+  X(std::int32_t, counts, [kJoints], "count",                                                             \
+    "encoder counts of joints 1 to 6, 0 at the start pose (Encoders, DACs, the plant)")                                    \
+  X(std::uint8_t, inject, , "", "fault-injection requests; configuration bits in the first frame (The inject byte)")
+
+#define OSC_FRAME_MEMBER(type, name, extent, unit, doc) type name extent = {};
+
 struct SensorFrame {
-  std::uint32_t seq = 0;
-  std::int32_t counts[kJoints] = {};
-  std::uint8_t inject = 0;
+  OSC_SENSOR_FIELDS(OSC_FRAME_MEMBER)
 };
 
 /// The kinds of link error a receiver tells apart, each counted (LinkCounters) in telemetry.
+// X(Name, "name", meaning), in counter order.
+#define OSC_LINK_ERROR_LIST(X)                                                                      \
+  X(Crc, "bad_crc", "a complete frame whose CRC does not match")                                    \
+  X(Header, "bad_header", "the sync pair, then an unknown frame type (or a frame of the wrong type)") \
+  X(Length, "bad_length", "the sync pair and a known type, with the wrong length")                  \
+  X(Junk, "junk_bytes", "bytes discarded while hunting for the sync pair (junk, lost sync)")        \
+  X(ShortFrame, "short_frames", "a frame that started and was cut short (silence before its end)")  \
+  X(Seq, "seq_errors", "a valid frame with an unexpected sequence number")                          \
+  X(Silence, "timeouts", "no frame within the silence limit")
+
 enum LinkError : std::uint8_t {
-  kErrCrc,       ///< a complete frame whose CRC does not match
-  kErrHeader,    ///< the sync pair, then an unknown frame type (or a frame of the wrong type)
-  kErrLength,    ///< the sync pair and a known type, with the wrong length
-  kErrJunk,      ///< bytes discarded while hunting for the sync pair (junk, lost sync)
-  kErrShortFrame,///< a frame that started and was cut short (silence before its end)
-  kErrSeq,       ///< a valid frame with an unexpected sequence number
-  kErrSilence,   ///< no frame within the silence limit
+#define OSC_LINK_ERROR_ENUM(Name, name, doc) kErr##Name,
+  OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_ENUM)
+#undef OSC_LINK_ERROR_ENUM
   kLinkErrorKinds
 };
 /// Names in telemetry (JSON, logs), in LinkError order.
-constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {"bad_crc",      "bad_header", "bad_length", "junk_bytes",
-                                                          "short_frames", "seq_errors", "timeouts"};
+constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {
+#define OSC_LINK_ERROR_NAME(Name, name, doc) name,
+    OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_NAME)
+#undef OSC_LINK_ERROR_NAME
+};
+/// What each kind means, in LinkError order.
+constexpr const char* kLinkErrorDocs[kLinkErrorKinds] = {
+#define OSC_LINK_ERROR_DOC(Name, name, doc) doc,
+    OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_DOC)
+#undef OSC_LINK_ERROR_DOC
+};
 
 /// Link errors counted by kind since start (32-bit counters that wrap; compare differences).
 struct LinkCounters {
@@ -75,30 +100,71 @@ struct LinkCounters {
   }
 };
 
-struct ActuatorFrame {
-  std::uint32_t seq = 0;
-  std::int32_t codes[kJoints] = {};
-  std::uint32_t faults = 0;      ///< latched osc::Fault bits
-  std::uint8_t state = 0;        ///< osc::SupervisorState
-  /// Control step (observer + controller + adaptation) of the previous tick, its max and mean, and
-  /// the max of the whole tick (encoders to DACs, with this frame's transmission), in cycles.
-  std::uint32_t step_cycles = 0, max_cycles = 0, mean_cycles = 0, tick_max_cycles = 0;
-  std::uint32_t stack_used = 0;  ///< bytes, high-water mark
-  float theta_hat[3 * kJoints] = {};
-  float tau_f_hat[kJoints] = {};
-  LinkCounters link;             ///< the firmware's link errors by kind, since start
-  /// The longest gap between two received bytes, in cycles, and how many gaps were longer than
-  /// params::kLinkSilenceTicks control periods (what a tick-based silence watchdog would have seen).
-  std::uint32_t rx_gap_max = 0, rx_long_gaps = 0;
-};
+#define OSC_ACTUATOR_FIELDS(X)                                                                             \
+  X(std::uint32_t, seq, , "",                                                                             \
+    "the sequence number of the sensor frame this answers; 0xFFFFFFFF in the hello frame")                \
+  X(std::int32_t, codes, [kJoints], "code", "DAC codes of joints 1 to 6, within the DAC full scale (Encoders, DACs, the plant)")   \
+  X(std::uint32_t, faults, , "", "latched fault bits (Fault bits)")                                            \
+  X(std::uint8_t, state, , "", "supervisor state (Supervisor states)")                                                \
+  X(std::uint32_t, step_cycles, , "cycles", "this tick's control step (observer, controller, adaptation); the last one's in a tick without one")                      \
+  X(std::uint32_t, max_cycles, , "cycles", "the longest control step so far")                              \
+  X(std::uint32_t, mean_cycles, , "cycles", "the mean control step so far")                                \
+  X(std::uint32_t, tick_max_cycles, , "cycles",                                                           \
+    "the longest whole tick before this one (encoders to DACs, with its frame's transmission)")                   \
+  X(std::uint32_t, stack_used, , "bytes", "the main stack's high-water mark")                              \
+  X(float, theta_hat, [3 * kJoints], "N m s/rad, N m",                                                    \
+    "friction estimates: viscous of joints 1-6, then Coulomb 1-6, then Stribeck 1-6")                     \
+  X(float, tau_f_hat, [kJoints], "N m", "the estimated friction torque of joints 1 to 6")                  \
+  X(LinkCounters, link, , "",                                                                             \
+    "the firmware's link errors since start, one u32 per kind (Link error counters)")           \
+  X(std::uint32_t, rx_gap_max, , "cycles", "the longest gap between two received bytes")                   \
+  X(std::uint32_t, rx_long_gaps, , "",                                                                    \
+    "gaps longer than params::kLinkSilenceTicks control periods (a tick-based silence watchdog's view)")
 
-constexpr int kSensorPayload = 4 + 4 * kJoints + 1;
-constexpr int kActuatorPayload =
-    4 + 4 * kJoints + 4 + 1 + 4 * 5 + 4 * 3 * kJoints + 4 * kJoints + 4 * kLinkErrorKinds + 4 * 2;
+struct ActuatorFrame {
+  OSC_ACTUATOR_FIELDS(OSC_FRAME_MEMBER)
+};
+#undef OSC_FRAME_MEMBER
+
+namespace detail {
+/// The wire form of a field's C++ type: element type name, element size and count.
+template <class T> struct Wire;
+template <> struct Wire<std::uint8_t> { static constexpr const char* type_name = "u8"; static constexpr int size = 1, count = 1; };
+template <> struct Wire<std::uint32_t> { static constexpr const char* type_name = "u32"; static constexpr int size = 4, count = 1; };
+template <> struct Wire<std::int32_t> { static constexpr const char* type_name = "i32"; static constexpr int size = 4, count = 1; };
+template <> struct Wire<float> { static constexpr const char* type_name = "f32"; static constexpr int size = 4, count = 1; };
+static_assert(sizeof(float) == 4, "f32 is IEEE 754 binary32");
+template <class T, int N> struct Wire<T[N]> {
+  static constexpr const char* type_name = Wire<T>::type_name;
+  static constexpr int size = Wire<T>::size, count = N * Wire<T>::count;
+};
+template <> struct Wire<LinkCounters> : Wire<std::uint32_t[kLinkErrorKinds]> {};
+template <class T> constexpr int kWireBytes = Wire<T>::size * Wire<T>::count;
+}  // namespace detail
+
+/// One field of a payload as the protocol document lists it.
+struct FieldInfo {
+  const char* name;
+  const char* type;  ///< u8, u32, i32, f32
+  int count;         ///< values of that type
+  int bytes;         ///< count x the type's size
+  const char* unit;
+  const char* doc;
+};
+#define OSC_FIELD_INFO(type, name, extent, unit, doc)                                          \
+  FieldInfo{#name, detail::Wire<type extent>::type_name, detail::Wire<type extent>::count,           \
+            detail::kWireBytes<type extent>, unit, doc},
+constexpr FieldInfo kSensorFields[] = {OSC_SENSOR_FIELDS(OSC_FIELD_INFO)};
+constexpr FieldInfo kActuatorFields[] = {OSC_ACTUATOR_FIELDS(OSC_FIELD_INFO)};
+#undef OSC_FIELD_INFO
+
+#define OSC_FIELD_BYTES(type, name, extent, unit, doc) +detail::kWireBytes<type extent>
+constexpr int kSensorPayload = 0 OSC_SENSOR_FIELDS(OSC_FIELD_BYTES);
+constexpr int kActuatorPayload = 0 OSC_ACTUATOR_FIELDS(OSC_FIELD_BYTES);
+#undef OSC_FIELD_BYTES
 constexpr int kOverhead = 6;
 constexpr int kMaxFrame = kActuatorPayload + kOverhead;
 static_assert(kActuatorPayload < 256 && kSensorPayload < 256, "length fits a byte");
-static_assert(kActuatorPayload == 185, "the actuator frame's layout (encode/decode below) changed: update the docs");
 
 /// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), one bit at a time: the definition,
 /// which makes the table below and the tests' reference.
@@ -135,35 +201,51 @@ inline std::uint16_t crc16(const std::uint8_t* p, int n, std::uint16_t crc = 0xF
 static_assert(detail::kCrc16Table.v[1] == 0x1021, "the table's first power of x is the polynomial");
 
 namespace detail {
+/// Writes fields in their wire form, little-endian.
 struct Writer {
   std::uint8_t* p;
-  void u8(std::uint8_t v) { *p++ = v; }
-  void u32(std::uint32_t v) {
+  void put(std::uint8_t v) { *p++ = v; }
+  void put(std::uint32_t v) {
     for (int i = 0; i < 4; ++i) *p++ = static_cast<std::uint8_t>(v >> (8 * i));
   }
-  void i32(std::int32_t v) { u32(static_cast<std::uint32_t>(v)); }
-  void f32(float v) {
+  void put(std::int32_t v) { put(static_cast<std::uint32_t>(v)); }
+  void put(float v) {
     std::uint32_t u;
     std::memcpy(&u, &v, 4);
-    u32(u);
+    put(u);
   }
+  template <class T, int N>
+  void put(const T (&a)[N]) {
+    for (const T& v : a) put(v);
+  }
+  void put(const LinkCounters& c) { put(c.count); }
 };
+/// Reads them back.
 struct Reader {
   const std::uint8_t* p;
-  std::uint8_t u8() { return *p++; }
-  std::uint32_t u32() {
-    std::uint32_t v = 0;
+  void get(std::uint8_t& v) { v = *p++; }
+  void get(std::uint32_t& v) {
+    v = 0;
     for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(*p++) << (8 * i);
-    return v;
   }
-  std::int32_t i32() { return static_cast<std::int32_t>(u32()); }
-  float f32() {
-    const std::uint32_t u = u32();
-    float v;
+  void get(std::int32_t& v) {
+    std::uint32_t u;
+    get(u);
+    v = static_cast<std::int32_t>(u);
+  }
+  void get(float& v) {
+    std::uint32_t u;
+    get(u);
     std::memcpy(&v, &u, 4);
-    return v;
   }
+  template <class T, int N>
+  void get(T (&a)[N]) {
+    for (T& v : a) get(v);
+  }
+  void get(LinkCounters& c) { get(c.count); }
 };
+#define OSC_FIELD_PUT(type, name, extent, unit, doc) w.put(f.name);
+#define OSC_FIELD_GET(type, name, extent, unit, doc) r.get(f.name);
 inline int finish(std::uint8_t* buf, FrameType type, int payload) {
   buf[0] = kSync0;
   buf[1] = kSync1;
@@ -179,28 +261,13 @@ inline int finish(std::uint8_t* buf, FrameType type, int payload) {
 /// Encodes into buf (at least kMaxFrame bytes); returns the frame length.
 inline int encode(const SensorFrame& f, std::uint8_t* buf) {
   detail::Writer w{buf + 4};
-  w.u32(f.seq);
-  for (int i = 0; i < kJoints; ++i) w.i32(f.counts[i]);
-  w.u8(f.inject);
+  OSC_SENSOR_FIELDS(OSC_FIELD_PUT)
   return detail::finish(buf, kSensorFrame, kSensorPayload);
 }
 
 inline int encode(const ActuatorFrame& f, std::uint8_t* buf) {
   detail::Writer w{buf + 4};
-  w.u32(f.seq);
-  for (int i = 0; i < kJoints; ++i) w.i32(f.codes[i]);
-  w.u32(f.faults);
-  w.u8(f.state);
-  w.u32(f.step_cycles);
-  w.u32(f.max_cycles);
-  w.u32(f.mean_cycles);
-  w.u32(f.tick_max_cycles);
-  w.u32(f.stack_used);
-  for (float v : f.theta_hat) w.f32(v);
-  for (float v : f.tau_f_hat) w.f32(v);
-  for (std::uint32_t c : f.link.count) w.u32(c);
-  w.u32(f.rx_gap_max);
-  w.u32(f.rx_long_gaps);
+  OSC_ACTUATOR_FIELDS(OSC_FIELD_PUT)
   return detail::finish(buf, kActuatorFrame, kActuatorPayload);
 }
 
@@ -274,28 +341,13 @@ class Parser {
   bool decode(SensorFrame& f) const {
     if (type() != kSensorFrame) return false;
     detail::Reader r{buf_ + 2};
-    f.seq = r.u32();
-    for (int i = 0; i < kJoints; ++i) f.counts[i] = r.i32();
-    f.inject = r.u8();
+    OSC_SENSOR_FIELDS(OSC_FIELD_GET)
     return true;
   }
   bool decode(ActuatorFrame& f) const {
     if (type() != kActuatorFrame) return false;
     detail::Reader r{buf_ + 2};
-    f.seq = r.u32();
-    for (int i = 0; i < kJoints; ++i) f.codes[i] = r.i32();
-    f.faults = r.u32();
-    f.state = r.u8();
-    f.step_cycles = r.u32();
-    f.max_cycles = r.u32();
-    f.mean_cycles = r.u32();
-    f.tick_max_cycles = r.u32();
-    f.stack_used = r.u32();
-    for (float& v : f.theta_hat) v = r.f32();
-    for (float& v : f.tau_f_hat) v = r.f32();
-    for (std::uint32_t& c : f.link.count) c = r.u32();
-    f.rx_gap_max = r.u32();
-    f.rx_long_gaps = r.u32();
+    OSC_ACTUATOR_FIELDS(OSC_FIELD_GET)
     return true;
   }
 
@@ -303,5 +355,8 @@ class Parser {
   std::uint8_t buf_[kMaxFrame] = {};
   int stage_ = 0, need_ = 0, have_ = 0, junk_ = 0;
 };
+
+#undef OSC_FIELD_PUT
+#undef OSC_FIELD_GET
 
 }  // namespace pil

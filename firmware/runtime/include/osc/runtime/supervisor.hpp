@@ -10,6 +10,14 @@
 namespace osc {
 
 enum class SupervisorState : std::uint8_t { kInit = 0, kRun = 1, kFault = 2 };
+/// Names of the states, by code (telemetry, logs, the protocol document).
+constexpr const char* kSupervisorStateNames[] = {"init", "run", "fault"};
+constexpr int kSupervisorStateCount = sizeof(kSupervisorStateNames) / sizeof(kSupervisorStateNames[0]);
+static_assert(kSupervisorStateCount == static_cast<int>(SupervisorState::kFault) + 1, "a name for every state");
+/// The name of a state code ("?" for a code that is no state).
+constexpr const char* supervisor_state_name(std::uint8_t code) {
+  return code < kSupervisorStateCount ? kSupervisorStateNames[code] : "?";
+}
 
 struct SupervisorInput {
   std::uint32_t faults;  ///< fault conditions detected in this tick
