@@ -228,8 +228,8 @@ bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& er
 }
 
 PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
-  using clock = std::chrono::steady_clock;
-  const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
     switch (parse_actuator_bytes(parser_, rx_, rx_len_, rx_pos_, f, counters_, err)) {
@@ -240,7 +240,7 @@ PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, 
       case RxResult::kNeedMore:
         break;
     }
-    const double left = std::chrono::duration<double>(deadline - clock::now()).count();
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
     if (left <= 0) {
       const bool short_frame = parser_.in_frame();
       ++counters_[short_frame ? pil::kErrShortFrame : pil::kErrSilence];
@@ -272,13 +272,13 @@ bool PilClient::codes_in_range(const pil::ActuatorFrame& a) {
 
 PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::ActuatorFrame& a, double timeout_s,
                                         std::string& err) {
-  using clock = std::chrono::steady_clock;
-  const auto deadline = clock::now() + std::chrono::duration<double>(timeout_s);
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   Exchange x = Exchange::kLost;
   if (send(s, err)) {
     for (;;) {
       pil::ActuatorFrame f;
-      const double left = std::chrono::duration<double>(deadline - clock::now()).count();
+      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
       const Rx r = receive_frame(f, std::max(left, 0.0), err);
       if (r != Rx::kFrame) {
         x = r == Rx::kCorrupt ? Exchange::kZeroed : Exchange::kLost;

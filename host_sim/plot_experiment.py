@@ -146,7 +146,8 @@ def plot_tracking(out, summary, runs):
         style = dict(lw=0.8, color="k")
         for sign in (1, -1):
             axs[i][2].axhline(sign * t1[i], ls="--", **style, label=("Table I (with)" if sign > 0 and i == 0 else None))
-            axs[i][2].axhline(sign * t3[i], ls=":", **style, label=("Table III (without)" if sign > 0 and i == 0 else None))
+            axs[i][2].axhline(sign * t3[i], ls=":", **style,
+                              label=("Table III (without)" if sign > 0 and i == 0 else None))
         axs[i][1].axhline(t1[i], ls="--", **style)
         axs[i][1].axhline(t3[i], ls=":", **style)
         for j in range(2):

@@ -243,7 +243,8 @@ def fixed_closed_loop():
     fx_ad, fx_no = errors(run_of(res["fixed"], "adaptive"), "last"), errors(run_of(res["fixed"], "none"), "last")
     lines = ["| 120 s, max \\|e\\| over the last 20 s | " + " | ".join(AXES) + " |", "|---|---|---|---|---|---|---|"]
     for sc in ("double", "float", "fixed"):
-        lines.append(row(f"{sc}, adaptive (robust law)", errors(run_of(res[sc], "adaptive"), "last"), bold=sc == "fixed"))
+        lines.append(row(f"{sc}, adaptive (robust law)", errors(run_of(res[sc], "adaptive"), "last"),
+                         bold=sc == "fixed"))
     for sc in ("float", "fixed"):
         lines.append(row(f"{sc}, without compensation", errors(run_of(res[sc], "none"), "last")))
     lines.append(row("fixed / float, adaptive (criterion ≤ 1.5)", [a / b for a, b in zip(fx_ad, fl_ad)], 2))
@@ -288,7 +289,8 @@ def fixed_accuracy():
 @table("fixed_functions", "docs/fixed_point.md", "host")
 def fixed_functions():
     out = test_output("test_fixed")
-    lines = ["| function (Q12.19 in and out) | method | stated max error (tested) | measured worst |", "|---|---|---|---|"]
+    lines = ["| function (Q12.19 in and out) | method | stated max error (tested) | measured worst |",
+             "|---|---|---|---|"]
     methods = {"sin": ("x = k π/2 + r (π/2 to 61 bits), Taylor to r¹¹ in Q30", "0.51 LSB"),
                "cos": ("the same reduction, Taylor to r¹²", "0.51 LSB"),
                "exp": ("x = k ln 2 + r, Taylor to r⁸ in Q30, times 2^k", "0.51 LSB + 4·10⁻⁹ eˣ"),
@@ -439,7 +441,8 @@ def qemu_experiment():
              "| firmware in QEMU, 120 s | adaptive | without compensation |",
              "|---|---|---|",
              f"| control step, max / mean [instructions] | {thousands(fa['firmware_step_instructions_max'])} / "
-             f"{thousands(fa['firmware_step_instructions_mean'])} | {thousands(fn['firmware_step_instructions_max'])} / "
+             f"{thousands(fa['firmware_step_instructions_mean'])} | "
+             f"{thousands(fn['firmware_step_instructions_max'])} / "
              f"{thousands(fn['firmware_step_instructions_mean'])} |",
              f"| whole tick incl. link I/O, max [instructions] | {thousands(fa['firmware_tick_instructions_max'])} | "
              f"{thousands(fn['firmware_tick_instructions_max'])} |",
@@ -498,14 +501,15 @@ def stuck_peaks():
             r = run_of(s, mode)
             lines.append(f"| reference motion while still, gated, {args[-1]} friction, {label} [counts] | "
                          + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_counts"]) + " |")
-    lines.append(f"| threshold `kStuckMotionCounts` [counts] | " + " | ".join([f"{counts_max:g}"] * 6) + " |")
+    lines.append("| threshold `kStuckMotionCounts` [counts] | " + " | ".join([f"{counts_max:g}"] * 6) + " |")
     return "\n".join(lines)
 
 
 HOUR = ("--mode", "adaptive", "--duration", "3600")
 HOUR_RUNS = [("paper friction (default)", HOUR), ("corke", HOUR + ("--friction", "corke")),
              ("none (final window 60 s)", HOUR + ("--friction", "none", "--final-window", "60")),
-             ("model error −0.1", HOUR + ("--model-error", "-0.1")), ("model error +0.1", HOUR + ("--model-error", "0.1")),
+             ("model error −0.1", HOUR + ("--model-error", "-0.1")),
+             ("model error +0.1", HOUR + ("--model-error", "0.1")),
              ("float, default plant", HOUR + ("--scalar", "float"))]
 
 
@@ -558,7 +562,8 @@ def monitors_hour():
     lines.append(f"| tracking error, orientation [deg] ({math.degrees(ori):.2f}) | "
                  + " | ".join(f"{max(r['max_error_deg']):.3f}" for r in rs) + " |")
     lines.append("| friction estimates θ̂, min … max | "
-                 + " | ".join(f"{min(r['theta_min_seen']):.2f} … {max(r['theta_max_seen']):.2f}" if r["mode"] == "adaptive"
+                 + " | ".join(f"{min(r['theta_min_seen']):.2f} … {max(r['theta_max_seen']):.2f}"
+                              if r["mode"] == "adaptive"
                               else "(off)" for r in rs) + " |")
     return "\n".join(lines)
 
@@ -571,7 +576,8 @@ MONITOR_PERTURBATIONS = [(), ("--delay", "1e-4"), ("--delay", "3e-4"), ("--model
 def monitor_margins():
     """The stuck-encoder monitor's fault-free peaks against its thresholds: 300 s in every scalar,
     on both presets, in both modes, nominal and perturbed (72 runs of 300 s)."""
-    criteria = [("reference motion while still", "stuck_monitor_peak_counts", [parse_params("kStuckMotionCounts", 1)[0]] * 6,
+    criteria = [("reference motion while still", "stuck_monitor_peak_counts",
+                 [parse_params("kStuckMotionCounts", 1)[0]] * 6,
                  "counts"),
                 ("torque change while still", "stuck_monitor_peak_dtau_Nm", parse_params("kStuckTorque", 6), "N m"),
                 ("torque change, moving joint silent", "stuck_monitor_peak_dtau_silent_Nm",
@@ -661,7 +667,8 @@ def t_protocol_frame():
     rows = ["| offset | bytes | field | value |", "|---|---|---|---|",
             f"| 0 | 1 | sync | `{hexs(p['sync'][0])}` |",
             f"| 1 | 1 | sync | `{hexs(p['sync'][1])}` |",
-            f"| 2 | 1 | type | {s['code']} {s['name']} (host to firmware), {a['code']} {a['name']} (firmware to host) |",
+            f"| 2 | 1 | type | {s['code']} {s['name']} (host to firmware), "
+            f"{a['code']} {a['name']} (firmware to host) |",
             f"| 3 | 1 | length | the payload's bytes: {s['payload']} ({s['name']}), {a['payload']} ({a['name']}) |",
             "| 4 | length | payload | the fields of the type, in the order of its table below |",
             "| 4 + length | 2 | CRC | CRC-16/CCITT-FALSE of bytes 2 to 3 + length (type, length, payload), "
@@ -759,14 +766,17 @@ def t_protocol_constants():
     rows = ["| constant | value |", "|---|---|",
             f"| hello frame's `seq` | `{hexs(p['hello_seq'], 8)}` |",
             f"| largest frame | {p['max_frame']} bytes |",
-            f"| CRC-16/CCITT-FALSE | polynomial `{hexs(p['crc']['poly'], 4)}`, initial value `{hexs(p['crc']['init'], 4)}`, "
-            f"no reflection, no final XOR; check value (the CRC of the ASCII bytes `123456789`) `{hexs(p['crc']['check'], 4)}` |",
+            f"| CRC-16/CCITT-FALSE | polynomial `{hexs(p['crc']['poly'], 4)}`, "
+            f"initial value `{hexs(p['crc']['init'], 4)}`, no reflection, no final XOR; check value (the CRC of the "
+            f"ASCII bytes `123456789`) `{hexs(p['crc']['check'], 4)}` |",
             f"| control rate | {p['control_hz']} Hz (trajectory time = ticks / {p['control_hz']} s) |",
             f"| DAC full scale | ±{p['dac_max_code']} |",
-            f"| encoder counts per motor revolution | {p['encoder_counts_per_motor_rev']:g} (after quadrature decoding) |",
+            f"| encoder counts per motor revolution | {p['encoder_counts_per_motor_rev']:g} "
+            "(after quadrature decoding) |",
             f"| link timeout (lockstep) | {p['link_timeout_s'] * 1000:g} ms without a byte |",
             f"| silence limit (timer-paced) | {p['link_silence_ticks']} ticks without a frame |",
-            f"| link fault latch | {p['link_error_limit']} ticks with link errors within {p['link_error_window']} ticks |"]
+            f"| link fault latch | {p['link_error_limit']} ticks with link errors "
+            f"within {p['link_error_window']} ticks |"]
     return "\n".join(rows)
 
 

@@ -83,7 +83,8 @@ def main():
         faults = sorted({f for r in rs for f in r["faults"]})
         exc = [r["excursion_mm"] for r in rs]
         print(f"| {label} | {len(rs)} | {worst} | {fast}/{len(rs)} | {', '.join(faults)} | {max(exc):.2f} | "
-              f"{sum(1 for e in exc if e <= 5)}/{len(rs)} | {max(r['max_torque_after_detection_Nm'] for r in rs):.2f} |")
+              f"{sum(1 for e in exc if e <= 5)}/{len(rs)} | "
+              f"{max(r['max_torque_after_detection_Nm'] for r in rs):.2f} |")
 
 
 if __name__ == "__main__":

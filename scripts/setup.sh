@@ -8,8 +8,10 @@ pkgs=(cmake make g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-d
                                             # flashing the STM32F4 board (the flash target)
       clang libclang-rt-14-dev llvm-14      # the fuzz preset: clang 14 (Debian 12), its sanitizer and
                                             # libFuzzer runtimes, llvm-symbolizer for the reports
-      libyaml-cpp-dev libcli11-dev nlohmann-json3-dev)  # the experiment's configuration file, command
+      libyaml-cpp-dev libcli11-dev nlohmann-json3-dev   # the experiment's configuration file, command
                                                         # line and JSON (host tools only)
+      clang-format clang-tidy flake8 universal-ctags)   # scripts/lint.sh: style, naming, Python,
+                                                        # function lengths
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

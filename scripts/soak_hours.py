@@ -20,7 +20,9 @@ def main(argv):
         hour = [m for k, m in enumerate(wins[h * per_hour:(h + 1) * per_hour]) if (h * per_hour + k) * w >= 120]
         worst = [max(m[i] for m in hour) for i in range(6)]
         mean = [sum(m[i] for m in hour) / len(hour) for i in range(6)]
-        f = lambda v: "/".join(f"{x:.3f}" for x in v[:3]) + ", " + "/".join(f"{x:.4f}" for x in v[3:])
+
+        def f(v):
+            return "/".join(f"{x:.3f}" for x in v[:3]) + ", " + "/".join(f"{x:.4f}" for x in v[3:])
         print(f"| {h + 1}{' (from 120 s)' if h == 0 else ''} | {f(worst)} | {f(mean)} |")
     th = run["theta_hat"]
     print(f"\nθ̂ J1 at the end: vis {th[0]:.2f}, cou {th[6]:.2f}, sti {th[12]:.2f}; friction rms error "

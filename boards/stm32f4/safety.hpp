@@ -49,9 +49,9 @@ class Safety {
     pin_configure(chip, pins::kEstop);
     chip.rcc->APB2ENR = chip.rcc->APB2ENR | RccRegs::kSyscfgEn;
     read_back(chip.rcc->APB2ENR);
-    constexpr int line = pins::kEstopExtiLine;
-    Reg& cr = chip.syscfg->EXTICR[line / 4];
-    const std::uint32_t shift = 4u * (line % 4);
+    constexpr int kEstopLine = pins::kEstopExtiLine;
+    Reg& cr = chip.syscfg->EXTICR[kEstopLine / 4];
+    const std::uint32_t shift = 4u * (kEstopLine % 4);
     cr = (cr & ~(0xFu << shift)) | (static_cast<std::uint32_t>(pins::kEstop.pin.port) << shift);
     chip.exti->RTSR = chip.exti->RTSR | kLine;
     chip.exti->FTSR = chip.exti->FTSR & ~kLine;

@@ -46,9 +46,9 @@ struct EncoderUnwrap {
   std::int32_t position = 0;
 
   std::int32_t update(std::uint32_t raw) {
-    constexpr std::uint32_t mask = Bits == 32 ? 0xFFFFFFFFu : ((1u << Bits) - 1u);
-    std::uint32_t delta = (raw - last) & mask;
-    last = raw & mask;
+    constexpr std::uint32_t kMask = Bits == 32 ? 0xFFFFFFFFu : ((1u << Bits) - 1u);
+    std::uint32_t delta = (raw - last) & kMask;
+    last = raw & kMask;
     // Sign-extend the N-bit difference.
     std::int32_t d = static_cast<std::int32_t>(delta << (32 - Bits)) >> (32 - Bits);
     // Modular 32-bit position: a counter that runs past INT32_MAX wraps instead of overflowing a

@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Lints the tree (CI runs it from scripts/test.sh, after the host build):
+#   clang-format   every C++ file against .clang-format (Debian's clang-format 14)
+#   clang-tidy     .clang-tidy's naming and bug-prone checks over the host build's own sources, and through
+#                  them every project header they include (the firmware's, the HAL's, the STM32F4 board's)
+#   flake8         the Python scripts (setup.cfg)
+#   function lengths  the functions of firmware/, host_sim/ and boards/ over 80 lines (reported)
+# usage: scripts/lint.sh [HOST_BUILD_DIR]   (default build/host; it needs compile_commands.json)
+# Exit 1 when a check fails, with what to run to fix it.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+build=${1:-build/host}
+status=0
+step() { echo "lint: $*"; }
+
+mapfile -t cpp < <(git ls-files '*.cpp' '*.hpp' '*.h')
+step "clang-format, ${#cpp[@]} files"
+if ! clang-format --dry-run -Werror "${cpp[@]}" 2>/tmp/lint_format.$$; then
+  grep -m 20 'error:' /tmp/lint_format.$$
+  echo "lint: clang-format: files differ from .clang-format (fix: clang-format -i FILE)"
+  status=1
+fi
+rm -f /tmp/lint_format.$$
+
+mapfile -t py < <(git ls-files '*.py')
+step "flake8, ${#py[@]} files"
+flake8 "${py[@]}" || { echo "lint: flake8 failed"; status=1; }
+
+if [ -f "$build/compile_commands.json" ]; then
+  tidy=(host_sim/*.cpp tests/test_stm32f4.cpp tests/test_supervisor.cpp tests/test_link.cpp)
+  step "clang-tidy, ${#tidy[@]} translation units"
+  findings=$(printf '%s\n' "${tidy[@]}" | xargs -P 2 -n 1 clang-tidy -p "$build" --quiet 2>/dev/null |
+             grep -E 'error:|warning:' | sort -u)
+  if [ -n "$findings" ]; then
+    echo "$findings" | head -40
+    echo "lint: clang-tidy: $(echo "$findings" | wc -l) findings (.clang-tidy)"
+    status=1
+  fi
+else
+  echo "lint: clang-tidy: no $build/compile_commands.json (cmake --preset host first)"
+  status=1
+fi
+
+step "function lengths"
+/usr/bin/python3 scripts/function_lengths.py --limit 80
+
+[ $status -eq 0 ] && echo "lint: pass" || echo "lint: FAIL"
+exit $status
