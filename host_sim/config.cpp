@@ -27,9 +27,7 @@ std::string number_text(double v) {
   return std::string(buf, r.ptr);
 }
 
-std::string range_text(double lo, double hi) {
-  return "[" + number_text(lo) + ", " + number_text(hi) + "]";
-}
+std::string range_text(double lo, double hi) { return "[" + number_text(lo) + ", " + number_text(hi) + "]"; }
 
 enum class Kind { kNumber, kList, kName };
 
@@ -38,11 +36,11 @@ enum class Kind { kNumber, kList, kName };
 /// an error text for what only it can check (empty: fine).
 struct Entry {
   const char* key;
-  const char* doc;                    // unit and meaning: the YAML comment and --help
+  const char* doc;  // unit and meaning: the YAML comment and --help
   Kind kind;
-  double lo = 0, hi = 0;              // kNumber, and each element of a kList
-  std::vector<std::string> names;     // kName: the values allowed
-  bool paper = true;                  // part of the paper's set-up (differences_from_paper)
+  double lo = 0, hi = 0;           // kNumber, and each element of a kList
+  std::vector<std::string> names;  // kName: the values allowed
+  bool paper = true;               // part of the paper's set-up (differences_from_paper)
   std::function<json(const Settings&)> get;
   std::function<std::string(Settings&, const json&)> put;
   std::function<bool(const Settings&)> shown;  // printed only when true (null: always)
@@ -61,8 +59,8 @@ std::string mode_name(const Settings& s) {
 }
 
 const osc::FrictionCoefficients* friction_preset(const std::string& name) {
-  static const osc::FrictionCoefficients* const kPresets[] = {&osc::robot::kFrictionPaper,
-                                                               &osc::robot::kFrictionCorke, &osc::kFrictionNone};
+  static const osc::FrictionCoefficients* const kPresets[] = {&osc::robot::kFrictionPaper, &osc::robot::kFrictionCorke,
+                                                              &osc::kFrictionNone};
   for (const auto* p : kPresets)
     if (name == p->name) return p;
   return nullptr;
@@ -118,24 +116,27 @@ const std::vector<Entry>& entries() {
     // run
     number("run.duration", "simulated seconds per run [s]", 1, 86400, true,
            [](Settings& s) -> double& { return s.base.duration; });
-    name("run.modes", "with friction compensation (Table I), without (Table III), or both", {"both", "adaptive", "none"},
-         false, mode_name, [](Settings& s, const std::string& m) {
+    name("run.modes", "with friction compensation (Table I), without (Table III), or both",
+         {"both", "adaptive", "none"}, false, mode_name, [](Settings& s, const std::string& m) {
            s.run_adaptive = m != "none";
            s.run_none = m != "adaptive";
          });
-    name("run.scalar", "the controller's arithmetic (fixed: Q12.19 fixed point, docs/fixed_point.md)",
-         std::vector<std::string>(std::begin(kScalarNames), std::end(kScalarNames)), false,
-         [](const Settings& s) { return std::string(kScalarNames[static_cast<int>(s.base.scalar)]); },
-         [](Settings& s, const std::string& m) {
-           for (int i = 0; i < static_cast<int>(std::size(kScalarNames)); ++i)
-             if (m == kScalarNames[i]) s.base.scalar = static_cast<Scalar>(i);
-         });
+    name(
+        "run.scalar", "the controller's arithmetic (fixed: Q12.19 fixed point, docs/fixed_point.md)",
+        std::vector<std::string>(std::begin(kScalarNames), std::end(kScalarNames)), false,
+        [](const Settings& s) { return std::string(kScalarNames[static_cast<int>(s.base.scalar)]); },
+        [](Settings& s, const std::string& m) {
+          for (int i = 0; i < static_cast<int>(std::size(kScalarNames)); ++i)
+            if (m == kScalarNames[i]) s.base.scalar = static_cast<Scalar>(i);
+        });
     {
       std::vector<std::string> laws(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount);
-      name("run.adaptation", "friction adaptation law: paper is (67) exactly, robust adds projection and leakage "
-           "(docs/adaptation.md)", laws, false,
-           [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
-           [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
+      name(
+          "run.adaptation",
+          "friction adaptation law: paper is (67) exactly, robust adds projection and leakage "
+          "(docs/adaptation.md)",
+          laws, false, [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
+          [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
     }
     number("run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
            true, [](Settings& s) -> double& { return s.base.final_window; });
@@ -152,16 +153,34 @@ const std::vector<Entry>& entries() {
     list6("controller.ki", "controller gain k_i of (69)", 1e-3, 1e6, true,
           [](Settings& s) -> Vec6& { return s.base.gains.ki; });
     {
-      Entry e{"controller.k_ad", "adaptation gain: every diagonal entry of K_ad", Kind::kNumber, 0, 1e5, {}, true,
-              nullptr, nullptr, nullptr, nullptr};
+      Entry e{"controller.k_ad",
+              "adaptation gain: every diagonal entry of K_ad",
+              Kind::kNumber,
+              0,
+              1e5,
+              {},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       e.get = [](const Settings& s) { return json(s.base.gains.kad); };
       e.put = [](Settings& s, const json& v) {
         s.base.gains.kad = v.get<double>();
         return std::string();
       };
       t.push_back(e);
-      Entry d{"controller.tau_dec", "the controller's Stribeck decay tau_dec of model (2), every joint [s^2/rad^2]",
-              Kind::kNumber, 0.01, 100, {}, true, nullptr, nullptr, nullptr, nullptr};
+      Entry d{"controller.tau_dec",
+              "the controller's Stribeck decay tau_dec of model (2), every joint [s^2/rad^2]",
+              Kind::kNumber,
+              0.01,
+              100,
+              {},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       d.get = [](const Settings& s) { return json(s.base.gains.tau_dec(0)); };
       d.put = [](Settings& s, const json& v) {
         s.base.gains.tau_dec.setConstant(v.get<double>());
@@ -183,8 +202,17 @@ const std::vector<Entry>& entries() {
       if (period_ticks == osc::kTrajectoryPeriodTicks) spec.omega = osc::params::kOmega;
     };
     {
-      Entry a{"trajectory.amplitude", "of each sinusoid about the start position [m]", Kind::kNumber, 0, 0.2, {}, true,
-              nullptr, nullptr, nullptr, nullptr};
+      Entry a{"trajectory.amplitude",
+              "of each sinusoid about the start position [m]",
+              Kind::kNumber,
+              0,
+              0.2,
+              {},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       a.get = [](const Settings& s) { return json(s.base.gains.trajectory.amplitude); };
       a.put = [reshape](Settings& s, const json& v) {
         const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
@@ -192,8 +220,17 @@ const std::vector<Entry>& entries() {
         return std::string();
       };
       t.push_back(a);
-      Entry p{"trajectory.period", "of the sinusoids [s], a whole number of samples (1 ms)", Kind::kNumber, 0.5, 60, {},
-              true, nullptr, nullptr, nullptr, nullptr};
+      Entry p{"trajectory.period",
+              "of the sinusoids [s], a whole number of samples (1 ms)",
+              Kind::kNumber,
+              0.5,
+              60,
+              {},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       p.get = [](const Settings& s) {
         return json(static_cast<double>(s.base.gains.trajectory.period_ticks) * osc::params::kDt);
       };
@@ -207,8 +244,17 @@ const std::vector<Entry>& entries() {
         return std::string();
       };
       t.push_back(p);
-      Entry c{"trajectory.envelope", "rate c of the envelope 1 - exp(-c t^3) [1/s^3]", Kind::kNumber, 1e-3, 10, {},
-              true, nullptr, nullptr, nullptr, nullptr};
+      Entry c{"trajectory.envelope",
+              "rate c of the envelope 1 - exp(-c t^3) [1/s^3]",
+              Kind::kNumber,
+              1e-3,
+              10,
+              {},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       c.get = [](const Settings& s) { return json(s.base.gains.trajectory.envelope); };
       c.put = [reshape](Settings& s, const json& v) {
         const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
@@ -220,8 +266,12 @@ const std::vector<Entry>& entries() {
 
     // start pose, in degrees within the joint limits
     {
-      Entry q{"start_pose", "joint angles q1..q6 at the start [deg], within the joint limits", Kind::kList, -360, 360,
-              {}, true, nullptr, nullptr, nullptr, nullptr};
+      Entry q{"start_pose", "joint angles q1..q6 at the start [deg], within the joint limits",
+              Kind::kList,  -360,
+              360,          {},
+              true,         nullptr,
+              nullptr,      nullptr,
+              nullptr};
       q.get = [](const Settings& s) { return vec_json(s.base.q_start, 1 / kDeg); };
       q.put = [](Settings& s, const json& v) {
         for (int i = 0; i < 6; ++i) {
@@ -244,12 +294,22 @@ const std::vector<Entry>& entries() {
       Entry f{"plant.friction.preset",
               "the simulated robot's friction: paper (Table II), corke (toolbox), none, or custom (vis, cou, sti "
               "below; setting any of them makes it custom)",
-              Kind::kName, 0, 0, {"paper", "corke", "none", "custom"}, true, nullptr, nullptr, nullptr, nullptr};
+              Kind::kName,
+              0,
+              0,
+              {"paper", "corke", "none", "custom"},
+              true,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       f.get = [](const Settings& s) { return json(std::string(s.base.plant.friction.name)); };
       f.put = [](Settings& s, const json& v) {
         const std::string n = v.get<std::string>();
-        if (const osc::FrictionCoefficients* p = friction_preset(n)) s.base.plant.friction = *p;
-        else s.base.plant.friction.name = "custom";  // keeps the coefficients it has
+        if (const osc::FrictionCoefficients* p = friction_preset(n))
+          s.base.plant.friction = *p;
+        else
+          s.base.plant.friction.name = "custom";  // keeps the coefficients it has
         return std::string();
       };
       t.push_back(f);
@@ -278,7 +338,15 @@ const std::vector<Entry>& entries() {
     {
       Entry e{"plant.smooth_steps",
               "substeps the plant's RK4 takes at once while no joint velocity changes sign (1: fixed step)",
-              Kind::kNumber, 1, 16, {}, false, nullptr, nullptr, nullptr, nullptr};
+              Kind::kNumber,
+              1,
+              16,
+              {},
+              false,
+              nullptr,
+              nullptr,
+              nullptr,
+              nullptr};
       e.get = [](const Settings& s) { return json(s.base.plant.smooth_steps); };
       e.put = [](Settings& s, const json& v) {
         const double n = v.get<double>();
@@ -344,7 +412,8 @@ bool set_entry(const Entry& e, const YAML::Node& n, Settings& s, std::string& er
         const std::string where = key + "[" + std::to_string(i + 1) + "]";
         if (!read_number(n[i], x)) return err = where + ": expected a number, got " + node_text(n[i]), false;
         if (!std::isfinite(x)) return err = where + ": the value must be finite", false;
-        if (x < lo || x > hi) return err = where + ": " + number_text(x) + " is out of range " + range_text(lo, hi), false;
+        if (x < lo || x > hi)
+          return err = where + ": " + number_text(x) + " is out of range " + range_text(lo, hi), false;
         v.push_back(x);
       }
       break;
@@ -435,8 +504,10 @@ bool validate_settings(const Settings& s, std::string& err) {
   osc::opspace_update(model, data, os, Vec6(s.base.q_start), R);
   if (!(os.Jf.rcond >= 2 * s.base.gains.min_rcond)) {
     char buf[160];
-    std::snprintf(buf, sizeof buf, "start_pose: too close to a singularity (Jacobian reciprocal condition %.2g, the "
-                  "controller needs %.2g or more)", static_cast<double>(os.Jf.rcond), 2 * s.base.gains.min_rcond);
+    std::snprintf(buf, sizeof buf,
+                  "start_pose: too close to a singularity (Jacobian reciprocal condition %.2g, the "
+                  "controller needs %.2g or more)",
+                  static_cast<double>(os.Jf.rcond), 2 * s.base.gains.min_rcond);
     return err = buf, false;
   }
   return true;
@@ -471,15 +542,18 @@ std::string config_yaml(const Settings& s) {
     } else {
       out << v.get<std::string>();
     }
-    if (e.kind == Kind::kName) range = allowed_names(e);
-    else if (!e.element_range) range = range_text(e.lo, e.hi);
+    if (e.kind == Kind::kName)
+      range = allowed_names(e);
+    else if (!e.element_range)
+      range = range_text(e.lo, e.hi);
     out << YAML::Comment(std::string(e.doc) + (range.empty() ? "" : "; " + range));
   }
   while (!open.empty()) out << YAML::EndMap, open.pop_back();
   out << YAML::EndMap;
-  std::string text = "# puma_experiment configuration: feed it back with --config FILE, change one entry with\n"
-                     "# --set key=value. The defaults are the paper's set-up (Section VI), from the firmware's\n"
-                     "# headers (params.hpp, the robot description).\n";
+  std::string text =
+      "# puma_experiment configuration: feed it back with --config FILE, change one entry with\n"
+      "# --set key=value. The defaults are the paper's set-up (Section VI), from the firmware's\n"
+      "# headers (params.hpp, the robot description).\n";
   return text + out.c_str() + "\n";
 }
 

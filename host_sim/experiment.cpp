@@ -24,7 +24,7 @@ struct TickReport {
   std::uint32_t faults = 0;
   bool has_observer = false;  // x_tilde is available (in-process controller only)
   double x_tilde[6] = {};
-  double xd_hat[6] = {};      // the observer's velocity estimate: m/s, rad/s (in-process only)
+  double xd_hat[6] = {};  // the observer's velocity estimate: m/s, rad/s (in-process only)
   double tau_f_hat[6] = {};
   double theta_hat[18] = {};
 };
@@ -34,8 +34,8 @@ template <class S>
 class LocalController {
  public:
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
-    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode, q0.cast<S>(),
-                PlantHal::kPeriodNs);
+    task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode,
+                q0.cast<S>(), PlantHal::kPeriodNs);
     task_->set_encoder_resolution(cfg.encoder_counts_per_motor_rev);
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
@@ -156,7 +156,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   for (long k = 0; k < n; ++k) {
     const double t = k * dt;
     const osc::TrajectorySpec<double>& spec = cfg.gains.trajectory;
-    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k), osc::params::kControlHz);  // as the controller
+    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k),
+                                                      osc::params::kControlHz);  // as the controller
     // Errors of the true plant at the sample instant.
     osc::forward_kinematics(truth, tdata, plant.q());
     const osc::Desired<double> d = osc::trajectory(spec, p0, t_ref);
@@ -178,7 +179,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.status = rep.faults, res.fault_time = t;
       FaultState& fs = res.fault;
       fs.tick = k, fs.t = t, fs.faults = rep.faults;
-      for (int i = 0; i < 6; ++i) fs.q[i] = plant.q()(i), fs.qd[i] = plant.qd()(i), fs.tau[i] = tau_old(i), fs.e[i] = e[i];
+      for (int i = 0; i < 6; ++i)
+        fs.q[i] = plant.q()(i), fs.qd[i] = plant.qd()(i), fs.tau[i] = tau_old(i), fs.e[i] = e[i];
       for (int i = 0; i < 18; ++i) fs.theta_hat[i] = rep.theta_hat[i];
     }
     // Statistics stop at a fault: after it the amplifiers are off and the robot falls.
@@ -193,7 +195,8 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       }
       if (ir.detected >= 0)
         for (int i = 0; i < 6; ++i)
-          if (std::abs(tau_new(i)) > ir.max_torque_after) ir.max_torque_after = std::abs(tau_new(i)), ir.max_torque_joint = i;
+          if (std::abs(tau_new(i)) > ir.max_torque_after)
+            ir.max_torque_after = std::abs(tau_new(i)), ir.max_torque_joint = i;
     }
 
     double xt[6], xdt[6];
@@ -220,25 +223,25 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
       res.window_theta_range.push_back({rep.theta_hat[0], rep.theta_hat[0]});
     }
     if (counting) {
-    auto& wmax = res.window_max.back();
-    auto& wth = res.window_theta_range.back();
-    for (int i = 0; i < 18; ++i) {
-      wth[0] = std::min(wth[0], rep.theta_hat[i]);
-      wth[1] = std::max(wth[1], rep.theta_hat[i]);
-      res.theta_min_seen[i] = k == 0 ? rep.theta_hat[i] : std::min(res.theta_min_seen[i], rep.theta_hat[i]);
-      res.theta_max_seen[i] = k == 0 ? rep.theta_hat[i] : std::max(res.theta_max_seen[i], rep.theta_hat[i]);
-    }
-    for (int i = 0; i < 6; ++i) {
-      wmax[i] = std::max(wmax[i], std::abs(e[i]));
-      res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
-      if (t >= t_final) {
-        res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
-        if (rep.has_observer) {
-          res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
-          res.max_observer_velocity_error[i] = std::max(res.max_observer_velocity_error[i], std::abs(xdt[i]));
+      auto& wmax = res.window_max.back();
+      auto& wth = res.window_theta_range.back();
+      for (int i = 0; i < 18; ++i) {
+        wth[0] = std::min(wth[0], rep.theta_hat[i]);
+        wth[1] = std::max(wth[1], rep.theta_hat[i]);
+        res.theta_min_seen[i] = k == 0 ? rep.theta_hat[i] : std::min(res.theta_min_seen[i], rep.theta_hat[i]);
+        res.theta_max_seen[i] = k == 0 ? rep.theta_hat[i] : std::max(res.theta_max_seen[i], rep.theta_hat[i]);
+      }
+      for (int i = 0; i < 6; ++i) {
+        wmax[i] = std::max(wmax[i], std::abs(e[i]));
+        res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
+        if (t >= t_final) {
+          res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
+          if (rep.has_observer) {
+            res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
+            res.max_observer_velocity_error[i] = std::max(res.max_observer_velocity_error[i], std::abs(xdt[i]));
+          }
         }
       }
-    }
     }
     const Vec6 tau_f = plant.friction(plant.qd());
     if (counting && t >= t_final) {
@@ -310,7 +313,8 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   res.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   timespec cpu1{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &cpu1);
-  res.cpu_seconds = static_cast<double>(cpu1.tv_sec - cpu0.tv_sec) + 1e-9 * static_cast<double>(cpu1.tv_nsec - cpu0.tv_nsec);
+  res.cpu_seconds =
+      static_cast<double>(cpu1.tv_sec - cpu0.tv_sec) + 1e-9 * static_cast<double>(cpu1.tv_nsec - cpu0.tv_nsec);
   return res;
 }
 

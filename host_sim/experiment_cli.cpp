@@ -30,16 +30,16 @@ constexpr Shorthand kShorthands[] = {
     {"--model-error", "controller.model_error", "controller link mass/inertia relative error (default 0; -0.5..0.5)"},
     {"--encoder-cpr", "plant.encoder_cpr", "encoder counts per motor revolution, plant and controller (default 1000)"},
     {"--substep", "plant.substep", "plant RK4 step in seconds (default 1e-4; 1e-6..1e-3)"},
-    {"--smooth-steps", "plant.smooth_steps", "plant RK4 substeps taken at once away from velocity reversals (default 8; 1..16)"},
+    {"--smooth-steps", "plant.smooth_steps",
+     "plant RK4 substeps taken at once away from velocity reversals (default 8; 1..16)"},
     {"--delay", "plant.delay", "computation delay inside the sample in seconds (default 2e-4; 0..1e-3)"},
 };
 
 /// Keys the firmware image compiles in: with --qemu they must keep their defaults.
-constexpr const char* kHostOnlyKeys[] = {"controller.knd",    "controller.k",       "controller.ks",
-                                         "controller.ki",     "controller.k_ad",    "controller.tau_dec",
-                                         "controller.leakage", "controller.model_error", "trajectory.amplitude",
-                                         "trajectory.period", "trajectory.envelope", "start_pose",
-                                         "plant.encoder_cpr"};
+constexpr const char* kHostOnlyKeys[] = {
+    "controller.knd",      "controller.k",       "controller.ks",          "controller.ki",        "controller.k_ad",
+    "controller.tau_dec",  "controller.leakage", "controller.model_error", "trajectory.amplitude", "trajectory.period",
+    "trajectory.envelope", "start_pose",         "plant.encoder_cpr"};
 
 struct Parsed {
   std::vector<std::pair<const Shorthand*, std::string>> shorthands;
@@ -56,8 +56,9 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
   app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--config", o.config_file, "read the configuration from this YAML file (see --print-config)")
       ->type_name("FILE");
-  app.add_option("--set", p.sets, "set one configuration key, after --config and the options below "
-                                  "(e.g. --set trajectory.amplitude=0.1); repeatable")
+  app.add_option("--set", p.sets,
+                 "set one configuration key, after --config and the options below "
+                 "(e.g. --set trajectory.amplitude=0.1); repeatable")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("--print-config", o.print_config, "print the effective configuration as YAML and exit");
@@ -82,8 +83,10 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
                  "encoder-stuck | encoder-jump | encoder-garbage | encoder-noise | dac-stuck | overrun | estop "
                  "(docs/safety.md)")
       ->type_name("KIND[:J]@S");
-  app.add_flag("--no-csv", [&o](std::int64_t) { o.csv = false; }, "do not write time series");
-  app.add_flag("--no-progress", [&o](std::int64_t) { o.progress = false; }, "no progress bar");
+  app.add_flag(
+      "--no-csv", [&o](std::int64_t) { o.csv = false; }, "do not write time series");
+  app.add_flag(
+      "--no-progress", [&o](std::int64_t) { o.progress = false; }, "no progress bar");
 }
 
 /// Reads a configuration file of at most kMaxConfigBytes (a device such as /dev/zero, or a file that
@@ -168,11 +171,14 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
     for (const char* key : kHostOnlyKeys)
       for (const std::string& d : changed)
         if (d == key)
-          return err = d + " applies to the host-built controller only, not with --qemu (the firmware image "
-                           "compiles in its defaults)", false;
+          return err = d +
+                       " applies to the host-built controller only, not with --qemu (the firmware image "
+                       "compiles in its defaults)",
+                 false;
     if (o.base.injection.enabled && !info(o.base.injection.kind).per_joint)
       return err = std::string("--inject ") + info(o.base.injection.kind).name +
-                   " applies to the host-built controller only, not with --qemu", false;
+                   " applies to the host-built controller only, not with --qemu",
+             false;
   }
   return true;
 }

@@ -11,13 +11,13 @@
 namespace sim {
 
 struct ExperimentOptions : Settings {
-  std::string config_file;   ///< --config (empty: the defaults)
-  bool print_config = false; ///< --print-config: print the effective configuration and exit 0
+  std::string config_file;    ///< --config (empty: the defaults)
+  bool print_config = false;  ///< --print-config: print the effective configuration and exit 0
   std::string json, csv_dir = "out";
   bool csv = true, progress = true;
   bool qemu = false;
   PilLink pil_link = PilLink::kSemihosting;  ///< --pil-link: how the frames reach the image in QEMU
-  bool help = false;  ///< --help or -h: print usage() and exit 0
+  bool help = false;                         ///< --help or -h: print usage() and exit 0
   std::string elf = OSC_DEFAULT_PIL_ELF;
 };
 

@@ -9,13 +9,13 @@
 namespace sim {
 
 // X(Name, "name", joint-specific, what the hardware does from the injection time on)
-#define SIM_INJECTION_LIST(X)                                                                            \
-  X(EncoderStuck, "encoder-stuck", true, "the encoder reading freezes at its value at the injection time") \
+#define SIM_INJECTION_LIST(X)                                                                                        \
+  X(EncoderStuck, "encoder-stuck", true, "the encoder reading freezes at its value at the injection time")           \
   X(EncoderJump, "encoder-jump", true, "the reading jumps by ten times the largest plausible step and stays offset") \
-  X(EncoderGarbage, "encoder-garbage", true, "the reading is INT32_MAX (far outside the joint range)")   \
-  X(EncoderNoise, "encoder-noise", true, "a 50 ms burst of uniform noise of +-1 plausible step on the reading") \
-  X(DacStuck, "dac-stuck", true, "the amplifier holds the DAC code it had at the injection time")         \
-  X(Overrun, "overrun", false, "the control tick at the injection time takes three periods")              \
+  X(EncoderGarbage, "encoder-garbage", true, "the reading is INT32_MAX (far outside the joint range)")               \
+  X(EncoderNoise, "encoder-noise", true, "a 50 ms burst of uniform noise of +-1 plausible step on the reading")      \
+  X(DacStuck, "dac-stuck", true, "the amplifier holds the DAC code it had at the injection time")                    \
+  X(Overrun, "overrun", false, "the control tick at the injection time takes three periods")                         \
   X(Estop, "estop", false, "the emergency-stop input becomes active and stays active")
 
 enum class InjectionKind : std::uint8_t {

@@ -23,16 +23,23 @@ void print(const char* name, const M& m) {
 
 int main(int argc, char** argv) {
   using namespace osc;
-  CLI::App app("Prints forward kinematics, Jacobians, A(q), g(q), c(q, qd), Lambda and the Jacobian condition "
-               "of the PUMA 560 model at a named pose or given joint angles.",
-               "osc_model_info");
+  CLI::App app(
+      "Prints forward kinematics, Jacobians, A(q), g(q), c(q, qd), Lambda and the Jacobian condition "
+      "of the PUMA 560 model at a named pose or given joint angles.",
+      "osc_model_info");
   std::string pose = "qn";
   std::vector<double> qv, qdv;
-  auto* pose_opt = app.add_option("--pose", pose, "named pose (default qn)")->check(CLI::IsMember({"qn", "qz", "qr", "qs"}));
+  auto* pose_opt =
+      app.add_option("--pose", pose, "named pose (default qn)")->check(CLI::IsMember({"qn", "qz", "qr", "qs"}));
   app.add_option("--q", qv, "joint angles q1,...,q6 [rad]")
-      ->delimiter(',')->expected(6)->check(CLI::Range(-100.0, 100.0))->excludes(pose_opt);
+      ->delimiter(',')
+      ->expected(6)
+      ->check(CLI::Range(-100.0, 100.0))
+      ->excludes(pose_opt);
   app.add_option("--qd", qdv, "joint speeds [rad/s] for c(q, qd) (default 0)")
-      ->delimiter(',')->expected(6)->check(CLI::Range(-100.0, 100.0));
+      ->delimiter(',')
+      ->expected(6)
+      ->check(CLI::Range(-100.0, 100.0));
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
@@ -42,8 +49,10 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "osc_model_info: %s\n(osc_model_info --help lists the options)\n", e.what());
     return 2;
   }
-  const double* named = pose == "qz" ? puma560::kQz : pose == "qr" ? puma560::kQr : pose == "qs" ? puma560::kQs
-                                                                                  : puma560::kQn;
+  const double* named = pose == "qz"   ? puma560::kQz
+                        : pose == "qr" ? puma560::kQr
+                        : pose == "qs" ? puma560::kQs
+                                       : puma560::kQn;
   Vec6<double> q = Eigen::Map<const Vec6<double>>(named), qd = Vec6<double>::Zero();
   std::string name = pose;
   if (!qv.empty()) q = Eigen::Map<const Vec6<double>>(qv.data()), name = "given q";

@@ -114,7 +114,8 @@ bool write_stream(const std::string& path, const std::string& text, std::string&
 
 bool write_all(int fd, const std::string& text, const std::string& name, std::string& err) {
   // A reader that went away is an error here, not a silent death by SIGPIPE.
-  struct sigaction ignore {}, old {};
+  struct sigaction ignore {
+  }, old{};
   ignore.sa_handler = SIG_IGN;
   sigaction(SIGPIPE, &ignore, &old);
   const char* p = text.data();

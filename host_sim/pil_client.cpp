@@ -18,8 +18,8 @@
 
 namespace sim {
 
-RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
-                              pil::ActuatorFrame& f, pil::LinkCounters& counters, std::string& err) {
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+                              pil::LinkCounters& counters, std::string& err) {
   while (pos < len) {
     const pil::Parser::Result r = parser.feed(bytes[pos++]);
     switch (r) {
@@ -50,9 +50,12 @@ PilClient::~PilClient() { stop(); }
 const char* name(PilLink link) { return link == PilLink::kUart ? "uart" : "semihosting"; }
 
 bool parse_pil_link(const std::string& text, PilLink& link) {
-  if (text == "uart") link = PilLink::kUart;
-  else if (text == "semihosting") link = PilLink::kSemihosting;
-  else return false;
+  if (text == "uart")
+    link = PilLink::kUart;
+  else if (text == "semihosting")
+    link = PilLink::kSemihosting;
+  else
+    return false;
   return true;
 }
 
@@ -130,7 +133,9 @@ std::string qemu_machine(const std::string& elf, std::string& err) {
   std::ifstream f(elf, std::ios::binary);
   if (!f) return err = "cannot read firmware image " + elf, "";
   std::string b((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
-  if (b.size() < 52 || b.compare(0, 4, "\x7F" "ELF") != 0)
+  if (b.size() < 52 || b.compare(0, 4,
+                                 "\x7F"
+                                 "ELF") != 0)
     return err = "firmware image " + elf + " is not an ELF file", "";
   if (b[4] != 1 || b[5] != 1 || le16(b, 18) != 40)
     return err = "firmware image " + elf + " is not a 32-bit little-endian ARM ELF file", "";
@@ -147,9 +152,10 @@ std::string qemu_machine(const std::string& elf, std::string& err) {
   }
   if (arch == 10) return "mps2-an385";  // ARMv7 (with the M profile: ARMv7-M, the Cortex-M3)
   if (arch == 13) return "mps2-an386";  // ARMv7E-M (Cortex-M4F)
-  return err = "firmware image " + elf + (arch < 0 ? " names no ARM architecture (no build attributes)"
-                                                   : " is for ARM architecture " + std::to_string(arch) +
-                                                         ", not ARMv7-M or ARMv7E-M (no MPS2 machine here)"),
+  return err = "firmware image " + elf +
+               (arch < 0 ? " names no ARM architecture (no build attributes)"
+                         : " is for ARM architecture " + std::to_string(arch) +
+                               ", not ARMv7-M or ARMv7E-M (no MPS2 machine here)"),
          "";
 }
 
@@ -297,8 +303,8 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
         x = Exchange::kZeroed;
       } else if (!codes_in_range(f)) {
         ++code_range_errors_;
-        err = "actuator frame " + std::to_string(f.seq) + " has a DAC code outside +-" +
-              std::to_string(osc::kDacMaxCode);
+        err =
+            "actuator frame " + std::to_string(f.seq) + " has a DAC code outside +-" + std::to_string(osc::kDacMaxCode);
         x = Exchange::kZeroed;
       } else {
         x = Exchange::kApplied;
@@ -313,16 +319,20 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
 
 std::string PilClient::exit_description() {
   for (int i = 0; i < 100 && !reaped_; ++i) {
-    if (waitpid(pid_, &wait_status_, WNOHANG) == pid_) reaped_ = true;
-    else usleep(10000);
+    if (waitpid(pid_, &wait_status_, WNOHANG) == pid_)
+      reaped_ = true;
+    else
+      usleep(10000);
   }
   if (!reaped_) return "exited; still running after 1 s";
   if (WIFSIGNALED(wait_status_)) return "killed by signal " + std::to_string(WTERMSIG(wait_status_));
   const int code = WEXITSTATUS(wait_status_);
   // The firmware's own exits (boards/common/cortex_m/startup.cpp); QEMU ends with 0 on the reset
   // that -no-reboot turns into an exit (e.g. the watchdog's).
-  const char* what = code == 91 ? ": hard fault" : code == 90 ? ": unexpected interrupt"
-                     : code == 0 ? ": a normal end, or a reset under -no-reboot" : "";
+  const char* what = code == 91   ? ": hard fault"
+                     : code == 90 ? ": unexpected interrupt"
+                     : code == 0  ? ": a normal end, or a reset under -no-reboot"
+                                  : "";
   return "exited, status " + std::to_string(code) + what;
 }
 

@@ -31,8 +31,8 @@ std::string qemu_machine(const std::string& elf, std::string& err);
 /// frame completes (kFrame, decoded into f) or the link is corrupt (kError, message in err); pos
 /// advances past the bytes consumed, so bytes after a frame stay for the next call. Every error and
 /// every junk byte is counted in counters, by kind.
-RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos,
-                              pil::ActuatorFrame& f, pil::LinkCounters& counters, std::string& err);
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+                              pil::LinkCounters& counters, std::string& err);
 
 class PilClient {
  public:

@@ -20,12 +20,12 @@ using Vec3 = Eigen::Vector3d;
 struct PlantConfig {
   osc::FrictionCoefficients friction = osc::robot::kFrictionPaper;
   double tau_dec = osc::params::kTauDec;
-  double substep = 1e-4;              ///< RK4 step [s] (10 kHz) wherever a joint's velocity changes sign
+  double substep = 1e-4;  ///< RK4 step [s] (10 kHz) wherever a joint's velocity changes sign
   /// Away from velocity reversals (every joint's velocity keeps its sign through the step, so the
   /// friction of model (2) is smooth) RK4 takes this many substeps at once; 1 = fixed step.
   int smooth_steps = 8;
-  double compute_delay = 0.2e-3;      ///< from the encoder sample to the DAC update [s]
-  double link_scale = 1.0;            ///< scales every link mass and inertia (model-error studies)
+  double compute_delay = 0.2e-3;  ///< from the encoder sample to the DAC update [s]
+  double link_scale = 1.0;        ///< scales every link mass and inertia (model-error studies)
 };
 
 /// Articulated-body forward dynamics of the PUMA 560 (armature on each joint's scalar inertia),

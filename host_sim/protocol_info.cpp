@@ -25,8 +25,13 @@ json fields(const pil::FieldInfo (&list)[N]) {
   json out = json::array();
   int offset = 0;
   for (const pil::FieldInfo& f : list) {
-    out.push_back({{"name", f.name}, {"type", f.type}, {"count", f.count}, {"bytes", f.bytes},
-                   {"offset", offset}, {"unit", f.unit}, {"doc", f.doc}});
+    out.push_back({{"name", f.name},
+                   {"type", f.type},
+                   {"count", f.count},
+                   {"bytes", f.bytes},
+                   {"offset", offset},
+                   {"unit", f.unit},
+                   {"doc", f.doc}});
     offset += f.bytes;
   }
   return out;
@@ -46,8 +51,9 @@ json examples() {
   pil::SensorFrame first;
   first.seq = 0;
   first.inject = pil::config_adaptation(osc::AdaptationLaw::kPaper);
-  out.push_back({{"what", "the first sensor frame: sequence 0, every encoder at 0 (the start pose), the paper's "
-                          "adaptation law requested"},
+  out.push_back({{"what",
+                  "the first sensor frame: sequence 0, every encoder at 0 (the start pose), the paper's "
+                  "adaptation law requested"},
                  {"frame", "sensor"},
                  {"bytes", bytes_of(buf, pil::encode(first, buf))}});
   pil::SensorFrame later;
@@ -71,9 +77,10 @@ json examples() {
   a.tau_f_hat[0] = -0.25f;
   a.link[pil::kErrSeq] = 1;
   a.rx_gap_max = 250000;
-  out.push_back({{"what", "actuator frame 1234: codes 120, -9100, 2047, 0, -15, 3, state run, no fault, step 9 560 "
-                          "cycles (max 9 600, mean 9 500), tick max 13 640, stack 2 960 bytes, theta_hat[0] 1.5, "
-                          "tau_f_hat[0] -0.25, one sequence error, longest receive gap 250 000 cycles"},
+  out.push_back({{"what",
+                  "actuator frame 1234: codes 120, -9100, 2047, 0, -15, 3, state run, no fault, step 9 560 "
+                  "cycles (max 9 600, mean 9 500), tick max 13 640, stack 2 960 bytes, theta_hat[0] 1.5, "
+                  "tau_f_hat[0] -0.25, one sequence error, longest receive gap 250 000 cycles"},
                  {"frame", "actuator"},
                  {"bytes", bytes_of(buf, pil::encode(a, buf))}});
   return out;
@@ -90,14 +97,20 @@ int main(int argc, char** argv) {
   j["sync"] = {pil::kSync0, pil::kSync1};
   j["overhead"] = pil::kOverhead;
   j["max_frame"] = pil::kMaxFrame;
-  j["types"] = {{{"name", "sensor"}, {"code", pil::kSensorFrame}, {"payload", pil::kSensorPayload},
-                 {"from", "host"}, {"to", "firmware"}},
-                {{"name", "actuator"}, {"code", pil::kActuatorFrame}, {"payload", pil::kActuatorPayload},
-                 {"from", "firmware"}, {"to", "host"}}};
+  j["types"] = {{{"name", "sensor"},
+                 {"code", pil::kSensorFrame},
+                 {"payload", pil::kSensorPayload},
+                 {"from", "host"},
+                 {"to", "firmware"}},
+                {{"name", "actuator"},
+                 {"code", pil::kActuatorFrame},
+                 {"payload", pil::kActuatorPayload},
+                 {"from", "firmware"},
+                 {"to", "host"}}};
   j["hello_seq"] = pil::kHelloSeq;
   const char check[] = "123456789";
-  j["crc"] = {{"poly", 0x1021}, {"init", 0xFFFF},
-              {"check", pil::crc16(reinterpret_cast<const std::uint8_t*>(check), 9)}};
+  j["crc"] = {
+      {"poly", 0x1021}, {"init", 0xFFFF}, {"check", pil::crc16(reinterpret_cast<const std::uint8_t*>(check), 9)}};
   j["sensor_fields"] = fields(pil::kSensorFields);
   j["actuator_fields"] = fields(pil::kActuatorFields);
   j["inject"] = {{"non_finite", pil::kInjectNonFinite},

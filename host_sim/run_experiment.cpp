@@ -4,7 +4,6 @@
 // CSV header, and the config.yaml written beside the time series.
 #include <unistd.h>
 
-
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
@@ -63,7 +62,8 @@ void print_windows(const sim::ExperimentResult& r) {
 std::string counters_text(const pil::LinkCounters& c) {
   std::string s;
   for (int k = 0; k < pil::kLinkErrorKinds; ++k)
-    if (c.count[k]) s += (s.empty() ? "" : ", ") + std::string(pil::kLinkErrorNames[k]) + " " + std::to_string(c.count[k]);
+    if (c.count[k])
+      s += (s.empty() ? "" : ", ") + std::string(pil::kLinkErrorNames[k]) + " " + std::to_string(c.count[k]);
   return s.empty() ? "none" : s;
 }
 
@@ -108,14 +108,17 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
     for (const auto& r : runs) {
       std::printf(" %14.3f", r.max_error[i]);
       // A run that faulted before the end has no "last" window.
-      if (r.status) std::printf(" %14s", "(faulted)");
-      else std::printf(" %14.3f", r.final_max_error[i]);
+      if (r.status)
+        std::printf(" %14s", "(faulted)");
+      else
+        std::printf(" %14.3f", r.final_max_error[i]);
     }
     std::printf(" %10.2f %10.2f\n", sim::kPaperTable1[i], sim::kPaperTable3[i]);
   }
   for (const auto& r : runs)
-    if (r.status) std::printf("  [%s] faulted at %.3f s: its 'all' column covers the run up to the fault only\n",
-                              r.mode.c_str(), r.fault_time);
+    if (r.status)
+      std::printf("  [%s] faulted at %.3f s: its 'all' column covers the run up to the fault only\n", r.mode.c_str(),
+                  r.fault_time);
   const sim::ExperimentResult* ad = nullptr;
   const sim::ExperimentResult* no = nullptr;
   for (const auto& r : runs) (r.mode == "adaptive" ? ad : no) = &r;
@@ -132,8 +135,10 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
   if (ad) {
     static const char* names[3] = {"tau_vis [N m s/rad]", "tau_cou [N m]", "tau_sti [N m]"};
     if (ad->status)
-      std::printf("\nFriction estimates at the fault (t = %.3f s): not identified values (estimate / plant's true "
-                  "value)\n%-20s", ad->fault_time, "");
+      std::printf(
+          "\nFriction estimates at the fault (t = %.3f s): not identified values (estimate / plant's true "
+          "value)\n%-20s",
+          ad->fault_time, "");
     else
       std::printf("\nIdentified friction coefficients after %.0f s (estimate / plant's true value, preset '%s')\n%-20s",
                   ad->duration, ad->friction_preset.c_str(), "");
@@ -150,37 +155,46 @@ void print_tables(const std::vector<sim::ExperimentResult>& runs, const sim::Pro
   }
   for (const auto& r : runs)
     if (r.has_observer && !r.status)
-      std::printf("[%s] observer error over the last %gs: |x~| max %.4f %.4f %.4f mm  %.5f %.5f %.5f deg; velocity "
-                  "%.2f %.2f %.2f mm/s  %.3f %.3f %.3f deg/s\n",
-                  r.mode.c_str(), r.final_window, r.max_observer_error[0], r.max_observer_error[1],
-                  r.max_observer_error[2], r.max_observer_error[3], r.max_observer_error[4], r.max_observer_error[5],
-                  r.max_observer_velocity_error[0], r.max_observer_velocity_error[1], r.max_observer_velocity_error[2],
-                  r.max_observer_velocity_error[3], r.max_observer_velocity_error[4], r.max_observer_velocity_error[5]);
+      std::printf(
+          "[%s] observer error over the last %gs: |x~| max %.4f %.4f %.4f mm  %.5f %.5f %.5f deg; velocity "
+          "%.2f %.2f %.2f mm/s  %.3f %.3f %.3f deg/s\n",
+          r.mode.c_str(), r.final_window, r.max_observer_error[0], r.max_observer_error[1], r.max_observer_error[2],
+          r.max_observer_error[3], r.max_observer_error[4], r.max_observer_error[5], r.max_observer_velocity_error[0],
+          r.max_observer_velocity_error[1], r.max_observer_velocity_error[2], r.max_observer_velocity_error[3],
+          r.max_observer_velocity_error[4], r.max_observer_velocity_error[5]);
   for (const auto& r : runs) print_windows(r);
   for (const auto& r : runs) {
     if (!r.error.empty()) std::printf("[%s] LINK ERROR: %s\n", r.mode.c_str(), r.error.c_str());
     if (r.max_step_cycles)
-      std::printf("[%s] firmware control step (observer + controller + adaptation, %s): max %u, mean %u "
-                  "instructions (QEMU -icount shift=0); whole tick incl. link I/O max %u; stack used %u bytes\n",
-                  r.mode.c_str(), sim::kScalarNames[static_cast<int>(scalar)], r.max_step_cycles, r.mean_step_cycles, r.max_tick_cycles, r.stack_used);
+      std::printf(
+          "[%s] firmware control step (observer + controller + adaptation, %s): max %u, mean %u "
+          "instructions (QEMU -icount shift=0); whole tick incl. link I/O max %u; stack used %u bytes\n",
+          r.mode.c_str(), sim::kScalarNames[static_cast<int>(scalar)], r.max_step_cycles, r.mean_step_cycles,
+          r.max_tick_cycles, r.stack_used);
     if (r.max_step_cycles) {
-      std::printf("[%s] link: longest gap between received bytes %u cycles (ns of target time in QEMU), %u over %d periods; "
-                  "errors counted by the firmware: %s; by the host: %s, codes out of range %u; ticks zeroed %u%s%s\n",
-                  r.mode.c_str(), r.link.rx_gap_max, r.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
-                  counters_text(r.link.firmware).c_str(), counters_text(r.link.host).c_str(), r.link.host_code_range,
-                  r.link.zeroed_ticks, r.link.first_zeroed.empty() ? "" : ", the first: ", r.link.first_zeroed.c_str());
+      std::printf(
+          "[%s] link: longest gap between received bytes %u cycles (ns of target time in QEMU), %u over %d periods; "
+          "errors counted by the firmware: %s; by the host: %s, codes out of range %u; ticks zeroed %u%s%s\n",
+          r.mode.c_str(), r.link.rx_gap_max, r.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
+          counters_text(r.link.firmware).c_str(), counters_text(r.link.host).c_str(), r.link.host_code_range,
+          r.link.zeroed_ticks, r.link.first_zeroed.empty() ? "" : ", the first: ", r.link.first_zeroed.c_str());
     }
-    std::printf("[%s] simulated %.0f s in %.2f s wall (%.3gx real time); %.2f s CPU (%.3gx real time); "
-                "%.1f plant evaluations per sample\n",
-                r.mode.c_str(), r.duration, r.wall_seconds, r.duration / r.wall_seconds, r.cpu_seconds,
-                r.duration / r.cpu_seconds, static_cast<double>(r.plant_evaluations) / (r.duration / osc::params::kDt));
+    std::printf(
+        "[%s] simulated %.0f s in %.2f s wall (%.3gx real time); %.2f s CPU (%.3gx real time); "
+        "%.1f plant evaluations per sample\n",
+        r.mode.c_str(), r.duration, r.wall_seconds, r.duration / r.wall_seconds, r.cpu_seconds,
+        r.duration / r.cpu_seconds, static_cast<double>(r.plant_evaluations) / (r.duration / osc::params::kDt));
     if (r.injection.injection.enabled) {
       const sim::InjectionResult& ir = r.injection;
       std::printf("[%s] injected %s: ", r.mode.c_str(), sim::to_string(ir.injection).c_str());
-      if (ir.detected < 0) std::printf("never detected");
-      else std::printf("detected after %.1f ms as %s", (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults));
-      if (ir.zero_torque < 0) std::printf(", torque never zero");
-      else std::printf(", zero torque after %.1f ms", (ir.zero_torque - ir.injection.at) * 1e3);
+      if (ir.detected < 0)
+        std::printf("never detected");
+      else
+        std::printf("detected after %.1f ms as %s", (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults));
+      if (ir.zero_torque < 0)
+        std::printf(", torque never zero");
+      else
+        std::printf(", zero torque after %.1f ms", (ir.zero_torque - ir.injection.at) * 1e3);
       std::printf(", tip excursion %.2f mm, largest torque after detection %.2f N m\n", ir.excursion_mm,
                   ir.max_torque_after);
     }
@@ -211,7 +225,8 @@ int main(int argc, char** argv) {
   }
   if (o.qemu) {
     if (access(o.elf.c_str(), R_OK) != 0)
-      return fail("firmware image " + o.elf + " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
+      return fail("firmware image " + o.elf +
+                  " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
     // The M4F firmware computes in float (the M3 image in fixed point: --scalar fixed says so).
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf, o.pil_link, err);
@@ -231,7 +246,8 @@ int main(int argc, char** argv) {
   if (!o.json.empty() && sim::is_stdout(o.json)) {
     std::fflush(stdout);
     json_fd = dup(STDOUT_FILENO);
-    if (json_fd < 0 || dup2(STDERR_FILENO, STDOUT_FILENO) < 0) return fail_output("cannot set up standard output for --json");
+    if (json_fd < 0 || dup2(STDERR_FILENO, STDOUT_FILENO) < 0)
+      return fail_output("cannot set up standard output for --json");
   }
 
   sim::Provenance prov;
@@ -264,8 +280,7 @@ int main(int argc, char** argv) {
   // The runs are independent: one thread each (the machine has two cores).
   std::vector<sim::ExperimentResult> runs(cfgs.size());
   std::vector<std::thread> threads;
-  for (size_t i = 0; i < cfgs.size(); ++i)
-    threads.emplace_back([&, i] { runs[i] = sim::run_experiment(cfgs[i]); });
+  for (size_t i = 0; i < cfgs.size(); ++i) threads.emplace_back([&, i] { runs[i] = sim::run_experiment(cfgs[i]); });
   if (bar) {
     for (;;) {
       double sum = 0;
@@ -291,7 +306,8 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     const bool ok = json_fd >= 0 ? sim::write_all(json_fd, text, "standard output", err) && close(json_fd) == 0
                                  : sim::write_output(o.json, text, err);
-    if (!ok) return fail_output(err.empty() ? "cannot write standard output: " + std::string(std::strerror(errno)) : err);
+    if (!ok)
+      return fail_output(err.empty() ? "cannot write standard output: " + std::string(std::strerror(errno)) : err);
     std::printf("summary: %s\n", o.json.c_str());
   }
   if (std::fflush(stdout) != 0 || std::ferror(stdout)) return fail_output("cannot write standard output");

@@ -61,10 +61,12 @@ int main(int argc, char** argv) {
   std::string expect_faults;
   long expect_frames = -1;
   app.add_option("source", source, "capture file, or serial device (e.g. /dev/ttyUSB0)")->required();
-  app.add_option("--baud", baud, "baud rate of a serial device")->check(CLI::IsMember({115200, 230400, 460800, 921600}));
+  app.add_option("--baud", baud, "baud rate of a serial device")
+      ->check(CLI::IsMember({115200, 230400, 460800, 921600}));
   app.add_option("--frames", max_frames, "stop after this many frames (0: at the end of the file)");
   app.add_flag("--quiet", quiet, "the summary only");
-  app.add_option("--expect-faults", expect_faults, "fail unless the last frame's latched faults are these (e.g. estop)");
+  app.add_option("--expect-faults", expect_faults,
+                 "fail unless the last frame's latched faults are these (e.g. estop)");
   app.add_option("--expect-frames", expect_frames, "fail unless exactly this many frames came");
   CLI11_PARSE(app, argc, argv);
 

@@ -35,41 +35,48 @@ struct Fixture {
   }
 };
 
-template <class S> void BM_forward_kinematics(benchmark::State& st) {
+template <class S>
+void BM_forward_kinematics(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) {
     forward_kinematics(f.model, f.data, f.q);
     benchmark::DoNotOptimize(f.data.o[kDof]);
   }
 }
-template <class S> void BM_geometric_jacobian(benchmark::State& st) {
+template <class S>
+void BM_geometric_jacobian(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) {
     geometric_jacobian(f.data);
     benchmark::DoNotOptimize(f.data.J);
   }
 }
-template <class S> void BM_joint_inertia(benchmark::State& st) {
+template <class S>
+void BM_joint_inertia(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) {
     joint_inertia(f.model, f.data);
     benchmark::DoNotOptimize(f.data.A);
   }
 }
-template <class S> void BM_gravity(benchmark::State& st) {
+template <class S>
+void BM_gravity(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) benchmark::DoNotOptimize(gravity_torques(f.model, f.data));
 }
-template <class S> void BM_velocity_products(benchmark::State& st) {
+template <class S>
+void BM_velocity_products(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) benchmark::DoNotOptimize(velocity_products(f.model, f.data, f.qd));
 }
-template <class S> void BM_friction_regressor(benchmark::State& st) {
+template <class S>
+void BM_friction_regressor(benchmark::State& st) {
   Fixture<S> f;
   const Vec6<S> dec = Vec6<S>::Ones();
   for (auto _ : st) benchmark::DoNotOptimize(friction_regressor(f.qd, dec));
 }
-template <class S> void BM_jacobian_factor_solve(benchmark::State& st) {
+template <class S>
+void BM_jacobian_factor_solve(benchmark::State& st) {
   Fixture<S> f;
   SphericalWristJacobianFactor<S> jf;
   for (auto _ : st) {
@@ -77,22 +84,26 @@ template <class S> void BM_jacobian_factor_solve(benchmark::State& st) {
     benchmark::DoNotOptimize(jf.solve(f.v));
   }
 }
-template <class S> void BM_operational_inertia(benchmark::State& st) {
+template <class S>
+void BM_operational_inertia(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) benchmark::DoNotOptimize(operational_inertia(f.data.A, f.os.Jf));
 }
-template <class S> void BM_opspace_update(benchmark::State& st) {
+template <class S>
+void BM_opspace_update(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) {
     opspace_update(f.model, f.data, f.os, f.q, f.R_ref);
     benchmark::DoNotOptimize(f.os.A_ldlt);
   }
 }
-template <class S> void BM_psi_quadratic(benchmark::State& st) {
+template <class S>
+void BM_psi_quadratic(benchmark::State& st) {
   Fixture<S> f;
   for (auto _ : st) benchmark::DoNotOptimize(psi_quadratic(f.model, f.data, f.os, f.v));
 }
-template <class S> void BM_control_step(benchmark::State& st) {
+template <class S>
+void BM_control_step(benchmark::State& st) {
   Fixture<S> f;
   const Gains<S> g = Gains<S>::paper();
   auto cs = std::make_unique<ControllerState<S>>();
@@ -101,14 +112,15 @@ template <class S> void BM_control_step(benchmark::State& st) {
   int k = 0;
   for (auto _ : st) {
     q(1) = f.q(1) + static_cast<S>(1e-6 * (k % 100));
-    benchmark::DoNotOptimize(control_step(f.model, g, FrictionMode::kAdaptive, *cs, q, static_cast<S>(1e-3 * (k % 1000))));
+    benchmark::DoNotOptimize(
+        control_step(f.model, g, FrictionMode::kAdaptive, *cs, q, static_cast<S>(1e-3 * (k % 1000))));
     ++k;
   }
 }
 
-#define OSC_BENCH(name) \
+#define OSC_BENCH(name)             \
   BENCHMARK_TEMPLATE(name, double); \
-  BENCHMARK_TEMPLATE(name, float); \
+  BENCHMARK_TEMPLATE(name, float);  \
   BENCHMARK_TEMPLATE(name, Fixed)
 OSC_BENCH(BM_forward_kinematics);
 OSC_BENCH(BM_geometric_jacobian);

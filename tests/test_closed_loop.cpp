@@ -14,12 +14,12 @@ using namespace sim;
 namespace {
 
 void print(const char* what, const ExperimentResult& r) {
-  std::printf("%-28s max |e| all: %.3f %.3f %.3f mm %.4f %.4f %.4f deg | last: %.3f %.3f %.3f mm %.4f %.4f %.4f deg"
-              " | |x~| last: %.3f %.3f %.3f mm\n",
-              what, r.max_error[0], r.max_error[1], r.max_error[2], r.max_error[3], r.max_error[4], r.max_error[5],
-              r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], r.final_max_error[3],
-              r.final_max_error[4], r.final_max_error[5], r.max_observer_error[0], r.max_observer_error[1],
-              r.max_observer_error[2]);
+  std::printf(
+      "%-28s max |e| all: %.3f %.3f %.3f mm %.4f %.4f %.4f deg | last: %.3f %.3f %.3f mm %.4f %.4f %.4f deg"
+      " | |x~| last: %.3f %.3f %.3f mm\n",
+      what, r.max_error[0], r.max_error[1], r.max_error[2], r.max_error[3], r.max_error[4], r.max_error[5],
+      r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], r.final_max_error[3], r.final_max_error[4],
+      r.final_max_error[5], r.max_observer_error[0], r.max_observer_error[1], r.max_observer_error[2]);
 }
 
 /// Worst-case Cartesian error of one encoder count on every joint at the start pose [mm]:
@@ -190,10 +190,11 @@ TEST(ClosedLoop, AdaptationDoesNotDriftOnAFrictionlessPlant) {
     bool in_bounds = true;
     for (int i = 0; i < 18; ++i)
       in_bounds = in_bounds && r.theta_min_seen[i] >= 0.0 && r.theta_max_seen[i] <= osc::params::kThetaMax[i];
-    std::printf("%-6s law, frictionless plant, 300 s: theta^_vis,J1 %.4f, predicted friction rms (last 60 s) %.4f N m, "
-                "theta^ %s its bounds, fault %s at %.1f s\n", r.adaptation.c_str(), r.theta_hat[0],
-                r.friction_rms_error, in_bounds ? "inside" : "OUTSIDE", r.status ? osc::fault_name(r.status) : "none",
-                r.fault_time);
+    std::printf(
+        "%-6s law, frictionless plant, 300 s: theta^_vis,J1 %.4f, predicted friction rms (last 60 s) %.4f N m, "
+        "theta^ %s its bounds, fault %s at %.1f s\n",
+        r.adaptation.c_str(), r.theta_hat[0], r.friction_rms_error, in_bounds ? "inside" : "OUTSIDE",
+        r.status ? osc::fault_name(r.status) : "none", r.fault_time);
     return std::make_tuple(r.theta_hat[0], r.friction_rms_error, in_bounds, r.status, r.fault_time);
   };
   const auto [vis_robust, rms_robust, bounded_robust, status_robust, t_robust] = drift(osc::AdaptationLaw::kRobust);
@@ -230,7 +231,7 @@ TEST(ClosedLoop, PaperLawDriftScalesWithTheSquareOfTheEncoderQuantum) {
   };
   const double coarse = vis_j1(osc::AdaptationLaw::kPaper, 1000), fine = vis_j1(osc::AdaptationLaw::kPaper, 4000);
   EXPECT_GT(coarse, 4.0);
-  EXPECT_GT(coarse / fine, 8.0);   // delta^2 scaling (16x), less the small drift that remains without quantisation
+  EXPECT_GT(coarse / fine, 8.0);  // delta^2 scaling (16x), less the small drift that remains without quantisation
   EXPECT_LT(coarse / fine, 32.0);
   EXPECT_LT(vis_j1(osc::AdaptationLaw::kRobust, 1000), 0.1);
 }
@@ -256,10 +257,12 @@ TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
       ASSERT_EQ(r.status, 0u);
       for (int i = 0; i < 6; ++i)
         EXPECT_EQ(r.final_max_error[i], base.final_max_error[i]) << "uptime " << target << " axis " << i;
-      std::printf("%s controller, counter jumps to %llu at 25 s: last 10 s max |e| %.4f %.4f %.4f mm (without: %.4f %.4f %.4f)\n",
-                  kScalarNames[static_cast<int>(scalar)], static_cast<unsigned long long>(jump_at_tick + c.jump_ticks),
-                  r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], base.final_max_error[0],
-                  base.final_max_error[1], base.final_max_error[2]);
+      std::printf(
+          "%s controller, counter jumps to %llu at 25 s: last 10 s max |e| %.4f %.4f %.4f mm (without: %.4f %.4f "
+          "%.4f)\n",
+          kScalarNames[static_cast<int>(scalar)], static_cast<unsigned long long>(jump_at_tick + c.jump_ticks),
+          r.final_max_error[0], r.final_max_error[1], r.final_max_error[2], base.final_max_error[0],
+          base.final_max_error[1], base.final_max_error[2]);
     }
     c.jump_at = -1;
   }
@@ -273,8 +276,8 @@ ExperimentResult inject(const char* spec, double duration, osc::FrictionMode mod
   const ExperimentResult r = run_experiment(c);
   const InjectionResult& ir = r.injection;
   std::printf("%-22s detected after %6.1f ms as %-14s zero torque after %6.1f ms, excursion %.2f mm\n", spec,
-              (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults), (ir.zero_torque - ir.injection.at) * 1e3,
-              ir.excursion_mm);
+              (ir.detected - ir.injection.at) * 1e3, osc::fault_name(ir.faults),
+              (ir.zero_torque - ir.injection.at) * 1e3, ir.excursion_mm);
   return r;
 }
 
@@ -331,9 +334,9 @@ TEST(Injection, StuckAmplifierIsCaughtAndDisabledByTheFaultLine) {
 TEST(Injection, ParserRejectsBadSpecifications) {
   Injection inj;
   std::string err;
-  for (const char* bad : {"", "encoder-stuck", "encoder-stuck@", "encoder-stuck@-1", "encoder-stuck@nan",
-                          "encoder-stuck:0@1", "encoder-stuck:7@1", "encoder-stuck:12@1", "encoder-stuck:@1",
-                          "overrun:1@1", "melt@1", "estop@1x"}) {
+  for (const char* bad :
+       {"", "encoder-stuck", "encoder-stuck@", "encoder-stuck@-1", "encoder-stuck@nan", "encoder-stuck:0@1",
+        "encoder-stuck:7@1", "encoder-stuck:12@1", "encoder-stuck:@1", "overrun:1@1", "melt@1", "estop@1x"}) {
     err.clear();
     EXPECT_FALSE(parse_injection(bad, inj, err)) << bad;
     EXPECT_FALSE(err.empty()) << bad;
@@ -355,21 +358,21 @@ namespace {
 // docs/safety.md; CI runs 300 s of each).
 TEST(Monitors, NoFalseFaultWithOrWithoutCompensation) {
   for (const osc::FrictionCoefficients* fr : {&osc::robot::kFrictionPaper, &osc::robot::kFrictionCorke})
-  for (const osc::FrictionMode mode : {osc::FrictionMode::kAdaptive, osc::FrictionMode::kNone}) {
-    ExperimentConfig c = config(300, mode, *fr);
-    const ExperimentResult r = run_experiment(c);
-    EXPECT_EQ(r.status, 0u) << fr->name << ": " << osc::fault_name(r.status) << " at " << r.fault_time << " s";
-    std::printf("%-6s %-8s 300 s: stuck monitor peaks (counts / N m / N m while silent):", fr->name, r.mode.c_str());
-    for (int j = 0; j < 6; ++j) {
-      std::printf(" J%d %.1f/%.1f/%.1f", j + 1, r.stuck_peak[j], r.stuck_dtau_peak[j], r.stuck_dtau_silent_peak[j]);
-      EXPECT_LT(r.stuck_peak[j], 0.9 * osc::params::kStuckMotionCounts) << fr->name << " J" << j + 1;
-      EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << fr->name << " J" << j + 1;
-      EXPECT_LT(r.stuck_dtau_silent_peak[j], 0.8 * osc::params::kStuckTorqueSilent[j]) << fr->name << " J" << j + 1;
+    for (const osc::FrictionMode mode : {osc::FrictionMode::kAdaptive, osc::FrictionMode::kNone}) {
+      ExperimentConfig c = config(300, mode, *fr);
+      const ExperimentResult r = run_experiment(c);
+      EXPECT_EQ(r.status, 0u) << fr->name << ": " << osc::fault_name(r.status) << " at " << r.fault_time << " s";
+      std::printf("%-6s %-8s 300 s: stuck monitor peaks (counts / N m / N m while silent):", fr->name, r.mode.c_str());
+      for (int j = 0; j < 6; ++j) {
+        std::printf(" J%d %.1f/%.1f/%.1f", j + 1, r.stuck_peak[j], r.stuck_dtau_peak[j], r.stuck_dtau_silent_peak[j]);
+        EXPECT_LT(r.stuck_peak[j], 0.9 * osc::params::kStuckMotionCounts) << fr->name << " J" << j + 1;
+        EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << fr->name << " J" << j + 1;
+        EXPECT_LT(r.stuck_dtau_silent_peak[j], 0.8 * osc::params::kStuckTorqueSilent[j]) << fr->name << " J" << j + 1;
+      }
+      const double pos = std::max({r.max_error[0], r.max_error[1], r.max_error[2]});
+      std::printf("; worst position error %.2f mm\n", pos);
+      EXPECT_LT(pos, 0.5 * osc::params::kTrackingLimitPosition * 1e3);
     }
-    const double pos = std::max({r.max_error[0], r.max_error[1], r.max_error[2]});
-    std::printf("; worst position error %.2f mm\n", pos);
-    EXPECT_LT(pos, 0.5 * osc::params::kTrackingLimitPosition * 1e3);
-  }
 }
 
 }  // namespace

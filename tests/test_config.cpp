@@ -14,7 +14,9 @@ namespace {
 
 using sim::Settings;
 
-bool apply(Settings& s, const std::string& yaml, std::string& err) { return sim::apply_config(yaml, "test.yaml", s, err); }
+bool apply(Settings& s, const std::string& yaml, std::string& err) {
+  return sim::apply_config(yaml, "test.yaml", s, err);
+}
 
 TEST(Config, DefaultsAreTheFirmwareHeadersValues) {
   const Settings s;
@@ -37,8 +39,9 @@ TEST(Config, DefaultsAreTheFirmwareHeadersValues) {
 TEST(Config, PrintedConfigurationReadsBackToTheSameSettings) {
   Settings s;
   std::string err;
-  ASSERT_TRUE(apply(s, "trajectory: {amplitude: 0.03, period: 2.5}\nplant:\n  friction: {preset: corke}\n"
-                       "  delay: 0.0005\nrun: {modes: adaptive, scalar: float}\nstart_pose: [10, 40, -170, 5, 50, -5]\n",
+  ASSERT_TRUE(apply(s,
+                    "trajectory: {amplitude: 0.03, period: 2.5}\nplant:\n  friction: {preset: corke}\n"
+                    "  delay: 0.0005\nrun: {modes: adaptive, scalar: float}\nstart_pose: [10, 40, -170, 5, 50, -5]\n",
                     err))
       << err;
   const std::string text = sim::config_yaml(s);
@@ -198,7 +201,7 @@ TEST(Config, ConfiguredTrajectoryAndStartPoseReachTheRun) {
       EXPECT_TRUE(sim::apply_setting(set, s, err)) << err;
     }
     sim::ExperimentConfig c = s.base;
-    c.duration = 6;  // the envelope has risen to 1 - exp(-10.8)
+    c.duration = 6;                     // the envelope has risen to 1 - exp(-10.8)
     c.mode = osc::FrictionMode::kNone;  // paper friction, uncompensated: errors grow with the motion
     return sim::run_experiment(c);
   };

@@ -11,9 +11,7 @@ using namespace osc;
 
 namespace {
 
-Vec6<double> q_start() {
-  return joint_vector<double>(robot::kQStart);
-}
+Vec6<double> q_start() { return joint_vector<double>(robot::kQStart); }
 
 constexpr TrajectorySpec<double> kPaperTrajectory = TrajectorySpec<double>::paper();
 
@@ -45,7 +43,8 @@ TEST(Trajectory, StartsAtRestAndDerivativesMatchFiniteDifferences) {
   EXPECT_EQ(d0.x.tail<3>().norm(), 0.0);  // orientation held
   const double h = 1e-5;
   for (double t : {0.3, 1.7, 4.2, 9.9, 33.3, 119.0}) {
-    const Desired<double> d = trajectory(kPaperTrajectory, p0, t), dp = trajectory(kPaperTrajectory, p0, t + h), dm = trajectory(kPaperTrajectory, p0, t - h);
+    const Desired<double> d = trajectory(kPaperTrajectory, p0, t), dp = trajectory(kPaperTrajectory, p0, t + h),
+                          dm = trajectory(kPaperTrajectory, p0, t - h);
     EXPECT_LT(((dp.x - dm.x) / (2 * h) - d.xd).norm(), 1e-8) << t;
     EXPECT_LT(((dp.xd - dm.xd) / (2 * h) - d.xdd).norm(), 1e-7) << t;
   }
@@ -263,7 +262,7 @@ TEST_F(Stages, AdaptationWaitsForItsFirstSampleThenFollowsEquation67) {
   a.theta_hat.setConstant(1.0);
   a.q_prev = q;
   a.qd_hat_prev = v6(0.1, -0.2, 0.3, 0.0, 0.5, -0.6);
-  a.qd_hat_prev2 = v6(9, 9, 9, 9, 9, 9);  // not used by (67)
+  a.qd_hat_prev2 = v6(9, 9, 9, 9, 9, 9);                              // not used by (67)
   a.w_prev = friction_regressor_diagonals(a.qd_hat_prev, G.tau_dec);  // what the last sample recorded
   a.w_prev2 = friction_regressor_diagonals(a.qd_hat_prev2, G.tau_dec);
   a.samples = 0;
@@ -325,14 +324,15 @@ TEST_F(Stages, ForceCommandIsEquations31_36) {
   const Vec6<double> tau_f_hat = v6(1, -1, 2, 0.1, 0.2, -0.1);
   const ForceCommand<double> c = force_command(model, G, data, os, d, ob, tau_f_hat);
   // Each operational force on its own, as the paper writes (35), with Lambda formed.
-  const Vec6<double> e = d.x - os.x;                               // (36)
+  const Vec6<double> e = d.x - os.x;  // (36)
   const Vec6<double> v = d.xd + G.ks.cwiseProduct(e);
   const Vec6<double> psi_v = psi_bilinear(model, data, os, ob.xd_hat, v);  // Psi(x, x^dot) v
   const Vec6<double> p = operational_gravity(os);
   const Vec6<double> f_hat = operational_friction(os, tau_f_hat);  // (31)
   const Mat6<double> Lambda = operational_inertia(data, os);
   const Vec6<double> w_e = Lambda * (d.xdd + G.ks.cwiseProduct(d.xd - ob.xd_hat)) + psi_v + p + f_hat;  // (35)
-  const Vec6<double> F = (G.ks + G.knd).cwiseProduct(v - ob.xd_hat) + w_e - G.ki.cwiseProduct(ob.x_tilde);  // (32), (34)
+  const Vec6<double> F =
+      (G.ks + G.knd).cwiseProduct(v - ob.xd_hat) + w_e - G.ki.cwiseProduct(ob.x_tilde);  // (32), (34)
   EXPECT_LT((c.e - e).norm(), 1e-15);
   EXPECT_LT((c.F - F).norm(), 1e-10 * (1 + F.norm()));
   // The bias force the observer reuses: h(x, x^dot) + p + f^.

@@ -19,7 +19,7 @@ using fixed::Q;
 
 namespace {
 
-__extension__ using I128 = __int128;  // exact products and quotients for the reference
+__extension__ using I128 = __int128;      // exact products and quotients for the reference
 constexpr double kLsb = 1.0 / (1 << 19);  // of Fixed
 constexpr std::int32_t kMax = INT32_MAX, kMin = INT32_MIN;
 
@@ -135,12 +135,13 @@ TEST(FixedArithmetic, ConversionsToFloatAndDoubleAreExactOrCorrectlyRounded) {
     EXPECT_EQ(static_cast<float>(x), static_cast<float>(d));
   }
   // The edges, and the ties of the rounding to 24 bits (even down, odd up), in three formats.
-  for (std::int32_t raw : {1, -1, 2, INT32_MAX, INT32_MIN, INT32_MIN + 1, (1 << 24) - 1, 1 << 24, (1 << 24) + 1,
-                           (1 << 24) + 3, -((1 << 24) + 1), -((1 << 24) + 3), (1 << 30) + 64, (1 << 30) + 192,
-                           0x7FFFFFC0, 0x7FFFFF40}) {
+  for (std::int32_t raw :
+       {1, -1, 2, INT32_MAX, INT32_MIN, INT32_MIN + 1, (1 << 24) - 1, 1 << 24, (1 << 24) + 1, (1 << 24) + 3,
+        -((1 << 24) + 1), -((1 << 24) + 3), (1 << 30) + 64, (1 << 30) + 192, 0x7FFFFFC0, 0x7FFFFF40}) {
     EXPECT_EQ(static_cast<float>(Fixed::from_raw(raw)), static_cast<float>(static_cast<double>(Fixed::from_raw(raw))))
         << raw;
-    EXPECT_EQ(static_cast<float>(FixedIo::from_raw(raw)), static_cast<float>(static_cast<double>(FixedIo::from_raw(raw))))
+    EXPECT_EQ(static_cast<float>(FixedIo::from_raw(raw)),
+              static_cast<float>(static_cast<double>(FixedIo::from_raw(raw))))
         << raw;
     EXPECT_EQ(static_cast<float>(fixed::Q<30>::from_raw(raw)),
               static_cast<float>(static_cast<double>(fixed::Q<30>::from_raw(raw))))
@@ -225,14 +226,16 @@ constexpr double kSinCosMaxLsb = 0.51;
 constexpr double kSqrtMaxLsb = 0.5;
 constexpr double kAtan2MaxLsb = 0.51;
 constexpr double kAsinMaxLsb = 0.51;
-constexpr double kExpMaxLsb = 0.51;       // plus kExpMaxRelative of the result
+constexpr double kExpMaxLsb = 0.51;  // plus kExpMaxRelative of the result
 constexpr double kExpMaxRelative = 4e-9;
 
 TEST(FixedFunctions, SinAndCosWithinTheirStatedErrorEverywhere) {
   const auto args = arguments(-40, 40);
   double at_s = 0, at_c = 0;
-  const double es = worst_lsb(args, [](Fixed x) { return math::sin(x); }, [](double x) { return std::sin(x); }, &at_s);
-  const double ec = worst_lsb(args, [](Fixed x) { return math::cos(x); }, [](double x) { return std::cos(x); }, &at_c);
+  const double es = worst_lsb(
+      args, [](Fixed x) { return math::sin(x); }, [](double x) { return std::sin(x); }, &at_s);
+  const double ec = worst_lsb(
+      args, [](Fixed x) { return math::cos(x); }, [](double x) { return std::cos(x); }, &at_c);
   std::printf("sin: worst %.4f LSB at %.6f; cos: worst %.4f LSB at %.6f\n", es, at_s, ec, at_c);
   EXPECT_LE(es, kSinCosMaxLsb);
   EXPECT_LE(ec, kSinCosMaxLsb);
@@ -271,7 +274,8 @@ TEST(FixedFunctions, ExpWithinItsStatedErrorEverywhere) {
   }
   // e^x just below the top of the range.
   fixed::take_flags();
-  EXPECT_NEAR(static_cast<double>(math::exp(Fixed(8.3))), std::exp(static_cast<double>(Fixed(8.3))), 4e-9 * 4096 + kLsb);
+  EXPECT_NEAR(static_cast<double>(math::exp(Fixed(8.3))), std::exp(static_cast<double>(Fixed(8.3))),
+              4e-9 * 4096 + kLsb);
   EXPECT_EQ(fixed::take_flags(), 0u);
   std::printf("exp: worst |error| - %.0e e^x = %.4f LSB at %.6f\n", kExpMaxRelative, worst, at);
   EXPECT_LE(worst, kExpMaxLsb);
@@ -289,12 +293,12 @@ TEST(FixedFunctions, Atan2WithinItsStatedErrorEverywhere) {
   for (std::int32_t a : {0, 1, -1, kMax, kMin})
     for (std::int32_t b : {0, 1, -1, kMax, kMin}) {
       const double want = std::atan2(a * kLsb, b * kLsb);
-      worst = std::max(worst, std::abs(static_cast<double>(math::atan2(Fixed::from_raw(a), Fixed::from_raw(b))) - want) / kLsb);
+      worst = std::max(
+          worst, std::abs(static_cast<double>(math::atan2(Fixed::from_raw(a), Fixed::from_raw(b))) - want) / kLsb);
     }
   std::printf("atan2: worst %.4f LSB\n", worst);
   EXPECT_LE(worst, kAtan2MaxLsb);
-  for (int i = 0; i <= 8; ++i)
-    EXPECT_NEAR(fixed::detail::kAtanEighthsQ30[i], std::atan(i / 8.0) * (1 << 30), 0.5) << i;
+  for (int i = 0; i <= 8; ++i) EXPECT_NEAR(fixed::detail::kAtanEighthsQ30[i], std::atan(i / 8.0) * (1 << 30), 0.5) << i;
 }
 
 TEST(FixedFunctions, AsinWithinItsStatedErrorOnItsWholeDomain) {
@@ -339,7 +343,8 @@ TEST(FixedEigen, PartialPivLuAndLltSolveLikeDouble) {
       const Vec6<Fixed> x6 = llt.solve(b6.cast<Fixed>());
       const Eigen::PartialPivLU<Mat3<double>> lud(A3);
       worst_lu = std::max(worst_lu, (x3.cast<double>() - lud.solve(b3)).cwiseAbs().maxCoeff());
-      worst_lu = std::max(worst_lu, (y3.cast<double>() - Vec3<double>(lud.transpose().solve(b3))).cwiseAbs().maxCoeff());
+      worst_lu =
+          std::max(worst_lu, (y3.cast<double>() - Vec3<double>(lud.transpose().solve(b3))).cwiseAbs().maxCoeff());
       worst_llt = std::max(worst_llt, (x6.cast<double>() - A6.llt().solve(b6)).cwiseAbs().maxCoeff());
       worst_rcond = std::max(worst_rcond, std::abs(static_cast<double>(lu.rcond()) - lud.rcond()));
     }

@@ -41,7 +41,9 @@ struct Peaks {
 };
 
 template <class M>
-double amax(const M& m) { return m.template cast<double>().cwiseAbs().maxCoeff(); }
+double amax(const M& m) {
+  return m.template cast<double>().cwiseAbs().maxCoeff();
+}
 
 /// The kernel chain of one control step at (q, v = x dot, a = x ddot) in scalar S; returns the
 /// peaks of its named quantities (in S, converted) and leaves the flags to the caller.

@@ -46,20 +46,20 @@ constexpr double kDomainRcond = 0.1;
 constexpr double kOutsideRelative = 2e-2;
 
 // The budgets (absolute; units of each kernel).
-constexpr double kBudgetPosition = 1.2e-5;    // FK: frame-6 origin [m]
-constexpr double kBudgetRotation = 1.4e-5;    // FK: R6 entries [1]
-constexpr double kBudgetPhi = 1.4e-5;         // FK: orientation coordinates [rad] (atan2, asin)
-constexpr double kBudgetJacobian = 1.4e-5;    // J, geometric [m/rad, 1]
-constexpr double kBudgetInertia = 1.6e-4;     // A [kg m^2]
-constexpr double kBudgetGravity = 2e-3;       // g [N m]
-constexpr double kBudgetVelocity = 1.4e-4;    // c [N m], |qd_i| <= 1 rad/s
-constexpr double kBudgetLambda = 0.3;         // Lambda [kg, kg m, kg m^2]
-constexpr double kBudgetOpGravity = 3e-2;     // p [N, N m]
-constexpr double kBudgetPsi = 0.12;           // h(v) = Psi(x, v) v [N, N m], |v| <= 0.2
-constexpr double kBudgetRegressor = 4e-6;     // W_j [rad/s, 1]
-constexpr double kBudgetTau = 3.0;            // control_step tau [N m]
-constexpr double kBudgetQdHat = 1e-2;         // control_step's observed joint velocity q^dot [rad/s]
-constexpr double kBudgetTauPerCount = 0.5;    // ... and at most this fraction of one encoder count's effect
+constexpr double kBudgetPosition = 1.2e-5;  // FK: frame-6 origin [m]
+constexpr double kBudgetRotation = 1.4e-5;  // FK: R6 entries [1]
+constexpr double kBudgetPhi = 1.4e-5;       // FK: orientation coordinates [rad] (atan2, asin)
+constexpr double kBudgetJacobian = 1.4e-5;  // J, geometric [m/rad, 1]
+constexpr double kBudgetInertia = 1.6e-4;   // A [kg m^2]
+constexpr double kBudgetGravity = 2e-3;     // g [N m]
+constexpr double kBudgetVelocity = 1.4e-4;  // c [N m], |qd_i| <= 1 rad/s
+constexpr double kBudgetLambda = 0.3;       // Lambda [kg, kg m, kg m^2]
+constexpr double kBudgetOpGravity = 3e-2;   // p [N, N m]
+constexpr double kBudgetPsi = 0.12;         // h(v) = Psi(x, v) v [N, N m], |v| <= 0.2
+constexpr double kBudgetRegressor = 4e-6;   // W_j [rad/s, 1]
+constexpr double kBudgetTau = 3.0;          // control_step tau [N m]
+constexpr double kBudgetQdHat = 1e-2;       // control_step's observed joint velocity q^dot [rad/s]
+constexpr double kBudgetTauPerCount = 0.5;  // ... and at most this fraction of one encoder count's effect
 
 /// Largest absolute difference between a fixed-point and a double Eigen object.
 template <class A, class B>
@@ -128,8 +128,7 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
       if (flagged) {
         ++outside_flagged;
       } else {
-        const double rel = std::max({err(Lf, Ld) / largest(Ld), err(hf, h) / largest(h),
-                                     err(pgf, pg) / largest(pg)});
+        const double rel = std::max({err(Lf, Ld) / largest(Ld), err(hf, h) / largest(h), err(pgf, pg) / largest(pg)});
         outside_rel(rel);
         EXPECT_LE(rel, kOutsideRelative) << "an unflagged, inaccurate result at state " << k;
       }
@@ -179,8 +178,8 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
 /// A controller state in double and the same state in fixed point.
 template <class S>
 void set_state(ControllerState<S>& st, const Vec3<double>& p0, const Mat3<double>& R_ref, const Vec6<double>& x_hat,
-               const Vec6<double>& y, const Vec18<double>& theta, const Vec6<double>& q_prev,
-               const Vec6<double>& qd1, const Vec6<double>& qd2) {
+               const Vec6<double>& y, const Vec18<double>& theta, const Vec6<double>& q_prev, const Vec6<double>& qd1,
+               const Vec6<double>& qd2) {
   st.p0 = p0.cast<S>();
   st.R_ref = R_ref.cast<S>();
   st.obs.x_hat = x_hat.cast<S>();
@@ -198,7 +197,9 @@ void set_state(ControllerState<S>& st, const Vec3<double>& p0, const Mat3<double
 
 /// v rounded to Q12.19 (the double controller starts from exactly the fixed-point state).
 template <class V>
-auto quantised(const V& v) { return v.template cast<Fixed>().template cast<double>().eval(); }
+auto quantised(const V& v) {
+  return v.template cast<Fixed>().template cast<double>().eval();
+}
 
 TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
   test::RandomStates rs;
@@ -279,8 +280,10 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
       continue;
     }
     bool within_drives = true;  // the torques within the amplifiers' limits (beyond, the DACs clip)
-    for (int i = 0; i < kDof; ++i) within_drives = within_drives && std::abs(od.tau(i)) <= robot::kDrives.torque_limit[i];
-    if (largest(operational_inertia(sd->data, sd->os), h) > kDomain || sd->os.Jf.rcond < kDomainRcond || !within_drives) {
+    for (int i = 0; i < kDof; ++i)
+      within_drives = within_drives && std::abs(od.tau(i)) <= robot::kDrives.torque_limit[i];
+    if (largest(operational_inertia(sd->data, sd->os), h) > kDomain || sd->os.Jf.rcond < kDomainRcond ||
+        !within_drives) {
       ++outside;
       if (of.status == kFaultOverflow) {
         ++outside_flagged;
@@ -310,12 +313,14 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
     worst_rel = std::max(worst_rel, e / od.tau.cwiseAbs().maxCoeff());
     max_tau = std::max(max_tau, od.tau.cwiseAbs().maxCoeff());
   }
-  std::printf("outside the domain: %d states, %d of them flagged (overflow), the others' tau within %.1e relative "
-              "(the worst at rcond %.1e); %d states skipped at a joint velocity reversal\n", outside, outside_flagged,
-              outside_rel.v, outside_rcond, skipped_at_rest);
-  std::printf("control_step tau: worst |error| %.2e N m (budget %.1f), relative to max |tau| %.1e; largest |tau| %.1f N m; "
-              "worst error / effect of one encoder count %.3f (budget %.2f)\n",
-              worst, kBudgetTau, worst_rel, max_tau, worst_vs_count, kBudgetTauPerCount);
+  std::printf(
+      "outside the domain: %d states, %d of them flagged (overflow), the others' tau within %.1e relative "
+      "(the worst at rcond %.1e); %d states skipped at a joint velocity reversal\n",
+      outside, outside_flagged, outside_rel.v, outside_rcond, skipped_at_rest);
+  std::printf(
+      "control_step tau: worst |error| %.2e N m (budget %.1f), relative to max |tau| %.1e; largest |tau| %.1f N m; "
+      "worst error / effect of one encoder count %.3f (budget %.2f)\n",
+      worst, kBudgetTau, worst_rel, max_tau, worst_vs_count, kBudgetTauPerCount);
   std::printf("observed joint velocity q^dot: worst |error| %.2e rad/s (budget %.1e)\n", worst_qd_hat, kBudgetQdHat);
   EXPECT_LE(worst, kBudgetTau);
   EXPECT_LE(worst_qd_hat, kBudgetQdHat);
@@ -342,12 +347,14 @@ TEST(FixedKernels, TheTargetImagesReferenceValuesAreWhatTheHostComputes) {
   const std::vector<std::int32_t> committed(std::begin(reference::kValues), std::end(reference::kValues));
   if (got != committed) {
     std::printf("---- tests/fixed_reference_values.inc ----\n");
-    std::printf("// Generated by FixedKernels.TheTargetImagesReferenceValuesAreWhatTheHostComputes\n"
-                "// (tests/test_fixed_kernels.cpp): the raw Q12.19 outputs of kernel_outputs for each case, then\n"
-                "// step_outputs (tests/fixed_reference.hpp), %zu words.\n"
-                "constexpr std::int32_t kValues[] = {",
-                got.size());
-    for (std::size_t k = 0; k < got.size(); ++k) std::printf("%s%d", k % 10 ? ", " : (k ? ",\n    " : "\n    "), got[k]);
+    std::printf(
+        "// Generated by FixedKernels.TheTargetImagesReferenceValuesAreWhatTheHostComputes\n"
+        "// (tests/test_fixed_kernels.cpp): the raw Q12.19 outputs of kernel_outputs for each case, then\n"
+        "// step_outputs (tests/fixed_reference.hpp), %zu words.\n"
+        "constexpr std::int32_t kValues[] = {",
+        got.size());
+    for (std::size_t k = 0; k < got.size(); ++k)
+      std::printf("%s%d", k % 10 ? ", " : (k ? ",\n    " : "\n    "), got[k]);
     std::printf("};\n---- end ----\n");
   }
   EXPECT_EQ(got, committed);

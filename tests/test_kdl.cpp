@@ -91,8 +91,8 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
   const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
   test::RandomStates rs;
-  Worst w_fk{"FK, all link frames [R p]"}, w_jac{"geometric Jacobian"}, w_A{"A(q) with armature"},
-      w_c{"c(q, qd)"}, w_g{"g(q)"}, w_jd{"Jdot qd (HYBRID)"};
+  Worst w_fk{"FK, all link frames [R p]"}, w_jac{"geometric Jacobian"}, w_A{"A(q) with armature"}, w_c{"c(q, qd)"},
+      w_g{"g(q)"}, w_jd{"Jdot qd (HYBRID)"};
   KDL::Jacobian J(kDof);
   KDL::JntSpaceInertiaMatrix H(kDof);
   KDL::JntArray C(kDof), G(kDof);

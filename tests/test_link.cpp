@@ -128,10 +128,10 @@ struct LinkNode : ::testing::Test {
 // ---------------------------------------------------------------- every error kind, lockstep
 struct ErrorCase {
   const char* name;
-  pil::LinkError counter;      // the counter that counts it
-  std::uint32_t fault;         // the fault repeated errors latch
-  int error_ticks;             // ticks at zero per injection (a lost sync also costs the next frame)
-  int answer_seq_offset;       // the answer's sequence number relative to the first frame used
+  pil::LinkError counter;  // the counter that counts it
+  std::uint32_t fault;     // the fault repeated errors latch
+  int error_ticks;         // ticks at zero per injection (a lost sync also costs the next frame)
+  int answer_seq_offset;   // the answer's sequence number relative to the first frame used
   std::function<Answers(LinkNode&)> inject;
 };
 
@@ -307,8 +307,13 @@ TEST_F(LinkNode, TimerPacedCorruptionZeroesTheNextTick) {
       [](LinkNode& t) { return with(t.frame(), 10, 0x40); },  // bad CRC
       [](LinkNode& t) { return with(t.frame(), 2, 0x07); },   // bad header
       [](LinkNode& t) { return with(t.frame(), 3, 0x01); },   // bad length
-      [](LinkNode&) { return Bytes{0x01, 0x02, 0x03}; },      // junk between frames
-      [](LinkNode& t) { ++t.seq; return t.frame(); },          // wrong sequence number
+      [](LinkNode&) {
+        return Bytes{0x01, 0x02, 0x03};
+      },  // junk between frames
+      [](LinkNode& t) {
+        ++t.seq;
+        return t.frame();
+      },  // wrong sequence number
   };
   for (const auto& make : corrupt) {
     restart();

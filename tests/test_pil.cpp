@@ -187,23 +187,24 @@ TEST(PilClientAmplifiers, OnlyAValidInRangeAnswerToTheTickIsApplied) {
   using X = PilClient::Exchange;
   const std::int32_t max = static_cast<std::int32_t>(osc::kDacMaxCode);
   ScriptedPeer peer;
-  peer.add(ScriptedPeer::answer(0, -max));      // tick 0: at the range limit, applied
+  peer.add(ScriptedPeer::answer(0, -max));  // tick 0: at the range limit, applied
   peer.add(ScriptedPeer::answer(1, max));
-  peer.bytes.back() ^= 0x01;                    // tick 1: corrupt (CRC)
+  peer.bytes.back() ^= 0x01;  // tick 1: corrupt (CRC)
   pil::ActuatorFrame big = ScriptedPeer::answer(2, 100);
-  big.codes[3] = max + 1;                       // tick 2: one code out of range
+  big.codes[3] = max + 1;  // tick 2: one code out of range
   peer.add(big);
   peer.bytes.insert(peer.bytes.end(), {0x00, 0xA5, 0x01});  // junk
-  peer.add(ScriptedPeer::answer(2, 7));         // a stale answer (to tick 2), skipped
-  peer.add(ScriptedPeer::answer(3, 300));       // tick 3: applied
-  peer.add(ScriptedPeer::answer(5, 400));       // tick 4: answered as tick 5: not this tick's
+  peer.add(ScriptedPeer::answer(2, 7));                     // a stale answer (to tick 2), skipped
+  peer.add(ScriptedPeer::answer(3, 300));                   // tick 3: applied
+  peer.add(ScriptedPeer::answer(5, 400));                   // tick 4: answered as tick 5: not this tick's
   PilClient c;
   std::string err;
   ASSERT_TRUE(c.start(peer.command(), err, 5.0)) << err;
   struct Want {
     X x;
     std::int32_t code0;
-  } want[] = {{X::kApplied, -max}, {X::kZeroed, 0}, {X::kZeroed, 0}, {X::kApplied, 300}, {X::kZeroed, 0}, {X::kLost, 0}};
+  } want[] = {{X::kApplied, -max}, {X::kZeroed, 0}, {X::kZeroed, 0},
+              {X::kApplied, 300},  {X::kZeroed, 0}, {X::kLost, 0}};
   for (std::uint32_t k = 0; k < 6; ++k) {
     pil::SensorFrame s;
     s.seq = k;
@@ -315,8 +316,10 @@ TEST_F(Link, SlowHostOrDescheduledEmulatorIsNeitherAFaultNorAReset) {
   static_assert(osc::params::kLinkTimeout > 0.05, "the waits stay below the link timeout");
   healthy(3);
   for (int k = 0; k < 10; ++k) {
-    if (k % 2) std::this_thread::sleep_for(std::chrono::milliseconds(30));
-    else ASSERT_TRUE(link.freeze_peer(0.03, err)) << err;
+    if (k % 2)
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    else
+      ASSERT_TRUE(link.freeze_peer(0.03, err)) << err;
     const pil::ActuatorFrame a = exchange();
     ASSERT_EQ(a.faults, 0u) << osc::fault_name(a.faults);
     ASSERT_EQ(a.seq, seq - 1);
@@ -338,7 +341,7 @@ TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
 
 TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
   healthy(5);
-  expect_zeroed_once(answer(with(frame(), 2, 0x07)), pil::kErrHeader);  // unknown frame type
+  expect_zeroed_once(answer(with(frame(), 2, 0x07)), pil::kErrHeader);                       // unknown frame type
   EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
 }
 
@@ -445,10 +448,11 @@ TEST(PilClosedLoop, TracksLikeTheInProcessController) {
   }
   std::printf("firmware step: max %u, mean %u cycles; stack used %u bytes\n", remote.max_step_cycles,
               remote.mean_step_cycles, remote.stack_used);
-  std::printf("link: longest gap between bytes received by the firmware %u cycles, %u gaps over %d periods; "
-              "link errors: firmware %u, host %u\n",
-              remote.link.rx_gap_max, remote.link.rx_long_gaps, osc::params::kLinkSilenceTicks,
-              remote.link.firmware.total(), remote.link.host.total());
+  std::printf(
+      "link: longest gap between bytes received by the firmware %u cycles, %u gaps over %d periods; "
+      "link errors: firmware %u, host %u\n",
+      remote.link.rx_gap_max, remote.link.rx_long_gaps, osc::params::kLinkSilenceTicks, remote.link.firmware.total(),
+      remote.link.host.total());
   EXPECT_TRUE(remote.link.clean());
   // Same float code on both sides; on the target the compiler (contracted multiply-adds) and libm
   // (sinf, cosf, expf, atan2f) differ in the last bits. After the start transient (the second half
@@ -513,7 +517,8 @@ TEST(PilQemu, TheUartAndTheSemihostingLinkRunTheSameLoopBitForBit) {
   for (std::size_t k = 0; k < r[0].log.size(); ++k) {
     const LogRow &u = r[0].log[k], &v = r[1].log[k];
     bool same = u.t == v.t;
-    for (int i = 0; i < 6; ++i) same = same && u.tau[i] == v.tau[i] && u.e[i] == v.e[i] && u.tau_f_hat[i] == v.tau_f_hat[i];
+    for (int i = 0; i < 6; ++i)
+      same = same && u.tau[i] == v.tau[i] && u.e[i] == v.e[i] && u.tau_f_hat[i] == v.tau_f_hat[i];
     for (int i = 0; i < 18; ++i) same = same && u.theta_hat[i] == v.theta_hat[i];
     differ += !same;
   }
@@ -521,8 +526,8 @@ TEST(PilQemu, TheUartAndTheSemihostingLinkRunTheSameLoopBitForBit) {
   for (int i = 0; i < 6; ++i) EXPECT_EQ(r[1].max_error[i], r[0].max_error[i]) << i;
   for (int i = 0; i < 18; ++i) EXPECT_EQ(r[1].theta_hat[i], r[0].theta_hat[i]) << i;
   EXPECT_EQ(r[1].friction_rms_error, r[0].friction_rms_error);
-  std::printf("bit for bit: %zu ticks of torques, errors, theta^ and friction estimates, %zu differ\n",
-              r[0].log.size(), differ);
+  std::printf("bit for bit: %zu ticks of torques, errors, theta^ and friction estimates, %zu differ\n", r[0].log.size(),
+              differ);
 }
 
 // The machine comes from the image's build attributes; anything else is refused with a reason.
@@ -557,10 +562,12 @@ TEST(PilClosedLoop, TheAdaptationLawIsConfiguredOverTheLink) {
     c.pil_command = peer_command();
     remote_of[l] = run_experiment(c);
     ASSERT_TRUE(remote_of[l].error.empty()) << remote_of[l].error;
-    for (int i = 0; i < 18; ++i) spread[l] = std::max(spread[l], std::abs(remote_of[l].theta_hat[i] - local.theta_hat[i]));
+    for (int i = 0; i < 18; ++i)
+      spread[l] = std::max(spread[l], std::abs(remote_of[l].theta_hat[i] - local.theta_hat[i]));
   }
   double between = 0;
-  for (int i = 0; i < 18; ++i) between = std::max(between, std::abs(remote_of[0].theta_hat[i] - remote_of[1].theta_hat[i]));
+  for (int i = 0; i < 18; ++i)
+    between = std::max(between, std::abs(remote_of[0].theta_hat[i] - remote_of[1].theta_hat[i]));
   std::printf("theta^ over the link vs in process: paper %.3g, robust %.3g; paper vs robust %.3g\n", spread[0],
               spread[1], between);
   double lowest[2] = {0, 0};

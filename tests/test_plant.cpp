@@ -15,9 +15,7 @@ using namespace sim;
 
 namespace {
 
-Vec6 q_start() {
-  return osc::joint_vector<double>(osc::robot::kQStart);
-}
+Vec6 q_start() { return osc::joint_vector<double>(osc::robot::kQStart); }
 
 TEST(Plant, ArticulatedBodyInvertsTheKernelsInverseDynamics) {
   // ABA (plant) and CRBA/RNEA (controller kernels) are separate code paths: A qdd + c + g must
@@ -92,9 +90,12 @@ TEST(Plant, HalvingTheStepInOpenLoop) {
     return plant.q();
   };
   const double smooth = (run(1e-4, osc::kFrictionNone) - run(5e-5, osc::kFrictionNone)).cwiseAbs().maxCoeff();
-  const double rough = (run(1e-4, osc::robot::kFrictionPaper) - run(5e-5, osc::robot::kFrictionPaper)).cwiseAbs().maxCoeff();
-  std::printf("open loop, step 1e-4 vs 5e-5 s, max joint-angle difference after 2 s: %.2e rad without friction, "
-              "%.2e rad with the paper's friction\n", smooth, rough);
+  const double rough =
+      (run(1e-4, osc::robot::kFrictionPaper) - run(5e-5, osc::robot::kFrictionPaper)).cwiseAbs().maxCoeff();
+  std::printf(
+      "open loop, step 1e-4 vs 5e-5 s, max joint-angle difference after 2 s: %.2e rad without friction, "
+      "%.2e rad with the paper's friction\n",
+      smooth, rough);
   EXPECT_LT(smooth, 1e-9);
   EXPECT_LT(rough, 5e-4);  // a few encoder counts (one count is 6e-5 .. 1.2e-4 rad on joints 1-3)
 }
@@ -118,9 +119,10 @@ TEST(Plant, HalvingTheStepChangesA10sClosedLoopRunByLessThanTolerance) {
   double dmax_pos = 0, dmax_ang = 0;
   for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
   for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
-  std::printf("closed loop, step %.0e vs %.0e s: max sample difference %.3f mm %.4f deg; max-error statistics "
-              "differ by %.4f mm %.5f deg\n",
-              a.plant.substep, b.plant.substep, dpos, dang, dmax_pos, dmax_ang);
+  std::printf(
+      "closed loop, step %.0e vs %.0e s: max sample difference %.3f mm %.4f deg; max-error statistics "
+      "differ by %.4f mm %.5f deg\n",
+      a.plant.substep, b.plant.substep, dpos, dang, dmax_pos, dmax_ang);
   // Stated tolerance on the table entries: one encoder quantum at the start pose (0.069 mm) and 0.01 deg.
   EXPECT_LT(dmax_pos, 0.069);
   EXPECT_LT(dmax_ang, 0.01);
@@ -153,11 +155,14 @@ TEST(Plant, SmoothStepsAgreeWithTheFixedStep) {
   const int s = PlantConfig{}.smooth_steps;
   ASSERT_GT(s, 1);
   long n_fixed = 0, n_smooth = 0;
-  const double smooth = (run(1, osc::kFrictionNone, &n_fixed) - run(s, osc::kFrictionNone, &n_smooth)).cwiseAbs().maxCoeff();
-  const double rough = (run(1, osc::robot::kFrictionPaper, nullptr) - run(s, osc::robot::kFrictionPaper, nullptr)).cwiseAbs().maxCoeff();
-  std::printf("open loop, %d substeps at once vs fixed: max joint-angle difference after 2 s %.2e rad without friction, "
-              "%.2e rad with the paper's friction; %.1f vs %.1f evaluations per sample\n",
-              s, smooth, rough, n_smooth / 2000.0, n_fixed / 2000.0);
+  const double smooth =
+      (run(1, osc::kFrictionNone, &n_fixed) - run(s, osc::kFrictionNone, &n_smooth)).cwiseAbs().maxCoeff();
+  const double rough =
+      (run(1, osc::robot::kFrictionPaper, nullptr) - run(s, osc::robot::kFrictionPaper, nullptr)).cwiseAbs().maxCoeff();
+  std::printf(
+      "open loop, %d substeps at once vs fixed: max joint-angle difference after 2 s %.2e rad without friction, "
+      "%.2e rad with the paper's friction; %.1f vs %.1f evaluations per sample\n",
+      s, smooth, rough, n_smooth / 2000.0, n_fixed / 2000.0);
   EXPECT_LT(smooth, 1e-9);
   EXPECT_LT(rough, 5e-4);
   EXPECT_EQ(n_fixed, 2000 * 40);
@@ -180,10 +185,12 @@ TEST(Plant, SmoothStepsAgreeWithTheFixedStep) {
   double dmax_pos = 0, dmax_ang = 0;
   for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
   for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
-  const double per_sample_a = static_cast<double>(ra.plant_evaluations) / 10000, per_sample_b = static_cast<double>(rb.plant_evaluations) / 10000;
-  std::printf("closed loop, %d substeps at once vs fixed: max sample difference %.3f mm %.4f deg; max-error statistics "
-              "differ by %.4f mm %.5f deg; %.1f vs %.1f evaluations per sample\n",
-              s, dpos, dang, dmax_pos, dmax_ang, per_sample_b, per_sample_a);
+  const double per_sample_a = static_cast<double>(ra.plant_evaluations) / 10000,
+               per_sample_b = static_cast<double>(rb.plant_evaluations) / 10000;
+  std::printf(
+      "closed loop, %d substeps at once vs fixed: max sample difference %.3f mm %.4f deg; max-error statistics "
+      "differ by %.4f mm %.5f deg; %.1f vs %.1f evaluations per sample\n",
+      s, dpos, dang, dmax_pos, dmax_ang, per_sample_b, per_sample_a);
   EXPECT_LT(dmax_pos, 0.069);
   EXPECT_LT(dmax_ang, 0.01);
   EXPECT_LT(dpos, 0.15);

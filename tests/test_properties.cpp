@@ -104,8 +104,7 @@ TEST_F(Props, AnalyticJacobianAndJdotMatchFiniteDifferences) {
     }
     worst_Jd = std::max(worst_Jd, (jd_fd - jd).norm() / std::max(jd.norm(), 1e-3));
   }
-  std::printf("analytic Jacobian vs central differences: %.2e; analytic Jdot qd: %.2e (relative)\n", worst_J,
-              worst_Jd);
+  std::printf("analytic Jacobian vs central differences: %.2e; analytic Jdot qd: %.2e (relative)\n", worst_J, worst_Jd);
   EXPECT_LT(worst_J, 1e-7);
   EXPECT_LT(worst_Jd, 1e-6);
 }
@@ -163,8 +162,8 @@ TEST_F(Props, PsiAndChristoffelFormsAreSymmetricBilinear) {
     const Vec6<double> cq = velocity_products(model, data, u).c;
     worst_c = std::max(worst_c, (coriolis_matrix(model, data, u) * u - cq).norm() / std::max(cq.norm(), 1e-9));
   }
-  std::printf("relative: (8) %.1e, property 2 %.1e, psi_quadratic vs psi_bilinear %.1e, B qd vs c %.1e\n",
-              worst_psi, worst_B, worst_h, worst_c);
+  std::printf("relative: (8) %.1e, property 2 %.1e, psi_quadratic vs psi_bilinear %.1e, B qd vs c %.1e\n", worst_psi,
+              worst_B, worst_h, worst_c);
   EXPECT_LT(worst_psi, 1e-10);
   EXPECT_LT(worst_B, 1e-12);
   EXPECT_LT(worst_h, 1e-12);
@@ -183,8 +182,8 @@ TEST_F(Props, FrictionRegressorReproducesModel2IncludingZeroVelocity) {
   for (int k = 0; k < kStates; ++k) {
     Vec6<double> qd = rs.vec(2.0);
     const int rest = k % kDof;
-    qd(rest) = 0.0;                                     // sgn(0) = 0: no friction on a joint at rest
-    if (k % 3 == 0) qd((rest + 3) % kDof) = -0.0;       // negative zero too
+    qd(rest) = 0.0;                                // sgn(0) = 0: no friction on a joint at rest
+    if (k % 3 == 0) qd((rest + 3) % kDof) = -0.0;  // negative zero too
     Vec6<double> tau, tw;
     Regressor<double> W;
     {
@@ -227,9 +226,10 @@ TEST_F(Props, BlockFactorisationOfTheJacobian) {
     worst_t = std::max(worst_t, (xt - rt).norm() / rt.norm());
     min_rcond = std::min(min_rcond, static_cast<double>(os.Jf.rcond));
   }
-  std::printf("J factor vs dense 6x6 LU, relative: solve %.1e, solve_transpose %.1e; |J12| max %.1e; "
-              "min rcond on random states %.1e\n",
-              worst_s, worst_t, worst_block, min_rcond);
+  std::printf(
+      "J factor vs dense 6x6 LU, relative: solve %.1e, solve_transpose %.1e; |J12| max %.1e; "
+      "min rcond on random states %.1e\n",
+      worst_s, worst_t, worst_block, min_rcond);
   EXPECT_LT(worst_block, 1e-15);
   EXPECT_LT(worst_s, 1e-10);
   EXPECT_LT(worst_t, 1e-10);
@@ -237,7 +237,7 @@ TEST_F(Props, BlockFactorisationOfTheJacobian) {
 
   // Named poses: qz, qr and qs are wrist-singular (q5 = 0); qn is well conditioned.
   SphericalWristJacobianFactor<double> f;
-  auto rcond_at = [&](const double (&pose)[kDof]) {
+  auto rcond_at = [&](const double(&pose)[kDof]) {
     NoMalloc guard;
     forward_kinematics(model, data, test::from_array(pose));
     geometric_jacobian(data);
@@ -304,9 +304,10 @@ TEST_F(Props, FloatKernelsAgreeWithDouble) {
     wP = std::max(wP, rel(hf, h));
     wF = std::max(wF, rel(tff, tf));
   }
-  std::printf("float vs double, max relative: A %.1e, J %.1e, Ja %.1e, Lambda %.1e, g %.1e, c %.1e, Psi %.1e, "
-              "tau_f %.1e\n",
-              wA, wJ, wJa, wL, wg, wc, wP, wF);
+  std::printf(
+      "float vs double, max relative: A %.1e, J %.1e, Ja %.1e, Lambda %.1e, g %.1e, c %.1e, Psi %.1e, "
+      "tau_f %.1e\n",
+      wA, wJ, wJa, wL, wg, wc, wP, wF);
   EXPECT_LT(wA, 1e-4);
   EXPECT_LT(wJ, 1e-4);
   EXPECT_LT(wJa, 1e-4);
@@ -371,8 +372,10 @@ TEST(FloatFunctions, SinCosAndExpWithinTheirStatedErrors) {
     const double e = std::abs(math::exp(v) - exact) / exact;
     if (e > we) we = e, we_at = v;
   }
-  std::printf("float sin: worst |error| %.2e at %.4f, cos %.2e (stated 6e-8); exp: worst relative %.2e at %.4f "
-              "(stated 2.4e-7)\n", ws, ws_at, wc, we, we_at);
+  std::printf(
+      "float sin: worst |error| %.2e at %.4f, cos %.2e (stated 6e-8); exp: worst relative %.2e at %.4f "
+      "(stated 2.4e-7)\n",
+      ws, ws_at, wc, we, we_at);
   EXPECT_LE(ws, 6e-8);
   EXPECT_LE(wc, 6e-8);
   EXPECT_LE(we, 2.4e-7);

@@ -157,14 +157,13 @@ TEST(Stm32Encoders, SixteenBitCountersUnwrapAcrossBothWraps) {
   std::int32_t c[hal::kJoints];
   // Steps of up to 30000 counts between ticks (below the 32768 limit), through 0 and 65535 both ways.
   const std::vector<std::pair<std::uint32_t, std::int32_t>> steps = {
-      {65530u, -6},      // backwards through 0
-      {30000u, 30000},   // forwards through 0 again (+30006)
-      {60000u, 60000},   // forwards
-      {24464u, 90000},   // forwards through 65535 (+30000)
-      {60000u, 60000},   // backwards through 65535 (-30000)
-      {35536u, 35536},   // backwards
-      {5536u, 5536},
-      {45536u, -20000},  // backwards through 0 (-25536)
+      {65530u, -6},                       // backwards through 0
+      {30000u, 30000},                    // forwards through 0 again (+30006)
+      {60000u, 60000},                    // forwards
+      {24464u, 90000},                    // forwards through 65535 (+30000)
+      {60000u, 60000},                    // backwards through 65535 (-30000)
+      {35536u, 35536},                    // backwards
+      {5536u, 5536},   {45536u, -20000},  // backwards through 0 (-25536)
   };
   for (const auto& [raw, want] : steps) {
     t.CNT = raw;
@@ -201,7 +200,8 @@ TEST(Stm32Encoders, EveryJointReadsItsOwnTimer) {
   FakeChip f;
   EncoderBank enc;
   enc.init(f.chip());
-  for (int j = 0; j < hal::kJoints; ++j) f.timer(pins::kEncoders[j].timer).CNT = static_cast<std::uint32_t>(10 * (j + 1));
+  for (int j = 0; j < hal::kJoints; ++j)
+    f.timer(pins::kEncoders[j].timer).CNT = static_cast<std::uint32_t>(10 * (j + 1));
   std::int32_t c[hal::kJoints];
   enc.read(c);
   for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(c[j], 10 * (j + 1));
@@ -267,8 +267,8 @@ TEST(Stm32Dac, InitSetsTheRangeAndZeroBeforePoweringUp) {
   using E = RecordingBus::Event;
   std::vector<E::Kind> kinds;
   for (const E& e : bus.events) kinds.push_back(e.kind);
-  const std::vector<E::Kind> want = {E::kFrame, E::kFrame, E::kFrame, E::kFrame, E::kFrame, E::kFrame,
-                                     E::kLdac,  E::kFrame, E::kFrame};
+  const std::vector<E::Kind> want = {E::kFrame, E::kFrame, E::kFrame, E::kFrame, E::kFrame,
+                                     E::kFrame, E::kLdac,  E::kFrame, E::kFrame};
   ASSERT_EQ(kinds, want);
   for (int c = 0; c < 2; ++c) {
     EXPECT_EQ(bus.events[3 * c].frame, (ad5754r::Frame{{0x0C, 0x00, 0x04}})) << "±10 V, all channels";

@@ -14,10 +14,14 @@ namespace {
 Supervisor oracle(Supervisor s, SupervisorInput in) {
   Supervisor n = s;
   n.latched = s.latched | in.faults;  // every bit, named in the catalogue or not
-  if (s.state == SupervisorState::kFault) n.state = SupervisorState::kFault;
-  else if (n.latched) n.state = SupervisorState::kFault;
-  else if (s.state == SupervisorState::kInit) n.state = in.ready ? SupervisorState::kRun : SupervisorState::kInit;
-  else n.state = SupervisorState::kRun;
+  if (s.state == SupervisorState::kFault)
+    n.state = SupervisorState::kFault;
+  else if (n.latched)
+    n.state = SupervisorState::kFault;
+  else if (s.state == SupervisorState::kInit)
+    n.state = in.ready ? SupervisorState::kRun : SupervisorState::kInit;
+  else
+    n.state = SupervisorState::kRun;
   return n;
 }
 
@@ -140,7 +144,7 @@ TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
 
 TEST_F(TaskFixture, EncoderJumpFaultsInTheSameTick) {
   run(3);
-  hal.counts[1] += task->max_count_step[1];  // the largest plausible step is no jump (the torque it
+  hal.counts[1] += task->max_count_step[1];   // the largest plausible step is no jump (the torque it
   EXPECT_EQ(run(1) & kFaultEncoderJump, 0u);  // asks for while the other joints stand still is another matter)
   hal.counts[1] += task->max_count_step[1] + 1;
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
@@ -159,7 +163,8 @@ TEST_F(TaskFixture, ReadingsWithinTheLimitsPlusMarginAreAcceptedBeyondThemNot) {
   // The first sample at the edge of the plausible range of joint 1 (its limit plus the margin,
   // less one count): accepted; one count further: a fault.
   const double c = task->counts_per_rad(0);
-  const auto edge = static_cast<std::int32_t>((robot::kArm.q_max[0] + params::kJointLimitMargin - robot::kQStart[0]) * c);
+  const auto edge =
+      static_cast<std::int32_t>((robot::kArm.q_max[0] + params::kJointLimitMargin - robot::kQStart[0]) * c);
   hal.counts[0] = edge;
   run(1);
   EXPECT_EQ(task->sup.latched & kFaultEncoderRange, 0u);
@@ -276,14 +281,14 @@ TEST_F(TaskFixture, ATickWithoutASampleCommandsZeroTorqueWithoutAFault) {
   const std::uint32_t steps = task->step_timing.count;
   hal.sample = false;
   EXPECT_EQ(run(1), 0u);
-  EXPECT_TRUE(hal.all_zero());                      // zero codes in this tick
-  EXPECT_EQ(task->step_timing.count, steps);        // no control step
+  EXPECT_TRUE(hal.all_zero());                        // zero codes in this tick
+  EXPECT_EQ(task->step_timing.count, steps);          // no control step
   EXPECT_EQ(task->sup.state, SupervisorState::kRun);  // and no latch
   EXPECT_FALSE(hal.fault_line);
-  EXPECT_EQ(task->tick, tick + 1);                  // the sample clock runs on
+  EXPECT_EQ(task->tick, tick + 1);  // the sample clock runs on
   hal.sample = true;
   EXPECT_EQ(run(1), 0u);
-  EXPECT_FALSE(hal.all_zero());                     // torque again with the next sample
+  EXPECT_FALSE(hal.all_zero());  // torque again with the next sample
 }
 
 TEST_F(TaskFixture, TheEncoderJumpLimitSpansTheTicksWithoutASample) {

@@ -34,8 +34,8 @@ struct RandomStates {
         const double lo = robot::kArm.q_min[i], hi = robot::kArm.q_max[i];
         q(i) = lo + (hi - lo) * 0.5 * (u(rng) + 1.0);
       }
-      if (std::abs(std::sin(q(4))) < 0.2) continue;                      // wrist
-      if (std::abs(std::cos(q(2) + 0.047)) < 0.2) continue;              // elbow (stretched/folded)
+      if (std::abs(std::sin(q(4))) < 0.2) continue;          // wrist
+      if (std::abs(std::cos(q(2) + 0.047)) < 0.2) continue;  // elbow (stretched/folded)
       return q;
     }
   }

@@ -86,8 +86,7 @@ class DacPair {
       ok = bus_.write(c, frame(kDacRegister, kAllChannels, 0)) && ok;
     }
     bus_.ldac_pulse();
-    for (int c = 0; c < kChips; ++c)
-      ok = bus_.write(c, frame(kPowerControl, 0, kPowerUpABC | kPowerUpReference)) && ok;
+    for (int c = 0; c < kChips; ++c) ok = bus_.write(c, frame(kPowerControl, 0, kPowerUpABC | kPowerUpReference)) && ok;
     return ok;
   }
 

@@ -73,7 +73,9 @@ constexpr std::uint32_t kQemuTimerHz = 1000000000, kQemuCpuHz = 168000000;
 /// QEMU 7.2's timer model re-bases its count on every write to PSC, CNT or EGR.UG and then fires
 /// after ARR plus that base instead of ARR + 1 counts: the QEMU image runs TIM2 unprescaled with
 /// its 32-bit reload (999 999 at 1 GHz: 1 ms) and writes none of the three (control_timer_start).
-constexpr stm32f4::TimerDivider qemu_control_divider() { return stm32f4::control_divider_32bit(kQemuTimerHz, kControlHz); }
+constexpr stm32f4::TimerDivider qemu_control_divider() {
+  return stm32f4::control_divider_32bit(kQemuTimerHz, kControlHz);
+}
 
 // ---------------------------------------------------------------- telemetry
 constexpr std::uint32_t kTelemetryBaud = 460800;
@@ -154,8 +156,8 @@ struct Board {
       chip.rcc->APB1ENR = chip.rcc->APB1ENR | stm32f4::RccRegs::kTim6En;
       stm32f4::read_back(chip.rcc->APB1ENR);
     }
-    stm32f4::control_timer_start(chip.timer(kControlTimer), kQemu ? qemu_control_divider()
-                                                                  : stm32f4::control_divider(timer_hz(), kControlHz));
+    stm32f4::control_timer_start(chip.timer(kControlTimer),
+                                 kQemu ? qemu_control_divider() : stm32f4::control_divider(timer_hz(), kControlHz));
     cortex_m::irq_enable(kControlIrq);
   }
   /// The control timer's acknowledgement, first thing in its interrupt.
@@ -172,9 +174,15 @@ struct Board {
   }
   /// The boot report, one line: "<fault or ok>, sysclk, reset cause".
   cortex_m::text::Line& describe(cortex_m::text::Line& l) const {
-    return l.str("boot ").str(stm32f4::boot_fault_name(boot)).str(", sysclk ").u32(clocks.sysclk)
-        .str(clocks.on_pll() ? " Hz (HSE, PLL)" : " Hz (HSI fallback)").str(", reset cause ")
-        .str(reset_cause_name(reset_flags)).str(", cycle counter ").str(CycleCounter::dwt ? "DWT" : "SysTick");
+    return l.str("boot ")
+        .str(stm32f4::boot_fault_name(boot))
+        .str(", sysclk ")
+        .u32(clocks.sysclk)
+        .str(clocks.on_pll() ? " Hz (HSE, PLL)" : " Hz (HSI fallback)")
+        .str(", reset cause ")
+        .str(reset_cause_name(reset_flags))
+        .str(", cycle counter ")
+        .str(CycleCounter::dwt ? "DWT" : "SysTick");
   }
 
  private:

@@ -27,13 +27,20 @@ enum class BootFault : std::uint8_t {
 };
 constexpr const char* boot_fault_name(BootFault f) {
   switch (f) {
-    case BootFault::kNone: return "none";
-    case BootFault::kHseTimeout: return "hse_timeout";
-    case BootFault::kPllTimeout: return "pll_timeout";
-    case BootFault::kFlashLatency: return "flash_latency";
-    case BootFault::kSwitchTimeout: return "clock_switch_timeout";
-    case BootFault::kWatchdogSetup: return "watchdog_setup";
-    case BootFault::kDacSetup: return "dac_setup";
+    case BootFault::kNone:
+      return "none";
+    case BootFault::kHseTimeout:
+      return "hse_timeout";
+    case BootFault::kPllTimeout:
+      return "pll_timeout";
+    case BootFault::kFlashLatency:
+      return "flash_latency";
+    case BootFault::kSwitchTimeout:
+      return "clock_switch_timeout";
+    case BootFault::kWatchdogSetup:
+      return "watchdog_setup";
+    case BootFault::kDacSetup:
+      return "dac_setup";
   }
   return "?";
 }
@@ -80,8 +87,7 @@ inline Clocks clock_fallback(RccRegs& rcc, BootFault why, const ClockPolls& poll
 
 /// Sets up the clock tree (runs on HSI, from reset, before any peripheral is clocked). Returns the
 /// clocks in use: kPllClocks, or kHsiClocks with the step that failed.
-inline Clocks clock_init(RccRegs& rcc, FlashRegs& flash, const ClockPolls& polls = {},
-                         const PllSetting& pll = kPll) {
+inline Clocks clock_init(RccRegs& rcc, FlashRegs& flash, const ClockPolls& polls = {}, const PllSetting& pll = kPll) {
   rcc.CR = rcc.CR | RccRegs::kHseOn;
   if (!poll_until([&] { return (rcc.CR & RccRegs::kHseRdy) != 0; }, polls.hse))
     return detail::clock_fallback(rcc, BootFault::kHseTimeout, polls);

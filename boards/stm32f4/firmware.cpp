@@ -37,8 +37,8 @@ struct Snapshot {
   bool amplifier;
 };
 Snapshot g_before_estop{}, g_after_estop{};
-volatile std::uint32_t g_estop_seen_at = 0;      // ticks completed when the E-stop interrupt ran
-volatile std::uint32_t g_estop_latched_in = 0;   // the tick that latched `estop`
+volatile std::uint32_t g_estop_seen_at = 0;     // ticks completed when the E-stop interrupt ran
+volatile std::uint32_t g_estop_latched_in = 0;  // the tick that latched `estop`
 
 Snapshot snapshot() {
   std::int32_t w = 0;
@@ -46,7 +46,11 @@ Snapshot snapshot() {
     const std::int32_t c = g_board.hal.written()[i];
     w = c > w ? c : -c > w ? -c : w;
   }
-  return {g_task.sup.state, g_task.sup.latched, g_board.hal.feeds(), g_task.codes[1], w,
+  return {g_task.sup.state,
+          g_task.sup.latched,
+          g_board.hal.feeds(),
+          g_task.codes[1],
+          w,
           g_board.safety.amplifier_enabled()};
 }
 
@@ -60,7 +64,8 @@ extern "C" void OSC_CONTROL_TIMER_HANDLER() {
   }
   g_faults = g_faults | g_board.hal.tick(g_task);
   if (k % board::kTelemetryEvery == 0) {
-    const int n = pil::encode(osc::telemetry_frame(g_task, g_board.hal.written(), k, cortex_m::stack_used_sweep()), g_frame);
+    const int n =
+        pil::encode(osc::telemetry_frame(g_task, g_board.hal.written(), k, cortex_m::stack_used_sweep()), g_frame);
     if (g_board.uart.offer(g_frame, n)) ++g_frames;
   }
   if constexpr (board::kQemu) {
@@ -112,25 +117,79 @@ int smoke_verdict() {
 
   Line l1;
   g_board.describe(l1).emit();
-  Line().str("ticks ").u32(g_ticks).str(", spacing ").u32(lo).str("..").u32(hi).str(" cycles (period ").u32(period)
-      .str(")").emit();
-  Line().str("control step: max ").u32(g_task.step_timing.max).str(", mean ").u32(g_task.step_timing.mean())
-      .str(" cycles; whole tick max ").u32(g_task.timing.max).str(" cycles (").u32(g_task.timing.max * 1000u / 168u)
-      .str(" instructions at -icount shift=0)").emit();
-  Line().str("before the E-stop: state ").u32(static_cast<std::uint32_t>(b.state)).str(", faults ").u32(b.latched)
-      .str(", torque code joint 2 ").i32(b.task_code).str(", DAC codes written ")
-      .str(b.written_max == 0 ? "zero" : "NONZERO").str(" (boot fault), amplifier ").str(b.amplifier ? "ON" : "off")
-      .str(", watchdog feeds ").u32(b.feeds).emit();
-  Line().str("E-stop: interrupt after tick ").u32(g_estop_seen_at).str(", latched by tick ").u32(g_estop_latched_in)
-      .str(", faults ").str(osc::fault_name(a.latched)).str(", DAC codes ").str(a.written_max == 0 ? "zero" : "NONZERO")
-      .str(", amplifier ").str(a.amplifier ? "ON" : "off").str(", watchdog feeds ").u32(a.feeds).emit();
-  Line().str("telemetry: ").u32(g_frames).str(" frames, ").u32(g_board.uart.dropped()).str(" dropped; stack used ")
-      .u32(cortex_m::stack_used()).str(" bytes").emit();
+  Line()
+      .str("ticks ")
+      .u32(g_ticks)
+      .str(", spacing ")
+      .u32(lo)
+      .str("..")
+      .u32(hi)
+      .str(" cycles (period ")
+      .u32(period)
+      .str(")")
+      .emit();
+  Line()
+      .str("control step: max ")
+      .u32(g_task.step_timing.max)
+      .str(", mean ")
+      .u32(g_task.step_timing.mean())
+      .str(" cycles; whole tick max ")
+      .u32(g_task.timing.max)
+      .str(" cycles (")
+      .u32(g_task.timing.max * 1000u / 168u)
+      .str(" instructions at -icount shift=0)")
+      .emit();
+  Line()
+      .str("before the E-stop: state ")
+      .u32(static_cast<std::uint32_t>(b.state))
+      .str(", faults ")
+      .u32(b.latched)
+      .str(", torque code joint 2 ")
+      .i32(b.task_code)
+      .str(", DAC codes written ")
+      .str(b.written_max == 0 ? "zero" : "NONZERO")
+      .str(" (boot fault), amplifier ")
+      .str(b.amplifier ? "ON" : "off")
+      .str(", watchdog feeds ")
+      .u32(b.feeds)
+      .emit();
+  Line()
+      .str("E-stop: interrupt after tick ")
+      .u32(g_estop_seen_at)
+      .str(", latched by tick ")
+      .u32(g_estop_latched_in)
+      .str(", faults ")
+      .str(osc::fault_name(a.latched))
+      .str(", DAC codes ")
+      .str(a.written_max == 0 ? "zero" : "NONZERO")
+      .str(", amplifier ")
+      .str(a.amplifier ? "ON" : "off")
+      .str(", watchdog feeds ")
+      .u32(a.feeds)
+      .emit();
+  Line()
+      .str("telemetry: ")
+      .u32(g_frames)
+      .str(" frames, ")
+      .u32(g_board.uart.dropped())
+      .str(" dropped; stack used ")
+      .u32(cortex_m::stack_used())
+      .str(" bytes")
+      .emit();
   Line v;
   v.str(ok ? "stm32f4_qemu: pass" : "stm32f4_qemu: FAIL");
   if (!ok)
-    v.str(" (boot ").u32(boot_ok).str(", spacing ").u32(spacing_ok).str(", run ").u32(run_ok).str(", estop ")
-        .u32(estop_ok).str(", telemetry ").u32(telemetry_ok).str(")");
+    v.str(" (boot ")
+        .u32(boot_ok)
+        .str(", spacing ")
+        .u32(spacing_ok)
+        .str(", run ")
+        .u32(run_ok)
+        .str(", estop ")
+        .u32(estop_ok)
+        .str(", telemetry ")
+        .u32(telemetry_ok)
+        .str(")");
   g_board.uart.write_blocking(v.text());
   g_board.uart.write_blocking("\r\n");
   v.emit();

@@ -26,8 +26,8 @@ constexpr Pin PE(std::uint8_t n) { return {Port::E, n}; }
 /// docs/stm32f4.md).
 struct EncoderChannel {
   Timer timer;
-  int bits;                         // counter width: 32 for TIM2 and TIM5, else 16
-  Reg RccRegs::* enable_register;   // its clock enable
+  int bits;                       // counter width: 32 for TIM2 and TIM5, else 16
+  Reg RccRegs::*enable_register;  // its clock enable
   std::uint32_t enable_bit;
   PinConfig a, b;
   bool invert;
@@ -63,12 +63,12 @@ constexpr int kEstopExtiLine = 1;
 constexpr PinConfig kFaultLed = output(PD(14), false);
 
 // ---------------------------------------------------------------- telemetry
-constexpr PinConfig kUartTx = alternate(PA(2), 7, Speed::kMedium);             // USART2_TX
-constexpr PinConfig kUartRx = alternate(PA(3), 7, Speed::kLow, Pull::kUp);     // USART2_RX
+constexpr PinConfig kUartTx = alternate(PA(2), 7, Speed::kMedium);          // USART2_TX
+constexpr PinConfig kUartRx = alternate(PA(3), 7, Speed::kLow, Pull::kUp);  // USART2_RX
 
 // ---------------------------------------------------------------- every pin, once
-constexpr PinConfig kOthers[] = {kDacSck, kDacMosi, kDacSync[0], kDacSync[1], kDacLdac, kDacClr,
-                                 kAmpEnable, kEstop, kFaultLed, kUartTx, kUartRx};
+constexpr PinConfig kOthers[] = {kDacSck,    kDacMosi, kDacSync[0], kDacSync[1], kDacLdac, kDacClr,
+                                 kAmpEnable, kEstop,   kFaultLed,   kUartTx,     kUartRx};
 constexpr int kPinCount = 2 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
 constexpr Pin pin_at(int i) {
   return i < 2 * hal::kJoints ? (i % 2 ? kEncoders[i / 2].b.pin : kEncoders[i / 2].a.pin)

@@ -94,7 +94,7 @@ class Safety {
   BootFault watchdog_start() {
     IwdgRegs& w = *chip_.iwdg;
     chip_.dbgmcu->APB1_FZ = chip_.dbgmcu->APB1_FZ | DbgmcuRegs::kIwdgStop;  // halted by a debugger: paused
-    w.KR = IwdgRegs::kStart;  // starts the LSI too
+    w.KR = IwdgRegs::kStart;                                                // starts the LSI too
     w.KR = IwdgRegs::kUnlock;
     w.PR = kWatchdogPrescaler;
     w.RLR = kWatchdogReload;

@@ -34,8 +34,8 @@ class SpiDacBus {
   void init(const Chip& chip, std::uint32_t pclk1_hz) {
     chip.rcc->APB1ENR = chip.rcc->APB1ENR | RccRegs::kSpi2En;
     read_back(chip.rcc->APB1ENR);
-    for (const PinConfig& p : {pins::kDacSync[0], pins::kDacSync[1], pins::kDacLdac, pins::kDacClr, pins::kDacSck,
-                               pins::kDacMosi})
+    for (const PinConfig& p :
+         {pins::kDacSync[0], pins::kDacSync[1], pins::kDacLdac, pins::kDacClr, pins::kDacSck, pins::kDacMosi})
       pin_configure(chip, p);
     spi_ = chip.spi2;
     for (int c = 0; c < ad5754r::kChips; ++c) sync_[c] = &chip.port(pins::kDacSync[c].pin.port);

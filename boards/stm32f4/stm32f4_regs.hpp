@@ -33,20 +33,20 @@ bool poll_until(Ready ready, std::uint32_t polls) {
 
 // ---------------------------------------------------------------- RCC (RM0090 7.3)
 struct RccRegs {
-  Reg CR;          // 0x00 clock control
-  Reg PLLCFGR;     // 0x04 main PLL configuration
-  Reg CFGR;        // 0x08 clock configuration
-  Reg CIR;         // 0x0C clock interrupt
+  Reg CR;       // 0x00 clock control
+  Reg PLLCFGR;  // 0x04 main PLL configuration
+  Reg CFGR;     // 0x08 clock configuration
+  Reg CIR;      // 0x0C clock interrupt
   Reg AHB1RSTR, AHB2RSTR, AHB3RSTR, reserved0;
   Reg APB1RSTR, APB2RSTR, reserved1[2];
-  Reg AHB1ENR;     // 0x30 GPIO port clocks
+  Reg AHB1ENR;  // 0x30 GPIO port clocks
   Reg AHB2ENR, AHB3ENR, reserved2;
-  Reg APB1ENR;     // 0x40 TIM2..7, SPI2/3, USART2/3, ...
-  Reg APB2ENR;     // 0x44 TIM1/8, USART1/6, SPI1, SYSCFG, ...
+  Reg APB1ENR;  // 0x40 TIM2..7, SPI2/3, USART2/3, ...
+  Reg APB2ENR;  // 0x44 TIM1/8, USART1/6, SPI1, SYSCFG, ...
   Reg reserved3[2];
   Reg AHB1LPENR, AHB2LPENR, AHB3LPENR, reserved4, APB1LPENR, APB2LPENR, reserved5[2];
-  Reg BDCR;        // 0x70 backup domain control
-  Reg CSR;         // 0x74 control/status: LSI, reset flags
+  Reg BDCR;  // 0x70 backup domain control
+  Reg CSR;   // 0x74 control/status: LSI, reset flags
 
   // CR
   static constexpr std::uint32_t kHsiOn = 1u << 0, kHsiRdy = 1u << 1, kHseOn = 1u << 16, kHseRdy = 1u << 17,
@@ -69,8 +69,8 @@ struct RccRegs {
   // APB2ENR
   static constexpr std::uint32_t kTim1En = 1u << 0, kTim8En = 1u << 1, kSyscfgEn = 1u << 14;
   // CSR: reset flags (cleared by writing RMVF)
-  static constexpr std::uint32_t kRmvf = 1u << 24, kPinRstf = 1u << 26, kPorRstf = 1u << 27,
-                                 kSftRstf = 1u << 28, kIwdgRstf = 1u << 29;
+  static constexpr std::uint32_t kRmvf = 1u << 24, kPinRstf = 1u << 26, kPorRstf = 1u << 27, kSftRstf = 1u << 28,
+                                 kIwdgRstf = 1u << 29;
 };
 static_assert(offsetof(RccRegs, AHB1ENR) == 0x30 && offsetof(RccRegs, APB1ENR) == 0x40 &&
                   offsetof(RccRegs, APB2ENR) == 0x44 && offsetof(RccRegs, CSR) == 0x74,
@@ -133,8 +133,8 @@ struct SpiRegs {
   Reg SR;   // 0x08 RXNE 0, TXE 1, MODF 5, OVR 6, BSY 7
   Reg DR;   // 0x0C
   Reg CRCPR, RXCRCR, TXCRCR, I2SCFGR, I2SPR;
-  static constexpr std::uint32_t kCpha = 1u << 0, kCpol = 1u << 1, kMstr = 1u << 2, kSpe = 1u << 6,
-                                 kSsi = 1u << 8, kSsm = 1u << 9;
+  static constexpr std::uint32_t kCpha = 1u << 0, kCpol = 1u << 1, kMstr = 1u << 2, kSpe = 1u << 6, kSsi = 1u << 8,
+                                 kSsm = 1u << 9;
   static constexpr std::uint32_t br(std::uint32_t b) { return b << 3; }
   static constexpr std::uint32_t kRxne = 1u << 0, kTxe = 1u << 1, kBsy = 1u << 7;
 };
@@ -150,7 +150,8 @@ struct UsartRegs {
   static constexpr std::uint32_t kRxne = 1u << 5, kTc = 1u << 6, kTxe = 1u << 7;
   static constexpr std::uint32_t kRe = 1u << 2, kTe = 1u << 3, kUe = 1u << 13;
 };
-static_assert(offsetof(UsartRegs, CR1) == 0x0C && offsetof(UsartRegs, GTPR) == 0x18, "USART register map (RM0090 30.6.8)");
+static_assert(offsetof(UsartRegs, CR1) == 0x0C && offsetof(UsartRegs, GTPR) == 0x18,
+              "USART register map (RM0090 30.6.8)");
 
 // ---------------------------------------------------------------- IWDG (RM0090 21.4)
 struct IwdgRegs {

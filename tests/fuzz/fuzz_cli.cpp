@@ -4,10 +4,10 @@
 // Invariants: the parser never crashes (CLI11 and yaml-cpp exceptions are caught inside) and either
 //  - succeeds with an empty error and every value within its documented range: duration [1, 86400],
 //    encoder counts per motor revolution [100, 1e7], model error [-0.5, 0.5], RK4 substep
-//    [1e-6, 1e-3], whole RK4 substeps at once [1, 16], delay [0, dt], final window [1, 3600], all finite; a known friction preset,
-//    scalar and adaptation law; at least one mode to run; non-empty file names; trajectory within
-//    its ranges with a whole period; and its effective configuration, printed and read back into
-//    the defaults, prints the same again (--print-config is a fixed point); or
+//    [1e-6, 1e-3], whole RK4 substeps at once [1, 16], delay [0, dt], final window [1, 3600], all finite; a known
+//    friction preset, scalar and adaptation law; at least one mode to run; non-empty file names; trajectory within its
+//    ranges with a whole period; and its effective configuration, printed and read back into the defaults, prints the
+//    same again (--print-config is a fixed point); or
 //  - fails with a message;
 // and parsing the same arguments again gives the same answer.
 #include <cmath>
@@ -47,7 +47,8 @@ void check_options(const sim::ExperimentOptions& o) {
   FUZZ_CHECK(in_range(tr.amplitude, 0, 0.2) && in_range(tr.envelope, 1e-3, 10));
   FUZZ_CHECK(tr.period_ticks >= 500 && tr.period_ticks <= 60000 && tr.settled_ticks % tr.period_ticks == 0);
   for (int i = 0; i < 6; ++i)
-    FUZZ_CHECK(o.base.q_start(i) >= osc::robot::kArm.q_min[i] - 1e-9 && o.base.q_start(i) <= osc::robot::kArm.q_max[i] + 1e-9);
+    FUZZ_CHECK(o.base.q_start(i) >= osc::robot::kArm.q_min[i] - 1e-9 &&
+               o.base.q_start(i) <= osc::robot::kArm.q_max[i] + 1e-9);
   // The printed configuration reads back to itself.
   const std::string text = sim::config_yaml(o);
   sim::Settings back;

@@ -82,10 +82,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         const std::int64_t off = static_cast<std::int64_t>(in.u8() % 3) - 1;
         std::int64_t v = 0;
         switch ((mode >> 5) & 3) {
-          case 0: v = task->min_counts[j] + off; break;
-          case 1: v = task->max_counts[j] + off; break;
-          case 2: v = static_cast<std::int64_t>(prev[j]) + task->max_count_step[j] + off; break;
-          case 3: v = static_cast<std::int64_t>(prev[j]) - task->max_count_step[j] + off; break;
+          case 0:
+            v = task->min_counts[j] + off;
+            break;
+          case 1:
+            v = task->max_counts[j] + off;
+            break;
+          case 2:
+            v = static_cast<std::int64_t>(prev[j]) + task->max_count_step[j] + off;
+            break;
+          case 3:
+            v = static_cast<std::int64_t>(prev[j]) - task->max_count_step[j] + off;
+            break;
         }
         c[j] = static_cast<std::int32_t>(v < INT32_MIN ? INT32_MIN : v > INT32_MAX ? INT32_MAX : v);
         break;

@@ -35,8 +35,10 @@ struct Checked {
     const pil::Parser::Result r = p.feed(b);
     switch (r) {
       case pil::Parser::kPending:
-        if (was_in) FUZZ_CHECK(p.in_frame());
-        else FUZZ_CHECK(p.in_frame() == (b == pil::kSync0));
+        if (was_in)
+          FUZZ_CHECK(p.in_frame());
+        else
+          FUZZ_CHECK(p.in_frame() == (b == pil::kSync0));
         break;
       case pil::Parser::kJunk:  // bytes discarded while hunting for the sync pair
         FUZZ_CHECK(p.junk() == 1 || p.junk() == 2);
@@ -113,8 +115,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (int i = 0; i < len; ++i) {
       const pil::Parser::Result r = c.feed(buf[i]);
       if (!idle) continue;
-      if (i < len - 1) FUZZ_CHECK(r == pil::Parser::kPending);
-      else FUZZ_CHECK(r == (flip < 0 ? pil::Parser::kFrame : pil::Parser::kBadChecksum));
+      if (i < len - 1)
+        FUZZ_CHECK(r == pil::Parser::kPending);
+      else
+        FUZZ_CHECK(r == (flip < 0 ? pil::Parser::kFrame : pil::Parser::kBadChecksum));
     }
   }
   return 0;

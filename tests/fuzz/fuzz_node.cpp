@@ -62,14 +62,14 @@ pil::ActuatorFrame take_frame() {
 struct Driver {
   explicit Driver(Node& n) : node(n) {}
   Node& node;
-  pil::Parser shadow;               // the specification's view of the byte stream
-  std::uint32_t expected_seq = 0;   // the sequence number the node expects next
-  std::uint32_t last_seq = 0;       // sequence number of the latest valid sensor frame
-  bool link_fault_due = false;      // a link fault the next actuator frame must show
-  bool faulted = false;             // kFault seen
-  bool synced = false;              // the last thing parsed was a valid sensor frame
-  bool seq_tracked = true;          // expected_seq is known (a timeout may or may not use one up)
-  bool seq_check = false;           // the next answer must carry last_seq
+  pil::Parser shadow;              // the specification's view of the byte stream
+  std::uint32_t expected_seq = 0;  // the sequence number the node expects next
+  std::uint32_t last_seq = 0;      // sequence number of the latest valid sensor frame
+  bool link_fault_due = false;     // a link fault the next actuator frame must show
+  bool faulted = false;            // kFault seen
+  bool synced = false;             // the last thing parsed was a valid sensor frame
+  bool seq_tracked = true;         // expected_seq is known (a timeout may or may not use one up)
+  bool seq_check = false;          // the next answer must carry last_seq
   int ticks = 0;
 
   void check_tick() {

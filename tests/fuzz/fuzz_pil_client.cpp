@@ -38,10 +38,9 @@ struct Event {
   }
 };
 
-const char* const kErrors[] = {"unexpected frame type from the firmware",
-                               "corrupted actuator frame (checksum mismatch)",
-                               "corrupted actuator frame (bad header: unknown type)",
-                               "corrupted actuator frame (bad header: wrong length)"};
+const char* const kErrors[] = {
+    "unexpected frame type from the firmware", "corrupted actuator frame (checksum mismatch)",
+    "corrupted actuator frame (bad header: unknown type)", "corrupted actuator frame (bad header: wrong length)"};
 
 /// One call of the client's parsing on buf[pos..len), checked; appends its event unless kNeedMore.
 sim::RxResult step(pil::Parser& parser, const std::uint8_t* buf, int len, int& pos, std::size_t base,
@@ -144,8 +143,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   for (const Expect& x : expect) {
     const auto it = std::find_if(whole.begin(), whole.end(), [&](const Event& e) { return e.end == x.end; });
     FUZZ_CHECK(it != whole.end());
-    if (x.actuator) FUZZ_CHECK(it->r == sim::RxResult::kFrame);
-    else FUZZ_CHECK(it->r == sim::RxResult::kError && it->err == kErrors[0]);
+    if (x.actuator)
+      FUZZ_CHECK(it->r == sim::RxResult::kFrame);
+    else
+      FUZZ_CHECK(it->r == sim::RxResult::kError && it->err == kErrors[0]);
   }
   return 0;
 }

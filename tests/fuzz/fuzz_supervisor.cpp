@@ -25,10 +25,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::uint8_t arg = in.u8();
     std::uint32_t faults = 0;
     switch (flags & 3) {
-      case 0: break;
-      case 1: faults = 1u << (arg & 31); break;
-      case 2: faults = static_cast<std::uint32_t>(arg) << ((flags >> 2) & 31); break;
-      case 3: faults = in.u32(); break;
+      case 0:
+        break;
+      case 1:
+        faults = 1u << (arg & 31);
+        break;
+      case 2:
+        faults = static_cast<std::uint32_t>(arg) << ((flags >> 2) & 31);
+        break;
+      case 3:
+        faults = in.u32();
+        break;
     }
     const osc::SupervisorInput input{faults, (flags & 0x80) != 0};
     const osc::Supervisor n = osc::supervisor_next(s, input);

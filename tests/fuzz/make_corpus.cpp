@@ -198,10 +198,12 @@ void pil_client() {
 void cli() {
   put("fuzz_cli", "none", {});
   put("fuzz_cli", "help", args({"--help"}));
-  put("fuzz_cli", "numbers", args({"--duration", "30", "--model-error", "-0.1", "--encoder-cpr", "4096", "--substep",
-                                   "5e-5", "--delay", "0", "--final-window", "60"}));
-  put("fuzz_cli", "words", args({"--mode", "adaptive", "--friction", "corke", "--scalar", "float", "--adaptation",
-                                 "paper", "--no-csv", "--no-progress"}));
+  put("fuzz_cli", "numbers",
+      args({"--duration", "30", "--model-error", "-0.1", "--encoder-cpr", "4096", "--substep", "5e-5", "--delay", "0",
+            "--final-window", "60"}));
+  put("fuzz_cli", "words",
+      args({"--mode", "adaptive", "--friction", "corke", "--scalar", "float", "--adaptation", "paper", "--no-csv",
+            "--no-progress"}));
   put("fuzz_cli", "files", args({"--qemu", "--elf", "fw.elf", "--json", "s.json", "--csv-dir", "out dir"}));
   put("fuzz_cli", "bad_value", args({"--duration", "1e999"}));
   put("fuzz_cli", "missing_value", args({"--mode"}));

@@ -22,7 +22,7 @@ struct WatchdogRegs {
   volatile std::uint32_t RIS;     // 0x010 raw interrupt status (bit 0)
   volatile std::uint32_t MIS;     // 0x014 masked interrupt status (bit 0)
   std::uint32_t reserved[(0xC00 - 0x018) / 4];
-  volatile std::uint32_t LOCK;    // 0xC00 kUnlockKey unlocks; reads 1 while locked
+  volatile std::uint32_t LOCK;  // 0xC00 kUnlockKey unlocks; reads 1 while locked
   static constexpr std::uint32_t kIntEnable = 1u << 0, kResetEnable = 1u << 1;
   static constexpr std::uint32_t kUnlockKey = 0x1ACCE551u;
 };
@@ -67,9 +67,9 @@ struct Watchdog {
   /// Pauses the watchdog for a wait of unknown length; start() resumes it from a full count. The
   /// part stops its counter when CTRL.INTEN goes low (DDI 0479). QEMU 7.2's model (Debian 12's;
   /// later QEMU stops it as the part does) does not: its counter runs on, and its second expiry
-  /// latches the reset even with CTRL.RESEN low, to be asserted as soon as start() sets RESEN. So the count restarts from
-  /// the longest LOAD too: the two expiries are 2^33 clock cycles away (344 s at 25 MHz), where
-  /// stop() leaves them two LOADs away.
+  /// latches the reset even with CTRL.RESEN low, to be asserted as soon as start() sets RESEN. So the count restarts
+  /// from the longest LOAD too: the two expiries are 2^33 clock cycles away (344 s at 25 MHz), where stop() leaves them
+  /// two LOADs away.
   static void pause() {
     WatchdogRegs& w = regs();
     w.LOCK = WatchdogRegs::kUnlockKey;

@@ -103,7 +103,7 @@ inline int command_line(char* buf, int n) {
 }
 [[noreturn]] inline void exit(int code) {
   const std::uint32_t block[2] = {0x20026u, static_cast<std::uint32_t>(code)};  // ApplicationExit
-  call(0x20, block);  // SYS_EXIT_EXTENDED
+  call(0x20, block);                                                            // SYS_EXIT_EXTENDED
   for (;;) {
   }
 }

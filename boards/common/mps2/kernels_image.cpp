@@ -20,13 +20,21 @@ constexpr bool kFixed = fixed::is_q_v<F>;
 int g_failures = 0;
 
 template <class T>
-double d(T v) { return static_cast<double>(v); }
+double d(T v) {
+  return static_cast<double>(v);
+}
 
 void check(const char* what, double got, double want, double tol) {
   const double err = got > want ? got - want : want - got;
   if (!(err <= tol)) {
-    cortex_m::text::Line().str("FAIL ").str(what).str(" got ").fix(static_cast<float>(got), 5).str(" want ")
-        .fix(static_cast<float>(want), 5).emit();
+    cortex_m::text::Line()
+        .str("FAIL ")
+        .str(what)
+        .str(" got ")
+        .fix(static_cast<float>(got), 5)
+        .str(" want ")
+        .fix(static_cast<float>(want), 5)
+        .emit();
     ++g_failures;
   }
 }
@@ -34,7 +42,9 @@ void check(const char* what, double got, double want, double tol) {
 /// A result the compiler must compute where it stands (in the timed scope), although nothing reads
 /// it: its address escapes into an empty asm that clobbers memory.
 template <class T>
-void keep(const T& v) { asm volatile("" : : "r"(&v) : "memory"); }
+void keep(const T& v) {
+  asm volatile("" : : "r"(&v) : "memory");
+}
 
 /// Instructions from construction to destruction; the memory clobbers keep the timed kernel, which
 /// reads the global workspace, between the two counter reads.
@@ -62,7 +72,11 @@ ControllerState<F> g_state;
 
 int main() {
   board::cycle_counter_init();
-  cortex_m::text::Line().str("kernels_image: PUMA 560 kernels in ").str(board::kScalarName).str(" on ").str(board::kCore)
+  cortex_m::text::Line()
+      .str("kernels_image: PUMA 560 kernels in ")
+      .str(board::kScalarName)
+      .str(" on ")
+      .str(board::kCore)
       .emit();
   g_model = Model<F>::of(robot::kArm);
   const Vec6<F> qn = joint_vector<F>(puma560::kQn), q0 = joint_vector<F>(robot::kQStart);
@@ -211,8 +225,13 @@ int main() {
     sum += dt;
     check("control_step status", static_cast<double>(out.status), 0.0, 0.0);
   }
-  cortex_m::text::Line().str("  control_step (observer + controller + adaptation), worst of 20: ").u32(worst)
-      .str(", mean ").u32(sum / 20).str(" instructions").emit();
+  cortex_m::text::Line()
+      .str("  control_step (observer + controller + adaptation), worst of 20: ")
+      .u32(worst)
+      .str(", mean ")
+      .u32(sum / 20)
+      .str(" instructions")
+      .emit();
   check("control_step holds gravity at rest", d((g_state.obs.x_hat - g_os.x).norm()) < 1.0 ? 1.0 : 0.0, 1.0, 0.0);
 
   if constexpr (kFixed) {
@@ -225,16 +244,30 @@ int main() {
           const std::int32_t want = n < count ? reference::kValues[n] : 0;
           if (m(i, j).raw() == want) continue;
           if (++mismatches <= 5)
-            cortex_m::text::Line().str("FAIL reference ").str(name).str(" word ").i32(n).str(": got ").i32(m(i, j).raw())
-                .str(" want ").i32(want).emit();
+            cortex_m::text::Line()
+                .str("FAIL reference ")
+                .str(name)
+                .str(" word ")
+                .i32(n)
+                .str(": got ")
+                .i32(m(i, j).raw())
+                .str(" want ")
+                .i32(want)
+                .emit();
         }
     };
     fixed::take_flags();
     for (const reference::Case& rc : reference::kCases) reference::kernel_outputs(rc, g_model, g_data, g_os, emit);
     reference::step_outputs(g_model, g_state, emit);
     const std::uint32_t flags = fixed::take_flags();
-    cortex_m::text::Line().str("reference values (host, Q12.19): ").i32(n).str(" words, ").i32(mismatches)
-        .str(" differ; arithmetic flags ").u32(flags).emit();
+    cortex_m::text::Line()
+        .str("reference values (host, Q12.19): ")
+        .i32(n)
+        .str(" words, ")
+        .i32(mismatches)
+        .str(" differ; arithmetic flags ")
+        .u32(flags)
+        .emit();
     if (n != count) ++g_failures;
     if (flags != 0) ++g_failures;
     g_failures += mismatches;

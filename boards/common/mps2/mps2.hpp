@@ -165,9 +165,12 @@ inline void watchdog_expired(std::uint32_t faults) {
 inline cortex_m::ResetCause reset_cause() { return cortex_m::reset_cause(); }
 inline const char* reset_cause_name(cortex_m::ResetCause c) {
   switch (c) {
-    case cortex_m::ResetCause::kPowerOn: return "power-on";
-    case cortex_m::ResetCause::kWatchdog: return "watchdog";
-    case cortex_m::ResetCause::kOther: return "other";
+    case cortex_m::ResetCause::kPowerOn:
+      return "power-on";
+    case cortex_m::ResetCause::kWatchdog:
+      return "watchdog";
+    case cortex_m::ResetCause::kOther:
+      return "other";
   }
   return "?";
 }

@@ -51,8 +51,10 @@ int g_console_in = -1, g_console_out = -1;  // semihosting handles (kSemihosting
 
 struct Mps2Board {
   static void link_write(const std::uint8_t* p, int n) {
-    if (g_transport == Transport::kSemihosting) board::semihost::write(g_console_out, p, n);
-    else board::uart_write(p, n);
+    if (g_transport == Transport::kSemihosting)
+      board::semihost::write(g_console_out, p, n);
+    else
+      board::uart_write(p, n);
   }
   static std::uint32_t cycles() { return board::cycles(); }
   static std::uint32_t stack_used() { return board::stack_used_sweep(); }  // every tick: a bounded sweep
@@ -107,17 +109,15 @@ struct ConsoleRx {
 };
 ConsoleRx g_console_rx;
 
-bool rx_ready() {
-  return g_transport == Transport::kSemihosting ? g_console_rx.ready() : board::uart_rx_ready();
-}
-std::uint8_t rx_read() {
-  return g_transport == Transport::kSemihosting ? g_console_rx.read() : board::uart_read();
-}
+bool rx_ready() { return g_transport == Transport::kSemihosting ? g_console_rx.ready() : board::uart_rx_ready(); }
+std::uint8_t rx_read() { return g_transport == Transport::kSemihosting ? g_console_rx.read() : board::uart_read(); }
 /// Waits for the next byte: the UART sleeps until a byte or an interrupt; the console blocks until
 /// bytes come.
 void rx_wait() {
-  if (g_transport == Transport::kSemihosting) g_console_rx.wait();
-  else board::sleep_until_rx_or_irq();
+  if (g_transport == Transport::kSemihosting)
+    g_console_rx.wait();
+  else
+    board::sleep_until_rx_or_irq();
 }
 
 }  // namespace

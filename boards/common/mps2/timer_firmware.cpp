@@ -72,8 +72,14 @@ bool stack_sweep_agrees() {
   (void)use_stack_deeply();
   for (int k = 0; k < kCalls; ++k) swept = board::stack_used_sweep();
   const bool deeper_found = swept == board::stack_used() && swept > before && swept >= 6144;
-  cortex_m::text::Line().str("stack sweep: ").u32(before).str(" bytes, then ").u32(swept).str(" after a 6 KiB frame (")
-      .str(never_above && equal && deeper_found ? "agrees with the full scan" : "DISAGREES with the full scan").str(")")
+  cortex_m::text::Line()
+      .str("stack sweep: ")
+      .u32(before)
+      .str(" bytes, then ")
+      .u32(swept)
+      .str(" after a 6 KiB frame (")
+      .str(never_above && equal && deeper_found ? "agrees with the full scan" : "DISAGREES with the full scan")
+      .str(")")
       .emit();
   return never_above && equal && deeper_found;
 }
@@ -97,18 +103,36 @@ int main() {
     hi = d > hi ? d : hi;
   }
   cortex_m::text::Line().str("ticks: ").i32(g_ticks).str(", spacing ").u32(lo).str("..").u32(hi).str(" ns").emit();
-  cortex_m::text::Line().str("control step: max ").u32(g_task.timing.max).str(", mean ").u32(g_task.timing.mean())
-      .str(" instructions (-icount shift=0)").emit();
-  cortex_m::text::Line().str("supervisor state ").u32(static_cast<std::uint32_t>(g_task.sup.state)).str(", faults ")
-      .u32(g_faults).str(", torque code joint 2: ").i32(g_hal.codes[1]).emit();
+  cortex_m::text::Line()
+      .str("control step: max ")
+      .u32(g_task.timing.max)
+      .str(", mean ")
+      .u32(g_task.timing.mean())
+      .str(" instructions (-icount shift=0)")
+      .emit();
+  cortex_m::text::Line()
+      .str("supervisor state ")
+      .u32(static_cast<std::uint32_t>(g_task.sup.state))
+      .str(", faults ")
+      .u32(g_faults)
+      .str(", torque code joint 2: ")
+      .i32(g_hal.codes[1])
+      .emit();
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
-  cortex_m::text::Line().str("watchdog: fed by ").i32(g_feeds).str(" of ").i32(kTicks).str(" ticks, ")
-      .str(watchdog_ok ? "never expired" : "EXPIRED or unfed").str("; reset cause ")
-      .str(board::reset_cause_name(cause)).emit();
+  cortex_m::text::Line()
+      .str("watchdog: fed by ")
+      .i32(g_feeds)
+      .str(" of ")
+      .i32(kTicks)
+      .str(" ticks, ")
+      .str(watchdog_ok ? "never expired" : "EXPIRED or unfed")
+      .str("; reset cause ")
+      .str(board::reset_cause_name(cause))
+      .emit();
   const bool spacing_ok = lo + 100 >= kPeriodNs && hi <= kPeriodNs + 100;
   const bool sweep_ok = stack_sweep_agrees();
-  const bool ok = spacing_ok && watchdog_ok && sweep_ok && g_faults == 0 && g_task.sup.state == osc::SupervisorState::kRun &&
-                  g_hal.codes[1] != 0;
+  const bool ok = spacing_ok && watchdog_ok && sweep_ok && g_faults == 0 &&
+                  g_task.sup.state == osc::SupervisorState::kRun && g_hal.codes[1] != 0;
   cortex_m::text::Line().str(ok ? "timer_firmware: pass" : "timer_firmware: FAIL").emit();
   return ok ? 0 : 1;
 }

@@ -35,13 +35,13 @@ constexpr std::uint32_t kToleranceNs = 10000u;       // on the expiry instants (
 /// What the NMI of the first expiry saw; survives the reset.
 struct Record {
   std::uint32_t magic;
-  std::uint32_t scenario;       // the scenario that ran before the reset
-  std::uint32_t ticks;          // ticks completed at the first expiry
-  std::uint32_t feeds;          // watchdog feeds by then
-  std::uint32_t expiry_ns;      // from the last feed to the first expiry (NMI)
-  std::uint32_t alive_ns;       // from the last feed to the last instant before the reset
-  std::uint32_t faults;         // the supervisor's latched bits at the first expiry
-  std::uint32_t codes_zero;     // every DAC code was 0 at the first expiry
+  std::uint32_t scenario;    // the scenario that ran before the reset
+  std::uint32_t ticks;       // ticks completed at the first expiry
+  std::uint32_t feeds;       // watchdog feeds by then
+  std::uint32_t expiry_ns;   // from the last feed to the first expiry (NMI)
+  std::uint32_t alive_ns;    // from the last feed to the last instant before the reset
+  std::uint32_t faults;      // the supervisor's latched bits at the first expiry
+  std::uint32_t codes_zero;  // every DAC code was 0 at the first expiry
 };
 constexpr std::uint32_t kRecordMagic = 0x57444F47u;
 __attribute__((section(".noinit"))) volatile Record g_rec;
@@ -58,11 +58,28 @@ bool near(std::uint32_t v, std::uint32_t want) { return v + kToleranceNs >= want
 /// Checks what the previous boot's scenario left in the record.
 bool check_previous(std::uint32_t s) {
   const std::uint32_t n = kHealthyTicks[s];
-  Line().str("scenario ").u32(s + 1).str(" (").str(kScenarioName[s]).str("): ").u32(g_rec.ticks).str(" ticks, ")
-      .u32(g_rec.feeds).str(" feeds; latched faults ").u32(g_rec.faults).str(", DAC codes ")
-      .str(g_rec.codes_zero ? "zero" : "held").str(" at the first expiry").emit();
-  Line().str("  after the last feed: first expiry (NMI) at ").u32(g_rec.expiry_ns).str(" ns, reset at ")
-      .u32(g_rec.alive_ns).str(" ns").emit();
+  Line()
+      .str("scenario ")
+      .u32(s + 1)
+      .str(" (")
+      .str(kScenarioName[s])
+      .str("): ")
+      .u32(g_rec.ticks)
+      .str(" ticks, ")
+      .u32(g_rec.feeds)
+      .str(" feeds; latched faults ")
+      .u32(g_rec.faults)
+      .str(", DAC codes ")
+      .str(g_rec.codes_zero ? "zero" : "held")
+      .str(" at the first expiry")
+      .emit();
+  Line()
+      .str("  after the last feed: first expiry (NMI) at ")
+      .u32(g_rec.expiry_ns)
+      .str(" ns, reset at ")
+      .u32(g_rec.alive_ns)
+      .str(" ns")
+      .emit();
   bool ok = g_rec.feeds == n && near(g_rec.expiry_ns, board::kWatchdogExpiryNs) &&
             near(g_rec.alive_ns, 2 * board::kWatchdogExpiryNs) && cortex_m::watchdog_faults() == g_rec.faults;
   switch (s) {
@@ -122,15 +139,23 @@ extern "C" void NMI_Handler() {
 int main() {
   board::cycle_counter_init();
   const cortex_m::ResetCause cause = board::reset_cause();
-  Line().str("boot: reset cause ").str(board::reset_cause_name(cause)).str(", watchdog resets ")
-      .u32(cortex_m::watchdog_resets()).emit();
+  Line()
+      .str("boot: reset cause ")
+      .str(board::reset_cause_name(cause))
+      .str(", watchdog resets ")
+      .u32(cortex_m::watchdog_resets())
+      .emit();
   g_task.init(osc::Model<board::Scalar>::of(osc::robot::kArm), osc::Gains<board::Scalar>::paper(),
               osc::FrictionMode::kAdaptive, osc::joint_vector<board::Scalar>(osc::robot::kQStart), kPeriodNs);
   // Up with zero torque: every DAC code 0, the supervisor starting, the fault line released.
   const bool outputs_ok = g_hal.codes_zero() && g_task.sup.state == osc::SupervisorState::kInit &&
                           g_task.sup.latched == 0 && !board::g_fault_line;
-  Line().str("outputs at start: DAC codes ").str(g_hal.codes_zero() ? "zero" : "NOT ZERO").str(", supervisor ")
-      .str(g_task.sup.state == osc::SupervisorState::kInit ? "init" : "NOT INIT").emit();
+  Line()
+      .str("outputs at start: DAC codes ")
+      .str(g_hal.codes_zero() ? "zero" : "NOT ZERO")
+      .str(", supervisor ")
+      .str(g_task.sup.state == osc::SupervisorState::kInit ? "init" : "NOT INIT")
+      .emit();
 
   std::uint32_t scenario = kDone;
   bool ok = outputs_ok;
@@ -150,13 +175,22 @@ int main() {
   }
   if (scenario == kDone) {
     const bool all = cortex_m::watchdog_resets() == kDone;
-    Line().str(all ? "watchdog_firmware: pass (" : "watchdog_firmware: FAIL (").u32(cortex_m::watchdog_resets())
-        .str(" watchdog resets)").emit();
+    Line()
+        .str(all ? "watchdog_firmware: pass (" : "watchdog_firmware: FAIL (")
+        .u32(cortex_m::watchdog_resets())
+        .str(" watchdog resets)")
+        .emit();
     return all ? 0 : 1;
   }
 
   const std::uint32_t n = kHealthyTicks[scenario];
-  Line().str("scenario ").u32(scenario + 1).str(": ").u32(n).str(" healthy ticks, then ").str(kScenarioName[scenario])
+  Line()
+      .str("scenario ")
+      .u32(scenario + 1)
+      .str(": ")
+      .u32(n)
+      .str(" healthy ticks, then ")
+      .str(kScenarioName[scenario])
       .emit();
   g_scenario = scenario;
   board::watchdog_start();

@@ -36,7 +36,7 @@ struct AdaptationState {
   // The regressor at q^dot(t - dt) and q^dot(t - 2 dt): friction_estimate computed them in those
   // samples (each costs six exponentials).
   RegressorDiagonals<S> w_prev, w_prev2;
-  int samples;           // samples recorded so far (saturates at 2)
+  int samples;  // samples recorded so far (saturates at 2)
 };
 
 /// The error signal of (67): the measured increment less the observer's prediction,
@@ -106,7 +106,9 @@ void adaptation_record(const Gains<S>& G, AdaptationState<S>& a, const Vec18<S>&
 
 /// Estimated joint friction (30): tau_f^ = W_j(q^dot) theta^.
 template <class S>
-Vec6<S> friction_estimate(const RegressorDiagonals<S>& w, const Vec18<S>& theta_hat) { return w.times(theta_hat); }
+Vec6<S> friction_estimate(const RegressorDiagonals<S>& w, const Vec18<S>& theta_hat) {
+  return w.times(theta_hat);
+}
 template <class S>
 Vec6<S> friction_estimate(const Gains<S>& G, const Vec18<S>& theta_hat, const Vec6<S>& qd_hat) {
   return friction_estimate(friction_regressor_diagonals(qd_hat, G.tau_dec), theta_hat);

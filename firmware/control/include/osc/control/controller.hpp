@@ -27,11 +27,11 @@ namespace osc {
 
 template <class S>
 struct ControllerState {
-  Vec3<S> p0;                  // start position (trajectory centre)
-  Mat3<S> R_ref;               // start orientation: reference of the orientation coordinates
-  ObserverState<S> obs;        // x^, y (21)-(22)
-  AdaptationState<S> adapt;    // theta^ and the previous sample (67)
-  Data<S> data;                // workspace
+  Vec3<S> p0;                // start position (trajectory centre)
+  Mat3<S> R_ref;             // start orientation: reference of the orientation coordinates
+  ObserverState<S> obs;      // x^, y (21)-(22)
+  AdaptationState<S> adapt;  // theta^ and the previous sample (67)
+  Data<S> data;              // workspace
   OpSpace<S> os;
 };
 
@@ -61,9 +61,9 @@ void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In
 
 template <class S>
 struct ForceCommand {
-  Vec6<S> F;             // operational force (32)
-  Vec6<S> e;             // tracking error (36)
-  BiasForce<S> bias;     // h(x, x^dot) + p + f^, which the observer update (22) reuses
+  Vec6<S> F;          // operational force (32)
+  Vec6<S> e;          // tracking error (36)
+  BiasForce<S> bias;  // h(x, x^dot) + p + f^, which the observer update (22) reuses
 };
 
 /// The force command (32) with w_e (35), the tracking error (36) and the observed filtered
@@ -73,9 +73,9 @@ template <class S>
 ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Data<S>& data, const OpSpace<S>& os,
                               const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& tau_f_hat) {
   ForceCommand<S> c;
-  c.e = d.x - os.x;                                   // (36)
+  c.e = d.x - os.x;  // (36)
   const Vec6<S> v = d.xd + G.ks.cwiseProduct(c.e);
-  const Vec6<S> eta_p = v - ob.xd_hat;                // (34)
+  const Vec6<S> eta_p = v - ob.xd_hat;  // (34)
   // Psi(x, x^dot) x^dot and Psi(x, x^dot) v in their joint-space parts, from one pass (q^dot = J^{-1} x^dot).
   const PsiTerms<S> psi = psi_terms(model, data, os, ob.qd_hat, v);
   // (35): w_e = Lambda a_r + Psi(x, x^dot) v + p + f^, a_r = x_d ddot + k_s (x_d dot - x^dot). Each term

@@ -10,28 +10,34 @@
 namespace osc {
 
 // X(Name, "name", description), in bit order.
-#define OSC_FAULT_LIST(X)                                                                        \
-  X(NonFinite, "non_finite", "a non-finite value anywhere in the step")                          \
-  X(EncoderJump, "encoder_jump", "an encoder moved further in one tick than the joint can")       \
-  X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")      \
-  X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                   \
-  X(Overrun, "overrun", "the next tick arrived before this one ended")                           \
-  X(LinkLost, "link_lost", "repeated link errors, the last a silence alone (no frame, no byte)")   \
-  X(LinkCorrupt, "link_corrupt", "repeated link errors, the last a bad, cut short or stray frame")  \
-  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")          \
-  X(EncoderStuck, "encoder_stuck", "an encoder stood still while the reference moved its joint by more than the bound") \
-  X(Tracking, "tracking", "the measured tracking error exceeded its bound")                               \
-  X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                    \
-  X(Estop, "estop", "the emergency-stop input is active")                                                 \
-  X(Overflow, "overflow", "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \
-  X(DacBus, "dac_bus", "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")
+#define OSC_FAULT_LIST(X)                                                                                      \
+  X(NonFinite, "non_finite", "a non-finite value anywhere in the step")                                        \
+  X(EncoderJump, "encoder_jump", "an encoder moved further in one tick than the joint can")                    \
+  X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")                   \
+  X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                                 \
+  X(Overrun, "overrun", "the next tick arrived before this one ended")                                         \
+  X(LinkLost, "link_lost", "repeated link errors, the last a silence alone (no frame, no byte)")               \
+  X(LinkCorrupt, "link_corrupt", "repeated link errors, the last a bad, cut short or stray frame")             \
+  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")                \
+  X(EncoderStuck, "encoder_stuck",                                                                             \
+    "an encoder stood still while the reference moved its joint by more than the bound")                       \
+  X(Tracking, "tracking", "the measured tracking error exceeded its bound")                                    \
+  X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                         \
+  X(Estop, "estop", "the emergency-stop input is active")                                                      \
+  X(Overflow, "overflow",                                                                                      \
+    "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \
+  X(DacBus, "dac_bus",                                                                                         \
+    "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")
 
 namespace detail {
 enum FaultBit : unsigned {
+// A count after an X-macro expansion: clang-format would indent it as a continuation.
+// clang-format off
 #define OSC_FAULT_BIT(Name, name, doc) kBit##Name,
   OSC_FAULT_LIST(OSC_FAULT_BIT)
 #undef OSC_FAULT_BIT
   kFaultCount
+  // clang-format on
 };
 }  // namespace detail
 

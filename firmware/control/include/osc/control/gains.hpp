@@ -1,6 +1,6 @@
 // The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, the task's
-// trajectory (68), and the choices a caller makes (friction mode, adaptation law). Defaults from params.hpp; the adaptation law
-// defaults to the robust one (docs/adaptation.md); AdaptationLaw::kPaper gives (67) exactly.
+// trajectory (68), and the choices a caller makes (friction mode, adaptation law). Defaults from params.hpp; the
+// adaptation law defaults to the robust one (docs/adaptation.md); AdaptationLaw::kPaper gives (67) exactly.
 #pragma once
 
 #include <cstdint>
@@ -24,9 +24,7 @@ enum class AdaptationLaw : std::uint8_t {
 constexpr const char* kAdaptationLawNames[] = {"paper", "robust"};
 constexpr int kAdaptationLawCount = sizeof(kAdaptationLawNames) / sizeof(kAdaptationLawNames[0]);
 
-constexpr const char* adaptation_law_name(AdaptationLaw law) {
-  return kAdaptationLawNames[static_cast<int>(law)];
-}
+constexpr const char* adaptation_law_name(AdaptationLaw law) { return kAdaptationLawNames[static_cast<int>(law)]; }
 /// The law of a name; false when there is none.
 constexpr bool adaptation_law_from_name(std::string_view name, AdaptationLaw& law) {
   for (int i = 0; i < kAdaptationLawCount; ++i)
@@ -45,8 +43,8 @@ struct Gains {
   S dt;
   S min_rcond;
   AdaptationLaw adaptation;
-  Vec18<S> theta_max;  // projection bounds of the robust law (lower bounds 0)
-  S leakage;           // sigma of the robust law [1/s]
+  Vec18<S> theta_max;            // projection bounds of the robust law (lower bounds 0)
+  S leakage;                     // sigma of the robust law [1/s]
   TrajectorySpec<S> trajectory;  // the task (68)
 
   static Gains paper() {

@@ -7,32 +7,32 @@
 
 namespace osc::params {
 
-constexpr unsigned kControlHz = 1000;                 ///< control rate: the timer interrupt [Hz]
-constexpr double kDt = 1.0 / kControlHz;              ///< sampling time [s]
+constexpr unsigned kControlHz = 1000;     ///< control rate: the timer interrupt [Hz]
+constexpr double kDt = 1.0 / kControlHz;  ///< sampling time [s]
 
 /// Gains (69), diagonal, one entry per operational axis: x, y, z, then the three rotations.
 constexpr double kKnd[6] = {120, 120, 120, 35, 35, 35};
 constexpr double kK[6] = {108, 108, 108, 32, 32, 32};
 constexpr double kKs[6] = {97, 97, 97, 30, 30, 30};
 constexpr double kKi[6] = {2000, 2000, 2000, 3000, 3000, 3000};
-constexpr double kKad = 500;      ///< every diagonal entry of K_ad (18x18)
-constexpr double kTauDec = 1;     ///< every tau_dec (known Stribeck coefficient) [s^2/rad^2]
+constexpr double kKad = 500;   ///< every diagonal entry of K_ad (18x18)
+constexpr double kTauDec = 1;  ///< every tau_dec (known Stribeck coefficient) [s^2/rad^2]
 
 /// The robust adaptation law (osc/control/adaptation.hpp, docs/adaptation.md).
 /// Projection bounds of theta = [vis; cou; sti] for a PUMA 560: three times the larger of the paper's
 /// Table II and the Corke/Armstrong-Helouvry values per joint, rounded up; the Stribeck excess is
 /// bounded like the Coulomb level. The lower bounds are 0 (friction dissipates).
-constexpr double kThetaMax[18] = {18, 30, 18, 2, 6, 3,     // vis [N m s/rad]
-                                  80, 32, 20, 4, 3, 4,     // cou [N m]
-                                  80, 32, 20, 4, 3, 4};    // sti [N m]
+constexpr double kThetaMax[18] = {18, 30, 18, 2, 6, 3,   // vis [N m s/rad]
+                                  80, 32, 20, 4, 3, 4,   // cou [N m]
+                                  80, 32, 20, 4, 3, 4};  // sti [N m]
 /// Leakage (sigma-modification towards 0) [1/s]: a time constant of 1000 s, slow against the
 /// adaptation (about 60 s) and fast against the residual quantisation drift.
 constexpr double kAdaptationLeakage = 1e-3;
 
 /// Trajectory (68): amplitude, angular frequency (period 5 s, f = 1) and envelope rate.
-constexpr double kAmplitude = 0.050;            ///< [m]
-constexpr double kOmega = 0.4 * kPi;            ///< [rad/s]
-constexpr double kEnvelope = 0.05;              ///< 1 - exp(-kEnvelope t^3)
+constexpr double kAmplitude = 0.050;  ///< [m]
+constexpr double kOmega = 0.4 * kPi;  ///< [rad/s]
+constexpr double kEnvelope = 0.05;    ///< 1 - exp(-kEnvelope t^3)
 
 /// Reciprocal-condition threshold of the Jacobian below which the controller refuses to act.
 constexpr double kMinJacobianRcond = 1e-3;
@@ -81,11 +81,10 @@ constexpr double kThetaFaultBand = 1.0;
 constexpr int kLinkSilenceTicks = 2;
 /// Silence when the host paces the ticks (lockstep processor in the loop, as in QEMU): no byte for
 /// this long [s of the target's virtual time] is a silence error (or a short frame, if one had
-/// started). Not kLinkSilenceTicks periods: in lockstep the target's clock runs on while it waits (polls, or sleeps in WFI)
-/// for the host's next frame, and that wait is the host's wall-clock time (the plant's step, the pipe,
-/// the scheduler of a shared machine) turned into target time: gaps of up to 1.7 ms measured in
-/// healthy runs (docs/firmware.md), too close to 2 ms. The plant is frozen meanwhile, so the wait
-/// costs it no torque.
+/// started). Not kLinkSilenceTicks periods: in lockstep the target's clock runs on while it waits (polls, or sleeps in
+/// WFI) for the host's next frame, and that wait is the host's wall-clock time (the plant's step, the pipe, the
+/// scheduler of a shared machine) turned into target time: gaps of up to 1.7 ms measured in healthy runs
+/// (docs/firmware.md), too close to 2 ms. The plant is frozen meanwhile, so the wait costs it no torque.
 constexpr double kLinkTimeout = 0.1;
 /// Error ticks (ticks with at least one link error) that latch a link fault when they fall within
 /// kLinkErrorWindow ticks: link_lost when the last was a silence, link_corrupt otherwise. Fewer cost

@@ -43,7 +43,8 @@ struct TrajectorySpec {
 
 /// The spec of a trajectory with the given amplitude [m], period (a whole number of samples) and
 /// envelope rate c [1/s^3]: settled_ticks is the first whole number of periods with c t^3 >= 400.
-inline TrajectorySpec<double> trajectory_spec(double amplitude, std::uint64_t period_ticks, double envelope, double dt) {
+inline TrajectorySpec<double> trajectory_spec(double amplitude, std::uint64_t period_ticks, double envelope,
+                                              double dt) {
   TrajectorySpec<double> s{amplitude, 2 * kPi / (static_cast<double>(period_ticks) * dt), envelope, period_ticks, 0};
   std::uint64_t n = 1;
   while (envelope * (n * period_ticks * dt) * (n * period_ticks * dt) * (n * period_ticks * dt) < 400.0) ++n;
@@ -84,8 +85,10 @@ Desired<S> trajectory(const TrajectorySpec<S>& spec, const Vec3<S>& p0, S t) {
   S sn, cs;
   math::sincos(w * t, sn, cs);
   // x: A sin(wt) s;  y, z: A cos(wt) s.
-  const S px = A * sn * s, pxd = A * (w * cs * s + sn * sd), pxdd = A * (-w * w * sn * s + lit<S>(2) * w * cs * sd + sn * sdd);
-  const S py = A * cs * s, pyd = A * (-w * sn * s + cs * sd), pydd = A * (-w * w * cs * s - lit<S>(2) * w * sn * sd + cs * sdd);
+  const S px = A * sn * s, pxd = A * (w * cs * s + sn * sd),
+          pxdd = A * (-w * w * sn * s + lit<S>(2) * w * cs * sd + sn * sdd);
+  const S py = A * cs * s, pyd = A * (-w * sn * s + cs * sd),
+          pydd = A * (-w * w * cs * s - lit<S>(2) * w * sn * sd + cs * sdd);
   Desired<S> d;
   d.x << p0(0) + px, p0(1) + py, p0(2) + py, S(0), S(0), S(0);
   d.xd << pxd, pyd, pyd, S(0), S(0), S(0);

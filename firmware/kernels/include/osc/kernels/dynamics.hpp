@@ -81,7 +81,7 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
     IO(1, 2) += Ic(1, 2) - mc(1) * c(2);
     IO(1, 0) = IO(0, 1), IO(2, 0) = IO(0, 2), IO(2, 1) = IO(1, 2);
     const Vec3<S> z = data.R[j - 1].col(2);
-    const Vec3<S> p = m * vO[j - 1] + cross(z, h);  // linear momentum
+    const Vec3<S> p = m * vO[j - 1] + cross(z, h);   // linear momentum
     const Vec3<S> L = IO * z + cross(h, vO[j - 1]);  // angular momentum about the base origin
     for (int i = 1; i <= j; ++i) {
       data.A(i - 1, j - 1) = dot_sum(Vec3<S>(data.R[i - 1].col(2)), L, vO[i - 1], p);

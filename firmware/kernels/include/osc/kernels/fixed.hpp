@@ -168,9 +168,8 @@ template <int S, class... P>
   static_assert(sizeof...(P) % 2 == 0);
   ProductSum<S> s;
   const std::int32_t v[] = {ab...};
-  [&]<int... K>(std::integer_sequence<int, K...>) {
-    (s.add(K, v[2 * K], v[2 * K + 1]), ...);
-  }(std::make_integer_sequence<int, sizeof...(P) / 2>{});
+  [&]<int... K>(std::integer_sequence<int, K...>) { (s.add(K, v[2 * K], v[2 * K + 1]), ...); }
+  (std::make_integer_sequence<int, sizeof...(P) / 2>{});
   return s.rounded();
 }
 
@@ -271,10 +270,10 @@ constexpr std::int32_t q30(double v) { return static_cast<std::int32_t>(v * 1073
 /// the rest in Q61.
 constexpr std::int64_t kPio2Q61 = 3622009729038561421LL;
 constexpr std::int64_t kLn2Q61 = 1598288580650331957LL;
-constexpr std::int64_t kPio2Q30 = 1686629713LL;      // round(pi/2 2^30)
-constexpr std::int64_t kPiQ30 = 3373259426LL;        // round(pi 2^30)
-constexpr std::int32_t kTwoOverPiQ30 = 683565276;    // round(2/pi 2^30)
-constexpr std::int32_t kInvLn2Q30 = 1549082005;      // round(2^30 / ln 2)
+constexpr std::int64_t kPio2Q30 = 1686629713LL;    // round(pi/2 2^30)
+constexpr std::int64_t kPiQ30 = 3373259426LL;      // round(pi 2^30)
+constexpr std::int32_t kTwoOverPiQ30 = 683565276;  // round(2/pi 2^30)
+constexpr std::int32_t kInvLn2Q30 = 1549082005;    // round(2^30 / ln 2)
 /// atan(i / 8) in Q30, i = 0..8 (mpmath, 200 bits; tests/test_fixed.cpp checks each).
 constexpr std::int32_t kAtanEighthsQ30[9] = {0,         133525159, 263043837, 385227074, 497837829,
                                              599791448, 690954054, 771837835, 843314857};
@@ -379,8 +378,7 @@ class Q {
   constexpr explicit Q(float v) : r_(from_double(static_cast<double>(v))) {}
   /// From another format: rounded when it has more fraction bits, saturated when out of range.
   template <int G>
-    requires(G != F)
-  constexpr explicit Q(Q<G> o) : r_(convert<G>(o.raw())) {}
+  requires(G != F) constexpr explicit Q(Q<G> o) : r_(convert<G>(o.raw())) {}
 
   static constexpr Q from_raw(Raw r) {
     Q q;
@@ -392,7 +390,9 @@ class Q {
   static constexpr Q min() { return from_raw(detail::kRawMin); }
   static constexpr Q lsb() { return from_raw(1); }
 
-  explicit constexpr operator double() const { return static_cast<double>(r_) / static_cast<double>(std::int64_t{1} << F); }
+  explicit constexpr operator double() const {
+    return static_cast<double>(r_) / static_cast<double>(std::int64_t{1} << F);
+  }
   /// Correctly rounded (to nearest, ties to even), assembled from the integer's bits: no floating-point
   /// operation, so a core without an FPU converts without a soft-float routine (telemetry frames).
   explicit constexpr operator float() const {
@@ -433,8 +433,7 @@ class Q {
   friend Q operator/(Q a, Q b) { return from_raw(detail::div_shifted(a.r_, F, b.r_)); }
   /// A product with another format, in this one (e.g. a quantity times a hardware scale).
   template <int G>
-    requires(G != F)
-  [[gnu::always_inline]] friend Q operator*(Q a, Q<G> b) {
+  requires(G != F) [[gnu::always_inline]] friend Q operator*(Q a, Q<G> b) {
     return from_raw(detail::mul_shift<G>(a.r_, b.raw()));
   }
   template <std::integral I>
@@ -468,8 +467,10 @@ class Q {
   static constexpr Raw from_double(double v) {
     const double s = v * static_cast<double>(std::int64_t{1} << F);
     if (!(s == s)) {  // NaN
-      if (std::is_constant_evaluated()) detail::literal_out_of_range();
-      else detail::raise_flag(kDomain);
+      if (std::is_constant_evaluated())
+        detail::literal_out_of_range();
+      else
+        detail::raise_flag(kDomain);
       return 0;
     }
     if (s >= 2147483647.5 || s < -2147483648.5) {
@@ -490,29 +491,42 @@ class Q {
   Raw r_;
 };
 
-template <class T> struct IsQ : std::false_type {};
-template <int F> struct IsQ<Q<F>> : std::true_type {};
-template <class T> inline constexpr bool is_q_v = IsQ<T>::value;
+template <class T>
+struct IsQ : std::false_type {};
+template <int F>
+struct IsQ<Q<F>> : std::true_type {};
+template <class T>
+inline constexpr bool is_q_v = IsQ<T>::value;
 
 // ---------------------------------------------------------------- elementary functions
 // Errors are against double evaluated at the same (quantised) argument, over the whole input
 // range, in units of the result's last bit (LSB = 2^-F); tests/test_fixed.cpp measures them.
 
 template <int F>
-[[gnu::always_inline]] inline Q<F> abs(Q<F> v) { return v.raw() < 0 ? -v : v; }
+[[gnu::always_inline]] inline Q<F> abs(Q<F> v) {
+  return v.raw() < 0 ? -v : v;
+}
 template <int F>
-constexpr bool isfinite(Q<F>) { return true; }
+constexpr bool isfinite(Q<F>) {
+  return true;
+}
 template <int F>
-constexpr bool isnan(Q<F>) { return false; }
+constexpr bool isnan(Q<F>) {
+  return false;
+}
 template <int F>
-constexpr bool isinf(Q<F>) { return false; }
+constexpr bool isinf(Q<F>) {
+  return false;
+}
 
 namespace detail {
 /// A Q30 value (int64) rounded into Q<F>.
 template <int F>
 Q<F> from_q30(std::int64_t v) {
-  if constexpr (F < 30) return Q<F>::from_raw(narrow(shift_round(v, 30 - F)));
-  else return Q<F>::from_raw(narrow(v));
+  if constexpr (F < 30)
+    return Q<F>::from_raw(narrow(shift_round(v, 30 - F)));
+  else
+    return Q<F>::from_raw(narrow(v));
 }
 /// sin and cos of a Q<F> angle: x = k pi/2 + r with |r| <= pi/4, r exact to 2^-30 (pi/2 to 61 bits).
 template <int F>
@@ -576,7 +590,7 @@ Q<F> exp(Q<F> x) {
   p = q30(1.0 / 6) + mul30(r, p);
   p = q30(0.5) + mul30(r, p);
   const std::int64_t e = kOneQ30 + r + mul30(r, mul30(r, p));  // e^r in Q30, 0.70..1.42
-  const int shift = static_cast<int>(k) + F - 30;                // e^x = e 2^k, in Q<F>
+  const int shift = static_cast<int>(k) + F - 30;              // e^x = e 2^k, in Q<F>
   if (shift >= 0) return Q<F>::from_raw(narrow(e << shift));
   return Q<F>::from_raw(narrow(shift_round(e, -shift)));
 }
@@ -614,7 +628,7 @@ Q<F> asin(Q<F> x) {
     xr = xr > 0 ? one : -one;
   }
   const std::uint64_t ax = static_cast<std::uint64_t>(xr < 0 ? -xr : xr);
-  const std::uint64_t c2 = (static_cast<std::uint64_t>(one) << F) - ax * ax;   // 1 - x^2 in Q(2F)
+  const std::uint64_t c2 = (static_cast<std::uint64_t>(one) << F) - ax * ax;  // 1 - x^2 in Q(2F)
   const std::uint64_t c = detail::isqrt64_round(c2 << (60 - 2 * F));          // Q30
   const std::int64_t a = detail::atan2_abs_q30(ax << (30 - F), c);
   return detail::from_q30<F>(xr < 0 ? -a : a);
@@ -685,9 +699,12 @@ namespace Eigen::internal {
 // of rounding and saturating at every product and sum. The result is the correctly rounded sum
 // (when it fits), and a multiply-accumulate costs a fraction of a rounded product on a core
 // without an FPU. Nothing else of Eigen changes: float and double take Eigen's own paths.
-template <class Op> struct OscQProductOp : std::false_type {};
-template <int F> struct OscQProductOp<scalar_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
-template <int F> struct OscQProductOp<scalar_conj_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
+template <class Op>
+struct OscQProductOp : std::false_type {};
+template <int F>
+struct OscQProductOp<scalar_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
+template <int F>
+struct OscQProductOp<scalar_conj_product_op<osc::fixed::Q<F>, osc::fixed::Q<F>>> : std::true_type {};
 
 template <int F>
 struct OscQDotRedux {
@@ -698,9 +715,8 @@ struct OscQDotRedux {
   [[gnu::always_inline]] static void for_each_coeff(const Xpr& xpr, Fn&& fn) {
     constexpr int R = Xpr::RowsAtCompileTime, C = Xpr::ColsAtCompileTime;
     if constexpr (R != Dynamic && C != Dynamic) {
-      [&]<int... K>(std::integer_sequence<int, K...>) {
-        (fn(std::integral_constant<int, K>{}, K % R, K / R), ...);
-      }(std::make_integer_sequence<int, R * C>{});
+      [&]<int... K>(std::integer_sequence<int, K...>) { (fn(std::integral_constant<int, K>{}, K % R, K / R), ...); }
+      (std::make_integer_sequence<int, R * C>{});
     } else {
       int k = 0;
       for (Index j = 0; j < xpr.cols(); ++j)
@@ -731,19 +747,23 @@ struct OscQDotRedux {
 
 // Eigen picks its redux by traversal and unrolling; a Q<F> scalar never vectorises
 // (DefaultTraversal), and small fixed sizes unroll completely: both cases take the one-rounding sum.
-#define OSC_Q_DOT_REDUX(UNROLLING)                                                                          \
-  template <int F, class Op, class L, class R>                                                            \
-    requires OscQProductOp<Op>::value                                                                     \
-  struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>, redux_evaluator<CwiseBinaryOp<Op, L, R>>, \
-                    DefaultTraversal, UNROLLING> {                                                        \
-    template <class Ev, class Func, class Xpr>                                                            \
-    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) { return OscQDotRedux<F>::run(xpr); } \
-  };                                                                                                      \
-  template <int F, class X>                                                                               \
-  struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>,                                    \
+#define OSC_Q_DOT_REDUX(UNROLLING)                                                                                     \
+  template <int F, class Op, class L, class R>                                                                         \
+  requires OscQProductOp<Op>::value struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>,               \
+                                                      redux_evaluator<CwiseBinaryOp<Op, L, R>>, DefaultTraversal,      \
+                                                      UNROLLING> {                                                     \
+    template <class Ev, class Func, class Xpr>                                                                         \
+    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) {                                              \
+      return OscQDotRedux<F>::run(xpr);                                                                                \
+    }                                                                                                                  \
+  };                                                                                                                   \
+  template <int F, class X>                                                                                            \
+  struct redux_impl<scalar_sum_op<osc::fixed::Q<F>, osc::fixed::Q<F>>,                                                 \
                     redux_evaluator<CwiseUnaryOp<scalar_abs2_op<osc::fixed::Q<F>>, X>>, DefaultTraversal, UNROLLING> { \
-    template <class Ev, class Func, class Xpr>                                                            \
-    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) { return OscQDotRedux<F>::run(xpr); } \
+    template <class Ev, class Func, class Xpr>                                                                         \
+    static osc::fixed::Q<F> run(const Ev&, const Func&, const Xpr& xpr) {                                              \
+      return OscQDotRedux<F>::run(xpr);                                                                                \
+    }                                                                                                                  \
   };
 OSC_Q_DOT_REDUX(NoUnrolling)
 OSC_Q_DOT_REDUX(CompleteUnrolling)

@@ -5,7 +5,8 @@
 
 namespace osc {
 
-template <class S> using Regressor = Eigen::Matrix<S, kDof, 3 * kDof>;
+template <class S>
+using Regressor = Eigen::Matrix<S, kDof, 3 * kDof>;
 
 /// Coefficients of (2). theta = [tau_vis; tau_cou; tau_sti] (20); tau_dec is known.
 template <class S>

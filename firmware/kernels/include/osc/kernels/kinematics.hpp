@@ -36,9 +36,15 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
     const Vec3<S> z = R.col(2);
     Rn.col(0) = x;
     switch (l.twist) {
-      case Twist::kZero: Rn.col(1) = y, Rn.col(2) = z; break;
-      case Twist::kPlusHalfPi: Rn.col(1) = z, Rn.col(2) = -y; break;
-      case Twist::kMinusHalfPi: Rn.col(1) = -z, Rn.col(2) = y; break;
+      case Twist::kZero:
+        Rn.col(1) = y, Rn.col(2) = z;
+        break;
+      case Twist::kPlusHalfPi:
+        Rn.col(1) = z, Rn.col(2) = -y;
+        break;
+      case Twist::kMinusHalfPi:
+        Rn.col(1) = -z, Rn.col(2) = y;
+        break;
       case Twist::kGeneral:
         Rn.col(1) = combine(l.cos_alpha, y, l.sin_alpha, z);
         Rn.col(2) = combine(l.cos_alpha, z, S(-l.sin_alpha), y);
@@ -89,7 +95,7 @@ Vec6<S> operational_coordinates(const Data<S>& data, const Mat3<S>& R_ref) {
 /// and yaw that its derivative needs too.
 template <class S>
 struct PhiRate {
-  Mat3<S> Einv;  // E^{-1}(phi): phi_dot = E^{-1} w
+  Mat3<S> Einv;      // E^{-1}(phi): phi_dot = E^{-1} w
   S cb, sb, cg, sg;  // cos, sin of pitch (phi_2) and yaw (phi_3)
 };
 
@@ -99,15 +105,15 @@ PhiRate<S> phi_rate(const Vec3<S>& phi) {
   math::sincos(phi(1), E.sb, E.cb);
   math::sincos(phi(2), E.sg, E.cg);
   const S cg_cb = E.cg / E.cb, sg_cb = E.sg / E.cb;
-  E.Einv << cg_cb, sg_cb, S(0),
-            -E.sg, E.cg, S(0),
-            E.sb * cg_cb, E.sb * sg_cb, S(1);
+  E.Einv << cg_cb, sg_cb, S(0), -E.sg, E.cg, S(0), E.sb * cg_cb, E.sb * sg_cb, S(1);
   return E;
 }
 
 /// E^{-1}(phi): maps the base angular velocity w to phi_dot (E(phi) phi_dot = w).
 template <class S>
-Mat3<S> angular_to_phi_rate(const Vec3<S>& phi) { return phi_rate(phi).Einv; }
+Mat3<S> angular_to_phi_rate(const Vec3<S>& phi) {
+  return phi_rate(phi).Einv;
+}
 
 /// Analytic Jacobian Ja = blockdiag(I, E^{-1}(phi)) J, so that x_dot = Ja q_dot.
 template <class S>
@@ -117,7 +123,9 @@ Mat6<S> analytic_jacobian(const Mat6<S>& J, const PhiRate<S>& E) {
   return Ja;
 }
 template <class S>
-Mat6<S> analytic_jacobian(const Mat6<S>& J, const Vec3<S>& phi) { return analytic_jacobian(J, phi_rate(phi)); }
+Mat6<S> analytic_jacobian(const Mat6<S>& J, const Vec3<S>& phi) {
+  return analytic_jacobian(J, phi_rate(phi));
+}
 
 /// Edot phi_dot for the products of the rates p01 = phi_dot_1 phi_dot_2, p20 = phi_dot_3 phi_dot_1,
 /// p21 = phi_dot_3 phi_dot_2 (symmetrised products for the bilinear form).

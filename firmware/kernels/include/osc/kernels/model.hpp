@@ -9,16 +9,25 @@
 
 namespace osc {
 
-template <class S> using Vec3 = Eigen::Matrix<S, 3, 1>;
-template <class S> using Vec6 = Eigen::Matrix<S, 6, 1>;
-template <class S> using Vec18 = Eigen::Matrix<S, 18, 1>;
-template <class S> using Mat3 = Eigen::Matrix<S, 3, 3>;
-template <class S> using Mat6 = Eigen::Matrix<S, 6, 6>;
+template <class S>
+using Vec3 = Eigen::Matrix<S, 3, 1>;
+template <class S>
+using Vec6 = Eigen::Matrix<S, 6, 1>;
+template <class S>
+using Vec18 = Eigen::Matrix<S, 18, 1>;
+template <class S>
+using Mat3 = Eigen::Matrix<S, 3, 3>;
+template <class S>
+using Mat6 = Eigen::Matrix<S, 6, 6>;
 
 /// Vector argument whose scalar is deduced from another parameter (a Model or workspace), so that
 /// Eigen expressions can be passed directly.
-template <class T> struct NonDeduced { using type = T; };
-template <class S> using Vec6In = typename NonDeduced<Vec6<S>>::type;
+template <class T>
+struct NonDeduced {
+  using type = T;
+};
+template <class S>
+using Vec6In = typename NonDeduced<Vec6<S>>::type;
 
 /// A joint vector of a robot table (angles, limits, poses) in the kernel's scalar.
 template <class S>
@@ -30,7 +39,8 @@ Vec6<S> joint_vector(const double (&a)[kDof]) {
 
 /// a x b, each component a_i b_j - a_j b_i by math::dot2_minus (one rounding in fixed point).
 template <class A, class B>
-[[gnu::always_inline]] inline Vec3<typename A::Scalar> cross(const Eigen::MatrixBase<A>& a, const Eigen::MatrixBase<B>& b) {
+[[gnu::always_inline]] inline Vec3<typename A::Scalar> cross(const Eigen::MatrixBase<A>& a,
+                                                             const Eigen::MatrixBase<B>& b) {
   using S = typename A::Scalar;
   if constexpr (fixed::is_q_v<S>) {
     const Vec3<S> u = a, v = b;
@@ -44,8 +54,10 @@ template <class A, class B>
 /// u . v + w . x of 3-vectors, rounded once in fixed point (a six-term math::sum_of_products).
 template <class S>
 [[gnu::always_inline]] inline S dot_sum(const Vec3<S>& u, const Vec3<S>& v, const Vec3<S>& w, const Vec3<S>& x) {
-  if constexpr (fixed::is_q_v<S>) return math::sum_of_products(u(0), v(0), u(1), v(1), u(2), v(2), w(0), x(0), w(1), x(1), w(2), x(2));
-  else return u.dot(v) + w.dot(x);
+  if constexpr (fixed::is_q_v<S>)
+    return math::sum_of_products(u(0), v(0), u(1), v(1), u(2), v(2), w(0), x(0), w(1), x(1), w(2), x(2));
+  else
+    return u.dot(v) + w.dot(x);
 }
 
 /// a u + b v of two 3-vectors, each component by math::sum_of_products (one rounding in fixed point).
@@ -74,14 +86,14 @@ template <class S>
 struct Model {
   struct Link {
     S a, d, cos_alpha, sin_alpha;
-    Twist twist;          // the structure of alpha (kGeneral: use cos_alpha, sin_alpha)
+    Twist twist;  // the structure of alpha (kGeneral: use cos_alpha, sin_alpha)
     S mass;
-    Vec3<S> com;          // COM in frame i
-    Vec3<S> inertia;      // principal moments about the COM, axes of frame i
+    Vec3<S> com;      // COM in frame i
+    Vec3<S> inertia;  // principal moments about the COM, axes of frame i
   };
   Link link[kDof];
-  Vec6<S> armature;       // G^2 * Jm, added to the diagonal of A(q)
-  S gravity;              // along -z0
+  Vec6<S> armature;  // G^2 * Jm, added to the diagonal of A(q)
+  S gravity;         // along -z0
 
   /// The model of an arm from its description (osc/robots/arm.hpp), with every link mass and
   /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error).
@@ -113,11 +125,11 @@ template <class S>
 struct Data {
   Mat3<S> R[kDof + 1];
   Vec3<S> o[kDof + 1];
-  Vec3<S> com[kDof + 1];   // COM of link i in the base frame (index 0 unused)
-  Mat3<S> Ic[kDof + 1];    // inertia of link i about its COM, base axes (symmetric)
-  Vec3<S> vO[kDof];        // o_i x z_i: velocity of the point at the base origin under a unit rate of joint i + 1
-  Mat6<S> J;               // geometric Jacobian [v; w] of the frame-6 origin, base frame
-  Mat6<S> A;               // joint-space inertia, armature included
+  Vec3<S> com[kDof + 1];  // COM of link i in the base frame (index 0 unused)
+  Mat3<S> Ic[kDof + 1];   // inertia of link i about its COM, base axes (symmetric)
+  Vec3<S> vO[kDof];       // o_i x z_i: velocity of the point at the base origin under a unit rate of joint i + 1
+  Mat6<S> J;              // geometric Jacobian [v; w] of the frame-6 origin, base frame
+  Mat6<S> A;              // joint-space inertia, armature included
 };
 
 }  // namespace osc

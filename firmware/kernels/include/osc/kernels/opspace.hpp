@@ -93,8 +93,10 @@ struct LdltFactor {
       if (!(d(J) > S(0))) positive = false;
       d_inv(J) = S(1) / d(J);
       for (int i = J + 1; i < N; ++i) {
-        if constexpr (J == 0) L(i, 0) = A(i, 0) * d_inv(0);
-        else L(i, J) = (A(i, J) - L.row(i).template head<J>().dot(t.template head<J>())) * d_inv(J);
+        if constexpr (J == 0)
+          L(i, 0) = A(i, 0) * d_inv(0);
+        else
+          L(i, J) = (A(i, J) - L.row(i).template head<J>().dot(t.template head<J>())) * d_inv(J);
       }
     });
   }
@@ -117,8 +119,8 @@ struct LdltFactor {
   /// f(std::integral_constant<int, I>{}) for I = 0, 1, ..., N - 1 in order.
   template <class Fn>
   static void for_each_index(Fn&& f) {
-    [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }(
-        std::make_integer_sequence<int, N>{});
+    [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }
+    (std::make_integer_sequence<int, N>{});
   }
 };
 
@@ -137,18 +139,17 @@ Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor
 /// the observer and controller need that depends on q only.
 template <class S>
 struct OpSpace {
-  Vec6<S> x;               // [p; phi]
-  PhiRate<S> E;            // E^{-1}(phi) and the trig of phi
-  Mat6<S> Ja;              // analytic Jacobian
-  SphericalWristJacobianFactor<S> Jf;    // factorisation of Ja
-  LdltFactor<S, kDof> A_ldlt;  // A = L D L^T
-  Vec6<S> g;               // joint gravity torques
+  Vec6<S> x;                           // [p; phi]
+  PhiRate<S> E;                        // E^{-1}(phi) and the trig of phi
+  Mat6<S> Ja;                          // analytic Jacobian
+  SphericalWristJacobianFactor<S> Jf;  // factorisation of Ja
+  LdltFactor<S, kDof> A_ldlt;          // A = L D L^T
+  Vec6<S> g;                           // joint gravity torques
 };
 
 /// Computes kinematics, A(q), g(q), Ja, its factorisation and the L D L^T factors of A at q.
 template <class S>
-void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q,
-                    const Mat3<S>& R_ref) {
+void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q, const Mat3<S>& R_ref) {
   forward_kinematics(model, data, q);
   geometric_jacobian(data);
   joint_inertia(model, data);
@@ -162,19 +163,27 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
 
 /// Lambda of the current state (opspace_update must have run).
 template <class S>
-Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S>& os) { return operational_inertia(data.A, os.Jf); }
+Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S>& os) {
+  return operational_inertia(data.A, os.Jf);
+}
 
 /// p(x) = J^{-T} g(q) (5).
 template <class S>
-Vec6<S> operational_gravity(const OpSpace<S>& os) { return os.Jf.solve_transpose(os.g); }
+Vec6<S> operational_gravity(const OpSpace<S>& os) {
+  return os.Jf.solve_transpose(os.g);
+}
 
 /// f = J^{-T} tau_f (5), (31).
 template <class S>
-Vec6<S> operational_friction(const OpSpace<S>& os, const Vec6In<S>& tau_f) { return os.Jf.solve_transpose(tau_f); }
+Vec6<S> operational_friction(const OpSpace<S>& os, const Vec6In<S>& tau_f) {
+  return os.Jf.solve_transpose(tau_f);
+}
 
 /// Gamma = J^T F (5).
 template <class S>
-Vec6<S> joint_torques(const OpSpace<S>& os, const Vec6In<S>& F) { return os.Ja.transpose() * F; }
+Vec6<S> joint_torques(const OpSpace<S>& os, const Vec6In<S>& F) {
+  return os.Ja.transpose() * F;
+}
 
 /// Lambda^{-1} w = J A^{-1} J^T w, by the L D L^T factors of A.
 template <class S>

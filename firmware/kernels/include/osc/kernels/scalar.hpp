@@ -16,7 +16,9 @@ namespace osc {
 
 /// Literal of the kernel's scalar type (evaluated at compile time for float/double).
 template <class S>
-constexpr S lit(double v) { return static_cast<S>(v); }
+constexpr S lit(double v) {
+  return static_cast<S>(v);
+}
 
 /// A table of literals (per-joint limits) in the kernel's scalar. Bound to a constexpr variable it is
 /// converted at compile time: indexing it at run time then costs no conversion from double (on a
@@ -44,24 +46,33 @@ namespace detail {
 [[gnu::always_inline]] inline void sincos_float(float v, float& s, float& c) {
   const int k = round_to_int(v * 0.636619772f);
   const float fk = static_cast<float>(k);
-  const float a = v - fk * 1.57080078125f;  // exact
-  const float b = fk * -4.453584551811218e-06f;  // exact
-  const float r = a - b, bv = r - a;  // TwoSum: r + e = a - b exactly
+  const float a = v - fk * 1.57080078125f;                                        // exact
+  const float b = fk * -4.453584551811218e-06f;                                   // exact
+  const float r = a - b, bv = r - a;                                              // TwoSum: r + e = a - b exactly
   const float r_lo = ((a - (r - bv)) - (b + bv)) - fk * -8.705516307827565e-10f;  // r + r_lo = v - k pi/2
   const float z = r * r;
   const float sr_lo = r * z * (-1.66666667e-1f + z * (8.33333333e-3f + z * (-1.98412698e-4f + z * 2.75573192e-6f)));
   const float sr = r + sr_lo;
   const float hz = 0.5f * z, w = 1.0f - hz;
-  const float cr_lo = ((1.0f - w) - hz) + z * z * (4.16666667e-2f + z * (-1.38888889e-3f + z * (2.48015873e-5f + z * -2.75573192e-7f)));
+  const float cr_lo =
+      ((1.0f - w) - hz) + z * z * (4.16666667e-2f + z * (-1.38888889e-3f + z * (2.48015873e-5f + z * -2.75573192e-7f)));
   const float cr = w + cr_lo;
   // sin(r + r_lo) = sin r + r_lo cos r, cos(r + r_lo) = cos r - r_lo sin r (r_lo^2 is below 2^-40).
   const float ps = r + (sr_lo + r_lo * cr);
   const float pc = w + (cr_lo - r_lo * sr);
   switch (static_cast<unsigned>(k) & 3u) {
-    case 0: s = ps, c = pc; break;
-    case 1: s = pc, c = -ps; break;
-    case 2: s = -ps, c = -pc; break;
-    default: s = -pc, c = ps; break;
+    case 0:
+      s = ps, c = pc;
+      break;
+    case 1:
+      s = pc, c = -ps;
+      break;
+    case 2:
+      s = -ps, c = -pc;
+      break;
+    default:
+      s = -pc, c = ps;
+      break;
   }
 }
 /// e^v in float: v = k ln 2 + r, |r| <= ln 2 / 2 (ln 2 in two floats, the first with 12 significant
@@ -73,8 +84,11 @@ namespace detail {
   const int k = round_to_int(v * 1.44269502f);
   const float fk = static_cast<float>(k);
   const float r = (v - fk * 0.693115234375f) - fk * 3.194618329871446e-05f;
-  const float p = 1.0f + r * (1.0f + r * (0.5f + r * (1.66666667e-1f + r * (4.16666667e-2f + r * (8.33333333e-3f +
-                                       r * (1.38888889e-3f + r * 1.98412698e-4f))))));
+  const float p =
+      1.0f +
+      r * (1.0f +
+           r * (0.5f + r * (1.66666667e-1f +
+                            r * (4.16666667e-2f + r * (8.33333333e-3f + r * (1.38888889e-3f + r * 1.98412698e-4f))))));
   // 2^k as two factors: each is a normal float for k in [-126, 128] (k = 128 only just below 88.72).
   const int k1 = k / 2, k2 = k - k1;
   const float s1 = std::bit_cast<float>(static_cast<std::uint32_t>(k1 + 127) << 23);
@@ -110,24 +124,27 @@ inline bool isfinite(double v) { return std::isfinite(v); }
 /// sin v and cos v together (one argument reduction in fixed point).
 inline void sincos(float v, float& s, float& c) { detail::sincos_float(v, s, c); }
 inline void sincos(double v, double& s, double& c) { s = std::sin(v), c = std::cos(v); }
-using fixed::sin;
+using fixed::abs;
+using fixed::asin;
+using fixed::atan2;
 using fixed::cos;
+using fixed::exp;
+using fixed::isfinite;
+using fixed::sin;
 using fixed::sincos;
 using fixed::sqrt;
-using fixed::exp;
-using fixed::abs;
-using fixed::atan2;
-using fixed::asin;
-using fixed::isfinite;
 
 /// a0 b0 + a1 b1 + ...: a dot product written out (a plane rotation, an entry of an inertia). Fixed
 /// point rounds it once (the exact products summed in 64 bits, fixed::detail::ProductSum), not once
 /// per product and sum.
 template <class S, class... R>
 [[gnu::always_inline]] inline S sum_of_products(S a, S b, R... rest) {
-  if constexpr (fixed::is_q_v<S>) return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), rest.raw()...));
-  else if constexpr (sizeof...(R) == 0) return a * b;
-  else return a * b + sum_of_products(rest...);
+  if constexpr (fixed::is_q_v<S>)
+    return S::from_raw(fixed::detail::dot_raw<S::kFractionBits>(a.raw(), b.raw(), rest.raw()...));
+  else if constexpr (sizeof...(R) == 0)
+    return a * b;
+  else
+    return a * b + sum_of_products(rest...);
 }
 /// a b - c d, likewise (the component of a cross product).
 template <class S>
@@ -144,7 +161,9 @@ template <class S>
 
 /// sgn with sgn(0) = 0, eq. (3).
 template <class S>
-S sgn(S v) { return v > S(0) ? S(1) : (v < S(0) ? S(-1) : S(0)); }
+S sgn(S v) {
+  return v > S(0) ? S(1) : (v < S(0) ? S(-1) : S(0));
+}
 
 /// True when every coefficient of an Eigen expression is finite.
 template <class Derived>
@@ -160,30 +179,43 @@ bool all_finite(const Derived& m) {
 /// whose overflows show as non-finite values instead.
 template <class S>
 bool take_arithmetic_fault() {
-  if constexpr (fixed::is_q_v<S>) return fixed::take_flags() != 0;
-  else return false;
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::take_flags() != 0;
+  else
+    return false;
 }
 
 /// The scalar of hardware units at the I/O boundary (encoder counts, counts per radian, DAC
 /// codes), whose magnitudes reach 10^5: the scalar itself for float and double, FixedIo for the
 /// fixed-point kernels.
-template <class S> struct IoScalar { using type = S; };
-template <int F> struct IoScalar<fixed::Q<F>> { using type = FixedIo; };
-template <class S> using io_scalar_t = typename IoScalar<S>::type;
+template <class S>
+struct IoScalar {
+  using type = S;
+};
+template <int F>
+struct IoScalar<fixed::Q<F>> {
+  using type = FixedIo;
+};
+template <class S>
+using io_scalar_t = typename IoScalar<S>::type;
 
 /// n / d of two integers (sample counts to seconds): n (1/d) for float and double (the same bits
 /// as n times a sample time 1/d), rounded once in fixed point.
 template <class S>
 S ratio(std::uint64_t n, std::uint32_t d) {
-  if constexpr (fixed::is_q_v<S>) return fixed::ratio<S::kFractionBits>(static_cast<std::int64_t>(n), d);
-  else return static_cast<S>(n) * (S(1) / static_cast<S>(d));
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::ratio<S::kFractionBits>(static_cast<std::int64_t>(n), d);
+  else
+    return static_cast<S>(n) * (S(1) / static_cast<S>(d));
 }
 
 /// An integer n (encoder counts) divided by a scale of the I/O scalar (counts per radian).
 template <class S>
 S quotient(std::int32_t n, io_scalar_t<S> d) {
-  if constexpr (fixed::is_q_v<S>) return fixed::quotient<S::kFractionBits>(n, d);
-  else return static_cast<S>(n) / d;
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::quotient<S::kFractionBits>(n, d);
+  else
+    return static_cast<S>(n) / d;
 }
 }  // namespace math
 }  // namespace osc

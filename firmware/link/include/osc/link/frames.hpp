@@ -45,11 +45,10 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
 // X(type, name, extent, unit, meaning): one payload field, in wire order. `extent` is empty for one
 // value or [N] for N of them; the wire type follows the C++ type (detail::Wire): std::uint8_t u8,
 // std::uint32_t u32, std::int32_t i32, float f32 (IEEE 754 binary32), all little-endian.
-#define OSC_SENSOR_FIELDS(X)                                                                               \
-  X(std::uint32_t, seq, , "",                                                                             \
-    "sequence number: 0 in the first frame, one more in each next frame (wraps at 2^32)")                 \
-  X(std::int32_t, counts, [kJoints], "count",                                                             \
-    "encoder counts of joints 1 to 6, 0 at the start pose (Encoders, DACs, the plant)")                                    \
+#define OSC_SENSOR_FIELDS(X)                                                                                        \
+  X(std::uint32_t, seq, , "", "sequence number: 0 in the first frame, one more in each next frame (wraps at 2^32)") \
+  X(std::int32_t, counts, [kJoints], "count",                                                                       \
+    "encoder counts of joints 1 to 6, 0 at the start pose (Encoders, DACs, the plant)")                             \
   X(std::uint8_t, inject, , "", "fault-injection requests; configuration bits in the first frame (The inject byte)")
 
 #define OSC_FRAME_MEMBER(type, name, extent, unit, doc) type name extent = {};
@@ -60,20 +59,23 @@ struct SensorFrame {
 
 /// The kinds of link error a receiver tells apart, each counted (LinkCounters) in telemetry.
 // X(Name, "name", meaning), in counter order.
-#define OSC_LINK_ERROR_LIST(X)                                                                      \
-  X(Crc, "bad_crc", "a complete frame whose CRC does not match")                                    \
+#define OSC_LINK_ERROR_LIST(X)                                                                        \
+  X(Crc, "bad_crc", "a complete frame whose CRC does not match")                                      \
   X(Header, "bad_header", "the sync pair, then an unknown frame type (or a frame of the wrong type)") \
-  X(Length, "bad_length", "the sync pair and a known type, with the wrong length")                  \
-  X(Junk, "junk_bytes", "bytes discarded while hunting for the sync pair (junk, lost sync)")        \
-  X(ShortFrame, "short_frames", "a frame that started and was cut short (silence before its end)")  \
-  X(Seq, "seq_errors", "a valid frame with an unexpected sequence number")                          \
+  X(Length, "bad_length", "the sync pair and a known type, with the wrong length")                    \
+  X(Junk, "junk_bytes", "bytes discarded while hunting for the sync pair (junk, lost sync)")          \
+  X(ShortFrame, "short_frames", "a frame that started and was cut short (silence before its end)")    \
+  X(Seq, "seq_errors", "a valid frame with an unexpected sequence number")                            \
   X(Silence, "timeouts", "no frame within the silence limit")
 
 enum LinkError : std::uint8_t {
+// A count after an X-macro expansion: clang-format would indent it as a continuation.
+// clang-format off
 #define OSC_LINK_ERROR_ENUM(Name, name, doc) kErr##Name,
   OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_ENUM)
 #undef OSC_LINK_ERROR_ENUM
   kLinkErrorKinds
+  // clang-format on
 };
 /// Names in telemetry (JSON, logs), in LinkError order.
 constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {
@@ -100,25 +102,25 @@ struct LinkCounters {
   }
 };
 
-#define OSC_ACTUATOR_FIELDS(X)                                                                             \
-  X(std::uint32_t, seq, , "",                                                                             \
-    "the sequence number of the sensor frame this answers; 0xFFFFFFFF in the hello frame")                \
-  X(std::int32_t, codes, [kJoints], "code", "DAC codes of joints 1 to 6, within the DAC full scale (Encoders, DACs, the plant)")   \
-  X(std::uint32_t, faults, , "", "latched fault bits (Fault bits)")                                            \
-  X(std::uint8_t, state, , "", "supervisor state (Supervisor states)")                                                \
-  X(std::uint32_t, step_cycles, , "cycles", "this tick's control step (observer, controller, adaptation); the last one's in a tick without one")                      \
-  X(std::uint32_t, max_cycles, , "cycles", "the longest control step so far")                              \
-  X(std::uint32_t, mean_cycles, , "cycles", "the mean control step so far")                                \
-  X(std::uint32_t, tick_max_cycles, , "cycles",                                                           \
-    "the longest whole tick before this one (encoders to DACs, with its frame's transmission)")                   \
-  X(std::uint32_t, stack_used, , "bytes", "the main stack's high-water mark")                              \
-  X(float, theta_hat, [3 * kJoints], "N m s/rad, N m",                                                    \
-    "friction estimates: viscous of joints 1-6, then Coulomb 1-6, then Stribeck 1-6")                     \
-  X(float, tau_f_hat, [kJoints], "N m", "the estimated friction torque of joints 1 to 6")                  \
-  X(LinkCounters, link, , "",                                                                             \
-    "the firmware's link errors since start, one u32 per kind (Link error counters)")           \
-  X(std::uint32_t, rx_gap_max, , "cycles", "the longest gap between two received bytes")                   \
-  X(std::uint32_t, rx_long_gaps, , "",                                                                    \
+#define OSC_ACTUATOR_FIELDS(X)                                                                                       \
+  X(std::uint32_t, seq, , "", "the sequence number of the sensor frame this answers; 0xFFFFFFFF in the hello frame") \
+  X(std::int32_t, codes, [kJoints], "code",                                                                          \
+    "DAC codes of joints 1 to 6, within the DAC full scale (Encoders, DACs, the plant)")                             \
+  X(std::uint32_t, faults, , "", "latched fault bits (Fault bits)")                                                  \
+  X(std::uint8_t, state, , "", "supervisor state (Supervisor states)")                                               \
+  X(std::uint32_t, step_cycles, , "cycles",                                                                          \
+    "this tick's control step (observer, controller, adaptation); the last one's in a tick without one")             \
+  X(std::uint32_t, max_cycles, , "cycles", "the longest control step so far")                                        \
+  X(std::uint32_t, mean_cycles, , "cycles", "the mean control step so far")                                          \
+  X(std::uint32_t, tick_max_cycles, , "cycles",                                                                      \
+    "the longest whole tick before this one (encoders to DACs, with its frame's transmission)")                      \
+  X(std::uint32_t, stack_used, , "bytes", "the main stack's high-water mark")                                        \
+  X(float, theta_hat, [3 * kJoints], "N m s/rad, N m",                                                               \
+    "friction estimates: viscous of joints 1-6, then Coulomb 1-6, then Stribeck 1-6")                                \
+  X(float, tau_f_hat, [kJoints], "N m", "the estimated friction torque of joints 1 to 6")                            \
+  X(LinkCounters, link, , "", "the firmware's link errors since start, one u32 per kind (Link error counters)")      \
+  X(std::uint32_t, rx_gap_max, , "cycles", "the longest gap between two received bytes")                             \
+  X(std::uint32_t, rx_long_gaps, , "",                                                                               \
     "gaps longer than params::kLinkSilenceTicks control periods (a tick-based silence watchdog's view)")
 
 struct ActuatorFrame {
@@ -128,18 +130,38 @@ struct ActuatorFrame {
 
 namespace detail {
 /// The wire form of a field's C++ type: element type name, element size and count.
-template <class T> struct Wire;
-template <> struct Wire<std::uint8_t> { static constexpr const char* type_name = "u8"; static constexpr int size = 1, count = 1; };
-template <> struct Wire<std::uint32_t> { static constexpr const char* type_name = "u32"; static constexpr int size = 4, count = 1; };
-template <> struct Wire<std::int32_t> { static constexpr const char* type_name = "i32"; static constexpr int size = 4, count = 1; };
-template <> struct Wire<float> { static constexpr const char* type_name = "f32"; static constexpr int size = 4, count = 1; };
+template <class T>
+struct Wire;
+template <>
+struct Wire<std::uint8_t> {
+  static constexpr const char* type_name = "u8";
+  static constexpr int size = 1, count = 1;
+};
+template <>
+struct Wire<std::uint32_t> {
+  static constexpr const char* type_name = "u32";
+  static constexpr int size = 4, count = 1;
+};
+template <>
+struct Wire<std::int32_t> {
+  static constexpr const char* type_name = "i32";
+  static constexpr int size = 4, count = 1;
+};
+template <>
+struct Wire<float> {
+  static constexpr const char* type_name = "f32";
+  static constexpr int size = 4, count = 1;
+};
 static_assert(sizeof(float) == 4, "f32 is IEEE 754 binary32");
-template <class T, int N> struct Wire<T[N]> {
+template <class T, int N>
+struct Wire<T[N]> {
   static constexpr const char* type_name = Wire<T>::type_name;
   static constexpr int size = Wire<T>::size, count = N * Wire<T>::count;
 };
-template <> struct Wire<LinkCounters> : Wire<std::uint32_t[kLinkErrorKinds]> {};
-template <class T> constexpr int kWireBytes = Wire<T>::size * Wire<T>::count;
+template <>
+struct Wire<LinkCounters> : Wire<std::uint32_t[kLinkErrorKinds]> {};
+template <class T>
+constexpr int kWireBytes = Wire<T>::size* Wire<T>::count;
 }  // namespace detail
 
 /// One field of a payload as the protocol document lists it.
@@ -151,9 +173,13 @@ struct FieldInfo {
   const char* unit;
   const char* doc;
 };
-#define OSC_FIELD_INFO(type, name, extent, unit, doc)                                          \
-  FieldInfo{#name, detail::Wire<type extent>::type_name, detail::Wire<type extent>::count,           \
-            detail::kWireBytes<type extent>, unit, doc},
+#define OSC_FIELD_INFO(type, name, extent, unit, doc) \
+  FieldInfo{#name,                                    \
+            detail::Wire<type extent>::type_name,     \
+            detail::Wire<type extent>::count,         \
+            detail::kWireBytes<type extent>,          \
+            unit,                                     \
+            doc},
 constexpr FieldInfo kSensorFields[] = {OSC_SENSOR_FIELDS(OSC_FIELD_INFO)};
 constexpr FieldInfo kActuatorFields[] = {OSC_ACTUATOR_FIELDS(OSC_FIELD_INFO)};
 #undef OSC_FIELD_INFO
@@ -171,8 +197,7 @@ static_assert(kActuatorPayload < 256 && kSensorPayload < 256, "length fits a byt
 constexpr std::uint16_t crc16_bitwise(const std::uint8_t* p, int n, std::uint16_t crc = 0xFFFF) {
   for (int i = 0; i < n; ++i) {
     crc = static_cast<std::uint16_t>(crc ^ (static_cast<std::uint16_t>(p[i]) << 8));
-    for (int b = 0; b < 8; ++b)
-      crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : (crc << 1));
+    for (int b = 0; b < 8; ++b) crc = static_cast<std::uint16_t>((crc & 0x8000) ? (crc << 1) ^ 0x1021 : (crc << 1));
   }
   return crc;
 }

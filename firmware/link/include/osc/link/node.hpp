@@ -29,11 +29,11 @@ namespace osc {
 /// What the link node needs from a board (all static).
 template <class B>
 concept PilBoard = requires(const std::uint8_t* bytes, int n, std::uint32_t cycles, bool active) {
-  { B::link_write(bytes, n) } -> std::same_as<void>;       // blocking write of n bytes
-  { B::cycles() } -> std::same_as<std::uint32_t>;          // free-running cycle counter
-  { B::stack_used() } -> std::same_as<std::uint32_t>;      // main-stack high-water mark [bytes], per tick
-  { B::burn(cycles) } -> std::same_as<void>;               // busy-wait (fault injection only)
-  { B::fault_output(active) } -> std::same_as<void>;       // the board's fault line
+  { B::link_write(bytes, n) } -> std::same_as<void>;   // blocking write of n bytes
+  { B::cycles() } -> std::same_as<std::uint32_t>;      // free-running cycle counter
+  { B::stack_used() } -> std::same_as<std::uint32_t>;  // main-stack high-water mark [bytes], per tick
+  { B::burn(cycles) } -> std::same_as<void>;           // busy-wait (fault injection only)
+  { B::fault_output(active) } -> std::same_as<void>;   // the board's fault line
 };
 
 template <class S, PilBoard Board>
@@ -198,17 +198,17 @@ class PilNode {
   }
 
   pil::Parser parser_;
-  pil::SensorFrame frame_;      // the latest valid sensor frame
+  pil::SensorFrame frame_;  // the latest valid sensor frame
   pil::LinkCounters counters_;
   std::uint32_t expected_seq_ = 0;
   std::uint32_t answer_seq_ = pil::kHelloSeq;  // sequence number of the next actuator frame
-  std::uint32_t errors_ = 0;    // 1 << pil::LinkError of the errors since the last tick
-  bool fresh_ = false;          // a valid sensor frame arrived since the last tick
-  bool synced_ = false;         // the last thing received was a valid frame (junk now is a new error)
-  bool sample_ = false;         // this tick has a valid sample
+  std::uint32_t errors_ = 0;                   // 1 << pil::LinkError of the errors since the last tick
+  bool fresh_ = false;                         // a valid sensor frame arrived since the last tick
+  bool synced_ = false;                        // the last thing received was a valid frame (junk now is a new error)
+  bool sample_ = false;                        // this tick has a valid sample
   bool configured_ = false;
-  int silent_ticks_ = 0;        // timer-paced: ticks in a row without a frame
-  std::uint32_t latch_ = 0;     // link fault for io_faults()
+  int silent_ticks_ = 0;                                     // timer-paced: ticks in a row without a frame
+  std::uint32_t latch_ = 0;                                  // link fault for io_faults()
   std::uint64_t error_ticks_[params::kLinkErrorLimit] = {};  // ticks of the latest error ticks
   int error_count_ = 0, error_next_ = 0;
   bool have_rx_ = false;

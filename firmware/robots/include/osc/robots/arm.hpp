@@ -11,20 +11,20 @@ constexpr double kPi = 3.14159265358979323846;
 
 /// Standard DH row and inertial data of one link (inertia about the COM, axes of frame i).
 struct LinkParams {
-  double a, d, alpha;        // [m], [m], [rad]
-  double mass;               // [kg]
-  double com[3];             // COM in frame i [m]
-  double inertia[3];         // Ixx, Iyy, Izz about the COM [kg m^2]; products are 0
-  double motor_inertia;      // Jm [kg m^2], motor side
-  double gear_ratio;         // G (signed), motor turns per joint turn
+  double a, d, alpha;    // [m], [m], [rad]
+  double mass;           // [kg]
+  double com[3];         // COM in frame i [m]
+  double inertia[3];     // Ixx, Iyy, Izz about the COM [kg m^2]; products are 0
+  double motor_inertia;  // Jm [kg m^2], motor side
+  double gear_ratio;     // G (signed), motor turns per joint turn
 };
 
 /// The arm: kinematics, inertia, gravity and joint limits.
 struct ArmDescription {
   const char* name;
   LinkParams links[kDof];
-  double gravity;            ///< magnitude [m/s^2]; gravity acts along -z0
-  double q_min[kDof];        ///< joint limits [rad]
+  double gravity;      ///< magnitude [m/s^2]; gravity acts along -z0
+  double q_min[kDof];  ///< joint limits [rad]
   double q_max[kDof];
 };
 

@@ -43,32 +43,31 @@ struct ControlTask {
   Model<S> model;
   Gains<S> gains;
   FrictionMode mode;
-  Vec6<S> q_start;            // joint angles at which the encoders read zero
+  Vec6<S> q_start;                            // joint angles at which the encoders read zero
   Vec6<math::io_scalar_t<S>> counts_per_rad;  // encoder counts per joint radian (the robot's drives by default)
-  std::uint64_t tick;         // samples since start (64 bits: never wraps in service)
-  bool have_counts;           // a first encoder sample has been taken
+  std::uint64_t tick;                         // samples since start (64 bits: never wraps in service)
+  bool have_counts;                           // a first encoder sample has been taken
   ControllerState<S> state;
-  StepOutput<S> last;         // the most recent step, for telemetry
-  std::int32_t codes[kDof];   // the most recent DAC codes
+  StepOutput<S> last;        // the most recent step, for telemetry
+  std::int32_t codes[kDof];  // the most recent DAC codes
   std::int32_t prev_counts[kDof];
-  std::uint32_t prev_counts_age;      // ticks since prev_counts were sampled
-  std::int32_t max_count_step[kDof];  // largest plausible encoder change per tick
+  std::uint32_t prev_counts_age;                    // ticks since prev_counts were sampled
+  std::int32_t max_count_step[kDof];                // largest plausible encoder change per tick
   std::int64_t min_counts[kDof], max_counts[kDof];  // plausible readings: joint limits plus a margin
-  std::uint16_t sat_ticks[kDof];      // consecutive clipped ticks per joint
-  Vec6<S> stuck_motion;               // reference motion since each encoder's last change [counts]
-  std::uint64_t last_move_tick[kDof];  // tick of each encoder's last change
-  std::uint32_t move_interval[kDof];   // ticks between its last two changes (its recent count rate)
-  Vec6<S> tau_at_move;                // the torque commanded at each encoder's last change
-  Vec6<S> stuck_dtau_peak;            // the largest torque change seen while an encoder stood still
-  Vec6<S> stuck_dtau_gated_peak;      // ... while it was silent for kStuckIntervals of its intervals
-  Vec6<S> stuck_peak;                 // the largest stuck_motion seen (the monitor's headroom)
+  std::uint16_t sat_ticks[kDof];                    // consecutive clipped ticks per joint
+  Vec6<S> stuck_motion;                             // reference motion since each encoder's last change [counts]
+  std::uint64_t last_move_tick[kDof];               // tick of each encoder's last change
+  std::uint32_t move_interval[kDof];                // ticks between its last two changes (its recent count rate)
+  Vec6<S> tau_at_move;                              // the torque commanded at each encoder's last change
+  Vec6<S> stuck_dtau_peak;                          // the largest torque change seen while an encoder stood still
+  Vec6<S> stuck_dtau_gated_peak;                    // ... while it was silent for kStuckIntervals of its intervals
+  Vec6<S> stuck_peak;                               // the largest stuck_motion seen (the monitor's headroom)
   Supervisor sup;
-  std::uint32_t period_cycles;        // overrun budget per step (0: not checked)
-  StepTiming timing;                  // the whole tick: I/O, step, supervision
-  StepTiming step_timing;             // the control step alone: observer + controller + adaptation
+  std::uint32_t period_cycles;  // overrun budget per step (0: not checked)
+  StepTiming timing;            // the whole tick: I/O, step, supervision
+  StepTiming step_timing;       // the control step alone: observer + controller + adaptation
 
-  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0,
-            std::uint32_t period = 0) {
+  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0) {
     model = m;
     gains = g;
     mode = fm;

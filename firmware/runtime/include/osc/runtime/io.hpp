@@ -12,8 +12,7 @@ namespace osc {
 
 /// Encoder counts per joint radian of the robot's drives, or of encoders with another resolution
 /// (counts per motor revolution, after quadrature decoding).
-constexpr double counts_per_rad(int joint,
-                                double counts_per_motor_rev = robot::kDrives.encoder_counts_per_motor_rev) {
+constexpr double counts_per_rad(int joint, double counts_per_motor_rev = robot::kDrives.encoder_counts_per_motor_rev) {
   return counts_per_motor_rev * abs_of(robot::kArm.links[joint].gear_ratio) / (2 * kPi);
 }
 /// The encoder change of one control period at the joint's maximum speed [counts] (the plausible
@@ -49,7 +48,8 @@ struct DacTable {
     }
   }
 };
-template <class W> inline constexpr DacTable<W> kDacTable{};
+template <class W>
+inline constexpr DacTable<W> kDacTable{};
 
 /// DAC code of a joint torque, saturated at the code range. Returns true when it saturated. The
 /// code is computed in the I/O scalar (it reaches 32767).

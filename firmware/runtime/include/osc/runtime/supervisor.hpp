@@ -49,8 +49,6 @@ constexpr bool torque_enabled(const Supervisor& s) { return s.state == Superviso
 /// A tick that ends in this state may feed a hardware watchdog: kRun, or kInit, with no fault
 /// latched. A tick that latched a fault (and every tick after it) is not healthy, so the watchdog
 /// expires (docs/firmware.md, "Watchdog").
-constexpr bool supervisor_healthy(const Supervisor& s) {
-  return s.state != SupervisorState::kFault && s.latched == 0;
-}
+constexpr bool supervisor_healthy(const Supervisor& s) { return s.state != SupervisorState::kFault && s.latched == 0; }
 
 }  // namespace osc

@@ -38,8 +38,7 @@ constexpr double kQStart[kDof] = {0, kPi / 4, -kPi, 0, kPi / 4, 0};
 /// Encoders: 250-line incremental encoders on the motor shafts, read in quadrature (4x).
 /// DACs: 16-bit bipolar, full scale = the joint torque limit (assumed peak amplifier torques).
 /// Plausible joint speeds: about twice the PUMA 560's maximum joint speeds.
-constexpr DriveParams kDrives = {
-    1000, 16, {97.6, 186.4, 89.4, 24.2, 20.1, 21.3}, {8.0, 8.0, 8.0, 16.0, 16.0, 16.0}};
+constexpr DriveParams kDrives = {1000, 16, {97.6, 186.4, 89.4, 24.2, 20.1, 21.3}, {8.0, 8.0, 8.0, 16.0, 16.0, 16.0}};
 
 /// Toolbox (Corke/Armstrong-Helouvry) motor-side friction: viscous B and Coulomb Tc(+), Tc(-).
 constexpr double kMotorViscous[kDof] = {1.48e-3, 0.817e-3, 1.38e-3, 71.2e-6, 82.6e-6, 36.7e-6};
