@@ -21,8 +21,9 @@ and is rewritten in place. Kinds:
         firmware's field lists, constants and encoder); checked exactly in CI (ctest docs_tables_protocol)
 
 --check regenerates the selected tables in memory and compares them with the docs: the same text,
-or numbers within 2 % (the simulated plant is compiled for the build machine's vector unit, so
-another machine may round its last bits differently); exit 1 listing the stale tables.
+or numbers within 2 % (the host build computes the same bits on every x86-64 machine; a build with
+-DOSC_NATIVE_PLANT=ON does not, and its quantisation-level figures can move by more); exit 1 listing
+the stale tables.
 By default every host and m4f table whose build exists is regenerated (and written).
 """
 import argparse
