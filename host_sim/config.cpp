@@ -58,12 +58,19 @@ std::string mode_name(const Settings& s) {
   return s.run_adaptive && s.run_none ? "both" : s.run_adaptive ? "adaptive" : "none";
 }
 
+/// The robot's friction preset of that name (osc::robot::kFrictionPresets), or null.
 const osc::FrictionCoefficients* friction_preset(const std::string& name) {
-  static const osc::FrictionCoefficients* const kPresets[] = {&osc::robot::kFrictionPaper, &osc::robot::kFrictionCorke,
-                                                              &osc::kFrictionNone};
-  for (const auto* p : kPresets)
+  for (const auto* p : osc::robot::kFrictionPresets)
     if (name == p->name) return p;
   return nullptr;
+}
+
+/// The preset names, then "custom".
+std::vector<std::string> friction_preset_names() {
+  std::vector<std::string> names;
+  for (const auto* p : osc::robot::kFrictionPresets) names.emplace_back(p->name);
+  names.emplace_back("custom");
+  return names;
 }
 
 /// Sets one coefficient list of the plant's friction (0 vis, 1 cou, 2 sti): the friction is then custom.
@@ -292,12 +299,12 @@ const std::vector<Entry>& entries() {
     // plant
     {
       Entry f{"plant.friction.preset",
-              "the simulated robot's friction: paper (Table II), corke (toolbox), none, or custom (vis, cou, sti "
-              "below; setting any of them makes it custom)",
+              "the simulated robot's friction: a preset of the robot (the PUMA 560's: paper, Table II; corke, "
+              "the toolbox's; none), or custom (vis, cou, sti below; setting any of them makes it custom)",
               Kind::kName,
               0,
               0,
-              {"paper", "corke", "none", "custom"},
+              friction_preset_names(),
               true,
               nullptr,
               nullptr,

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string_view>
+#include <type_traits>
 
 #include "osc/control/params.hpp"
 #include "osc/control/trajectory.hpp"
@@ -35,34 +36,67 @@ constexpr bool adaptation_law_from_name(std::string_view name, AdaptationLaw& la
   return false;
 }
 
+namespace detail {
+/// A gain's paper value in the scalar of its field: a list of params.hpp, a number (every element of
+/// a vector gets it), or a value of the field's own type (an enum, the trajectory).
+template <class Field, class V>
+Field gain_value(const V& v) {
+  if constexpr (requires { Field::RowsAtCompileTime; }) {
+    using S = typename Field::Scalar;
+    Field f;
+    for (int i = 0; i < Field::RowsAtCompileTime; ++i) {
+      if constexpr (std::is_arithmetic_v<V>)
+        f(i) = lit<S>(v);
+      else
+        f(i) = lit<S>(v[i]);
+    }
+    return f;
+  } else if constexpr (std::is_arithmetic_v<V>) {
+    return lit<Field>(v);
+  } else {
+    return v;
+  }
+}
+/// A gain in another scalar T: Eigen vectors and the trajectory cast, numbers converted, enums kept.
+template <class T, class Field>
+auto gain_cast(const Field& v) {
+  if constexpr (requires { v.template cast<T>(); })
+    return v.template cast<T>();
+  else if constexpr (std::is_enum_v<Field>)
+    return v;
+  else
+    return static_cast<T>(v);
+}
+}  // namespace detail
+
+// X(type, name, paper value, meaning): the controller's parameters, each declared once; the struct,
+// Gains::paper() and Gains::cast() are made from this list.
+#define OSC_GAINS_FIELDS(X)                                                                         \
+  X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz")              \
+  X(Vec6<S>, k, params::kK, "observer gain k of (69)")                                              \
+  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)")                                        \
+  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)")                                        \
+  X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad")                          \
+  X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay of model (2), per joint")   \
+  X(S, dt, params::kDt, "the sample time [s]")                                                      \
+  X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition")      \
+  X(AdaptationLaw, adaptation, AdaptationLaw::kRobust, "the friction adaptation law")               \
+  X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)") \
+  X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law [1/s]")                \
+  X(TrajectorySpec<S>, trajectory, TrajectorySpec<S>::paper(), "the task (68)")
+
 template <class S>
 struct Gains {
-  Vec6<S> knd, k, ks, ki;
-  S kad;
-  Vec6<S> tau_dec;
-  S dt;
-  S min_rcond;
-  AdaptationLaw adaptation;
-  Vec18<S> theta_max;            // projection bounds of the robust law (lower bounds 0)
-  S leakage;                     // sigma of the robust law [1/s]
-  TrajectorySpec<S> trajectory;  // the task (68)
+#define OSC_GAINS_MEMBER(type, name, paper, doc) type name;
+  OSC_GAINS_FIELDS(OSC_GAINS_MEMBER)
+#undef OSC_GAINS_MEMBER
 
+  /// The paper's set-up (params.hpp) and the firmware's default law.
   static Gains paper() {
     Gains g;
-    for (int i = 0; i < kDof; ++i) {
-      g.knd(i) = lit<S>(params::kKnd[i]);
-      g.k(i) = lit<S>(params::kK[i]);
-      g.ks(i) = lit<S>(params::kKs[i]);
-      g.ki(i) = lit<S>(params::kKi[i]);
-      g.tau_dec(i) = lit<S>(params::kTauDec);
-    }
-    g.kad = lit<S>(params::kKad);
-    g.dt = lit<S>(params::kDt);
-    g.min_rcond = lit<S>(params::kMinJacobianRcond);
-    g.adaptation = AdaptationLaw::kRobust;
-    for (int i = 0; i < 3 * kDof; ++i) g.theta_max(i) = lit<S>(params::kThetaMax[i]);
-    g.leakage = lit<S>(params::kAdaptationLeakage);
-    g.trajectory = TrajectorySpec<S>::paper();
+#define OSC_GAINS_PAPER(type, name, paper, doc) g.name = detail::gain_value<type>(paper);
+    OSC_GAINS_FIELDS(OSC_GAINS_PAPER)
+#undef OSC_GAINS_PAPER
     return g;
   }
 
@@ -70,18 +104,9 @@ struct Gains {
   template <class T>
   Gains<T> cast() const {
     Gains<T> g;
-    g.knd = knd.template cast<T>();
-    g.k = k.template cast<T>();
-    g.ks = ks.template cast<T>();
-    g.ki = ki.template cast<T>();
-    g.kad = static_cast<T>(kad);
-    g.tau_dec = tau_dec.template cast<T>();
-    g.dt = static_cast<T>(dt);
-    g.min_rcond = static_cast<T>(min_rcond);
-    g.adaptation = adaptation;
-    g.theta_max = theta_max.template cast<T>();
-    g.leakage = static_cast<T>(leakage);
-    g.trajectory = trajectory.template cast<T>();
+#define OSC_GAINS_CAST(type, name, paper, doc) g.name = detail::gain_cast<T>(name);
+    OSC_GAINS_FIELDS(OSC_GAINS_CAST)
+#undef OSC_GAINS_CAST
     return g;
   }
 };
