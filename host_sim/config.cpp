@@ -41,10 +41,11 @@ struct Entry {
   double lo = 0, hi = 0;           // kNumber, and each element of a kList
   std::vector<std::string> names;  // kName: the values allowed
   bool paper = true;               // part of the paper's set-up (differences_from_paper)
-  std::function<json(const Settings&)> get;
-  std::function<std::string(Settings&, const json&)> put;
-  std::function<bool(const Settings&)> shown;  // printed only when true (null: always)
-  std::function<void(const Settings&, double& lo, double& hi, int element)> element_range;  // per-element bounds
+  std::function<json(const Settings&)> get = nullptr;
+  std::function<std::string(Settings&, const json&)> put = nullptr;
+  std::function<bool(const Settings&)> shown = nullptr;  // printed only when true (null: always)
+  std::function<void(const Settings&, double& lo, double& hi, int element)> element_range =
+      nullptr;  // per-element bounds
 };
 
 json vec_json(const double* v, int n, double scale = 1) {
@@ -89,7 +90,7 @@ const std::vector<Entry>& entries() {
     std::vector<Entry> t;
     auto number = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
                        std::function<double&(Settings&)> ref) {
-      Entry e{key, doc, Kind::kNumber, lo, hi, {}, paper, nullptr, nullptr, nullptr, nullptr};
+      Entry e{key, doc, Kind::kNumber, lo, hi, {}, paper};
       e.get = [ref](const Settings& s) { return json(ref(const_cast<Settings&>(s))); };
       e.put = [ref](Settings& s, const json& v) {
         ref(s) = v.get<double>();
@@ -100,7 +101,7 @@ const std::vector<Entry>& entries() {
     // A list of six numbers, each in [lo, hi], stored scaled by `scale` into the settings.
     auto list6 = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
                       std::function<Vec6&(Settings&)> ref, double scale = 1) {
-      Entry e{key, doc, Kind::kList, lo, hi, {}, paper, nullptr, nullptr, nullptr, nullptr};
+      Entry e{key, doc, Kind::kList, lo, hi, {}, paper};
       e.get = [ref, scale](const Settings& s) { return vec_json(ref(const_cast<Settings&>(s)), 1 / scale); };
       e.put = [ref, scale](Settings& s, const json& v) {
         for (int i = 0; i < 6; ++i) ref(s)(i) = v[i].get<double>() * scale;
@@ -111,7 +112,7 @@ const std::vector<Entry>& entries() {
     auto name = [&t](const char* key, const char* doc, std::vector<std::string> names, bool paper,
                      std::function<std::string(const Settings&)> get,
                      std::function<void(Settings&, const std::string&)> put) {
-      Entry e{key, doc, Kind::kName, 0, 0, std::move(names), paper, nullptr, nullptr, nullptr, nullptr};
+      Entry e{key, doc, Kind::kName, 0, 0, std::move(names), paper};
       e.get = [get](const Settings& s) { return json(get(s)); };
       e.put = [put](Settings& s, const json& v) {
         put(s, v.get<std::string>());
@@ -160,34 +161,15 @@ const std::vector<Entry>& entries() {
     list6("controller.ki", "controller gain k_i of (69)", 1e-3, 1e6, true,
           [](Settings& s) -> Vec6& { return s.base.gains.ki; });
     {
-      Entry e{"controller.k_ad",
-              "adaptation gain: every diagonal entry of K_ad",
-              Kind::kNumber,
-              0,
-              1e5,
-              {},
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
-      e.get = [](const Settings& s) { return json(s.base.gains.kad); };
-      e.put = [](Settings& s, const json& v) {
-        s.base.gains.kad = v.get<double>();
-        return std::string();
-      };
-      t.push_back(e);
+      number("controller.k_ad", "adaptation gain: every diagonal entry of K_ad", 0, 1e5, true,
+             [](Settings& s) -> double& { return s.base.gains.kad; });
       Entry d{"controller.tau_dec",
               "the controller's Stribeck decay tau_dec of model (2), every joint [s^2/rad^2]",
               Kind::kNumber,
               0.01,
               100,
               {},
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+              true};
       d.get = [](const Settings& s) { return json(s.base.gains.tau_dec(0)); };
       d.put = [](Settings& s, const json& v) {
         s.base.gains.tau_dec.setConstant(v.get<double>());
@@ -209,17 +191,7 @@ const std::vector<Entry>& entries() {
       if (period_ticks == osc::kTrajectoryPeriodTicks) spec.omega = osc::params::kOmega;
     };
     {
-      Entry a{"trajectory.amplitude",
-              "of each sinusoid about the start position [m]",
-              Kind::kNumber,
-              0,
-              0.2,
-              {},
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+      Entry a{"trajectory.amplitude", "of each sinusoid about the start position [m]", Kind::kNumber, 0, 0.2, {}, true};
       a.get = [](const Settings& s) { return json(s.base.gains.trajectory.amplitude); };
       a.put = [reshape](Settings& s, const json& v) {
         const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
@@ -233,11 +205,7 @@ const std::vector<Entry>& entries() {
               0.5,
               60,
               {},
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+              true};
       p.get = [](const Settings& s) {
         return json(static_cast<double>(s.base.gains.trajectory.period_ticks) * osc::params::kDt);
       };
@@ -251,17 +219,8 @@ const std::vector<Entry>& entries() {
         return std::string();
       };
       t.push_back(p);
-      Entry c{"trajectory.envelope",
-              "rate c of the envelope 1 - exp(-c t^3) [1/s^3]",
-              Kind::kNumber,
-              1e-3,
-              10,
-              {},
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+      Entry c{
+          "trajectory.envelope", "rate c of the envelope 1 - exp(-c t^3) [1/s^3]", Kind::kNumber, 1e-3, 10, {}, true};
       c.get = [](const Settings& s) { return json(s.base.gains.trajectory.envelope); };
       c.put = [reshape](Settings& s, const json& v) {
         const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
@@ -273,12 +232,9 @@ const std::vector<Entry>& entries() {
 
     // start pose, in degrees within the joint limits
     {
-      Entry q{"start_pose", "joint angles q1..q6 at the start [deg], within the joint limits",
-              Kind::kList,  -360,
-              360,          {},
-              true,         nullptr,
-              nullptr,      nullptr,
-              nullptr};
+      Entry q{
+          "start_pose", "joint angles q1..q6 at the start [deg], within the joint limits", Kind::kList, -360, 360, {},
+          true};
       q.get = [](const Settings& s) { return vec_json(s.base.q_start, 1 / kDeg); };
       q.put = [](Settings& s, const json& v) {
         for (int i = 0; i < 6; ++i) {
@@ -305,11 +261,7 @@ const std::vector<Entry>& entries() {
               0,
               0,
               friction_preset_names(),
-              true,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+              true};
       f.get = [](const Settings& s) { return json(std::string(s.base.plant.friction.name)); };
       f.put = [](Settings& s, const json& v) {
         const std::string n = v.get<std::string>();
@@ -324,7 +276,7 @@ const std::vector<Entry>& entries() {
                                        {"plant.friction.cou", "Coulomb levels per joint [N m]"},
                                        {"plant.friction.sti", "Stribeck excess per joint [N m]"}};
       for (int k = 0; k < 3; ++k) {
-        Entry c{kCoef[k][0], kCoef[k][1], Kind::kList, 0, 200, {}, true, nullptr, nullptr, nullptr, nullptr};
+        Entry c{kCoef[k][0], kCoef[k][1], Kind::kList, 0, 200, {}, true};
         c.get = [k](const Settings& s) {
           const osc::FrictionCoefficients& fr = s.base.plant.friction;
           return vec_json(k == 0 ? fr.vis : k == 1 ? fr.cou : fr.sti, 6);
@@ -349,11 +301,7 @@ const std::vector<Entry>& entries() {
               1,
               16,
               {},
-              false,
-              nullptr,
-              nullptr,
-              nullptr,
-              nullptr};
+              false};
       e.get = [](const Settings& s) { return json(s.base.plant.smooth_steps); };
       e.put = [](Settings& s, const json& v) {
         const double n = v.get<double>();

@@ -729,23 +729,26 @@ def t_protocol_link_errors():
     return "\n".join(rows)
 
 
+def markdown_table(header, rows):
+    """A table of a header row (its cells) and rows of cells."""
+    return "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+                     + ["| " + " | ".join(str(c) for c in r) + " |" for r in rows])
+
+
 @table("protocol_states", "docs/protocol.md", "protocol")
 def t_protocol_states():
     meaning = {"init": "no valid sample yet: zero torque",
                "run": "torque commanded",
                "fault": "a fault latched: zero torque until a reset (no transition leaves it)"}
-    rows = ["| code | state | meaning |", "|---|---|---|"]
-    for k, name in enumerate(protocol()["states"]):
-        rows.append(f"| {k} | `{name}` | {meaning.get(name, '')} |")
-    return "\n".join(rows)
+    return markdown_table(["code", "state", "meaning"],
+                          [(k, f"`{name}`", meaning.get(name, "")) for k, name in enumerate(protocol()["states"])])
 
 
 @table("protocol_faults", "docs/protocol.md", "protocol")
 def t_protocol_faults():
-    rows = ["| bit | mask | name | meaning |", "|---|---|---|---|"]
-    for k, f in enumerate(protocol()["faults"]):
-        rows.append(f"| {k} | `{hexs(1 << k, 8)}` | `{f['name']}` | {f['doc']} |")
-    return "\n".join(rows)
+    return markdown_table(["bit", "mask", "name", "meaning"],
+                          [(k, f"`{hexs(1 << k, 8)}`", f"`{f['name']}`", f["doc"])
+                           for k, f in enumerate(protocol()["faults"])])
 
 
 @table("protocol_joints", "docs/protocol.md", "protocol")

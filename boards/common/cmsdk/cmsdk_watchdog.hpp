@@ -40,43 +40,46 @@ template <std::uintptr_t Base>
 struct Watchdog {
   static WatchdogRegs& regs() { return *reinterpret_cast<WatchdogRegs*>(Base); }
 
-  /// Starts counting from `load` with the interrupt and the reset output enabled.
-  static void start(std::uint32_t load) {
+  /// Writes registers while unlocked (every write of this driver), then locks again.
+  template <class Write>
+  static void unlocked(Write write) {
     WatchdogRegs& w = regs();
     w.LOCK = WatchdogRegs::kUnlockKey;
-    w.LOAD = load;
-    w.INTCLR = 1;
-    w.CTRL = WatchdogRegs::kIntEnable | WatchdogRegs::kResetEnable;
+    write(w);
     w.LOCK = 0;
+  }
+
+  /// Starts counting from `load` with the interrupt and the reset output enabled.
+  static void start(std::uint32_t load) {
+    unlocked([load](WatchdogRegs& w) {
+      w.LOAD = load;
+      w.INTCLR = 1;
+      w.CTRL = WatchdogRegs::kIntEnable | WatchdogRegs::kResetEnable;
+    });
   }
   /// Clears the interrupt and restarts the count from LOAD.
   static void feed() {
-    WatchdogRegs& w = regs();
-    w.LOCK = WatchdogRegs::kUnlockKey;
-    w.INTCLR = 1;
-    w.LOCK = 0;
+    unlocked([](WatchdogRegs& w) { w.INTCLR = 1; });
   }
   /// Stops the counter (interrupt and reset off).
   static void stop() {
-    WatchdogRegs& w = regs();
-    w.LOCK = WatchdogRegs::kUnlockKey;
-    w.CTRL = 0;
-    w.INTCLR = 1;
-    w.LOCK = 0;
+    unlocked([](WatchdogRegs& w) {
+      w.CTRL = 0;
+      w.INTCLR = 1;
+    });
   }
   /// Pauses the watchdog for a wait of unknown length; start() resumes it from a full count. The
   /// part stops its counter when CTRL.INTEN goes low (DDI 0479). QEMU 7.2's model (Debian 12's;
   /// later QEMU stops it as the part does) does not: its counter runs on, and its second expiry
-  /// latches the reset even with CTRL.RESEN low, to be asserted as soon as start() sets RESEN. So the count restarts
-  /// from the longest LOAD too: the two expiries are 2^33 clock cycles away (344 s at 25 MHz), where stop() leaves them
-  /// two LOADs away.
+  /// latches the reset even with CTRL.RESEN low, to be asserted as soon as start() sets RESEN. So
+  /// the count restarts from the longest LOAD too: the two expiries are 2^33 clock cycles away
+  /// (344 s at 25 MHz), where stop() leaves them two LOADs away.
   static void pause() {
-    WatchdogRegs& w = regs();
-    w.LOCK = WatchdogRegs::kUnlockKey;
-    w.CTRL = 0;
-    w.LOAD = 0xFFFFFFFFu;
-    w.INTCLR = 1;
-    w.LOCK = 0;
+    unlocked([](WatchdogRegs& w) {
+      w.CTRL = 0;
+      w.LOAD = 0xFFFFFFFFu;
+      w.INTCLR = 1;
+    });
   }
   /// The count has expired once since the last feed (the interrupt is raised).
   static bool expired_once() { return (regs().RIS & 1u) != 0; }

@@ -53,19 +53,15 @@ constexpr int kFaultCount = detail::kFaultCount;
 static_assert(kFaultCount <= 32, "the fault bits fit the 32-bit fault word of the link and the supervisor");
 /// Every defined fault bit.
 constexpr std::uint32_t kAllFaults = (1u << kFaultCount) - 1u;
-/// Names of the fault bits, in bit order (for telemetry and logs).
-constexpr const char* kFaultNames[kFaultCount] = {
-#define OSC_FAULT_NAME(Name, name, doc) name,
-    OSC_FAULT_LIST(OSC_FAULT_NAME)
-#undef OSC_FAULT_NAME
-};
+// The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
+// `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.
+#define OSC_X_NAME(Name, name, doc) name,
+#define OSC_X_DOC(Name, name, doc) doc,
 
+/// Names of the fault bits, in bit order (for telemetry and logs).
+constexpr const char* kFaultNames[kFaultCount] = {OSC_FAULT_LIST(OSC_X_NAME)};
 /// What each fault means, in bit order.
-constexpr const char* kFaultDocs[kFaultCount] = {
-#define OSC_FAULT_DOC(Name, name, doc) doc,
-    OSC_FAULT_LIST(OSC_FAULT_DOC)
-#undef OSC_FAULT_DOC
-};
+constexpr const char* kFaultDocs[kFaultCount] = {OSC_FAULT_LIST(OSC_X_DOC)};
 
 /// Name of the lowest fault bit set in bits ("none" for 0).
 constexpr const char* fault_name(std::uint32_t bits) {

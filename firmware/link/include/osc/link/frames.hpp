@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC
 #include "osc/control/gains.hpp"
 #include "osc/robots/arm.hpp"
 
@@ -78,17 +79,9 @@ enum LinkError : std::uint8_t {
   // clang-format on
 };
 /// Names in telemetry (JSON, logs), in LinkError order.
-constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {
-#define OSC_LINK_ERROR_NAME(Name, name, doc) name,
-    OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_NAME)
-#undef OSC_LINK_ERROR_NAME
-};
+constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {OSC_LINK_ERROR_LIST(OSC_X_NAME)};
 /// What each kind means, in LinkError order.
-constexpr const char* kLinkErrorDocs[kLinkErrorKinds] = {
-#define OSC_LINK_ERROR_DOC(Name, name, doc) doc,
-    OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_DOC)
-#undef OSC_LINK_ERROR_DOC
-};
+constexpr const char* kLinkErrorDocs[kLinkErrorKinds] = {OSC_LINK_ERROR_LIST(OSC_X_DOC)};
 
 /// Link errors counted by kind since start (32-bit counters that wrap; compare differences).
 struct LinkCounters {
