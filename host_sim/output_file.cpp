@@ -13,6 +13,9 @@
 namespace sim {
 namespace {
 
+/// What an output path names (symbolic links followed).
+enum class OutputKind { kStdout, kNew, kRegular, kStream };
+
 std::string reason() { return std::strerror(errno); }
 
 std::string dir_of(const std::string& p) {
@@ -134,13 +137,6 @@ bool write_all(int fd, const std::string& text, const std::string& name, std::st
   }
   sigaction(SIGPIPE, &old, nullptr);
   return ok;
-}
-
-bool output_kind(const std::string& path, OutputKind& kind, std::string& err) {
-  Target t;
-  if (!resolve(path, t, err)) return false;
-  kind = t.kind;
-  return true;
 }
 
 bool check_output(const std::string& path, std::string& err) {

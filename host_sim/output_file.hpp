@@ -14,13 +14,6 @@
 
 namespace sim {
 
-/// What an output path names (symbolic links followed).
-enum class OutputKind { kStdout, kNew, kRegular, kStream };
-
-/// Classifies `path`; false with `err` when it cannot be written at all (a directory, a dangling link
-/// into a missing directory, a link loop).
-bool output_kind(const std::string& path, OutputKind& kind, std::string& err);
-
 /// Before a long run: whether `path` can take an output (its directory is writable, a device or FIFO
 /// is writable); creates nothing that stays and never opens a FIFO (that would block).
 bool check_output(const std::string& path, std::string& err);
