@@ -57,9 +57,9 @@ class LocalController {
   }
   void skip_ticks(std::uint64_t n) { task_->tick += n; }
   void finish(ExperimentResult& res) {
-    for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck_peak(i));
-    for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck_dtau_peak(i));
-    for (int i = 0; i < 6; ++i) res.stuck_dtau_silent_peak[i] = static_cast<double>(task_->stuck_dtau_gated_peak(i));
+    for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck.peak(i));
+    for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck.dtau_peak(i));
+    for (int i = 0; i < 6; ++i) res.stuck_dtau_silent_peak[i] = static_cast<double>(task_->stuck.dtau_gated_peak(i));
   }
 
  private:

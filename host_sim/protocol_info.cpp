@@ -15,6 +15,7 @@
 #include "osc/robot.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
+#include "osc/runtime/timing.hpp"
 
 namespace {
 
@@ -126,6 +127,9 @@ int main(int argc, char** argv) {
     j["link_errors"].push_back({{"name", pil::kLinkErrorNames[i]}, {"doc", pil::kLinkErrorDocs[i]}});
   j["states"] = json::array();
   for (int i = 0; i < osc::kSupervisorStateCount; ++i) j["states"].push_back(osc::kSupervisorStateNames[i]);
+  j["tick_stages"] = json::array();
+  for (int i = 0; i < osc::kTickStages; ++i)
+    j["tick_stages"].push_back({{"name", osc::kTickStageNames[i]}, {"doc", osc::kTickStageDocs[i]}});
   j["faults"] = json::array();
   for (int i = 0; i < osc::kFaultCount; ++i)
     j["faults"].push_back({{"name", osc::kFaultNames[i]}, {"doc", osc::kFaultDocs[i]}});

@@ -1,11 +1,15 @@
 // osc_telemetry: reads a board's telemetry stream (boards/stm32f4: an actuator frame every 10th tick
 // over its USART) with the PIL link's parser (osc/link/frames.hpp), from a capture file or a serial
 // device, and prints one line a frame and a summary. Bytes between frames (the boot line) are
-// counted as junk, not errors. Exit status 0 when at least one frame came and none was bad (and the
+// counted as junk, not errors. With --json, each frame is a JSON line (its keys the actuator frame's field
+// names, host_sim/frame_json.hpp) and the summary goes to stderr. Exit status 0 when at least one frame came and none
+// was bad (and the
 // --expect-* conditions hold), 1 otherwise, 2 on a bad command line or an unreadable source.
 //
 //   osc_telemetry build/m4f/boards/stm32f4/stm32f4_qemu_usart2.bin
 //   osc_telemetry --baud 460800 --frames 500 /dev/ttyUSB0
+//   osc_telemetry --json capture.bin | python3 -c 'import json,sys; [print(json.loads(l)["stage_cycles"]) for l in
+//   sys.stdin]'
 #include <fcntl.h>
 #include <termios.h>
 #include <unistd.h>
@@ -14,6 +18,7 @@
 #include <cstdio>
 #include <string>
 
+#include "frame_json.hpp"
 #include "osc/control/faults.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/supervisor.hpp"
@@ -57,7 +62,7 @@ int main(int argc, char** argv) {
   std::string source;
   int baud = 460800;
   long max_frames = 0;
-  bool quiet = false;
+  bool quiet = false, as_json = false;
   std::string expect_faults;
   long expect_frames = -1;
   app.add_option("source", source, "capture file, or serial device (e.g. /dev/ttyUSB0)")->required();
@@ -65,6 +70,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({115200, 230400, 460800, 921600}));
   app.add_option("--frames", max_frames, "stop after this many frames (0: at the end of the file)");
   app.add_flag("--quiet", quiet, "the summary only");
+  app.add_flag("--json", as_json,
+               "each frame as a line of JSON (keys: the frame's field names); the summary on stderr");
   app.add_option("--expect-faults", expect_faults,
                  "fail unless the last frame's latched faults are these (e.g. estop)");
   app.add_option("--expect-frames", expect_frames, "fail unless exactly this many frames came");
@@ -99,7 +106,9 @@ int main(int argc, char** argv) {
       } else {
         if (frames++ == 0) first = a;
         last = a;
-        if (!quiet) {
+        if (as_json && !quiet) {
+          std::printf("%s\n", sim::frame_json(a).dump().c_str());
+        } else if (!quiet) {
           std::printf("seq %u %s faults %s codes", a.seq, state_name(a.state), fault_names(a.faults).c_str());
           for (std::int32_t c : a.codes) std::printf(" %d", c);
           std::printf(" step %u max %u tick_max %u stack %u\n", a.step_cycles, a.max_cycles, a.tick_max_cycles,
@@ -109,8 +118,9 @@ int main(int argc, char** argv) {
     }
   }
   close(fd);
-  std::printf("frames %ld (seq %u..%u), bad %ld, other type %ld, junk bytes %ld; last: state %s, faults %s\n", frames,
-              first.seq, last.seq, bad, other_type, junk, state_name(last.state), fault_names(last.faults).c_str());
+  std::fprintf(as_json ? stderr : stdout,
+               "frames %ld (seq %u..%u), bad %ld, other type %ld, junk bytes %ld; last: state %s, faults %s\n", frames,
+               first.seq, last.seq, bad, other_type, junk, state_name(last.state), fault_names(last.faults).c_str());
   bool ok = frames > 0 && bad == 0 && other_type == 0;
   if (expect_frames >= 0 && frames != expect_frames) {
     std::printf("expected %ld frames\n", expect_frames);

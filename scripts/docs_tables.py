@@ -378,9 +378,14 @@ def kernel_instructions(out):
     return rows
 
 
-def timer_step(out, what="control step in the 1 kHz timer interrupt (`timer_firmware`, 200 ticks): max / mean"):
+def timer_step(out, what="whole tick in the 1 kHz timer interrupt (`timer_firmware`, 200 ticks): max / mean"):
+    """The tick, then each of its stages (osc::TickStage; the image's clock counts 40 instructions a step)."""
     m = re.search(r"control step: max (\d+), mean (\d+) instructions", out)
-    return [(what, f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))}")] if m else []
+    rows = [(what, f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))}")] if m else []
+    stages = re.search(r"^tick stages, max/mean: (.*) instructions$", out, re.M)
+    for name, mx, mean in re.findall(r"(\w+) (\d+)/(\d+)", stages.group(1) if stages else ""):
+        rows.append((f"&nbsp;&nbsp;tick stage `{name}`: max / mean", f"{thousands(int(mx))} / {thousands(int(mean))}"))
+    return rows
 
 
 @table("target_instructions", "docs/benchmarks.md", "m4f")
@@ -742,6 +747,12 @@ def t_protocol_states():
                "fault": "a fault latched: zero torque until a reset (no transition leaves it)"}
     return markdown_table(["code", "state", "meaning"],
                           [(k, f"`{name}`", meaning.get(name, "")) for k, name in enumerate(protocol()["states"])])
+
+
+@table("protocol_tick_stages", "docs/protocol.md", "protocol")
+def t_protocol_tick_stages():
+    return markdown_table(["index", "stage", "what it times"],
+                          [(k, f"`{s['name']}`", s["doc"]) for k, s in enumerate(protocol()["tick_stages"])])
 
 
 @table("protocol_faults", "docs/protocol.md", "protocol")

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "experiment.hpp"
+#include "frame_json.hpp"
 #include "osc/control/params.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/io.hpp"
@@ -85,6 +86,39 @@ TEST(PilProtocol, RoundTripAndEverySingleBitFlipIsDetected) {
       detected += !frame;
     }
   EXPECT_EQ(detected, total);
+}
+
+// A frame's JSON keys are its field list's names in wire order, with the values decoded from the wire.
+TEST(PilProtocol, FrameJsonKeysAreTheFieldListInWireOrder) {
+  pil::ActuatorFrame a;
+  a.seq = 77;
+  for (int i = 0; i < 6; ++i) a.codes[i] = 100 * i - 250;
+  a.state = 1;
+  a.theta_hat[2] = 0.75f;
+  a.link[pil::kErrSeq] = 3;
+  std::uint8_t buf[pil::kMaxFrame];
+  const int n = pil::encode(a, buf);
+  pil::Parser p;
+  for (int i = 0; i < n; ++i) p.feed(buf[i]);
+  pil::ActuatorFrame b;
+  ASSERT_TRUE(p.decode(b));
+  const auto j = sim::frame_json(b);
+  ASSERT_EQ(j.size(), std::size(pil::kActuatorFields));
+  int k = 0;
+  for (const auto& [key, value] : j.items()) {
+    const pil::FieldInfo& f = pil::kActuatorFields[k++];
+    EXPECT_EQ(key, f.name);
+    // One JSON number per wire value: an array of count of them, the link counters an object.
+    EXPECT_EQ(value.is_primitive() ? 1 : static_cast<int>(value.size()), f.count) << key;
+  }
+  EXPECT_EQ(j["seq"], 77);
+  EXPECT_EQ(j["codes"][5], 250);
+  EXPECT_EQ(j["state"], 1);
+  EXPECT_EQ(j["theta_hat"][2], 0.75);
+  EXPECT_EQ(j["link"]["seq_errors"], 3);
+  const auto s = sim::frame_json(pil::SensorFrame{});
+  ASSERT_EQ(s.size(), std::size(pil::kSensorFields));
+  EXPECT_EQ(s.begin().key(), "seq");
 }
 
 // CRC-16/CCITT-FALSE: the catalogue's check value (CRC of the ASCII digits "123456789" is 0x29B1),

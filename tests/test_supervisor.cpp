@@ -144,9 +144,9 @@ TEST_F(TaskFixture, HealthyTicksRunAndCommandTorque) {
 
 TEST_F(TaskFixture, EncoderJumpFaultsInTheSameTick) {
   run(3);
-  hal.counts[1] += task->max_count_step[1];   // the largest plausible step is no jump (the torque it
+  hal.counts[1] += task->jump.max_step[1];    // the largest plausible step is no jump (the torque it
   EXPECT_EQ(run(1) & kFaultEncoderJump, 0u);  // asks for while the other joints stand still is another matter)
-  hal.counts[1] += task->max_count_step[1] + 1;
+  hal.counts[1] += task->jump.max_step[1] + 1;
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
   expect_latched(kFaultEncoderJump);
 }
@@ -212,12 +212,12 @@ TEST_F(TaskFixture, PersistentSaturationFaults) {
     hal.counts[0] = k;
     for (int i = 1; i < kDof; ++i) hal.counts[i] = k % 2;
     f = run(1);
-    if (first_clip < 0 && task->sat_ticks[0] > 0) first_clip = k;
+    if (first_clip < 0 && task->saturation.ticks[0] > 0) first_clip = k;
   }
   EXPECT_EQ(f, static_cast<std::uint32_t>(kFaultSaturation)) << "after " << k << " ticks";
   ASSERT_GE(first_clip, 0);
   int longest = 0;  // the joint that tripped it has been clipped exactly kSaturationTicks ticks
-  for (int i = 0; i < kDof; ++i) longest = std::max<int>(longest, task->sat_ticks[i]);
+  for (int i = 0; i < kDof; ++i) longest = std::max<int>(longest, task->saturation.ticks[i]);
   EXPECT_EQ(longest, params::kSaturationTicks);
   expect_latched(kFaultSaturation);
 }
@@ -296,12 +296,12 @@ TEST_F(TaskFixture, TheEncoderJumpLimitSpansTheTicksWithoutASample) {
   hal.sample = false;
   run(2);  // two ticks without a sample: the next one is three ticks after the last
   hal.sample = true;
-  hal.counts[1] += 3 * task->max_count_step[1];
+  hal.counts[1] += 3 * task->jump.max_step[1];
   EXPECT_EQ(run(1) & kFaultEncoderJump, 0u);  // no jump (the stuck and tracking monitors see it, though)
   hal.sample = false;
   run(1);
   hal.sample = true;
-  hal.counts[1] += 2 * task->max_count_step[1] + 1;  // beyond two ticks' worth
+  hal.counts[1] += 2 * task->jump.max_step[1] + 1;  // beyond two ticks' worth
   EXPECT_EQ(run(1), static_cast<std::uint32_t>(kFaultEncoderJump));
 }
 
@@ -315,7 +315,7 @@ TEST_F(TaskFixture, HoldTickRepeatsTheCodesAndRunsTheClocks) {
   EXPECT_EQ(hal.writes, writes + 1);
   EXPECT_TRUE(std::equal(before, before + kDof, hal.written));
   EXPECT_EQ(task->tick, tick + 1);
-  EXPECT_EQ(task->prev_counts_age, 1u);
+  EXPECT_EQ(task->jump.age, 1u);
 }
 
 // Found by tests/fuzz/fuzz_supervisor: a fault bit outside the catalogue (here from a HAL's I/O

@@ -27,6 +27,7 @@
 #include "cortex_m.hpp"
 #include "encoders.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/frames.hpp"
 #include "safety.hpp"
 #include "spi_bus.hpp"
 #include "stm32f4_regs.hpp"
@@ -79,8 +80,10 @@ constexpr stm32f4::TimerDivider qemu_control_divider() {
 
 // ---------------------------------------------------------------- telemetry
 constexpr std::uint32_t kTelemetryBaud = 460800;
-/// An actuator frame (191 bytes, 4.1 ms at 460 800 baud) every 10th tick: 100 frames a second.
+/// An actuator frame (pil::kMaxFrame bytes, 10 bits each on the line) every 10th tick: 100 frames a second.
 constexpr std::uint32_t kTelemetryEvery = 10;
+static_assert(10u * pil::kMaxFrame * kControlHz <= kTelemetryBaud * kTelemetryEvery * 6 / 10,
+              "a telemetry frame fills at most 60 % of the line's time between frames");
 
 /// The QEMU image's encoders: a still robot.
 struct StillEncoders {

@@ -56,8 +56,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
              osc::joint_vector<double>(osc::robot::kQStart));
   if (in.u8() & 1) task->set_encoder_resolution(100.0 + static_cast<double>(in.u32() % 9999901u));
   for (int i = 0; i < osc::kDof; ++i) {
-    FUZZ_CHECK(task->min_counts[i] < 0 && task->max_counts[i] > 0);
-    FUZZ_CHECK(task->max_count_step[i] > 0);
+    FUZZ_CHECK(task->range.min_counts[i] < 0 && task->range.max_counts[i] > 0);
+    FUZZ_CHECK(task->jump.max_step[i] > 0);
   }
 
   FuzzHal hal;
@@ -83,16 +83,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::int64_t v = 0;
         switch ((mode >> 5) & 3) {
           case 0:
-            v = task->min_counts[j] + off;
+            v = task->range.min_counts[j] + off;
             break;
           case 1:
-            v = task->max_counts[j] + off;
+            v = task->range.max_counts[j] + off;
             break;
           case 2:
-            v = static_cast<std::int64_t>(prev[j]) + task->max_count_step[j] + off;
+            v = static_cast<std::int64_t>(prev[j]) + task->jump.max_step[j] + off;
             break;
           case 3:
-            v = static_cast<std::int64_t>(prev[j]) - task->max_count_step[j] + off;
+            v = static_cast<std::int64_t>(prev[j]) - task->jump.max_step[j] + off;
             break;
         }
         c[j] = static_cast<std::int32_t>(v < INT32_MIN ? INT32_MIN : v > INT32_MAX ? INT32_MAX : v);
@@ -101,8 +101,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     bool range = false, jump = false;
     for (int i = 0; i < osc::kDof; ++i) {
-      if (c[i] < task->min_counts[i] || c[i] > task->max_counts[i]) range = true;
-      if (have_prev && abs64(static_cast<std::int64_t>(c[i]) - prev[i]) > task->max_count_step[i]) jump = true;
+      if (c[i] < task->range.min_counts[i] || c[i] > task->range.max_counts[i]) range = true;
+      if (have_prev && abs64(static_cast<std::int64_t>(c[i]) - prev[i]) > task->jump.max_step[i]) jump = true;
       prev[i] = c[i];
       hal.next[i] = c[i];
     }

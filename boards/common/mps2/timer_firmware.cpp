@@ -84,6 +84,17 @@ bool stack_sweep_agrees() {
   return never_above && equal && deeper_found;
 }
 
+/// Each stage of the tick (osc::TickStage): its worst and mean instructions.
+void report_stages() {
+  cortex_m::text::Line line;
+  line.str("tick stages, max/mean:");
+  for (int s = 0; s < osc::kTickStages; ++s) {
+    const osc::StepTiming& t = g_task.stages.stage[s];
+    line.str(" ").str(osc::kTickStageNames[s]).str(" ").u32(t.max).str("/").u32(t.mean());
+  }
+  line.str(" instructions").emit();
+}
+
 int main() {
   board::cycle_counter_init();
   const cortex_m::ResetCause cause = board::reset_cause();
@@ -110,6 +121,7 @@ int main() {
       .u32(g_task.timing.mean())
       .str(" instructions (-icount shift=0)")
       .emit();
+  report_stages();
   cortex_m::text::Line()
       .str("supervisor state ")
       .u32(static_cast<std::uint32_t>(g_task.sup.state))

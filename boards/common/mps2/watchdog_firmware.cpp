@@ -111,7 +111,7 @@ extern "C" void TIMER0_Handler() {
     board::control_irq_disable();
     return;
   }
-  if (s == kFaultLatched && k == kHealthyTicks[s]) g_hal.jump = 4 * g_task.max_count_step[0];
+  if (s == kFaultLatched && k == kHealthyTicks[s]) g_hal.jump = 4 * g_task.jump.max_step[0];
   osc::control_tick(g_task, g_hal);
   g_ticks = k + 1;
   if (osc::supervisor_healthy(g_task.sup)) {  // the feeding rule

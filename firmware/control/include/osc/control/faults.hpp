@@ -22,7 +22,8 @@ namespace osc {
   X(EncoderStuck, "encoder_stuck",                                                                             \
     "an encoder stood still while the reference moved its joint by more than the bound")                       \
   X(Tracking, "tracking", "the measured tracking error exceeded its bound")                                    \
-  X(ThetaBounds, "theta_bounds", "a friction estimate left its bounds [0, theta_max]")                         \
+  X(ThetaBounds, "theta_bounds",                                                                               \
+    "a friction estimate left its band [-b theta_max, (1 + b) theta_max], b = params::kThetaFaultBand")        \
   X(Estop, "estop", "the emergency-stop input is active")                                                      \
   X(Overflow, "overflow",                                                                                      \
     "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \

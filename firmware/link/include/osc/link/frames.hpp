@@ -377,4 +377,17 @@ class Parser {
 #undef OSC_FIELD_PUT
 #undef OSC_FIELD_GET
 
+/// Calls visit(name, value) for each field of a frame, in wire order; value is the member itself (a
+/// number, an array or LinkCounters). Host tools make their JSON keys from it (host_sim/frame_json.hpp).
+#define OSC_FIELD_VISIT(type, name, extent, unit, doc) visit(#name, f.name);
+template <class Visit>
+void for_each_field(const SensorFrame& f, Visit&& visit) {
+  OSC_SENSOR_FIELDS(OSC_FIELD_VISIT)
+}
+template <class Visit>
+void for_each_field(const ActuatorFrame& f, Visit&& visit) {
+  OSC_ACTUATOR_FIELDS(OSC_FIELD_VISIT)
+}
+#undef OSC_FIELD_VISIT
+
 }  // namespace pil

@@ -1,0 +1,56 @@
+// The tick's timing, in the HAL's cycle-counter units (instructions under QEMU's -icount shift=0,
+// core cycles on a board): a running record per quantity, and the stages of control_tick()
+// (osc/runtime/control_task.hpp), each timed on every tick.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC
+
+namespace osc {
+
+/// The last, largest and mean of a duration measured once a tick.
+struct StepTiming {
+  std::uint32_t last = 0, max = 0;
+  std::uint64_t sum = 0;
+  std::uint32_t count = 0;
+  std::uint32_t mean() const { return count ? static_cast<std::uint32_t>(sum / count) : 0; }
+  void add(std::uint32_t c) {
+    last = c;
+    if (c > max) max = c;
+    sum += c;
+    ++count;
+  }
+};
+
+/// The stages of a tick, in order: the block diagram of control_tick().
+// X(Name, "name", what the stage does)
+#define OSC_TICK_STAGE_LIST(X)                                                                                   \
+  X(Read, "read", "the HAL's I/O faults and the encoder read")                                                   \
+  X(Checks, "checks", "the encoder monitors: range, jump (EncoderRangeMonitor, EncoderJumpMonitor)")             \
+  X(Step, "step", "counts to angles, the reference's time, the control step (observer, controller, adaptation)") \
+  X(Monitors, "monitors", "the step's monitors: stuck encoder, tracking, friction-estimate band")                \
+  X(Output, "output", "torques to DAC codes, saturation, overflow and overrun, supervisor, DAC write")
+
+enum TickStage : std::uint8_t {
+// clang-format off
+#define OSC_TICK_STAGE_ENUM(Name, name, doc) kStage##Name,
+  OSC_TICK_STAGE_LIST(OSC_TICK_STAGE_ENUM)
+#undef OSC_TICK_STAGE_ENUM
+  kTickStages
+  // clang-format on
+};
+/// The stages' names (telemetry, reports) and meanings, in TickStage order.
+constexpr const char* kTickStageNames[kTickStages] = {OSC_TICK_STAGE_LIST(OSC_X_NAME)};
+constexpr const char* kTickStageDocs[kTickStages] = {OSC_TICK_STAGE_LIST(OSC_X_DOC)};
+
+/// Each stage's timing: stage s of a tick lasted from mark s to mark s + 1.
+struct TickTiming {
+  StepTiming stage[kTickStages];
+  /// The stages of one tick from its kTickStages + 1 cycle-counter marks.
+  void add(const std::uint32_t (&marks)[kTickStages + 1]) {
+    for (int s = 0; s < kTickStages; ++s) stage[s].add(marks[s + 1] - marks[s]);
+  }
+};
+
+}  // namespace osc

@@ -1,0 +1,252 @@
+// The tick's monitors (osc/runtime/monitors.hpp), each alone against its rule written out from
+// docs/safety.md and params::, in double, float and fixed point; and the tick's stage timing.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "osc/runtime/control_task.hpp"
+
+using namespace osc;
+
+namespace {
+
+template <class S>
+class Monitors : public ::testing::Test {};
+using Scalars = ::testing::Types<double, float, Fixed>;
+TYPED_TEST_SUITE(Monitors, Scalars);
+
+TEST(EncoderRange, LimitsPlusTheMarginRoundedOutwards) {
+  EncoderRangeMonitor m;
+  const double c = 1000;  // counts per radian
+  for (int i = 0; i < kDof; ++i) m.set(i, 0.25, c);
+  for (int i = 0; i < kDof; ++i) {
+    // The rule: (q_min - margin - q0) c, truncated, less one; likewise above.
+    const double lo = (robot::kArm.q_min[i] - params::kJointLimitMargin - 0.25) * c;
+    const double hi = (robot::kArm.q_max[i] + params::kJointLimitMargin - 0.25) * c;
+    EXPECT_LE(m.min_counts[i], std::floor(lo));
+    EXPECT_GE(m.min_counts[i], std::floor(lo) - 2);
+    EXPECT_GE(m.max_counts[i], std::ceil(hi));
+    EXPECT_LE(m.max_counts[i], std::ceil(hi) + 2);
+  }
+  std::int32_t counts[kDof] = {};
+  EXPECT_EQ(m.check(counts), 0u);
+  for (int i = 0; i < kDof; ++i) {
+    std::int32_t at[kDof] = {};
+    at[i] = static_cast<std::int32_t>(m.max_counts[i]);
+    EXPECT_EQ(m.check(at), 0u) << i;
+    at[i] += 1;
+    EXPECT_EQ(m.check(at), kFaultEncoderRange) << i;
+    at[i] = static_cast<std::int32_t>(m.min_counts[i]);
+    EXPECT_EQ(m.check(at), 0u) << i;
+    at[i] -= 1;
+    EXPECT_EQ(m.check(at), kFaultEncoderRange) << i;
+  }
+}
+
+TEST(EncoderJump, TheSpeedLimitOverTheTicksSinceTheLastSample) {
+  EncoderJumpMonitor m;
+  m.reset();
+  for (int i = 0; i < kDof; ++i) m.set(i, counts_per_rad(i));
+  for (int i = 0; i < kDof; ++i)  // speed limit x 1 ms x counts/rad, + 1
+    EXPECT_EQ(m.max_step[i],
+              static_cast<std::int32_t>(robot::kDrives.max_joint_speed[i] * 1e-3 * counts_per_rad(i)) + 1);
+  std::int32_t c[kDof] = {100, -100, 5, 0, 7, 1 << 30};
+  bool moved[kDof] = {};
+  m.tick();
+  EXPECT_EQ(m.check(c, moved), 0u);  // the first sample: anything within range is fine
+  EXPECT_TRUE(m.have_counts);
+  for (bool b : moved) EXPECT_TRUE(b);  // the monitors start here
+  m.tick();
+  c[1] += m.max_step[1];
+  EXPECT_EQ(m.check(c, moved), 0u);
+  EXPECT_TRUE(moved[1]);
+  EXPECT_FALSE(moved[0]);
+  // Two ticks, one of them without a sample: twice the step is plausible, one count more is not.
+  m.tick();
+  m.tick();
+  EXPECT_EQ(m.age, 2u);
+  c[2] -= 2 * m.max_step[2];
+  EXPECT_EQ(m.check(c, moved), 0u);
+  m.tick();
+  c[2] -= m.max_step[2] + 1;
+  EXPECT_EQ(m.check(c, moved), kFaultEncoderJump);
+  EXPECT_EQ(m.age, 0u);
+  // A wrap of the 32-bit count is a jump, not a small step.
+  m.tick();
+  c[5] = std::numeric_limits<std::int32_t>::min();
+  std::int32_t before[kDof];
+  std::copy(c, c + kDof, before);
+  m.tick();
+  before[5] = std::numeric_limits<std::int32_t>::max();
+  EXPECT_EQ(m.check(before, moved), kFaultEncoderJump);
+  EXPECT_EQ(m.check(c, moved), kFaultEncoderJump);
+}
+
+TEST(Saturation, ConsecutiveClippedTicks) {
+  SaturationMonitor m;
+  m.reset();
+  for (int k = 1; k < params::kSaturationTicks; ++k) ASSERT_EQ(m.check(3, true), 0u) << k;
+  EXPECT_EQ(m.check(3, false), 0u);  // one unclipped tick starts the count again
+  for (int k = 1; k < params::kSaturationTicks; ++k) ASSERT_EQ(m.check(3, true), 0u) << k;
+  EXPECT_EQ(m.check(3, true), kFaultSaturation);
+  EXPECT_EQ(m.check(2, true), 0u);  // per joint
+}
+
+TYPED_TEST(Monitors, TrackingLimits) {
+  using S = TypeParam;
+  const double lp = params::kTrackingLimitPosition, lo = params::kTrackingLimitOrientation;
+  auto check = [](double x, double y, double z, double a, double b, double c) {
+    Vec6<S> e;
+    e << lit<S>(x), lit<S>(y), lit<S>(z), lit<S>(a), lit<S>(b), lit<S>(c);
+    return TrackingMonitor<S>::check(e);
+  };
+  EXPECT_EQ(check(0, 0, 0, 0, 0, 0), 0u);
+  // The translation's norm: 0.99 lp along a diagonal is in, 1.01 lp out.
+  const double d = 1 / std::sqrt(3.0);
+  EXPECT_EQ(check(0.99 * lp * d, -0.99 * lp * d, 0.99 * lp * d, 0, 0, 0), 0u);
+  EXPECT_EQ(check(1.01 * lp * d, -1.01 * lp * d, 1.01 * lp * d, 0, 0, 0), kFaultTracking);
+  // Each orientation component alone.
+  for (int i = 3; i < 6; ++i) {
+    double v[6] = {0, 0, 0, 0, 0, 0};
+    v[i] = -0.99 * lo;
+    EXPECT_EQ(check(v[0], v[1], v[2], v[3], v[4], v[5]), 0u) << i;
+    v[i] = -1.01 * lo;
+    EXPECT_EQ(check(v[0], v[1], v[2], v[3], v[4], v[5]), kFaultTracking) << i;
+  }
+}
+
+TYPED_TEST(Monitors, ThetaBand) {
+  using S = TypeParam;
+  using Theta = decltype(Gains<S>::paper().theta_max);
+  const Theta mx = Gains<S>::paper().theta_max;
+  const double band = params::kThetaFaultBand;
+  Theta th = mx;
+  EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), 0u);
+  for (int i : {0, 7, 17}) {
+    th = mx;
+    th(i) = lit<S>((1 + band) * params::kThetaMax[i] * 0.99);
+    EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), 0u) << i;
+    th(i) = lit<S>((1 + band) * params::kThetaMax[i] * 1.01);
+    EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), kFaultThetaBounds) << i;
+    th(i) = lit<S>(-band * params::kThetaMax[i] * 0.99);
+    EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), 0u) << i;
+    th(i) = lit<S>(-band * params::kThetaMax[i] * 1.01);
+    EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), kFaultThetaBounds) << i;
+  }
+  if constexpr (std::numeric_limits<S>::has_quiet_NaN) {
+    th = mx;
+    th(4) = std::numeric_limits<S>::quiet_NaN();
+    EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), kFaultThetaBounds);
+  }
+}
+
+/// The stuck-encoder monitor fed a step output by hand: joint `j` driven at `qd` rad/s with torque
+/// `tau` while its encoder stands still from tick 1 on.
+template <class S>
+struct StuckRig {
+  StuckEncoderMonitor<S> m;
+  Vec6<math::io_scalar_t<S>> cpr;
+  StepOutput<S> out{};
+  std::uint64_t tick = 0;
+  StuckRig() {
+    m.reset();
+    for (int i = 0; i < kDof; ++i) cpr(i) = lit<math::io_scalar_t<S>>(counts_per_rad(i));
+    out.tau.setZero();
+    out.qd_ref.setZero();
+  }
+  /// One tick; `moved`: every encoder counted.
+  std::uint32_t step(bool moved_all) {
+    bool moved[kDof];
+    for (bool& b : moved) b = moved_all;
+    return m.check(out, moved, tick++, lit<S>(params::kDt), cpr);
+  }
+};
+
+TYPED_TEST(Monitors, StuckEncoderTorqueChangeWhileStill) {
+  using S = TypeParam;
+  for (int j = 0; j < kDof; ++j) {
+    StuckRig<S> r;
+    r.tick = 1000;  // the first count 1000 ticks after the start: a slow joint
+    r.out.tau(j) = lit<S>(5);
+    EXPECT_EQ(r.step(true), 0u);  // counted at a torque of 5 N m
+    // Still, but the torque within 5 +- 0.95 kStuckTorque: fine for a while (the silent checks
+    // wait kStuckIntervals of its 1000-tick interval).
+    r.out.tau(j) = lit<S>(5 - 0.95 * params::kStuckTorque[j]);
+    for (int k = 0; k < 100; ++k) ASSERT_EQ(r.step(false), 0u) << j << " " << k;
+    r.out.tau(j) = lit<S>(5 + 1.05 * params::kStuckTorque[j]);
+    EXPECT_EQ(r.step(false), kFaultEncoderStuck) << j;
+    EXPECT_GE(static_cast<double>(r.m.dtau_peak(j)), 1.04 * params::kStuckTorque[j]);
+  }
+}
+
+TYPED_TEST(Monitors, StuckEncoderSilentWhileTheReferenceMoves) {
+  using S = TypeParam;
+  const int j = 1;
+  StuckRig<S> r;
+  // Counting every tick: the recent interval is 1 tick.
+  for (int k = 0; k < 5; ++k) ASSERT_EQ(r.step(true), 0u);
+  // Then silent, with the reference moving the joint by v counts a tick: the monitor waits out
+  // kStuckIntervals intervals, then faults once the motion passes kStuckMotionCounts.
+  const double v = 2.0;  // counts per tick
+  r.out.qd_ref(j) = lit<S>(v / (params::kDt * counts_per_rad(j)));
+  const int expect = static_cast<int>(std::ceil(params::kStuckMotionCounts / v));
+  int fault_tick = -1;
+  for (int k = 1; k <= 2 * expect && fault_tick < 0; ++k)
+    if (r.step(false) & kFaultEncoderStuck) fault_tick = k;
+  EXPECT_NEAR(fault_tick, expect + 1, 2);
+  // A joint that was counting fast also faults on the smaller silent torque change.
+  StuckRig<S> t;
+  for (int k = 0; k < 5; ++k) ASSERT_EQ(t.step(true), 0u);
+  t.out.tau(j) = lit<S>(1.05 * params::kStuckTorqueSilent[j]);
+  int first = -1;
+  for (int k = 1; k <= 3 * params::kStuckIntervals && first < 0; ++k)
+    if (t.step(false) & kFaultEncoderStuck) first = k;
+  EXPECT_EQ(first, params::kStuckIntervals + 1);
+}
+
+/// Cycles advance by a different amount at each call, so each stage has its own length.
+struct StagedHal {
+  std::uint32_t clock = 0, calls = 0;
+  std::int32_t written[kDof] = {};
+  bool fault_line = false;
+  void fault_output(bool a) { fault_line = a; }
+  bool read_encoders(std::int32_t c[kDof]) {
+    for (int i = 0; i < kDof; ++i) c[i] = 0;
+    return true;
+  }
+  void write_dacs(const std::int32_t c[kDof]) { std::copy(c, c + kDof, written); }
+  std::uint32_t cycles() { return clock += ++calls; }
+  std::uint32_t io_faults() { return 0; }
+};
+static_assert(hal::ControlHal<StagedHal>);
+
+TEST(TickStages, EveryStageTimedAndTheyAddUpToTheTick) {
+  auto task = std::make_unique<ControlTask<double>>();
+  task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
+             joint_vector<double>(robot::kQStart));
+  StagedHal hal;
+  for (int k = 0; k < 3; ++k) {
+    const std::uint32_t calls_before = hal.calls;
+    ASSERT_EQ(control_tick(*task, hal), 0u);
+    std::uint32_t sum = 0;
+    for (const StepTiming& s : task->stages.stage) {
+      EXPECT_EQ(s.count, static_cast<std::uint32_t>(k + 1));
+      EXPECT_GT(s.last, 0u);
+      sum += s.last;
+    }
+    EXPECT_EQ(sum, task->timing.last);
+    // Marks at calls n+1 .. n+8 (the step's two reads and the overrun check between): the clock
+    // advances by the sum of the call numbers in between, and the step stage holds three calls.
+    const std::uint32_t n = calls_before;
+    EXPECT_EQ(task->stages.stage[kStageRead].last, n + 2);
+    EXPECT_EQ(task->stages.stage[kStageChecks].last, n + 3);
+    EXPECT_EQ(task->stages.stage[kStageStep].last, (n + 4) + (n + 5) + (n + 6));
+    EXPECT_EQ(task->stages.stage[kStageMonitors].last, n + 7);
+    EXPECT_EQ(task->stages.stage[kStageOutput].last, (n + 8) + (n + 9));
+  }
+  EXPECT_STREQ(kTickStageNames[kStageStep], "step");
+}
+
+}  // namespace
