@@ -336,7 +336,14 @@ struct Link : ::testing::Test {
   }
 };
 
-TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) { healthy(20); }
+TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) {
+  healthy(20);
+  // The tick's stages: each timed, the step the longest of them, the control step within it.
+  EXPECT_GT(last.stage_cycles[osc::kStageStep], 0u);
+  for (int s = 0; s < osc::kTickStages; ++s)
+    EXPECT_LE(last.stage_cycles[s], last.stage_cycles[osc::kStageStep]) << osc::kTickStageNames[s];
+  EXPECT_GE(last.stage_cycles[osc::kStageStep], last.step_cycles);
+}
 
 // A slow host, and an emulator descheduled by a busy machine. While the firmware waits for a byte,
 // QEMU's virtual time follows the wall clock (-icount sleep=on): a host that sends its next frame

@@ -14,6 +14,7 @@
 #include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC
 #include "osc/control/gains.hpp"
 #include "osc/robots/arm.hpp"
+#include "osc/runtime/timing.hpp"
 
 namespace pil {
 
@@ -107,6 +108,7 @@ struct LinkCounters {
   X(std::uint32_t, mean_cycles, , "cycles", "the mean control step so far")                                          \
   X(std::uint32_t, tick_max_cycles, , "cycles",                                                                      \
     "the longest whole tick before this one (encoders to DACs, with its frame's transmission)")                      \
+  X(std::uint32_t, stage_cycles, [osc::kTickStages], "cycles", "this tick's stages, in Tick stages order")           \
   X(std::uint32_t, stack_used, , "bytes", "the main stack's high-water mark")                                        \
   X(float, theta_hat, [3 * kJoints], "N m s/rad, N m",                                                               \
     "friction estimates: viscous of joints 1-6, then Coulomb 1-6, then Stribeck 1-6")                                \

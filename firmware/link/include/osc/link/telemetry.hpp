@@ -25,6 +25,7 @@ pil::ActuatorFrame telemetry_frame(const ControlTask<S>& task, const std::int32_
   a.max_cycles = task.step_timing.max;
   a.mean_cycles = task.step_timing.mean();
   a.tick_max_cycles = task.timing.max;
+  for (int s = 0; s < kTickStages; ++s) a.stage_cycles[s] = task.stages.stage[s].last;
   a.stack_used = stack_used;
   for (int i = 0; i < 3 * kDof; ++i) a.theta_hat[i] = static_cast<float>(task.state.adapt.theta_hat(i));
   for (int i = 0; i < kDof; ++i) a.tau_f_hat[i] = static_cast<float>(task.last.tau_f_hat(i));
