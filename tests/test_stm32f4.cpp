@@ -1,4 +1,5 @@
-// The STM32F4 board's drivers (boards/stm32f4) on the host, each pointed at fake register blocks in
+// The STM32F4 board's drivers on the host (the chip's, boards/common/stm32f4; the AD5754R's,
+// boards/common/devices/ad5754r; the board's, boards/stm32f4), each pointed at fake register blocks in
 // RAM (a Chip of zeroed structs the test presets and reads back): the bounded clock set-up and its
 // fallbacks, the encoder unwrap across the 16- and 32-bit counter wraps, the AD5754R frames and the
 // one LDAC per burst, the SPI bus and its bounded waits, the zero-on-fault path, the E-stop latch,
@@ -12,6 +13,7 @@
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "control_timer.hpp"
+#include "dac_bus.hpp"
 #include "encoders.hpp"
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
@@ -23,6 +25,9 @@
 using namespace stm32f4;
 
 namespace {
+
+/// The board's encoders: a timer per joint, as its pin map says.
+using Encoders = EncoderBank<pins::kEncoders>;
 
 /// Every register block of the board, in RAM, zeroed.
 struct FakeChip {
@@ -129,9 +134,9 @@ TEST(Stm32Clock, EveryBootFaultHasAName) {
 
 TEST(Stm32Encoders, InitPutsEveryTimerInEncoderModeWithItsPins) {
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   enc.init(f.chip());
-  for (const pins::EncoderChannel& e : pins::kEncoders) {
+  for (const EncoderChannel& e : pins::kEncoders) {
     const TimRegs& t = f.timer(e.timer);
     EXPECT_EQ(t.SMCR, 3u) << "encoder mode 3 (x4)";
     EXPECT_EQ(t.CCMR1 & 0x0303u, 0x0101u) << "CC1S = TI1, CC2S = TI2";
@@ -145,13 +150,13 @@ TEST(Stm32Encoders, InitPutsEveryTimerInEncoderModeWithItsPins) {
     }
   }
   // The table's widths are the hardware's: TIM2 and TIM5 are the 32-bit timers.
-  for (const pins::EncoderChannel& e : pins::kEncoders)
+  for (const EncoderChannel& e : pins::kEncoders)
     EXPECT_EQ(e.bits, e.timer == Timer::kTim2 || e.timer == Timer::kTim5 ? 32 : 16);
 }
 
 TEST(Stm32Encoders, SixteenBitCountersUnwrapAcrossBothWraps) {
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   enc.init(f.chip());
   TimRegs& t = f.timer(Timer::kTim1);  // joint 1, 16-bit
   std::int32_t c[hal::kJoints];
@@ -174,7 +179,7 @@ TEST(Stm32Encoders, SixteenBitCountersUnwrapAcrossBothWraps) {
 
 TEST(Stm32Encoders, ThirtyTwoBitCountersUnwrapAcrossBothWraps) {
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   enc.init(f.chip());
   EXPECT_EQ(f.timer(Timer::kTim2).CNT, 0u) << "init zeroes the counters";
   f.timer(Timer::kTim2).CNT = 0xFFFFFF00u;  // counts from here on (restart) near the 32-bit wrap
@@ -198,7 +203,7 @@ TEST(Stm32Encoders, ThirtyTwoBitCountersUnwrapAcrossBothWraps) {
 
 TEST(Stm32Encoders, EveryJointReadsItsOwnTimer) {
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   enc.init(f.chip());
   for (int j = 0; j < hal::kJoints; ++j)
     f.timer(pins::kEncoders[j].timer).CNT = static_cast<std::uint32_t>(10 * (j + 1));
@@ -334,10 +339,10 @@ struct FakeCycles {
 
 struct BoardRig {
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   RecordingDac dac;
   Safety safety;
-  BoardHal<EncoderBank, RecordingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RecordingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
   osc::ControlTask<double> task;
   BoardRig() {
     const Chip c = f.chip();
@@ -352,7 +357,36 @@ struct BoardRig {
     return hal.tick(task);
   }
 };
-static_assert(hal::ControlHal<BoardHal<EncoderBank, RecordingDac, FakeCycles>>);
+static_assert(hal::ControlHal<BoardHal<Encoders, RecordingDac, FakeCycles>>);
+// What BoardHal needs from its drivers: the board's and the fakes satisfy it...
+static_assert(EncoderInput<Encoders> && DacOutput<ad5754r::DacPair<SpiDacBus>> && DacOutput<RecordingDac> &&
+              CycleClock<FakeCycles>);
+// ...and a driver that lacks a function, returns the wrong type or needs an instance does not: BoardHal
+// refuses it.
+struct DacWithoutClear {
+  bool write(const std::int32_t*) { return true; }
+};
+struct DacWithVoidWrite {
+  void write(const std::int32_t*) {}  // cannot report a bus fault
+  void clear() {}
+};
+struct EncodersWithoutRead {
+  void init(const Chip&) {}
+};
+struct CyclesOfAnInstance {
+  std::uint32_t cycles() { return 0; }
+};
+static_assert(!DacOutput<DacWithoutClear> && !DacOutput<DacWithVoidWrite>);
+static_assert(!EncoderInput<EncodersWithoutRead>);
+static_assert(!CycleClock<CyclesOfAnInstance>);
+template <class E, class D, class C>
+concept BoardHalOf = requires {
+  typename BoardHal<E, D, C>;
+};
+static_assert(BoardHalOf<Encoders, RecordingDac, FakeCycles>);
+static_assert(!BoardHalOf<Encoders, DacWithVoidWrite, FakeCycles>);
+static_assert(!BoardHalOf<EncodersWithoutRead, RecordingDac, FakeCycles>);
+static_assert(!BoardHalOf<Encoders, RecordingDac, CyclesOfAnInstance>);
 
 TEST(Stm32Board, AmplifierOffUntilTheSupervisorRunsHealthy) {
   BoardRig r;
@@ -427,13 +461,13 @@ TEST(Stm32Board, AnEstopDuringTheBurstClearsTheOutputs) {
     }
   };
   FakeChip f;
-  EncoderBank enc;
+  Encoders enc;
   RacingDac dac;
   Safety safety;
   enc.init(f.chip());
   safety.init(f.chip());
   dac.s = &safety;
-  BoardHal<EncoderBank, RacingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RacingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
   const std::int32_t codes[hal::kJoints] = {1, 2, 3, 4, 5, 6};
   hal.write_dacs(codes);
   EXPECT_EQ(dac.clears, 1) << "CLR pulsed: the codes of that burst never reach the joints";
@@ -517,8 +551,8 @@ TEST(Stm32ControlTimer, OneKilohertzFromEachTimerClock) {
 
 TEST(Stm32Telemetry, AFrameGoesOutWhileTheTransmitterIsEmptyAndTheNextWaits) {
   FakeChip f;
-  TelemetryUart u;
-  u.init(f.chip(), 42000000, 460800);
+  TelemetryUart<pil::kMaxFrame> u;
+  u.init(f.chip(), 42000000, 460800, pins::kUartTx, pins::kUartRx);
   EXPECT_EQ(f.usart2.BRR, 91u);
   EXPECT_EQ(f.usart2.CR1, UsartRegs::kUe | UsartRegs::kTe | UsartRegs::kRe);
   osc::ControlTask<float> task;

@@ -1,7 +1,8 @@
-// Board support for an STM32F407 controller board (Cortex-M4F, 168 MHz): the drivers of this folder
-// wired to the chip (stm32f4::Chip::hardware()), the boot sequence, the interrupts and their
-// priorities. Over the shared Cortex-M code (boards/common/cortex_m); no virtual calls, no heap.
-// docs/stm32f4.md describes the board; pins.hpp is its pin map.
+// Board support for an STM32F407 controller board (Cortex-M4F, 168 MHz): the chip's drivers
+// (boards/common/stm32f4) and the DAC's (boards/common/devices/ad5754r) wired to its pins (pins.hpp)
+// and to the chip (stm32f4::Chip::hardware()), with this folder's safety I/O, DAC bus and HAL
+// binding; the boot sequence, the interrupts and their priorities. Over the shared Cortex-M code
+// (boards/common/cortex_m); no virtual calls, no heap. docs/stm32f4.md describes the board.
 //
 // Build-time switch OSC_STM32F4_QEMU (the image stm32f4_qemu, for QEMU's netduinoplus2, an
 // STM32F405 with the same core and memory map): QEMU models TIM2..TIM5, the USARTs, SPI, SYSCFG and
@@ -25,11 +26,12 @@
 #include "clock.hpp"
 #include "control_timer.hpp"
 #include "cortex_m.hpp"
+#include "dac_bus.hpp"
 #include "encoders.hpp"
 #include "osc/control/params.hpp"
 #include "osc/link/frames.hpp"
+#include "pins.hpp"
 #include "safety.hpp"
-#include "spi_bus.hpp"
 #include "stm32f4_regs.hpp"
 #include "text.hpp"
 #include "usart.hpp"
@@ -92,7 +94,7 @@ struct StillEncoders {
     for (int i = 0; i < hal::kJoints; ++i) counts[i] = 0;
   }
 };
-using Encoders = std::conditional_t<kQemu, StillEncoders, stm32f4::EncoderBank>;
+using Encoders = std::conditional_t<kQemu, StillEncoders, stm32f4::EncoderBank<stm32f4::pins::kEncoders>>;
 
 /// Step timing: the DWT cycle counter, or SysTick where the DWT does not count (start() finds out).
 struct CycleCounter {
@@ -117,6 +119,8 @@ inline const char* reset_cause_name(std::uint32_t csr) {
 
 using Dac = ad5754r::DacPair<stm32f4::SpiDacBus>;
 using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter>;
+/// The telemetry USART: an actuator frame at a time.
+using TelemetryUart = stm32f4::TelemetryUart<pil::kMaxFrame>;
 
 /// The board: its drivers and what the boot found.
 struct Board {
@@ -128,7 +132,7 @@ struct Board {
   stm32f4::SpiDacBus dac_bus;
   Dac dac{dac_bus};
   stm32f4::Safety safety;
-  stm32f4::TelemetryUart uart;
+  TelemetryUart uart;
   Hal hal{encoders, dac, safety, chip.timer(kControlTimer)};
 
   /// Boot, with interrupts still off: clocks (bounded, HSI fallback), the reset cause, the cycle
@@ -146,7 +150,7 @@ struct Board {
     dac_bus.init(chip, clocks.pclk1);
     if (!dac.init()) note(BootFault::kDacSetup);
     encoders.init(chip);
-    uart.init(chip, clocks.pclk1, kTelemetryBaud);
+    uart.init(chip, clocks.pclk1, kTelemetryBaud, stm32f4::pins::kUartTx, stm32f4::pins::kUartRx);
   }
   /// The independent watchdog: from here on only healthy ticks keep the MCU out of reset.
   void start_watchdog() { note(safety.watchdog_start()); }

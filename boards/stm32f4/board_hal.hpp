@@ -1,9 +1,11 @@
 // The board's binding of the control task (hal::ControlHal): encoders from the timers, torque
 // commands to the DAC pair, the E-stop and the control timer's overrun as I/O faults, and a tick
 // (BoardHal::tick) that drives the safety outputs and feeds the watchdog after the control step.
-// Templates over the drivers (the board's, or fakes in tests/test_stm32f4.cpp): no virtual calls.
+// Templates over the drivers (the board's, or fakes in tests/test_stm32f4.cpp), each constrained by
+// the concept of what the binding needs from it: no virtual calls.
 #pragma once
 
+#include <concepts>
 #include <cstdint>
 
 #include "control_timer.hpp"
@@ -14,8 +16,25 @@
 
 namespace stm32f4 {
 
-/// Encoders: read(counts). Dac: write(codes) -> bool, clear(). CycleClock: static cycles().
-template <class Encoders, class Dac, class CycleClock>
+/// The encoders: every joint's accumulated count (e.g. EncoderBank, or a still robot's zeros).
+template <class E>
+concept EncoderInput = requires(E& e, std::int32_t* counts) {
+  { e.read(counts) } -> std::same_as<void>;
+};
+/// The torque outputs: one tick's codes (false: a bus fault), and every output to 0 V at once
+/// (e.g. ad5754r::DacPair).
+template <class D>
+concept DacOutput = requires(D& d, const std::int32_t* codes) {
+  { d.write(codes) } -> std::same_as<bool>;
+  { d.clear() } -> std::same_as<void>;
+};
+/// The step timing's clock: a free-running 32-bit cycle count, read without an instance.
+template <class C>
+concept CycleClock = requires {
+  { C::cycles() } -> std::same_as<std::uint32_t>;
+};
+
+template <EncoderInput Encoders, DacOutput Dac, CycleClock Clock>
 class BoardHal {
  public:
   BoardHal(Encoders& encoders, Dac& dac, Safety& safety, TimRegs& control_timer)
@@ -37,7 +56,7 @@ class BoardHal {
     // An E-stop that came during the burst: its codes may already be latched; clear them now.
     if (!zero && safety_.estop()) dac_.clear();
   }
-  std::uint32_t cycles() { return CycleClock::cycles(); }
+  std::uint32_t cycles() { return Clock::cycles(); }
   std::uint32_t io_faults() {
     std::uint32_t f = safety_.io_faults();
     // The next update already pending when this tick starts (acknowledged on entry): overrun.

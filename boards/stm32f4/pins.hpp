@@ -1,12 +1,14 @@
 // The board's pin map: every pin the firmware uses, its alternate function (datasheet DS8626,
-// table 9 "alternate function mapping") and its role, in one place. The encoder table also names
-// each joint's timer, its counter width and its clock-enable bit. docs/stm32f4.md, "Wiring",
-// is this file as a table; the pins are chosen free on the STM32F4DISCOVERY (MB997) where they can
-// be (the exceptions are noted there).
+// table 9 "alternate function mapping") and its role, in one place; the chip's drivers
+// (boards/common/stm32f4) take their pins from here. The encoder table also names each joint's
+// timer, its counter width and its clock-enable bit. docs/stm32f4.md, "Wiring", is this file as a
+// table; the pins are chosen free on the STM32F4DISCOVERY (MB997) where they can be (the exceptions
+// are noted there).
 #pragma once
 
 #include <cstdint>
 
+#include "encoders.hpp"
 #include "gpio.hpp"
 #include "hal/hal.hpp"
 #include "stm32f4_regs.hpp"
@@ -20,21 +22,13 @@ constexpr Pin PD(std::uint8_t n) { return {Port::D, n}; }
 constexpr Pin PE(std::uint8_t n) { return {Port::E, n}; }
 
 // ---------------------------------------------------------------- encoders
-/// One joint's quadrature encoder: a timer in encoder mode 3 (x4: both edges of both channels),
-/// channel A on the timer's CH1 input, B on CH2. `invert` reverses the counting direction (CC1P):
-/// set it for a joint whose encoder counts against the joint's positive direction (first power-up,
-/// docs/stm32f4.md).
-struct EncoderChannel {
-  Timer timer;
-  int bits;                       // counter width: 32 for TIM2 and TIM5, else 16
-  Reg RccRegs::*enable_register;  // its clock enable
-  std::uint32_t enable_bit;
-  PinConfig a, b;
-  bool invert;
-};
 // The inputs come from line receivers (push-pull); the pull-ups only hold an unplugged input still.
 constexpr PinConfig enc(Pin p, std::uint8_t af) { return alternate(p, af, Speed::kLow, Pull::kUp); }
-constexpr EncoderChannel kEncoders[hal::kJoints] = {
+/// One timer in encoder mode per joint (stm32f4::EncoderChannel, encoders.hpp). `invert`: set it for
+/// a joint whose encoder counts against the joint's positive direction (first power-up,
+/// docs/stm32f4.md). A 16-bit counter is unwrapped right while fewer than 32768 counts pass between
+/// two ticks, about 240 times the fastest joint's counts per tick.
+inline constexpr EncoderChannel kEncoders[hal::kJoints] = {
     {Timer::kTim1, 16, &RccRegs::APB2ENR, RccRegs::kTim1En, enc(PE(9), 1), enc(PE(11), 1), false},  // joint 1
     {Timer::kTim2, 32, &RccRegs::APB1ENR, RccRegs::kTim2En, enc(PA(15), 1), enc(PB(3), 1), false},  // joint 2
     {Timer::kTim3, 16, &RccRegs::APB1ENR, RccRegs::kTim3En, enc(PB(4), 2), enc(PB(5), 2), false},   // joint 3

@@ -1,5 +1,6 @@
-// GPIO pins (RM0090 8.3, 8.4): a pin's configuration as data (PinConfig, the board's table is
-// pins.hpp) and the few operations the drivers need, over a port's register block.
+// GPIO pins (RM0090 8.3, 8.4): a pin's configuration as data (PinConfig; a board's pin map,
+// boards/<board>/pins.hpp, is a table of them) and the few operations the drivers need, over a
+// port's register block.
 #pragma once
 
 #include <cstdint>

@@ -1,10 +1,11 @@
-// STM32F405/407 registers this board uses, written from the reference manual (ST RM0090, rev. 19:
-// the section named at each block) and the ARMv7-M core where noted. Minimal: only the blocks and
-// bits the drivers touch. Each block is a struct whose layout is the manual's register map
-// (offsets static_assert'ed); a driver takes a reference to a block, so that a host test can hand it
-// a block in RAM (tests/test_stm32f4.cpp). Chip (at the end) names every block the board uses: at
-// their hardware addresses on the target, or fakes in a test. No core-only instruction here: the
-// header compiles on the host.
+// STM32F405/407 registers the chip's drivers (this folder, boards/common/stm32f4) use, written from
+// the reference manual (ST RM0090, rev. 19: the section named at each block) and the ARMv7-M core
+// where noted. Minimal: only the blocks and bits the drivers touch. Each block is a struct whose
+// layout is the manual's register map (offsets static_assert'ed); a driver takes a reference to a
+// block, so that a host test can hand it a block in RAM (tests/test_stm32f4.cpp). Chip (at the end)
+// names every block the drivers use: at their hardware addresses on the target, or fakes in a test.
+// A board that needs another block or bit adds it here. No core-only instruction here: the header
+// compiles on the host.
 #pragma once
 
 #include <cstddef>
@@ -23,7 +24,7 @@ inline void read_back(const Reg& r) {
 }
 
 /// Polls `ready` at most `polls` times: true as soon as it holds, false if it never did. Every wait
-/// on a hardware flag in this board's drivers is one of these.
+/// on a hardware flag in these drivers is one of these.
 template <class Ready>
 bool poll_until(Ready ready, std::uint32_t polls) {
   for (std::uint32_t i = 0; i < polls; ++i)
@@ -204,11 +205,12 @@ constexpr std::uintptr_t kTim2 = 0x40000000u, kTim3 = 0x40000400u, kTim4 = 0x400
                          kDbgmcu = 0xE0042000u;
 }  // namespace addr
 
-/// The timers of this board, by role: one per joint in encoder mode, TIM6 for the control interrupt.
+/// The timers the drivers use: TIM1..TIM5 and TIM8 (encoder mode or a periodic interrupt), TIM6 (basic:
+/// a periodic interrupt).
 enum class Timer : std::uint8_t { kTim1, kTim2, kTim3, kTim4, kTim5, kTim8, kTim6 };
 constexpr int kTimers = 7;
 
-/// Every register block the board's drivers use: the hardware's (hardware()), or fakes in RAM.
+/// Every register block the drivers use: the hardware's (hardware()), or fakes in RAM.
 struct Chip {
   RccRegs* rcc;
   FlashRegs* flash;

@@ -22,8 +22,9 @@
 //     enable, bit 1 clear select, bit 0 SDO disable;
 //   - bipolar coding is two's complement with the BIN/2sCOMP pin tied low (offset binary with it
 //     high): code 0 is 0 V, +32767 is +10 V × 32767/32768, -32768 is -10 V.
-// The hardware (SPI, SYNC, LDAC, CLR pins) is the Bus template parameter: spi_bus.hpp on the
-// board, a recording bus in tests/test_stm32f4.cpp.
+// The hardware (SPI, SYNC, LDAC, CLR pins) is the Bus template parameter, a board's: on the STM32F4
+// board boards/stm32f4/dac_bus.hpp, in tests/test_stm32f4.cpp a recording bus. The driver knows no
+// chip (its target, ad5754r, exports this folder alone).
 #pragma once
 
 #include <concepts>
@@ -39,6 +40,8 @@ constexpr std::uint16_t kRangeBipolar10V = 4;
 constexpr std::uint8_t kControlFunctionSet = 1;  ///< channel field of a control-register write: settings
 constexpr std::uint16_t kTsdEnable = 1u << 3, kClampEnable = 1u << 2, kSdoDisable = 1u << 0;  // clear select 0
 constexpr std::uint16_t kPowerUpABC = 0x7u, kPowerUpReference = 1u << 4;
+
+constexpr std::uint32_t kMaxSclkHz = 30000000;  ///< the fastest SCLK (data sheet, timing characteristics)
 
 constexpr int kChips = 2;
 constexpr int kChannelsUsed = 3;  ///< per chip
