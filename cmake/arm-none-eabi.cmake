@@ -34,5 +34,7 @@ set(CMAKE_C_FLAGS_RELEASE_INIT "-O3 -DNDEBUG")
 set(CMAKE_EXE_LINKER_FLAGS_INIT "${OSC_CPU_FLAGS} -nostartfiles --specs=nano.specs -Wl,--gc-sections")
 
 set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
+# Packages from the host too: Eigen's (header-only; the top-level CMakeLists.txt finds it).
+set(CMAKE_FIND_ROOT_PATH_MODE_PACKAGE BOTH)
 set(CMAKE_FIND_ROOT_PATH_MODE_LIBRARY ONLY)
 set(CMAKE_FIND_ROOT_PATH_MODE_INCLUDE ONLY)

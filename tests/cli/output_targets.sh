@@ -115,6 +115,25 @@ figure_symlink_and_directory)  # the figures: a link written through; a director
   echo "$out" | grep -q 'cannot write out/window_max_errors.png: it is a directory' || fail "message: $out"
   no_temp_files out || fail "temporary files left"
   ;;
+csv_dir_is_not_a_command)  # a directory name is never handed to a shell: this one used to run `touch pwned`
+  "$exe" --duration 1 --mode none --no-progress --csv-dir "x'; touch pwned; echo '" >/dev/null || fail "exit $?"
+  test ! -e pwned || fail "the directory's name ran as a command"
+  test -d "x'; touch pwned; echo '" || fail "no directory of that name"
+  ;;
+unwritable_json_fails_before_the_run)  # a missing folder: refused before the run, nothing left behind
+  out=$("$exe" --duration 3600 --no-csv --json missing/dir/s.json 2>&1)
+  status=$?
+  test $status -eq 2 || fail "exit $status, not 2"
+  echo "$out" | grep -q 'cannot write missing/dir/s.json' || fail "message: $out"
+  ! echo "$out" | grep -q 'real time' || fail "the run started"
+  test -z "$(find . -name '*.tmp')" || fail "temporary files left"
+  ;;
+json_that_is_a_directory_fails_before_the_run)
+  mkdir j
+  out=$("$exe" --duration 3600 --no-csv --json j 2>&1)
+  echo "$out" | grep -q 'is a directory' || fail "message: $out"
+  test -z "$(find . -name '*.tmp')" || fail "temporary files left"
+  ;;
 *)
   fail "unknown case"
   ;;

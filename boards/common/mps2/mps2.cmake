@@ -60,15 +60,16 @@ function(osc_add_mps2_board)
   set_tests_properties(watchdog_reset_qemu PROPERTIES PASS_REGULAR_EXPRESSION "watchdog_firmware: pass")
 endfunction()
 
-# osc_add_pil_test(NAME SCALAR LINK [ARGS...]): the host's PIL tests (build/host/tests/test_pil, so
-# the host preset must be built first; scripts/test.sh does) against this build's pil_firmware in
-# QEMU over LINK (semihosting or uart, host_sim/pil_client.hpp): fault injection through the link
-# and the closed loop against the host-built controller in SCALAR (float or fixed).
+# osc_add_pil_test(NAME SCALAR LINK [ARGS...]): the host's PIL tests (OSC_TEST_PIL: the host build's
+# tests/test_pil, in OSC_HOST_TOOLS_DIR; the host preset must be built first, scripts/test.sh does)
+# against this build's pil_firmware in QEMU over LINK (semihosting or uart, host_sim/pil_client.hpp):
+# fault injection through the link and the closed loop against the host-built controller in SCALAR
+# (float or fixed).
 # With LOADED N before the arguments, the test runs while N busy processes compete for the cores
 # (tests/run_under_load.sh).
 function(osc_add_pil_test name scalar link)
   cmake_parse_arguments(PARSE_ARGV 3 PIL "" "LOADED" "")
-  set(cmd ${PROJECT_SOURCE_DIR}/build/host/tests/test_pil ${PIL_UNPARSED_ARGUMENTS})
+  set(cmd ${OSC_TEST_PIL} ${PIL_UNPARSED_ARGUMENTS})
   if(PIL_LOADED)
     set(cmd bash ${PROJECT_SOURCE_DIR}/tests/run_under_load.sh ${PIL_LOADED} ${cmd})
   endif()
@@ -84,6 +85,7 @@ endfunction()
 # with the UART bit for bit. Over the UART, byte by byte as on a board: the link tests, timeouts
 # included.
 function(osc_add_pil_tests scalar)
+  osc_host_tool(OSC_TEST_PIL test_pil tests)
   osc_add_pil_test(pil_qemu ${scalar} semihosting
                    --gtest_filter=-Link.ShortFrameTimesOutWithZeroCodes:Link.SilenceGetsZeroCodesRepeatedSilenceLatchesLinkLost)
   osc_add_pil_test(pil_qemu_uart ${scalar} uart --gtest_filter=Link.*)
