@@ -5,18 +5,29 @@
 # for a fixed time: docs/fuzzing.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# Each stage's wall time, printed as it ends (CI must stay under 30 minutes on the 2-core machine).
+stage_start=$SECONDS
+stage() { echo "test.sh: $1 took $((SECONDS - stage_start)) s (total $SECONDS s)"; stage_start=$SECONDS; }
 bash scripts/setup.sh
+stage setup
 cmake --preset host >/dev/null
 cmake --build --preset host
+stage "host build"
 bash scripts/lint.sh build/host
+stage lint
 ctest --preset host
+stage "host tests"
 if [ -f boards/CMakeLists.txt ]; then
   for preset in m4f m3; do
     cmake --preset $preset >/dev/null
     cmake --build --preset $preset
+    stage "$preset build"
     ctest --preset $preset
+    stage "$preset tests"
   done
 fi
 cmake --preset fuzz >/dev/null
 cmake --build --preset fuzz
+stage "fuzz build"
 ctest --preset fuzz
+stage "fuzz tests"
