@@ -16,7 +16,7 @@
 namespace sim {
 
 /// The in-process controller's arithmetic: double, float, or the fixed-point Q12.19 of
-/// osc/kernels/fixed.hpp.
+/// osc/math/fixed.hpp.
 enum class Scalar { kDouble, kFloat, kFixed };
 /// Names of the scalars, in enum order (configuration, command lines).
 constexpr const char* kScalarNames[] = {"double", "float", "fixed"};

@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
-"""Lists the functions of firmware/, host_sim/ and boards/ longer than a limit, by universal-ctags.
+"""Lists the functions of firmware/, host_sim/, boards/ and tests/boards/ longer than a limit (universal-ctags).
 
 usage: function_lengths.py [--limit N] [--check] [--top K] [PATH ...]
 
 A function's length is its lines from its first to its last (ctags' line and end fields), the
-signature and the closing brace included. Default paths: firmware host_sim boards. --check exits 1
-when a function is longer than the limit (default 80); --top K prints the K longest whatever the
-limit. Lambdas count within the function that holds them.
+signature and the closing brace included. Default paths: firmware host_sim boards tests/boards (the
+boards' test images). --check exits 1 when a function is longer than the limit (default 80); --top K
+prints the K longest whatever the limit. Lambdas count within the function that holds them.
 """
 import argparse
 import os
@@ -48,7 +48,7 @@ def main(argv):
     ap.add_argument("--limit", type=int, default=80)
     ap.add_argument("--check", action="store_true", help="exit 1 when a function is longer than the limit")
     ap.add_argument("--top", type=int, default=0, help="print the K longest")
-    ap.add_argument("paths", nargs="*", default=["firmware", "host_sim", "boards"])
+    ap.add_argument("paths", nargs="*", default=["firmware", "host_sim", "boards", "tests/boards"])
     a = ap.parse_args(argv[1:])
     fs = functions(a.paths)
     long = [f for f in fs if f[0] > a.limit]

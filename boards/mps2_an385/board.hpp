@@ -1,12 +1,12 @@
 // Board support for QEMU's mps2-an385: Arm MPS2 with the AN385 FPGA image, a Cortex-M3 without an
 // FPU, with the AN386's memory map and CMSDK peripherals (boards/common/mps2/mps2.hpp). The images
-// compute the control law in Q12.19 fixed point (osc/kernels/fixed.hpp, docs/fixed_point.md);
+// compute the control law in Q12.19 fixed point (osc/math/fixed.hpp, docs/fixed_point.md);
 // kernels_image_softfloat computes it in float through the compiler's soft-float routines, to
 // measure the alternative.
 #pragma once
 
 #include "mps2.hpp"
-#include "osc/kernels/fixed.hpp"
+#include "osc/math/fixed.hpp"
 
 namespace board {
 

@@ -1,7 +1,7 @@
 // The board's binding of the control task (hal::ControlHal): encoders from the timers, torque
 // commands to the DAC pair, the E-stop and the control timer's overrun as I/O faults, and a tick
 // (BoardHal::tick) that drives the safety outputs and feeds the watchdog after the control step.
-// Templates over the drivers (the board's, or fakes in tests/test_stm32f4.cpp), each constrained by
+// Templates over the drivers (the board's, or fakes in tests/boards/stm32f4/test_stm32f4.cpp), each constrained by
 // the concept of what the binding needs from it: no virtual calls.
 #pragma once
 

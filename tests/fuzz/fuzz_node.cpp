@@ -12,7 +12,7 @@
 //    line is on exactly in kFault;
 //  - a corrupt header, length or checksum, a frame of the wrong type, a sequence gap, junk after a
 //    valid frame or a link timeout gives zero codes in the very next actuator frame (repeated errors
-//    latch a link fault: tests/test_link.cpp); once in kFault the node never leaves it;
+//    latch a link fault: tests/firmware/link/test_link.cpp); once in kFault the node never leaves it;
 //  - the actuator frame answering a valid sensor frame carries its sequence number.
 #include <cstdint>
 #include <memory>

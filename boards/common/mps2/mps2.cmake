@@ -1,13 +1,16 @@
 # The boards/<board>/CMakeLists.txt of an MPS2 board built from CMSDK parts (mps2-an385, mps2-an386):
-# one call of osc_add_mps2_board(NAME CPU QEMU_MACHINE). The wiring, the interrupt table, the linker
+# one call of osc_add_mps2_board(NAME CPU QEMU_MACHINE PIL_SCALAR DOCS_TABLES). The wiring, the interrupt table, the linker
 # script and the images are shared (boards/common/mps2, linker/mps2.ld); the board's own folder has
 # its board.hpp (the core and the scalar of its images, board::Scalar) and this call. Defines the
-# images kernels_image, heap_probe, pil_firmware, timer_firmware and watchdog_firmware with their
+# images kernels_image, heap_probe, pil_firmware, timer_firmware and watchdog_firmware (all but
+# pil_firmware are tests, with their sources in tests/boards/) with their
 # tests (FORBIDDEN_ON_CONTROL_PATH: a regular expression of routines the control path must not call); sets OSC_BOARD_ENABLED in the caller (false when CPU is not this toolchain's).
 set(OSC_MPS2_DIR ${CMAKE_CURRENT_LIST_DIR})
+# The test images (kernels_image, timer_firmware, watchdog_firmware) live with the tests.
+set(OSC_MPS2_TESTS_DIR ${PROJECT_SOURCE_DIR}/tests/boards/mps2)
 
 function(osc_add_mps2_board)
-  cmake_parse_arguments(B "" "NAME;CPU;QEMU_MACHINE;FORBIDDEN_ON_CONTROL_PATH" "" ${ARGN})
+  cmake_parse_arguments(B "" "NAME;CPU;QEMU_MACHINE;FORBIDDEN_ON_CONTROL_PATH;PIL_SCALAR;DOCS_TABLES" "" ${ARGN})
   osc_add_board(NAME ${B_NAME} CPU ${B_CPU} LINKER_SCRIPT ${PROJECT_SOURCE_DIR}/linker/mps2.ld
                 QEMU_MACHINE ${B_QEMU_MACHINE} SOURCES ${OSC_MPS2_DIR}/vectors.cpp)
   set(OSC_BOARD_ENABLED ${OSC_BOARD_ENABLED} PARENT_SCOPE)
@@ -18,14 +21,14 @@ function(osc_add_mps2_board)
   target_link_libraries(board_${B_NAME} PUBLIC cmsdk)  # the CMSDK watchdog driver
 
   # Every kernel in the board's scalar against the published vectors (and, in fixed point, the
-  # host's results bit for bit: tests/fixed_reference.hpp), with per-kernel instruction counts.
-  osc_board_image(${B_NAME} kernels_image ${OSC_MPS2_DIR}/kernels_image.cpp)
-  target_include_directories(kernels_image PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  # host's results bit for bit: tests/support/fixed_reference.hpp), with per-kernel instruction counts.
+  osc_board_image(${B_NAME} kernels_image ${OSC_MPS2_TESTS_DIR}/kernels_image.cpp)
+  target_include_directories(kernels_image PRIVATE ${PROJECT_SOURCE_DIR}/tests/support)
   add_test(NAME kernels_image_qemu COMMAND kernels_image)
   osc_image_checks(kernels_image)
 
   # The link-time heap ban: an image that calls malloc must fail to link.
-  osc_board_image(${B_NAME} heap_probe ${OSC_CORTEX_M_DIR}/heap_probe.cpp)
+  osc_board_image(${B_NAME} heap_probe ${PROJECT_SOURCE_DIR}/tests/boards/cortex_m/heap_probe.cpp)
   set_target_properties(heap_probe PROPERTIES EXCLUDE_FROM_ALL TRUE)
   add_test(NAME heap_use_fails_link COMMAND ${CMAKE_COMMAND} --build ${CMAKE_BINARY_DIR} --target heap_probe)
   # Passes only on the linker script's heap assertion (not on any other build failure).
@@ -46,7 +49,7 @@ function(osc_add_mps2_board)
   endforeach()
 
   # The control task in the real 1 kHz timer interrupt (no plant).
-  osc_board_image(${B_NAME} timer_firmware ${OSC_MPS2_DIR}/timer_firmware.cpp)
+  osc_board_image(${B_NAME} timer_firmware ${OSC_MPS2_TESTS_DIR}/timer_firmware.cpp)
   add_test(NAME timer_firmware_qemu COMMAND timer_firmware)
   # The image feeds the watchdog; under -no-reboot a watchdog reset would end QEMU with status 0,
   # so the test also needs the image's own verdict.
@@ -55,9 +58,14 @@ function(osc_add_mps2_board)
   # The watchdog end to end: healthy ticks feed it; a hung tick, a latched fault and a disabled
   # control interrupt each let it reset the board (QEMU reboots the image; a record in .noinit RAM
   # carries the scenario across the resets).
-  osc_board_image(${B_NAME} watchdog_firmware ${OSC_MPS2_DIR}/watchdog_firmware.cpp)
+  osc_board_image(${B_NAME} watchdog_firmware ${OSC_MPS2_TESTS_DIR}/watchdog_firmware.cpp)
   osc_add_reboot_test(watchdog_reset_qemu watchdog_firmware)
   set_tests_properties(watchdog_reset_qemu PROPERTIES PASS_REGULAR_EXPRESSION "watchdog_firmware: pass")
+
+  # The host's PIL tests against pil_firmware, the host controller in PIL_SCALAR; the generated
+  # tables of docs/ of kind DOCS_TABLES (scripts/docs_tables.py) current for this build's images.
+  osc_add_pil_tests(${B_PIL_SCALAR})
+  osc_add_docs_tables_test(${B_DOCS_TABLES})
 endfunction()
 
 # osc_add_pil_test(NAME SCALAR LINK [ARGS...]): the host's PIL tests (OSC_TEST_PIL: the host build's
@@ -66,12 +74,12 @@ endfunction()
 # fault injection through the link and the closed loop against the host-built controller in SCALAR
 # (float or fixed).
 # With LOADED N before the arguments, the test runs while N busy processes compete for the cores
-# (tests/run_under_load.sh).
+# (tests/support/run_under_load.sh).
 function(osc_add_pil_test name scalar link)
   cmake_parse_arguments(PARSE_ARGV 3 PIL "" "LOADED" "")
   set(cmd ${OSC_TEST_PIL} ${PIL_UNPARSED_ARGUMENTS})
   if(PIL_LOADED)
-    set(cmd bash ${PROJECT_SOURCE_DIR}/tests/run_under_load.sh ${PIL_LOADED} ${cmd})
+    set(cmd bash ${PROJECT_SOURCE_DIR}/tests/support/run_under_load.sh ${PIL_LOADED} ${cmd})
   endif()
   add_test(NAME ${name} COMMAND ${cmd})
   set_tests_properties(${name} PROPERTIES

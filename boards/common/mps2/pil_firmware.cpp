@@ -20,7 +20,7 @@
 //     leaves the firmware waiting; the host's own timeout reports it. The link's timeouts are tested
 //     over the UART.
 // The node, the frames, the ticks and what they compute are the same on both: the same run gives
-// the same torques, bit for bit (tests/test_pil.cpp, PilQemu).
+// the same torques, bit for bit (tests/host_sim/test_pil.cpp, PilQemu).
 //
 // The CMSDK watchdog (board.hpp) starts with the link (the first received byte). Its PIL policy
 // (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop

@@ -2,7 +2,7 @@
 // the reference manual (ST RM0090, rev. 19: the section named at each block) and the ARMv7-M core
 // where noted. Minimal: only the blocks and bits the drivers touch. Each block is a struct whose
 // layout is the manual's register map (offsets static_assert'ed); a driver takes a reference to a
-// block, so that a host test can hand it a block in RAM (tests/test_stm32f4.cpp). Chip (at the end)
+// block, so that a host test can hand it a block in RAM (tests/boards/stm32f4/test_stm32f4.cpp). Chip (at the end)
 // names every block the drivers use: at their hardware addresses on the target, or fakes in a test.
 // A board that needs another block or bit adds it here. No core-only instruction here: the header
 // compiles on the host.

@@ -23,7 +23,7 @@
 //   - bipolar coding is two's complement with the BIN/2sCOMP pin tied low (offset binary with it
 //     high): code 0 is 0 V, +32767 is +10 V × 32767/32768, -32768 is -10 V.
 // The hardware (SPI, SYNC, LDAC, CLR pins) is the Bus template parameter, a board's: on the STM32F4
-// board boards/stm32f4/dac_bus.hpp, in tests/test_stm32f4.cpp a recording bus. The driver knows no
+// board boards/stm32f4/dac_bus.hpp, in tests/boards/stm32f4/test_stm32f4.cpp a recording bus. The driver knows no
 // chip (its target, ad5754r, exports this folder alone).
 #pragma once
 

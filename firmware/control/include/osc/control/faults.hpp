@@ -30,16 +30,20 @@ namespace osc {
   X(DacBus, "dac_bus",                                                                                         \
     "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")
 
+// The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
+// `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.
+#define OSC_X_NAME(Name, name, doc) name,
+#define OSC_X_DOC(Name, name, doc) doc,
+// Its enumerators, named with a prefix: with OSC_X_PREFIX defined as kStage,
+// `LIST(OSC_X_ENUMERATOR)` is kStageRead, kStageChecks, ...
+#define OSC_X_CAT_(a, b) a##b
+#define OSC_X_CAT(a, b) OSC_X_CAT_(a, b)
+#define OSC_X_ENUMERATOR(Name, name, doc) OSC_X_CAT(OSC_X_PREFIX, Name),
+
 namespace detail {
-enum FaultBit : unsigned {
-// A count after an X-macro expansion: clang-format would indent it as a continuation.
-// clang-format off
-#define OSC_FAULT_BIT(Name, name, doc) kBit##Name,
-  OSC_FAULT_LIST(OSC_FAULT_BIT)
-#undef OSC_FAULT_BIT
-  kFaultCount
-  // clang-format on
-};
+#define OSC_X_PREFIX kBit
+enum FaultBit : unsigned { OSC_FAULT_LIST(OSC_X_ENUMERATOR) kFaultCount };
+#undef OSC_X_PREFIX
 }  // namespace detail
 
 /// Named fault bits (sticky once latched).
@@ -54,10 +58,6 @@ constexpr int kFaultCount = detail::kFaultCount;
 static_assert(kFaultCount <= 32, "the fault bits fit the 32-bit fault word of the link and the supervisor");
 /// Every defined fault bit.
 constexpr std::uint32_t kAllFaults = (1u << kFaultCount) - 1u;
-// The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
-// `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.
-#define OSC_X_NAME(Name, name, doc) name,
-#define OSC_X_DOC(Name, name, doc) doc,
 
 /// Names of the fault bits, in bit order (for telemetry and logs).
 constexpr const char* kFaultNames[kFaultCount] = {OSC_FAULT_LIST(OSC_X_NAME)};

@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 
 #include "osc/robots/arm.hpp"
-#include "osc/kernels/scalar.hpp"
+#include "osc/math/scalar.hpp"
 
 namespace osc {
 

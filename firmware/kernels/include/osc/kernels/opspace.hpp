@@ -72,7 +72,7 @@ struct SphericalWristJacobianFactor {
 /// factorisation takes N divisions and a solve none (Eigen's LLT takes N square roots and N(N-1)/2
 /// divisions, and N divisions per triangular solve). positive is false when a pivot is not positive
 /// (A not positive definite); the solve is then meaningless. A(q) with its armature is positive
-/// definite by construction, so the control step does not test it (tests/test_properties.cpp does).
+/// definite by construction, so the control step does not test it (tests/firmware/kernels/test_properties.cpp does).
 template <class S, int N>
 struct LdltFactor {
   Eigen::Matrix<S, N, N> L;  // strictly lower part: L; the rest unused

@@ -11,7 +11,7 @@
 #include <cstdint>
 #include <cstring>
 
-#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
 #include "osc/control/gains.hpp"
 #include "osc/robots/arm.hpp"
 #include "osc/runtime/timing.hpp"
@@ -70,15 +70,9 @@ struct SensorFrame {
   X(Seq, "seq_errors", "a valid frame with an unexpected sequence number")                            \
   X(Silence, "timeouts", "no frame within the silence limit")
 
-enum LinkError : std::uint8_t {
-// A count after an X-macro expansion: clang-format would indent it as a continuation.
-// clang-format off
-#define OSC_LINK_ERROR_ENUM(Name, name, doc) kErr##Name,
-  OSC_LINK_ERROR_LIST(OSC_LINK_ERROR_ENUM)
-#undef OSC_LINK_ERROR_ENUM
-  kLinkErrorKinds
-  // clang-format on
-};
+#define OSC_X_PREFIX kErr
+enum LinkError : std::uint8_t { OSC_LINK_ERROR_LIST(OSC_X_ENUMERATOR) kLinkErrorKinds };
+#undef OSC_X_PREFIX
 /// Names in telemetry (JSON, logs), in LinkError order.
 constexpr const char* kLinkErrorNames[kLinkErrorKinds] = {OSC_LINK_ERROR_LIST(OSC_X_NAME)};
 /// What each kind means, in LinkError order.

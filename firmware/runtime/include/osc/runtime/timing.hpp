@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
 
 namespace osc {
 
@@ -32,14 +32,9 @@ struct StepTiming {
   X(Monitors, "monitors", "the step's monitors: stuck encoder, tracking, friction-estimate band")                \
   X(Output, "output", "torques to DAC codes, saturation, overflow and overrun, supervisor, DAC write")
 
-enum TickStage : std::uint8_t {
-// clang-format off
-#define OSC_TICK_STAGE_ENUM(Name, name, doc) kStage##Name,
-  OSC_TICK_STAGE_LIST(OSC_TICK_STAGE_ENUM)
-#undef OSC_TICK_STAGE_ENUM
-  kTickStages
-  // clang-format on
-};
+#define OSC_X_PREFIX kStage
+enum TickStage : std::uint8_t { OSC_TICK_STAGE_LIST(OSC_X_ENUMERATOR) kTickStages };
+#undef OSC_X_PREFIX
 /// The stages' names (telemetry, reports) and meanings, in TickStage order.
 constexpr const char* kTickStageNames[kTickStages] = {OSC_TICK_STAGE_LIST(OSC_X_NAME)};
 constexpr const char* kTickStageDocs[kTickStages] = {OSC_TICK_STAGE_LIST(OSC_X_DOC)};

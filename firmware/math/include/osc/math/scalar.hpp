@@ -1,5 +1,5 @@
 // The one place the kernels touch elementary functions and literals.
-// double and float forward to <cmath>; the fixed-point scalars (osc/kernels/fixed.hpp) bring their
+// double and float forward to <cmath>; the fixed-point scalars (osc/math/fixed.hpp) bring their
 // own overloads of these functions into osc::math (the kernels call them qualified) and a
 // constructor from double for literals (lit<S>).
 #pragma once
@@ -10,7 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "osc/kernels/fixed.hpp"
+#include "osc/math/fixed.hpp"
 
 namespace osc {
 
@@ -42,7 +42,7 @@ namespace detail {
 /// too (as fdlibm's cosine kernel does). Taylor polynomials of sin to r^9 and of cos to r^10
 /// (truncation below 2e-9 at pi/4), each result rounded once from r or 1 - r^2/2 and a small sum.
 /// |error| <= 6e-8 (one float ulp of 1) for |v| <= 6400, tested
-/// against double (tests/test_properties.cpp, FloatFunctions).
+/// against double (tests/firmware/kernels/test_properties.cpp, FloatFunctions).
 [[gnu::always_inline]] inline void sincos_float(float v, float& s, float& c) {
   const int k = round_to_int(v * 0.636619772f);
   const float fk = static_cast<float>(k);

@@ -2,18 +2,20 @@
 // point on the M3, or float in soft-float routines on the M3 for comparison), checks them against
 // the published PUMA 560 vectors, and reports the instructions each takes (QEMU -icount shift=0).
 // In fixed point it also compares every kernel with the host's results bit for bit
-// (tests/fixed_reference.hpp) and requires the arithmetic flag clear. Exit status 0 = pass.
+// (tests/support/fixed_reference.hpp) and requires the arithmetic flag clear. Exit status 0 = pass.
 #include <cstdint>
 
 #include "board.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
+#include "puma560_published.hpp"
 #include "text.hpp"
 
 namespace {
 
 using namespace osc;
+namespace published = osc::test::published;
 using F = board::Scalar;
 constexpr bool kFixed = fixed::is_q_v<F>;
 
@@ -68,22 +70,10 @@ Data<F> g_data;
 OpSpace<F> g_os;
 ControllerState<F> g_state;
 
-}  // namespace
-
-int main() {
-  board::cycle_counter_init();
-  cortex_m::text::Line()
-      .str("kernels_image: PUMA 560 kernels in ")
-      .str(board::kScalarName)
-      .str(" on ")
-      .str(board::kCore)
-      .emit();
-  g_model = Model<F>::of(robot::kArm);
-  const Vec6<F> qn = joint_vector<F>(puma560::kQn), q0 = joint_vector<F>(robot::kQStart);
-  Vec6<F> qd, one;
-  qd << 1, 2, 3, 1, 2, 3;
+/// The joint-space kernels at qn, against the published gravity, inertia and Coriolis values.
+void joint_space_kernels(const Vec6<F>& qn, const Vec6<F>& qd) {
+  Vec6<F> one, g, c, tau;
   one.setOnes();
-  Vec6<F> g, c, tau;
   Mat6<F> B;
   {
     Timer t("forward_kinematics");
@@ -118,16 +108,20 @@ int main() {
     keep(B);
   }
   const double tol = 2e-3;
-  check("g2", d(g(1)), 31.6399, tol * 31.6399);
-  check("g3", d(g(2)), 6.0351, tol * 6.0351);
-  check("g5", d(g(4)), 0.0283, 2e-4);
-  const double Mdiag[6] = {3.6594, 4.4137, 0.9378, 0.1925, 0.1713, 0.1941};
-  for (int i = 0; i < 6; ++i) check("M_ii", d(g_data.A(i, i)), Mdiag[i], 1e-3 * Mdiag[i] + 1e-4);
-  // rne(qn, 1, 1) without the toolbox's friction: published value minus that friction.
-  check("B(1,2)", d(B(0, 1)), -2.0494, 2e-3);
-  check("B(2,3)", d(B(1, 2)), 1.9287, 2e-3);
+  check("g2", d(g(1)), published::kGravityQn[1], tol * published::kGravityQn[1]);
+  check("g3", d(g(2)), published::kGravityQn[2], tol * published::kGravityQn[2]);
+  check("g5", d(g(4)), published::kGravityQn[4], 2e-4);
+  for (int i = 0; i < 6; ++i) {
+    const double m = published::kInertiaQn[6 * i + i];
+    check("M_ii", d(g_data.A(i, i)), m, 1e-3 * m + 1e-4);
+  }
+  check("B(1,2)", d(B(0, 1)), published::kCoriolisQn[1], 2e-3);
+  check("B(2,3)", d(B(1, 2)), published::kCoriolisQn[6 + 2], 2e-3);
   check("c = B qd", d((B * qd - c).norm()), 0.0, 1e-3);
+}
 
+/// Friction (2) and its regressor (19), consistent with each other; returns the friction torque.
+Vec6<F> friction_kernels(const Vec6<F>& qd) {
   Vec6<F> fr;
   Regressor<F> W;
   const FrictionParams<F> fp = FrictionParams<F>::from(robot::kFrictionPaper, 1.0);
@@ -142,7 +136,12 @@ int main() {
     keep(W);
   }
   check("W theta = tau_f", d((W * fp.theta() - fr).norm()), 0.0, 1e-4);
+  return fr;
+}
 
+/// The operational-space update at q0, and the wrist factor and Lambda at qn against the published
+/// Lambda.
+void operational_inertia_kernels(const Vec6<F>& q0, const Vec6<F>& qn) {
   forward_kinematics(g_model, g_data, q0);
   const Mat3<F> R_ref = g_data.R[kDof];
   {
@@ -164,12 +163,16 @@ int main() {
     Lg = operational_inertia(g_data.A, Jg);
     keep(Lg);
   }
-  check("Lambda(1,1)", d(Lg(0, 0)), 17.2954, 0.05);
-  check("Lambda(3,3)", d(Lg(2, 2)), 13.3348, 0.05);
-  check("Lambda(6,6)", d(Lg(5, 5)), 0.5791, 2e-3);
+  check("Lambda(1,1)", d(Lg(0, 0)), published::kLambdaQn[0], 0.05);
+  check("Lambda(3,3)", d(Lg(2, 2)), published::kLambdaQn[6 * 2 + 2], 0.05);
+  check("Lambda(6,6)", d(Lg(5, 5)), published::kLambdaQn[6 * 5 + 5], 2e-3);
   check("rcond(qn) > 1e-3", d(Jg.rcond) > 1e-3 ? 1.0 : 0.0, 1.0, 0.0);
-
+  // Back to q0 for what follows.
   opspace_update(g_model, g_data, g_os, q0, R_ref);
+}
+
+/// Psi, p, f, Gamma = J^T F, the Lambda solve and Jdot qd at q0 (after opspace_update).
+void operational_force_kernels(const Vec6<F>& qd, const Vec6<F>& fr) {
   Vec6<F> v, h, hb, p, f, G, l, jd;
   v << lit<F>(0.05), lit<F>(-0.02), lit<F>(0.03), lit<F>(0.01), lit<F>(0.02), lit<F>(-0.01);
   {
@@ -210,8 +213,10 @@ int main() {
     jd = analytic_jdot_qd(g_model, g_data, g_os, qd);
     keep(jd);
   }
+}
 
-  // The full control step (observer, controller, adaptation), a few samples.
+/// The control step (observer, controller, adaptation) over a few samples: worst and mean.
+void control_step_kernels(const Vec6<F>& q0) {
   const Gains<F> gains = Gains<F>::paper();
   controller_init(g_model, g_state, q0);
   std::uint32_t worst = 0, sum = 0;
@@ -233,7 +238,10 @@ int main() {
       .str(" instructions")
       .emit();
   check("control_step holds gravity at rest", d((g_state.obs.x_hat - g_os.x).norm()) < 1.0 ? 1.0 : 0.0, 1.0, 0.0);
+}
 
+/// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear.
+void fixed_reference_check() {
   if constexpr (kFixed) {
     // Every kernel against the host's Q12.19 results, bit for bit.
     int n = 0, mismatches = 0;
@@ -272,7 +280,28 @@ int main() {
     if (flags != 0) ++g_failures;
     g_failures += mismatches;
   }
+}
 
+}  // namespace
+
+int main() {
+  board::cycle_counter_init();
+  cortex_m::text::Line()
+      .str("kernels_image: PUMA 560 kernels in ")
+      .str(board::kScalarName)
+      .str(" on ")
+      .str(board::kCore)
+      .emit();
+  g_model = Model<F>::of(robot::kArm);
+  const Vec6<F> qn = joint_vector<F>(puma560::kQn), q0 = joint_vector<F>(robot::kQStart);
+  Vec6<F> qd;
+  qd << 1, 2, 3, 1, 2, 3;
+  joint_space_kernels(qn, qd);
+  const Vec6<F> fr = friction_kernels(qd);
+  operational_inertia_kernels(q0, qn);
+  operational_force_kernels(qd, fr);
+  control_step_kernels(q0);
+  fixed_reference_check();
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
   return g_failures ? 1 : 0;

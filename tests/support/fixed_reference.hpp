@@ -1,7 +1,7 @@
 // Reference values of the fixed-point kernels, shared by the host tests and the Cortex-M3 kernels
 // image (boards/common/mps2/kernels_image.cpp): every kernel's Q12.19 output at three states, and
 // the torques of 20 control steps, as raw words. The arithmetic is integer, so the target must
-// reproduce the host's values bit for bit. tests/test_fixed_kernels.cpp checks that the committed
+// reproduce the host's values bit for bit. tests/firmware/kernels/test_fixed_kernels.cpp checks that the committed
 // values (fixed_reference_values.inc) are what the host computes now (and prints new ones when a
 // kernel changed); the same file checks these kernels against double within their budgets.
 #pragma once

@@ -369,7 +369,7 @@ TEST_F(Link, SlowHostOrDescheduledEmulatorIsNeitherAFaultNorAReset) {
   }
 }
 
-// Link errors (the firmware's side; every kind in detail: tests/test_link.cpp): the answer carries
+// Link errors (the firmware's side; every kind in detail: tests/firmware/link/test_link.cpp): the answer carries
 // zero codes at once and counts the error, a single error does not latch, repeated errors do.
 TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
   healthy(5);
