@@ -38,7 +38,9 @@ TEST(GainKeys, EveryGainWithAKeyIsAControllerEntryWithItsRangeAndUnit) {
     ASSERT_NE(line, "") << g.name << ": no controller." << p.key;
     EXPECT_LT(p.lo, p.hi) << g.name;
     EXPECT_NE(line.find(std::string("# ") + g.doc), std::string::npos) << line;
-    if (*p.unit) EXPECT_NE(line.find(std::string(" [") + p.unit + "]; "), std::string::npos) << line;
+    if (*p.unit) {
+      EXPECT_NE(line.find(std::string(" [") + p.unit + "]; "), std::string::npos) << line;
+    }
     EXPECT_NE(line.find("; [" + number(p.lo) + ", " + number(p.hi) + "]"), std::string::npos) << line;
     // The paper's value is inside the range, so that the printed configuration reads back.
     std::string err;
