@@ -10,6 +10,7 @@
 #include <functional>
 #include <iterator>
 #include <sstream>
+#include <type_traits>
 
 #include "osc_git_revision.hpp"
 
@@ -35,8 +36,8 @@ enum class Kind { kNumber, kList, kName };
 /// of numbers, names); `get` reads one from the settings and `put` stores a checked one, returning
 /// an error text for what only it can check (empty: fine).
 struct Entry {
-  const char* key;
-  const char* doc;  // unit and meaning: the YAML comment and --help
+  std::string key;
+  std::string doc;  // unit and meaning: the YAML comment and --help
   Kind kind;
   double lo = 0, hi = 0;           // kNumber, and each element of a kList
   std::vector<std::string> names;  // kName: the values allowed
@@ -85,232 +86,243 @@ std::function<std::string(Settings&, const json&)> put_friction(int which) {
   };
 }
 
+/// A number entry stored in the settings as is.
+void number(std::vector<Entry>& t, std::string key, std::string doc, double lo, double hi, bool paper,
+            std::function<double&(Settings&)> ref) {
+  Entry e{std::move(key), std::move(doc), Kind::kNumber, lo, hi, {}, paper};
+  e.get = [ref](const Settings& s) { return json(ref(const_cast<Settings&>(s))); };
+  e.put = [ref](Settings& s, const json& v) {
+    ref(s) = v.get<double>();
+    return std::string();
+  };
+  t.push_back(e);
+}
+
+/// A list of six numbers, each in [lo, hi], stored scaled by `scale` into the settings.
+void list6(std::vector<Entry>& t, std::string key, std::string doc, double lo, double hi, bool paper,
+           std::function<Vec6&(Settings&)> ref, double scale = 1) {
+  Entry e{std::move(key), std::move(doc), Kind::kList, lo, hi, {}, paper};
+  e.get = [ref, scale](const Settings& s) { return vec_json(ref(const_cast<Settings&>(s)), 1 / scale); };
+  e.put = [ref, scale](Settings& s, const json& v) {
+    for (int i = 0; i < 6; ++i) ref(s)(i) = v[i].get<double>() * scale;
+    return std::string();
+  };
+  t.push_back(e);
+}
+
+/// A name entry: one of `names`.
+void name(std::vector<Entry>& t, std::string key, std::string doc, std::vector<std::string> names, bool paper,
+          std::function<std::string(const Settings&)> get, std::function<void(Settings&, const std::string&)> put) {
+  Entry e{std::move(key), std::move(doc), Kind::kName, 0, 0, std::move(names), paper};
+  e.get = [get](const Settings& s) { return json(get(s)); };
+  e.put = [put](Settings& s, const json& v) {
+    put(s, v.get<std::string>());
+    return std::string();
+  };
+  t.push_back(e);
+}
+
+void add_run_entries(std::vector<Entry>& t) {
+  number(t, "run.duration", "simulated seconds per run [s]", 1, 86400, true,
+         [](Settings& s) -> double& { return s.base.duration; });
+  name(t, "run.modes", "with friction compensation (Table I), without (Table III), or both",
+       {"both", "adaptive", "none"}, false, mode_name, [](Settings& s, const std::string& m) {
+         s.run_adaptive = m != "none";
+         s.run_none = m != "adaptive";
+       });
+  name(
+      t, "run.scalar", "the controller's arithmetic (fixed: Q12.19 fixed point, docs/fixed_point.md)",
+      std::vector<std::string>(std::begin(kScalarNames), std::end(kScalarNames)), false,
+      [](const Settings& s) { return std::string(kScalarNames[static_cast<int>(s.base.scalar)]); },
+      [](Settings& s, const std::string& m) {
+        for (int i = 0; i < static_cast<int>(std::size(kScalarNames)); ++i)
+          if (m == kScalarNames[i]) s.base.scalar = static_cast<Scalar>(i);
+      });
+  name(
+      t, "run.adaptation",
+      "friction adaptation law: paper is (67) exactly, robust adds projection and leakage (docs/adaptation.md)",
+      std::vector<std::string>(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount), false,
+      [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
+      [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
+  number(t, "run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
+         true, [](Settings& s) -> double& { return s.base.final_window; });
+  number(t, "run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,
+         [](Settings& s) -> double& { return s.base.window; });
+}
+
+/// The entry controller.<key> of one gain of OSC_GAINS_FIELDS, as its parameter column says (form F:
+/// a list of six, a number, or one number for every element), checked against the gain's type here.
+/// A gain without a key (GainForm::kNone) has no entry.
+template <osc::GainForm F, class T>
+void add_gain(std::vector<Entry>& t, const osc::GainParam& p, const char* doc, T osc::Gains<double>::*gain) {
+  if constexpr (F == osc::GainForm::kNone) return;
+  const std::string key = std::string("controller.") + p.key;
+  const std::string text = std::string(doc) + (*p.unit ? std::string(" [") + p.unit + "]" : "");
+  if constexpr (F == osc::GainForm::kPerAxis) {
+    static_assert(std::is_same_v<T, Vec6>, "a per-axis parameter is a vector of six");
+    list6(t, key, text, p.lo, p.hi, true, [gain](Settings& s) -> Vec6& { return s.base.gains.*gain; });
+  } else if constexpr (F == osc::GainForm::kOne) {
+    static_assert(std::is_same_v<T, double>, "a parameter of one number is a number");
+    number(t, key, text, p.lo, p.hi, true, [gain](Settings& s) -> double& { return s.base.gains.*gain; });
+  } else if constexpr (F == osc::GainForm::kEvery) {
+    static_assert(std::is_same_v<T, Vec6>, "one number for every element: a vector of six");
+    Entry e{key, text, Kind::kNumber, p.lo, p.hi, {}, true};
+    e.get = [gain](const Settings& s) { return json((s.base.gains.*gain)(0)); };
+    e.put = [gain](Settings& s, const json& v) {
+      (s.base.gains.*gain).setConstant(v.get<double>());
+      return std::string();
+    };
+    t.push_back(e);
+  }
+}
+
+void add_controller_entries(std::vector<Entry>& t) {
+  // The gains' keys come from their one list, in its order: gains (69), diagonal, axes x, y, z, then
+  // the rotations about X, Y, Z; K_ad, tau_dec, the leakage.
+  namespace gain_param = osc::gain_param;  // the parameter column's helpers
+#define SIM_GAIN_ENTRY(type, name, paper, doc, param) add_gain<(param).form>(t, param, doc, &osc::Gains<double>::name);
+  OSC_GAINS_FIELDS(SIM_GAIN_ENTRY)
+#undef SIM_GAIN_ENTRY
+  number(t, "controller.model_error", "relative error of the controller's link masses and inertias", -0.5, 0.5, true,
+         [](Settings& s) -> double& { return s.base.model_error; });
+}
+
+/// Trajectory (68) with one of amplitude, period or envelope changed. omega keeps the exact value
+/// of params.hpp for the paper's period.
+void reshape(Settings& s, double amplitude, std::uint64_t period_ticks, double envelope) {
+  osc::TrajectorySpec<double>& spec = s.base.gains.trajectory;
+  const osc::TrajectorySpec<double> old = spec;
+  spec = osc::trajectory_spec(amplitude, period_ticks, envelope, osc::params::kDt);
+  if (period_ticks == old.period_ticks) spec.omega = old.omega;
+  if (period_ticks == osc::kTrajectoryPeriodTicks) spec.omega = osc::params::kOmega;
+}
+
+void add_trajectory_entries(std::vector<Entry>& t) {
+  Entry a{"trajectory.amplitude", "of each sinusoid about the start position [m]", Kind::kNumber, 0, 0.2, {}, true};
+  a.get = [](const Settings& s) { return json(s.base.gains.trajectory.amplitude); };
+  a.put = [](Settings& s, const json& v) {
+    const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+    reshape(s, v.get<double>(), o.period_ticks, o.envelope);
+    return std::string();
+  };
+  t.push_back(a);
+  Entry p{
+      "trajectory.period", "of the sinusoids [s], a whole number of samples (1 ms)", Kind::kNumber, 0.5, 60, {}, true};
+  p.get = [](const Settings& s) {
+    return json(static_cast<double>(s.base.gains.trajectory.period_ticks) * osc::params::kDt);
+  };
+  p.put = [](Settings& s, const json& v) {
+    const double period = v.get<double>();
+    const double ticks = std::round(period / osc::params::kDt);
+    if (std::abs(ticks * osc::params::kDt - period) > 1e-9)
+      return number_text(period) + " s is not a whole number of samples of " + number_text(osc::params::kDt) + " s";
+    const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+    reshape(s, o.amplitude, static_cast<std::uint64_t>(ticks), o.envelope);
+    return std::string();
+  };
+  t.push_back(p);
+  Entry c{"trajectory.envelope", "rate c of the envelope 1 - exp(-c t^3) [1/s^3]", Kind::kNumber, 1e-3, 10, {}, true};
+  c.get = [](const Settings& s) { return json(s.base.gains.trajectory.envelope); };
+  c.put = [](Settings& s, const json& v) {
+    const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
+    reshape(s, o.amplitude, o.period_ticks, v.get<double>());
+    return std::string();
+  };
+  t.push_back(c);
+}
+
+/// The start pose, in degrees within the joint limits.
+void add_start_pose_entry(std::vector<Entry>& t) {
+  Entry q{"start_pose", "joint angles q1..q6 at the start [deg], within the joint limits", Kind::kList, -360, 360, {},
+          true};
+  q.get = [](const Settings& s) { return vec_json(s.base.q_start, 1 / kDeg); };
+  q.put = [](Settings& s, const json& v) {
+    for (int i = 0; i < 6; ++i) {
+      double rad = v[i].get<double>() * kDeg;
+      // The printed degrees read back as the description's radians exactly.
+      if (std::abs(rad - osc::robot::kQStart[i]) < 1e-12) rad = osc::robot::kQStart[i];
+      s.base.q_start(i) = rad;
+    }
+    return std::string();
+  };
+  q.element_range = [](const Settings&, double& lo, double& hi, int i) {
+    lo = std::round(osc::robot::kArm.q_min[i] / kDeg * 1e6) / 1e6;
+    hi = std::round(osc::robot::kArm.q_max[i] / kDeg * 1e6) / 1e6;
+  };
+  t.push_back(q);
+}
+
+/// The plant's friction: a preset of the robot by name, or custom coefficients.
+void add_plant_friction_entries(std::vector<Entry>& t) {
+  Entry f{"plant.friction.preset",
+          "the simulated robot's friction: a preset of the robot (the PUMA 560's: paper, Table II; corke, "
+          "the toolbox's; none), or custom (vis, cou, sti below; setting any of them makes it custom)",
+          Kind::kName,
+          0,
+          0,
+          friction_preset_names(),
+          true};
+  f.get = [](const Settings& s) { return json(std::string(s.base.plant.friction.name)); };
+  f.put = [](Settings& s, const json& v) {
+    const std::string n = v.get<std::string>();
+    if (const osc::FrictionCoefficients* p = friction_preset(n))
+      s.base.plant.friction = *p;
+    else
+      s.base.plant.friction.name = "custom";  // keeps the coefficients it has
+    return std::string();
+  };
+  t.push_back(f);
+  const char* const kCoef[3][2] = {{"plant.friction.vis", "viscous coefficients per joint [N m s/rad]"},
+                                   {"plant.friction.cou", "Coulomb levels per joint [N m]"},
+                                   {"plant.friction.sti", "Stribeck excess per joint [N m]"}};
+  for (int k = 0; k < 3; ++k) {
+    Entry c{kCoef[k][0], kCoef[k][1], Kind::kList, 0, 200, {}, true};
+    c.get = [k](const Settings& s) {
+      const osc::FrictionCoefficients& fr = s.base.plant.friction;
+      return vec_json(k == 0 ? fr.vis : k == 1 ? fr.cou : fr.sti, 6);
+    };
+    c.put = put_friction(k);
+    c.shown = [](const Settings& s) { return std::string(s.base.plant.friction.name) == "custom"; };
+    t.push_back(c);
+  }
+}
+
+void add_plant_entries(std::vector<Entry>& t) {
+  add_plant_friction_entries(t);
+  number(t, "plant.tau_dec", "the simulated robot's Stribeck decay tau_dec [s^2/rad^2]", 0.01, 100, true,
+         [](Settings& s) -> double& { return s.base.plant.tau_dec; });
+  number(t, "plant.encoder_cpr", "encoder counts per motor revolution, plant and controller alike", 100, 1e7, true,
+         [](Settings& s) -> double& { return s.base.encoder_counts_per_motor_rev; });
+  number(t, "plant.delay", "computation delay from the encoder sample to the DAC update [s]", 0, osc::params::kDt, true,
+         [](Settings& s) -> double& { return s.base.plant.compute_delay; });
+  number(t, "plant.substep", "the plant's RK4 step [s] (through velocity reversals)", 1e-6, 1e-3, false,
+         [](Settings& s) -> double& { return s.base.plant.substep; });
+  Entry e{"plant.smooth_steps",
+          "substeps the plant's RK4 takes at once while no joint velocity changes sign (1: fixed step)",
+          Kind::kNumber,
+          1,
+          16,
+          {},
+          false};
+  e.get = [](const Settings& s) { return json(s.base.plant.smooth_steps); };
+  e.put = [](Settings& s, const json& v) {
+    const double n = v.get<double>();
+    if (n != std::floor(n)) return number_text(n) + " is not a whole number";
+    s.base.plant.smooth_steps = static_cast<int>(n);
+    return std::string();
+  };
+  t.push_back(e);
+}
+
+/// The configuration's entries, in the order of the printed file.
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> kEntries = [] {
     std::vector<Entry> t;
-    auto number = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
-                       std::function<double&(Settings&)> ref) {
-      Entry e{key, doc, Kind::kNumber, lo, hi, {}, paper};
-      e.get = [ref](const Settings& s) { return json(ref(const_cast<Settings&>(s))); };
-      e.put = [ref](Settings& s, const json& v) {
-        ref(s) = v.get<double>();
-        return std::string();
-      };
-      t.push_back(e);
-    };
-    // A list of six numbers, each in [lo, hi], stored scaled by `scale` into the settings.
-    auto list6 = [&t](const char* key, const char* doc, double lo, double hi, bool paper,
-                      std::function<Vec6&(Settings&)> ref, double scale = 1) {
-      Entry e{key, doc, Kind::kList, lo, hi, {}, paper};
-      e.get = [ref, scale](const Settings& s) { return vec_json(ref(const_cast<Settings&>(s)), 1 / scale); };
-      e.put = [ref, scale](Settings& s, const json& v) {
-        for (int i = 0; i < 6; ++i) ref(s)(i) = v[i].get<double>() * scale;
-        return std::string();
-      };
-      t.push_back(e);
-    };
-    auto name = [&t](const char* key, const char* doc, std::vector<std::string> names, bool paper,
-                     std::function<std::string(const Settings&)> get,
-                     std::function<void(Settings&, const std::string&)> put) {
-      Entry e{key, doc, Kind::kName, 0, 0, std::move(names), paper};
-      e.get = [get](const Settings& s) { return json(get(s)); };
-      e.put = [put](Settings& s, const json& v) {
-        put(s, v.get<std::string>());
-        return std::string();
-      };
-      t.push_back(e);
-    };
-
-    // run
-    number("run.duration", "simulated seconds per run [s]", 1, 86400, true,
-           [](Settings& s) -> double& { return s.base.duration; });
-    name("run.modes", "with friction compensation (Table I), without (Table III), or both",
-         {"both", "adaptive", "none"}, false, mode_name, [](Settings& s, const std::string& m) {
-           s.run_adaptive = m != "none";
-           s.run_none = m != "adaptive";
-         });
-    name(
-        "run.scalar", "the controller's arithmetic (fixed: Q12.19 fixed point, docs/fixed_point.md)",
-        std::vector<std::string>(std::begin(kScalarNames), std::end(kScalarNames)), false,
-        [](const Settings& s) { return std::string(kScalarNames[static_cast<int>(s.base.scalar)]); },
-        [](Settings& s, const std::string& m) {
-          for (int i = 0; i < static_cast<int>(std::size(kScalarNames)); ++i)
-            if (m == kScalarNames[i]) s.base.scalar = static_cast<Scalar>(i);
-        });
-    {
-      std::vector<std::string> laws(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount);
-      name(
-          "run.adaptation",
-          "friction adaptation law: paper is (67) exactly, robust adds projection and leakage "
-          "(docs/adaptation.md)",
-          laws, false, [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
-          [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
-    }
-    number("run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
-           true, [](Settings& s) -> double& { return s.base.final_window; });
-    number("run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,
-           [](Settings& s) -> double& { return s.base.window; });
-
-    // controller: gains (69), diagonal, axes x, y, z, then the rotations about X, Y, Z.
-    list6("controller.knd", "observer gain k_nd of (69), per axis x y z rx ry rz", 1e-3, 1e5, true,
-          [](Settings& s) -> Vec6& { return s.base.gains.knd; });
-    list6("controller.k", "observer gain k of (69)", 1e-3, 1e5, true,
-          [](Settings& s) -> Vec6& { return s.base.gains.k; });
-    list6("controller.ks", "controller gain k_s of (69)", 1e-3, 1e5, true,
-          [](Settings& s) -> Vec6& { return s.base.gains.ks; });
-    list6("controller.ki", "controller gain k_i of (69)", 1e-3, 1e6, true,
-          [](Settings& s) -> Vec6& { return s.base.gains.ki; });
-    {
-      number("controller.k_ad", "adaptation gain: every diagonal entry of K_ad", 0, 1e5, true,
-             [](Settings& s) -> double& { return s.base.gains.kad; });
-      Entry d{"controller.tau_dec",
-              "the controller's Stribeck decay tau_dec of model (2), every joint [s^2/rad^2]",
-              Kind::kNumber,
-              0.01,
-              100,
-              {},
-              true};
-      d.get = [](const Settings& s) { return json(s.base.gains.tau_dec(0)); };
-      d.put = [](Settings& s, const json& v) {
-        s.base.gains.tau_dec.setConstant(v.get<double>());
-        return std::string();
-      };
-      t.push_back(d);
-    }
-    number("controller.leakage", "leakage sigma of the robust law [1/s]", 0, 1, true,
-           [](Settings& s) -> double& { return s.base.gains.leakage; });
-    number("controller.model_error", "relative error of the controller's link masses and inertias", -0.5, 0.5, true,
-           [](Settings& s) -> double& { return s.base.model_error; });
-
-    // trajectory (68). omega keeps the exact value of params.hpp for the paper's period.
-    auto reshape = [](Settings& s, double amplitude, std::uint64_t period_ticks, double envelope) {
-      osc::TrajectorySpec<double>& spec = s.base.gains.trajectory;
-      const osc::TrajectorySpec<double> old = spec;
-      spec = osc::trajectory_spec(amplitude, period_ticks, envelope, osc::params::kDt);
-      if (period_ticks == old.period_ticks) spec.omega = old.omega;
-      if (period_ticks == osc::kTrajectoryPeriodTicks) spec.omega = osc::params::kOmega;
-    };
-    {
-      Entry a{"trajectory.amplitude", "of each sinusoid about the start position [m]", Kind::kNumber, 0, 0.2, {}, true};
-      a.get = [](const Settings& s) { return json(s.base.gains.trajectory.amplitude); };
-      a.put = [reshape](Settings& s, const json& v) {
-        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
-        reshape(s, v.get<double>(), o.period_ticks, o.envelope);
-        return std::string();
-      };
-      t.push_back(a);
-      Entry p{"trajectory.period",
-              "of the sinusoids [s], a whole number of samples (1 ms)",
-              Kind::kNumber,
-              0.5,
-              60,
-              {},
-              true};
-      p.get = [](const Settings& s) {
-        return json(static_cast<double>(s.base.gains.trajectory.period_ticks) * osc::params::kDt);
-      };
-      p.put = [reshape](Settings& s, const json& v) {
-        const double period = v.get<double>();
-        const double ticks = std::round(period / osc::params::kDt);
-        if (std::abs(ticks * osc::params::kDt - period) > 1e-9)
-          return number_text(period) + " s is not a whole number of samples of " + number_text(osc::params::kDt) + " s";
-        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
-        reshape(s, o.amplitude, static_cast<std::uint64_t>(ticks), o.envelope);
-        return std::string();
-      };
-      t.push_back(p);
-      Entry c{
-          "trajectory.envelope", "rate c of the envelope 1 - exp(-c t^3) [1/s^3]", Kind::kNumber, 1e-3, 10, {}, true};
-      c.get = [](const Settings& s) { return json(s.base.gains.trajectory.envelope); };
-      c.put = [reshape](Settings& s, const json& v) {
-        const osc::TrajectorySpec<double> o = s.base.gains.trajectory;
-        reshape(s, o.amplitude, o.period_ticks, v.get<double>());
-        return std::string();
-      };
-      t.push_back(c);
-    }
-
-    // start pose, in degrees within the joint limits
-    {
-      Entry q{
-          "start_pose", "joint angles q1..q6 at the start [deg], within the joint limits", Kind::kList, -360, 360, {},
-          true};
-      q.get = [](const Settings& s) { return vec_json(s.base.q_start, 1 / kDeg); };
-      q.put = [](Settings& s, const json& v) {
-        for (int i = 0; i < 6; ++i) {
-          double rad = v[i].get<double>() * kDeg;
-          // The printed degrees read back as the description's radians exactly.
-          if (std::abs(rad - osc::robot::kQStart[i]) < 1e-12) rad = osc::robot::kQStart[i];
-          s.base.q_start(i) = rad;
-        }
-        return std::string();
-      };
-      q.element_range = [](const Settings&, double& lo, double& hi, int i) {
-        lo = std::round(osc::robot::kArm.q_min[i] / kDeg * 1e6) / 1e6;
-        hi = std::round(osc::robot::kArm.q_max[i] / kDeg * 1e6) / 1e6;
-      };
-      t.push_back(q);
-    }
-
-    // plant
-    {
-      Entry f{"plant.friction.preset",
-              "the simulated robot's friction: a preset of the robot (the PUMA 560's: paper, Table II; corke, "
-              "the toolbox's; none), or custom (vis, cou, sti below; setting any of them makes it custom)",
-              Kind::kName,
-              0,
-              0,
-              friction_preset_names(),
-              true};
-      f.get = [](const Settings& s) { return json(std::string(s.base.plant.friction.name)); };
-      f.put = [](Settings& s, const json& v) {
-        const std::string n = v.get<std::string>();
-        if (const osc::FrictionCoefficients* p = friction_preset(n))
-          s.base.plant.friction = *p;
-        else
-          s.base.plant.friction.name = "custom";  // keeps the coefficients it has
-        return std::string();
-      };
-      t.push_back(f);
-      const char* const kCoef[3][2] = {{"plant.friction.vis", "viscous coefficients per joint [N m s/rad]"},
-                                       {"plant.friction.cou", "Coulomb levels per joint [N m]"},
-                                       {"plant.friction.sti", "Stribeck excess per joint [N m]"}};
-      for (int k = 0; k < 3; ++k) {
-        Entry c{kCoef[k][0], kCoef[k][1], Kind::kList, 0, 200, {}, true};
-        c.get = [k](const Settings& s) {
-          const osc::FrictionCoefficients& fr = s.base.plant.friction;
-          return vec_json(k == 0 ? fr.vis : k == 1 ? fr.cou : fr.sti, 6);
-        };
-        c.put = put_friction(k);
-        c.shown = [](const Settings& s) { return std::string(s.base.plant.friction.name) == "custom"; };
-        t.push_back(c);
-      }
-    }
-    number("plant.tau_dec", "the simulated robot's Stribeck decay tau_dec [s^2/rad^2]", 0.01, 100, true,
-           [](Settings& s) -> double& { return s.base.plant.tau_dec; });
-    number("plant.encoder_cpr", "encoder counts per motor revolution, plant and controller alike", 100, 1e7, true,
-           [](Settings& s) -> double& { return s.base.encoder_counts_per_motor_rev; });
-    number("plant.delay", "computation delay from the encoder sample to the DAC update [s]", 0, osc::params::kDt, true,
-           [](Settings& s) -> double& { return s.base.plant.compute_delay; });
-    number("plant.substep", "the plant's RK4 step [s] (through velocity reversals)", 1e-6, 1e-3, false,
-           [](Settings& s) -> double& { return s.base.plant.substep; });
-    {
-      Entry e{"plant.smooth_steps",
-              "substeps the plant's RK4 takes at once while no joint velocity changes sign (1: fixed step)",
-              Kind::kNumber,
-              1,
-              16,
-              {},
-              false};
-      e.get = [](const Settings& s) { return json(s.base.plant.smooth_steps); };
-      e.put = [](Settings& s, const json& v) {
-        const double n = v.get<double>();
-        if (n != std::floor(n)) return number_text(n) + " is not a whole number";
-        s.base.plant.smooth_steps = static_cast<int>(n);
-        return std::string();
-      };
-      t.push_back(e);
-    }
+    add_run_entries(t);
+    add_controller_entries(t);
+    add_trajectory_entries(t);
+    add_start_pose_entry(t);
+    add_plant_entries(t);
     return t;
   }();
   return kEntries;

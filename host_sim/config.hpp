@@ -1,8 +1,9 @@
 // The experiment's configuration file (YAML, read and written by yaml-cpp): gains (69), K_ad,
 // tau_dec, the trajectory (68), the start pose, the plant and the run. Every entry is one row of a
 // table in config.cpp, which knows its key, unit, range and whether it belongs to the paper's
-// set-up; the defaults are the firmware's compile-time values (params.hpp, the robot description),
-// read from those headers, never written a second time.
+// set-up (the gains' rows come from their one list, OSC_GAINS_FIELDS in osc/control/gains.hpp);
+// the defaults are the firmware's compile-time values (params.hpp, the robot description), read
+// from those headers, never written a second time.
 //
 //   puma_experiment --print-config > c.yaml        the effective configuration, with units and ranges
 //   puma_experiment --config c.yaml --set trajectory.amplitude=0.1

@@ -19,16 +19,6 @@ namespace {
 
 constexpr double kRadToDeg = 180.0 / osc::kPi;
 
-/// What the controller reports back each tick.
-struct TickReport {
-  std::uint32_t faults = 0;
-  bool has_observer = false;  // x_tilde is available (in-process controller only)
-  double x_tilde[6] = {};
-  double xd_hat[6] = {};  // the observer's velocity estimate: m/s, rad/s (in-process only)
-  double tau_f_hat[6] = {};
-  double theta_hat[18] = {};
-};
-
 /// The host-built controller: the firmware's control task, in process.
 template <class S>
 class LocalController {
@@ -125,157 +115,97 @@ class RemoteController {
   std::string first_zeroed_;
 };
 
+/// The true plant's errors, through double kinematics: the tracking error e against the task
+/// (68), and the observer's errors against the true operational velocity.
+class GroundTruth {
+ public:
+  explicit GroundTruth(const Vec6& q0) {
+    osc::forward_kinematics(model_, data_, q0);
+    p0_ = data_.o[6];
+    R_ref_ = data_.R[6];
+  }
+  /// e of the plant at q in sample k: mm (x, y, z), deg (about X, Y, Z).
+  void tracking_error(const osc::TrajectorySpec<double>& spec, long k, const Vec6& q, double e[6]) {
+    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k),
+                                                      osc::params::kControlHz);  // as the controller
+    osc::forward_kinematics(model_, data_, q);
+    const osc::Desired<double> d = osc::trajectory(spec, p0_, t_ref);
+    phi_ = osc::orientation_coordinates(data_.R[6], R_ref_);
+    for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - data_.o[6](i)) * 1e3;
+    for (int i = 0; i < 3; ++i) e[3 + i] = -phi_(i) * kRadToDeg;
+  }
+  /// The observer's errors at the pose of the last tracking_error (mm, deg; mm/s, deg/s). They are
+  /// known only for the in-process controller; over the link they are not sent, and NaN here.
+  void observer_errors(const TickReport& rep, const Vec6& qd, double xt[6], double xdt[6]) {
+    if (!rep.has_observer) {
+      for (int i = 0; i < 6; ++i) xt[i] = xdt[i] = std::numeric_limits<double>::quiet_NaN();
+      return;
+    }
+    // The true operational velocity: the analytic Jacobian of the plant's pose times its joint speeds.
+    osc::geometric_jacobian(data_);
+    const Mat6 Ja = osc::analytic_jacobian(data_.J, phi_);
+    const Vec6 xd_true = Ja * qd;
+    for (int i = 0; i < 6; ++i) {
+      const double scale = i < 3 ? 1e3 : kRadToDeg;
+      xt[i] = rep.x_tilde[i] * scale;
+      xdt[i] = (rep.xd_hat[i] - xd_true(i)) * scale;
+    }
+  }
+
+ private:
+  const osc::Model<double> model_ = osc::Model<double>::of(osc::robot::kArm);
+  osc::Data<double> data_;
+  Vec3 p0_;
+  Mat3 R_ref_;
+  Vec3 phi_ = Vec3::Zero();
+};
+
+/// The closed loop, sample by sample: the true errors, the controller's tick, the metrics of the
+/// result (metrics.hpp) observe the sample, the plant advances.
 template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
   PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev, cfg.injection);
-  InjectionResult& ir = res.injection;
-  ir.injection = cfg.injection;
-
-  // Ground truth for the error statistics: the plant's own state through double kinematics.
-  const osc::Model<double> truth = osc::Model<double>::of(osc::robot::kArm);
-  osc::Data<double> tdata;
-  osc::forward_kinematics(truth, tdata, q0);
-  const Vec3 p0 = tdata.o[6];
-  const Mat3 R_ref = tdata.R[6];
-
+  GroundTruth truth(q0);
   const double dt = osc::params::kDt;
   const long n = std::lround(cfg.duration / dt);
-  const long log_every = std::max(1L, std::lround(cfg.log_period / dt));
-  const double t_final = cfg.duration - cfg.final_window;
-  double fr_err2 = 0, fr2 = 0;
-  long fr_n = 0;
-  Vec6 tau_old = Vec6::Zero();
   const long progress_every = std::max(1L, n / 100);
   const long jump_tick = cfg.jump_at >= 0 ? std::lround(cfg.jump_at / dt) : -1;
-  const long window_ticks = std::max(1L, std::lround(cfg.window / dt));
-  res.window = cfg.window;
-  res.final_window = std::min(cfg.final_window, cfg.duration);
-  TickReport rep;
+  const double t_final = cfg.duration - cfg.final_window;  // the "last" statistics from here
+  Sample s;
   for (long k = 0; k < n; ++k) {
-    const double t = k * dt;
-    const osc::TrajectorySpec<double>& spec = cfg.gains.trajectory;
-    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k),
-                                                      osc::params::kControlHz);  // as the controller
-    // Errors of the true plant at the sample instant.
-    osc::forward_kinematics(truth, tdata, plant.q());
-    const osc::Desired<double> d = osc::trajectory(spec, p0, t_ref);
-    const Vec3 phi = osc::orientation_coordinates(tdata.R[6], R_ref);
-    double e[6];
-    for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - tdata.o[6](i)) * 1e3;
-    for (int i = 0; i < 3; ++i) e[3 + i] = -phi(i) * kRadToDeg;
-
+    s.k = k;
+    s.t = k * dt;
+    s.last = s.t >= t_final;
+    truth.tracking_error(cfg.gains.trajectory, k, plant.q(), s.e);
     if constexpr (requires { ctrl.skip_ticks(std::uint64_t{0}); }) {
       if (k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
     }
     // The controller: encoders -> control step -> DAC codes.
-    hal.begin_sample(t);
-    if (!ctrl.tick(hal, rep, res.error)) {
+    hal.begin_sample(s.t);
+    if (!ctrl.tick(hal, s.rep, res.error)) {
       res.error = "tick " + std::to_string(k) + ": " + res.error;
       break;
     }
-    if (rep.faults != 0 && res.status == 0) {
-      res.status = rep.faults, res.fault_time = t;
-      FaultState& fs = res.fault;
-      fs.tick = k, fs.t = t, fs.faults = rep.faults;
-      for (int i = 0; i < 6; ++i)
-        fs.q[i] = plant.q()(i), fs.qd[i] = plant.qd()(i), fs.tau[i] = tau_old(i), fs.e[i] = e[i];
-      for (int i = 0; i < 18; ++i) fs.theta_hat[i] = rep.theta_hat[i];
-    }
-    // Statistics stop at a fault: after it the amplifiers are off and the robot falls.
-    const bool counting = res.status == 0;
-    if (counting) res.stats_until = t + dt;
-    const Vec6 tau_new = hal.torque();
-    if (hal.injection_active()) {
-      if (rep.faults != 0 && ir.detected < 0) ir.detected = t, ir.faults = rep.faults;
-      if (ir.zero_torque < 0) {
-        ir.excursion_mm = std::max(ir.excursion_mm, std::sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]));
-        if ((tau_new.array() == 0.0).all()) ir.zero_torque = t;
-      }
-      if (ir.detected >= 0)
-        for (int i = 0; i < 6; ++i)
-          if (std::abs(tau_new(i)) > ir.max_torque_after)
-            ir.max_torque_after = std::abs(tau_new(i)), ir.max_torque_joint = i;
-    }
-
-    double xt[6], xdt[6];
-    // The observer's errors are known only for the in-process controller; over the link they are
-    // not sent, and the time series leaves their columns out rather than showing zeros.
-    res.has_observer = rep.has_observer;
-    if (rep.has_observer) {
-      // The true operational velocity: the analytic Jacobian of the plant's pose times its joint speeds.
-      osc::geometric_jacobian(tdata);
-      const Mat6 Ja = osc::analytic_jacobian(tdata.J, phi);
-      const Vec6 xd_true = Ja * plant.qd();
-      for (int i = 0; i < 6; ++i) {
-        const double scale = i < 3 ? 1e3 : kRadToDeg;
-        xt[i] = rep.x_tilde[i] * scale;
-        xdt[i] = (rep.xd_hat[i] - xd_true(i)) * scale;
-      }
-    } else {
-      for (int i = 0; i < 6; ++i) xt[i] = xdt[i] = std::numeric_limits<double>::quiet_NaN();
-    }
-    if (!counting) {
-      // Only the time series goes on after a fault (the figures show what the robot did).
-    } else if (k % window_ticks == 0) {
-      res.window_max.push_back({0, 0, 0, 0, 0, 0});
-      res.window_theta_range.push_back({rep.theta_hat[0], rep.theta_hat[0]});
-    }
-    if (counting) {
-      auto& wmax = res.window_max.back();
-      auto& wth = res.window_theta_range.back();
-      for (int i = 0; i < 18; ++i) {
-        wth[0] = std::min(wth[0], rep.theta_hat[i]);
-        wth[1] = std::max(wth[1], rep.theta_hat[i]);
-        res.theta_min_seen[i] = k == 0 ? rep.theta_hat[i] : std::min(res.theta_min_seen[i], rep.theta_hat[i]);
-        res.theta_max_seen[i] = k == 0 ? rep.theta_hat[i] : std::max(res.theta_max_seen[i], rep.theta_hat[i]);
-      }
-      for (int i = 0; i < 6; ++i) {
-        wmax[i] = std::max(wmax[i], std::abs(e[i]));
-        res.max_error[i] = std::max(res.max_error[i], std::abs(e[i]));
-        if (t >= t_final) {
-          res.final_max_error[i] = std::max(res.final_max_error[i], std::abs(e[i]));
-          if (rep.has_observer) {
-            res.max_observer_error[i] = std::max(res.max_observer_error[i], std::abs(xt[i]));
-            res.max_observer_velocity_error[i] = std::max(res.max_observer_velocity_error[i], std::abs(xdt[i]));
-          }
-        }
-      }
-    }
-    const Vec6 tau_f = plant.friction(plant.qd());
-    if (counting && t >= t_final) {
-      for (int i = 0; i < 6; ++i) {
-        const double df = rep.tau_f_hat[i] - tau_f(i);
-        fr_err2 += df * df;
-        fr2 += tau_f(i) * tau_f(i);
-      }
-      ++fr_n;
-    }
-    if (k % log_every == 0) {
-      LogRow r;
-      r.t = t;
-      for (int i = 0; i < 6; ++i) {
-        r.e[i] = e[i];
-        r.x_tilde[i] = xt[i];
-        r.xd_tilde[i] = xdt[i];
-        r.tau[i] = tau_new(i);
-        r.tau_f[i] = tau_f(i);
-        r.tau_f_hat[i] = rep.tau_f_hat[i];
-      }
-      for (int i = 0; i < 18; ++i) r.theta_hat[i] = rep.theta_hat[i];
-      res.log.push_back(r);
-    }
-    plant.advance_sample(tau_old, tau_new, dt);
-    res.plant_evaluations = plant.evaluations();
-    tau_old = tau_new;
+    s.counting = s.counting && s.rep.faults == 0;
+    s.q = plant.q();
+    s.qd = plant.qd();
+    s.tau = hal.torque();
+    s.tau_f = plant.friction(plant.qd());
+    s.injection_active = hal.injection_active();
+    truth.observer_errors(s.rep, plant.qd(), s.x_tilde, s.xd_tilde);
+    res.each([&s](auto& m) {
+      if constexpr (requires { m.observe(s); }) m.observe(s);
+    });
+    plant.advance_sample(s.tau_before, s.tau, dt);
+    s.tau_before = s.tau;
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);
   }
-  for (int i = 0; i < 18; ++i) res.theta_hat[i] = res.status ? res.fault.theta_hat[i] : rep.theta_hat[i];
-  if (fr_n > 0) {
-    res.friction_rms_error = std::sqrt(fr_err2 / (6.0 * fr_n));
-    res.friction_rms = std::sqrt(fr2 / (6.0 * fr_n));
-  }
+  res.plant_evaluations = plant.evaluations();
+  res.each([](auto& m) {
+    if constexpr (requires { m.end(); }) m.end();
+  });
   ctrl.finish(res);
   if (cfg.progress) cfg.progress(1.0);
 }
@@ -291,11 +221,9 @@ ExperimentResult run_experiment(const ExperimentConfig& cfg) {
   res.duration = cfg.duration;
   res.adaptation = osc::adaptation_law_name(cfg.gains.adaptation);
   res.friction_preset = cfg.plant.friction.name;
-  for (int i = 0; i < 6; ++i) {
-    res.theta_true[i] = cfg.plant.friction.vis[i];
-    res.theta_true[6 + i] = cfg.plant.friction.cou[i];
-    res.theta_true[12 + i] = cfg.plant.friction.sti[i];
-  }
+  res.each([&cfg](auto& m) {
+    if constexpr (requires { m.begin(cfg); }) m.begin(cfg);
+  });
   const Vec6 q0 = cfg.q_start;
   if (!cfg.pil_command.empty()) {
     RemoteController ctrl(cfg, res.error);

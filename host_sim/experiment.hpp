@@ -9,6 +9,7 @@
 
 #include "osc/control/controller.hpp"
 #include "injection.hpp"
+#include "metrics.hpp"
 #include "osc/control/gains.hpp"
 #include "osc/link/frames.hpp"
 #include "plant.hpp"
@@ -51,91 +52,15 @@ struct ExperimentConfig {
   double pil_timeout = 10.0;  ///< wall-clock wait per actuator frame [s]
 };
 
-/// One logged sample of the time series.
-struct LogRow {
-  double t;
-  double e[6];         // tracking error of the true plant: mm (x, y, z), deg (about X, Y, Z)
-  double x_tilde[6];   // observer position error: mm, deg
-  double xd_tilde[6];  // observer velocity error x^dot - x dot (true): mm/s, deg/s
-  double tau[6];       // joint torque the amplifiers applied [N m]
-  double theta_hat[18];
-  double tau_f[6];      // true plant friction [N m]
-  double tau_f_hat[6];  // estimated friction (30) [N m]
-};
-
-/// What an injected fault did (ExperimentConfig::injection).
-struct InjectionResult {
-  Injection injection;
-  double detected = -1;         ///< [s] first tick with a fault at or after the injection (-1: never)
-  std::uint32_t faults = 0;     ///< the fault bits raised in that tick
-  double zero_torque = -1;      ///< [s] first sample from which every amplifier torque is zero (-1: never)
-  double excursion_mm = 0;      ///< largest |p - p_d| of the true tip from injection to zero torque (or the end)
-  double max_torque_after = 0;  ///< largest |tau| an amplifier applied after detection [N m]
-  int max_torque_joint = -1;    ///< its joint (0-based)
-};
-
-/// Link health of a processor-in-the-loop run.
-struct LinkReport {
-  pil::LinkCounters firmware;         // errors the firmware counted on the sensor frames
-  pil::LinkCounters host;             // errors the host counted on the actuator frames
-  std::uint32_t host_code_range = 0;  // answers with a DAC code out of range (applied as zero)
-  std::uint32_t zeroed_ticks = 0;     // ticks whose amplifiers got zero because of a link error
-  std::string first_zeroed;           // why the first of them was zeroed
-  /// The firmware's longest gap between received bytes [cycles = instructions under QEMU -icount
-  /// shift=0 = ns of its virtual time], and the gaps longer than params::kLinkSilenceTicks periods.
-  std::uint32_t rx_gap_max = 0, rx_long_gaps = 0;
-  bool clean() const { return firmware.total() == 0 && host.total() == 0 && host_code_range == 0 && zeroed_ticks == 0; }
-};
-
-/// The state of the plant and the controller at the tick a fault latched.
-struct FaultState {
-  long tick = -1;                ///< sample index (-1: no fault)
-  double t = -1;                 ///< [s]
-  std::uint32_t faults = 0;      ///< the fault bits of that tick
-  double q[6] = {}, qd[6] = {};  ///< plant joint angles [rad] and speeds [rad/s]
-  double tau[6] = {};            ///< torque the amplifiers applied in the sample before [N m]
-  double e[6] = {};              ///< tracking error: mm, deg
-  double theta_hat[18] = {};     ///< the friction estimates
-};
-
-struct ExperimentResult {
-  std::string mode;
+/// A run: its name and set-up, then its metrics (metrics.hpp), in the order of its JSON and console
+/// lines. A new per-run metric is one more name in this list.
+struct ExperimentResult
+    : Metrics<FaultSnapshot, TrackingMaxima, ObserverMaxima, WindowMaxima, FrictionEstimates, FrictionRms,
+              StuckMonitorPeaks, FirmwareReport, InjectionTracking, RunCost, TimeSeries> {
+  std::string mode;  // "adaptive" or "none"
   std::string friction_preset;
-  double duration = 0;
-  double max_error[6] = {};                    // over the whole run: mm, mm, mm, deg, deg, deg
-  double final_max_error[6] = {};              // over the last final_window seconds
-  double max_observer_error[6] = {};           // |x~| over the last final_window seconds: mm, deg
-  double max_observer_velocity_error[6] = {};  // |x^dot - x dot| over the last final_window seconds: mm/s, deg/s
-  bool has_observer = false;                   // the observer's errors are known (in-process controller)
-  /// The statistics (errors, windows, theta^) cover the run up to the fault's tick only, when one
-  /// latched: after it the amplifiers are off and the robot falls, which is no result.
-  double stats_until = 0;  // [s]
-  double theta_hat[18] = {};
-  double theta_true[18] = {};
-  double final_window = 0;         // [s] of the "last" statistics
-  double theta_min_seen[18] = {};  // extremes of each theta^ over the run
-  double theta_max_seen[18] = {};
-  double window = 0;                                      // [s]
-  std::vector<std::array<double, 6>> window_max;          // max |e| per consecutive window: mm, deg
-  std::vector<std::array<double, 2>> window_theta_range;  // min and max of all theta^ per window
-  std::string adaptation;                                 // the adaptation law's name
-  double friction_rms_error = 0;                          // rms of tau_f_hat - tau_f over the last window [N m]
-  double friction_rms = 0;                                // rms of tau_f over the last window [N m]
-  double stuck_peak[6] = {};
-  double stuck_dtau_peak[6] = {};         // the stuck-encoder monitor's largest torque change [N m] (in process)
-  double stuck_dtau_silent_peak[6] = {};  // ... while the encoder was also silent (kStuckTorqueSilent) [N m]
-  std::uint32_t status = 0;               // first fault bits reported (0: none)
-  double fault_time = -1;                 // [s] of the first fault (-1: none)
-  FaultState fault;                       // where and how the first fault latched
-  InjectionResult injection;              // when cfg.injection.enabled
-  std::string error;                      // link error (PIL), empty when the run completed
-  std::uint32_t max_step_cycles = 0, mean_step_cycles = 0, max_tick_cycles = 0,
-                stack_used = 0;  // firmware telemetry (PIL)
-  LinkReport link;               // PIL only
-  double wall_seconds = 0;
-  double cpu_seconds = 0;      // CPU time of the thread that ran it (wall time counts other jobs too)
-  long plant_evaluations = 0;  // articulated-body evaluations of the plant over the run
-  std::vector<LogRow> log;
+  double duration = 0;     // [s]
+  std::string adaptation;  // the adaptation law's name
 };
 
 /// A run's mode as the outputs name it: "adaptive" or "none".

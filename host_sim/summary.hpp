@@ -32,8 +32,12 @@ struct Provenance {
   }
 };
 
-/// One run as JSON: its statistics, fault (name, tick, time, state), injection and link reports.
+/// One run as JSON: its name and set-up, then each metric's keys (metrics.hpp), in the list's order.
 json json_run(const ExperimentResult& r, bool csv);
+
+/// The metrics' console lines (observer, windows, firmware, injection, cost), metric by metric, a
+/// line per run.
+void print_metric_lines(const std::vector<ExperimentResult>& runs);
 
 /// The summary: provenance, the effective configuration, the paper's tables, and every run once.
 json summary_json(const std::vector<ExperimentResult>& runs, const Settings& cfg, const Provenance& prov, bool csv);

@@ -69,32 +69,78 @@ auto gain_cast(const Field& v) {
 }
 }  // namespace detail
 
-// X(type, name, paper value, meaning): the controller's parameters, each declared once; the struct,
-// Gains::paper() and Gains::cast() are made from this list.
-#define OSC_GAINS_FIELDS(X)                                                                         \
-  X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz")              \
-  X(Vec6<S>, k, params::kK, "observer gain k of (69)")                                              \
-  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)")                                        \
-  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)")                                        \
-  X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad")                          \
-  X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay of model (2), per joint")   \
-  X(S, dt, params::kDt, "the sample time [s]")                                                      \
-  X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition")      \
-  X(AdaptationLaw, adaptation, AdaptationLaw::kRobust, "the friction adaptation law")               \
-  X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)") \
-  X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law [1/s]")                \
-  X(TrajectorySpec<S>, trajectory, TrajectorySpec<S>::paper(), "the task (68)")
+/// Whether and how a parameter is set from outside the firmware (GainParam).
+enum class GainForm : std::uint8_t {
+  kNone,     ///< not from outside: a build constant, or set through keys of its own (the law, the task)
+  kPerAxis,  ///< a list of six numbers, one per axis or joint
+  kOne,      ///< one number
+  kEvery,    ///< one number, given to every element of the vector
+};
+
+/// A parameter's facts for the tables that set it (the host experiment's controller.<key> entries,
+/// later the runtime parameter tables): its key, form, accepted range (of each element) and unit.
+struct GainParam {
+  const char* key;
+  GainForm form;
+  double lo, hi;
+  const char* unit;  ///< "" where it has none (the gains of (69))
+};
+namespace gain_param {
+constexpr GainParam per_axis(const char* key, double lo, double hi, const char* unit = "") {
+  return {key, GainForm::kPerAxis, lo, hi, unit};
+}
+constexpr GainParam one(const char* key, double lo, double hi, const char* unit = "") {
+  return {key, GainForm::kOne, lo, hi, unit};
+}
+constexpr GainParam every(const char* key, double lo, double hi, const char* unit = "") {
+  return {key, GainForm::kEvery, lo, hi, unit};
+}
+constexpr GainParam none() { return {"", GainForm::kNone, 0, 0, ""}; }
+}  // namespace gain_param
+
+// X(type, name, paper value, meaning, parameter): the controller's parameters, each declared once;
+// the struct, Gains::paper(), Gains::cast() and kGainInfo are made from this list, and the host
+// experiment's controller.<key> entries (host_sim/config.cpp) from its parameter column.
+#define OSC_GAINS_FIELDS(X)                                                                                        \
+  X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz",                             \
+    gain_param::per_axis("knd", 1e-3, 1e5))                                                                        \
+  X(Vec6<S>, k, params::kK, "observer gain k of (69)", gain_param::per_axis("k", 1e-3, 1e5))                       \
+  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)", gain_param::per_axis("ks", 1e-3, 1e5))                \
+  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)", gain_param::per_axis("ki", 1e-3, 1e6))                \
+  X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad", gain_param::one("k_ad", 0, 1e5))        \
+  X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay tau_dec of model (2), every joint",        \
+    gain_param::every("tau_dec", 0.01, 100, "s^2/rad^2"))                                                          \
+  X(S, dt, params::kDt, "the sample time [s]", gain_param::none())                                                 \
+  X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition", gain_param::none()) \
+  X(AdaptationLaw, adaptation, AdaptationLaw::kRobust, "the friction adaptation law", gain_param::none())          \
+  X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)",                \
+    gain_param::none())                                                                                            \
+  X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law",                                     \
+    gain_param::one("leakage", 0, 1, "1/s"))                                                                       \
+  X(TrajectorySpec<S>, trajectory, TrajectorySpec<S>::paper(), "the task (68)", gain_param::none())
+
+/// Each parameter's name, meaning and parameter facts, in the list's order.
+struct GainInfo {
+  const char* name;
+  const char* doc;
+  GainParam param;
+};
+inline constexpr GainInfo kGainInfo[] = {
+#define OSC_GAINS_INFO(type, name, paper, doc, param) {#name, doc, param},
+    OSC_GAINS_FIELDS(OSC_GAINS_INFO)
+#undef OSC_GAINS_INFO
+};
 
 template <class S>
 struct Gains {
-#define OSC_GAINS_MEMBER(type, name, paper, doc) type name;
+#define OSC_GAINS_MEMBER(type, name, paper, doc, param) type name;
   OSC_GAINS_FIELDS(OSC_GAINS_MEMBER)
 #undef OSC_GAINS_MEMBER
 
   /// The paper's set-up (params.hpp) and the firmware's default law.
   static Gains paper() {
     Gains g;
-#define OSC_GAINS_PAPER(type, name, paper, doc) g.name = detail::gain_value<type>(paper);
+#define OSC_GAINS_PAPER(type, name, paper, doc, param) g.name = detail::gain_value<type>(paper);
     OSC_GAINS_FIELDS(OSC_GAINS_PAPER)
 #undef OSC_GAINS_PAPER
     return g;
@@ -104,7 +150,7 @@ struct Gains {
   template <class T>
   Gains<T> cast() const {
     Gains<T> g;
-#define OSC_GAINS_CAST(type, name, paper, doc) g.name = detail::gain_cast<T>(name);
+#define OSC_GAINS_CAST(type, name, paper, doc, param) g.name = detail::gain_cast<T>(name);
     OSC_GAINS_FIELDS(OSC_GAINS_CAST)
 #undef OSC_GAINS_CAST
     return g;
