@@ -114,23 +114,39 @@ VelocityChange<S> velocity_change(S v, S a, S vt, S amax, S j) {
   const S sign = vt >= coast_velocity(v, a, j) ? S(1) : S(-1);
   const S dv = sign * (vt - v), b = sign * a, half_b2 = lit<S>(0.5) * b * b;
   const S ap2 = j * dv + half_b2;
-  S ap = ap2 > zero ? math::sqrt(ap2) : zero, t2 = zero;
-  if (ap > amax) {
-    ap = amax;
-    t2 = (dv - (amax * amax - half_b2) / j) / amax;
-    if (t2 < zero) t2 = zero;
-  }
+  const S ap = ap2 > amax * amax ? amax : (ap2 > zero ? math::sqrt(ap2) : zero);
   const S t1 = ap > b ? (ap - b) / j : zero;  // rounding may leave ap a hair below b
-  return {sign, t1, t2, ap / j};
+  const S t3 = ap / j;
+  if (!(ap2 > amax * amax)) return {sign, t1, zero, t3};
+  // The hold: what the two ramps of the rounded durations leave of dv (in exact arithmetic
+  // (ap^2 - b^2)/(2j) and ap^2/(2j)), the hold and the ramp down at exactly amax (hold_acceleration).
+  // So the velocity reached is right to the rounding of the hold (in fixed point the ramps'
+  // durations round to 2^-19 s, which at 100 m/s^3 would otherwise leave a cruise 1e-5 m/s off).
+  const S half = lit<S>(0.5);
+  const S t2 = (dv - t1 * (b + j * t1 * half) - t3 * (amax - j * t3 * half)) / amax;
+  return {sign, t1, t2 > zero ? t2 : zero, t3};
 }
 
-/// A profile under construction: (jerk, duration) pieces, at most pre-phase 2 + 7.
+/// The acceleration of a zero-jerk segment: in exact arithmetic one of -amax (a hold), 0 (a cruise)
+/// and +amax, so the nearest of them. The ramps before it end there only to the rounding of their
+/// durations (in fixed point 2^-19 s, at 100 m/s^3 an acceleration 1e-4 m/s^2 off, which over a 1 s
+/// cruise would become 5e-5 m); the jump this leaves in a is that rounding.
+template <class S>
+S hold_acceleration(S a, S amax) {
+  const S half = lit<S>(0.5) * amax;
+  return a > half ? amax : (a < -half ? -amax : S(0));
+}
+
+/// A profile under construction: (jerk, duration) pieces, at most pre-phase 2 + 7; amax, the
+/// acceleration of its holds.
 template <class S>
 struct Pieces {
   static constexpr int kCapacity = 9;
+  S amax;
   S jerk[kCapacity];
   S t[kCapacity];
   int n = 0;
+  explicit Pieces(S amax_) : amax(amax_) {}
   void add(S jerk_, S t_) {
     jerk[n] = jerk_;
     t[n] = t_;
@@ -142,7 +158,10 @@ struct Pieces {
     add(-(c.sign * j), c.t3);
   }
   Kin<S> end(Kin<S> s) const {
-    for (int i = 0; i < n; ++i) s = advance(s, jerk[i], t[i]);
+    for (int i = 0; i < n; ++i) {
+      if (jerk[i] == S(0) && t[i] > S(0)) s.a = hold_acceleration(s.a, amax);
+      s = advance(s, jerk[i], t[i]);
+    }
     return s;
   }
   S duration() const {
@@ -185,14 +204,14 @@ Pieces<S> main_profile(S u, S b, S x_target, S vlim, S amax, S j, bool at_limit)
   const S zero(0);
   const Kin<S> s0{zero, u, b};
   auto f2 = [&](S vp, S tc) {
-    Pieces<S> f;
+    Pieces<S> f(amax);
     f.add(at_limit ? VelocityChange<S>{S(1), -b / j, zero, zero} : velocity_change(u, b, vp, amax, j), j);
     f.add(zero, tc);
     f.add(velocity_change(vp, zero, zero, amax, j), j);
     return f;
   };
   auto f1 = [&](S t1) {
-    Pieces<S> f;
+    Pieces<S> f(amax);
     f.add(j, t1);
     const Kin<S> s1 = advance(s0, j, t1);
     f.add(velocity_change(s1.v, s1.a, zero, amax, j), j);
@@ -214,7 +233,7 @@ Pieces<S> main_profile(S u, S b, S x_target, S vlim, S amax, S j, bool at_limit)
 template <class S>
 Pieces<S> plan_pieces(const Kin<S>& start, S target, S vlim, S amax, S j) {
   const S zero(0);
-  Pieces<S> out;
+  Pieces<S> out(amax);
   Kin<S> s = start;
   // The pre-phase: if a0 carries the velocity past vlim, ramp towards -sign(a) amax until the
   // coast velocity is +-vlim (the first two segments of velocity_change to (+-vlim, 0)).
@@ -228,7 +247,7 @@ Pieces<S> plan_pieces(const Kin<S>& start, S target, S vlim, S amax, S j) {
     if (c.t2 > zero) s.a = c.sign * amax;  // exactly at the limit, so that the hold continues unbroken
   }
   // The direction: towards the target from the hardest stop's end.
-  Pieces<S> stop;
+  Pieces<S> stop(amax);
   stop.add(velocity_change(s.v, s.a, zero, amax, j), j);
   const S d = target >= stop.end(s).p ? S(1) : S(-1);
   const Pieces<S> m = main_profile(d * s.v, d * s.a, d * (target - s.p), vlim, amax, j, pre && d * vc > zero);
@@ -278,6 +297,7 @@ class JerkProfile {
       const S k3 = k * k * k;
       Pieces<S> scaled = fastest;
       for (int i = 0; i < scaled.n; ++i) scaled.t[i] = scaled.t[i] * k, scaled.jerk[i] = scaled.jerk[i] / k3;
+      scaled.amax = scaled.amax / (k * k);
       assemble(start, target, scaled);
       return ProfileStatus::kOk;
     }
@@ -334,6 +354,7 @@ class JerkProfile {
         if (n_ > 0)
           s = jerk_profile::advance<S>({seg_[n_ - 1].p, seg_[n_ - 1].v, seg_[n_ - 1].a}, seg_[n_ - 1].jerk,
                                        seg_[n_ - 1].duration);
+        if (pieces.jerk[i] == S(0)) s.a = jerk_profile::hold_acceleration(s.a, pieces.amax);
         seg_[n_++] = {t, pieces.t[i], pieces.jerk[i], s.p, s.v, s.a};
       }
       t += pieces.t[i];
