@@ -7,6 +7,7 @@
 #include <climits>
 #include <cstdint>
 #include <type_traits>
+#include <utility>
 
 namespace osc::fixed {
 
