@@ -12,6 +12,7 @@
 
 #include "kdl_puma.hpp"
 #include "osc/control/controller.hpp"
+#include "osc/control/jerk_profile.hpp"
 #include "plant.hpp"
 
 using namespace osc;
@@ -118,6 +119,29 @@ void BM_control_step(benchmark::State& st) {
   }
 }
 
+/// The jerk-limited profile: plan() from a moving start (the general case: a bisection on the peak velocity) and at()
+/// at every 1 ms of the move, as the tick calls it.
+template <class S>
+void BM_jerk_profile_plan(benchmark::State& st) {
+  JerkProfile<S> pr;
+  const JerkLimits<S> lim{S(1), S(5), S(50)};
+  int k = 0;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(pr.plan(S(0.2), S(0.8), S(2), S(0.38 + 1e-4 * (k++ % 100)), lim));
+    benchmark::ClobberMemory();
+  }
+}
+template <class S>
+void BM_jerk_profile_at(benchmark::State& st) {
+  JerkProfile<S> pr;
+  pr.plan(S(0.2), S(0.8), S(2), S(0.9), JerkLimits<S>{S(1), S(5), S(50)});
+  int k = 0;
+  for (auto _ : st) {
+    benchmark::DoNotOptimize(pr.at(math::ratio<S>(static_cast<std::uint64_t>(k), 1000)));
+    k = k == 860 ? 0 : k + 1;
+  }
+}
+
 #define OSC_BENCH(name)             \
   BENCHMARK_TEMPLATE(name, double); \
   BENCHMARK_TEMPLATE(name, float);  \
@@ -133,6 +157,10 @@ OSC_BENCH(BM_operational_inertia);
 OSC_BENCH(BM_opspace_update);
 OSC_BENCH(BM_psi_quadratic);
 OSC_BENCH(BM_control_step);
+BENCHMARK_TEMPLATE(BM_jerk_profile_plan, double);
+BENCHMARK_TEMPLATE(BM_jerk_profile_plan, float);
+BENCHMARK_TEMPLATE(BM_jerk_profile_at, double);
+BENCHMARK_TEMPLATE(BM_jerk_profile_at, float);
 
 void BM_plant_forward_dynamics(benchmark::State& st) {
   sim::ArticulatedBody body;

@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "board.hpp"
+#include "osc/control/jerk_profile.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
@@ -240,6 +241,29 @@ void control_step_kernels(const Vec6<F>& q0) {
   check("control_step holds gravity at rest", d((g_state.obs.x_hat - g_os.x).norm()) < 1.0 ? 1.0 : 0.0, 1.0, 0.0);
 }
 
+/// The jerk-limited profile: plan() from a moving start (a bisection on the peak velocity) and the
+/// worst at() over the move at 1 ms, as the tick calls it; the end reached.
+JerkProfile<F> g_profile;
+void jerk_profile_kernels() {
+  const JerkLimits<F> lim{lit<F>(1), lit<F>(5), lit<F>(50)};
+  {
+    Timer t("JerkProfile::plan (moving start, bisection)");
+    keep(g_profile.plan(lit<F>(0.2), lit<F>(0.8), lit<F>(2), lit<F>(0.38), lim));
+  }
+  std::uint32_t worst = 0;
+  MotionState<F> s{};
+  for (std::uint64_t k = 0; k < 700; ++k) {
+    const F t = math::ratio<F>(k, 1000);
+    const std::uint32_t t0 = board::cycles();
+    s = g_profile.at(t);
+    keep(s);
+    const std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst) worst = dt;
+  }
+  cortex_m::text::Line().str("  JerkProfile::at, worst of 700: ").u32(worst).str(" instructions").emit();
+  check("profile ends at the target", d(s.p), 0.38, 1e-4);
+}
+
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear.
 void fixed_reference_check() {
   if constexpr (kFixed) {
@@ -301,6 +325,7 @@ int main() {
   operational_inertia_kernels(q0, qn);
   operational_force_kernels(qd, fr);
   control_step_kernels(q0);
+  jerk_profile_kernels();
   fixed_reference_check();
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();

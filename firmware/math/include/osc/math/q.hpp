@@ -6,6 +6,7 @@
 
 #include <bit>
 #include <climits>
+#include <compare>
 #include <concepts>
 #include <cstdint>
 #include <type_traits>
