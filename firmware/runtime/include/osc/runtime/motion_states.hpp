@@ -1,0 +1,280 @@
+// The motion state machine (issue 23): a pure function from (machine, one tick's command and events)
+// to the next machine and what the tick must do: accept or refuse the command with a named reason,
+// the stop category in effect, torque on or off, capture the pose to hold, report an aborted or a
+// completed motion. Not yet wired into the tick.
+//
+// How it combines with the Supervisor (osc/runtime/supervisor.hpp, unchanged): the supervisor stays
+// the category-0 latch below this machine. A tick's fault bits go to both, and both are in fault in
+// that tick; torque reaches the DACs only when both allow it (torque_enabled(sup) && step.torque).
+// The runtime passes an enable only once the supervisor runs (kRun: a measured pose exists to hold).
+// supervisor_next never leaves kFault, so a clear that this machine accepts (causes gone) is the one
+// event on which the runtime re-initialises the supervisor ({kInit, 0}, with the task's init at the
+// measured pose); the next enable starts the observer there (MotionStep::enabling).
+//
+// Stop categories (IEC 60204-1): a fault is category 0 (zero torque, amplifiers off, at once); a stop
+// command, a stale stream or a reached limit is category 2 (decelerate along the path within the
+// limits, then hold with power on). A disable while moving is the same deceleration, then the torque
+// off at rest: category 1 in the standard's terms, reported tick by tick as category 2 while it
+// decelerates. Disabling cuts the torque of every joint: the brakes (joints 1 to 3 of a PUMA) and a
+// supported wrist are the integration's concern.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
+
+namespace osc {
+
+// X(Name, "name", meaning), in code order (each list below is declared once, by OSC_MOTION_ENUM).
+#define OSC_MOTION_STATE_LIST(X)                                                               \
+  X(Disabled, "disabled", "no torque, no fault: an enable holds the measured pose")            \
+  X(Holding, "holding", "torque on, holding the pose captured on entry, the observer running") \
+  X(Moving, "moving", "following the motion generator (move_to, stream, paper, queued moves)") \
+  X(Stopping, "stopping", "category-2 stop: decelerating along the path to rest, torque on")   \
+  X(Fault, "fault", "category-0 stop: zero torque, amplifiers off; sticky until a clear")
+
+#define OSC_MOTION_COMMAND_LIST(X)                                                      \
+  X(None, "none", "no command this tick (a code outside this list counts as none)")     \
+  X(Enable, "enable", "torque on, holding the measured pose (observer started there)")  \
+  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")   \
+  X(Move, "move", "any motion: move_to, stream, the paper's trajectory, a queued move") \
+  X(Stop, "stop", "category-2 stop of the motion, then hold")                           \
+  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")
+
+/// Why a command was refused or a running motion aborted. The geometric ones are decided by the
+/// motion generator, which refuses with them after this machine accepted; motion_next() decides the
+/// rest.
+#define OSC_MOTION_REASON_LIST(X)                                                                          \
+  X(None, "none", "not refused, not aborted")                                                              \
+  X(OutOfWorkspace, "out_of_workspace", "the target is outside the workspace (motion generator)")          \
+  X(NearSingular, "near_singular", "the path passes too near a singular pose (motion generator)")          \
+  X(OverLimit, "over_limit", "a joint, speed or acceleration limit would be exceeded (motion generator)")  \
+  X(QueueFull, "queue_full", "no room in the motion queue (motion generator)")                             \
+  X(NotEnabled, "not_enabled", "a move or a stop while disabled: enable first")                            \
+  X(Faulted, "faulted", "in fault, or a fault aborted the motion; the cause is in MotionStep::cause")      \
+  X(Stopping, "stopping", "a move during a category-2 stop: sent again once at rest (completion stopped)") \
+  X(StopCommand, "stop_command", "a stop command aborted the motion")                                      \
+  X(DisableCommand, "disable_command", "a disable command aborted the motion (stop, then disabled)")       \
+  X(StaleStream, "stale_stream", "the runtime stopped the motion: its stream of setpoints went stale")     \
+  X(LimitReached, "limit_reached", "the runtime stopped the motion: a limit was reached")
+
+#define OSC_COMMAND_OUTCOME_LIST(X)                   \
+  X(None, "none", "no command this tick")             \
+  X(Accepted, "accepted", "the command was accepted") \
+  X(Refused, "refused", "the command was refused, for the reason named")
+
+#define OSC_STOP_CATEGORY_LIST(X)                                                              \
+  X(None, "none", "no stop in effect")                                                         \
+  X(Category0, "category_0", "uncontrolled stop: zero torque and amplifiers off in this tick") \
+  X(Category2, "category_2", "controlled stop: decelerate along the path within the limits, then hold")
+
+#define OSC_MOTION_COMPLETION_LIST(X)                                                              \
+  X(None, "none", "nothing completed this tick")                                                   \
+  X(Finished, "finished", "the motion finished: the generator's queue ran empty at rest; holding") \
+  X(Stopped, "stopped", "a category-2 stop reached rest; holding, or disabled after a disable")
+
+/// The names, meanings and count of an enumeration declared by OSC_MOTION_ENUM, in code order.
+template <class E>
+struct MotionNames;
+
+// enum class Type { kName, ... } from an X-macro list, and MotionNames<Type>.
+#define OSC_X_PREFIX k
+#define OSC_MOTION_ENUM(Type, LIST)                                 \
+  enum class Type : std::uint8_t { LIST(OSC_X_ENUMERATOR) };        \
+  template <>                                                       \
+  struct MotionNames<Type> {                                        \
+    static constexpr const char* kNames[] = {LIST(OSC_X_NAME)};     \
+    static constexpr const char* kDocs[] = {LIST(OSC_X_DOC)};       \
+    static constexpr int kCount = sizeof(kNames) / sizeof(*kNames); \
+  }
+OSC_MOTION_ENUM(MotionState, OSC_MOTION_STATE_LIST);
+OSC_MOTION_ENUM(MotionCommand, OSC_MOTION_COMMAND_LIST);
+OSC_MOTION_ENUM(MotionReason, OSC_MOTION_REASON_LIST);
+OSC_MOTION_ENUM(CommandOutcome, OSC_COMMAND_OUTCOME_LIST);
+OSC_MOTION_ENUM(StopCategory, OSC_STOP_CATEGORY_LIST);
+OSC_MOTION_ENUM(MotionCompletion, OSC_MOTION_COMPLETION_LIST);
+#undef OSC_MOTION_ENUM
+#undef OSC_X_PREFIX
+
+// A list that grows fails here: motion_next() and its table must say what the new entry does.
+static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kFault) + 1);
+static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kClear) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kLimitReached) + 1);
+static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
+static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
+static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kStopped) + 1);
+
+/// The name of a code of one of these enumerations ("?" for a code outside its list).
+template <class E>
+constexpr const char* motion_name(E e) {
+  const auto i = static_cast<unsigned>(e);
+  return i < MotionNames<E>::kCount ? MotionNames<E>::kNames[i] : "?";
+}
+
+struct MotionMachine {
+  MotionState state = MotionState::kDisabled;
+  std::uint32_t latched = 0;     ///< fault bits since the last accepted clear (nonzero only in kFault)
+  bool disable_at_rest = false;  ///< kStopping only: the stop ends in kDisabled, not kHolding
+};
+
+/// One tick's command and events.
+struct MotionInput {
+  MotionCommand command = MotionCommand::kNone;
+  std::uint32_t faults = 0;  ///< fault bits detected in this tick (category 0), in the catalogue or not
+  std::uint32_t causes = 0;  ///< fault conditions still present (e.g. the E-stop held): a clear needs none
+  /// The runtime's category-2 stop of a motion (kStaleStream, kLimitReached); kNone: no request.
+  MotionReason stop_request = MotionReason::kNone;
+  bool motion_finished = false;  ///< the generator's queue ran empty at rest
+  bool stopped = false;          ///< the category-2 deceleration reached rest
+};
+
+/// The next machine and what the tick does.
+struct MotionStep {
+  MotionMachine machine;
+  CommandOutcome outcome = CommandOutcome::kNone;  ///< of this tick's command
+  MotionReason refusal = MotionReason::kNone;      ///< why it was refused (kNone unless refused)
+  /// With a refusal `faulted`: the bits behind it (a clear's: those present now; else the latched).
+  std::uint32_t cause = 0;
+  MotionReason abort = MotionReason::kNone;  ///< a running motion was aborted in this tick, and why
+  MotionCompletion completion = MotionCompletion::kNone;
+  StopCategory stop = StopCategory::kNone;  ///< the stop in effect after this tick
+  bool torque = false;                      ///< torque on in this tick's output (off in a fault's tick)
+  bool capture_pose = false;                ///< entered kHolding: hold the measured pose from now on
+  bool enabling = false;                    ///< enabled: start the observer at the measured pose, ramp torque in
+};
+
+namespace detail {
+
+constexpr bool motion_state_known(MotionState s) { return static_cast<int>(s) < MotionNames<MotionState>::kCount; }
+
+/// A machine in fault (or faulting now, or unreadable): only a clear with no cause present leaves it.
+constexpr MotionStep motion_fault_tick(const MotionMachine& m, const MotionInput& in, MotionCommand c) {
+  MotionStep r{};
+  if (m.state == MotionState::kMoving) r.abort = MotionReason::kFaulted;
+  const std::uint32_t present = in.faults | in.causes;
+  if (c == MotionCommand::kClear && present == 0) {
+    r.machine = {MotionState::kDisabled, 0, false};
+    r.outcome = CommandOutcome::kAccepted;
+    return r;
+  }
+  r.machine = {MotionState::kFault, m.latched | in.faults, false};
+  r.stop = StopCategory::kCategory0;
+  if (c == MotionCommand::kNone) return r;
+  r.outcome = CommandOutcome::kRefused;
+  r.refusal = MotionReason::kFaulted;
+  r.cause = c == MotionCommand::kClear ? present : r.machine.latched;
+  return r;
+}
+
+/// The events of the tick, in order: the generator's reports (finished, stopped), then the
+/// runtime's stop request. A state they do not name ignores them.
+constexpr MotionStep motion_events(const MotionMachine& m, const MotionInput& in) {
+  MotionStep r{};
+  r.machine = {m.state, 0, m.state == MotionState::kStopping && m.disable_at_rest};
+  if (m.state == MotionState::kMoving && in.motion_finished) {
+    r.machine.state = MotionState::kHolding;
+    r.completion = MotionCompletion::kFinished;
+  } else if (m.state == MotionState::kMoving && in.stop_request != MotionReason::kNone) {
+    r.machine.state = MotionState::kStopping;
+    r.abort = in.stop_request;
+  } else if (m.state == MotionState::kStopping && in.stopped) {
+    r.machine = {m.disable_at_rest ? MotionState::kDisabled : MotionState::kHolding, 0, false};
+    r.completion = MotionCompletion::kStopped;
+  }
+  return r;
+}
+
+constexpr void motion_refuse(MotionStep& r, MotionReason why) {
+  r.outcome = CommandOutcome::kRefused;
+  r.refusal = why;
+}
+
+/// Starts a category-2 stop of a motion in progress (the first abort of a tick names it).
+constexpr void motion_stop(MotionStep& r, MotionReason why) {
+  r.machine.state = MotionState::kStopping;
+  if (r.abort == MotionReason::kNone) r.abort = why;
+}
+
+/// The command, on the state the events left (the table of motion_next()).
+constexpr void motion_command(MotionStep& r, MotionCommand c) {
+  MotionMachine& m = r.machine;
+  r.outcome = c == MotionCommand::kNone ? CommandOutcome::kNone : CommandOutcome::kAccepted;
+  const bool disabled = m.state == MotionState::kDisabled;
+  switch (c) {
+    case MotionCommand::kEnable:
+      r.enabling = disabled;
+      if (disabled) m.state = MotionState::kHolding;
+      m.disable_at_rest = false;
+      return;
+    case MotionCommand::kDisable:
+      if (m.state == MotionState::kHolding) m.state = MotionState::kDisabled;
+      if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kDisableCommand);
+      m.disable_at_rest = m.state == MotionState::kStopping;
+      return;
+    case MotionCommand::kMove:
+      if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
+      if (m.state == MotionState::kStopping) return motion_refuse(r, MotionReason::kStopping);
+      m.state = MotionState::kMoving;
+      return;
+    case MotionCommand::kStop:
+      if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
+      if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kStopCommand);
+      return;
+    case MotionCommand::kNone:
+    case MotionCommand::kClear:
+      return;
+  }
+}
+
+}  // namespace detail
+
+/// Transition table. One tick: the fault rows first; otherwise the events, then the command on the
+/// state they left.
+///   any state, faults != 0, or latched != 0, or a state code outside the list:
+///                                -> fault, latched |= faults (a bit outside the catalogue too);
+///                                   category 0, torque off in this tick; a motion in progress is
+///                                   aborted: faulted; a command is refused: faulted (cause: latched)
+///   fault, clear, faults | causes == 0   -> disabled, latched cleared, accepted
+///   fault, clear, a cause present        -> fault, refused: faulted (cause: faults | causes)
+///   events (states not named ignore them):
+///   moving, motion finished              -> holding, completion finished, pose captured
+///   moving, stop requested (reason r)    -> stopping, category 2, motion aborted: r
+///   stopping, stopped                    -> holding (pose captured), or disabled if a disable is
+///                                           pending; completion stopped
+///   commands (= : stays, accepted; a command code outside the list is none):
+///              enable            disable                  move                 stop
+///   disabled   holding, enabling =                        refused not_enabled  refused not_enabled
+///   holding    =                 disabled                 moving               =
+///   moving     =                 stopping, pending [1]    = (re-target/queue)  stopping [2]
+///   stopping   =, not pending    =, pending               refused stopping     =
+///   clear: = in every state but fault.
+///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
+/// Torque is on in holding, moving, stopping; the stop in effect is category 0 in fault, 2 in
+/// stopping. The pose is captured whenever holding is entered (enable, finished, stopped).
+/// Decisions: a command whose end state already holds is accepted and does nothing (enable when
+/// enabled, disable when disabled, stop when holding or stopping, clear outside fault): repeating
+/// one is harmless. A move or a stop while disabled is refused (not_enabled): nothing holds the arm,
+/// and the client must know. A move while stopping is refused (stopping): the stop must reach rest first, or a
+/// stale stream's or a reached limit's stop would be overridden by the next setpoint, and the move
+/// would be planned from a state still decelerating; it is sent again after the completion
+/// `stopped`. An enable while stopping to disable cancels the disable (the last command wins; the
+/// stop still ends at rest, holding). In fault, every command but clear is refused (faulted): the
+/// client learns that the arm is in a category-0 stop, and a disable is no way around a clear.
+/// A motion is aborted once, with the reason of the tick that ended it: a fault during a stop
+/// aborts nothing more (the stop's completion never comes; the fault is the report), and a stop
+/// request in the tick a motion finished at rest is ignored (holding, nothing to stop).
+constexpr MotionStep motion_next(const MotionMachine& m, const MotionInput& in) {
+  const bool known_command = static_cast<int>(in.command) < MotionNames<MotionCommand>::kCount;
+  const MotionCommand c = known_command ? in.command : MotionCommand::kNone;
+  if (in.faults != 0 || m.latched != 0 || m.state == MotionState::kFault || !detail::motion_state_known(m.state))
+    return detail::motion_fault_tick(m, in, c);
+  MotionStep r = detail::motion_events(m, in);
+  detail::motion_command(r, c);
+  const MotionState s = r.machine.state;
+  r.stop = s == MotionState::kStopping ? StopCategory::kCategory2 : StopCategory::kNone;
+  r.torque = s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping;
+  r.capture_pose = s == MotionState::kHolding && m.state != MotionState::kHolding;
+  return r;
+}
+
+}  // namespace osc
