@@ -109,12 +109,14 @@ void BM_control_step(benchmark::State& st) {
   const Gains<S> g = Gains<S>::paper();
   auto cs = std::make_unique<ControllerState<S>>();
   controller_init(f.model, *cs, f.q);
+  const PaperMotion<S> paper{g.trajectory, cs->data.o[kDof]};
   Vec6<S> q = f.q;
   int k = 0;
   for (auto _ : st) {
     q(1) = f.q(1) + static_cast<S>(1e-6 * (k % 100));
+    // The paper's motion and the step: what the tick computes.
     benchmark::DoNotOptimize(
-        control_step(f.model, g, FrictionMode::kAdaptive, *cs, q, static_cast<S>(1e-3 * (k % 1000))));
+        control_step(f.model, g, FrictionMode::kAdaptive, *cs, q, paper.at_time(static_cast<S>(1e-3 * (k % 1000)))));
     ++k;
   }
 }

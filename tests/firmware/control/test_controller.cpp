@@ -63,13 +63,14 @@ TEST(Adaptation, SampledLawMatchesEquation67) {
   auto st = std::make_unique<ControllerState<double>>();
   const Vec6<double> q0 = q_start();
   controller_init(model, *st, q0);
+  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
   st->obs.y << 0.01, -0.02, 0.015, 0.01, -0.01, 0.02;  // a non-zero observed velocity
-  control_step(model, G, FrictionMode::kAdaptive, *st, q0, 0.0);
+  control_step(model, G, FrictionMode::kAdaptive, *st, q0, paper.at_time(0.0));
   const Vec6<double> qdh = st->adapt.qd_hat_prev;
   ASSERT_GT(qdh.cwiseAbs().minCoeff(), 0.0);
   Vec6<double> q1 = q0;
   q1 << q0(0) + 2e-5, q0(1) - 1e-5, q0(2) + 3e-5, q0(3), q0(4) + 1e-5, q0(5) - 2e-5;
-  control_step(model, G, FrictionMode::kAdaptive, *st, q1, 1e-3);
+  control_step(model, G, FrictionMode::kAdaptive, *st, q1, paper.at_time(1e-3));
   Vec18<double> expect;
   for (int i = 0; i < kDof; ++i) {
     const double Dq = q1(i) - q0(i) - qdh(i) * 1e-3;
@@ -87,9 +88,10 @@ TEST(Adaptation, NoCompensationModeNeverAdapts) {
   auto st = std::make_unique<ControllerState<double>>();
   Vec6<double> q = q_start();
   controller_init(model, *st, q);
+  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
   for (int k = 0; k < 50; ++k) {
     q(0) += 1e-5;
-    const StepOutput<double> out = control_step(model, G, FrictionMode::kNone, *st, q, k * 1e-3);
+    const StepOutput<double> out = control_step(model, G, FrictionMode::kNone, *st, q, paper.at_time(k * 1e-3));
     ASSERT_EQ(out.status, kFaultNone);
     EXPECT_EQ(out.tau_f_hat.norm(), 0.0);
   }
@@ -142,22 +144,24 @@ TEST(ControlStep, FaultsCommandZeroTorque) {
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   controller_init(model, *st, q_start());
+  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
   Vec6<double> q = q_start();
   q(3) = std::numeric_limits<double>::quiet_NaN();
-  StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, 0.0);
+  StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, paper.at_time(0.0));
   EXPECT_EQ(out.status, kFaultNonFinite);
   EXPECT_EQ(out.tau.norm(), 0.0);
-  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), std::numeric_limits<double>::infinity());
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(),
+                     paper.at_time(std::numeric_limits<double>::infinity()));
   EXPECT_EQ(out.status, kFaultNonFinite);
   EXPECT_EQ(out.tau.norm(), 0.0);
   // Wrist singularity (q5 = 0).
   q = q_start();
   q(4) = 0.0;
-  out = control_step(model, G, FrictionMode::kAdaptive, *st, q, 0.0);
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q, paper.at_time(0.0));
   EXPECT_EQ(out.status, kFaultSingular);
   EXPECT_EQ(out.tau.norm(), 0.0);
   // A healthy step afterwards works and produces finite torques.
-  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), 0.0);
+  out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), paper.at_time(0.0));
   EXPECT_EQ(out.status, kFaultNone);
   EXPECT_TRUE(math::all_finite(out.tau));
 }
@@ -168,11 +172,53 @@ TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
   const Gains<double> G = Gains<double>::paper();
   auto st = std::make_unique<ControllerState<double>>();
   controller_init(model, *st, q_start());
-  const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), 0.0);
+  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
+  const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), paper.at_time(0.0));
   ASSERT_EQ(out.status, kFaultNone);
   Data<double> data;
   forward_kinematics(model, data, q_start());
   EXPECT_LT((out.tau - gravity_torques(model, data)).norm(), 1e-9);
+}
+
+// control_step tracks the desired state it is given, whatever its source: the tracking error is
+// d.x - x, and a non-finite d is the fault non_finite with zero torque.
+TEST(ControlStep, TracksTheDesiredStateItIsGiven) {
+  const Model<double> model = Model<double>::of(robot::kArm);
+  const Gains<double> G = Gains<double>::paper();
+  auto st = std::make_unique<ControllerState<double>>();
+  controller_init(model, *st, q_start());
+  Desired<double> d;
+  d.x << st->data.o[kDof] + Vec3<double>(0.004, -0.002, 0.001), 0.001, -0.002, 0.003;
+  d.xd << 0.01, 0.02, -0.01, 0, 0.01, 0;
+  d.xdd.setZero();
+  const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), d);
+  ASSERT_EQ(out.status, kFaultNone);
+  EXPECT_LT((out.e - (d.x - out.x)).norm(), 1e-15);
+  EXPECT_GT(out.e.norm(), 1e-3);
+  EXPECT_LT((out.qd_ref - st->os.Jf.solve(d.xd)).norm(), 1e-12);  // the joint rates the reference commands
+  for (int part = 0; part < 3; ++part) {
+    Desired<double> bad = d;
+    Vec6<double>& v = part == 0 ? bad.x : part == 1 ? bad.xd : bad.xdd;
+    v(part + 2) = std::numeric_limits<double>::quiet_NaN();
+    const StepOutput<double> o = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), bad);
+    EXPECT_EQ(o.status, kFaultNonFinite) << part;
+    EXPECT_EQ(o.tau.norm(), 0.0) << part;
+  }
+}
+
+// The paper's motion counts its time from the sample it started at, with the integer sample count
+// (trajectory_time), so that a motion started later is the same motion shifted.
+TEST(PaperMotion, StartsWhereItIsStartedAndCountsFromItsStartTick) {
+  const Vec3<double> p0(0.5, -0.1, 0.2);
+  const PaperMotion<double> now{kPaperTrajectory, p0, 0}, later{kPaperTrajectory, p0, 123456};
+  EXPECT_LT((now.at_tick(0, 1000).x.head<3>() - p0).norm(), 1e-15);  // the envelope starts at zero
+  for (std::uint64_t n : {0ull, 1ull, 2500ull, 30000ull, 1000000ull}) {
+    const Desired<double> a = now.at_tick(n, 1000), b = later.at_tick(123456 + n, 1000);
+    EXPECT_EQ(a.x, b.x) << n;
+    EXPECT_EQ(a.xd, b.xd) << n;
+    EXPECT_EQ(a.xdd, b.xdd) << n;
+    EXPECT_EQ(a.x, trajectory(kPaperTrajectory, p0, trajectory_time(kPaperTrajectory, n, 1000)).x) << n;
+  }
 }
 
 template <class S>
@@ -182,10 +228,11 @@ void run_steps_without_allocation() {
   auto st = std::make_unique<ControllerState<S>>();
   Vec6<S> q = q_start().cast<S>();
   controller_init(model, *st, q);
+  const PaperMotion<S> paper{G.trajectory, st->data.o[kDof]};
   test::NoMalloc guard;
   for (int k = 0; k < 20; ++k) {
     q(1) += lit<S>(1e-5);
-    const StepOutput<S> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, lit<S>(k * 1e-3));
+    const StepOutput<S> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, paper.at_time(lit<S>(k * 1e-3)));
     ASSERT_EQ(out.status, kFaultNone);
   }
 }

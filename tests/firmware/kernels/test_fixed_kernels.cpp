@@ -177,10 +177,9 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
 
 /// A controller state in double and the same state in fixed point.
 template <class S>
-void set_state(ControllerState<S>& st, const Vec3<double>& p0, const Mat3<double>& R_ref, const Vec6<double>& x_hat,
-               const Vec6<double>& y, const Vec18<double>& theta, const Vec6<double>& q_prev, const Vec6<double>& qd1,
+void set_state(ControllerState<S>& st, const Mat3<double>& R_ref, const Vec6<double>& x_hat, const Vec6<double>& y,
+               const Vec18<double>& theta, const Vec6<double>& q_prev, const Vec6<double>& qd1,
                const Vec6<double>& qd2) {
-  st.p0 = p0.cast<S>();
   st.R_ref = R_ref.cast<S>();
   st.obs.x_hat = x_hat.cast<S>();
   st.obs.y = y.cast<S>();
@@ -241,14 +240,15 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
     const Vec6<double> q_prev = quantised(Vec6<double>(q - rs.vec(1e-4)));
     const Vec6<double> qd1 = quantised(rs.vec(0.5)), qd2 = quantised(rs.vec(0.5));
     const Vec18<double> th = quantised(theta);
-    set_state(*sd, p0, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
-    set_state(*sf, p0, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
+    set_state(*sd, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
+    set_state(*sf, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
     StepOutput<double> od;
     StepOutput<Fixed> of;
     {
       test::NoMalloc guard;
-      od = control_step(md, gd, FrictionMode::kAdaptive, *sd, q, t);
-      of = control_step(mf, gf, FrictionMode::kAdaptive, *sf, q.cast<Fixed>(), Fixed(t));
+      od = control_step(md, gd, FrictionMode::kAdaptive, *sd, q, trajectory(gd.trajectory, p0, t));
+      of = control_step(mf, gf, FrictionMode::kAdaptive, *sf, q.cast<Fixed>(),
+                        trajectory(gf.trajectory, Vec3<Fixed>(p0.cast<Fixed>()), Fixed(t)));
     }
     if (od.status == kFaultSingular) {  // the controller refuses to act: nothing to compare
       ++outside;
@@ -304,8 +304,10 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
     for (int j = 0; j < kDof; ++j) {
       Vec6<double> qc = q;
       qc(j) += 1.0 / counts_per_rad(j);
-      set_state(*sd, p0, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
-      per_count = std::max(per_count, err(control_step(md, gd, FrictionMode::kAdaptive, *sd, qc, t).tau, od.tau));
+      set_state(*sd, R_ref, x_hat, yq, th, q_prev, qd1, qd2);
+      const StepOutput<double> oc =
+          control_step(md, gd, FrictionMode::kAdaptive, *sd, qc, trajectory(gd.trajectory, p0, t));
+      per_count = std::max(per_count, err(oc.tau, od.tau));
     }
     worst_vs_count = std::max(worst_vs_count, e / per_count);
     EXPECT_LE(e, kBudgetTauPerCount * per_count) << "state " << k;

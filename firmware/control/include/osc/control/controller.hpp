@@ -1,10 +1,11 @@
 // The adaptive observer-controller of the paper. One call of control_step() is one sample: encoder
-// angles q(t) in, joint torques out. It reads as the block diagram, one stage per call:
+// angles q(t) and the desired state d = (x_d, x_d dot, x_d ddot) in, joint torques out. d comes from
+// a motion source (motion.hpp; the paper's is trajectory (68)). It reads as the block diagram, one
+// stage per call:
 //   kinematics and dynamics at q           opspace_update          (4), (5)
 //   friction adaptation                    adaptation_step         (67) or robust   adaptation.hpp
 //   observer output                        observer_output         (21), (23), (28)  observer.hpp
 //   friction estimate                      friction_estimate       (30)
-//   desired trajectory                     trajectory              (68)      trajectory.hpp
 //   force command                          force_command           (31)-(36)
 //   joint torques                          joint_torques           (5)
 //   observer update                        observer_update         (22)      observer.hpp
@@ -20,14 +21,13 @@
 #include "osc/control/faults.hpp"
 #include "osc/control/gains.hpp"
 #include "osc/control/observer.hpp"
-#include "osc/control/trajectory.hpp"
+#include "osc/control/motion.hpp"
 #include "osc/kernels/opspace.hpp"
 
 namespace osc {
 
 template <class S>
 struct ControllerState {
-  Vec3<S> p0;                // start position (trajectory centre)
   Mat3<S> R_ref;             // start orientation: reference of the orientation coordinates
   ObserverState<S> obs;      // x^, y (21)-(22)
   AdaptationState<S> adapt;  // theta^ and the previous sample (67)
@@ -48,13 +48,13 @@ struct StepOutput {
   std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular / kFaultOverflow (then tau = 0)
 };
 
-/// Starts the observer at the measured pose: x^(0) = x(0), y(0) = -k x~(0) = 0; theta^(0) = 0.
+/// Starts the observer at the measured pose: x^(0) = x(0), y(0) = -k x~(0) = 0; theta^(0) = 0. The
+/// orientation coordinates are taken relative to the orientation at q0 (R_ref).
 template <class S>
 void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q0) {
   forward_kinematics(model, st.data, q0);
-  st.p0 = st.data.o[kDof];
   st.R_ref = st.data.R[kDof];
-  st.obs.x_hat << st.p0, Vec3<S>::Zero();
+  st.obs.x_hat << st.data.o[kDof], Vec3<S>::Zero();
   st.obs.y.setZero();
   adaptation_init(st.adapt, Vec6<S>(q0));
 }
@@ -89,10 +89,11 @@ ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Da
   return c;
 }
 
-/// One sample of the adaptive observer-controller at time t with encoder angles q.
+/// One sample of the adaptive observer-controller: encoder angles q, desired state d (a motion
+/// source's, motion.hpp).
 template <class S>
 StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, ControllerState<S>& st,
-                           const Vec6In<S>& q, S t) {
+                           const Vec6In<S>& q, const Desired<S>& d) {
   StepOutput<S> out{};
   out.tau.setZero();
   out.x.setZero();
@@ -103,7 +104,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.qd_ref.setZero();
   out.rcond = S(0);
   out.status = kFaultNone;
-  if (!math::all_finite(q) || !math::isfinite(t)) {
+  if (!math::all_finite(q) || !math::all_finite(d.x) || !math::all_finite(d.xd) || !math::all_finite(d.xdd)) {
     out.status = kFaultNonFinite;
     return out;
   }
@@ -124,7 +125,6 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
   const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
   const Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
-  const Desired<S> d = trajectory(G.trajectory, st.p0, t);
   const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat);
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);

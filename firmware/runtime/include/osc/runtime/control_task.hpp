@@ -29,6 +29,7 @@ struct ControlTask {
   Vec6<math::io_scalar_t<S>> counts_per_rad;  // encoder counts per joint radian (the robot's drives by default)
   std::uint64_t tick;                         // samples since start (64 bits: never wraps in service)
   ControllerState<S> state;
+  PaperMotion<S> motion;      // the motion source: the paper's (68) about the start pose
   StepOutput<S> last;         // the most recent step, for telemetry
   std::int32_t codes[kDof];   // the most recent DAC codes
   EncoderRangeMonitor range;  // the encoder checks (osc/runtime/monitors.hpp)
@@ -48,6 +49,7 @@ struct ControlTask {
     q_start = q0;
     tick = 0;
     controller_init(model, state, q0);
+    motion = {gains.trajectory, state.data.o[kDof], 0};
     for (int i = 0; i < kDof; ++i) codes[i] = 0;
     jump.reset();
     stuck.reset();
@@ -117,9 +119,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const bool stepped = sampled && task.sup.state != SupervisorState::kFault && faults == 0;
   if (stepped) {
     const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
-    const S t = trajectory_time<S>(task.gains.trajectory, task.tick, params::kControlHz);
+    const Desired<S> d = task.motion.at_tick(task.tick, params::kControlHz);
     const std::uint32_t s0 = hal.cycles();
-    task.last = control_step(task.model, task.gains, task.mode, task.state, q, t);
+    task.last = control_step(task.model, task.gains, task.mode, task.state, q, d);
     task.step_timing.add(hal.cycles() - s0);
     faults |= task.last.status;  // non_finite, singular
   }

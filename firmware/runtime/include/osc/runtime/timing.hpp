@@ -25,11 +25,12 @@ struct StepTiming {
 
 /// The stages of a tick, in order: the block diagram of control_tick().
 // X(Name, "name", what the stage does)
-#define OSC_TICK_STAGE_LIST(X)                                                                                   \
-  X(Read, "read", "the HAL's I/O faults and the encoder read")                                                   \
-  X(Checks, "checks", "the encoder monitors: range, jump (EncoderRangeMonitor, EncoderJumpMonitor)")             \
-  X(Step, "step", "counts to angles, the reference's time, the control step (observer, controller, adaptation)") \
-  X(Monitors, "monitors", "the step's monitors: stuck encoder, tracking, friction-estimate band")                \
+#define OSC_TICK_STAGE_LIST(X)                                                                                  \
+  X(Read, "read", "the HAL's I/O faults and the encoder read")                                                  \
+  X(Checks, "checks", "the encoder monitors: range, jump (EncoderRangeMonitor, EncoderJumpMonitor)")            \
+  X(Step, "step",                                                                                               \
+    "counts to angles, the motion source's desired state, the control step (observer, controller, adaptation)") \
+  X(Monitors, "monitors", "the step's monitors: stuck encoder, tracking, friction-estimate band")               \
   X(Output, "output", "torques to DAC codes, saturation, overflow and overrun, supervisor, DAC write")
 
 #define OSC_X_PREFIX kStage
