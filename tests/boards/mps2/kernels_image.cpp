@@ -253,7 +253,7 @@ void jerk_profile_kernels() {
     keep(g_profile.plan(lit<F>(0.2), lit<F>(0.8), lit<F>(2), lit<F>(0.38), lim));
   }
   std::uint32_t worst = 0;
-  MotionState<F> s{};
+  ProfileState<F> s{};
   for (std::uint64_t k = 0; k < 700; ++k) {
     const F t = math::ratio<F>(k, 1000);
     const std::uint32_t t0 = board::cycles();

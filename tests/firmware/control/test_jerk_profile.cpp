@@ -30,7 +30,7 @@ struct Report {
 Report check(const JerkProfile<double>& pr, double target, const Lim& lim, double v_allowed) {
   Report r;
   auto sample = [&](double t) {
-    const MotionState<double> s = pr.at(t);
+    const ProfileState<double> s = pr.at(t);
     r.v_peak = std::max(r.v_peak, std::abs(s.v));
     r.a_peak = std::max(r.a_peak, std::abs(s.a));
     r.v_excess = std::max(r.v_excess, std::abs(s.v) / v_allowed - 1);
@@ -55,7 +55,7 @@ Report check(const JerkProfile<double>& pr, double target, const Lim& lim, doubl
     }
   }
   // at() at the end and beyond.
-  const MotionState<double> e = pr.at(pr.duration());
+  const ProfileState<double> e = pr.at(pr.duration());
   r.end = std::max({r.end, std::abs(e.p - target), std::abs(e.v), std::abs(e.a)});
   return r;
 }
@@ -151,7 +151,7 @@ TEST(JerkProfile, RandomStartsKeepTheLimitsAreContinuousAndEndAtTheTargetAtRest)
     ASSERT_LT(r.end, 1e-9) << k << " p0 " << c.p0 << " v0 " << c.v0 << " a0 " << c.a0 << " target " << c.target;
     ASSERT_LE(pr.segment_count(), 7) << k;
     // The start is the start.
-    const MotionState<double> s0 = pr.at(0);
+    const ProfileState<double> s0 = pr.at(0);
     ASSERT_NEAR(s0.p, c.p0, 1e-15);
     ASSERT_NEAR(s0.v, c.v0, 1e-15);
     ASSERT_NEAR(s0.a, c.a0, 1e-15);
@@ -297,7 +297,7 @@ TEST(JerkProfile, PlanWithDurationLastsExactlyTKeepsTheLimitsAndEndsAtTheTarget)
   ASSERT_EQ(pr.plan(0, 0, 0, 0.5, Lim{1, 5, 50}), ProfileStatus::kOk);
   ASSERT_EQ(slow.plan_with_duration(0, 0, 0, 0.5, Lim{1, 5, 50}, 2 * pr.duration()), ProfileStatus::kOk);
   for (double f : {0.1, 0.35, 0.5, 0.8}) {
-    const MotionState<double> a = pr.at(f * pr.duration()), b = slow.at(f * slow.duration());
+    const ProfileState<double> a = pr.at(f * pr.duration()), b = slow.at(f * slow.duration());
     EXPECT_NEAR(b.p, a.p, 1e-12);
     EXPECT_NEAR(b.v, a.v / 2, 1e-12);
     EXPECT_NEAR(b.a, a.a / 4, 1e-12);
@@ -372,12 +372,12 @@ double worst_against_double(bool with_duration, bool rotations, double* worst_en
     const int n = static_cast<int>(ref.duration() * 1000) + 2;
     for (int k = 0; k <= n; ++k) {
       const S t = math::ratio<S>(static_cast<std::uint64_t>(k), 1000);
-      const MotionState<S> s = pr.at(t);
+      const ProfileState<S> s = pr.at(t);
       worst = std::max(worst, std::abs(static_cast<double>(s.p) - ref.at(static_cast<double>(t)).p));
     }
     // The end of the last segment, by its cubic in S (at() itself returns the target beyond it).
     const JerkSegment<S>& g = pr.segment(pr.segment_count() - 1);
-    const MotionState<S> e = pr.at(g.t0 + g.duration - S(g.duration * S(1e-6)));
+    const ProfileState<S> e = pr.at(g.t0 + g.duration - S(g.duration * S(1e-6)));
     *worst_end =
         std::max({*worst_end, std::abs(static_cast<double>(e.p) - m.target), std::abs(static_cast<double>(e.v))});
   }

@@ -61,7 +61,7 @@ struct JerkLimits {
 
 /// A state on the profile: position, velocity, acceleration, and the jerk acting from there.
 template <class S>
-struct MotionState {
+struct ProfileState {
   S p, v, a, j;
 };
 
@@ -311,7 +311,7 @@ class JerkProfile {
   }
 
   /// (p, v, a, j) at time t from the start: t < 0 the start, t beyond the end the target at rest.
-  MotionState<S> at(S t) const {
+  ProfileState<S> at(S t) const {
     if (!(t < duration_)) return {target_, S(0), S(0), S(0)};
     int i = 0;
     while (i + 1 < n_ && !(t < seg_[i + 1].t0)) ++i;
