@@ -610,19 +610,19 @@ def monitor_margins():
     return "\n".join(lines)
 
 
-BENCH_ROWS = [("FK, all frames", "forward_kinematics", "kdl_forward_kinematics", "forward_kinematics"),
-              ("geometric Jacobian (after FK)", "geometric_jacobian", "kdl_jacobian", "jacobian"),
-              ("A(q), CRBA (after FK)", "joint_inertia", "kdl_mass", "mass"),
-              ("g(q) (after FK: composite bodies)", "gravity", "kdl_gravity", "gravity"),
-              ("c(q,q̇) and J̇q̇, one RNEA pass", "velocity_products", "kdl_coriolis", "coriolis"),
+BENCH_ROWS = [("FK, all frames", "forward_kinematics", "kdl/forward_kinematics", "forward_kinematics"),
+              ("geometric Jacobian (after FK)", "geometric_jacobian", "kdl/jacobian", "jacobian"),
+              ("A(q), CRBA (after FK)", "joint_inertia", "kdl/mass", "mass"),
+              ("g(q) (after FK: composite bodies)", "gravity", "kdl/gravity", "gravity"),
+              ("c(q,q̇) and J̇q̇, one RNEA pass", "velocity_products", "kdl/coriolis", "coriolis"),
               ("W_j(q̇) (19)", "friction_regressor", None, None),
               ("J factor (spherical wrist: 2× 3×3) + solve", "jacobian_factor_solve", None, None),
               ("Λ = J⁻ᵀAJ⁻¹", "operational_inertia", None, None),
               ("opspace_update: FK, J, A, g, J_a, J factor, L D Lᵀ of A", "opspace_update", None, None),
               ("h(v) = Ψ(x,v)v", "psi_quadratic", None, None),
               ("full control step (observer + controller + adaptation)", "control_step", None, None),
-              ("plant forward dynamics (ABA, host_sim)", None, "kdl_forward_dynamics", "ChainFdSolver_RNE"),
-              ("J̇q̇", None, "kdl_jacdot", "jacdot")]
+              ("plant forward dynamics (ABA, host_sim)", None, "kdl/forward_dynamics", "ChainFdSolver_RNE"),
+              ("J̇q̇", None, "kdl/jacdot", "jacdot")]
 
 
 @table("host_benchmarks", "docs/benchmarks.md", "long")

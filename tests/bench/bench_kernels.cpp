@@ -172,62 +172,56 @@ void BM_plant_forward_dynamics(benchmark::State& st) {
 }
 BENCHMARK(BM_plant_forward_dynamics);
 
-// KDL computing the same quantities.
-struct KdlFixture {
+// KDL computing the same quantities: its solvers built once on the same state, each call timed
+// (BM_kdl/<quantity>).
+struct KdlSolvers {
   KDL::Chain chain = test::puma560_chain();
   Fixture<double> f;
   KDL::JntArray q = test::to_kdl(f.q), qd = test::to_kdl(f.qd);
+  KDL::ChainFkSolverPos_recursive fk{chain};
+  KDL::ChainJntToJacSolver jacobian{chain};
+  KDL::ChainDynParam dynamics{chain, KDL::Vector(0, 0, -9.81)};
+  KDL::ChainJntToJacDotSolver jacdot{chain};
+  KDL::ChainFdSolver_RNE forward_dynamics{chain, KDL::Vector(0, 0, -9.81)};
+  KDL::Frame frame;
+  KDL::Jacobian J{kDof};
+  KDL::JntSpaceInertiaMatrix H{kDof};
+  KDL::JntArray out{kDof}, tau{kDof}, qdd{kDof};
+  KDL::Twist twist;
+  KDL::Wrenches wrenches{chain.getNrOfSegments(), KDL::Wrench::Zero()};
+
+  enum Quantity { kFk, kJacobian, kMass, kCoriolis, kGravity, kJacDot, kForwardDynamics };
+  int compute(Quantity which) {
+    switch (which) {
+      case kFk:
+        return fk.JntToCart(q, frame);
+      case kJacobian:
+        return jacobian.JntToJac(q, J);
+      case kMass:
+        return dynamics.JntToMass(q, H);
+      case kCoriolis:
+        return dynamics.JntToCoriolis(q, qd, out);
+      case kGravity:
+        return dynamics.JntToGravity(q, out);
+      case kJacDot:
+        return jacdot.JntToJacDot(KDL::JntArrayVel(q, qd), twist);
+      case kForwardDynamics:
+        return forward_dynamics.CartToJnt(q, qd, tau, wrenches, qdd);
+    }
+    return -1;
+  }
 };
-void BM_kdl_forward_kinematics(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainFkSolverPos_recursive fk(k.chain);
-  KDL::Frame F;
-  for (auto _ : st) benchmark::DoNotOptimize(fk.JntToCart(k.q, F));
+void BM_kdl(benchmark::State& st, KdlSolvers::Quantity which) {
+  auto k = std::make_unique<KdlSolvers>();
+  for (auto _ : st) benchmark::DoNotOptimize(k->compute(which));
 }
-void BM_kdl_jacobian(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainJntToJacSolver s(k.chain);
-  KDL::Jacobian J(kDof);
-  for (auto _ : st) benchmark::DoNotOptimize(s.JntToJac(k.q, J));
-}
-void BM_kdl_mass(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
-  KDL::JntSpaceInertiaMatrix H(kDof);
-  for (auto _ : st) benchmark::DoNotOptimize(d.JntToMass(k.q, H));
-}
-void BM_kdl_coriolis(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
-  KDL::JntArray C(kDof);
-  for (auto _ : st) benchmark::DoNotOptimize(d.JntToCoriolis(k.q, k.qd, C));
-}
-void BM_kdl_gravity(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainDynParam d(k.chain, KDL::Vector(0, 0, -9.81));
-  KDL::JntArray G(kDof);
-  for (auto _ : st) benchmark::DoNotOptimize(d.JntToGravity(k.q, G));
-}
-void BM_kdl_jacdot(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainJntToJacDotSolver s(k.chain);
-  KDL::Twist t;
-  for (auto _ : st) benchmark::DoNotOptimize(s.JntToJacDot(KDL::JntArrayVel(k.q, k.qd), t));
-}
-void BM_kdl_forward_dynamics(benchmark::State& st) {
-  KdlFixture k;
-  KDL::ChainFdSolver_RNE s(k.chain, KDL::Vector(0, 0, -9.81));
-  KDL::JntArray tau(kDof), qdd(kDof);
-  KDL::Wrenches f(k.chain.getNrOfSegments(), KDL::Wrench::Zero());
-  for (auto _ : st) benchmark::DoNotOptimize(s.CartToJnt(k.q, k.qd, tau, f, qdd));
-}
-BENCHMARK(BM_kdl_forward_kinematics);
-BENCHMARK(BM_kdl_jacobian);
-BENCHMARK(BM_kdl_mass);
-BENCHMARK(BM_kdl_coriolis);
-BENCHMARK(BM_kdl_gravity);
-BENCHMARK(BM_kdl_jacdot);
-BENCHMARK(BM_kdl_forward_dynamics);
+BENCHMARK_CAPTURE(BM_kdl, forward_kinematics, KdlSolvers::kFk);
+BENCHMARK_CAPTURE(BM_kdl, jacobian, KdlSolvers::kJacobian);
+BENCHMARK_CAPTURE(BM_kdl, mass, KdlSolvers::kMass);
+BENCHMARK_CAPTURE(BM_kdl, coriolis, KdlSolvers::kCoriolis);
+BENCHMARK_CAPTURE(BM_kdl, gravity, KdlSolvers::kGravity);
+BENCHMARK_CAPTURE(BM_kdl, jacdot, KdlSolvers::kJacDot);
+BENCHMARK_CAPTURE(BM_kdl, forward_dynamics, KdlSolvers::kForwardDynamics);
 
 }  // namespace
 

@@ -67,6 +67,43 @@ TEST(Plant, FrictionFollowsModel2) {
   EXPECT_EQ(f(2), 0.0);  // sgn(0) = 0
 }
 
+/// 2 s of the plant in open loop from the start pose: gravity compensation plus a sinusoidal torque
+/// that makes every joint reverse. Each 1 ms sample goes through Plant::integrate or, with
+/// `sampled`, Plant::advance_sample (the smooth-step path); the joint angles at the end, and the
+/// articulated-body evaluations it took in `evaluations` (when given).
+Vec6 open_loop(const PlantConfig& cfg, bool sampled, long* evaluations) {
+  Plant plant(cfg);
+  plant.reset(q_start());
+  osc::Data<double> data;
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
+  for (int k = 0; k < 2000; ++k) {
+    osc::forward_kinematics(model, data, plant.q());
+    Vec6 tau = osc::gravity_torques(model, data);
+    for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::kPi * (0.7 + 0.2 * i) * k * 1e-3);
+    if (sampled)
+      plant.advance_sample(tau, tau, 1e-3);
+    else
+      plant.integrate(tau, 1e-3);
+  }
+  if (evaluations) *evaluations = plant.evaluations();
+  return plant.q();
+}
+
+/// How two runs of the same experiment differ: the largest difference of a logged tracking error
+/// sample (mm, deg) and of the max-error statistics (mm, deg).
+struct RunDifference {
+  double pos = 0, ang = 0, max_pos = 0, max_ang = 0;
+  RunDifference(const ExperimentResult& a, const ExperimentResult& b) {
+    for (int i = 0; i < 6; ++i) {
+      double& sample = i < 3 ? pos : ang;  // x, y, z in mm; the angles in deg
+      for (size_t k = 0; k < a.log.size() && k < b.log.size(); ++k)
+        sample = std::max(sample, std::abs(a.log[k].e[i] - b.log[k].e[i]));
+      double& stat = i < 3 ? max_pos : max_ang;
+      stat = std::max(stat, std::abs(a.max_error[i] - b.max_error[i]));
+    }
+  }
+};
+
 TEST(Plant, HalvingTheStepInOpenLoop) {
   // Integration error alone (no feedback): 2 s under a sinusoidal torque that makes every joint
   // reverse. Without friction the dynamics are smooth and RK4 converges to round-off; with the
@@ -77,17 +114,7 @@ TEST(Plant, HalvingTheStepInOpenLoop) {
     PlantConfig cfg;
     cfg.substep = h;
     cfg.friction = friction;
-    Plant plant(cfg);
-    plant.reset(q_start());
-    osc::Data<double> data;
-    const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
-    for (int k = 0; k < 2000; ++k) {
-      osc::forward_kinematics(model, data, plant.q());
-      Vec6 tau = osc::gravity_torques(model, data);
-      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::kPi * (0.7 + 0.2 * i) * k * 1e-3);
-      plant.integrate(tau, 1e-3);
-    }
-    return plant.q();
+    return open_loop(cfg, false, nullptr);
   };
   const double smooth = (run(1e-4, osc::kFrictionNone) - run(5e-5, osc::kFrictionNone)).cwiseAbs().maxCoeff();
   const double rough =
@@ -111,14 +138,8 @@ TEST(Plant, HalvingTheStepChangesA10sClosedLoopRunByLessThanTolerance) {
   b.plant.substep = a.plant.substep / 2;
   const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
   ASSERT_EQ(ra.log.size(), rb.log.size());
-  double dpos = 0, dang = 0;
-  for (size_t k = 0; k < ra.log.size(); ++k) {
-    for (int i = 0; i < 3; ++i) dpos = std::max(dpos, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
-    for (int i = 3; i < 6; ++i) dang = std::max(dang, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
-  }
-  double dmax_pos = 0, dmax_ang = 0;
-  for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
-  for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
+  const RunDifference diff(ra, rb);
+  const double dpos = diff.pos, dang = diff.ang, dmax_pos = diff.max_pos, dmax_ang = diff.max_ang;
   std::printf(
       "closed loop, step %.0e vs %.0e s: max sample difference %.3f mm %.4f deg; max-error statistics "
       "differ by %.4f mm %.5f deg\n",
@@ -139,18 +160,7 @@ TEST(Plant, SmoothStepsAgreeWithTheFixedStep) {
     PlantConfig cfg;
     cfg.smooth_steps = smooth;
     cfg.friction = friction;
-    Plant plant(cfg);
-    plant.reset(q_start());
-    osc::Data<double> data;
-    const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
-    for (int k = 0; k < 2000; ++k) {
-      osc::forward_kinematics(model, data, plant.q());
-      Vec6 tau = osc::gravity_torques(model, data);
-      for (int i = 0; i < 6; ++i) tau(i) += (i < 3 ? 15.0 : 3.0) * std::sin(2 * osc::kPi * (0.7 + 0.2 * i) * k * 1e-3);
-      plant.advance_sample(tau, tau, 1e-3);
-    }
-    if (evaluations) *evaluations = plant.evaluations();
-    return Vec6(plant.q());
+    return open_loop(cfg, true, evaluations);
   };
   const int s = PlantConfig{}.smooth_steps;
   ASSERT_GT(s, 1);
@@ -177,14 +187,8 @@ TEST(Plant, SmoothStepsAgreeWithTheFixedStep) {
   b.plant.smooth_steps = s;
   const ExperimentResult ra = run_experiment(a), rb = run_experiment(b);
   ASSERT_EQ(ra.log.size(), rb.log.size());
-  double dpos = 0, dang = 0;
-  for (size_t k = 0; k < ra.log.size(); ++k) {
-    for (int i = 0; i < 3; ++i) dpos = std::max(dpos, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
-    for (int i = 3; i < 6; ++i) dang = std::max(dang, std::abs(ra.log[k].e[i] - rb.log[k].e[i]));
-  }
-  double dmax_pos = 0, dmax_ang = 0;
-  for (int i = 0; i < 3; ++i) dmax_pos = std::max(dmax_pos, std::abs(ra.max_error[i] - rb.max_error[i]));
-  for (int i = 3; i < 6; ++i) dmax_ang = std::max(dmax_ang, std::abs(ra.max_error[i] - rb.max_error[i]));
+  const RunDifference diff(ra, rb);
+  const double dpos = diff.pos, dang = diff.ang, dmax_pos = diff.max_pos, dmax_ang = diff.max_ang;
   const double per_sample_a = static_cast<double>(ra.plant_evaluations) / 10000,
                per_sample_b = static_cast<double>(rb.plant_evaluations) / 10000;
   std::printf(

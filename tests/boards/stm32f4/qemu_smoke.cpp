@@ -136,38 +136,25 @@ void report_timing(const Spacing& s) {
       .emit();
 }
 
+/// Ends a line with what a snapshot's outputs were: "<codes>zero|NONZERO<note>, amplifier ON|off,
+/// watchdog feeds n".
+void emit_outputs(Line& line, const Snapshot& s, const char* codes, const char* note) {
+  line.str(codes).str(s.written_max == 0 ? "zero" : "NONZERO").str(note);
+  line.str(", amplifier ").str(s.amplifier ? "ON" : "off").str(", watchdog feeds ").u32(s.feeds).emit();
+}
+
 /// The report's lines on the state before and after the E-stop, and the telemetry.
 void report_estop() {
   const Snapshot& b = g_before_estop;
   const Snapshot& a = g_after_estop;
-  Line()
-      .str("before the E-stop: state ")
-      .u32(static_cast<std::uint32_t>(b.state))
-      .str(", faults ")
-      .u32(b.latched)
-      .str(", torque code joint 2 ")
-      .i32(b.task_code)
-      .str(", DAC codes written ")
-      .str(b.written_max == 0 ? "zero" : "NONZERO")
-      .str(" (boot fault), amplifier ")
-      .str(b.amplifier ? "ON" : "off")
-      .str(", watchdog feeds ")
-      .u32(b.feeds)
-      .emit();
-  Line()
-      .str("E-stop: interrupt after tick ")
-      .u32(g_estop_seen_at)
-      .str(", latched by tick ")
-      .u32(g_estop_latched_in)
-      .str(", faults ")
-      .str(osc::fault_name(a.latched))
-      .str(", DAC codes ")
-      .str(a.written_max == 0 ? "zero" : "NONZERO")
-      .str(", amplifier ")
-      .str(a.amplifier ? "ON" : "off")
-      .str(", watchdog feeds ")
-      .u32(a.feeds)
-      .emit();
+  Line before;
+  before.str("before the E-stop: state ").u32(static_cast<std::uint32_t>(b.state)).str(", faults ").u32(b.latched);
+  before.str(", torque code joint 2 ").i32(b.task_code);
+  emit_outputs(before, b, ", DAC codes written ", " (boot fault)");
+  Line after;
+  after.str("E-stop: interrupt after tick ").u32(g_estop_seen_at).str(", latched by tick ").u32(g_estop_latched_in);
+  after.str(", faults ").str(osc::fault_name(a.latched));
+  emit_outputs(after, a, ", DAC codes ", "");
   Line()
       .str("telemetry: ")
       .u32(g_app.frames)

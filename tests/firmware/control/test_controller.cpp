@@ -139,12 +139,19 @@ TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
   EXPECT_LT(worst_semi, 1.0);
 }
 
-TEST(ControlStep, FaultsCommandZeroTorque) {
+/// A controller in double just initialised at the start pose, with the paper's motion about it.
+struct ControlStep : ::testing::Test {
   const Model<double> model = Model<double>::of(robot::kArm);
   const Gains<double> G = Gains<double>::paper();
-  auto st = std::make_unique<ControllerState<double>>();
-  controller_init(model, *st, q_start());
-  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
+  std::unique_ptr<ControllerState<double>> st = std::make_unique<ControllerState<double>>();
+  PaperMotion<double> paper;
+  void SetUp() override {
+    controller_init(model, *st, q_start());
+    paper = {G.trajectory, st->data.o[kDof], 0};
+  }
+};
+
+TEST_F(ControlStep, FaultsCommandZeroTorque) {
   Vec6<double> q = q_start();
   q(3) = std::numeric_limits<double>::quiet_NaN();
   StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q, paper.at_time(0.0));
@@ -166,13 +173,8 @@ TEST(ControlStep, FaultsCommandZeroTorque) {
   EXPECT_TRUE(math::all_finite(out.tau));
 }
 
-TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
+TEST_F(ControlStep, AtRestAtTheStartItHoldsGravity) {
   // x = x_d, observer at rest: F = p(x), so Gamma = J^T p = g(q).
-  const Model<double> model = Model<double>::of(robot::kArm);
-  const Gains<double> G = Gains<double>::paper();
-  auto st = std::make_unique<ControllerState<double>>();
-  controller_init(model, *st, q_start());
-  const PaperMotion<double> paper{G.trajectory, st->data.o[kDof]};
   const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), paper.at_time(0.0));
   ASSERT_EQ(out.status, kFaultNone);
   Data<double> data;
@@ -182,11 +184,7 @@ TEST(ControlStep, AtRestAtTheStartItHoldsGravity) {
 
 // control_step tracks the desired state it is given, whatever its source: the tracking error is
 // d.x - x, and a non-finite d is the fault non_finite with zero torque.
-TEST(ControlStep, TracksTheDesiredStateItIsGiven) {
-  const Model<double> model = Model<double>::of(robot::kArm);
-  const Gains<double> G = Gains<double>::paper();
-  auto st = std::make_unique<ControllerState<double>>();
-  controller_init(model, *st, q_start());
+TEST_F(ControlStep, TracksTheDesiredStateItIsGiven) {
   Desired<double> d;
   d.x << st->data.o[kDof] + Vec3<double>(0.004, -0.002, 0.001), 0.001, -0.002, 0.003;
   d.xd << 0.01, 0.02, -0.01, 0, 0.01, 0;
@@ -237,7 +235,7 @@ void run_steps_without_allocation() {
   }
 }
 
-TEST(ControlStep, AllocationFreeInDoubleAndFloat) {
+TEST(ControlStepScalars, AllocationFreeInDoubleAndFloat) {
   run_steps_without_allocation<double>();
   run_steps_without_allocation<float>();
 }
