@@ -116,20 +116,19 @@ class RemoteController {
 };
 
 /// The true plant's errors, through double kinematics: the tracking error e against the task
-/// (68), and the observer's errors against the true operational velocity.
+/// (the paper's motion about the start pose, as the controller's), and the observer's errors
+/// against the true operational velocity.
 class GroundTruth {
  public:
-  explicit GroundTruth(const Vec6& q0) {
+  GroundTruth(const Vec6& q0, const osc::TrajectorySpec<double>& spec) {
     osc::forward_kinematics(model_, data_, q0);
-    p0_ = data_.o[6];
+    paper_ = {spec, data_.o[6], 0};
     R_ref_ = data_.R[6];
   }
   /// e of the plant at q in sample k: mm (x, y, z), deg (about X, Y, Z).
-  void tracking_error(const osc::TrajectorySpec<double>& spec, long k, const Vec6& q, double e[6]) {
-    const double t_ref = osc::trajectory_time<double>(spec, static_cast<std::uint64_t>(k),
-                                                      osc::params::kControlHz);  // as the controller
+  void tracking_error(long k, const Vec6& q, double e[6]) {
     osc::forward_kinematics(model_, data_, q);
-    const osc::Desired<double> d = osc::trajectory(spec, p0_, t_ref);
+    const osc::Desired<double> d = paper_.at_tick(static_cast<std::uint64_t>(k), osc::params::kControlHz);
     phi_ = osc::orientation_coordinates(data_.R[6], R_ref_);
     for (int i = 0; i < 3; ++i) e[i] = (d.x(i) - data_.o[6](i)) * 1e3;
     for (int i = 0; i < 3; ++i) e[3 + i] = -phi_(i) * kRadToDeg;
@@ -155,7 +154,7 @@ class GroundTruth {
  private:
   const osc::Model<double> model_ = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> data_;
-  Vec3 p0_;
+  osc::PaperMotion<double> paper_;
   Mat3 R_ref_;
   Vec3 phi_ = Vec3::Zero();
 };
@@ -167,7 +166,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   Plant plant(cfg.plant);
   plant.reset(q0);
   PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev, cfg.injection);
-  GroundTruth truth(q0);
+  GroundTruth truth(q0, cfg.gains.trajectory);
   const double dt = osc::params::kDt;
   const long n = std::lround(cfg.duration / dt);
   const long progress_every = std::max(1L, n / 100);
@@ -178,7 +177,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     s.k = k;
     s.t = k * dt;
     s.last = s.t >= t_final;
-    truth.tracking_error(cfg.gains.trajectory, k, plant.q(), s.e);
+    truth.tracking_error(k, plant.q(), s.e);
     if constexpr (requires { ctrl.skip_ticks(std::uint64_t{0}); }) {
       if (k == jump_tick) ctrl.skip_ticks(cfg.jump_ticks);
     }
