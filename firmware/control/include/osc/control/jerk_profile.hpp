@@ -310,6 +310,18 @@ class JerkProfile {
     return ProfileStatus::kOk;
   }
 
+  /// The hardest stop from (p0, v0, a0): the time-optimal change to v = a = 0 at full jerk, wherever
+  /// it comes to rest (a category-2 stop along the axis). The target is where it ends.
+  ProfileStatus plan_stop(S p0, S v0, S a0, const JerkLimits<S>& lim) {
+    const ProfileStatus st = check(p0, v0, a0, p0, lim);
+    if (st != ProfileStatus::kOk) return st;
+    const jerk_profile::Kin<S> start{p0, v0, a0};
+    jerk_profile::Pieces<S> stop(lim.a);
+    stop.add(jerk_profile::velocity_change(v0, a0, S(0), lim.a, lim.j), lim.j);
+    assemble(start, stop.end(start).p, stop);
+    return ProfileStatus::kOk;
+  }
+
   /// (p, v, a, j) at time t from the start: t < 0 the start, t beyond the end the target at rest.
   ProfileState<S> at(S t) const {
     if (!(t < duration_)) return {target_, S(0), S(0), S(0)};

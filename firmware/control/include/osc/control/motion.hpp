@@ -1,10 +1,16 @@
 // The motion sources: where each control step's desired state d = (x_d, x_d dot, x_d ddot) comes
-// from. control_step() tracks whatever d it is given; a source computes d for the tick. So far one
-// source: the built-in "paper" motion, trajectory (68) about the position at which it starts.
+// from. control_step() tracks whatever d it is given; the MotionGenerator computes d for the tick
+// from one of three sources:
+//   hold    the pose captured on enable or where the last motion came to rest, at rest;
+//   move    queued point-to-point moves (CartesianMove, cartesian_move.hpp), one after another;
+//   paper   the paper's motion (68) about the position at which it started (PaperMotion).
+// and stops any of them along its path (category 2): a move by its profiles' hardest stops, the
+// paper's motion by a jerk-limited slow-down of its time.
 #pragma once
 
 #include <cstdint>
 
+#include "osc/control/cartesian_move.hpp"
 #include "osc/control/trajectory.hpp"
 
 namespace osc {
@@ -19,11 +25,167 @@ struct PaperMotion {
 
   /// d at time t [s] since the start.
   Desired<S> at_time(S t) const { return trajectory(spec, p0, t); }
-  /// d at sample `tick` of a clock of rate_hz samples per second: its time from the integer sample
-  /// count since the start (trajectory_time: exact over any uptime).
-  Desired<S> at_tick(std::uint64_t tick, std::uint32_t rate_hz) const {
-    return at_time(trajectory_time<S>(spec, tick - start_tick, rate_hz));
+  /// The time since the start at sample `tick` of a clock of rate_hz samples per second, from the
+  /// integer sample count (trajectory_time: exact over any uptime).
+  S time_at_tick(std::uint64_t tick, std::uint32_t rate_hz) const {
+    return trajectory_time<S>(spec, tick - start_tick, rate_hz);
   }
+  /// d at sample `tick`.
+  Desired<S> at_tick(std::uint64_t tick, std::uint32_t rate_hz) const { return at_time(time_at_tick(tick, rate_hz)); }
+};
+
+/// The category-2 stop of the paper's motion: its own time tau slowed from rate 1 to rest along a
+/// jerk-limited profile (tau_dot from 1 to 0, |tau_ddot| <= kPaperStopRate, |tau_dddot| <=
+/// kPaperStopJerk), so that the reference decelerates along the paper's path:
+///   x = x(tau), x_dot = x'(tau) tau_dot, x_ddot = x''(tau) tau_dot^2 + x'(tau) tau_ddot.
+/// (68)'s peak speed 0.063 m/s and acceleration 0.079 m/s^2 per axis bound the stop's reference to
+/// 0.079 + 0.063 * 0.5 m/s^2 per axis.
+constexpr double kPaperStopRate = 0.5;  ///< [1/s]: tau_dot falls from 1 to 0 in about 2 s
+constexpr double kPaperStopJerk = 1.0;  ///< [1/s^2]
+
+/// What a tick of the generator reports to the motion state machine (osc/runtime/motion_states.hpp).
+struct MotionEvents {
+  bool finished = false;  ///< the motion ended at rest with nothing queued (not after a stop)
+  bool stopped = false;   ///< a category-2 stop reached rest
+};
+
+enum class MotionSource : std::uint8_t { kHold, kMove, kPaper };
+
+template <class S>
+class MotionGenerator {
+ public:
+  static constexpr int kQueueLength = params::kMoveQueueLength;
+
+  /// Holds `pose` (orientation coordinates relative to R_ref, the controller's), clears the queue.
+  void hold(const Pose<S>& pose, const Mat3<S>& R_ref) {
+    R_ref_ = R_ref;
+    set_hold(pose);
+  }
+  /// Starts the paper's motion at sample `tick` about the held position.
+  void start_paper(const TrajectorySpec<S>& spec, std::uint64_t tick) {
+    paper_ = {spec, hold_pose_.p, tick};
+    source_ = MotionSource::kPaper;
+    stopping_ = braking_ = false;
+    count_ = 0;
+  }
+  /// Appends a move planned from queue_end() (CartesianMove::plan). false: the queue is full. While
+  /// the paper's motion runs, brake() it first: the moves start where its slow-down ends.
+  bool push(const CartesianMove<S>& m) {
+    if (queue_full()) return false;
+    queue_[(head_ + count_) % kQueueSlots] = m;
+    ++count_;
+    return true;
+  }
+  /// Where the next move pushed starts: the last queued move's end (the running one's, or where its
+  /// brake ends), where the paper's slow-down ends, or the held pose.
+  Pose<S> queue_end() const {
+    if (count_ > 0) return queue_[(head_ + count_ - 1) % kQueueSlots].end();
+    if (source_ == MotionSource::kPaper) return {paper_.at_time(stop_tau_.target()).x.template head<3>(), hold_pose_.R};
+    return hold_pose_;
+  }
+  /// No room for another move: the running one and kQueueLength waiting.
+  bool queue_full() const { return count_ >= kQueueSlots; }
+  /// Starts the queued moves at sample `tick` (from the held pose, at rest).
+  void start_moves(std::uint64_t tick) {
+    if (source_ != MotionSource::kHold || count_ == 0) return;
+    source_ = MotionSource::kMove;
+    start_tick_ = tick;
+  }
+  /// Decelerates the running motion along its path from sample `tick` on and drops the moves
+  /// waiting: a move by its profiles' hardest stops, the paper's motion by slowing its time. Moves
+  /// pushed afterwards start where it comes to rest (a re-target); with none, it ends in a hold
+  /// (MotionEvents::finished). Holding, or already braking: nothing changes.
+  void brake(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) {
+    if (source_ == MotionSource::kHold || braking_) return;
+    const S t = math::ratio<S>(tick - start_tick_, rate_hz);
+    if (source_ == MotionSource::kMove) {
+      queue_[head_].stop(t, lim);
+      count_ = 1;
+    } else {
+      const S tau = paper_.time_at_tick(tick, rate_hz);
+      stop_tau_.plan_stop(tau, S(1), S(0), {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+    }
+    start_tick_ = tick;
+    braking_ = true;
+  }
+  /// The category-2 stop: brake(), and the motion ends in a hold (MotionEvents::stopped) whatever is
+  /// pushed afterwards (the state machine refuses moves while stopping).
+  void stop(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) {
+    brake(tick, rate_hz, lim);
+    if (source_ != MotionSource::kHold) stopping_ = true;
+  }
+
+  /// d at sample `tick`; reports a motion's end at rest (then holds where it ended).
+  Desired<S> at_tick(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
+    if (source_ == MotionSource::kPaper) return paper_at(tick, rate_hz, ev);
+    if (source_ == MotionSource::kHold) return hold_d_;
+    S t = math::ratio<S>(tick - start_tick_, rate_hz);
+    while (!(t < queue_[head_].duration())) {
+      // The running move ended at rest: the next one starts from there in this tick.
+      const Pose<S> end = queue_[head_].end();
+      head_ = (head_ + 1) % kQueueSlots;
+      --count_;
+      braking_ = false;
+      if (count_ == 0 || stopping_) return end_at_rest(end, ev);
+      start_tick_ = tick;
+      t = S(0);
+    }
+    return queue_[head_].at(t);
+  }
+
+  MotionSource source() const { return source_; }
+  bool stopping() const { return stopping_; }
+  bool braking() const { return braking_; }
+  int queued() const { return count_; }
+  const Pose<S>& hold_pose() const { return hold_pose_; }
+  const Mat3<S>& reference_orientation() const { return R_ref_; }
+
+ private:
+  static constexpr int kQueueSlots = kQueueLength + 1;  // the running move and those waiting
+
+  void set_hold(const Pose<S>& pose) {
+    hold_pose_ = pose;
+    hold_d_.x << pose.p, orientation_coordinates<S>(pose.R, R_ref_);
+    hold_d_.xd.setZero();
+    hold_d_.xdd.setZero();
+    source_ = MotionSource::kHold;
+    stopping_ = braking_ = false;
+    count_ = 0;
+  }
+  /// The motion came to rest at `end`: stopped (a stop) or finished, holding there.
+  Desired<S> end_at_rest(const Pose<S>& end, MotionEvents& ev) {
+    (stopping_ ? ev.stopped : ev.finished) = true;
+    set_hold(end);
+    return hold_d_;
+  }
+
+  Desired<S> paper_at(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
+    if (!braking_) return paper_.at_tick(tick, rate_hz);
+    const S t = math::ratio<S>(tick - start_tick_, rate_hz);
+    const ProfileState<S> tau = stop_tau_.at(t);
+    Desired<S> d = paper_.at_time(tau.p);
+    d.xdd = d.xdd * (tau.v * tau.v) + d.xd * tau.a;
+    d.xd = d.xd * tau.v;
+    if (t < stop_tau_.duration()) return d;
+    const Pose<S> end{d.x.template head<3>(), hold_pose_.R};  // (68) keeps the orientation it started with
+    if (count_ == 0 || stopping_) return end_at_rest(end, ev);
+    // Moves pushed while braking start here, at rest.
+    source_ = MotionSource::kMove;
+    braking_ = false;
+    start_tick_ = tick;
+    return queue_[head_].at(S(0));
+  }
+
+  MotionSource source_ = MotionSource::kHold;
+  bool stopping_ = false, braking_ = false;
+  Pose<S> hold_pose_{Vec3<S>::Zero(), Mat3<S>::Identity()};
+  Desired<S> hold_d_{};
+  Mat3<S> R_ref_ = Mat3<S>::Identity();
+  PaperMotion<S> paper_{};
+  JerkProfile<S> stop_tau_;
+  CartesianMove<S> queue_[kQueueSlots];
+  int head_ = 0, count_ = 0;
+  std::uint64_t start_tick_ = 0;
 };
 
 }  // namespace osc

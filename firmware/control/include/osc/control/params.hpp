@@ -37,6 +37,24 @@ constexpr double kEnvelope = 0.05;    ///< 1 - exp(-kEnvelope t^3)
 /// Reciprocal-condition threshold of the Jacobian below which the controller refuses to act.
 constexpr double kMinJacobianRcond = 1e-3;
 
+/// Motion generation (osc/control/cartesian_move.hpp, docs/motion.md): the configured maxima of a
+/// move's reference, translation of the wrist centre [m/s, m/s^2, m/s^3] and rotation about the
+/// move's axis [rad/s, rad/s^2, rad/s^3]. A command may ask for less, never more (over_limit).
+/// Chosen so that the controller tracks a move at these limits within 1 mm (docs/motion.md).
+constexpr double kMoveLinear[3] = {0.10, 0.25, 2.5};
+constexpr double kMoveAngular[3] = {0.5, 1.0, 10.0};
+/// A planned path keeps every joint this far inside its limits [rad] (out_of_workspace).
+constexpr double kWorkspaceMargin = 0.05;
+/// ... and the Jacobian's reciprocal condition at least this (near_singular): ten times the
+/// controller's own threshold, so that a path that passes the check never reaches it.
+constexpr double kPathMinRcond = 10 * kMinJacobianRcond;
+/// Points checked along a planned path, besides its end (inverse kinematics at each).
+constexpr int kPathCheckPoints = 16;
+/// Moves a queue holds beyond the one running.
+constexpr int kMoveQueueLength = 16;
+/// Enable: the torque beyond the gravity the model predicts is ramped in over this time [s].
+constexpr double kEnableRamp = 0.05;
+
 /// Supervision limits.
 /// How far an encoder reading may lie outside the joint limits (overtravel to the hard stops)
 /// before it is implausible, from the first sample on [rad].
