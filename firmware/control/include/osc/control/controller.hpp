@@ -59,6 +59,15 @@ void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In
   adaptation_init(st.adapt, Vec6<S>(q0));
 }
 
+/// Restarts the observer at the measured pose q (an enable after a disable or a cleared fault):
+/// as controller_init, but the friction estimates theta^ learnt so far are kept.
+template <class S>
+void controller_restart(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
+  const Vec18<S> theta_hat = st.adapt.theta_hat;
+  controller_init(model, st, q);
+  st.adapt.theta_hat = theta_hat;
+}
+
 template <class S>
 struct ForceCommand {
   Vec6<S> F;          // operational force (32)

@@ -47,6 +47,7 @@ constexpr double kPaperStopJerk = 1.0;  ///< [1/s^2]
 struct MotionEvents {
   bool finished = false;  ///< the motion ended at rest with nothing queued (not after a stop)
   bool stopped = false;   ///< a category-2 stop reached rest
+  std::uint32_t done_id = 0;  ///< a move that reached its target at rest in this tick (its id; not a braked one)
 };
 
 enum class MotionSource : std::uint8_t { kHold, kMove, kPaper };
@@ -60,19 +61,23 @@ class MotionGenerator {
   void hold(const Pose<S>& pose, const Mat3<S>& R_ref) {
     R_ref_ = R_ref;
     set_hold(pose);
+    ++epoch_;
   }
   /// Starts the paper's motion at sample `tick` about the held position.
-  void start_paper(const TrajectorySpec<S>& spec, std::uint64_t tick) {
+  void start_paper(const TrajectorySpec<S>& spec, std::uint64_t tick, std::uint32_t id = 0) {
     paper_ = {spec, hold_pose_.p, tick};
+    paper_id_ = id;
+    ++epoch_;
     source_ = MotionSource::kPaper;
     stopping_ = braking_ = false;
     count_ = 0;
   }
   /// Appends a move planned from queue_end() (CartesianMove::plan). false: the queue is full. While
   /// the paper's motion runs, brake() it first: the moves start where its slow-down ends.
-  bool push(const CartesianMove<S>& m) {
+  bool push(const CartesianMove<S>& m, std::uint32_t id = 0) {
     if (queue_full()) return false;
     queue_[(head_ + count_) % kQueueSlots] = m;
+    ids_[(head_ + count_) % kQueueSlots] = id;
     ++count_;
     return true;
   }
@@ -83,6 +88,23 @@ class MotionGenerator {
     if (source_ == MotionSource::kPaper) return {paper_.at_time(stop_tau_.target()).x.template head<3>(), hold_pose_.R};
     return hold_pose_;
   }
+  /// Where the running motion would come to rest if brake() ran at sample `tick` (the start of a
+  /// re-target's move); the held pose when holding.
+  Pose<S> brake_end(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) const {
+    if (source_ == MotionSource::kHold || braking_) return queue_end();
+    if (source_ == MotionSource::kMove) {
+      CartesianMove<S> m = queue_[head_];
+      m.stop(math::ratio<S>(tick - start_tick_, rate_hz), lim);
+      return m.end();
+    }
+    JerkProfile<S> tau;
+    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0), {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+    return {paper_.at_time(tau.target()).x.template head<3>(), hold_pose_.R};
+  }
+  /// Counts the changes of queue_end() other than a push (hold, paper, brake, stop; a motion that
+  /// comes to rest ends where queue_end() said it would): a move planned
+  /// from queue_end() under one epoch is pushed only under the same one.
+  std::uint32_t epoch() const { return epoch_; }
   /// No room for another move: the running one and kQueueLength waiting.
   bool queue_full() const { return count_ >= kQueueSlots; }
   /// Starts the queued moves at sample `tick` (from the held pose, at rest).
@@ -107,6 +129,7 @@ class MotionGenerator {
     }
     start_tick_ = tick;
     braking_ = true;
+    ++epoch_;
   }
   /// The category-2 stop: brake(), and the motion ends in a hold (MotionEvents::stopped) whatever is
   /// pushed afterwards (the state machine refuses moves while stopping).
@@ -123,6 +146,7 @@ class MotionGenerator {
     while (!(t < queue_[head_].duration())) {
       // The running move ended at rest: the next one starts from there in this tick.
       const Pose<S> end = queue_[head_].end();
+      if (!braking_) ev.done_id = ids_[head_];
       head_ = (head_ + 1) % kQueueSlots;
       --count_;
       braking_ = false;
@@ -137,6 +161,11 @@ class MotionGenerator {
   bool stopping() const { return stopping_; }
   bool braking() const { return braking_; }
   int queued() const { return count_; }
+  /// The id of the running motion (the running move's, the paper's; 0 when holding).
+  std::uint32_t running_id() const {
+    if (source_ == MotionSource::kMove) return ids_[head_];
+    return source_ == MotionSource::kPaper ? paper_id_ : 0;
+  }
   const Pose<S>& hold_pose() const { return hold_pose_; }
   const Mat3<S>& reference_orientation() const { return R_ref_; }
 
@@ -184,8 +213,11 @@ class MotionGenerator {
   PaperMotion<S> paper_{};
   JerkProfile<S> stop_tau_;
   CartesianMove<S> queue_[kQueueSlots];
+  std::uint32_t ids_[kQueueSlots] = {};
+  std::uint32_t paper_id_ = 0;
   int head_ = 0, count_ = 0;
   std::uint64_t start_tick_ = 0;
+  std::uint32_t epoch_ = 0;
 };
 
 }  // namespace osc

@@ -48,6 +48,9 @@ constexpr double kWorkspaceMargin = 0.05;
 /// ... and the Jacobian's reciprocal condition at least this (near_singular): ten times the
 /// controller's own threshold, so that a path that passes the check never reaches it.
 constexpr double kPathMinRcond = 10 * kMinJacobianRcond;
+/// While moving, a Jacobian whose reciprocal condition falls below this stops the motion (category
+/// 2, limit_reached), before the controller's own threshold faults (category 0).
+constexpr double kLimitMinRcond = 2 * kMinJacobianRcond;
 /// Points checked along a planned path, besides its end (inverse kinematics at each).
 constexpr int kPathCheckPoints = 16;
 /// Moves a queue holds beyond the one running.

@@ -11,6 +11,7 @@
 #include "osc/control/controller.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/monitors.hpp"
+#include "osc/runtime/motion_commands.hpp"
 #include "osc/runtime/supervisor.hpp"
 #include "osc/runtime/timing.hpp"
 
@@ -19,6 +20,11 @@ namespace osc {
 static_assert(has_spherical_wrist(robot::kArm),
               "the kernels factor J block-triangularly (SphericalWristJacobianFactor): the robot needs a "
               "spherical wrist centred at the frame-6 origin");
+
+/// How a task starts: running the paper's experiment from the first sample (moving along (68)
+/// about the start pose, the observer started at q_start; the firmware's default, and bit for bit
+/// the paper's run), or disabled, waiting for an enable.
+enum class TaskStart : std::uint8_t { kPaper, kDisabled };
 
 template <class S>
 struct ControlTask {
@@ -29,7 +35,13 @@ struct ControlTask {
   Vec6<math::io_scalar_t<S>> counts_per_rad;  // encoder counts per joint radian (the robot's drives by default)
   std::uint64_t tick;                         // samples since start (64 bits: never wraps in service)
   ControllerState<S> state;
-  PaperMotion<S> motion;      // the motion source: the paper's (68) about the start pose
+  MotionMachine machine;      // the motion state machine (osc/runtime/motion_states.hpp)
+  MotionGenerator<S> gen;     // the desired state of each tick (osc/control/motion.hpp)
+  CartesianLimits<S> limits;  // the configured maxima of a move
+  TaskCommand<S> pending;     // the next tick's command (verb none: no command)
+  MotionReport report;        // this tick's answer and motion events
+  std::uint64_t ramp_start;   // the tick the enable's torque ramp started
+  bool ramping;               // the torque is being ramped in (enable)
   StepOutput<S> last;         // the most recent step, for telemetry
   std::int32_t codes[kDof];   // the most recent DAC codes
   EncoderRangeMonitor range;  // the encoder checks (osc/runtime/monitors.hpp)
@@ -42,14 +54,25 @@ struct ControlTask {
   StepTiming step_timing;       // the control step alone: observer + controller + adaptation
   TickTiming stages;            // each stage of the tick (TickStage)
 
-  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0) {
+  void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
+            TaskStart start = TaskStart::kPaper) {
     model = m;
     gains = g;
     mode = fm;
     q_start = q0;
     tick = 0;
     controller_init(model, state, q0);
-    motion = {gains.trajectory, state.data.o[kDof], 0};
+    machine = {};
+    gen.hold({state.data.o[kDof], state.data.R[kDof]}, state.R_ref);
+    if (start == TaskStart::kPaper) {
+      machine.state = MotionState::kMoving;
+      gen.start_paper(gains.trajectory, 0);
+    }
+    limits = CartesianLimits<S>::defaults();
+    pending = {};
+    report = {};
+    ramp_start = 0;
+    ramping = false;
     for (int i = 0; i < kDof; ++i) codes[i] = 0;
     jump.reset();
     stuck.reset();
@@ -96,10 +119,130 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const bool moved[kDof]) 
   return faults;
 }
 
+/// The states in which the control step runs and torque reaches the DACs.
+constexpr bool motion_powered(MotionState s) {
+  return s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping;
+}
+
+/// The limits checked every tick of a motion (a category-2 stop when one is reached): each joint
+/// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond.
+template <class S>
+MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q) {
+  if (task.machine.state != MotionState::kMoving) return MotionReason::kNone;
+  for (int i = 0; i < kDof; ++i)
+    if (q(i) < lit<S>(robot::kArm.q_min[i]) || q(i) > lit<S>(robot::kArm.q_max[i])) return MotionReason::kLimitReached;
+  if (task.last.rcond < lit<S>(params::kLimitMinRcond)) return MotionReason::kLimitReached;
+  return MotionReason::kNone;
+}
+
+/// Enable's torque ramp: the torque beyond the gravity the model predicts at q is ramped in over
+/// params::kEnableRamp, tau = g + r (tau - g), r from 0 to 1.
+template <class S>
+void ramp_torque(ControlTask<S>& task) {
+  constexpr auto kTicks = static_cast<std::uint32_t>(params::kEnableRamp * params::kControlHz);
+  const std::uint64_t n = task.tick - task.ramp_start;
+  if (n >= kTicks) {
+    task.ramping = false;
+    return;
+  }
+  const Vec6<S>& g = task.state.os.g;
+  task.last.tau = g + math::ratio<S>(n, kTicks) * (task.last.tau - g);
+}
+
+/// The command of the tick as the state machine sees it: none while an enable waits for a measured
+/// pose (the supervisor running and a checked sample in this tick: it stays pending), or when preparing refused it (the
+/// refusal goes into the report) or it is no longer valid (its plan's epoch passed: superseded; a
+/// paper command when the generator does not hold: busy).
+template <class S>
+MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured) {
+  const TaskCommand<S>& cmd = task.pending;
+  MotionReport& rep = task.report;
+  if (cmd.verb == MotionVerb::kNone) return MotionCommand::kNone;
+  if (cmd.verb == MotionVerb::kEnable && (task.sup.state != SupervisorState::kRun || !measured))
+    return MotionCommand::kNone;
+  rep.id = cmd.id;
+  rep.verb = cmd.verb;
+  MotionReason pre = cmd.refusal;
+  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kMoveTo && cmd.epoch != task.gen.epoch())
+    pre = MotionReason::kSuperseded;
+  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kPaper && task.gen.source() != MotionSource::kHold)
+    pre = MotionReason::kBusy;
+  if (pre == MotionReason::kNone) return verb_command(cmd.verb);
+  rep.outcome = CommandOutcome::kRefused;
+  rep.refusal = pre;
+  return MotionCommand::kNone;
+}
+
+/// What an accepted command and the machine's step ask of the generator and the controller, from
+/// the next tick on.
+template <class S>
+void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before, const Vec6<S>& q) {
+  const std::uint64_t next = task.tick + 1;
+  const bool accepted = st.outcome == CommandOutcome::kAccepted;
+  const TaskCommand<S>& cmd = task.pending;
+  if (st.enabling) {
+    controller_restart(task.model, task.state, q);
+    task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+    task.ramping = true;
+    task.ramp_start = next;
+  }
+  if (accepted && cmd.verb == MotionVerb::kMoveTo) {
+    if (cmd.brake) {
+      task.report.aborted_id = task.gen.running_id();
+      if (task.gen.source() != MotionSource::kHold) task.report.abort = MotionReason::kSuperseded;
+      task.gen.brake(next, params::kControlHz, task.limits);
+    }
+    task.gen.push(cmd.move, cmd.id);
+    task.gen.start_moves(next);
+  }
+  if (accepted && cmd.verb == MotionVerb::kPaper) task.gen.start_paper(task.gains.trajectory, next, cmd.id);
+  if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping)
+    task.gen.stop(next, params::kControlHz, task.limits);
+  if (accepted && cmd.verb == MotionVerb::kClear) {
+    task.sup = {SupervisorState::kInit, 0};
+    task.stuck.reset();
+    task.saturation.reset();
+  }
+  if (!motion_powered(st.machine.state)) task.ramping = false;
+}
+
+/// The motion stage at the end of a tick: the tick's command, faults and the generator's events
+/// through the state machine (motion_next), then what it decided (motion_apply). Returns whether
+/// torque may reach the DACs in this tick.
+template <class S>
+bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, const Vec6<S>& q, const MotionEvents& ev,
+                   MotionReason stop_request) {
+  task.report = {};
+  MotionInput in;
+  in.command = motion_command_of_tick(task, measured);
+  in.faults = faults;
+  in.stop_request = stop_request;
+  in.motion_finished = ev.finished;
+  in.stopped = ev.stopped;
+  const MotionState before = task.machine.state;
+  const std::uint32_t running = task.gen.running_id();
+  const MotionStep st = motion_next(task.machine, in);
+  task.machine = st.machine;
+  MotionReport& rep = task.report;
+  if (in.command != MotionCommand::kNone) {
+    rep.outcome = st.outcome;
+    rep.refusal = st.refusal;
+    rep.cause = st.cause;
+  }
+  rep.abort = st.abort;
+  rep.completion = st.completion;
+  rep.done_id = ev.done_id;
+  if (st.abort != MotionReason::kNone) rep.aborted_id = running;
+  motion_apply(task, st, before, q);
+  if (rep.verb != MotionVerb::kNone) task.pending.verb = MotionVerb::kNone;  // answered: taken
+  return st.torque;
+}
+
 /// One tick, the block diagram in five timed stages (TickStage): read, checks, step, monitors,
-/// output. Returns the fault bits detected in this tick. On any fault, whenever the supervisor is
-/// not in kRun, and in a tick without a valid sample (read_encoders() false: no control step), every
-/// DAC gets code 0 in this same tick.
+/// output; then the supervisor and the motion state machine. Returns the fault bits detected in
+/// this tick. On any fault, whenever the supervisor is not in kRun or the motion state machine has
+/// the torque off, and in a tick without a valid sample (read_encoders() false: no control step),
+/// every DAC gets code 0 in this same tick.
 template <class S, hal::ControlHal Hal>
 std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   std::uint32_t mark[kTickStages + 1];
@@ -116,10 +259,14 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageStep] = hal.cycles();
   // step
   for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
-  const bool stepped = sampled && task.sup.state != SupervisorState::kFault && faults == 0;
+  // The angles of a sample that passed the checks (the others are not converted: a wild count
+  // would saturate a fixed-point angle); the start pose otherwise, unused.
+  const bool measured = sampled && faults == 0;
+  const Vec6<S> q = measured ? angles_from_counts(task.q_start, task.counts_per_rad, counts) : task.q_start;
+  const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
+  MotionEvents ev;
   if (stepped) {
-    const Vec6<S> q = angles_from_counts(task.q_start, task.counts_per_rad, counts);
-    const Desired<S> d = task.motion.at_tick(task.tick, params::kControlHz);
+    const Desired<S> d = task.gen.at_tick(task.tick, params::kControlHz, ev);
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, d);
     task.step_timing.add(hal.cycles() - s0);
@@ -130,6 +277,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, moved);
   mark[kStageOutput] = hal.cycles();
   // output
+  if (stepped && task.ramping) ramp_torque(task);
   if (stepped)
     for (int i = 0; i < kDof; ++i)
       faults |= task.saturation.check(i, torque_to_code(i, task.last.tau(i), task.codes[i]));
@@ -140,7 +288,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
-  if (!torque_enabled(task.sup))
+  const MotionReason limit = stepped ? motion_limits_reached(task, q) : MotionReason::kNone;
+  const bool torque = motion_update(task, faults, measured, q, ev, limit);
+  if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   hal.write_dacs(task.codes);
   hal.fault_output(task.sup.state == SupervisorState::kFault);

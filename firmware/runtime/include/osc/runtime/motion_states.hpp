@@ -56,7 +56,11 @@ namespace osc {
   X(StopCommand, "stop_command", "a stop command aborted the motion")                                      \
   X(DisableCommand, "disable_command", "a disable command aborted the motion (stop, then disabled)")       \
   X(StaleStream, "stale_stream", "the runtime stopped the motion: its stream of setpoints went stale")     \
-  X(LimitReached, "limit_reached", "the runtime stopped the motion: a limit was reached")
+  X(LimitReached, "limit_reached", "the runtime stopped the motion: a limit was reached")                   \
+  X(Busy, "busy", "a paper command while a motion runs: stop it, or wait until it is done")                   \
+  X(Superseded, "superseded",                                                                                \
+    "a re-targeting move_to replaced the motion (aborted); or the queue changed between a command's planning "  \
+    "and its tick (refused: send it again)")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -93,13 +97,12 @@ OSC_MOTION_ENUM(MotionReason, OSC_MOTION_REASON_LIST);
 OSC_MOTION_ENUM(CommandOutcome, OSC_COMMAND_OUTCOME_LIST);
 OSC_MOTION_ENUM(StopCategory, OSC_STOP_CATEGORY_LIST);
 OSC_MOTION_ENUM(MotionCompletion, OSC_MOTION_COMPLETION_LIST);
-#undef OSC_MOTION_ENUM
-#undef OSC_X_PREFIX
+#undef OSC_X_PREFIX  // OSC_MOTION_ENUM stays defined: motion_commands.hpp declares its verbs with it
 
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
 static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kFault) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kClear) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kLimitReached) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kSuperseded) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kStopped) + 1);

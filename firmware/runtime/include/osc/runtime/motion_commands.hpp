@@ -1,0 +1,143 @@
+// The commands a client gives the control task (issue 23), how each is prepared outside the
+// interrupt, and what the task reports back.
+//
+// A command is prepared where there is time (the main loop of a board, the host's driver): a move
+// is checked against the configured limits, planned from where the queue will end
+// (MotionGenerator::queue_end, or where the running motion would come to rest for a re-target or
+// after the paper's motion) and checked along its path. What the geometry and the limits decide is
+// a refusal already (over_limit, queue_full, busy, out_of_workspace, near_singular). The prepared
+// command then waits in the task's mailbox (ControlTask::pending) for the next tick, which passes
+// it to the motion state machine (motion_states.hpp: not_enabled, stopping, faulted) and, once
+// accepted, to the generator: its effect starts with the tick after (one tick from arrival to the
+// first changed setpoint).
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/motion.hpp"
+#include "osc/runtime/motion_states.hpp"
+
+namespace osc {
+
+// X(Name, "name", meaning): the verbs of the command frame, in code order.
+#define OSC_MOTION_VERB_LIST(X)                                                                          \
+  X(None, "none", "no command")                                                                          \
+  X(Enable, "enable", "torque on, holding the measured pose; the observer starts there")                 \
+  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")                    \
+  X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion")      \
+  X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                     \
+  X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")             \
+  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")
+
+#define OSC_X_PREFIX k
+OSC_MOTION_ENUM(MotionVerb, OSC_MOTION_VERB_LIST);
+#undef OSC_X_PREFIX
+
+/// The state machine's command for a verb (a code outside the list: none).
+constexpr MotionCommand verb_command(MotionVerb v) {
+  switch (v) {
+    case MotionVerb::kEnable:
+      return MotionCommand::kEnable;
+    case MotionVerb::kDisable:
+      return MotionCommand::kDisable;
+    case MotionVerb::kMoveTo:
+    case MotionVerb::kPaper:
+      return MotionCommand::kMove;
+    case MotionVerb::kStop:
+      return MotionCommand::kStop;
+    case MotionVerb::kClear:
+      return MotionCommand::kClear;
+    case MotionVerb::kNone:
+      break;
+  }
+  return MotionCommand::kNone;
+}
+
+/// A move_to: the target of the wrist centre and, optionally, of the orientation; relative to
+/// where the queue ends (position offset in the base frame, rotation applied in the base frame)
+/// or absolute (the base-frame position; R = Rz(yaw) Ry(pitch) Rx(roll)); optional limits, each at
+/// most the configured maximum.
+template <class S>
+struct MoveRequest {
+  Vec3<S> position = Vec3<S>::Zero();  ///< [m]
+  Vec3<S> rpy = Vec3<S>::Zero();       ///< [rad], with has_rpy
+  bool relative = false;
+  bool has_rpy = false;
+  bool replace = false;  ///< re-target: brake the running motion along its path, drop the queue, go
+  bool has_limits = false;
+  CartesianLimits<S> limits{};
+};
+
+/// A command ready for the next tick.
+template <class S>
+struct TaskCommand {
+  MotionVerb verb = MotionVerb::kNone;
+  std::uint32_t id = 0;                         ///< the client's, echoed in the reports
+  MotionReason refusal = MotionReason::kNone;   ///< decided while preparing
+  bool brake = false;                           ///< move_to: brake the running motion first
+  std::uint32_t epoch = 0;                      ///< the generator's, when the move was planned
+  CartesianMove<S> move{};                      ///< move_to: the planned move
+};
+
+/// What one tick reports: the answer to its command, and a motion's end.
+struct MotionReport {
+  std::uint32_t id = 0;  ///< the command answered in this tick (0 with outcome none)
+  MotionVerb verb = MotionVerb::kNone;
+  CommandOutcome outcome = CommandOutcome::kNone;
+  MotionReason refusal = MotionReason::kNone;
+  std::uint32_t cause = 0;  ///< with refusal faulted: the fault bits behind it
+  /// A motion command (move_to, paper) that ended in this tick: done (its move reached its target
+  /// at rest) or aborted (why); 0: none.
+  std::uint32_t done_id = 0, aborted_id = 0;
+  MotionReason abort = MotionReason::kNone;
+  MotionCompletion completion = MotionCompletion::kNone;
+};
+
+/// The pose a move_to asks for, from where its move starts.
+template <class S>
+Pose<S> move_target(const Pose<S>& from, const MoveRequest<S>& req) {
+  Pose<S> to = from;
+  to.p = req.relative ? Vec3<S>(from.p + req.position) : req.position;
+  if (req.has_rpy) to.R = req.relative ? Mat3<S>(rpy_rotation<S>(req.rpy) * from.R) : rpy_rotation<S>(req.rpy);
+  return to;
+}
+
+/// Prepares a move_to for the tick `next_tick`: limits, queue, plan (the path check is the
+/// caller's, on the planned move). `max`: the configured limits.
+template <class S>
+TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits<S>& max, std::uint64_t next_tick,
+                            std::uint32_t rate_hz, const MoveRequest<S>& req, std::uint32_t id) {
+  TaskCommand<S> c;
+  c.verb = MotionVerb::kMoveTo;
+  c.id = id;
+  c.epoch = gen.epoch();
+  const CartesianLimits<S> lim = req.has_limits ? req.limits : max;
+  if (!lim.within(max)) {
+    c.refusal = MotionReason::kOverLimit;
+    return c;
+  }
+  // A re-target, or a move after the paper's motion, starts where the running motion comes to rest
+  // when braked in the tick after the command's.
+  c.brake = req.replace || gen.source() == MotionSource::kPaper;
+  if (!c.brake && gen.queue_full()) {
+    c.refusal = MotionReason::kQueueFull;
+    return c;
+  }
+  const Pose<S> from = c.brake ? gen.brake_end(next_tick + 1, rate_hz, max) : gen.queue_end();
+  if (c.move.plan(from, move_target(from, req), lim, gen.reference_orientation()) != ProfileStatus::kOk)
+    c.refusal = MotionReason::kOverLimit;  // a rotation beyond kMaxMoveRotation, a non-finite target
+  return c;
+}
+
+/// Prepares a command without a plan (every verb but move_to).
+template <class S>
+TaskCommand<S> prepare_command(const MotionGenerator<S>& gen, MotionVerb verb, std::uint32_t id) {
+  TaskCommand<S> c;
+  c.verb = verb;
+  c.id = id;
+  c.epoch = gen.epoch();
+  if (verb == MotionVerb::kPaper && gen.source() != MotionSource::kHold) c.refusal = MotionReason::kBusy;
+  return c;
+}
+
+}  // namespace osc
