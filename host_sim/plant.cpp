@@ -176,6 +176,11 @@ void Plant::integrate(const Vec6& tau, double duration) {
 }
 
 void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) {
+  if (braked_) {  // the brakes hold every joint: time passes, nothing moves
+    qd_.setZero();
+    t_ += dt;
+    return;
+  }
   const double d = std::min(cfg_.compute_delay, dt);
   integrate(tau_old, d);
   integrate(tau_new, dt - d);

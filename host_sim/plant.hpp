@@ -56,6 +56,11 @@ class Plant {
   void reset(const Vec6& q0, const Vec6& qd0 = Vec6::Zero());
   /// Advances one control sample of length dt: tau_old is held for the computation delay, then tau_new.
   void advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt);
+  /// The holding brakes: engaged, advance_sample() keeps every joint where it is, at rest (a PUMA's
+  /// brakes hold the arm while its power is off; the commanded-motion simulation engages them while
+  /// the controller is disabled or in fault).
+  void set_brakes(bool engaged) { braked_ = engaged; }
+  bool brakes() const { return braked_; }
   /// Integrates for duration with constant torque tau.
   void integrate(const Vec6& tau, double duration);
 
@@ -80,6 +85,7 @@ class Plant {
   osc::FrictionParams<double> friction_;  // the true friction, model (2) (the kernels' friction_torque)
   Vec6 q_ = Vec6::Zero(), qd_ = Vec6::Zero();
   double t_ = 0;
+  bool braked_ = false;
   mutable long evaluations_ = 0;
 };
 

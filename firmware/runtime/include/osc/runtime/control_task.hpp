@@ -149,8 +149,9 @@ void ramp_torque(ControlTask<S>& task) {
   task.last.tau = g + math::ratio<S>(n, kTicks) * (task.last.tau - g);
 }
 
-/// The command of the tick as the state machine sees it: none while an enable waits for a measured
-/// pose (the supervisor running and a checked sample in this tick: it stays pending), or when preparing refused it (the
+/// The command of the tick as the state machine sees it: none while an enable from disabled waits
+/// for a measured pose (the supervisor running and a checked sample in this tick: it stays
+/// pending), or when preparing refused it (the
 /// refusal goes into the report) or it is no longer valid (its plan's epoch passed: superseded; a
 /// paper command when the generator does not hold: busy).
 template <class S>
@@ -158,7 +159,8 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured) {
   const TaskCommand<S>& cmd = task.pending;
   MotionReport& rep = task.report;
   if (cmd.verb == MotionVerb::kNone) return MotionCommand::kNone;
-  if (cmd.verb == MotionVerb::kEnable && (task.sup.state != SupervisorState::kRun || !measured))
+  if (cmd.verb == MotionVerb::kEnable && task.machine.state == MotionState::kDisabled &&
+      (task.sup.state != SupervisorState::kRun || !measured))
     return MotionCommand::kNone;
   rep.id = cmd.id;
   rep.verb = cmd.verb;
@@ -183,6 +185,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (st.enabling) {
     controller_restart(task.model, task.state, q);
     task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+    task.stuck.reset(true);
     task.ramping = true;
     task.ramp_start = next;
   }

@@ -100,8 +100,12 @@ struct StuckEncoderMonitor {
   Vec6<S> dtau_peak;                   // the largest torque change seen while an encoder stood still
   Vec6<S> dtau_gated_peak;             // ... while it was silent for kStuckIntervals of its intervals
   Vec6<S> peak;                        // the largest motion seen
+  bool restart = false;                // the next check takes every encoder as just changed
 
-  void reset() {
+  /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
+  /// the torque jumps from zero to what holds the arm, and no encoder needs to count for that).
+  void reset(bool restart_next = false) {
+    restart = restart_next;
     motion.setZero();
     peak.setZero();
     tau_at_move.setZero();
@@ -119,9 +123,11 @@ struct StuckEncoderMonitor {
     static constexpr std::array<S, kDof> kTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
     static constexpr S kMotionBound = lit<S>(kStuckMotionBound), kMotionCounts = lit<S>(params::kStuckMotionCounts);
     std::uint32_t faults = 0;
+    const bool fresh = restart;
+    restart = false;
     for (int i = 0; i < kDof; ++i) {
       S& m = motion(i);
-      if (moved[i]) {
+      if (moved[i] || fresh) {
         const std::uint64_t gap = tick - last_move_tick[i];
         move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
         last_move_tick[i] = tick;

@@ -1,0 +1,82 @@
+// The simulated arm under commanded motion: the firmware's control task (in process, any scalar)
+// over the simulated PUMA 560 (PlantHal), started disabled, driven by commands as a board's main
+// loop would drive it: each command is prepared (motion_commands.hpp) and put in the task's mailbox,
+// which the next tick takes. The plant's brakes hold the arm while the controller is disabled or in
+// fault and release when it holds torque (a PUMA's arm power and brakes).
+//
+// Used by the closed-loop tests of commanded motion (tests/host_sim/test_motion_sim.cpp) and the
+// runner's scripted motions.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "osc/runtime/control_task.hpp"
+#include "plant.hpp"
+#include "plant_hal.hpp"
+
+namespace sim {
+
+template <class S>
+class MotionSim {
+ public:
+  /// The arm at rest at q0, its encoders zeroed there (the task's q_start), the controller disabled.
+  /// inj: a simulated hardware fault (injection.hpp), none by default.
+  explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
+                     osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
+                     const osc::Gains<double>& gains = osc::Gains<double>::paper())
+      : plant_(pc), hal_(plant_, q0, osc::robot::kDrives.encoder_counts_per_motor_rev, inj), task_(new osc::ControlTask<S>) {
+    plant_.reset(q0);
+    plant_.set_brakes(true);
+    task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(),
+                PlantHal::kPeriodNs, osc::TaskStart::kDisabled);
+  }
+
+  /// A command without a plan (enable, disable, paper, stop, clear), taken by the next tick.
+  void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command(task_->gen, verb, id); }
+  /// A move_to, prepared from where the queue will end, taken by the next tick.
+  void move_to(const osc::MoveRequest<S>& req, std::uint32_t id) {
+    task_->pending = osc::prepare_move(task_->gen, task_->limits, task_->tick, osc::params::kControlHz, req, id);
+  }
+  /// Whether the mailbox is free for the next command.
+  bool idle() const { return task_->pending.verb == osc::MotionVerb::kNone; }
+
+  /// One control period: the task's tick, then the plant over one sample with the torque the
+  /// amplifiers produce. Returns the tick's fault bits.
+  std::uint32_t tick() {
+    hal_.begin_sample(plant_.time());
+    const std::uint32_t faults = osc::control_tick(*task_, hal_);
+    const Vec6 tau = hal_.torque();
+    plant_.set_brakes(!osc::motion_powered(task_->machine.state));
+    plant_.advance_sample(tau_before_, tau, osc::params::kDt);
+    tau_before_ = tau;
+    return faults;
+  }
+
+  /// The wrist centre of the simulated arm [m] (the point the controller tracks).
+  Vec3 tip() const {
+    osc::forward_kinematics(model_, data_, plant_.q());
+    return data_.o[osc::kDof];
+  }
+  /// The reference of the last tick, x_d = x + e (the step's measured x and error).
+  Vec6 reference() const {
+    Vec6 r;
+    for (int i = 0; i < 6; ++i) r(i) = static_cast<double>(task_->last.x(i) + task_->last.e(i));
+    return r;
+  }
+
+  osc::ControlTask<S>& task() { return *task_; }
+  const osc::ControlTask<S>& task() const { return *task_; }
+  Plant& plant() { return plant_; }
+  PlantHal& hal() { return hal_; }
+
+ private:
+  Plant plant_;
+  PlantHal hal_;
+  std::unique_ptr<osc::ControlTask<S>> task_;  // large: keep off the stack
+  Vec6 tau_before_ = Vec6::Zero();
+  const osc::Model<double> model_ = osc::Model<double>::of(osc::robot::kArm);
+  mutable osc::Data<double> data_;
+};
+
+}  // namespace sim
