@@ -62,6 +62,10 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("--print-config", o.print_config, "print the effective configuration as YAML and exit");
+  app.add_option("--motion", o.motion,
+                 "play a motion script (timed commands: enable, move_to, paper, stop, disable, clear; "
+                 "docs/motion.md, examples/) on the simulated arm instead of the paper's experiment")
+      ->type_name("FILE.yaml");
   values.resize(std::size(kShorthands));
   for (size_t i = 0; i < std::size(kShorthands); ++i)
     app.add_option(kShorthands[i].flag, values[i], std::string(kShorthands[i].help) + "; sets " + kShorthands[i].key)
@@ -163,6 +167,9 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
     if (!o.qemu) return err = "--pil-link applies with --qemu only", false;
   }
   if (app.get_option("--json")->count() > 0 && o.json.empty()) return err = "--json needs a file name", false;
+  if (app.get_option("--motion")->count() > 0 && o.motion.empty()) return err = "--motion needs a file name", false;
+  if (!o.motion.empty() && o.qemu)
+    return err = "--motion runs the host-built controller (the command frames to the image are the next step)", false;
   if (o.csv_dir.empty()) return err = "--csv-dir needs a directory", false;
 
   if (o.qemu) {

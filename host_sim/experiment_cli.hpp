@@ -12,6 +12,7 @@ namespace sim {
 
 struct ExperimentOptions : Settings {
   std::string config_file;    ///< --config (empty: the defaults)
+  std::string motion;         ///< --motion: a motion script (motion_script.hpp) instead of the paper's experiment
   bool print_config = false;  ///< --print-config: print the effective configuration and exit 0
   std::string json, csv_dir = "out";
   bool csv = true, progress = true;

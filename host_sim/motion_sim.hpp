@@ -58,11 +58,15 @@ class MotionSim {
     osc::forward_kinematics(model_, data_, plant_.q());
     return data_.o[osc::kDof];
   }
-  /// The reference of the last tick, x_d = x + e (the step's measured x and error).
-  Vec6 reference() const {
-    Vec6 r;
-    for (int i = 0; i < 6; ++i) r(i) = static_cast<double>(task_->last.x(i) + task_->last.e(i));
-    return r;
+  /// The reference of the last step, x_d (the generator's, in the controller's coordinates).
+  Vec6 reference() const { return task_->desired.x.template cast<double>(); }
+  /// The true pose of the simulated arm in the controller's coordinates: the wrist centre and the
+  /// orientation relative to the controller's reference orientation.
+  Vec6 pose() const {
+    osc::forward_kinematics(model_, data_, plant_.q());
+    Vec6 x;
+    x << data_.o[osc::kDof], osc::orientation_coordinates<double>(data_.R[osc::kDof], task_->state.R_ref.template cast<double>());
+    return x;
   }
 
   osc::ControlTask<S>& task() { return *task_; }

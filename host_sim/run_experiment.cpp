@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -18,6 +19,7 @@
 #include "config.hpp"
 #include "experiment.hpp"
 #include "experiment_cli.hpp"
+#include "motion_script.hpp"
 #include "summary.hpp"
 #include "output_file.hpp"
 #include "pil_client.hpp"
@@ -214,6 +216,44 @@ int write_outputs(const Options& o, const std::vector<sim::ExperimentResult>& ru
   return 0;
 }
 
+/// --motion: plays the script on the simulated arm, prints a line per command, writes the JSON. 0: the
+/// script ran without a fault; 1: a fault or a timeout; 2: a bad script or output.
+int run_motion(const Options& o, int json_fd) {
+  std::string text, err;
+  {
+    std::ifstream f(o.motion, std::ios::binary);
+    if (!f) return fail("cannot read motion script " + o.motion);
+    text.assign(sim::kMaxConfigBytes + 1, '\0');
+    f.read(text.data(), static_cast<std::streamsize>(text.size()));
+    text.resize(static_cast<std::size_t>(f.gcount()));
+    if (text.size() > sim::kMaxConfigBytes) return fail("motion script " + o.motion + " is larger than 1 MiB");
+  }
+  sim::MotionScript script;
+  if (!sim::parse_motion_script(text, o.motion, script, err)) return fail(err);
+  sim::ExperimentConfig cfg = o.base;
+  cfg.mode = o.run_adaptive ? osc::FrictionMode::kAdaptive : osc::FrictionMode::kNone;
+  const sim::MotionRun run = sim::run_motion_script(script, cfg);
+  std::printf("motion script %s (%s, %s): %s after %.3f s; max tracking error %.3f mm, %.3f deg\n", o.motion.c_str(),
+              sim::kScalarNames[static_cast<int>(cfg.scalar)], sim::mode_name(cfg.mode), run.result.c_str(),
+              run.duration_s, run.max_error_mm, run.max_error_deg);
+  for (const sim::CommandRecord& r : run.commands) {
+    std::printf("  %6.3f s  %-8s %-9s", r.sent_s, r.cmd.c_str(), r.accepted ? "accepted" : ("refused " + r.refused).c_str());
+    if (r.done_s >= 0) std::printf("  done %.3f s", r.done_s);
+    if (!r.aborted.empty()) std::printf("  aborted %s at %.3f s", r.aborted.c_str(), r.aborted_s);
+    if (r.v > 0) std::printf("  tracking %.3f mm %.3f deg, v %.3f m/s", r.max_error_mm, r.max_error_deg, r.v);
+    std::printf("\n");
+  }
+  if (!o.json.empty()) {
+    const std::string out = sim::motion_run_json(run, o.motion, cfg);
+    std::fflush(stdout);
+    const bool ok = json_fd >= 0 ? sim::write_all(json_fd, out, "standard output", err) && close(json_fd) == 0
+                                 : sim::write_output(o.json, out, err);
+    if (!ok) return fail_output(err);
+    std::printf("summary: %s\n", o.json.c_str());
+  }
+  return run.result == "ok" ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -230,6 +270,7 @@ int main(int argc, char** argv) {
   }
   int json_fd = -1;
   if (const int code = prepare(o, json_fd)) return code;
+  if (!o.motion.empty()) return run_motion(o, json_fd);
 
   sim::Provenance prov;
   prov.revision = sim::git_revision();

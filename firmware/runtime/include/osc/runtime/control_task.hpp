@@ -43,6 +43,7 @@ struct ControlTask {
   std::uint64_t ramp_start;   // the tick the enable's torque ramp started
   bool ramping;               // the torque is being ramped in (enable)
   StepOutput<S> last;         // the most recent step, for telemetry
+  Desired<S> desired;         // the most recent step's desired state (the generator's reference)
   std::int32_t codes[kDof];   // the most recent DAC codes
   EncoderRangeMonitor range;  // the encoder checks (osc/runtime/monitors.hpp)
   EncoderJumpMonitor jump;
@@ -69,6 +70,7 @@ struct ControlTask {
       gen.start_paper(gains.trajectory, 0);
     }
     limits = CartesianLimits<S>::defaults();
+    desired.x.setZero(), desired.xd.setZero(), desired.xdd.setZero();
     pending = {};
     report = {};
     ramp_start = 0;
@@ -269,9 +271,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
   MotionEvents ev;
   if (stepped) {
-    const Desired<S> d = task.gen.at_tick(task.tick, params::kControlHz, ev);
+    task.desired = task.gen.at_tick(task.tick, params::kControlHz, ev);
     const std::uint32_t s0 = hal.cycles();
-    task.last = control_step(task.model, task.gains, task.mode, task.state, q, d);
+    task.last = control_step(task.model, task.gains, task.mode, task.state, q, task.desired);
     task.step_timing.add(hal.cycles() - s0);
     faults |= task.last.status;  // non_finite, singular
   }

@@ -1,0 +1,79 @@
+// Scripted motions (puma_experiment --motion FILE.yaml): a list of timed commands played in
+// lockstep against the simulated arm (motion_sim.hpp), with what each command did.
+//
+// The script (docs/motion.md, "Scripted motions"; examples/*.yaml):
+//   start_pose: [q1, ..., q6]      optional, degrees; the robot's start pose by default
+//   timeout: SECONDS               optional, 600: a run that has not ended by then is a timeout
+//   settle: SECONDS                optional, 1: how long the run goes on after the last step
+//   steps:
+//     - at: SECONDS | after: done  when it is sent: at that time (and after the step before it), or
+//                                  once the step before it was answered and the arm is at rest
+//       cmd: enable | disable | move_to | paper | stop | clear
+//       # move_to only:
+//       position: [x, y, z]        the wrist centre [m], base frame (an offset if relative)
+//       rpy_deg: [r, p, y]         optional orientation, R = Rz(y) Ry(p) Rx(r) (a rotation if relative)
+//       relative: true             optional
+//       replace: true              optional: re-target the running motion instead of queueing
+//       v: .., a: .., j: ..        optional linear limits [m/s, m/s^2, m/s^3], at most the maxima
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "experiment.hpp"
+#include "osc/runtime/motion_commands.hpp"
+
+namespace sim {
+
+struct MotionStepSpec {
+  bool after_done = false;  ///< sent once the previous step was answered and the arm is at rest
+  double at = 0;            ///< else: sent at this time [s]
+  osc::MotionVerb verb = osc::MotionVerb::kNone;
+  osc::MoveRequest<double> move;  ///< move_to
+  std::string text;               ///< the step as written, for the JSON
+};
+
+struct MotionScript {
+  std::vector<MotionStepSpec> steps;
+  std::optional<Vec6> start_pose;  ///< [rad]
+  double timeout = 600, settle = 1;
+};
+
+/// Parses a script (YAML text); false with one message naming the step and the key on error.
+bool parse_motion_script(const std::string& text, const std::string& name, MotionScript& script, std::string& err);
+
+/// What one command did.
+struct CommandRecord {
+  std::string cmd, step;
+  std::uint32_t id = 0;
+  double sent_s = -1, answered_s = -1, done_s = -1, aborted_s = -1;
+  bool accepted = false;
+  std::string refused, aborted;  ///< reason names (empty: none)
+  std::uint32_t cause = 0;
+  double max_error_mm = 0, max_error_deg = 0;  ///< tracking while the command's motion ran
+  double v = 0, a = 0, j = 0, w = 0, wd = 0;   ///< the reference's own maxima while it ran
+  bool running = false;                        ///< its motion is on (accepted, not yet ended)
+};
+
+struct MotionRun {
+  std::vector<CommandRecord> commands;
+  struct Transition {
+    double t;
+    std::string state;
+  };
+  std::vector<Transition> states;
+  std::uint32_t faults = 0;  ///< every fault bit seen
+  double fault_s = -1;
+  std::string result;  ///< "ok", "faulted" or "timeout"
+  double duration_s = 0, max_error_mm = 0, max_error_deg = 0;
+};
+
+/// Plays the script in the given scalar against the simulated arm (plant set-up from cfg).
+MotionRun run_motion_script(const MotionScript& script, const ExperimentConfig& cfg);
+
+/// The run as JSON text (commands[], states[], faults, result).
+std::string motion_run_json(const MotionRun& run, const std::string& script_name, const ExperimentConfig& cfg);
+
+}  // namespace sim
