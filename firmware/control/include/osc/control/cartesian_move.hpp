@@ -152,6 +152,10 @@ class CartesianMove {
     return d;
   }
 
+  /// The pose at time t (as at(t), before 0 the start, after duration() the end): the position and
+  /// the rotation Rot(k, psi(t)) R0 themselves, without the orientation coordinates (the path check,
+  /// path_check.hpp, follows these).
+  Pose<S> pose_at(S t) const { return {p0_ + u_ * s_.at(t).p, axis_rotation<S>(k_, psi_.at(t).p) * R0_}; }
   /// The pose at rest at the end (after a stop: where the stop ends).
   Pose<S> end() const { return {p0_ + u_ * s_.target(), axis_rotation<S>(k_, psi_.target()) * R0_}; }
   S duration() const { return s_.duration() > psi_.duration() ? s_.duration() : psi_.duration(); }

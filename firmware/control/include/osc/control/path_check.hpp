@@ -1,0 +1,293 @@
+// The path check of a point-to-point move (cartesian_move.hpp): before a move is accepted, whether
+// the arm can follow it from where it is (or from where the move queued before it ends) on the same
+// inverse-kinematics branch, with every joint inside its limits and the Jacobian well-conditioned.
+//
+// The path is sampled at params::kPathCheckPoints evenly spaced times t_i = i T / N, i = 0 .. N - 1
+// (T the move's duration, N = kPathCheckPoints), and at its end (i = N). At each sample the joint
+// angles q_i solving the pose (p_d, R_d) = move.pose_at(t_i) come from a few Newton steps that start
+// from the previous sample's solution (the first from the seed q, the arm's current angles):
+//   e = [p_d - p(q); 1/2 sum_c r_c(q) x r_d,c]       (r_c, r_d,c: the columns of R(q), R_d)
+//   q <- q + J(q)^{-1} e                               (J the geometric Jacobian of the wrist centre)
+// For R_d = Rot(k, theta) R(q) the orientation error is sin(theta) k, the rotation that J's angular
+// rows map the joint rates to, so the step is Newton's for the pose (quadratic convergence, no
+// orientation coordinates). J^{-1} is SphericalWristJacobianFactor's (opspace.hpp): two 3x3 inverses,
+// no 6x6 one. Each step is scaled down, if need be, so that no joint moves more than kMaxStep: a
+// damped Newton where J is nearly singular. Starting every sample from the one before keeps the
+// solution on the seed's branch (elbow up or down, wrist flipped or not, the seed's turn of each
+// joint): there is no closed-form solution and no switch between branches, and the joint limits are
+// those of the path the arm would actually follow.
+//
+// A sample fails, and the check stops there, in the order tested:
+//   kUnreachable     the Newton steps left a residual above kPositionTolerance or
+//                    kOrientationTolerance (or R more than 90 degrees from R_d): no solution on the
+//                    seed's branch near the previous sample's. A pose beyond the arm's reach, or one
+//                    past a fold of the branch, where the path touches a singular pose without
+//                    crossing it and only another branch goes on (the shoulder singularity, the
+//                    wrist centre passing next to joint 1's axis, is the usual one). Newton cannot
+//                    tell the two apart without a global solution; the caller reports both as
+//                    out_of_workspace.
+//   kOutOfWorkspace  a joint closer than params::kWorkspaceMargin to one of its limits
+//                    (robot::kArm.q_min, q_max);
+//   kNearSingular    the reciprocal condition that the controller tests (that of the analytic
+//                    Jacobian in the orientation coordinates relative to R_ref, controller.hpp)
+//                    below params::kPathMinRcond, or a singularity crossed since the sample before
+//                    (below), or in fixed point a saturated result in the sample's arithmetic (a
+//                    division by a near-zero determinant).
+// Between two samples the joints move continuously along the branch. A singularity the path
+// crosses there, with both samples' rcond above the threshold (joint 5 passing through 0 between
+// two samples), changes the sign of the determinant of one of the Jacobian's blocks, J11 (arm) or
+// J22 (wrist), or turns the roll and yaw coordinates by pi (pitch passing +-90 degrees relative to
+// R_ref): both are compared with the sample before. What a joint does between two samples the margin
+// kWorkspaceMargin covers, and kPathMinRcond is ten times the controller's threshold.
+//
+// Cost, bounded: the iteration counts are fixed (kFirstIterations at the first sample,
+// kIterations at each other), one forward kinematics, geometric Jacobian and factorisation each:
+// kEvaluations = 1 + 6 + 16 x 4 = 71 of them per check, plus per sample (17) one pose on the path
+// (pose_at), the orientation coordinates and the analytic Jacobian's factorisation. It runs when a
+// move is accepted, not every tick.
+//
+// Allocation-free, templated on the scalar (double, float, osc::Fixed); the kernels' workspace Data
+// is the caller's. In fixed point the check raises the sticky arithmetic flags of its thread of
+// execution like any kernel (near a singularity a determinant's reciprocal saturates): it takes the
+// flags raised before it on entry and gives them back on return, its own discarded, so that a
+// control step after it sees only its own. (On a target where the control interrupt computes in
+// fixed point too, the check must not run where that interrupt can preempt it: they share the flags.)
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "osc/control/cartesian_move.hpp"
+#include "osc/control/params.hpp"
+#include "osc/kernels/opspace.hpp"
+#include "osc/robot.hpp"
+
+namespace osc {
+
+/// The outcome of a path check (the first failure met along the path).
+enum class PathStatus : std::uint8_t {
+  kOk = 0,
+  kOutOfWorkspace,  ///< a joint within kWorkspaceMargin of a limit (or beyond)
+  kNearSingular,    ///< the Jacobian's reciprocal condition below kPathMinRcond
+  kUnreachable      ///< Newton did not converge: no joint angles on the seed's branch reach the pose
+};
+
+namespace path_check {
+/// The clearance reported when no sample reached the joint limit test: beyond any joint's range.
+constexpr double kNoClearance = 2 * kPi;
+}  // namespace path_check
+
+/// What check_path found.
+template <class S>
+struct PathCheck {
+  PathStatus status = PathStatus::kOk;
+  /// The first failing sample: 0 the start, params::kPathCheckPoints the end; -1 when kOk.
+  int sample = -1;
+  /// The smallest distance of a joint to its nearer limit over the samples that reached the joint
+  /// limit test [rad] (the margin not subtracted: kOutOfWorkspace when below kWorkspaceMargin).
+  S clearance = lit<S>(path_check::kNoClearance);
+  /// The smallest reciprocal condition over the samples that reached the Jacobian test (a
+  /// singularity crossed between two samples fails the check whatever it is).
+  S rcond = S(1);
+  /// The largest residual left by the Newton steps over the samples: position [m] and orientation
+  /// (|sin| of the angle) [rad], each the largest coordinate.
+  S position_error = S(0), orientation_error = S(0);
+  /// The joint angles at the end of the path (when not kOk: at the failing sample): the seed of the
+  /// check of the move queued after this one.
+  Vec6<S> q_end = Vec6<S>::Zero();
+};
+
+namespace path_check {
+
+/// Newton steps at the first sample (from the seed, which may lie a tracking error away from the
+/// move's start) and at every other (from the previous sample's solution).
+constexpr int kFirstIterations = 6;
+constexpr int kIterations = 4;
+/// Forward kinematics with Jacobian per check.
+constexpr int kEvaluations = 1 + kFirstIterations + params::kPathCheckPoints * kIterations;
+/// The largest change of any joint in one Newton step [rad]; a longer step is scaled down to it.
+constexpr double kMaxStep = 0.5;
+/// The residual above which a sample is unreachable: position [m] and orientation [rad], each
+/// coordinate, the same for every scalar. Far above what converged Newton steps leave (measured over
+/// the tests' moves: double 1e-15, float 2.5e-7, Q12.19 7.6e-6, four of its resolutions), far below
+/// what a pose out of reach leaves (its distance beyond the reach: centimetres at the first sample
+/// past it, at 16 samples a path).
+constexpr double kPositionTolerance = 1e-4;
+constexpr double kOrientationTolerance = 1e-3;
+/// The joint limits in the scalar (converted at compile time).
+template <class S>
+constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
+template <class S>
+constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
+
+/// Fixed point: takes the sticky arithmetic flags (those raised before the check); 0 for float and
+/// double.
+template <class S>
+std::uint32_t take_flags() {
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::take_flags();
+  else
+    return 0;
+}
+/// Fixed point: a saturated result since the check began (the check stops at the sample that
+/// raised it); false for float and double.
+template <class S>
+bool saturated() {
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::flags() != 0;
+  else
+    return false;
+}
+/// Fixed point: discards the check's flags and raises again those taken on entry.
+template <class S>
+void restore_flags(std::uint32_t before) {
+  if constexpr (fixed::is_q_v<S>) {
+    fixed::take_flags();
+    if (before != 0) fixed::detail::raise_flag(before);
+  }
+}
+
+/// Forward kinematics and the geometric Jacobian at q, and the Jacobian's factors.
+template <class S>
+void evaluate(const Model<S>& model, Data<S>& data, SphericalWristJacobianFactor<S>& Jf, const Vec6<S>& q) {
+  forward_kinematics(model, data, q);
+  geometric_jacobian(data);
+  Jf.compute(data.J);
+}
+
+/// The error of the pose in data (forward_kinematics run) against the target:
+/// [p_d - p; 1/2 sum_c r_c x r_d,c], the second sin(theta) k for R_d = Rot(k, theta) R. aligned:
+/// trace(R^T R_d) = 1 + 2 cos(theta) > 1, so that a small sine is a small angle, not one near pi.
+template <class S>
+Vec6<S> pose_error(const Data<S>& data, const Pose<S>& target, bool& aligned) {
+  const Mat3<S>& R = data.R[kDof];
+  const Mat3<S>& Rd = target.R;
+  Vec6<S> e;
+  e.template head<3>() = target.p - data.o[kDof];
+  e.template tail<3>() =
+      lit<S>(0.5) * (cross(R.col(0), Rd.col(0)) + cross(R.col(1), Rd.col(1)) + cross(R.col(2), Rd.col(2)));
+  const S trace = dot_sum<S>(R.col(0), Rd.col(0), R.col(1), Rd.col(1)) + R.col(2).dot(Rd.col(2));
+  aligned = trace > S(1);
+  return e;
+}
+
+/// q <- q + J^{-1} e, the step scaled down to kMaxStep in its largest joint.
+template <class S>
+void newton_step(const SphericalWristJacobianFactor<S>& Jf, const Vec6<S>& e, Vec6<S>& q) {
+  Vec6<S> dq = Jf.solve(e);
+  const S longest = dq.cwiseAbs().maxCoeff();
+  const S max_step = lit<S>(kMaxStep);
+  if (longest > max_step) dq *= max_step / longest;
+  q += dq;
+}
+
+/// The smallest distance of a joint of q to its nearer limit [rad].
+template <class S>
+S joint_clearance(const Vec6<S>& q) {
+  S c = lit<S>(kNoClearance);
+  for (int i = 0; i < kDof; ++i) {
+    const S lo = q(i) - kQMin<S>[i], hi = kQMax<S>[i] - q(i);
+    if (lo < c) c = lo;
+    if (hi < c) c = hi;
+  }
+  return c;
+}
+
+/// What the singularity test of a sample leaves for the next one's: the signs of the determinants of
+/// the geometric Jacobian's two blocks (each changes sign where the path crosses a singularity of the
+/// arm, J11, or of the wrist, J22) and the orientation coordinates (roll and yaw turn by pi where the
+/// path crosses their own singularity, pitch = +-90 degrees).
+template <class S>
+struct SingularityTrace {
+  bool valid = false;  // a sample came before
+  bool arm_positive = false, wrist_positive = false;
+  Vec3<S> phi = Vec3<S>::Zero();
+};
+
+/// det M, by a triple product.
+template <class S>
+S det3(const Mat3<S>& M) {
+  return M.col(0).dot(cross(M.col(1), M.col(2)));
+}
+
+/// a - b turned into [-pi, pi] (a, b in [-pi, pi]).
+template <class S>
+S angle_difference(S a, S b) {
+  const S d = a - b, pi = lit<S>(kPi), two_pi = lit<S>(2 * kPi);
+  return d > pi ? S(d - two_pi) : (d < -pi ? S(d + two_pi) : d);
+}
+
+/// The singularity test of a sample (data evaluated at its solution): the reciprocal condition that
+/// the controller tests, that of the analytic Jacobian in the orientation coordinates relative to
+/// R_ref (controller.hpp), and a singularity crossed since the sample before (trace); in fixed point
+/// also a saturated result in the sample's arithmetic. r.rcond updated.
+template <class S>
+bool near_singular(const Data<S>& data, const Mat3<S>& R_ref, SingularityTrace<S>& trace, PathCheck<S>& r) {
+  const Vec3<S> phi = orientation_coordinates<S>(data.R[kDof], R_ref);
+  SphericalWristJacobianFactor<S> Jf;
+  Jf.compute(analytic_jacobian(data.J, phi));
+  if (!(Jf.rcond >= r.rcond)) r.rcond = Jf.rcond;
+  const bool arm = det3<S>(data.J.template topLeftCorner<3, 3>()) > S(0);
+  const bool wrist = det3<S>(data.J.template bottomRightCorner<3, 3>()) > S(0);
+  const S half_pi = lit<S>(kPi / 2);
+  const bool crossed = trace.valid && (arm != trace.arm_positive || wrist != trace.wrist_positive ||
+                                       math::abs(angle_difference(phi(0), trace.phi(0))) > half_pi ||
+                                       math::abs(angle_difference(phi(2), trace.phi(2))) > half_pi);
+  trace = {true, arm, wrist, phi};
+  return !(Jf.rcond >= lit<S>(params::kPathMinRcond)) || crossed || saturated<S>();
+}
+
+/// The tests of one sample at its solution q (data evaluated there), in order; r's extremes updated.
+template <class S>
+PathStatus classify(const Data<S>& data, const Pose<S>& target, const Mat3<S>& R_ref, const Vec6<S>& q,
+                    SingularityTrace<S>& trace, PathCheck<S>& r) {
+  bool aligned;
+  const Vec6<S> e = pose_error(data, target, aligned);
+  const S ep = e.template head<3>().cwiseAbs().maxCoeff(), eo = e.template tail<3>().cwiseAbs().maxCoeff();
+  if (!(ep <= r.position_error)) r.position_error = ep;
+  if (!(eo <= r.orientation_error)) r.orientation_error = eo;
+  if (!(ep <= lit<S>(kPositionTolerance)) || !(eo <= lit<S>(kOrientationTolerance)) || !aligned)
+    return PathStatus::kUnreachable;
+  const S c = joint_clearance(q);
+  if (c < r.clearance) r.clearance = c;
+  if (!(c >= lit<S>(params::kWorkspaceMargin))) return PathStatus::kOutOfWorkspace;
+  if (near_singular(data, R_ref, trace, r)) return PathStatus::kNearSingular;
+  return PathStatus::kOk;
+}
+
+}  // namespace path_check
+
+/// Checks the path of `move` from the joint angles q_seed (the arm's, or the q_end of the check of
+/// the move queued before it); R_ref is the controller's reference orientation. data is the kernels'
+/// workspace (overwritten). See the file comment.
+template <class S>
+PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMove<S>& move, const Mat3<S>& R_ref,
+                        const Vec6<S>& q_seed) {
+  using namespace path_check;
+  constexpr int N = params::kPathCheckPoints;
+  const std::uint32_t before = path_check::take_flags<S>();
+  PathCheck<S> r;
+  Vec6<S> q = q_seed;
+  SphericalWristJacobianFactor<S> Jf;
+  SingularityTrace<S> trace;
+  evaluate(model, data, Jf, q);
+  for (int i = 0; i <= N; ++i) {
+    const Pose<S> target = i == N ? move.end() : move.pose_at(move.duration() * math::ratio<S>(i, N));
+    for (int k = 0; k < (i == 0 ? kFirstIterations : kIterations); ++k) {
+      bool aligned;
+      newton_step(Jf, pose_error(data, target, aligned), q);
+      evaluate(model, data, Jf, q);
+    }
+    const PathStatus s = classify(data, target, R_ref, q, trace, r);
+    if (s != PathStatus::kOk) {
+      r.status = s;
+      r.sample = i;
+      break;
+    }
+  }
+  r.q_end = q;
+  restore_flags<S>(before);
+  return r;
+}
+
+}  // namespace osc
