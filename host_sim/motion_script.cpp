@@ -48,7 +48,7 @@ bool triple(const YAML::Node& n, const std::string& key, osc::Vec3<double>& out,
 
 /// The keys of a step that apply to its command.
 bool known_key(const std::string& k, osc::MotionVerb v) {
-  if (k == "at" || k == "after" || k == "cmd") return true;
+  if (k == "at" || k == "after" || k == "cmd" || k == "delay") return true;
   if (v != osc::MotionVerb::kMoveTo) return false;
   return k == "position" || k == "rpy_deg" || k == "relative" || k == "replace" || k == "v" || k == "a" || k == "j";
 }
@@ -88,14 +88,19 @@ bool parse_step(const YAML::Node& n, const std::string& where, MotionStepSpec& s
     if (!number(n["at"], where + ".at", s.at, err)) return false;
     if (s.at < 0) return err = where + ".at: a time from the start, at least 0", false;
   } else if (n["after"]) {
-    if (n["after"].as<std::string>("") != "done") return err = where + ".after: the one value is done", false;
-    s.after_done = true;
+    const std::string a = n["after"].as<std::string>("");
+    if (a != "done" && a != "answered") return err = where + ".after: '" + a + "' is not done | answered", false;
+    (a == "done" ? s.after_done : s.after_answered) = true;
   } else {
-    return err = where + ": needs at: SECONDS or after: done", false;
+    return err = where + ": needs at: SECONDS, or after: done | answered", false;
   }
   for (const auto& kv : n) {
     const std::string k = kv.first.as<std::string>("");
     if (!known_key(k, s.verb)) return err = where + "." + k + ": not a key of " + cmd, false;
+  }
+  if (n["delay"]) {
+    if (!number(n["delay"], where + ".delay", s.delay, err)) return false;
+    if (s.delay < 0 || s.delay > 86400) return err = where + ".delay: 0 <= delay <= 86400 s", false;
   }
   if (s.verb == osc::MotionVerb::kMoveTo && !parse_move(n, where, s.move, err)) return false;
   YAML::Emitter e;
@@ -168,6 +173,7 @@ class Player {
       if (next_ < script_.steps.size() && due(t)) send(t);
       if (next_ == script_.steps.size() && end_at < 0 && at_rest() && sim_.idle()) end_at = t + script_.settle;
       if (end_at >= 0 && t >= end_at) return finish(t, "ok");
+      was_powered_ = osc::motion_powered(sim_.task().machine.state);
       const std::uint32_t f = sim_.tick();
       observe(t + dt, f);
       if (f != 0 && run_.fault_s < 0) run_.fault_s = t;
@@ -179,14 +185,22 @@ class Player {
     const osc::MotionState s = sim_.task().machine.state;
     return s != osc::MotionState::kMoving && s != osc::MotionState::kStopping;
   }
-  bool due(double t) const {
+  /// The next step's time has come: its at: (or the moment its after: done held first) plus its delay.
+  bool due(double t) {
     if (!sim_.idle()) return false;
     const MotionStepSpec& s = script_.steps[next_];
-    if (!s.after_done) return t >= s.at - 1e-9;
-    return (run_.commands.empty() || run_.commands.back().answered_s >= 0) && at_rest();
+    if (ready_s_ < 0) {
+      const bool answered = run_.commands.empty() || run_.commands.back().answered_s >= 0;
+      if (!s.after_done && !s.after_answered)
+        ready_s_ = s.at;
+      else if (answered && (s.after_answered || at_rest()))
+        ready_s_ = t;
+    }
+    return ready_s_ >= 0 && t >= ready_s_ + s.delay - 1e-9;
   }
   void send(double t) {
     const MotionStepSpec& s = script_.steps[next_++];
+    ready_s_ = -1;
     CommandRecord r;
     r.cmd = osc::motion_name(s.verb);
     r.step = s.text;
@@ -227,6 +241,8 @@ class Player {
   MotionSim<S> sim_;
   MotionRun run_;
   std::size_t next_ = 0;
+  double ready_s_ = -1;  // when the next step's condition held first (-1: not yet)
+  bool was_powered_ = false;  // the torque was on before this tick (its step ran: a reference to track)
   osc::Vec3<double> w_prev_ = osc::Vec3<double>::Zero(), wd_prev_ = osc::Vec3<double>::Zero();
   osc::Vec3<double> a_prev_ = osc::Vec3<double>::Zero();
   bool have_prev_ = false;
@@ -243,15 +259,17 @@ void Player<S>::observe(double t, std::uint32_t faults) {
     if (!r->accepted) r->refused = osc::motion_name(rep.refusal), r->cause = rep.cause;
     const bool motion = rep.verb == osc::MotionVerb::kMoveTo || rep.verb == osc::MotionVerb::kPaper;
     r->running = r->accepted && motion;
-    if (r->accepted && !motion && rep.verb != osc::MotionVerb::kStop && rep.verb != osc::MotionVerb::kDisable)
-      r->done_s = t;
+    // Done at once unless it started a motion or a stop (a stop or disable from holding has nothing to stop).
+    if (r->accepted && !motion && sim_.task().machine.state != osc::MotionState::kStopping) r->done_s = t;
   }
   if (CommandRecord* r = record(rep.done_id)) r->done_s = t, r->running = false;
   if (CommandRecord* r = rep.abort != osc::MotionReason::kNone ? record(rep.aborted_id) : nullptr)
     r->aborted = osc::motion_name(rep.abort), r->aborted_s = t, r->running = false;
-  if (rep.abort != osc::MotionReason::kNone)  // the moves waiting behind it are dropped with it
+  // The moves waiting behind it are dropped with it (not the re-targeting move answered in this tick).
+  if (rep.abort != osc::MotionReason::kNone)
     for (CommandRecord& r : run_.commands)
-      if (r.running && r.id != rep.aborted_id) r.aborted = osc::motion_name(rep.abort), r.aborted_s = t, r.running = false;
+      if (r.running && r.id != rep.aborted_id && !(rep.outcome != osc::CommandOutcome::kNone && r.id == rep.id))
+        r.aborted = osc::motion_name(rep.abort), r.aborted_s = t, r.running = false;
   if (rep.completion != osc::MotionCompletion::kNone)  // a stop or disable that reached rest
     for (CommandRecord& r : run_.commands)
       if (r.accepted && r.done_s < 0 && (r.cmd == "stop" || r.cmd == "disable")) r.done_s = t;
@@ -263,7 +281,7 @@ void Player<S>::observe(double t, std::uint32_t faults) {
 template <class S>
 void Player<S>::track(double t) {
   (void)t;
-  if (!osc::motion_powered(sim_.task().machine.state)) {
+  if (!was_powered_ || !osc::motion_powered(sim_.task().machine.state)) {
     have_prev_ = false;
     return;
   }

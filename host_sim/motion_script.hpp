@@ -6,8 +6,12 @@
 //   timeout: SECONDS               optional, 600: a run that has not ended by then is a timeout
 //   settle: SECONDS                optional, 1: how long the run goes on after the last step
 //   steps:
-//     - at: SECONDS | after: done  when it is sent: at that time (and after the step before it), or
-//                                  once the step before it was answered and the arm is at rest
+//     - at: SECONDS | after: done | after: answered
+//                                  when it is sent: at that time (and after the step before it); once
+//                                  the step before it was answered and the arm is at rest (every motion
+//                                  done); or once the step before it was answered (to queue behind a
+//                                  move, to stop or re-target it on its way)
+//       delay: SECONDS             optional: that much later than at: or after: says
 //       cmd: enable | disable | move_to | paper | stop | clear
 //       # move_to only:
 //       position: [x, y, z]        the wrist centre [m], base frame (an offset if relative)
@@ -28,8 +32,10 @@
 namespace sim {
 
 struct MotionStepSpec {
-  bool after_done = false;  ///< sent once the previous step was answered and the arm is at rest
+  bool after_done = false;      ///< sent once the previous step was answered and the arm is at rest
+  bool after_answered = false;  ///< sent once the previous step was answered
   double at = 0;            ///< else: sent at this time [s]
+  double delay = 0;         ///< sent this much later [s]
   osc::MotionVerb verb = osc::MotionVerb::kNone;
   osc::MoveRequest<double> move;  ///< move_to
   std::string text;               ///< the step as written, for the JSON

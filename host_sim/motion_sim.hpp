@@ -34,9 +34,10 @@ class MotionSim {
 
   /// A command without a plan (enable, disable, paper, stop, clear), taken by the next tick.
   void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command(task_->gen, verb, id); }
-  /// A move_to, prepared from where the queue will end, taken by the next tick.
+  /// A move_to, prepared (planned and its path checked) from where the queue will end, taken by the
+  /// next tick.
   void move_to(const osc::MoveRequest<S>& req, std::uint32_t id) {
-    task_->pending = osc::prepare_move(task_->gen, task_->limits, task_->tick, osc::params::kControlHz, req, id);
+    task_->pending = osc::prepare_checked_move(*task_, req, id);
   }
   /// Whether the mailbox is free for the next command.
   bool idle() const { return task_->pending.verb == osc::MotionVerb::kNone; }

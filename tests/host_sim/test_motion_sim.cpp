@@ -288,9 +288,50 @@ TEST(MotionSim, PaperMotionByCommandThenAStopAlongItsPath) {
   EXPECT_TRUE(state_is(sim, MotionState::kHolding));
 }
 
+/// A move to the pose of joint angles q (absolute position and orientation).
+MoveRequest<double> to_joint_pose(const V6& q) {
+  Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  forward_kinematics(model, data, q);
+  MoveRequest<double> r;
+  r.position = data.o[kDof];
+  r.has_rpy = true;
+  r.rpy = orientation_coordinates<double>(data.R[kDof], Mat3<double>::Identity());
+  return r;
+}
+
+TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
+  MotionSim<double> sim(start_pose());
+  answer(sim, MotionVerb::kEnable, 1);
+  run_ticks(sim, 100);
+  // Beyond the arm's reach.
+  EXPECT_EQ(answer_move(sim, relative<double>(2.0, 0, 0), 2).refusal, MotionReason::kOutOfWorkspace);
+  // Joint 5 from +45 deg through 0 to -20 deg: the wrist singularity on the way.
+  V6 q = start_pose();
+  q(4) = -0.35;
+  EXPECT_EQ(answer_move(sim, to_joint_pose(q), 3).refusal, MotionReason::kNearSingular);
+  // Joint 1 turned 90 degrees from 150 deg: past its limit of 160 deg.
+  V6 q1 = start_pose();
+  q1(0) = robot::kArm.q_max[0] - 0.05;
+  MotionSim<double> near(q1);
+  answer(near, MotionVerb::kEnable, 1);
+  run_ticks(near, 100);
+  const V3 p = near.task().gen.hold_pose().p;
+  MoveRequest<double> turn;
+  turn.position = V3(-p.y(), p.x(), p.z());
+  EXPECT_EQ(answer_move(near, turn, 2).refusal, MotionReason::kOutOfWorkspace);
+  // A reachable move is accepted and ends done.
+  q = start_pose();
+  q(4) = 0.5, q(0) = 0.2;
+  EXPECT_EQ(answer_move(sim, to_joint_pose(q), 4).outcome, CommandOutcome::kAccepted);
+  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.done_id == 4; }, 20000);
+  EXPECT_TRUE(r.ended);
+  EXPECT_EQ(r.faults, 0u);
+}
+
 TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
-  // Joint 1 near its limit (160 deg); a move that turns it past the limit (no path check in
-  // prepare_move: the tick's check stops it, category 2).
+  // Joint 1 near its limit (160 deg); a move that turns it past the limit, prepared without the path
+  // check (which would refuse it): the tick's check stops it, category 2.
   V6 q = start_pose();
   q(0) = robot::kArm.q_max[0] - 0.05;
   MotionSim<double> sim(q);
@@ -300,7 +341,9 @@ TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
   // A point 90 degrees further about the base axis, at the same radius and height.
   MoveRequest<double> req;
   req.position = V3(-p.y(), p.x(), p.z());
-  ASSERT_EQ(answer_move(sim, req, 2).outcome, CommandOutcome::kAccepted);
+  sim.task().pending = prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, req, 2);
+  sim.tick();
+  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
   const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.abort != MotionReason::kNone; }, 20000);
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(sim.task().report.abort, MotionReason::kLimitReached);

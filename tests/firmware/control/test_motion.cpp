@@ -283,7 +283,13 @@ void compare_scalar(double tol_pos, double tol_vel) {
   gs.hold(cast_pose(a), a.R.cast<S>());
   CartesianMove<double> md;
   CartesianMove<S> ms;
-  ASSERT_EQ(md.plan(a, b, kLim, a.R), ProfileStatus::kOk);
+  // The double plan at the limits the S plan uses (less its rounding margin, rounding_margin()).
+  const CartesianLimits<S> ls = CartesianLimits<S>::defaults();
+  const auto margin = [](const JerkLimits<S>& l) {
+    const JerkLimits<S> m = rounding_margin(l);
+    return JerkLimits<double>{static_cast<double>(m.v), static_cast<double>(m.a), static_cast<double>(m.j)};
+  };
+  ASSERT_EQ(md.plan(a, b, {margin(ls.linear), margin(ls.angular)}, a.R), ProfileStatus::kOk);
   ASSERT_EQ(ms.plan(cast_pose(a), cast_pose(b), CartesianLimits<S>::defaults(), a.R.cast<S>()), ProfileStatus::kOk);
   gd.push(md), gs.push(ms);
   gd.start_moves(0), gs.start_moves(0);

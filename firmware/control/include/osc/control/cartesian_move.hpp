@@ -21,6 +21,8 @@
 // at() every tick.
 #pragma once
 
+#include <type_traits>
+
 #include "osc/control/jerk_profile.hpp"
 #include "osc/control/trajectory.hpp"  // Desired
 #include "osc/kernels/kinematics.hpp"
@@ -53,6 +55,21 @@ struct CartesianLimits {
   }
 };
 
+/// The limits a plan uses: the asked ones less a margin for the scalar's rounding of the reference
+/// it produces, so that the reference, as evaluated and differenced tick by tick, stays within the
+/// asked ones. Measured excess without it (tests/firmware/control/test_motion.cpp, the motion tour):
+/// float 2e-4 of the jerk limit; Q12.19 3e-3 of the jerk, 2e-5 of v and a (a few resolution steps
+/// of the acceleration over one tick).
+template <class S>
+JerkLimits<S> rounding_margin(const JerkLimits<S>& l) {
+  if constexpr (fixed::is_q_v<S>)
+    return {l.v * lit<S>(0.999), l.a * lit<S>(0.999), l.j * lit<S>(0.98)};
+  else if constexpr (std::is_same_v<S, float>)
+    return {l.v * lit<S>(0.9999), l.a * lit<S>(0.9999), l.j * lit<S>(0.998)};
+  else
+    return l;
+}
+
 /// Rot(k, angle): the rotation by `angle` about the unit axis k (Rodrigues).
 template <class S>
 Mat3<S> axis_rotation(const Vec3<S>& k, S angle) {
@@ -71,14 +88,15 @@ Mat3<S> rpy_rotation(const Vec3<S>& rpy) {
 }
 
 /// The axis k and angle in [0, pi) of the rotation Rd (Rd = Rot(k, angle)); k = x and angle 0 for
-/// a rotation too small to name an axis. Angles near pi have no well-conditioned axis from this
+/// a rotation too small to name an axis (below 5e-7 rad, in fixed point 5e-5 rad). Angles near pi have no well-conditioned axis from this
 /// formula: callers refuse rotations beyond kMaxMoveRotation.
 template <class S>
 void rotation_axis_angle(const Mat3<S>& Rd, Vec3<S>& k, S& angle) {
   const Vec3<S> v(Rd(2, 1) - Rd(1, 2), Rd(0, 2) - Rd(2, 0), Rd(1, 0) - Rd(0, 1));  // 2 sin(angle) k
   const S n = math::sqrt(v.dot(v));
   const S c = Rd(0, 0) + Rd(1, 1) + Rd(2, 2) - S(1);  // 2 cos(angle)
-  if (!(n > lit<S>(1e-6))) {
+  // Below the scalar's rounding of R1 R0^T (Q12.19: a few 1e-6 per entry) there is no axis to name.
+  if (!(n > lit<S>(fixed::is_q_v<S> ? 1e-4 : 1e-6))) {
     k = Vec3<S>::UnitX();
     angle = S(0);
     return;
@@ -107,14 +125,15 @@ class CartesianMove {
     S angle;
     rotation_axis_angle<S>(Mat3<S>(to.R * from.R.transpose()), k_, angle);
     if (!(angle <= lit<S>(kMaxMoveRotation))) return ProfileStatus::kBadTarget;
-    ProfileStatus st = s_.plan(S(0), S(0), S(0), length, lim.linear);
-    if (st == ProfileStatus::kOk) st = psi_.plan(S(0), S(0), S(0), angle, lim.angular);
+    const JerkLimits<S> lin = rounding_margin(lim.linear), ang = rounding_margin(lim.angular);
+    ProfileStatus st = s_.plan(S(0), S(0), S(0), length, lin);
+    if (st == ProfileStatus::kOk) st = psi_.plan(S(0), S(0), S(0), angle, ang);
     if (st != ProfileStatus::kOk) return st;
     // Stretch the faster to the slower's duration (from rest: its time-scaled shape).
     if (s_.duration() < psi_.duration())
-      st = s_.plan_with_duration(S(0), S(0), S(0), length, lim.linear, psi_.duration());
+      st = s_.plan_with_duration(S(0), S(0), S(0), length, lin, psi_.duration());
     else if (psi_.duration() < s_.duration())
-      st = psi_.plan_with_duration(S(0), S(0), S(0), angle, lim.angular, s_.duration());
+      st = psi_.plan_with_duration(S(0), S(0), S(0), angle, ang, s_.duration());
     rotates_ = angle > S(0);
     phi_rest_ = orientation_coordinates<S>(R0_, R_ref_);
     return st;
@@ -124,8 +143,8 @@ class CartesianMove {
   /// (JerkProfile::plan_stop), along the same line and about the same axis. Time restarts at 0.
   void stop(S t, const CartesianLimits<S>& lim) {
     const ProfileState<S> s = s_.at(t), a = psi_.at(t);
-    s_.plan_stop(s.p, s.v, s.a, lim.linear);
-    psi_.plan_stop(a.p, a.v, a.a, lim.angular);
+    s_.plan_stop(s.p, s.v, s.a, rounding_margin(lim.linear));
+    psi_.plan_stop(a.p, a.v, a.a, rounding_margin(lim.angular));
   }
 
   /// The desired state at time t since the start (or since the stop): before 0 the start, after

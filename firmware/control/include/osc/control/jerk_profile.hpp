@@ -294,10 +294,11 @@ class JerkProfile {
     if (T < tmin) return ProfileStatus::kDurationTooShort;
     if (v0 == S(0) && a0 == S(0)) {
       const S k = tmin > S(0) ? T / tmin : S(1);
-      const S k3 = k * k * k;
       Pieces<S> scaled = fastest;
-      for (int i = 0; i < scaled.n; ++i) scaled.t[i] = scaled.t[i] * k, scaled.jerk[i] = scaled.jerk[i] / k3;
-      scaled.amax = scaled.amax / (k * k);
+      // jerk / k^3 and amax / k^2 one division at a time: k^3 leaves a fixed-point range (Q12.19:
+      // k > 16) where every quotient stays within it.
+      for (int i = 0; i < scaled.n; ++i) scaled.t[i] = scaled.t[i] * k, scaled.jerk[i] = scaled.jerk[i] / k / k / k;
+      scaled.amax = scaled.amax / k / k;
       assemble(start, target, scaled);
       return ProfileStatus::kOk;
     }

@@ -252,5 +252,9 @@ inline std::uint32_t take_flags() {
   detail::g_flags = 0;
   return f;
 }
+/// Sets the flags back to f (what take_flags() returned before a computation whose own flags were
+/// taken apart: a command's planning outside the control tick, whose saturations are its refusal,
+/// not the tick's fault).
+inline void restore_flags(std::uint32_t f) { detail::g_flags = f; }
 
 }  // namespace osc::fixed

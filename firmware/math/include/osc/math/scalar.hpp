@@ -185,6 +185,23 @@ bool take_arithmetic_fault() {
     return false;
 }
 
+/// The sticky arithmetic flags, taken (cleared) and put back: a computation outside the control
+/// tick (a command's planning) keeps its saturations apart from the tick's,
+///   const std::uint32_t saved = take_arithmetic_flags<S>();  ...;  bool bad = take_arithmetic_fault<S>();
+///   restore_arithmetic_flags<S>(saved);
+/// 0 and nothing for float and double.
+template <class S>
+std::uint32_t take_arithmetic_flags() {
+  if constexpr (fixed::is_q_v<S>)
+    return fixed::take_flags();
+  else
+    return 0;
+}
+template <class S>
+void restore_arithmetic_flags(std::uint32_t f) {
+  if constexpr (fixed::is_q_v<S>) fixed::restore_flags(f);
+}
+
 /// The scalar of hardware units at the I/O boundary (encoder counts, counts per radian, DAC
 /// codes), whose magnitudes reach 10^5: the scalar itself for float and double, FixedIo for the
 /// fixed-point kernels.

@@ -9,6 +9,7 @@
 
 #include "hal/hal.hpp"
 #include "osc/control/controller.hpp"
+#include "osc/control/path_check.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/monitors.hpp"
 #include "osc/runtime/motion_commands.hpp"
@@ -39,6 +40,8 @@ struct ControlTask {
   MotionGenerator<S> gen;     // the desired state of each tick (osc/control/motion.hpp)
   CartesianLimits<S> limits;  // the configured maxima of a move
   TaskCommand<S> pending;     // the next tick's command (verb none: no command)
+  Vec6<S> q_queue_end;        // the joint angles where the queued moves end (the next path check's seed)
+  Data<S> check_data;         // the path check's workspace (command preparation, outside the tick)
   MotionReport report;        // this tick's answer and motion events
   std::uint64_t ramp_start;   // the tick the enable's torque ramp started
   bool ramping;               // the torque is being ramped in (enable)
@@ -71,6 +74,7 @@ struct ControlTask {
     }
     limits = CartesianLimits<S>::defaults();
     desired.x.setZero(), desired.xd.setZero(), desired.xdd.setZero();
+    q_queue_end = q0;
     pending = {};
     report = {};
     ramp_start = 0;
@@ -187,6 +191,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (st.enabling) {
     controller_restart(task.model, task.state, q);
     task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+    task.q_queue_end = q;
     task.stuck.reset(true);
     task.ramping = true;
     task.ramp_start = next;
@@ -199,10 +204,13 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     }
     task.gen.push(cmd.move, cmd.id);
     task.gen.start_moves(next);
+    task.q_queue_end = cmd.q_end;
   }
   if (accepted && cmd.verb == MotionVerb::kPaper) task.gen.start_paper(task.gains.trajectory, next, cmd.id);
-  if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping)
+  if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
     task.gen.stop(next, params::kControlHz, task.limits);
+    task.q_queue_end = q;  // near where the stop ends: the next check's Newton steps start the path there
+  }
   if (accepted && cmd.verb == MotionVerb::kClear) {
     task.sup = {SupervisorState::kInit, 0};
     task.stuck.reset();
@@ -304,6 +312,36 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   task.timing.add(mark[kTickStages] - mark[kStageRead]);
   ++task.tick;
   return faults;
+}
+
+/// A path check's result as a refusal (none: the path is clear). A target beyond the arm's reach
+/// (kUnreachable) is out of its workspace.
+constexpr MotionReason path_refusal(PathStatus s) {
+  switch (s) {
+    case PathStatus::kOk:
+      return MotionReason::kNone;
+    case PathStatus::kNearSingular:
+      return MotionReason::kNearSingular;
+    case PathStatus::kOutOfWorkspace:
+    case PathStatus::kUnreachable:
+      break;
+  }
+  return MotionReason::kOutOfWorkspace;
+}
+
+/// Prepares a move_to in full, outside the tick (a board's main loop, the host's driver): the
+/// limits, the queue and the plan (prepare_move), then the path check (check_path) from the joint
+/// angles where the queue ends, or, for a move that starts where a braked motion comes to rest,
+/// from the last measured ones. Put the result in task.pending for the next tick.
+template <class S>
+TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& req, std::uint32_t id) {
+  TaskCommand<S> c = prepare_move(task.gen, task.limits, task.tick, params::kControlHz, req, id);
+  if (c.refusal != MotionReason::kNone) return c;
+  const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
+  const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
+  c.refusal = path_refusal(pc.status);
+  c.q_end = pc.q_end;
+  return c;
 }
 
 /// A tick without a new sample in which the I/O layer keeps the outputs (a short, bounded gap, e.g.

@@ -77,6 +77,7 @@ struct TaskCommand {
   bool brake = false;                           ///< move_to: brake the running motion first
   std::uint32_t epoch = 0;                      ///< the generator's, when the move was planned
   CartesianMove<S> move{};                      ///< move_to: the planned move
+  Vec6<S> q_end = Vec6<S>::Zero();              ///< move_to: the joint angles at its end (path check)
 };
 
 /// What one tick reports: the answer to its command, and a motion's end.
@@ -123,9 +124,13 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
     c.refusal = MotionReason::kQueueFull;
     return c;
   }
+  // The plan's fixed-point saturations are its own (a refusal), not the next tick's fault.
+  const std::uint32_t saved = math::take_arithmetic_flags<S>();
   const Pose<S> from = c.brake ? gen.brake_end(next_tick + 1, rate_hz, max) : gen.queue_end();
-  if (c.move.plan(from, move_target(from, req), lim, gen.reference_orientation()) != ProfileStatus::kOk)
-    c.refusal = MotionReason::kOverLimit;  // a rotation beyond kMaxMoveRotation, a non-finite target
+  const ProfileStatus st = c.move.plan(from, move_target(from, req), lim, gen.reference_orientation());
+  // A rotation beyond kMaxMoveRotation, a non-finite target, a plan that left the scalar's range.
+  if (math::take_arithmetic_fault<S>() || st != ProfileStatus::kOk) c.refusal = MotionReason::kOverLimit;
+  math::restore_arithmetic_flags<S>(saved);
   return c;
 }
 
