@@ -62,8 +62,7 @@ namespace osc {
     "a re-targeting move_to replaced the motion (aborted); or the queue changed between a command's planning " \
     "and its tick (refused: send it again)")                                                                   \
   X(BadCommand, "bad_command",                                                                                 \
-    "a command frame with a verb or flag outside its list, a non-finite number, a target out of bounds or a "  \
-    "limit not above 0 (osc/link/commands.hpp)")
+    "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
