@@ -1,16 +1,20 @@
 // osc_protocol: the link protocol's facts as JSON, read from the firmware's own declarations (the
-// field lists and constants of osc/link/frames.hpp, the fault catalogue, the supervisor's states, the
-// robot's drives) and its own encoder (the example frames). scripts/docs_tables.py --kind protocol
-// writes docs/protocol.md's tables from it; ctest docs_tables_protocol fails when they differ.
+// frame types and field lists and the constants of osc/link/frames.hpp and command_frames.hpp, the
+// fault catalogue, the supervisor's states, the motion state machine's and the commands' names, the
+// robot's drives, the move limits) and its own encoder (the example frames). scripts/docs_tables.py
+// --kind protocol writes docs/protocol.md's tables from it; ctest docs_tables_protocol fails when
+// they differ.
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <span>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "osc/control/gains.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/commands.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/io.hpp"
@@ -21,11 +25,10 @@ namespace {
 
 using nlohmann::json;
 
-template <std::size_t N>
-json fields(const pil::FieldInfo (&list)[N]) {
+json fields(const pil::FieldInfo* list, int n) {
   json out = json::array();
   int offset = 0;
-  for (const pil::FieldInfo& f : list) {
+  for (const pil::FieldInfo& f : std::span(list, static_cast<std::size_t>(n))) {
     out.push_back({{"name", f.name},
                    {"type", f.type},
                    {"count", f.count},
@@ -87,6 +90,61 @@ json examples() {
   return out;
 }
 
+/// The command protocol's examples: a move_to and the answer of the tick that accepted it.
+json command_examples() {
+  json out = json::array();
+  std::uint8_t buf[pil::kMaxFrame];
+  osc::MoveRequest<double> req;
+  req.position = osc::Vec3<double>(0.05, 0.0, -0.02);
+  req.relative = true;
+  out.push_back(
+      {{"what", "command 7: move_to, relative, by (0.05, 0, -0.02) m, orientation kept, the configured limits"},
+       {"frame", "command"},
+       {"bytes", bytes_of(buf, osc::encode_command(7, osc::MotionVerb::kMoveTo, req, buf))}});
+  osc::MotionReport r;
+  r.id = 7;
+  r.verb = osc::MotionVerb::kMoveTo;
+  r.outcome = osc::CommandOutcome::kAccepted;
+  out.push_back(
+      {{"what", "its answer: command 7 (move_to) accepted in tick 1234, state moving, one move queued"},
+       {"frame", "answer"},
+       {"bytes", bytes_of(buf, pil::encode(osc::frame_from_report(r, osc::MotionState::kMoving, 1, 1234), buf))}});
+  return out;
+}
+
+/// The names, codes and meanings of one of the motion state machine's enumerations.
+template <class E>
+json motion_names() {
+  json out = json::array();
+  for (int i = 0; i < osc::MotionNames<E>::kCount; ++i)
+    out.push_back({{"code", i}, {"name", osc::MotionNames<E>::kNames[i]}, {"doc", osc::MotionNames<E>::kDocs[i]}});
+  return out;
+}
+
+/// The command protocol: flags, bounds, the move limits, the names of the codes, examples.
+json command_protocol() {
+  json j;
+  j["flags"] = json::array();
+  for (int i = 0; i < pil::kCommandFlagCount; ++i)
+    j["flags"].push_back(
+        {{"bit", i}, {"mask", 1 << i}, {"name", pil::kCommandFlagNames[i]}, {"doc", pil::kCommandFlagDocs[i]}});
+  j["max_position"] = pil::kCommandMaxPosition;
+  j["max_angle"] = pil::kCommandMaxAngle;
+  const auto lim = osc::CartesianLimits<double>::defaults();
+  j["limits"] = {{"linear", {lim.linear.v, lim.linear.a, lim.linear.j}},
+                 {"angular", {lim.angular.v, lim.angular.a, lim.angular.j}}};
+  j["queue_length"] = osc::params::kMoveQueueLength;
+  j["max_move_rotation"] = osc::kMaxMoveRotation;
+  j["verbs"] = motion_names<osc::MotionVerb>();
+  j["motion_states"] = motion_names<osc::MotionState>();
+  j["reasons"] = motion_names<osc::MotionReason>();
+  j["outcomes"] = motion_names<osc::CommandOutcome>();
+  j["stop_categories"] = motion_names<osc::StopCategory>();
+  j["completions"] = motion_names<osc::MotionCompletion>();
+  j["examples"] = command_examples();
+  return j;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -98,22 +156,21 @@ int main(int argc, char** argv) {
   j["sync"] = {pil::kSync0, pil::kSync1};
   j["overhead"] = pil::kOverhead;
   j["max_frame"] = pil::kMaxFrame;
-  j["types"] = {{{"name", "sensor"},
-                 {"code", pil::kSensorFrame},
-                 {"payload", pil::kSensorPayload},
-                 {"from", "host"},
-                 {"to", "firmware"}},
-                {{"name", "actuator"},
-                 {"code", pil::kActuatorFrame},
-                 {"payload", pil::kActuatorPayload},
-                 {"from", "firmware"},
-                 {"to", "host"}}};
+  j["types"] = json::array();
+  for (const pil::FrameInfo& f : pil::kFrames) {
+    const std::string from = f.from;
+    j["types"].push_back({{"name", f.name},
+                          {"code", f.type},
+                          {"payload", f.payload},
+                          {"from", from},
+                          {"to", from == "host" ? "firmware" : "host"},
+                          {"when", f.when}});
+    j[std::string(f.name) + "_fields"] = fields(f.fields, f.field_count);
+  }
   j["hello_seq"] = pil::kHelloSeq;
   const char check[] = "123456789";
   j["crc"] = {
       {"poly", 0x1021}, {"init", 0xFFFF}, {"check", pil::crc16(reinterpret_cast<const std::uint8_t*>(check), 9)}};
-  j["sensor_fields"] = fields(pil::kSensorFields);
-  j["actuator_fields"] = fields(pil::kActuatorFields);
   j["inject"] = {{"non_finite", pil::kInjectNonFinite},
                  {"overrun", pil::kInjectOverrun},
                  {"adaptation_shift", pil::kConfigAdaptationShift},
@@ -147,6 +204,7 @@ int main(int argc, char** argv) {
   j["link_error_limit"] = osc::params::kLinkErrorLimit;
   j["link_error_window"] = osc::params::kLinkErrorWindow;
   j["examples"] = examples();
+  j["command"] = command_protocol();
   std::cout << j.dump(1) << "\n";
   return 0;
 }

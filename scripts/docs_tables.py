@@ -666,21 +666,29 @@ def hexs(v, width=2):
     return f"0x{v:0{width}X}"
 
 
+def article(word):
+    return "an" if word[0] in "aeiou" else "a"
+
+
 @table("protocol_frame", "docs/protocol.md", "protocol")
 def t_protocol_frame():
     p = protocol()
-    s, a = p["types"]
+    types = p["types"]
+    codes = ", ".join(f"{t['code']} {t['name']} ({t['from']} to {t['to']})" for t in types)
+    lengths = ", ".join(f"{t['payload']} ({t['name']})" for t in types)
     rows = ["| offset | bytes | field | value |", "|---|---|---|---|",
             f"| 0 | 1 | sync | `{hexs(p['sync'][0])}` |",
             f"| 1 | 1 | sync | `{hexs(p['sync'][1])}` |",
-            f"| 2 | 1 | type | {s['code']} {s['name']} (host to firmware), "
-            f"{a['code']} {a['name']} (firmware to host) |",
-            f"| 3 | 1 | length | the payload's bytes: {s['payload']} ({s['name']}), {a['payload']} ({a['name']}) |",
+            f"| 2 | 1 | type | {codes} |",
+            f"| 3 | 1 | length | the payload's bytes: {lengths} |",
             "| 4 | length | payload | the fields of the type, in the order of its table below |",
             "| 4 + length | 2 | CRC | CRC-16/CCITT-FALSE of bytes 2 to 3 + length (type, length, payload), "
             "low byte first |"]
-    return "\n".join(rows) + (f"\n\nA {s['name']} frame is {s['payload'] + p['overhead']} bytes, an {a['name']} frame "
-                              f"{a['payload'] + p['overhead']} ({p['overhead']} bytes of framing each).")
+    first, rest = types[0], types[1:]
+    sizes = [f"{article(first['name'])} {first['name']} frame is {first['payload'] + p['overhead']} bytes"]
+    sizes += [f"{article(t['name'])} {t['name']} frame {t['payload'] + p['overhead']}" for t in rest]
+    sentence = ", ".join(sizes)
+    return "\n".join(rows) + f"\n\n{sentence[0].upper()}{sentence[1:]} ({p['overhead']} bytes of framing each)."
 
 
 def field_rows(fields):
@@ -732,6 +740,83 @@ def t_protocol_link_errors():
     for k, e in enumerate(p["link_errors"]):
         rows.append(f"| {k} | {off + 4 * k} | `{e['name']}` | {e['doc']} |")
     return "\n".join(rows)
+
+
+@table("protocol_command", "docs/protocol.md", "protocol")
+def t_protocol_command():
+    return field_rows(protocol()["command_fields"])
+
+
+@table("protocol_answer", "docs/protocol.md", "protocol")
+def t_protocol_answer():
+    return field_rows(protocol()["answer_fields"])
+
+
+@table("protocol_state", "docs/protocol.md", "protocol")
+def t_protocol_state():
+    return field_rows(protocol()["state_fields"])
+
+
+@table("protocol_command_flags", "docs/protocol.md", "protocol")
+def t_protocol_command_flags():
+    flags = protocol()["command"]["flags"]
+    rows = [(f["bit"], f"`{hexs(f['mask'])}`", f"`{f['name']}`", f["doc"]) for f in flags]
+    rows.append(("other", "", "", "0 (a command with another bit set is refused: `bad_command`)"))
+    return markdown_table(["bit", "mask", "name", "meaning"], rows)
+
+
+@table("protocol_command_checks", "docs/protocol.md", "protocol")
+def t_protocol_command_checks():
+    c = protocol()["command"]
+    lin, ang = c["limits"]["linear"], c["limits"]["angular"]
+    rows = [("every `f32`", "finite (no NaN, no infinity), whatever the verb and the flags", "`bad_command`"),
+            ("`verb`", f"a code of Verbs (0 to {len(c['verbs']) - 1})", "`bad_command`"),
+            ("`flags`", "bits of Command flags only", "`bad_command`"),
+            ("`position`", f"each coordinate within ±{c['max_position']:g} m", "`bad_command`"),
+            ("`rpy`", f"each angle within ±2π rad (±{c['max_angle']:.6f})", "`bad_command`"),
+            ("`limits`, with `has_limits`", "each above 0", "`bad_command`"),
+            ("`limits`, with `has_limits`", f"each at most the configured maximum: linear {lin[0]:g} m/s, "
+             f"{lin[1]:g} m/s², {lin[2]:g} m/s³; angular {ang[0]:g} rad/s, {ang[1]:g} rad/s², {ang[2]:g} rad/s³",
+             "`over_limit`"),
+            ("move_to", f"room in the queue: the running move and {c['queue_length']} waiting (unless the move "
+             "brakes the running motion first: `replace`, or after the paper's motion)", "`queue_full`"),
+            ("move_to", f"a rotation of at most {math.degrees(c['max_move_rotation']):g}° from where the move starts, "
+             "and a plan within the limits", "`over_limit`")]
+    return markdown_table(["what", "must be", "else refused"], rows)
+
+
+def name_rows(entries):
+    return markdown_table(["code", "name", "meaning"], [(e["code"], f"`{e['name']}`", e["doc"]) for e in entries])
+
+
+@table("protocol_verbs", "docs/protocol.md", "protocol")
+def t_protocol_verbs():
+    return name_rows(protocol()["command"]["verbs"])
+
+
+@table("protocol_motion_states", "docs/protocol.md", "protocol")
+def t_protocol_motion_states():
+    return name_rows(protocol()["command"]["motion_states"])
+
+
+@table("protocol_outcomes", "docs/protocol.md", "protocol")
+def t_protocol_outcomes():
+    return name_rows(protocol()["command"]["outcomes"])
+
+
+@table("protocol_reasons", "docs/protocol.md", "protocol")
+def t_protocol_reasons():
+    return name_rows(protocol()["command"]["reasons"])
+
+
+@table("protocol_stop_categories", "docs/protocol.md", "protocol")
+def t_protocol_stop_categories():
+    return name_rows(protocol()["command"]["stop_categories"])
+
+
+@table("protocol_completions", "docs/protocol.md", "protocol")
+def t_protocol_completions():
+    return name_rows(protocol()["command"]["completions"])
 
 
 def markdown_table(header, rows):
@@ -795,10 +880,9 @@ def t_protocol_constants():
     return "\n".join(rows)
 
 
-@table("protocol_examples", "docs/protocol.md", "protocol")
-def t_protocol_examples():
+def example_dumps(examples):
     out = []
-    for e in protocol()["examples"]:
+    for e in examples:
         b = e["bytes"]
         out.append(f"{e['what'][0].upper()}{e['what'][1:]} ({len(b)} bytes):\n\n```")
         for row in range(0, len(b), 16):
@@ -808,6 +892,16 @@ def t_protocol_examples():
         out.append(f"```\n\nsync `A5 5A`, type {b[2]}, length {n}, payload bytes 4 to {3 + n}, CRC `{b[4 + n]:02X} "
                    f"{b[5 + n]:02X}` = `{hexs(crc, 4)}`.\n")
     return "\n".join(out)
+
+
+@table("protocol_examples", "docs/protocol.md", "protocol")
+def t_protocol_examples():
+    return example_dumps(protocol()["examples"])
+
+
+@table("protocol_command_examples", "docs/protocol.md", "protocol")
+def t_protocol_command_examples():
+    return example_dumps(protocol()["command"]["examples"])
 
 
 def block_re(name):

@@ -22,19 +22,26 @@ void fill(Input& in, T (&a)[N]) {
 }
 inline void fill(Input& in, pil::LinkCounters& c) { fill(in, c.count); }
 
-/// Encodes a sensor or actuator frame whose every field comes from the input, in the order of the
-/// frame's field list (osc/link/frames.hpp), into buf (kMaxFrame bytes); returns its length.
-inline int build_frame(fuzz::Input& in, bool actuator, std::uint8_t* buf) {
+/// Encodes a frame of the given type whose every field comes from the input, in the order of the
+/// frame's field list (osc/link/frames.hpp), into buf (kMaxFrame bytes); returns its length (0 for
+/// a type outside OSC_FRAME_LIST).
+inline int build_frame_of(fuzz::Input& in, pil::FrameType frame_type, std::uint8_t* buf) {
 #define OSC_FUZZ_FILL(type, name, extent, unit, doc) fill(in, f.name);
-  if (!actuator) {
-    pil::SensorFrame f;
-    OSC_SENSOR_FIELDS(OSC_FUZZ_FILL)
-    return pil::encode(f, buf);
+#define OSC_FUZZ_BUILD(Name, code, name, from, when, FIELDS) \
+  case pil::k##Name##Frame: {                                \
+    pil::Name##Frame f;                                      \
+    FIELDS(OSC_FUZZ_FILL)                                    \
+    return pil::encode(f, buf);                              \
   }
-  pil::ActuatorFrame f;
-  OSC_ACTUATOR_FIELDS(OSC_FUZZ_FILL)
+  switch (frame_type) { OSC_FRAME_LIST(OSC_FUZZ_BUILD) }
+#undef OSC_FUZZ_BUILD
 #undef OSC_FUZZ_FILL
-  return pil::encode(f, buf);
+  return 0;
+}
+
+/// A sensor or an actuator frame (build_frame_of).
+inline int build_frame(fuzz::Input& in, bool actuator, std::uint8_t* buf) {
+  return build_frame_of(in, actuator ? pil::kActuatorFrame : pil::kSensorFrame, buf);
 }
 
 }  // namespace fuzz

@@ -3,14 +3,14 @@
 // Invariants, checked after every byte fed:
 //  - kFrame and kBadChecksum end a frame: the last length + 6 bytes fed are the sync pair, a known
 //    type, that type's payload length, the payload and a CRC, which matches exactly for kFrame;
-//  - a kFrame decodes as its own type only, and re-encoding the decoded frame gives back exactly
-//    the bytes fed;
+//  - a kFrame decodes as its own type only (every type of OSC_FRAME_LIST: sensor, actuator and the
+//    command protocol's), and re-encoding the decoded frame gives back exactly the bytes fed;
 //  - in_frame(): false after a completed frame; from idle only the first sync byte starts a frame;
 //    a frame in progress stays in progress on kPending; after kBadHeader the parser is in a frame
 //    only if that byte was a first sync byte (resynchronisation on A5);
-//  - structured inputs (first byte odd): valid frames built from the input, with garbage between
-//    them, are each returned as kFrame on their last byte (never earlier) whenever the parser was
-//    idle before the frame; a frame with one bit flipped in its payload or CRC ends in kBadChecksum.
+//  - structured inputs (first byte odd): valid frames of every type built from the input, with
+//    garbage between them, are each returned as kFrame on their last byte (never earlier) whenever
+//    the parser was idle before the frame; a frame with one bit flipped in its payload or CRC ends in kBadChecksum.
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -21,8 +21,29 @@
 
 namespace {
 
+/// The payload length of a type, from the table of frame types (not the parser's payload_length).
 int payload_of(std::uint8_t type) {
-  return type == pil::kSensorFrame ? pil::kSensorPayload : type == pil::kActuatorFrame ? pil::kActuatorPayload : -1;
+  for (const pil::FrameInfo& f : pil::kFrames)
+    if (f.type == type) return f.payload;
+  return -1;
+}
+
+/// Decodes a completed frame as every type: exactly one, its own, succeeds; re-encodes it into out.
+int decode_and_encode(const pil::Parser& p, std::uint8_t* out) {
+  int decoded = 0, len = 0;
+#define OSC_FUZZ_DECODE(Name, code, name, from, when, FIELDS) \
+  {                                                           \
+    pil::Name##Frame g;                                       \
+    if (p.decode(g)) {                                        \
+      ++decoded;                                              \
+      FUZZ_CHECK(p.type() == pil::k##Name##Frame);            \
+      len = pil::encode(g, out);                              \
+    }                                                         \
+  }
+  OSC_FRAME_LIST(OSC_FUZZ_DECODE)
+#undef OSC_FUZZ_DECODE
+  FUZZ_CHECK(decoded == 1);
+  return len;
 }
 
 struct Checked {
@@ -66,18 +87,7 @@ struct Checked {
         FUZZ_CHECK((crc == got) == (r == pil::Parser::kFrame));
         if (r == pil::Parser::kFrame) {
           std::uint8_t out[pil::kMaxFrame];
-          pil::SensorFrame s;
-          pil::ActuatorFrame a;
-          int len = 0;
-          if (p.type() == pil::kSensorFrame) {
-            FUZZ_CHECK(p.decode(s));
-            FUZZ_CHECK(!p.decode(a));
-            len = pil::encode(s, out);
-          } else {
-            FUZZ_CHECK(p.decode(a));
-            FUZZ_CHECK(!p.decode(s));
-            len = pil::encode(a, out);
-          }
+          const int len = decode_and_encode(p, out);
           FUZZ_CHECK(len == static_cast<int>(total));
           FUZZ_CHECK(std::memcmp(out, f, total) == 0);
         }
@@ -100,12 +110,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     while (!in.empty()) c.feed(in.u8());
     return 0;
   }
-  // Structured: garbage, then a frame (maybe with one bit flipped), repeatedly.
+  // Structured: garbage, then a frame (maybe with one bit flipped), repeatedly. The frame's type:
+  // bit 3 and bits 5-6 of op, an index into the frame types (0 sensor, 1 actuator, then the others).
   while (!in.empty()) {
     const std::uint8_t op = in.u8();
     for (int k = op & 7; k > 0; --k) c.feed(in.u8());
     std::uint8_t buf[pil::kMaxFrame];
-    const int len = fuzz::build_frame(in, (op & 8) != 0, buf);
+    const int index = ((op >> 3) & 1) | (((op >> 5) & 3) << 1);
+    const int len = fuzz::build_frame_of(in, pil::kFrames[index % pil::kFrameTypes].type, buf);
     int flip = -1;
     if (op & 0x10) {
       flip = 4 + in.u8() % (len - 4);  // payload or CRC

@@ -4,13 +4,16 @@
 // running in kRun, each command-line option. Regenerate after a change of the link protocol or of
 // a target's input format, and commit the result (docs/fuzzing.md).
 #include <cstdint>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
 #include <vector>
 
 #include "osc/link/frames.hpp"
+#include "osc/runtime/motion_commands.hpp"
 
 namespace {
 
@@ -195,6 +198,94 @@ void pil_client() {
   put("fuzz_pil_client", "structured", d);
 }
 
+// fuzz_command's structured frames: op, id, verb, flags, then 12 numbers, as 16-bit integers (op bit
+// 3 clear: positions in 1/2048 m, angles in 1/4096 rad, limits in 1/50000 of their maximum) or as
+// raw f32 bits (op bit 3 set).
+struct Command {
+  std::uint32_t id;
+  osc::MotionVerb verb;
+  std::uint8_t flags;
+  double position[3], rpy[3];
+  double limits[6];  ///< fractions of the configured maxima (16-bit form), or values (raw form)
+};
+
+void u16(Bytes& b, int v) {
+  b.push_back(static_cast<std::uint8_t>(v & 0xFF));
+  b.push_back(static_cast<std::uint8_t>((v >> 8) & 0xFF));
+}
+void f32(Bytes& b, double v) {
+  const float f = static_cast<float>(v);
+  std::uint32_t u;
+  std::memcpy(&u, &f, 4);
+  u32(b, u);
+}
+
+void command_op(Bytes& b, std::uint8_t op, const Command& c) {
+  b.push_back(op);
+  for (int k = op & 7; k > 0; --k) b.push_back(0x5A);  // garbage before the frame
+  u32(b, c.id);
+  b.push_back(static_cast<std::uint8_t>(c.verb));
+  b.push_back(c.flags);
+  const bool raw = (op & 8) != 0;
+  for (double p : c.position) raw ? f32(b, p) : u16(b, static_cast<int>(std::lround(p * 2048)));
+  for (double r : c.rpy) raw ? f32(b, r) : u16(b, static_cast<int>(std::lround(r * 4096)));
+  for (double l : c.limits) raw ? f32(b, l) : u16(b, static_cast<int>(std::lround(l * 50000)));
+}
+
+void command() {
+  using osc::MotionVerb;
+  constexpr std::uint8_t kRel = pil::kFlagRelative, kRpy = pil::kFlagHasRpy, kRep = pil::kFlagReplace,
+                         kLim = pil::kFlagHasLimits;
+  const Command rel{1, MotionVerb::kMoveTo, kRel, {0.05, -0.02, 0.01}, {0, 0, 0}, {}};
+  const Command abs{
+      2, MotionVerb::kMoveTo, kRpy | kLim, {0.55, 0.05, 0.25}, {0.2, -0.1, 0.4}, {0.5, 0.5, 0.5, 0.8, 0.8, 0.8}};
+  const Command turn{3, MotionVerb::kMoveTo, kRel | kRpy, {0, 0, 0}, {0.0, 0.3, -0.2}, {}};
+  const Command retarget{4, MotionVerb::kMoveTo, kRel | kRep, {-0.03, 0.04, 0.0}, {0, 0, 0}, {}};
+  // Byte 0: bit 0 structured, bits 1-2 the generator (0 holding, 1 a move running, 2 the paper's
+  // motion), bits 3-7 the tick in 50 ms.
+  for (int how = 0; how < 3; ++how) {
+    Bytes b{static_cast<std::uint8_t>(1 | (how << 1) | (4 << 3))};
+    command_op(b, 0, rel);
+    command_op(b, 2, abs);
+    command_op(b, 0, turn);
+    command_op(b, 0x10, rel);  // one bit flipped
+    command_op(b, 0, retarget);
+    put("fuzz_command", std::string("moves_") + "0mp"[how], b);
+  }
+  Bytes verbs{1};
+  for (int v = 0; v <= 7; ++v) command_op(verbs, 0, {static_cast<std::uint32_t>(10 + v), MotionVerb(v), 0, {}, {}, {}});
+  put("fuzz_command", "verbs", verbs);
+  // Raw numbers at the edges: tiny limits over a long move, bounds, NaN, a flag outside the list.
+  Bytes edges{1};
+  command_op(
+      edges, 8,
+      {20, MotionVerb::kMoveTo, kRel | kLim, {10, -10, 10}, {0, 0, 0}, {1e-30, 1e-30, 1e-30, 1e-30, 1e-30, 1e-30}});
+  command_op(edges, 8, {21, MotionVerb::kMoveTo, kRel | kLim, {10, 0, 0}, {0, 0, 0}, {0.1, 1e-20, 2.5, 0.5, 1, 10}});
+  command_op(edges, 8, {22, MotionVerb::kMoveTo, kRpy, {0.5, 0.1, 0.3}, {6.2831850, -6.2831850, 0}, {}});
+  command_op(edges, 8, {23, MotionVerb::kMoveTo, kRel, {std::nan(""), 0, 0}, {0, 0, 0}, {}});
+  command_op(edges, 8, {24, MotionVerb::kMoveTo, 0x10, {0, 0, 0}, {0, 0, 0}, {}});
+  put("fuzz_command", "edges", edges);
+  Bytes queue{1};  // more moves than the queue holds
+  for (int k = 0; k < 18; ++k)
+    command_op(queue, 0,
+               {static_cast<std::uint32_t>(100 + k), MotionVerb::kMoveTo, kRel, {0.002, 0, 0}, {0, 0, 0}, {}});
+  put("fuzz_command", "queue_full", queue);
+  // Raw: encoded command frames among other bytes and frames.
+  Bytes raw{0, 0x00, pil::kSync0};
+  for (const Command* c : {&rel, &turn, &retarget}) {
+    pil::CommandFrame f;
+    f.id = c->id;
+    f.verb = static_cast<std::uint8_t>(c->verb);
+    f.flags = c->flags;
+    for (int i = 0; i < 3; ++i)
+      f.position[i] = static_cast<float>(c->position[i]), f.rpy[i] = static_cast<float>(c->rpy[i]);
+    std::uint8_t buf[pil::kMaxFrame];
+    append(raw, Bytes(buf, buf + pil::encode(f, buf)));
+    append(raw, sensor(3, 1));
+  }
+  put("fuzz_command", "raw_frames", raw);
+}
+
 void cli() {
   put("fuzz_cli", "none", {});
   put("fuzz_cli", "help", args({"--help"}));
@@ -221,6 +312,7 @@ int main(int argc, char** argv) {
   node();
   encoder();
   supervisor();
+  command();
   pil_client();
   cli();
   return 0;

@@ -1,11 +1,14 @@
 // Processor-in-the-loop link protocol: framed, checksummed, little-endian, lockstep (one sensor
 // frame from the host and one actuator frame back per tick). Shared by the firmware and host_sim.
+// The command protocol's frames (command, answer, state: osc/link/command_frames.hpp) use the same
+// framing.
 //
 // Frame:  0xA5 0x5A | type (1) | length (1) | payload (length bytes) | CRC-16/CCITT-FALSE (2, LE)
 // The CRC covers type, length and payload. Each payload is declared once, as a field list
-// (OSC_SENSOR_FIELDS, OSC_ACTUATOR_FIELDS): the frame structs, their encoding and decoding, the
-// payload lengths and the protocol document's tables (docs/protocol.md, checked by ctest
-// docs_tables_protocol) are all made from it. A field is added in its list, and nowhere else.
+// (OSC_SENSOR_FIELDS, OSC_ACTUATOR_FIELDS, OSC_COMMAND_FIELDS, ...), and each frame type once, in
+// OSC_FRAME_LIST: the frame structs, their encoding and decoding, the payload lengths, the parser's
+// table of types and the protocol document's tables (docs/protocol.md, checked by ctest
+// docs_tables_protocol) are all made from them. A field is added in its list, and nowhere else.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +16,7 @@
 
 #include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
 #include "osc/control/gains.hpp"
+#include "osc/link/command_frames.hpp"
 #include "osc/robots/arm.hpp"
 #include "osc/runtime/timing.hpp"
 
@@ -23,8 +27,6 @@ constexpr std::uint8_t kSync0 = 0xA5, kSync1 = 0x5A;
 /// before that may be lost). The host waits for it before its first sensor frame.
 constexpr std::uint32_t kHelloSeq = 0xFFFFFFFFu;
 constexpr int kJoints = osc::kDof;
-
-enum FrameType : std::uint8_t { kSensorFrame = 1, kActuatorFrame = 2 };
 
 /// Fault-injection requests in a sensor frame.
 enum Inject : std::uint8_t {
@@ -52,12 +54,6 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
   X(std::int32_t, counts, [kJoints], "count",                                                                       \
     "encoder counts of joints 1 to 6, 0 at the start pose (Encoders, DACs, the plant)")                             \
   X(std::uint8_t, inject, , "", "fault-injection requests; configuration bits in the first frame (The inject byte)")
-
-#define OSC_FRAME_MEMBER(type, name, extent, unit, doc) type name extent = {};
-
-struct SensorFrame {
-  OSC_SENSOR_FIELDS(OSC_FRAME_MEMBER)
-};
 
 /// The kinds of link error a receiver tells apart, each counted (LinkCounters) in telemetry.
 // X(Name, "name", meaning), in counter order.
@@ -112,9 +108,30 @@ struct LinkCounters {
   X(std::uint32_t, rx_long_gaps, , "",                                                                               \
     "gaps longer than params::kLinkSilenceTicks control periods (a tick-based silence watchdog's view)")
 
-struct ActuatorFrame {
-  OSC_ACTUATOR_FIELDS(OSC_FRAME_MEMBER)
-};
+// X(Name, code, "name", "sender", when it is sent, FIELDS): the frame types, in code order. Each
+// makes the struct NameFrame (its fields, in wire order), kNameFrame (its type code), kNameFields
+// (its fields as the document lists them), kNamePayload (its payload length), encode(),
+// Parser::decode() and for_each_field().
+#define OSC_FRAME_LIST(X)                                                                                           \
+  X(Sensor, 1, "sensor", "host", "one per control tick: the tick's encoder counts", OSC_SENSOR_FIELDS)              \
+  X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",            \
+    OSC_ACTUATOR_FIELDS)                                                                                            \
+  X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS) \
+  X(Answer, 4, "answer", "firmware",                                                                                \
+    "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)        \
+  X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)
+
+#define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
+enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };
+#undef OSC_FRAME_TYPE
+
+#define OSC_FRAME_MEMBER(type, name, extent, unit, doc) type name extent = {};
+#define OSC_FRAME_STRUCT(Name, code, name, from, when, FIELDS) \
+  struct Name##Frame {                                         \
+    FIELDS(OSC_FRAME_MEMBER)                                   \
+  };
+OSC_FRAME_LIST(OSC_FRAME_STRUCT)
+#undef OSC_FRAME_STRUCT
 #undef OSC_FRAME_MEMBER
 
 namespace detail {
@@ -169,17 +186,64 @@ struct FieldInfo {
             detail::kWireBytes<type extent>,          \
             unit,                                     \
             doc},
-constexpr FieldInfo kSensorFields[] = {OSC_SENSOR_FIELDS(OSC_FIELD_INFO)};
-constexpr FieldInfo kActuatorFields[] = {OSC_ACTUATOR_FIELDS(OSC_FIELD_INFO)};
+#define OSC_FRAME_FIELDS(Name, code, name, from, when, FIELDS) \
+  constexpr FieldInfo k##Name##Fields[] = {FIELDS(OSC_FIELD_INFO)};
+OSC_FRAME_LIST(OSC_FRAME_FIELDS)
+#undef OSC_FRAME_FIELDS
 #undef OSC_FIELD_INFO
 
 #define OSC_FIELD_BYTES(type, name, extent, unit, doc) +detail::kWireBytes<type extent>
-constexpr int kSensorPayload = 0 OSC_SENSOR_FIELDS(OSC_FIELD_BYTES);
-constexpr int kActuatorPayload = 0 OSC_ACTUATOR_FIELDS(OSC_FIELD_BYTES);
+#define OSC_FRAME_PAYLOAD(Name, code, name, from, when, FIELDS) \
+  constexpr int k##Name##Payload = 0 FIELDS(OSC_FIELD_BYTES);
+OSC_FRAME_LIST(OSC_FRAME_PAYLOAD)
+#undef OSC_FRAME_PAYLOAD
 #undef OSC_FIELD_BYTES
+
+/// A frame type as the protocol document lists it.
+struct FrameInfo {
+  const char* name;
+  FrameType type;
+  int payload;              ///< bytes
+  const char* from;         ///< the sender: host or firmware
+  const char* when;         ///< when it is sent
+  const FieldInfo* fields;  ///< its fields, in wire order
+  int field_count;
+};
+#define OSC_FRAME_INFO(Name, code, name, from, when, FIELDS) \
+  FrameInfo{name,                                            \
+            k##Name##Frame,                                  \
+            k##Name##Payload,                                \
+            from,                                            \
+            when,                                            \
+            k##Name##Fields,                                 \
+            static_cast<int>(sizeof(k##Name##Fields) / sizeof(FieldInfo))},
+constexpr FrameInfo kFrames[] = {OSC_FRAME_LIST(OSC_FRAME_INFO)};
+#undef OSC_FRAME_INFO
+constexpr int kFrameTypes = static_cast<int>(sizeof(kFrames) / sizeof(*kFrames));
+
+namespace detail {
+constexpr int max_payload() {
+  int m = 0;
+  for (const FrameInfo& f : kFrames) m = f.payload > m ? f.payload : m;
+  return m;
+}
+/// Every type code distinct and nonzero, every length fits its byte.
+constexpr bool frame_types_valid() {
+  for (int i = 0; i < kFrameTypes; ++i) {
+    if (kFrames[i].type == 0 || kFrames[i].payload >= 256) return false;
+    for (int k = 0; k < i; ++k)
+      if (kFrames[k].type == kFrames[i].type) return false;
+  }
+  return true;
+}
+}  // namespace detail
+static_assert(detail::frame_types_valid(), "distinct nonzero type codes; each length fits a byte");
+
 constexpr int kOverhead = 6;
-constexpr int kMaxFrame = kActuatorPayload + kOverhead;
-static_assert(kActuatorPayload < 256 && kSensorPayload < 256, "length fits a byte");
+constexpr int kMaxPayload = detail::max_payload();
+constexpr int kMaxFrame = kMaxPayload + kOverhead;
+static_assert(kMaxPayload == kActuatorPayload,
+              "the actuator frame is the largest: the boards size their telemetry (buffer, baud rate) by kMaxFrame");
 
 /// CRC-16/CCITT-FALSE (polynomial 0x1021, initial 0xFFFF), one bit at a time: the definition,
 /// which makes the table below and the tests' reference.
@@ -272,22 +336,27 @@ inline int finish(std::uint8_t* buf, FrameType type, int payload) {
 }
 }  // namespace detail
 
-/// Encodes into buf (at least kMaxFrame bytes); returns the frame length.
-inline int encode(const SensorFrame& f, std::uint8_t* buf) {
-  detail::Writer w{buf + 4};
-  OSC_SENSOR_FIELDS(OSC_FIELD_PUT)
-  return detail::finish(buf, kSensorFrame, kSensorPayload);
-}
-
-inline int encode(const ActuatorFrame& f, std::uint8_t* buf) {
-  detail::Writer w{buf + 4};
-  OSC_ACTUATOR_FIELDS(OSC_FIELD_PUT)
-  return detail::finish(buf, kActuatorFrame, kActuatorPayload);
-}
+/// encode(frame, buf): encodes into buf (at least kMaxFrame bytes); returns the frame length.
+#define OSC_FRAME_ENCODE(Name, code, name, from, when, FIELDS)    \
+  inline int encode(const Name##Frame& f, std::uint8_t* buf) {    \
+    detail::Writer w{buf + 4};                                    \
+    FIELDS(OSC_FIELD_PUT)                                         \
+    return detail::finish(buf, k##Name##Frame, k##Name##Payload); \
+  }
+OSC_FRAME_LIST(OSC_FRAME_ENCODE)
+#undef OSC_FRAME_ENCODE
 
 /// Payload length of a frame type, -1 for an unknown type.
 constexpr int payload_length(std::uint8_t type) {
-  return type == kSensorFrame ? kSensorPayload : type == kActuatorFrame ? kActuatorPayload : -1;
+#define OSC_FRAME_CASE(Name, code, name, from, when, FIELDS) \
+  case k##Name##Frame:                                       \
+    return k##Name##Payload;
+  switch (type) {
+    OSC_FRAME_LIST(OSC_FRAME_CASE)
+    default:
+      return -1;
+  }
+#undef OSC_FRAME_CASE
 }
 
 /// Streaming frame parser: feed bytes one at a time. Every byte is accounted for: part of a frame
@@ -352,18 +421,16 @@ class Parser {
   void reset() { stage_ = 0; }
   FrameType type() const { return static_cast<FrameType>(buf_[0]); }
 
-  bool decode(SensorFrame& f) const {
-    if (type() != kSensorFrame) return false;
-    detail::Reader r{buf_ + 2};
-    OSC_SENSOR_FIELDS(OSC_FIELD_GET)
-    return true;
+  /// decode(frame): the last kFrame's payload into a frame of its type (false for another type).
+#define OSC_FRAME_DECODE(Name, code, name, from, when, FIELDS) \
+  bool decode(Name##Frame& f) const {                          \
+    if (type() != k##Name##Frame) return false;                \
+    detail::Reader r{buf_ + 2};                                \
+    FIELDS(OSC_FIELD_GET)                                      \
+    return true;                                               \
   }
-  bool decode(ActuatorFrame& f) const {
-    if (type() != kActuatorFrame) return false;
-    detail::Reader r{buf_ + 2};
-    OSC_ACTUATOR_FIELDS(OSC_FIELD_GET)
-    return true;
-  }
+  OSC_FRAME_LIST(OSC_FRAME_DECODE)
+#undef OSC_FRAME_DECODE
 
  private:
   std::uint8_t buf_[kMaxFrame] = {};
@@ -376,14 +443,13 @@ class Parser {
 /// Calls visit(name, value) for each field of a frame, in wire order; value is the member itself (a
 /// number, an array or LinkCounters). Host tools make their JSON keys from it (host_sim/frame_json.hpp).
 #define OSC_FIELD_VISIT(type, name, extent, unit, doc) visit(#name, f.name);
-template <class Visit>
-void for_each_field(const SensorFrame& f, Visit&& visit) {
-  OSC_SENSOR_FIELDS(OSC_FIELD_VISIT)
-}
-template <class Visit>
-void for_each_field(const ActuatorFrame& f, Visit&& visit) {
-  OSC_ACTUATOR_FIELDS(OSC_FIELD_VISIT)
-}
+#define OSC_FRAME_FOR_EACH(Name, code, name, from, when, FIELDS) \
+  template <class Visit>                                         \
+  void for_each_field(const Name##Frame& f, Visit&& visit) {     \
+    FIELDS(OSC_FIELD_VISIT)                                      \
+  }
+OSC_FRAME_LIST(OSC_FRAME_FOR_EACH)
+#undef OSC_FRAME_FOR_EACH
 #undef OSC_FIELD_VISIT
 
 }  // namespace pil

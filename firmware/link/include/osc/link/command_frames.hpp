@@ -1,0 +1,96 @@
+// The command protocol's payloads (issue 23), declared once each as a field list like the sensor
+// and actuator frames' (osc/link/frames.hpp, which includes this file and makes the structs, their
+// encoding and decoding, the payload lengths and the protocol document's tables from them):
+//
+//   command  host -> controller   a client's command: a verb, move_to's target, options and limits
+//   answer   controller -> host   a tick's report: the answer to a command, a motion done or aborted
+//   state    controller -> host   the motion state, the latched faults, the reference and measured pose
+//
+// The conversions between these frames and the control task's commands and reports are in
+// osc/link/commands.hpp. Macros and constants only: no dependency beyond the fault catalogue's
+// X-macro helpers.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
+
+namespace pil {
+
+// X(Name, "name", meaning): the command frame's flag bits, bit k for the k-th entry. They qualify a
+// move_to; other verbs ignore them. A bit outside this list makes the command bad_command.
+#define OSC_COMMAND_FLAG_LIST(X)                                                                              \
+  X(Relative, "relative",                                                                                     \
+    "position is an offset from where the queue ends, rpy a rotation applied to its orientation (both in "    \
+    "the base frame); otherwise both are absolute")                                                           \
+  X(HasRpy, "has_rpy", "rpy gives the target orientation; otherwise the orientation stays as it is")          \
+  X(Replace, "replace",                                                                                       \
+    "re-target: brake the running motion along its path, drop the queued moves, move from where it comes to " \
+    "rest; otherwise the move is queued")                                                                     \
+  X(HasLimits, "has_limits", "limits apply to this move; otherwise the configured maxima (Command checks)")
+
+#define OSC_X_PREFIX kFlagBit
+enum CommandFlagBit : std::uint8_t { OSC_COMMAND_FLAG_LIST(OSC_X_ENUMERATOR) kCommandFlagCount };
+#undef OSC_X_PREFIX
+#define OSC_COMMAND_FLAG_MASK(Name, name, doc) \
+  constexpr std::uint8_t kFlag##Name = static_cast<std::uint8_t>(1u << kFlagBit##Name);
+OSC_COMMAND_FLAG_LIST(OSC_COMMAND_FLAG_MASK)
+#undef OSC_COMMAND_FLAG_MASK
+static_assert(kCommandFlagCount <= 8, "the flags fit their byte");
+/// Every defined flag bit.
+constexpr std::uint8_t kCommandFlagsKnown = static_cast<std::uint8_t>((1u << kCommandFlagCount) - 1u);
+/// Names and meanings of the flags, in bit order.
+constexpr const char* kCommandFlagNames[kCommandFlagCount] = {OSC_COMMAND_FLAG_LIST(OSC_X_NAME)};
+constexpr const char* kCommandFlagDocs[kCommandFlagCount] = {OSC_COMMAND_FLAG_LIST(OSC_X_DOC)};
+
+/// The bounds a command frame's numbers must be within (else bad_command): each coordinate of
+/// `position` within +-kCommandMaxPosition [m], each angle of `rpy` within +-kCommandMaxAngle [rad]
+/// (2 pi), every number finite, and with has_limits every limit above 0.
+constexpr double kCommandMaxPosition = 10.0;
+constexpr double kCommandMaxAngle = 6.283185307179586;
+
+// The field lists, X(type, name, extent, unit, meaning) as in frames.hpp. The references in
+// parentheses name the protocol document's tables.
+#define OSC_COMMAND_FIELDS(X)                                                                                 \
+  X(std::uint32_t, id, , "",                                                                                  \
+    "the client's number for the command, echoed in its answer and, for a motion, in done_id or aborted_id; " \
+    "use nonzero numbers (0 there means none)")                                                               \
+  X(std::uint8_t, verb, , "", "what to do (Verbs)")                                                           \
+  X(std::uint8_t, flags, , "", "move_to's options, one bit each (Command flags)")                             \
+  X(float, position, [3], "m",                                                                                \
+    "move_to: the target position of the wrist centre in the base frame (with relative: the offset)")         \
+  X(float, rpy, [3], "rad",                                                                                   \
+    "move_to with has_rpy: roll, pitch, yaw of the target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) "       \
+    "(with relative: of the rotation applied)")                                                               \
+  X(float, limits, [6], "m/s, m/s^2, m/s^3, rad/s, rad/s^2, rad/s^3",                                         \
+    "move_to with has_limits: the move's linear speed, acceleration and jerk, then its angular speed, "       \
+    "acceleration and jerk; each at most the configured maximum (Command checks)")
+
+#define OSC_ANSWER_FIELDS(X)                                                                                   \
+  X(std::uint32_t, id, , "", "the id of the command answered in this tick; 0 when none was")                   \
+  X(std::uint8_t, verb, , "", "its verb (Verbs); none when no command was answered")                           \
+  X(std::uint8_t, outcome, , "", "accepted or refused; none when no command was answered (Command outcomes)")  \
+  X(std::uint8_t, refusal, , "", "why the command was refused (Reasons); none unless refused")                 \
+  X(std::uint32_t, cause, , "", "with refusal faulted: the fault bits behind it (Fault bits)")                 \
+  X(std::uint32_t, done_id, , "", "the id of a move_to that reached its target at rest in this tick; 0: none") \
+  X(std::uint32_t, aborted_id, , "",                                                                           \
+    "the id of a motion (move_to, paper) aborted in this tick; 0: none, or a motion without an id")            \
+  X(std::uint8_t, abort, , "", "why a running motion was aborted in this tick (Reasons); none: no abort")      \
+  X(std::uint8_t, completion, , "", "a motion that came to rest in this tick (Completions)")                   \
+  X(std::uint8_t, state, , "", "the motion state after this tick (Motion states)")                             \
+  X(std::uint8_t, stop, , "", "the stop in effect after this tick (Stop categories)")                          \
+  X(std::uint8_t, queued, , "", "moves in the motion queue after this tick, the running one included")         \
+  X(std::uint32_t, tick, , "tick", "the number of the tick that answered (0: the first), low 32 bits")
+
+#define OSC_STATE_FIELDS(X)                                                                                   \
+  X(std::uint8_t, state, , "", "the motion state (Motion states)")                                            \
+  X(std::uint8_t, stop, , "", "the stop in effect (Stop categories)")                                         \
+  X(std::uint32_t, faults, , "", "the fault bits latched since the last accepted clear (Fault bits)")         \
+  X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included")                        \
+  X(float, x_d, [6], "m, rad",                                                                                \
+    "the reference pose of the last control step: the wrist centre's position in the base frame, then roll, " \
+    "pitch, yaw of the orientation as move_to's absolute rpy")                                                \
+  X(float, x, [6], "m, rad", "the measured pose of the last control step, the same way")                      \
+  X(std::uint32_t, tick, , "tick", "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")
+
+}  // namespace pil

@@ -1,0 +1,192 @@
+// The command protocol's frames (osc/link/command_frames.hpp) and the control task's commands and
+// reports (osc/runtime/motion_commands.hpp), both ways:
+//
+//   controller: command_from_frame (a command frame checked and decoded into a verb and a
+//               MoveRequest; a bad frame is refused: bad_command), prepare_frame_command (the same,
+//               prepared for the task's mailbox), answer_due / answer_frame (a tick's report as an
+//               answer frame), state_frame_from_task;
+//   host:       frame_from_command / encode_command (a command as a frame).
+//
+// Not yet wired into the link node's exchange (osc/link/node.hpp) or the host's client.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+
+#include "osc/link/frames.hpp"
+#include "osc/runtime/control_task.hpp"
+
+namespace osc {
+
+/// The stop in effect in a motion state: category 0 in fault, 2 while stopping (MotionStep::stop of
+/// the tick that left the machine in it).
+constexpr StopCategory stop_category_of(MotionState s) {
+  return s == MotionState::kFault      ? StopCategory::kCategory0
+         : s == MotionState::kStopping ? StopCategory::kCategory2
+                                       : StopCategory::kNone;
+}
+
+namespace detail {
+inline bool command_within(float v, double bound) { return std::fabs(static_cast<double>(v)) <= bound; }
+
+/// Every number finite, the position and the angles within their bounds, and with has_limits every
+/// limit above 0.
+inline bool command_numbers_valid(const pil::CommandFrame& f) {
+  for (int i = 0; i < 3; ++i)
+    if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
+      return false;
+  for (float l : f.limits) {
+    if (!std::isfinite(l)) return false;
+    if ((f.flags & pil::kFlagHasLimits) && !(l > 0.0f)) return false;
+  }
+  return true;  // a NaN fails command_within(): !(NaN <= bound)
+}
+}  // namespace detail
+
+/// Checks a command frame and decodes it: the verb, and for move_to the request (filled for every
+/// verb, so that frame_from_command gives the frame back). A verb or flag bit outside its list, a
+/// non-finite number, a position coordinate beyond +-kCommandMaxPosition, an angle beyond
+/// +-kCommandMaxAngle, or with has_limits a limit not above 0: bad_command, with `verb` the frame's
+/// when its code is in the list (none otherwise) and `req` cleared. The limits against the configured
+/// maxima, the queue and the path are prepare_move's.
+template <class S>
+MotionReason command_from_frame(const pil::CommandFrame& f, MoveRequest<S>& req, MotionVerb& verb) {
+  req = MoveRequest<S>{};
+  const bool known_verb = f.verb < MotionNames<MotionVerb>::kCount;
+  verb = known_verb ? static_cast<MotionVerb>(f.verb) : MotionVerb::kNone;
+  if (!known_verb || (f.flags & ~pil::kCommandFlagsKnown) != 0 || !detail::command_numbers_valid(f))
+    return MotionReason::kBadCommand;
+  for (int i = 0; i < 3; ++i) {
+    req.position(i) = lit<S>(static_cast<double>(f.position[i]));
+    req.rpy(i) = lit<S>(static_cast<double>(f.rpy[i]));
+  }
+  req.relative = (f.flags & pil::kFlagRelative) != 0;
+  req.has_rpy = (f.flags & pil::kFlagHasRpy) != 0;
+  req.replace = (f.flags & pil::kFlagReplace) != 0;
+  req.has_limits = (f.flags & pil::kFlagHasLimits) != 0;
+  JerkLimits<S>* const lim[2] = {&req.limits.linear, &req.limits.angular};
+  for (int k = 0; k < 2; ++k) {
+    lim[k]->v = lit<S>(static_cast<double>(f.limits[3 * k]));
+    lim[k]->a = lit<S>(static_cast<double>(f.limits[3 * k + 1]));
+    lim[k]->j = lit<S>(static_cast<double>(f.limits[3 * k + 2]));
+  }
+  return MotionReason::kNone;
+}
+
+/// A command frame, ready for the task's mailbox (ControlTask::pending) at tick `next_tick`: decoded
+/// (command_from_frame), then prepared (prepare_move for move_to, prepare_command otherwise; `max`:
+/// the configured limits). A bad frame gives a command refused with bad_command.
+template <class S>
+TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const CartesianLimits<S>& max,
+                                     std::uint64_t next_tick, std::uint32_t rate_hz, const pil::CommandFrame& f) {
+  MoveRequest<S> req;
+  MotionVerb verb;
+  const MotionReason why = command_from_frame(f, req, verb);
+  if (why != MotionReason::kNone) {
+    TaskCommand<S> c = prepare_command(gen, verb, f.id);
+    c.refusal = why;
+    return c;
+  }
+  return verb == MotionVerb::kMoveTo ? prepare_move(gen, max, next_tick, rate_hz, req, f.id)
+                                     : prepare_command(gen, verb, f.id);
+}
+
+/// Host side: a command as a frame (the request's numbers rounded to f32; for verbs other than
+/// move_to a default request gives zeros).
+template <class S>
+pil::CommandFrame frame_from_command(std::uint32_t id, MotionVerb verb, const MoveRequest<S>& req = {}) {
+  pil::CommandFrame f;
+  f.id = id;
+  f.verb = static_cast<std::uint8_t>(verb);
+  f.flags =
+      static_cast<std::uint8_t>((req.relative ? pil::kFlagRelative : 0) | (req.has_rpy ? pil::kFlagHasRpy : 0) |
+                                (req.replace ? pil::kFlagReplace : 0) | (req.has_limits ? pil::kFlagHasLimits : 0));
+  for (int i = 0; i < 3; ++i) {
+    f.position[i] = static_cast<float>(req.position(i));
+    f.rpy[i] = static_cast<float>(req.rpy(i));
+  }
+  const JerkLimits<S> lim[2] = {req.limits.linear, req.limits.angular};
+  for (int k = 0; k < 2; ++k) {
+    f.limits[3 * k] = static_cast<float>(lim[k].v);
+    f.limits[3 * k + 1] = static_cast<float>(lim[k].a);
+    f.limits[3 * k + 2] = static_cast<float>(lim[k].j);
+  }
+  return f;
+}
+
+/// Host side: encodes a command frame into buf (at least pil::kMaxFrame bytes); returns its length.
+template <class S>
+int encode_command(std::uint32_t id, MotionVerb verb, const MoveRequest<S>& req, std::uint8_t* buf) {
+  return pil::encode(frame_from_command(id, verb, req), buf);
+}
+
+/// Whether a tick's report has something to send: a command answered, a motion done or aborted, a
+/// completion.
+constexpr bool answer_due(const MotionReport& r) {
+  return r.outcome != CommandOutcome::kNone || r.done_id != 0 || r.aborted_id != 0 || r.abort != MotionReason::kNone ||
+         r.completion != MotionCompletion::kNone;
+}
+
+/// A tick's report as an answer frame, with the machine's state after the tick, the moves queued
+/// then and the tick's number.
+inline pil::AnswerFrame frame_from_report(const MotionReport& r, MotionState state, int queued, std::uint64_t tick) {
+  pil::AnswerFrame a;
+  a.id = r.id;
+  a.verb = static_cast<std::uint8_t>(r.verb);
+  a.outcome = static_cast<std::uint8_t>(r.outcome);
+  a.refusal = static_cast<std::uint8_t>(r.refusal);
+  a.cause = r.cause;
+  a.done_id = r.done_id;
+  a.aborted_id = r.aborted_id;
+  a.abort = static_cast<std::uint8_t>(r.abort);
+  a.completion = static_cast<std::uint8_t>(r.completion);
+  a.state = static_cast<std::uint8_t>(state);
+  a.stop = static_cast<std::uint8_t>(stop_category_of(state));
+  a.queued = static_cast<std::uint8_t>(queued < 0 ? 0 : queued > 255 ? 255 : queued);
+  a.tick = static_cast<std::uint32_t>(tick);
+  return a;
+}
+
+/// The answer of the tick control_tick() just ran (its report; task.tick has moved on to the next).
+template <class S>
+pil::AnswerFrame answer_frame(const ControlTask<S>& task) {
+  return frame_from_report(task.report, task.machine.state, task.gen.queued(), task.tick - 1);
+}
+
+namespace detail {
+/// A pose as six f32: the position, then roll, pitch, yaw as a move_to's absolute rpy.
+template <class S>
+void pose_floats(const Vec3<S>& p, const Mat3<S>& R, float out[6]) {
+  const Vec3<S> rpy = orientation_coordinates<S>(R, Mat3<S>::Identity());
+  for (int i = 0; i < 3; ++i) {
+    out[i] = static_cast<float>(p(i));
+    out[3 + i] = static_cast<float>(rpy(i));
+  }
+}
+}  // namespace detail
+
+/// The task's state after a tick: the motion state, the stop in effect, the latched faults, the
+/// moves queued, and the reference and measured poses of the last control step (x_d = x + e; before
+/// the first step, or after a step that failed, the pose the generator holds).
+template <class S>
+pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
+  pil::StateFrame f;
+  f.state = static_cast<std::uint8_t>(task.machine.state);
+  f.stop = static_cast<std::uint8_t>(stop_category_of(task.machine.state));
+  f.faults = task.machine.latched | task.sup.latched;
+  const int queued = task.gen.queued();
+  f.queued = static_cast<std::uint8_t>(queued > 255 ? 255 : queued);
+  const StepOutput<S>& out = task.last;
+  if (task.step_timing.count == 0 || out.status != kFaultNone) {
+    detail::pose_floats<S>(task.gen.hold_pose().p, task.gen.hold_pose().R, f.x_d);
+  } else {
+    const Vec6<S> x_d = out.x + out.e;
+    detail::pose_floats<S>(x_d.template head<3>(), Mat3<S>(rpy_rotation<S>(x_d.template tail<3>()) * task.state.R_ref),
+                           f.x_d);
+  }
+  detail::pose_floats<S>(task.state.data.o[kDof], task.state.data.R[kDof], f.x);
+  f.tick = static_cast<std::uint32_t>(task.tick - 1);
+  return f;
+}
+
+}  // namespace osc
