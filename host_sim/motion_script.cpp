@@ -127,7 +127,8 @@ bool parse_top(const YAML::Node& root, MotionScript& script, std::string& err) {
       if (!number(p[i], "start_pose[" + std::to_string(i) + "]", q(i), err)) return false;
       q(i) *= kDegToRad;
       if (q(i) < osc::robot::kArm.q_min[i] || q(i) > osc::robot::kArm.q_max[i])
-        return err = "start_pose[" + std::to_string(i) + "]: outside joint " + std::to_string(i + 1) + "'s limits", false;
+        return err = "start_pose[" + std::to_string(i) + "]: outside joint " + std::to_string(i + 1) + "'s limits",
+               false;
     }
     script.start_pose = q;
   }
@@ -148,7 +149,8 @@ bool parse_motion_script(const std::string& text, const std::string& name, Motio
   if (!parse_top(root, script, err)) return err = name + ": " + err, false;
   for (std::size_t i = 0; i < root["steps"].size(); ++i) {
     MotionStepSpec s;
-    if (!parse_step(root["steps"][i], "steps[" + std::to_string(i) + "]", s, err)) return err = name + ": " + err, false;
+    if (!parse_step(root["steps"][i], "steps[" + std::to_string(i) + "]", s, err))
+      return err = name + ": " + err, false;
     script.steps.push_back(s);
   }
   return true;
@@ -217,9 +219,9 @@ class Player {
     r.position = m.position.cast<S>();
     r.rpy = m.rpy.cast<S>();
     r.relative = m.relative, r.has_rpy = m.has_rpy, r.replace = m.replace, r.has_limits = m.has_limits;
-    r.limits = {{static_cast<S>(m.limits.linear.v), static_cast<S>(m.limits.linear.a), static_cast<S>(m.limits.linear.j)},
-                {static_cast<S>(m.limits.angular.v), static_cast<S>(m.limits.angular.a),
-                 static_cast<S>(m.limits.angular.j)}};
+    r.limits = {
+        {static_cast<S>(m.limits.linear.v), static_cast<S>(m.limits.linear.a), static_cast<S>(m.limits.linear.j)},
+        {static_cast<S>(m.limits.angular.v), static_cast<S>(m.limits.angular.a), static_cast<S>(m.limits.angular.j)}};
     return r;
   }
   CommandRecord* record(std::uint32_t id) {
@@ -241,7 +243,7 @@ class Player {
   MotionSim<S> sim_;
   MotionRun run_;
   std::size_t next_ = 0;
-  double ready_s_ = -1;  // when the next step's condition held first (-1: not yet)
+  double ready_s_ = -1;       // when the next step's condition held first (-1: not yet)
   bool was_powered_ = false;  // the torque was on before this tick (its step ran: a reference to track)
   osc::Vec3<double> w_prev_ = osc::Vec3<double>::Zero(), wd_prev_ = osc::Vec3<double>::Zero();
   osc::Vec3<double> a_prev_ = osc::Vec3<double>::Zero();
@@ -351,8 +353,8 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
   ordered_json states = ordered_json::array();
   for (const auto& s : run.states) states.push_back({{"t", s.t}, {"state", s.state}});
   j["states"] = states;
-  j["limits"] = {{"v", osc::params::kMoveLinear[0]},  {"a", osc::params::kMoveLinear[1]},
-                 {"j", osc::params::kMoveLinear[2]},  {"w", osc::params::kMoveAngular[0]},
+  j["limits"] = {{"v", osc::params::kMoveLinear[0]},   {"a", osc::params::kMoveLinear[1]},
+                 {"j", osc::params::kMoveLinear[2]},   {"w", osc::params::kMoveAngular[0]},
                  {"wd", osc::params::kMoveAngular[1]}, {"wdd", osc::params::kMoveAngular[2]}};
   return j.dump(2) + "\n";
 }

@@ -34,8 +34,8 @@ namespace sim {
 struct MotionStepSpec {
   bool after_done = false;      ///< sent once the previous step was answered and the arm is at rest
   bool after_answered = false;  ///< sent once the previous step was answered
-  double at = 0;            ///< else: sent at this time [s]
-  double delay = 0;         ///< sent this much later [s]
+  double at = 0;                ///< else: sent at this time [s]
+  double delay = 0;             ///< sent this much later [s]
   osc::MotionVerb verb = osc::MotionVerb::kNone;
   osc::MoveRequest<double> move;  ///< move_to
   std::string text;               ///< the step as written, for the JSON

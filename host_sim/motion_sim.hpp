@@ -25,11 +25,13 @@ class MotionSim {
   explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
                      osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
                      const osc::Gains<double>& gains = osc::Gains<double>::paper())
-      : plant_(pc), hal_(plant_, q0, osc::robot::kDrives.encoder_counts_per_motor_rev, inj), task_(new osc::ControlTask<S>) {
+      : plant_(pc),
+        hal_(plant_, q0, osc::robot::kDrives.encoder_counts_per_motor_rev, inj),
+        task_(new osc::ControlTask<S>) {
     plant_.reset(q0);
     plant_.set_brakes(true);
-    task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(),
-                PlantHal::kPeriodNs, osc::TaskStart::kDisabled);
+    task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(), PlantHal::kPeriodNs,
+                osc::TaskStart::kDisabled);
   }
 
   /// A command without a plan (enable, disable, paper, stop, clear), taken by the next tick.
@@ -66,7 +68,8 @@ class MotionSim {
   Vec6 pose() const {
     osc::forward_kinematics(model_, data_, plant_.q());
     Vec6 x;
-    x << data_.o[osc::kDof], osc::orientation_coordinates<double>(data_.R[osc::kDof], task_->state.R_ref.template cast<double>());
+    x << data_.o[osc::kDof],
+        osc::orientation_coordinates<double>(data_.R[osc::kDof], task_->state.R_ref.template cast<double>());
     return x;
   }
 

@@ -237,7 +237,8 @@ int run_motion(const Options& o, int json_fd) {
               sim::kScalarNames[static_cast<int>(cfg.scalar)], sim::mode_name(cfg.mode), run.result.c_str(),
               run.duration_s, run.max_error_mm, run.max_error_deg);
   for (const sim::CommandRecord& r : run.commands) {
-    std::printf("  %6.3f s  %-8s %-9s", r.sent_s, r.cmd.c_str(), r.accepted ? "accepted" : ("refused " + r.refused).c_str());
+    std::printf("  %6.3f s  %-8s %-9s", r.sent_s, r.cmd.c_str(),
+                r.accepted ? "accepted" : ("refused " + r.refused).c_str());
     if (r.done_s >= 0) std::printf("  done %.3f s", r.done_s);
     if (!r.aborted.empty()) std::printf("  aborted %s at %.3f s", r.aborted.c_str(), r.aborted_s);
     if (r.v > 0) std::printf("  tracking %.3f mm %.3f deg, v %.3f m/s", r.max_error_mm, r.max_error_deg, r.v);

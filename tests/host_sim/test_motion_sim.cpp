@@ -29,8 +29,8 @@ V6 start_pose() {
 struct Trace {
   int ticks = 0;
   std::uint32_t faults = 0;
-  double tracking = 0;  // largest |reference position - true tip| while torque was on [m]
-  double tip_moved = 0;  // largest |tip - tip at the start of the run| [m]
+  double tracking = 0;                // largest |reference position - true tip| while torque was on [m]
+  double tip_moved = 0;               // largest |tip - tip at the start of the run| [m]
   std::vector<MotionReport> reports;  // every tick's report with something in it
   bool ended = false;                 // the predicate became true
 };
@@ -59,7 +59,8 @@ Trace run_until(MotionSim<S>& sim, Pred done, int max_ticks) {
 
 template <class S>
 Trace run_ticks(MotionSim<S>& sim, int n) {
-  return run_until(sim, [](const MotionSim<S>&) { return false; }, n);
+  return run_until(
+      sim, [](const MotionSim<S>&) { return false; }, n);
 }
 
 /// Sends a command and runs the tick that answers it; returns that tick's report.
@@ -130,7 +131,8 @@ double move_and_finish(bool warm, double tol) {
     EXPECT_EQ(answer(sim, MotionVerb::kPaper, 2).outcome, CommandOutcome::kAccepted);
     run_ticks(sim, 10000);
     EXPECT_EQ(answer(sim, MotionVerb::kStop, 3).outcome, CommandOutcome::kAccepted);
-    run_until(sim, [](const MotionSim<S>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+    run_until(
+        sim, [](const MotionSim<S>& s) { return state_is(s, MotionState::kHolding); }, 10000);
   }
   MoveRequest<S> req = relative<S>(0.10, -0.08, 0.05);
   req.has_rpy = true;
@@ -138,7 +140,8 @@ double move_and_finish(bool warm, double tol) {
   EXPECT_EQ(answer_move(sim, req, 7).outcome, CommandOutcome::kAccepted);
   EXPECT_TRUE(state_is(sim, MotionState::kMoving));
   const V3 target = sim.task().gen.queue_end().p.template cast<double>();
-  const Trace r = run_until(sim, [](const MotionSim<S>& s) { return s.task().report.done_id != 0; }, 20000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<S>& s) { return s.task().report.done_id != 0; }, 20000);
   EXPECT_TRUE(r.ended);
   EXPECT_EQ(r.faults, 0u);
   EXPECT_EQ(sim.task().report.done_id, 7u);
@@ -172,7 +175,8 @@ TEST(MotionSim, StopDeceleratesThenHolds) {
   EXPECT_EQ(stop.abort, MotionReason::kStopCommand);
   EXPECT_EQ(stop.aborted_id, 2u);
   EXPECT_TRUE(state_is(sim, MotionState::kStopping));
-  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.completion != MotionCompletion::kNone; }, 10000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.completion != MotionCompletion::kNone; }, 10000);
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
   EXPECT_EQ(sim.task().report.done_id, 0u);  // the move did not reach its target
@@ -194,7 +198,8 @@ TEST(MotionSim, DisableWhileMovingStopsThenCutsTheTorque) {
   EXPECT_EQ(rep.outcome, CommandOutcome::kAccepted);
   EXPECT_EQ(rep.abort, MotionReason::kDisableCommand);
   EXPECT_TRUE(state_is(sim, MotionState::kStopping));
-  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kDisabled); }, 10000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kDisabled); }, 10000);
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
   EXPECT_EQ(r.faults, 0u);
@@ -234,7 +239,8 @@ TEST(MotionSim, EveryRuntimeRefusalIsNamed) {
   // stopping: a move during a stop.
   answer(sim, MotionVerb::kStop, 52);
   EXPECT_EQ(answer_move(sim, relative<double>(0.01, 0, 0), 53).refusal, MotionReason::kStopping);
-  run_until(sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+  run_until(
+      sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
   // superseded: the queue changed between the plan and its tick (here: a new hold).
   sim.move_to(relative<double>(0, 0.01, 0), 51);
   sim.task().gen.hold(sim.task().gen.hold_pose(), sim.task().gen.reference_orientation());
@@ -282,7 +288,8 @@ TEST(MotionSim, PaperMotionByCommandThenAStopAlongItsPath) {
   EXPECT_LE(moving.tracking, 1.5e-3);
   const MotionReport stop = answer(sim, MotionVerb::kStop, 3);
   EXPECT_EQ(stop.aborted_id, 2u);
-  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.completion != MotionCompletion::kNone; }, 10000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.completion != MotionCompletion::kNone; }, 10000);
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(r.faults, 0u);
   EXPECT_TRUE(state_is(sim, MotionState::kHolding));
@@ -324,7 +331,8 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
   q = start_pose();
   q(4) = 0.5, q(0) = 0.2;
   EXPECT_EQ(answer_move(sim, to_joint_pose(q), 4).outcome, CommandOutcome::kAccepted);
-  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.done_id == 4; }, 20000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.done_id == 4; }, 20000);
   EXPECT_TRUE(r.ended);
   EXPECT_EQ(r.faults, 0u);
 }
@@ -344,10 +352,12 @@ TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
   sim.task().pending = prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, req, 2);
   sim.tick();
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
-  const Trace r = run_until(sim, [](const MotionSim<double>& s) { return s.task().report.abort != MotionReason::kNone; }, 20000);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.abort != MotionReason::kNone; }, 20000);
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(sim.task().report.abort, MotionReason::kLimitReached);
-  const Trace rest = run_until(sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+  const Trace rest = run_until(
+      sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
   EXPECT_TRUE(rest.ended);
   EXPECT_EQ(r.faults | rest.faults, 0u);
 }

@@ -35,7 +35,7 @@ struct Trace {
   double v = 0, a = 0, j = 0, w = 0, wd = 0;  // peak linear speed, acceleration, jerk; angular speed, acceleration
   double jump = 0;                            // largest change of x, xd, xdd in one tick beyond what the limits allow
   double off_line = 0;                        // largest distance from the line p0 -> p1
-  double derivative = 0;  // largest mismatch of x, xd with the trapezoidal integrals of xd, xdd
+  double derivative = 0;                      // largest mismatch of x, xd with the trapezoidal integrals of xd, xdd
   int finished = 0, stopped = 0;              // events
   int ticks = 0;
   Desired<double> last{};
@@ -96,8 +96,10 @@ TEST(CartesianMove, StraightLineAboutOneAxisWithinItsLimitsEndingAtTheTarget) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> U(-1, 1);
   for (int trial = 0; trial < 20; ++trial) {
-    const Pose<double> a = pose(0.4 + 0.1 * U(rng), 0.1 * U(rng), 0.3 + 0.1 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
-    const Pose<double> b = pose(0.4 + 0.2 * U(rng), 0.2 * U(rng), 0.3 + 0.2 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
+    const Pose<double> a =
+        pose(0.4 + 0.1 * U(rng), 0.1 * U(rng), 0.3 + 0.1 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
+    const Pose<double> b =
+        pose(0.4 + 0.2 * U(rng), 0.2 * U(rng), 0.3 + 0.2 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
     const Mat3<double> R_ref = rpy_rotation<double>({0.1, -0.2, 0.3});
     CartesianMove<double> m;
     ASSERT_EQ(m.plan(a, b, kLim, R_ref), ProfileStatus::kOk);
@@ -127,7 +129,8 @@ TEST(CartesianMove, StraightLineAboutOneAxisWithinItsLimitsEndingAtTheTarget) {
 TEST(CartesianMove, OrientationRatesAreTheDerivativesOfItsCoordinates) {
   const Mat3<double> R_ref = rpy_rotation<double>({0.2, 0.1, -0.4});
   CartesianMove<double> m;
-  ASSERT_EQ(m.plan(pose(0.5, 0, 0.3, {0, 0, 0}), pose(0.5, 0.05, 0.3, {0.5, -0.4, 0.9}), kLim, R_ref), ProfileStatus::kOk);
+  ASSERT_EQ(m.plan(pose(0.5, 0, 0.3, {0, 0, 0}), pose(0.5, 0.05, 0.3, {0.5, -0.4, 0.9}), kLim, R_ref),
+            ProfileStatus::kOk);
   const double h = 1e-6;
   double worst_v = 0, worst_a = 0;
   for (double t = 0.01; t < m.duration(); t += 0.037) {
@@ -262,8 +265,8 @@ TEST(MotionGenerator, PaperMotionSlowsDownAlongItsPathAndMayBeFollowedByMoves) {
     EXPECT_EQ(after.stopped, then_move ? 0 : 1);
     EXPECT_EQ(after.finished, then_move ? 1 : 0);
     // The slow-down's acceleration: at most (68)'s plus its speed times kPaperStopRate, per axis.
-    const double bound = std::sqrt(3.0) * (spec.amplitude * spec.omega * spec.omega +
-                                           spec.amplitude * spec.omega * kPaperStopRate);
+    const double bound =
+        std::sqrt(3.0) * (spec.amplitude * spec.omega * spec.omega + spec.amplitude * spec.omega * kPaperStopRate);
     EXPECT_LE(after.a, std::max(bound, params::kMoveLinear[1]) * (1 + 1e-9));
     EXPECT_LE(after.jump, 0.0);
     EXPECT_LE(after.derivative, 0.25 * params::kMoveAngular[2] / kHz);

@@ -88,8 +88,8 @@ Mat3<S> rpy_rotation(const Vec3<S>& rpy) {
 }
 
 /// The axis k and angle in [0, pi) of the rotation Rd (Rd = Rot(k, angle)); k = x and angle 0 for
-/// a rotation too small to name an axis (below 5e-7 rad, in fixed point 5e-5 rad). Angles near pi have no well-conditioned axis from this
-/// formula: callers refuse rotations beyond kMaxMoveRotation.
+/// a rotation too small to name an axis (below 5e-7 rad, in fixed point 5e-5 rad). Angles near pi have no
+/// well-conditioned axis from this formula: callers refuse rotations beyond kMaxMoveRotation.
 template <class S>
 void rotation_axis_angle(const Mat3<S>& Rd, Vec3<S>& k, S& angle) {
   const Vec3<S> v(Rd(2, 1) - Rd(1, 2), Rd(0, 2) - Rd(2, 0), Rd(1, 0) - Rd(0, 1));  // 2 sin(angle) k

@@ -45,8 +45,8 @@ constexpr double kPaperStopJerk = 1.0;  ///< [1/s^2]
 
 /// What a tick of the generator reports to the motion state machine (osc/runtime/motion_states.hpp).
 struct MotionEvents {
-  bool finished = false;  ///< the motion ended at rest with nothing queued (not after a stop)
-  bool stopped = false;   ///< a category-2 stop reached rest
+  bool finished = false;      ///< the motion ended at rest with nothing queued (not after a stop)
+  bool stopped = false;       ///< a category-2 stop reached rest
   std::uint32_t done_id = 0;  ///< a move that reached its target at rest in this tick (its id; not a braked one)
 };
 
@@ -98,7 +98,8 @@ class MotionGenerator {
       return m.end();
     }
     JerkProfile<S> tau;
-    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0), {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0),
+                  {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
     return {paper_.at_time(tau.target()).x.template head<3>(), hold_pose_.R};
   }
   /// Counts the changes of queue_end() other than a push (hold, paper, brake, stop; a motion that

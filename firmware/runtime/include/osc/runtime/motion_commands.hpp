@@ -20,13 +20,13 @@
 namespace osc {
 
 // X(Name, "name", meaning): the verbs of the command frame, in code order.
-#define OSC_MOTION_VERB_LIST(X)                                                                          \
-  X(None, "none", "no command")                                                                          \
-  X(Enable, "enable", "torque on, holding the measured pose; the observer starts there")                 \
-  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")                    \
-  X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion")      \
-  X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                     \
-  X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")             \
+#define OSC_MOTION_VERB_LIST(X)                                                                     \
+  X(None, "none", "no command")                                                                     \
+  X(Enable, "enable", "torque on, holding the measured pose; the observer starts there")            \
+  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")               \
+  X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion") \
+  X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                \
+  X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")        \
   X(Clear, "clear", "leave fault for disabled, once no fault cause is present")
 
 #define OSC_X_PREFIX k
@@ -72,12 +72,12 @@ struct MoveRequest {
 template <class S>
 struct TaskCommand {
   MotionVerb verb = MotionVerb::kNone;
-  std::uint32_t id = 0;                         ///< the client's, echoed in the reports
-  MotionReason refusal = MotionReason::kNone;   ///< decided while preparing
-  bool brake = false;                           ///< move_to: brake the running motion first
-  std::uint32_t epoch = 0;                      ///< the generator's, when the move was planned
-  CartesianMove<S> move{};                      ///< move_to: the planned move
-  Vec6<S> q_end = Vec6<S>::Zero();              ///< move_to: the joint angles at its end (path check)
+  std::uint32_t id = 0;                        ///< the client's, echoed in the reports
+  MotionReason refusal = MotionReason::kNone;  ///< decided while preparing
+  bool brake = false;                          ///< move_to: brake the running motion first
+  std::uint32_t epoch = 0;                     ///< the generator's, when the move was planned
+  CartesianMove<S> move{};                     ///< move_to: the planned move
+  Vec6<S> q_end = Vec6<S>::Zero();             ///< move_to: the joint angles at its end (path check)
 };
 
 /// What one tick reports: the answer to its command, and a motion's end.
