@@ -5,6 +5,7 @@
 // The HAL is the concept hal::ControlHal (hal/hal.hpp).
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "hal/hal.hpp"
@@ -134,10 +135,13 @@ constexpr bool motion_powered(MotionState s) {
 /// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond.
 template <class S>
 MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q) {
+  static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
+  static constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
+  static constexpr S kMinRcond = lit<S>(params::kLimitMinRcond);
   if (task.machine.state != MotionState::kMoving) return MotionReason::kNone;
   for (int i = 0; i < kDof; ++i)
-    if (q(i) < lit<S>(robot::kArm.q_min[i]) || q(i) > lit<S>(robot::kArm.q_max[i])) return MotionReason::kLimitReached;
-  if (task.last.rcond < lit<S>(params::kLimitMinRcond)) return MotionReason::kLimitReached;
+    if (q(i) < kQMin[i] || q(i) > kQMax[i]) return MotionReason::kLimitReached;
+  if (task.last.rcond < kMinRcond) return MotionReason::kLimitReached;
   return MotionReason::kNone;
 }
 

@@ -1,0 +1,110 @@
+#!/usr/bin/env bash
+# motion_scripts.sh PUMA_EXPERIMENT PYTHON EXAMPLES_DIR CASE [ARGS...]: one check of puma_experiment
+# --motion (host_sim/motion_script.cpp, docs/motion.md "Scripted motions"): the example tour runs
+# without a fault in each scalar, its references within their limits and its moves tracked within
+# 1 mm; a bad script is exit status 2 with one message naming the step and the key, before any run.
+# Exit 0: pass; anything else: fail, with the reason.
+set -u
+exe=$1 py=$2 examples=$3 case=$4
+shift 4
+d=$(mktemp -d)
+trap 'rm -rf "$d"' EXIT
+fail() { echo "FAIL ($case): $*"; exit 1; }
+# bad_script 'EXPECTED MESSAGE' <<< 'YAML': refused with exit 2 and the message, nothing run.
+bad_script() {
+  cat >"$d/s.yaml"
+  out=$("$exe" --motion "$d/s.yaml" --json "$d/out.json" 2>&1)
+  status=$?
+  test "$status" -eq 2 || fail "exit $status, not 2: $out"
+  grep -qF -- "$1" <<<"$out" || fail "no '$1' in: $out"
+  test ! -e "$d/out.json" || fail "a JSON was written for a bad script"
+}
+
+case $case in
+tour)  # SCALAR: the example tour in that scalar
+  "$exe" --motion "$examples/motion_tour.yaml" --scalar "$1" --json "$d/tour.json" >"$d/out.txt" 2>&1 ||
+    fail "exit $?: $(cat "$d/out.txt")"
+  "$py" - "$d/tour.json" <<'PY' || fail "$(cat "$d/out.txt")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["result"] == "ok" and j["faults"] == [], (j["result"], j["faults"])
+L = j["limits"]
+cmds = j["commands"]
+assert {c["cmd"] for c in cmds} >= {"enable", "paper", "move_to", "stop", "disable"}, cmds
+for c in cmds:
+    assert c["accepted"] and c["refused"] is None, c
+    assert c["done_s"] is not None or c["aborted"] is not None, c
+    if c["cmd"] == "move_to":
+        for k in ("v", "a", "j", "w", "wd"):
+            assert c["reference_max"][k] <= L[k] * (1 + 1e-9), (k, c)
+        assert c["max_error_mm"] <= 1.0, c
+aborted = sorted(c["aborted"] for c in cmds if c["aborted"])
+assert aborted == ["stop_command", "stop_command", "superseded"], aborted
+states = [s["state"] for s in j["states"]]
+assert states[0] == "disabled" and states[-1] == "disabled" and "stopping" in states, states
+print("ok:", j["duration_s"], "s,", len(cmds), "commands, max tracking", j["max_error_mm"], "mm")
+PY
+  ;;
+refusals_are_named)  # a refused command is recorded with its reason's name, and the run goes on
+  cat >"$d/s.yaml" <<'YAML'
+steps:
+  - {at: 0.0, cmd: move_to, position: [0.01, 0, 0], relative: true}
+  - {after: done, cmd: enable}
+  - {after: done, cmd: move_to, position: [2.0, 0, 0], relative: true}
+  - {after: done, cmd: move_to, position: [0.01, 0, 0], relative: true, v: 5}
+  - {after: done, cmd: disable}
+YAML
+  "$exe" --motion "$d/s.yaml" --json "$d/r.json" >"$d/out.txt" 2>&1 || fail "exit $?: $(cat "$d/out.txt")"
+  "$py" - "$d/r.json" <<'PY' || fail "$(cat "$d/out.txt")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+got = [c["refused"] for c in j["commands"]]
+assert got == ["not_enabled", None, "out_of_workspace", "over_limit", None], got
+PY
+  ;;
+unknown_command)
+  bad_script "steps[1].cmd: 'jump' is not a command: enable | disable | move_to | paper | stop | clear" <<'YAML'
+steps:
+  - {at: 0, cmd: enable}
+  - {at: 1, cmd: jump}
+YAML
+  ;;
+move_without_position)
+  bad_script 'steps[0].position: move_to needs a position [x, y, z] in metres' <<'YAML'
+steps:
+  - {at: 0, cmd: move_to, relative: true}
+YAML
+  ;;
+key_of_another_command)
+  bad_script 'steps[0].position: not a key of enable' <<'YAML'
+steps:
+  - {at: 0, cmd: enable, position: [0, 0, 0]}
+YAML
+  ;;
+at_and_after)
+  bad_script 'steps[0]: at: and after: exclude each other' <<'YAML'
+steps:
+  - {at: 0, after: done, cmd: enable}
+YAML
+  ;;
+not_a_number)
+  bad_script 'steps[0].position[1]: not a number' <<'YAML'
+steps:
+  - {at: 0, cmd: move_to, position: [0, fast, 0]}
+YAML
+  ;;
+no_steps)
+  bad_script 'a motion script is a map with a non-empty list steps:' <<'YAML'
+- {at: 0, cmd: enable}
+YAML
+  ;;
+with_qemu)  # refused until the command frames reach the image
+  out=$("$exe" --motion "$examples/motion_tour.yaml" --qemu 2>&1)
+  test $? -eq 2 || fail "exit status not 2: $out"
+  grep -qF -- '--motion runs the host-built controller' <<<"$out" || fail "$out"
+  ;;
+*)
+  fail "unknown case"
+  ;;
+esac
+exit 0
