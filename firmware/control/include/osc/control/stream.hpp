@@ -1,0 +1,229 @@
+// A jerk-limited follower of streamed setpoints: a client sends samples x_k of the 6 operational
+// coordinates (wrist-centre position [m]; roll, pitch, yaw of R R_ref^T [rad]) at a fixed rate of
+// 10 Hz to 1 kHz; every 1 ms tick the follower produces a reference (x, xd, xdd) within the move
+// limits that follows the stream.
+//
+// Target. The linear interpolation between the last two samples, delayed by one sample period T
+// (so the segment is known when it is used): from the arrival of s_k,
+//   r(tau) = s_prev + (s_k - s_prev) tau / T,   v_r = (s_k - s_prev) / T,   tau in ticks since then,
+// where s_prev is where the target stood when s_k arrived (s_{k-1} for a punctual stream; the start
+// pose for the first sample), so the target never jumps, also for a sample that comes early or late.
+// A sample that is late (tau > T) finds the target extrapolated along v_r, for at most
+// kStreamExtrapolation; after end() the target stops at the last sample instead.
+//
+// Follower, per axis, each tick: the velocity it aims at
+//   v* = v_r + clamp(kp e, +-sqrt(2 a_b |e|)),  e = r - p,  clamped to +-vmax,
+// (the square root bounds the position term by a braking curve at a_b = amax / 2, so a large error
+// is closed without overshoot: kp alone would ask for a deceleration kp |v| > amax near vmax), then,
+// exactly over one tick dt, the time-optimal change from (v, a) to (v*, 0) under amax and jmax
+// (jerk_profile::velocity_change, its pieces evaluated over [0, dt] by advance()): |j| <= jmax and
+// |a| <= amax by construction. |v| <= vmax too: along such a change the coast velocity
+// v + a |a| / (2 jmax) moves monotonically towards v*, and v never passes the coast velocity
+// while a has the sign of its change, so with every v* within +-vmax so is v.
+//
+// Limits per axis, which guarantee the Euclidean ones of CartesianLimits (after rounding_margin):
+//   translation  v/sqrt(3), a/sqrt(3), j/sqrt(3) of linear:  |p_dot| <= v, |p_ddot| <= a, ...
+//   orientation  those of angular divided by sqrt(3) * 1.42:  w = E(phi) phi_dot, and for the
+//                roll-pitch-yaw rates ||E(phi)||_2 = sqrt(1 + |sin pitch|) <= sqrt(2) < 1.42, so
+//                |w| <= 1.42 |phi_dot| <= the angular speed limit at any pitch. For the angular
+//                acceleration, w_dot = E phi_ddot + Edot phi_dot: the first term is within the
+//                limit, the second is of the order |phi_dot|^2 (<= 0.04 rad/s^2 at the default
+//                0.5 rad/s), which the assumption of moderate rates covers (the tests measure it).
+//
+// Stale stream: no sample for more than max(2 T, 20 ms) makes stale() true (the target was
+// extrapolated from T on, at most kStreamExtrapolation); the caller then calls stop(): a category-2
+// stop, every axis braked to v = 0 (v* = 0, no position term) under its limits scaled by
+// |v_i| / max_k |v_k| within its group (translation, orientation), at least kStopScaleFloor and at
+// least |a_i|: the axes of a group, started at rest-to-rest proportions, stop together, so the
+// reference decelerates approximately along its current direction. stopped(): stopped and at rest.
+//
+// Time in integer ticks. Header-only, allocation-free, templated on the scalar.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/cartesian_move.hpp"  // CartesianLimits, rounding_margin
+#include "osc/control/jerk_profile.hpp"
+#include "osc/control/params.hpp"
+#include "osc/control/trajectory.hpp"  // Desired
+
+namespace osc {
+
+/// The longest extrapolation of a late stream's target along its last velocity [s].
+constexpr double kStreamExtrapolation = 0.1;
+/// A stream is stale after max(2 periods, kStreamTimeoutMin) without a sample [s].
+constexpr double kStreamTimeoutMin = 0.02;
+/// The position gain of the follower [1/s].
+constexpr double kStreamGain = 4.0;
+/// The bound on |E(phi)|_2 the orientation axes' limits assume (sqrt(2) at any pitch).
+constexpr double kStreamEBound = 1.42;
+/// The least scale of an axis' limits in a stop (an axis at rest still brings a to 0).
+constexpr double kStopScaleFloor = 0.1;
+
+namespace stream {
+/// Advances s over one tick dt by the time-optimal change from (v, a) to (vt, 0) under amax, j; the
+/// rest of the tick after the change has ended at (vt, 0) exactly.
+///
+/// The position: the tick's displacement is accumulated as its mean velocity (the pieces' mean
+/// velocities weighted by their fractions of the tick, at the velocity's resolution) into the
+/// residual lo [m/s of one tick], of which the whole steps of p (lo / kHz rounded) are moved to p.
+/// Advancing p itself would round each tick's v dt to p's resolution: in Q12.19 (2e-6 m) a speed
+/// below 1e-3 m/s would not move p at all, a dead band of 2e-4 m with xd != 0 at rest.
+template <class S>
+void step_axis(jerk_profile::Kin<S>& s, S& lo, S vt, S amax, S j, S dt) {
+  using namespace jerk_profile;
+  const S zero(0), half = lit<S>(0.5), sixth = lit<S>(1.0 / 6.0), hz(static_cast<int>(params::kControlHz));
+  const VelocityChange<S> c = velocity_change(s.v, s.a, vt, amax, j);
+  S left = dt, w = zero;
+  auto piece = [&](S jerk, S t) {
+    const S tt = t < left ? t : left;
+    if (!(tt > zero)) return;
+    w += (tt * hz) * (s.v + tt * (s.a * half + tt * (jerk * sixth)));
+    s.v = s.v + tt * (s.a + tt * (jerk * half));
+    s.a = s.a + tt * jerk;
+    left -= tt;
+  };
+  piece(c.sign * j, c.t1);
+  if (left > zero && c.t2 > zero) {
+    s.a = c.sign * amax;  // the hold, at the limit exactly (the ramp ends there to rounding)
+    piece(zero, c.t2);
+  }
+  piece(-(c.sign * j), c.t3);
+  if (left > zero) {
+    s.v = vt, s.a = zero;  // the change ended inside the tick: cruise at vt for the rest of it
+    w += (left * hz) * vt;
+  }
+  lo += w;
+  const S move = lo / hz;
+  s.p += move;
+  lo -= move * hz;
+}
+
+template <class S>
+S clamp(S x, S lim) {
+  return x > lim ? lim : (x < -lim ? -lim : x);
+}
+}  // namespace stream
+
+template <class S>
+class StreamFollower {
+ public:
+  static constexpr std::uint32_t kHz = params::kControlHz;
+  static constexpr std::uint32_t kExtrapolationTicks = static_cast<std::uint32_t>(kStreamExtrapolation * kHz + 0.5);
+
+  explicit StreamFollower(const CartesianLimits<S>& lim = CartesianLimits<S>::defaults()) {
+    const JerkLimits<S> l = rounding_margin(lim.linear), w = rounding_margin(lim.angular);
+    const S kl = lit<S>(0.57735026918962576), kw = lit<S>(0.57735026918962576 / kStreamEBound);
+    for (int i = 0; i < 6; ++i) {
+      const JerkLimits<S>& g = i < 3 ? l : w;
+      const S k = i < 3 ? kl : kw;
+      lim_[i] = {g.v * k, g.a * k, g.j * k};
+    }
+  }
+
+  /// Starts at x0 at rest (the held pose), the stream's period `period_ticks` (1 to 100 ticks: 1 kHz
+  /// to 10 Hz).
+  void start(const Vec6<S>& x0, std::uint32_t period_ticks) {
+    period_ = period_ticks > 0 ? period_ticks : 1;
+    const std::uint32_t twice = 2 * period_, min = static_cast<std::uint32_t>(kStreamTimeoutMin * kHz + 0.5);
+    timeout_ = twice > min ? twice : min;
+    prev_ = cur_ = x0;
+    since_ = 0;
+    ended_ = stopping_ = false;
+    for (int i = 0; i < 6; ++i) s_[i] = {x0(i), S(0), S(0)}, lo_[i] = S(0);
+  }
+
+  /// A new sample arrived (call before tick() of the same tick). Ignored after stop().
+  void push(const Vec6<S>& sample) {
+    if (stopping_) return;
+    Vec6<S> vr;
+    prev_ = target(vr);
+    cur_ = sample;
+    since_ = 0;
+    ended_ = false;
+  }
+
+  /// The stream has ended: the target stays at the last sample (no extrapolation, never stale).
+  void end() { ended_ = true; }
+
+  /// The category-2 stop: every axis brakes to rest, the axes of a group together.
+  void stop() {
+    if (stopping_) return;
+    stopping_ = true;
+    for (int g = 0; g < 6; g += 3) {
+      S vmax(0);
+      for (int i = g; i < g + 3; ++i) vmax = math::abs(s_[i].v) > vmax ? math::abs(s_[i].v) : vmax;
+      for (int i = g; i < g + 3; ++i) {
+        S k = vmax > S(0) ? math::abs(s_[i].v) / vmax : S(1);
+        if (k < lit<S>(kStopScaleFloor)) k = lit<S>(kStopScaleFloor);
+        const S a = lim_[i].a * k;
+        stop_[i] = {S(0), a > math::abs(s_[i].a) ? a : math::abs(s_[i].a), lim_[i].j * k};
+      }
+    }
+  }
+
+  /// The reference for this tick: the state one tick on.
+  Desired<S> tick() {
+    const S dt = lit<S>(params::kDt), kp = lit<S>(kStreamGain), kp2 = lit<S>(kStreamGain * kStreamGain);
+    Vec6<S> vr;
+    const Vec6<S> r = target(vr);
+    Desired<S> d;
+    for (int i = 0; i < 6; ++i) {
+      if (stopping_) {
+        stream::step_axis(s_[i], lo_[i], S(0), stop_[i].a, stop_[i].j, dt);
+      } else {
+        const JerkLimits<S>& l = lim_[i];
+        // kp e, bounded by the braking curve sqrt(2 a_b |e|) (a_b = amax / 2), which is the lower
+        // beyond |e| = amax / kp^2 (only there: a |e| of a small error is below the resolution of
+        // Q12.19, and the bound would be 0).
+        const S e = r(i) - s_[i].p, ae = math::abs(e);
+        const S vp = ae * kp2 > l.a ? (e > S(0) ? math::sqrt(l.a * ae) : -math::sqrt(l.a * ae)) : kp * e;
+        stream::step_axis(s_[i], lo_[i], stream::clamp(vr(i) + vp, l.v), l.a, l.j, dt);
+      }
+      d.x(i) = s_[i].p, d.xd(i) = s_[i].v, d.xdd(i) = s_[i].a;
+    }
+    if (since_ <= timeout_) ++since_;  // saturates: stale stays stale
+    return d;
+  }
+
+  /// No sample for more than max(2 T, 20 ms) (and end() not called).
+  bool stale() const { return !ended_ && since_ > timeout_; }
+  /// Stopped (stop()) and every axis at rest.
+  bool stopped() const { return stopping_ && at_rest(); }
+  /// Every axis at rest (v = a = 0).
+  bool at_rest() const {
+    for (int i = 0; i < 6; ++i)
+      if (s_[i].v != S(0) || s_[i].a != S(0)) return false;
+    return true;
+  }
+  /// The per-axis limits in use.
+  const JerkLimits<S>& limits(int axis) const { return lim_[axis]; }
+  /// The target r at this tick and its velocity v_r.
+  Vec6<S> target(Vec6<S>& vr) const {
+    // The target moves until tau = T (after end()), else until the stream is stale, extrapolating
+    // for at most kStreamExtrapolation; then it holds.
+    const std::uint32_t extrapolated = period_ + kExtrapolationTicks;
+    const std::uint32_t cap = ended_ ? period_ : (timeout_ < extrapolated ? timeout_ : extrapolated);
+    const std::uint32_t tau = since_ < cap ? since_ : cap;
+    const S f = math::ratio<S>(tau, period_), rate = math::ratio<S>(kHz, period_);
+    Vec6<S> r;
+    for (int i = 0; i < 6; ++i) {
+      const S dx = cur_(i) - prev_(i);
+      r(i) = prev_(i) + dx * f;
+      // v_r is clamped to vmax by the follower anyway: the difference is bounded first so that a
+      // far sample (2 pi rad at 1 kHz) stays within the fixed-point range.
+      vr(i) = since_ < cap ? stream::clamp(dx, lit<S>(2.0)) * rate : S(0);
+    }
+    return r;
+  }
+
+ private:
+  JerkLimits<S> lim_[6]{}, stop_[6]{};
+  jerk_profile::Kin<S> s_[6]{};
+  S lo_[6]{};  ///< the positions' residuals below their resolution (step_axis)
+  Vec6<S> prev_ = Vec6<S>::Zero(), cur_ = Vec6<S>::Zero();
+  std::uint32_t period_ = 1, timeout_ = 20, since_ = 0;
+  bool ended_ = false, stopping_ = false;
+};
+
+}  // namespace osc

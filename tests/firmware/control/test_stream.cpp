@@ -1,0 +1,241 @@
+// The follower of streamed setpoints (osc/control/stream.hpp): a smooth path streamed at 10, 50 and
+// 1000 Hz followed to its end within the Euclidean limits (speed, acceleration and jerk of the
+// translation from xd, xdd and the differences of xdd; the rotation's from w = E(phi) phi_dot, E
+// inverted numerically), close to the path while it runs; a jump beyond the limits followed within
+// them; a stream cut mid-path: stale after the stated time, then the category-2 stop to rest within
+// the limits; float and Q12.19 against double.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "osc/control/stream.hpp"
+#include "osc/math/fixed.hpp"
+
+using namespace osc;
+
+namespace {
+
+constexpr std::uint32_t kHz = params::kControlHz;
+constexpr double kDt = params::kDt;
+
+/// The path: 0.15 m along a diagonal and 0.2 rad of the orientation coordinates, min-jerk timing
+/// over 3 s (peak speed 1.875 * 0.15 / 3 = 0.094 m/s, 0.054 m/s per axis, within the per-axis
+/// 0.1 / sqrt(3) = 0.058 m/s).
+constexpr double kPathTime = 3.0;
+const Vec3<double> kP0(0.5, 0.0, 0.3), kDir = Vec3<double>(1, -1, 1).normalized();
+const Vec3<double> kPhi0(0.1, -0.2, 0.3), kAxis = Vec3<double>(1, 1, 1).normalized();
+
+Vec6<double> path(double t) {
+  const double u = std::clamp(t / kPathTime, 0.0, 1.0);
+  const double s = u * u * u * (10 - 15 * u + 6 * u * u);
+  Vec6<double> x;
+  x << kP0 + 0.15 * s * kDir, kPhi0 + 0.2 * s * kAxis;
+  return x;
+}
+
+/// The base angular velocity of a reference: w = E(phi) phi_dot, E = (E^{-1})^{-1} numerically.
+Vec3<double> omega(const Desired<double>& d) {
+  return angular_to_phi_rate<double>(d.x.tail<3>()).inverse() * d.xd.tail<3>();
+}
+
+/// Peaks of a reference over a run.
+struct Trace {
+  double v = 0, a = 0, j = 0, w = 0, wd = 0, phij = 0;
+  double lag = 0, off_line = 0;  // against the path delayed by T; distance from its straight line
+  int ticks = 0;
+  Desired<double> last{}, prev{};
+  Vec3<double> w_prev = Vec3<double>::Zero();
+
+  void add(const Desired<double>& d) {
+    v = std::max(v, d.xd.head<3>().norm());
+    a = std::max(a, d.xdd.head<3>().norm());
+    const Vec3<double> wn = omega(d);
+    w = std::max(w, wn.norm());
+    if (ticks > 0) {
+      j = std::max(j, (d.xdd.head<3>() - prev.xdd.head<3>()).norm() * kHz);
+      wd = std::max(wd, (wn - w_prev).norm() * kHz);
+      phij = std::max(phij, (d.xdd.tail<3>() - prev.xdd.tail<3>()).norm() * kHz);
+    }
+    prev = last = d, w_prev = wn;
+    ++ticks;
+  }
+};
+
+const CartesianLimits<double> kLim = CartesianLimits<double>::defaults();
+
+/// The Euclidean limits; the angular acceleration from differences of w with 5 % for the term
+/// Edot phi_dot (stream.hpp), the jerk of phi_ddot within the angular jerk limit.
+void expect_within_limits(const Trace& tr, double slack = 1e-9) {
+  EXPECT_LE(tr.v, kLim.linear.v * (1 + slack));
+  EXPECT_LE(tr.a, kLim.linear.a * (1 + slack));
+  EXPECT_LE(tr.j, kLim.linear.j * (1 + 1e-6));
+  EXPECT_LE(tr.w, kLim.angular.v * (1 + slack));
+  EXPECT_LE(tr.wd, kLim.angular.a * 1.05);
+  EXPECT_LE(tr.phij, kLim.angular.j * (1 + 1e-6));
+}
+
+Desired<double> to_double(const Desired<double>& d) { return d; }
+template <class S>
+Desired<double> to_double(const Desired<S>& d) {
+  return {d.x.template cast<double>(), d.xd.template cast<double>(), d.xdd.template cast<double>()};
+}
+
+/// Streams path() at rate_hz from tick 0 (sample k at tick k P, the path's time k P dt), until
+/// `cut` [s] (then nothing more) or to its end and then end(); runs `total` ticks.
+template <class S>
+Trace stream_path(StreamFollower<S>& f, std::uint32_t rate_hz, int total, double cut = 1e9) {
+  const std::uint32_t P = kHz / rate_hz;
+  f.start(path(0).cast<S>(), P);
+  Trace tr;
+  bool ended = false;
+  for (int n = 0; n < total; ++n) {
+    const double t = n * kDt;
+    if (n % P == 0 && t < cut && !ended) {
+      f.push(path(t).cast<S>());
+      if (t >= kPathTime) f.end(), ended = true;
+    }
+    const Desired<double> d = to_double(f.tick());
+    tr.add(d);
+    // The target is the path delayed by T; the reference is one tick on.
+    const Vec6<double> r = path((n + 1) * kDt - P * kDt);
+    tr.lag = std::max(tr.lag, (d.x.head<3>() - r.head<3>()).norm());
+    const Vec3<double> q = d.x.head<3>() - kP0;
+    tr.off_line = std::max(tr.off_line, (q - kDir * q.dot(kDir)).norm());
+  }
+  return tr;
+}
+
+TEST(StreamFollower, FollowsASmoothPathAtEachRateWithinTheLimits) {
+  const Vec6<double> end = path(kPathTime);
+  for (std::uint32_t rate : {10u, 50u, 1000u}) {
+    StreamFollower<double> f;
+    const Trace tr = stream_path(f, rate, 6000);
+    expect_within_limits(tr);
+    const double ep = (tr.last.x.head<3>() - end.head<3>()).norm();
+    const double ew = (tr.last.x.tail<3>() - end.tail<3>()).norm();
+    std::printf("%4u Hz: end %.2e m %.2e rad, lag to the delayed path %.2f mm, off the line %.3f mm, "
+                "peaks v %.4f a %.4f j %.3f w %.4f wd %.4f\n",
+                rate, ep, ew, 1e3 * tr.lag, 1e3 * tr.off_line, tr.v, tr.a, tr.j, tr.w, tr.wd);
+    EXPECT_LE(ep, 1e-3) << rate;
+    EXPECT_LE(ew, 1e-3) << rate;
+    EXPECT_LE(tr.lag, 5e-3) << rate;
+    EXPECT_LE(tr.off_line, 1e-3) << rate;
+  }
+}
+
+TEST(StreamFollower, AJumpBeyondTheLimitsIsFollowedWithinThem) {
+  for (std::uint32_t rate : {50u, 1000u}) {
+    StreamFollower<double> f;
+    const std::uint32_t P = kHz / rate;
+    Vec6<double> x0;
+    x0 << 0.5, 0.0, 0.3, 0.1, -0.2, 0.3;
+    Vec6<double> x1 = x0;
+    x1.head<3>() += 0.3 * Vec3<double>(1, 1, 0).normalized();
+    x1.tail<3>() += Vec3<double>(0.3, 0, -0.2);
+    f.start(x0, P);
+    Trace tr;
+    for (int n = 0; n < 12000; ++n) {
+      if (n % P == 0) f.push(n < 500 ? x0 : x1);
+      tr.add(f.tick());
+    }
+    expect_within_limits(tr);
+    EXPECT_LE((tr.last.x - x1).norm(), 1e-3) << rate;
+    // The jump is taken at the speed limit.
+    EXPECT_GE(tr.v, 0.9 * kLim.linear.v / std::sqrt(1.5)) << rate;
+  }
+}
+
+TEST(StreamFollower, StartsFromTheHeldPoseToAFarFirstSample) {
+  StreamFollower<double> f;
+  Vec6<double> x0, x1;
+  x0 << 0.5, 0.0, 0.3, 0, 0, 0;
+  x1 << 0.4, 0.2, 0.4, 0.2, 0.1, -0.3;
+  f.start(x0, 20);
+  Trace tr;
+  for (int n = 0; n < 12000; ++n) {
+    if (n % 20 == 0) f.push(x1);
+    tr.add(f.tick());
+  }
+  expect_within_limits(tr);
+  EXPECT_LE((tr.last.x - x1).norm(), 1e-3);
+}
+
+TEST(StreamFollower, ACutStreamGoesStaleAndStopsWithinTheLimits) {
+  for (std::uint32_t rate : {10u, 50u, 1000u}) {
+    const std::uint32_t P = kHz / rate;
+    const std::uint32_t timeout = std::max(2 * P, 20u);
+    StreamFollower<double> f;
+    // The last sample at 1.5 s (mid-path, near the peak speed).
+    const int last = static_cast<int>(1500 / P) * static_cast<int>(P);
+    const Trace before = stream_path(f, rate, last + 1, 1.5 + 1e-9);
+    EXPECT_FALSE(f.stale());
+    Trace gap;
+    int n = last + 1;
+    for (; !f.stale() && n < last + 1000; ++n) gap.add(f.tick());
+    // Stale after max(2 T, 20 ms) without a sample: tick() `timeout + 1` after the sample's.
+    EXPECT_EQ(n - last, static_cast<int>(timeout) + 1) << rate;
+    const Vec3<double> v0 = f.tick().xd.head<3>().cast<double>();
+    const Vec3<double> p0 = gap.last.x.head<3>();
+    f.stop();
+    Trace after;
+    while (!f.stopped() && after.ticks < 5000) after.add(f.tick());
+    expect_within_limits(before);
+    expect_within_limits(gap);
+    expect_within_limits(after);
+    EXPECT_TRUE(f.stopped()) << rate;
+    EXPECT_EQ(after.last.xd.norm(), 0.0);
+    EXPECT_EQ(after.last.xdd.norm(), 0.0);
+    // Braking from about 0.09 m/s at 0.25 m/s^2 (less the jerk ramps): well within a second.
+    EXPECT_LT(after.ticks, 1000) << rate;
+    // Along the direction it was moving in (within 2 degrees).
+    const Vec3<double> moved = after.last.x.head<3>() - p0;
+    EXPECT_GT(moved.normalized().dot(v0.normalized()), std::cos(2 * kPi / 180)) << rate;
+    std::printf("%4u Hz: stale after %d ticks, stop %d ticks over %.1f mm\n", rate, n - last, after.ticks,
+                1e3 * moved.norm());
+  }
+}
+
+/// The same stream in S and double (double at the limits S uses, less its rounding margin).
+template <class S>
+void compare_scalar(double tol_pos, double tol_vel) {
+  const CartesianLimits<S> ls = CartesianLimits<S>::defaults();
+  const auto margin = [](const JerkLimits<S>& l) {
+    const JerkLimits<S> m = rounding_margin(l);
+    return JerkLimits<double>{static_cast<double>(m.v), static_cast<double>(m.a), static_cast<double>(m.j)};
+  };
+  StreamFollower<double> fd(CartesianLimits<double>{margin(ls.linear), margin(ls.angular)});
+  StreamFollower<S> fs;
+  const Trace td = stream_path(fd, 50, 5000);
+  const Trace ts = stream_path(fs, 50, 5000);
+  expect_within_limits(ts);
+  // Step by step.
+  fd.start(path(0), 20), fs.start(path(0).cast<S>(), 20);
+  double ep = 0, ev = 0;
+  for (int n = 0; n < 5000; ++n) {
+    if (n % 20 == 0) fd.push(path(n * kDt)), fs.push(path(n * kDt).cast<S>());
+    const Desired<double> d = fd.tick(), s = to_double(fs.tick());
+    ep = std::max(ep, (s.x - d.x).norm());
+    ev = std::max(ev, (s.xd - d.xd).norm());
+  }
+  std::printf("against double: x %.2e, xd %.2e\n", ep, ev);
+  EXPECT_LE(ep, tol_pos);
+  EXPECT_LE(ev, tol_vel);
+  EXPECT_LE((ts.last.x - td.last.x).norm(), tol_pos);
+}
+
+TEST(StreamFollower, FloatAgreesWithDouble) { compare_scalar<float>(1e-5, 1e-4); }
+TEST(StreamFollower, FixedAgreesWithDouble) { compare_scalar<Fixed>(2e-4, 2e-3); }
+
+TEST(StreamFollower, CostPerTick) {
+  StreamFollower<double> f;
+  const auto t0 = std::chrono::steady_clock::now();
+  const Trace tr = stream_path(f, 1000, 6000);
+  const auto t1 = std::chrono::steady_clock::now();
+  std::printf("host, double, with the test's checks: %.2f us per tick\n",
+              std::chrono::duration<double, std::micro>(t1 - t0).count() / tr.ticks);
+}
+
+}  // namespace
