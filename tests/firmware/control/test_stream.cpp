@@ -21,16 +21,17 @@ namespace {
 constexpr std::uint32_t kHz = params::kControlHz;
 constexpr double kDt = params::kDt;
 
-/// The path: 0.15 m along a diagonal and 0.2 rad of the orientation coordinates, min-jerk timing
-/// over 3 s (peak speed 1.875 * 0.15 / 3 = 0.094 m/s, 0.054 m/s per axis, within the per-axis
-/// 0.1 / sqrt(3) = 0.058 m/s).
+/// The path: 0.15 m along a line and 0.2 rad of the orientation coordinates, cosine timing over
+/// 3 s (peak speed pi / 2 * 0.05 = 0.079 m/s, 0.055 m/s on x, within the per-axis 0.1 / sqrt(3) =
+/// 0.058 m/s; the axes' unequal shares make the per-axis followers' differences show as a distance
+/// from the line).
 constexpr double kPathTime = 3.0;
-const Vec3<double> kP0(0.5, 0.0, 0.3), kDir = Vec3<double>(1, -1, 1).normalized();
-const Vec3<double> kPhi0(0.1, -0.2, 0.3), kAxis = Vec3<double>(1, 1, 1).normalized();
+const Vec3<double> kP0(0.5, 0.0, 0.3), kDir = Vec3<double>(1, -0.8, 0.6).normalized();
+const Vec3<double> kPhi0(0.1, -0.2, 0.3), kAxis = Vec3<double>(1, 0.5, -0.7).normalized();
 
 Vec6<double> path(double t) {
   const double u = std::clamp(t / kPathTime, 0.0, 1.0);
-  const double s = u * u * u * (10 - 15 * u + 6 * u * u);
+  const double s = 0.5 * (1 - std::cos(kPi * u));
   Vec6<double> x;
   x << kP0 + 0.15 * s * kDir, kPhi0 + 0.2 * s * kAxis;
   return x;
@@ -116,13 +117,14 @@ TEST(StreamFollower, FollowsASmoothPathAtEachRateWithinTheLimits) {
     expect_within_limits(tr);
     const double ep = (tr.last.x.head<3>() - end.head<3>()).norm();
     const double ew = (tr.last.x.tail<3>() - end.tail<3>()).norm();
-    std::printf("%4u Hz: end %.2e m %.2e rad, lag to the delayed path %.2f mm, off the line %.3f mm, "
-                "peaks v %.4f a %.4f j %.3f w %.4f wd %.4f\n",
-                rate, ep, ew, 1e3 * tr.lag, 1e3 * tr.off_line, tr.v, tr.a, tr.j, tr.w, tr.wd);
+    std::printf(
+        "%4u Hz: end %.2e m %.2e rad, lag to the delayed path %.2f mm, off the line %.3f mm, "
+        "peaks v %.4f a %.4f j %.3f w %.4f wd %.4f\n",
+        rate, ep, ew, 1e3 * tr.lag, 1e3 * tr.off_line, tr.v, tr.a, tr.j, tr.w, tr.wd);
     EXPECT_LE(ep, 1e-3) << rate;
     EXPECT_LE(ew, 1e-3) << rate;
-    EXPECT_LE(tr.lag, 5e-3) << rate;
-    EXPECT_LE(tr.off_line, 1e-3) << rate;
+    EXPECT_LE(tr.lag, 2e-3) << rate;
+    EXPECT_LE(tr.off_line, 2e-4) << rate;
   }
 }
 
@@ -131,10 +133,12 @@ TEST(StreamFollower, AJumpBeyondTheLimitsIsFollowedWithinThem) {
     StreamFollower<double> f;
     const std::uint32_t P = kHz / rate;
     Vec6<double> x0;
-    x0 << 0.5, 0.0, 0.3, 0.1, -0.2, 0.3;
+    x0 << 0.5, 0.0, 0.3, 0.3, 0.6, 0.2;
     Vec6<double> x1 = x0;
     x1.head<3>() += 0.3 * Vec3<double>(1, 1, 0).normalized();
-    x1.tail<3>() += Vec3<double>(0.3, 0, -0.2);
+    // Every orientation rate at its limit, along E's largest singular direction (1, +-1, -1) at a
+    // pitch up to 1.1 rad: |w| = sqrt(1 + 2 sin(pitch) / 3) |phi_dot| = 1.26 |phi_dot|.
+    x1.tail<3>() += Vec3<double>(0.5, 0.5, -0.5);
     f.start(x0, P);
     Trace tr;
     for (int n = 0; n < 12000; ++n) {
@@ -226,16 +230,30 @@ void compare_scalar(double tol_pos, double tol_vel) {
   EXPECT_LE((ts.last.x - td.last.x).norm(), tol_pos);
 }
 
-TEST(StreamFollower, FloatAgreesWithDouble) { compare_scalar<float>(1e-5, 1e-4); }
-TEST(StreamFollower, FixedAgreesWithDouble) { compare_scalar<Fixed>(2e-4, 2e-3); }
+TEST(StreamFollower, FloatAgreesWithDouble) { compare_scalar<float>(2e-5, 1e-4); }
+TEST(StreamFollower, FixedAgreesWithDouble) { compare_scalar<Fixed>(1e-4, 1e-3); }
+
+/// The host time of tick() (and push() every 20 ticks) alone, per scalar: for the record only.
+template <class S>
+double microseconds_per_tick() {
+  StreamFollower<S> f;
+  f.start(path(0).cast<S>(), 20);
+  Vec6<S> samples[300];
+  for (int k = 0; k < 300; ++k) samples[k] = path(k * 0.02).cast<S>();
+  double sink = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int n = 0; n < 6000; ++n) {
+    if (n % 20 == 0) f.push(samples[std::min(n / 20, 299)]);
+    sink += static_cast<double>(f.tick().xdd(0));
+  }
+  const auto t1 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(std::isfinite(sink));
+  return std::chrono::duration<double, std::micro>(t1 - t0).count() / 6000;
+}
 
 TEST(StreamFollower, CostPerTick) {
-  StreamFollower<double> f;
-  const auto t0 = std::chrono::steady_clock::now();
-  const Trace tr = stream_path(f, 1000, 6000);
-  const auto t1 = std::chrono::steady_clock::now();
-  std::printf("host, double, with the test's checks: %.2f us per tick\n",
-              std::chrono::duration<double, std::micro>(t1 - t0).count() / tr.ticks);
+  std::printf("host, tick(): double %.3f us, float %.3f us, Q12.19 %.3f us\n", microseconds_per_tick<double>(),
+              microseconds_per_tick<float>(), microseconds_per_tick<Fixed>());
 }
 
 }  // namespace
