@@ -266,6 +266,47 @@ void jerk_profile_kernels() {
   check("profile ends at the target", d(s.p), 0.38, 1e-4);
 }
 
+/// The motion generator (issue 23): a move's plan and path check (both when a command is prepared,
+/// outside the tick), and the generator's worst tick over the move (a line and a rotation) at 1 ms.
+MotionGenerator<F> g_gen;
+CartesianMove<F> g_move;
+void motion_kernels(const Vec6<F>& q0) {
+  forward_kinematics(g_model, g_data, q0);
+  const Pose<F> from{g_data.o[kDof], g_data.R[kDof]};
+  Pose<F> to = from;
+  to.p += Vec3<F>(lit<F>(0.05), lit<F>(-0.04), lit<F>(0.03));
+  to.R = axis_rotation<F>(Vec3<F>::UnitZ(), lit<F>(0.2)) * from.R;
+  const CartesianLimits<F> lim = CartesianLimits<F>::defaults();
+  {
+    Timer t("CartesianMove::plan (a line and a rotation, synchronised)");
+    keep(g_move.plan(from, to, lim, from.R));
+  }
+  PathCheck<F> pc;
+  {
+    Timer t("check_path (16 samples and the end)");
+    pc = check_path(g_model, g_data, g_move, from.R, q0);
+  }
+  check("the move's path is clear", static_cast<double>(pc.status), 0.0, 0.0);
+  g_gen.hold(from, from.R);
+  g_gen.push(g_move, 1);
+  g_gen.start_moves(0);
+  std::uint32_t worst = 0;
+  MotionEvents ev;
+  const std::uint64_t n = static_cast<std::uint64_t>(static_cast<double>(g_move.duration()) * 1000) + 2;
+  Desired<F> des{};
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::uint32_t t0 = board::cycles();
+    des = g_gen.at_tick(k, params::kControlHz, ev);
+    keep(des);
+    const std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst) worst = dt;
+  }
+  cortex_m::text::Line().str("  MotionGenerator::at_tick, a move, worst tick: ").u32(worst).str(" instructions").emit();
+  check("the move ends done at its target", d((des.x.template head<3>() - to.p).norm()) + (ev.done_id == 1 ? 0 : 1),
+        0.0, 1e-4);
+  check("no saturation in fixed point", math::take_arithmetic_fault<F>() ? 1.0 : 0.0, 0.0, 0.0);
+}
+
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear.
 void fixed_reference_check() {
   if constexpr (kFixed) {
@@ -329,6 +370,7 @@ int main() {
   control_step_kernels(q0);
   jerk_profile_kernels();
   fixed_reference_check();
+  motion_kernels(q0);
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
   return g_failures ? 1 : 0;
