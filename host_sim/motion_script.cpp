@@ -228,7 +228,7 @@ class Player {
     return id >= 1 && id <= run_.commands.size() ? &run_.commands[id - 1] : nullptr;
   }
   void observe(double t, std::uint32_t faults);
-  void track(double t);
+  void track();
   void log_state(double t) {
     const char* name = osc::motion_name(sim_.task().machine.state);
     if (run_.states.empty() || run_.states.back().state != name) run_.states.push_back({t, name});
@@ -275,14 +275,13 @@ void Player<S>::observe(double t, std::uint32_t faults) {
   if (rep.completion != osc::MotionCompletion::kNone)  // a stop or disable that reached rest
     for (CommandRecord& r : run_.commands)
       if (r.accepted && r.done_s < 0 && (r.cmd == "stop" || r.cmd == "disable")) r.done_s = t;
-  track(t);
+  track();
   log_state(t);
 }
 
 /// Tracking error and the reference's own maxima, into every command whose motion runs.
 template <class S>
-void Player<S>::track(double t) {
-  (void)t;
+void Player<S>::track() {
   if (!was_powered_ || !osc::motion_powered(sim_.task().machine.state)) {
     have_prev_ = false;
     return;

@@ -35,7 +35,7 @@ class MotionSim {
   }
 
   /// A command without a plan (enable, disable, paper, stop, clear), taken by the next tick.
-  void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command(task_->gen, verb, id); }
+  void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command<S>(verb, id); }
   /// A move_to, prepared (planned and its path checked) from where the queue will end, taken by the
   /// next tick.
   void move_to(const osc::MoveRequest<S>& req, std::uint32_t id) {

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -307,6 +308,20 @@ MoveRequest<double> to_joint_pose(const V6& q) {
   return r;
 }
 
+/// The arm enabled with joint 1 at 0.05 rad from its limit of 160 deg, and a move a quarter turn
+/// further about the base axis (same radius and height): past that limit.
+MoveRequest<double> quarter_turn_near_the_limit(std::unique_ptr<MotionSim<double>>& sim) {
+  V6 q = start_pose();
+  q(0) = robot::kArm.q_max[0] - 0.05;
+  sim = std::make_unique<MotionSim<double>>(q);
+  answer(*sim, MotionVerb::kEnable, 1);
+  run_ticks(*sim, 100);
+  const V3 p = sim->task().gen.hold_pose().p;
+  MoveRequest<double> turn;
+  turn.position = V3(-p.y(), p.x(), p.z());
+  return turn;
+}
+
 TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
   MotionSim<double> sim(start_pose());
   answer(sim, MotionVerb::kEnable, 1);
@@ -318,15 +333,9 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
   q(4) = -0.35;
   EXPECT_EQ(answer_move(sim, to_joint_pose(q), 3).refusal, MotionReason::kNearSingular);
   // Joint 1 turned 90 degrees from 150 deg: past its limit of 160 deg.
-  V6 q1 = start_pose();
-  q1(0) = robot::kArm.q_max[0] - 0.05;
-  MotionSim<double> near(q1);
-  answer(near, MotionVerb::kEnable, 1);
-  run_ticks(near, 100);
-  const V3 p = near.task().gen.hold_pose().p;
-  MoveRequest<double> turn;
-  turn.position = V3(-p.y(), p.x(), p.z());
-  EXPECT_EQ(answer_move(near, turn, 2).refusal, MotionReason::kOutOfWorkspace);
+  std::unique_ptr<MotionSim<double>> near;
+  const MoveRequest<double> turn = quarter_turn_near_the_limit(near);
+  EXPECT_EQ(answer_move(*near, turn, 2).refusal, MotionReason::kOutOfWorkspace);
   // A reachable move is accepted and ends done.
   q = start_pose();
   q(4) = 0.5, q(0) = 0.2;
@@ -340,15 +349,9 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
 TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
   // Joint 1 near its limit (160 deg); a move that turns it past the limit, prepared without the path
   // check (which would refuse it): the tick's check stops it, category 2.
-  V6 q = start_pose();
-  q(0) = robot::kArm.q_max[0] - 0.05;
-  MotionSim<double> sim(q);
-  answer(sim, MotionVerb::kEnable, 1);
-  run_ticks(sim, 100);
-  const V3 p = sim.task().gen.hold_pose().p;
-  // A point 90 degrees further about the base axis, at the same radius and height.
-  MoveRequest<double> req;
-  req.position = V3(-p.y(), p.x(), p.z());
+  std::unique_ptr<MotionSim<double>> owner;
+  const MoveRequest<double> req = quarter_turn_near_the_limit(owner);
+  MotionSim<double>& sim = *owner;
   sim.task().pending = prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, req, 2);
   sim.tick();
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);

@@ -85,7 +85,7 @@ class MotionGenerator {
   /// brake ends), where the paper's slow-down ends, or the held pose.
   Pose<S> queue_end() const {
     if (count_ > 0) return queue_[(head_ + count_ - 1) % kQueueSlots].end();
-    if (source_ == MotionSource::kPaper) return {paper_.at_time(stop_tau_.target()).x.template head<3>(), hold_pose_.R};
+    if (source_ == MotionSource::kPaper) return paper_pose(stop_tau_.target());
     return hold_pose_;
   }
   /// Where the running motion would come to rest if brake() ran at sample `tick` (the start of a
@@ -97,10 +97,7 @@ class MotionGenerator {
       m.stop(math::ratio<S>(tick - start_tick_, rate_hz), lim);
       return m.end();
     }
-    JerkProfile<S> tau;
-    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0),
-                  {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
-    return {paper_.at_time(tau.target()).x.template head<3>(), hold_pose_.R};
+    return paper_pose(paper_slow_down(tick, rate_hz).target());
   }
   /// Counts the changes of queue_end() other than a push (hold, paper, brake, stop; a motion that
   /// comes to rest ends where queue_end() said it would): a move planned
@@ -125,8 +122,7 @@ class MotionGenerator {
       queue_[head_].stop(t, lim);
       count_ = 1;
     } else {
-      const S tau = paper_.time_at_tick(tick, rate_hz);
-      stop_tau_.plan_stop(tau, S(1), S(0), {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+      stop_tau_ = paper_slow_down(tick, rate_hz);
     }
     start_tick_ = tick;
     braking_ = true;
@@ -189,6 +185,16 @@ class MotionGenerator {
     return hold_d_;
   }
 
+  /// The slow-down of the paper's motion from sample `tick`: its time from rate 1 to rest.
+  JerkProfile<S> paper_slow_down(std::uint64_t tick, std::uint32_t rate_hz) const {
+    JerkProfile<S> tau;
+    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0),
+                  {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+    return tau;
+  }
+  /// The pose of the paper's motion at its time tau: (68) keeps the orientation it started with.
+  Pose<S> paper_pose(S tau) const { return {paper_.at_time(tau).x.template head<3>(), hold_pose_.R}; }
+
   Desired<S> paper_at(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
     if (!braking_) return paper_.at_tick(tick, rate_hz);
     const S t = math::ratio<S>(tick - start_tick_, rate_hz);
@@ -197,8 +203,8 @@ class MotionGenerator {
     d.xdd = d.xdd * (tau.v * tau.v) + d.xd * tau.a;
     d.xd = d.xd * tau.v;
     if (t < stop_tau_.duration()) return d;
-    const Pose<S> end{d.x.template head<3>(), hold_pose_.R};  // (68) keeps the orientation it started with
-    if (count_ == 0 || stopping_) return end_at_rest(end, ev);
+    // (68) keeps the orientation it started with (paper_pose, from d already evaluated).
+    if (count_ == 0 || stopping_) return end_at_rest({d.x.template head<3>(), hold_pose_.R}, ev);
     // Moves pushed while braking start here, at rest.
     source_ = MotionSource::kMove;
     braking_ = false;

@@ -120,15 +120,6 @@ constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
 template <class S>
 constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
 
-/// Fixed point: takes the sticky arithmetic flags (those raised before the check); 0 for float and
-/// double.
-template <class S>
-std::uint32_t take_flags() {
-  if constexpr (fixed::is_q_v<S>)
-    return fixed::take_flags();
-  else
-    return 0;
-}
 /// Fixed point: a saturated result since the check began (the check stops at the sample that
 /// raised it); false for float and double.
 template <class S>
@@ -137,14 +128,6 @@ bool saturated() {
     return fixed::flags() != 0;
   else
     return false;
-}
-/// Fixed point: discards the check's flags and raises again those taken on entry.
-template <class S>
-void restore_flags(std::uint32_t before) {
-  if constexpr (fixed::is_q_v<S>) {
-    fixed::take_flags();
-    if (before != 0) fixed::detail::raise_flag(before);
-  }
 }
 
 /// Forward kinematics and the geometric Jacobian at q, and the Jacobian's factors.
@@ -265,7 +248,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
                         const Vec6<S>& q_seed) {
   using namespace path_check;
   constexpr int N = params::kPathCheckPoints;
-  const std::uint32_t before = path_check::take_flags<S>();
+  const std::uint32_t before = math::take_arithmetic_flags<S>();  // the caller's, put back on return
   PathCheck<S> r;
   Vec6<S> q = q_seed;
   SphericalWristJacobianFactor<S> Jf;
@@ -286,7 +269,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
     }
   }
   r.q_end = q;
-  restore_flags<S>(before);
+  math::restore_arithmetic_flags<S>(before);  // the check's own discarded
   return r;
 }
 

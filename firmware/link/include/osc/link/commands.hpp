@@ -83,12 +83,12 @@ TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const Cartes
   MotionVerb verb;
   const MotionReason why = command_from_frame(f, req, verb);
   if (why != MotionReason::kNone) {
-    TaskCommand<S> c = prepare_command(gen, verb, f.id);
+    TaskCommand<S> c = prepare_command<S>(verb, f.id);
     c.refusal = why;
     return c;
   }
   return verb == MotionVerb::kMoveTo ? prepare_move(gen, max, next_tick, rate_hz, req, f.id)
-                                     : prepare_command(gen, verb, f.id);
+                                     : prepare_command<S>(verb, f.id);
 }
 
 /// Host side: a command as a frame (the request's numbers rounded to f32; for verbs other than
@@ -166,7 +166,7 @@ void pose_floats(const Vec3<S>& p, const Mat3<S>& R, float out[6]) {
 }  // namespace detail
 
 /// The task's state after a tick: the motion state, the stop in effect, the latched faults, the
-/// moves queued, and the reference and measured poses of the last control step (x_d = x + e; before
+/// moves queued, and the reference and measured poses of the last control step (ControlTask::desired; before
 /// the first step, or after a step that failed, the pose the generator holds).
 template <class S>
 pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
@@ -180,7 +180,7 @@ pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
   if (task.step_timing.count == 0 || out.status != kFaultNone) {
     detail::pose_floats<S>(task.gen.hold_pose().p, task.gen.hold_pose().R, f.x_d);
   } else {
-    const Vec6<S> x_d = out.x + out.e;
+    const Vec6<S>& x_d = task.desired.x;
     detail::pose_floats<S>(x_d.template head<3>(), Mat3<S>(rpy_rotation<S>(x_d.template tail<3>()) * task.state.R_ref),
                            f.x_d);
   }

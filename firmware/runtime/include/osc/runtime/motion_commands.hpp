@@ -134,14 +134,13 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
   return c;
 }
 
-/// Prepares a command without a plan (every verb but move_to).
+/// A command without a plan (every verb but move_to): nothing to prepare, the tick decides it (a
+/// paper command while a motion runs, busy, where the state is current).
 template <class S>
-TaskCommand<S> prepare_command(const MotionGenerator<S>& gen, MotionVerb verb, std::uint32_t id) {
+TaskCommand<S> prepare_command(MotionVerb verb, std::uint32_t id) {
   TaskCommand<S> c;
   c.verb = verb;
   c.id = id;
-  c.epoch = gen.epoch();
-  if (verb == MotionVerb::kPaper && gen.source() != MotionSource::kHold) c.refusal = MotionReason::kBusy;
   return c;
 }
 
