@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "motion_sim.hpp"
@@ -49,18 +52,14 @@ bool triple(const YAML::Node& n, const std::string& key, osc::Vec3<double>& out,
 /// The keys of a step that apply to its command.
 bool known_key(const std::string& k, osc::MotionVerb v) {
   if (k == "at" || k == "after" || k == "cmd" || k == "delay") return true;
+  if (v == osc::MotionVerb::kStream)
+    return k == "file" || k == "rate_hz" || k == "relative" || k == "cut_s" || k == "v" || k == "a" || k == "j";
   if (v != osc::MotionVerb::kMoveTo) return false;
   return k == "position" || k == "rpy_deg" || k == "relative" || k == "replace" || k == "v" || k == "a" || k == "j";
 }
 
-bool parse_move(const YAML::Node& n, const std::string& where, osc::MoveRequest<double>& m, std::string& err) {
-  if (!n["position"]) return err = where + ".position: move_to needs a position [x, y, z] in metres", false;
-  if (!triple(n["position"], where + ".position", m.position, err)) return false;
-  if (n["rpy_deg"]) {
-    if (!triple(n["rpy_deg"], where + ".rpy_deg", m.rpy, err)) return false;
-    m.rpy *= kDegToRad;
-    m.has_rpy = true;
-  }
+/// The options move_to and stream share: relative, and the linear limits v, a, j.
+bool parse_options(const YAML::Node& n, const std::string& where, osc::MoveRequest<double>& m, std::string& err) {
   try {
     if (n["relative"]) m.relative = n["relative"].as<bool>();
     if (n["replace"]) m.replace = n["replace"].as<bool>();
@@ -78,7 +77,42 @@ bool parse_move(const YAML::Node& n, const std::string& where, osc::MoveRequest<
   return true;
 }
 
-bool parse_step(const YAML::Node& n, const std::string& where, MotionStepSpec& s, std::string& err) {
+bool parse_move(const YAML::Node& n, const std::string& where, osc::MoveRequest<double>& m, std::string& err) {
+  if (!n["position"]) return err = where + ".position: move_to needs a position [x, y, z] in metres", false;
+  if (!triple(n["position"], where + ".position", m.position, err)) return false;
+  if (n["rpy_deg"]) {
+    if (!triple(n["rpy_deg"], where + ".rpy_deg", m.rpy, err)) return false;
+    m.rpy *= kDegToRad;
+    m.has_rpy = true;
+  }
+  return parse_options(n, where, m, err);
+}
+
+bool parse_stream(const YAML::Node& n, const std::string& where, const std::string& script_name, MotionStepSpec& s,
+                  std::string& err) {
+  if (!n["file"]) return err = where + ".file: stream needs a file (CSV of t, x, y, z[, roll, pitch, yaw])", false;
+  if (!n["rate_hz"]) return err = where + ".rate_hz: stream needs a rate, 10 to 1000 Hz", false;
+  double rate = 0;
+  if (!number(n["rate_hz"], where + ".rate_hz", rate, err)) return false;
+  if (!(rate >= 10 && rate <= 1000)) return err = where + ".rate_hz: 10 <= rate_hz <= 1000", false;
+  const double period = osc::params::kControlHz / rate;
+  s.move.period = static_cast<std::uint32_t>(std::lround(period));
+  if (std::fabs(period - s.move.period) > 1e-9)
+    return err = where + ".rate_hz: " + n["rate_hz"].as<std::string>("") +
+                 " Hz is not a whole number of 1 ms ticks (1000, 500, 250, 100, 50, 20, 10, ...)",
+           false;
+  if (n["cut_s"]) {
+    if (!number(n["cut_s"], where + ".cut_s", s.cut_s, err)) return false;
+    if (s.cut_s < 0) return err = where + ".cut_s: a time from the stream's start, at least 0", false;
+  }
+  std::filesystem::path file = n["file"].as<std::string>("");
+  if (file.is_relative()) file = std::filesystem::path(script_name).parent_path() / file;
+  if (!read_stream_csv(file.string(), s.path, s.path_rpy, err)) return err = where + ".file: " + err, false;
+  return parse_options(n, where, s.move, err);
+}
+
+bool parse_step(const YAML::Node& n, const std::string& where, const std::string& script_name, MotionStepSpec& s,
+                std::string& err) {
   if (!n.IsMap()) return err = where + ": a step is a map with cmd: and at: or after:", false;
   if (!n["cmd"]) return err = where + ".cmd: missing (" + verb_list() + ")", false;
   const std::string cmd = n["cmd"].as<std::string>("");
@@ -103,6 +137,7 @@ bool parse_step(const YAML::Node& n, const std::string& where, MotionStepSpec& s
     if (s.delay < 0 || s.delay > 86400) return err = where + ".delay: 0 <= delay <= 86400 s", false;
   }
   if (s.verb == osc::MotionVerb::kMoveTo && !parse_move(n, where, s.move, err)) return false;
+  if (s.verb == osc::MotionVerb::kStream && !parse_stream(n, where, script_name, s, err)) return false;
   YAML::Emitter e;
   e << YAML::Flow << n;
   s.text = e.c_str();
@@ -137,6 +172,52 @@ bool parse_top(const YAML::Node& root, MotionScript& script, std::string& err) {
 
 }  // namespace
 
+bool read_stream_csv(const std::string& path, std::vector<std::array<double, 7>>& rows, bool& has_rpy,
+                     std::string& err) {
+  std::ifstream in(path);
+  if (!in) return err = path + ": cannot be read", false;
+  rows.clear();
+  int columns = 0;
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    const std::string where = path + ":" + std::to_string(n) + ": ";
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.find_first_not_of(" \t") == std::string::npos || line[line.find_first_not_of(" \t")] == '#') continue;
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    bool numeric = true;
+    while (std::getline(ss, cell, ',')) {
+      char* end = nullptr;
+      const double x = std::strtod(cell.c_str(), &end);
+      if (end == cell.c_str() ||
+          cell.find_first_not_of(" \t", static_cast<std::size_t>(end - cell.c_str())) != std::string::npos)
+        numeric = false;
+      v.push_back(x);
+    }
+    if (!numeric && rows.empty() && columns == 0) {  // the header
+      columns = -1;
+      continue;
+    }
+    if (!numeric) return err = where + "not a row of numbers", false;
+    if (v.size() != 4 && v.size() != 7)
+      return err = where + std::to_string(v.size()) + " columns: t, x, y, z[, roll, pitch, yaw] needs 4 or 7", false;
+    if (columns > 0 && static_cast<int>(v.size()) != columns)
+      return err = where + "every row needs the same columns (" + std::to_string(columns) + ")", false;
+    columns = static_cast<int>(v.size());
+    for (double x : v)
+      if (!std::isfinite(x)) return err = where + "not a finite number", false;
+    std::array<double, 7> r{};
+    for (std::size_t i = 0; i < v.size(); ++i) r[i] = i >= 4 ? v[i] * kDegToRad : v[i];
+    if (rows.empty() && r[0] != 0) return err = where + "the path's time starts at 0", false;
+    if (!rows.empty() && !(r[0] > rows.back()[0])) return err = where + "t must increase from row to row", false;
+    rows.push_back(r);
+  }
+  if (rows.empty()) return err = path + ": no rows (t, x, y, z[, roll, pitch, yaw])", false;
+  has_rpy = columns == 7;
+  return true;
+}
+
 bool parse_motion_script(const std::string& text, const std::string& name, MotionScript& script, std::string& err) {
   YAML::Node root;
   try {
@@ -149,7 +230,7 @@ bool parse_motion_script(const std::string& text, const std::string& name, Motio
   if (!parse_top(root, script, err)) return err = name + ": " + err, false;
   for (std::size_t i = 0; i < root["steps"].size(); ++i) {
     MotionStepSpec s;
-    if (!parse_step(root["steps"][i], "steps[" + std::to_string(i) + "]", s, err))
+    if (!parse_step(root["steps"][i], "steps[" + std::to_string(i) + "]", name, s, err))
       return err = name + ": " + err, false;
     script.steps.push_back(s);
   }
@@ -173,6 +254,7 @@ class Player {
       const double t = k * dt;
       if (t > script_.timeout) return finish(t, "timeout");
       if (next_ < script_.steps.size() && due(t)) send(t);
+      stream_setpoint(k);
       if (next_ == script_.steps.size() && end_at < 0 && at_rest() && sim_.idle()) end_at = t + script_.settle;
       if (end_at >= 0 && t >= end_at) return finish(t, "ok");
       was_powered_ = osc::motion_powered(sim_.task().machine.state);
@@ -208,9 +290,12 @@ class Player {
     r.step = s.text;
     r.id = static_cast<std::uint32_t>(run_.commands.size() + 1);
     r.sent_s = t;
-    if (s.verb == osc::MotionVerb::kMoveTo)
+    if (s.verb == osc::MotionVerb::kMoveTo) {
       sim_.move_to(cast_request(s.move), r.id);
-    else
+    } else if (s.verb == osc::MotionVerb::kStream) {
+      sim_.stream(cast_request(s.move), r.id);
+      stream_ = {&s, r.id, 0, -1};
+    } else
       sim_.command(s.verb, r.id);
     run_.commands.push_back(r);
   }
@@ -219,6 +304,7 @@ class Player {
     r.position = m.position.cast<S>();
     r.rpy = m.rpy.cast<S>();
     r.relative = m.relative, r.has_rpy = m.has_rpy, r.replace = m.replace, r.has_limits = m.has_limits;
+    r.period = m.period;
     r.limits = {
         {static_cast<S>(m.limits.linear.v), static_cast<S>(m.limits.linear.a), static_cast<S>(m.limits.linear.j)},
         {static_cast<S>(m.limits.angular.v), static_cast<S>(m.limits.angular.a), static_cast<S>(m.limits.angular.j)}};
@@ -228,6 +314,32 @@ class Player {
     return id >= 1 && id <= run_.commands.size() ? &run_.commands[id - 1] : nullptr;
   }
   void observe(double t, std::uint32_t faults);
+  /// The running stream's setpoint due before tick k: the n-th, n periods after the tick the stream
+  /// started in, at the path's time n T (linear between rows); the last, at the path's end, ends it.
+  void stream_setpoint(long k) {
+    const MotionStepSpec* s = stream_.step;
+    const CommandRecord* r = record(stream_.id);
+    if (!s || !r || r->answered_s < 0) return;
+    if (!r->accepted || r->done_s >= 0 || r->aborted_s >= 0) return void(stream_ = {});
+    if (stream_.first_tick < 0) stream_.first_tick = k;  // the tick after the one that accepted it
+    const long period = static_cast<long>(s->move.period);
+    if ((k - stream_.first_tick) % period != 0) return;
+    const double t = static_cast<double>(stream_.sent) * period * osc::params::kDt;
+    if (s->cut_s >= 0 && t > s->cut_s + 1e-9) return;
+    const std::vector<std::array<double, 7>>& p = s->path;
+    const bool end = t >= p.back()[0] - 1e-9;
+    std::size_t i = 1;
+    while (i < p.size() && p[i][0] < t) ++i;
+    std::array<double, 7> x = p.back();
+    if (!end) {
+      const double f = (t - p[i - 1][0]) / (p[i][0] - p[i - 1][0]);
+      for (int c = 1; c < 7; ++c) x[c] = p[i - 1][c] + f * (p[i][c] - p[i - 1][c]);
+    }
+    const Vec3 pos(x[1], x[2], x[3]), rpy(x[4], x[5], x[6]);
+    sim_.setpoint(stream_.id, pos, s->path_rpy ? &rpy : nullptr, end);
+    ++stream_.sent;
+    if (end) stream_.step = nullptr;
+  }
   void track();
   void log_state(double t) {
     const char* name = osc::motion_name(sim_.task().machine.state);
@@ -248,6 +360,12 @@ class Player {
   osc::Vec3<double> w_prev_ = osc::Vec3<double>::Zero(), wd_prev_ = osc::Vec3<double>::Zero();
   osc::Vec3<double> a_prev_ = osc::Vec3<double>::Zero();
   bool have_prev_ = false;
+  struct {
+    const MotionStepSpec* step = nullptr;  // the stream being sent (null: none)
+    std::uint32_t id = 0;
+    long sent = 0;         // setpoints sent
+    long first_tick = -1;  // the tick of its first setpoint
+  } stream_;
 };
 
 /// The tick's report into the records: answers, motions done or aborted, stops completed.
@@ -259,7 +377,8 @@ void Player<S>::observe(double t, std::uint32_t faults) {
     r->answered_s = t;
     r->accepted = rep.outcome == osc::CommandOutcome::kAccepted;
     if (!r->accepted) r->refused = osc::motion_name(rep.refusal), r->cause = rep.cause;
-    const bool motion = rep.verb == osc::MotionVerb::kMoveTo || rep.verb == osc::MotionVerb::kPaper;
+    const bool motion = rep.verb == osc::MotionVerb::kMoveTo || rep.verb == osc::MotionVerb::kPaper ||
+                        rep.verb == osc::MotionVerb::kStream;
     r->running = r->accepted && motion;
     // Done at once unless it started a motion or a stop (a stop or disable from holding has nothing to stop).
     if (r->accepted && !motion && sim_.task().machine.state != osc::MotionState::kStopping) r->done_s = t;

@@ -12,15 +12,24 @@
 //                                  done); or once the step before it was answered (to queue behind a
 //                                  move, to stop or re-target it on its way)
 //       delay: SECONDS             optional: that much later than at: or after: says
-//       cmd: enable | disable | move_to | paper | stop | clear
+//       cmd: enable | disable | move_to | paper | stop | clear | stream
 //       # move_to only:
 //       position: [x, y, z]        the wrist centre [m], base frame (an offset if relative)
 //       rpy_deg: [r, p, y]         optional orientation, R = Rz(y) Ry(p) Rx(r) (a rotation if relative)
 //       relative: true             optional
 //       replace: true              optional: re-target the running motion instead of queueing
 //       v: .., a: .., j: ..        optional linear limits [m/s, m/s^2, m/s^3], at most the maxima
+//       # stream only (and relative:, v:, a:, j: as for move_to):
+//       file: PATH.csv             the path: rows t, x, y, z[, roll, pitch, yaw] in s, m, degrees
+//                                  (t from 0, increasing; a header row and # comments are skipped;
+//                                  PATH relative to the script's directory); with relative: true,
+//                                  offsets from the pose where the stream starts
+//       rate_hz: 10 .. 1000        the setpoints' rate: the path sampled (linearly between its rows)
+//                                  every 1 / rate_hz s; the last one, at the path's end, ends the stream
+//       cut_s: SECONDS             optional: no setpoint after this time (a stale stream: its stop)
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -37,9 +46,19 @@ struct MotionStepSpec {
   double at = 0;                ///< else: sent at this time [s]
   double delay = 0;             ///< sent this much later [s]
   osc::MotionVerb verb = osc::MotionVerb::kNone;
-  osc::MoveRequest<double> move;  ///< move_to
+  osc::MoveRequest<double> move;  ///< move_to; stream: relative, limits, period [ticks]
   std::string text;               ///< the step as written, for the JSON
+  /// stream: the path's rows (t [s], position [m], roll, pitch, yaw [rad]), and whether it has the
+  /// orientation; the time after which no setpoint is sent (negative: none).
+  std::vector<std::array<double, 7>> path;
+  bool path_rpy = false;
+  double cut_s = -1;
 };
+
+/// Reads a stream's path (CSV: t, x, y, z[, roll, pitch, yaw] in s, m, degrees; a header row and
+/// lines starting with # skipped); false with a message naming the file and line.
+bool read_stream_csv(const std::string& path, std::vector<std::array<double, 7>>& rows, bool& has_rpy,
+                     std::string& err);
 
 struct MotionScript {
   std::vector<MotionStepSpec> steps;

@@ -41,6 +41,15 @@ class MotionSim {
   void move_to(const osc::MoveRequest<S>& req, std::uint32_t id) {
     task_->pending = osc::prepare_checked_move(*task_, req, id);
   }
+  /// A stream command (req.period, req.relative, req.has_limits), taken by the next tick.
+  void stream(const osc::MoveRequest<S>& req, std::uint32_t id) {
+    task_->pending = osc::prepare_stream(task_->limits, req, id);
+  }
+  /// A setpoint of stream `id` for the next tick (rpy: null keeps the orientation); false: dropped.
+  bool setpoint(std::uint32_t id, const Vec3& position, const Vec3* rpy, bool end) {
+    const osc::Vec3<S> r = rpy ? osc::Vec3<S>(rpy->cast<S>()) : osc::Vec3<S>::Zero();
+    return osc::offer_setpoint(*task_, id, osc::Vec3<S>(position.cast<S>()), r, rpy != nullptr, end);
+  }
   /// Whether the mailbox is free for the next command.
   bool idle() const { return task_->pending.verb == osc::MotionVerb::kNone; }
 

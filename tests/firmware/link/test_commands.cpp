@@ -50,7 +50,8 @@ F decoded(const pil::Parser& p) {
   pil::CommandFrame c;
   pil::AnswerFrame n;
   pil::StateFrame t;
-  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t);
+  pil::SetpointFrame sp;
+  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));
@@ -70,10 +71,12 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kCommandFrame, 3);
   EXPECT_EQ(pil::kAnswerFrame, 4);
   EXPECT_EQ(pil::kStateFrame, 5);
-  EXPECT_EQ(pil::kCommandPayload, 4 + 1 + 1 + 12 + 12 + 24);
+  EXPECT_EQ(pil::kSetpointFrame, 6);
+  EXPECT_EQ(pil::kCommandPayload, 4 + 1 + 1 + 12 + 12 + 24 + 1);
+  EXPECT_EQ(pil::kSetpointPayload, 4 + 1 + 12 + 12);
   EXPECT_EQ(pil::kAnswerPayload, 4 + 1 + 1 + 1 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 4);
-  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 24 + 24 + 4);
-  ASSERT_EQ(pil::kFrameTypes, 5);
+  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4);
+  ASSERT_EQ(pil::kFrameTypes, 6);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -82,7 +85,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 6, 7, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 7, 8, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 TEST(CommandFrames, SensorAndActuatorFramesUnchangedByteForByte) {
@@ -152,6 +155,9 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
           break;
         case pil::kStateFrame:
           out = bytes_of(decoded<pil::StateFrame>(p));
+          break;
+        case pil::kSetpointFrame:
+          out = bytes_of(decoded<pil::SetpointFrame>(p));
           break;
       }
       ASSERT_EQ(out, in) << info.name;
@@ -233,6 +239,7 @@ TEST(CommandFrames, EveryVerbDecodes) {
     pil::CommandFrame f;
     f.id = 7;
     f.verb = static_cast<std::uint8_t>(v);
+    if (static_cast<MotionVerb>(v) == MotionVerb::kStream) f.period = 20;
     MoveRequest<double> req;
     MotionVerb verb;
     EXPECT_EQ(command_from_frame(f, req, verb), MotionReason::kNone) << motion_name(static_cast<MotionVerb>(v));
@@ -389,6 +396,72 @@ TEST(CommandFrames, BoundsAreInclusiveAndLimitsIgnoredWithoutTheFlag) {
   for (float& l : f.limits) l = -1.0f;  // not used: not checked but for being finite
   EXPECT_EQ(command_from_frame(f, req, verb), MotionReason::kNone);
   EXPECT_FALSE(req.has_limits);
+}
+
+TEST(CommandFrames, StreamPeriodBoundsAndOtherVerbsIgnoreIt) {
+  pil::CommandFrame f;
+  f.id = 5;
+  f.verb = static_cast<std::uint8_t>(MotionVerb::kStream);
+  MoveRequest<double> req;
+  MotionVerb verb;
+  for (int period : {0, 101, 255}) {
+    f.period = static_cast<std::uint8_t>(period);
+    EXPECT_EQ(command_from_frame(f, req, verb), MotionReason::kBadCommand) << period;
+    EXPECT_EQ(verb, MotionVerb::kStream);
+  }
+  for (int period : {1, 20, 100}) {
+    f.period = static_cast<std::uint8_t>(period);
+    ASSERT_EQ(command_from_frame(f, req, verb), MotionReason::kNone) << period;
+    EXPECT_EQ(req.period, static_cast<std::uint32_t>(period));
+  }
+  f.verb = static_cast<std::uint8_t>(MotionVerb::kMoveTo);
+  f.period = 0;
+  EXPECT_EQ(command_from_frame(f, req, verb), MotionReason::kNone);
+  // Limits above the maxima: prepare_stream's over_limit; within: accepted with them.
+  const CartesianLimits<double> max = CartesianLimits<double>::defaults();
+  f.verb = static_cast<std::uint8_t>(MotionVerb::kStream);
+  f.period = 10;
+  f.flags = pil::kFlagHasLimits | pil::kFlagRelative;
+  const double lim[6] = {max.linear.v / 2, max.linear.a, max.linear.j, max.angular.v, max.angular.a, max.angular.j};
+  for (int i = 0; i < 6; ++i) f.limits[i] = static_cast<float>(lim[i]);
+  const MotionGenerator<double> g;
+  TaskCommand<double> c = prepare_frame_command(g, max, 1, params::kControlHz, f);
+  EXPECT_EQ(c.refusal, MotionReason::kNone);
+  EXPECT_EQ(c.verb, MotionVerb::kStream);
+  EXPECT_EQ(c.period, 10u);
+  EXPECT_TRUE(c.relative);
+  EXPECT_NEAR(c.limits.linear.v, max.linear.v / 2, 1e-7);
+  f.limits[1] = static_cast<float>(2 * max.linear.a);
+  EXPECT_EQ(prepare_frame_command(g, max, 1, params::kControlHz, f).refusal, MotionReason::kOverLimit);
+}
+
+TEST(CommandFrames, SetpointRoundTripsAndBadOnesAreDropped) {
+  const Vec3<double> p(0.5, -0.25, 0.125), rpy(0.5, -0.25, 1.0);
+  pil::SetpointFrame f = setpoint_frame<double>(9, p, &rpy, true);
+  EXPECT_EQ(f.flags, pil::kSetpointEnd | pil::kSetpointHasRpy);
+  const pil::SetpointFrame g = decoded<pil::SetpointFrame>(parsed(bytes_of(f)));
+  EXPECT_EQ(bytes_of(g), bytes_of(f));
+  EXPECT_EQ(g.id, 9u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(g.position[i], static_cast<float>(p(i)));
+    EXPECT_EQ(g.rpy[i], static_cast<float>(rpy(i)));
+  }
+  EXPECT_EQ(setpoint_frame<double>(9, p, nullptr, false).flags, 0);
+  // No stream runs: dropped and counted; so is a bad one.
+  auto task = std::make_unique<ControlTask<double>>();
+  task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
+             joint_vector<double>(robot::kQStart), 0, TaskStart::kDisabled);
+  EXPECT_FALSE(offer_setpoint_frame(*task, f));
+  EXPECT_EQ(task->dropped, 1u);
+  EXPECT_FALSE(task->sample.valid);
+  for (auto spoil :
+       {+[](pil::SetpointFrame& s) { s.flags = 4; }, +[](pil::SetpointFrame& s) { s.position[1] = kNaN; },
+        +[](pil::SetpointFrame& s) { s.rpy[2] = 7.0f; }, +[](pil::SetpointFrame& s) { s.position[0] = 11.0f; }}) {
+    pil::SetpointFrame b = f;
+    spoil(b);
+    EXPECT_FALSE(offer_setpoint_frame(*task, b));
+  }
+  EXPECT_EQ(task->dropped, 5u);
 }
 
 TEST(CommandFrames, ReasonsListEndsWithBadCommand) {

@@ -3,14 +3,16 @@
 // from one of three sources:
 //   hold    the pose captured on enable or where the last motion came to rest, at rest;
 //   move    queued point-to-point moves (CartesianMove, cartesian_move.hpp), one after another;
-//   paper   the paper's motion (68) about the position at which it started (PaperMotion).
+//   paper   the paper's motion (68) about the position at which it started (PaperMotion);
+//   stream  streamed setpoints through the jerk-limited follower (StreamFollower, stream.hpp);
 // and stops any of them along its path (category 2): a move by its profiles' hardest stops, the
-// paper's motion by a jerk-limited slow-down of its time.
+// paper's motion by a jerk-limited slow-down of its time, a stream by braking every axis together.
 #pragma once
 
 #include <cstdint>
 
 #include "osc/control/cartesian_move.hpp"
+#include "osc/control/stream.hpp"
 #include "osc/control/trajectory.hpp"
 
 namespace osc {
@@ -45,12 +47,14 @@ constexpr double kPaperStopJerk = 1.0;  ///< [1/s^2]
 
 /// What a tick of the generator reports to the motion state machine (osc/runtime/motion_states.hpp).
 struct MotionEvents {
-  bool finished = false;      ///< the motion ended at rest with nothing queued (not after a stop)
-  bool stopped = false;       ///< a category-2 stop reached rest
-  std::uint32_t done_id = 0;  ///< a move that reached its target at rest in this tick (its id; not a braked one)
+  bool finished = false;  ///< the motion ended at rest with nothing queued (not after a stop)
+  bool stopped = false;   ///< a category-2 stop reached rest
+  /// A move that reached its target at rest in this tick, or a stream that ended and settled (its
+  /// id; not a braked one).
+  std::uint32_t done_id = 0;
 };
 
-enum class MotionSource : std::uint8_t { kHold, kMove, kPaper };
+enum class MotionSource : std::uint8_t { kHold, kMove, kPaper, kStream };
 
 template <class S>
 class MotionGenerator {
@@ -72,6 +76,30 @@ class MotionGenerator {
     stopping_ = braking_ = false;
     count_ = 0;
   }
+  /// Starts following a stream from the held pose at rest (its setpoints every `period` ticks; with
+  /// `relative`, offsets from the held pose: prepare_setpoint), keeping `lim`.
+  void start_stream(std::uint32_t period, bool relative, const CartesianLimits<S>& lim, std::uint32_t id) {
+    stream_.set_limits(lim);
+    stream_.start(hold_d_.x, period);
+    stream_relative_ = relative;
+    stream_id_ = id;
+    ++epoch_;
+    source_ = MotionSource::kStream;
+    stopping_ = braking_ = false;
+    count_ = 0;
+  }
+  /// A setpoint of the running stream (the follower's target x, in the controller's coordinates),
+  /// for this tick; `end`: its last.
+  void stream_setpoint(const Vec6<S>& x, bool end) {
+    if (source_ != MotionSource::kStream) return;
+    stream_.push(x);
+    if (end) stream_.end();
+  }
+  /// The running stream has gone stale (no setpoint for max(2 periods, 20 ms), not ended, not
+  /// braking): the runtime stops it (category 2, stale_stream).
+  bool stream_stale() const { return source_ == MotionSource::kStream && !braking_ && stream_.stale(); }
+  /// The running stream's setpoints are offsets from the held pose.
+  bool stream_relative() const { return stream_relative_; }
   /// Appends a move planned from queue_end() (CartesianMove::plan). false: the queue is full. While
   /// the paper's motion runs, brake() it first: the moves start where its slow-down ends.
   bool push(const CartesianMove<S>& m, std::uint32_t id = 0) {
@@ -118,7 +146,9 @@ class MotionGenerator {
   void brake(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) {
     if (source_ == MotionSource::kHold || braking_) return;
     const S t = math::ratio<S>(tick - start_tick_, rate_hz);
-    if (source_ == MotionSource::kMove) {
+    if (source_ == MotionSource::kStream) {
+      stream_.stop();
+    } else if (source_ == MotionSource::kMove) {
       queue_[head_].stop(t, lim);
       count_ = 1;
     } else {
@@ -139,6 +169,7 @@ class MotionGenerator {
   Desired<S> at_tick(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
     if (source_ == MotionSource::kPaper) return paper_at(tick, rate_hz, ev);
     if (source_ == MotionSource::kHold) return hold_d_;
+    if (source_ == MotionSource::kStream) return stream_at(ev);
     S t = math::ratio<S>(tick - start_tick_, rate_hz);
     while (!(t < queue_[head_].duration())) {
       // The running move ended at rest: the next one starts from there in this tick.
@@ -158,9 +189,10 @@ class MotionGenerator {
   bool stopping() const { return stopping_; }
   bool braking() const { return braking_; }
   int queued() const { return count_; }
-  /// The id of the running motion (the running move's, the paper's; 0 when holding).
+  /// The id of the running motion (the running move's, the paper's, the stream's; 0 when holding).
   std::uint32_t running_id() const {
     if (source_ == MotionSource::kMove) return ids_[head_];
+    if (source_ == MotionSource::kStream) return stream_id_;
     return source_ == MotionSource::kPaper ? paper_id_ : 0;
   }
   const Pose<S>& hold_pose() const { return hold_pose_; }
@@ -195,6 +227,18 @@ class MotionGenerator {
   /// The pose of the paper's motion at its time tau: (68) keeps the orientation it started with.
   Pose<S> paper_pose(S tau) const { return {paper_.at_time(tau).x.template head<3>(), hold_pose_.R}; }
 
+  /// The stream's reference; it ends at rest where the follower is: stopped (brake(), stop()), or
+  /// done (ended and settled: the last setpoint reached).
+  Desired<S> stream_at(MotionEvents& ev) {
+    const Desired<S> d = stream_.tick();
+    const bool done = !braking_ && stream_.settled();
+    if (!(braking_ ? stream_.stopped() : done)) return d;
+    if (done) ev.done_id = stream_id_;
+    end_at_rest({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)}, ev);
+    hold_d_.x = d.x;  // exactly where the follower is (not the coordinates' round trip through R)
+    return hold_d_;
+  }
+
   Desired<S> paper_at(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
     if (!braking_) return paper_.at_tick(tick, rate_hz);
     const S t = math::ratio<S>(tick - start_tick_, rate_hz);
@@ -222,6 +266,9 @@ class MotionGenerator {
   CartesianMove<S> queue_[kQueueSlots];
   std::uint32_t ids_[kQueueSlots] = {};
   std::uint32_t paper_id_ = 0;
+  StreamFollower<S> stream_;
+  std::uint32_t stream_id_ = 0;
+  bool stream_relative_ = false;
   int head_ = 0, count_ = 0;
   std::uint64_t start_tick_ = 0;
   std::uint32_t epoch_ = 0;

@@ -64,6 +64,8 @@ constexpr double kStreamTimeoutMin = 0.02;
 constexpr double kStreamGain = 4.0;
 /// The bound on |E(phi)|_2 the orientation axes' limits assume (sqrt(2) at any pitch).
 constexpr double kStreamEBound = 1.42;
+/// An ended stream is done within this distance of its last sample [m, rad] (settled()).
+constexpr double kStreamSettle = 1e-5;
 /// The least scale of an axis' limits in a stop (an axis at rest still brings a to 0).
 constexpr double kStopScaleFloor = 0.1;
 
@@ -118,7 +120,10 @@ class StreamFollower {
   static constexpr std::uint32_t kHz = params::kControlHz;
   static constexpr std::uint32_t kExtrapolationTicks = static_cast<std::uint32_t>(kStreamExtrapolation * kHz + 0.5);
 
-  explicit StreamFollower(const CartesianLimits<S>& lim = CartesianLimits<S>::defaults()) {
+  explicit StreamFollower(const CartesianLimits<S>& lim = CartesianLimits<S>::defaults()) { set_limits(lim); }
+
+  /// The limits the reference keeps (before start()).
+  void set_limits(const CartesianLimits<S>& lim) {
     const JerkLimits<S> l = rounding_margin(lim.linear), w = rounding_margin(lim.angular);
     const S kl = lit<S>(0.57735026918962576), kw = lit<S>(0.57735026918962576 / kStreamEBound);
     for (int i = 0; i < 6; ++i) {
@@ -197,6 +202,17 @@ class StreamFollower {
   bool stale() const { return !ended_ && since_ > timeout_; }
   /// Stopped (stop()) and every axis at rest.
   bool stopped() const { return stopping_ && at_rest(); }
+  /// Ended (end()), the target at the last sample, and every axis within kStreamSettle of it and
+  /// near rest (|v| <= kStreamSettle / s, |a| <= 10 kStreamSettle / s^2): the stream is done, and
+  /// the reference can hold its position with v = a = 0 (a step below the resolution of Q12.19's
+  /// speed and acceleration limits' margins).
+  bool settled() const {
+    if (!ended_ || since_ < period_) return false;
+    const S tol = lit<S>(kStreamSettle), atol = lit<S>(10 * kStreamSettle);
+    for (int i = 0; i < 6; ++i)
+      if (math::abs(cur_(i) - s_[i].p) > tol || math::abs(s_[i].v) > tol || math::abs(s_[i].a) > atol) return false;
+    return true;
+  }
   /// Every axis at rest (v = a = 0).
   bool at_rest() const {
     for (int i = 0; i < 6; ++i)

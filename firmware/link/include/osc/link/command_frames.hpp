@@ -5,6 +5,7 @@
 //   command  host -> controller   a client's command: a verb, move_to's target, options and limits
 //   answer   controller -> host   a tick's report: the answer to a command, a motion done or aborted
 //   state    controller -> host   the motion state, the latched faults, the reference and measured pose
+//   setpoint host -> controller   one sample of a stream (the stream command started it)
 //
 // The conversions between these frames and the control task's commands and reports are in
 // osc/link/commands.hpp. Macros and constants only: no dependency beyond the fault catalogue's
@@ -18,16 +19,17 @@
 namespace pil {
 
 // X(Name, "name", meaning): the command frame's flag bits, bit k for the k-th entry. They qualify a
-// move_to; other verbs ignore them. A bit outside this list makes the command bad_command.
+// move_to (relative and has_limits a stream too); other verbs ignore them. A bit outside this list
+// makes the command bad_command.
 #define OSC_COMMAND_FLAG_LIST(X)                                                                              \
   X(Relative, "relative",                                                                                     \
     "position is an offset from where the queue ends, rpy a rotation applied to its orientation (both in "    \
-    "the base frame); otherwise both are absolute")                                                           \
+    "the base frame); otherwise both are absolute. stream: its setpoints are, from the pose it starts at")    \
   X(HasRpy, "has_rpy", "rpy gives the target orientation; otherwise the orientation stays as it is")          \
   X(Replace, "replace",                                                                                       \
     "re-target: brake the running motion along its path, drop the queued moves, move from where it comes to " \
     "rest; otherwise the move is queued")                                                                     \
-  X(HasLimits, "has_limits", "limits apply to this move; otherwise the configured maxima (Command checks)")
+  X(HasLimits, "has_limits", "limits apply to this move or stream; otherwise the configured maxima (Command checks)")
 
 #define OSC_X_PREFIX kFlagBit
 enum CommandFlagBit : std::uint8_t { OSC_COMMAND_FLAG_LIST(OSC_X_ENUMERATOR) kCommandFlagCount };
@@ -42,6 +44,26 @@ constexpr std::uint8_t kCommandFlagsKnown = static_cast<std::uint8_t>((1u << kCo
 /// Names and meanings of the flags, in bit order.
 constexpr const char* kCommandFlagNames[kCommandFlagCount] = {OSC_COMMAND_FLAG_LIST(OSC_X_NAME)};
 constexpr const char* kCommandFlagDocs[kCommandFlagCount] = {OSC_COMMAND_FLAG_LIST(OSC_X_DOC)};
+
+// X(Name, "name", meaning): the setpoint frame's flag bits, bit k for the k-th entry. A bit outside
+// this list makes the setpoint bad (dropped and counted).
+#define OSC_SETPOINT_FLAG_LIST(X)                                                                 \
+  X(End, "end", "the stream's last setpoint: the arm comes to rest there and the stream is done") \
+  X(HasRpy, "has_rpy", "rpy gives the orientation; otherwise it stays as the stream started")
+
+#define OSC_X_PREFIX kSetpointBit
+enum SetpointFlagBit : std::uint8_t { OSC_SETPOINT_FLAG_LIST(OSC_X_ENUMERATOR) kSetpointFlagCount };
+#undef OSC_X_PREFIX
+#define OSC_SETPOINT_FLAG_MASK(Name, name, doc) \
+  constexpr std::uint8_t kSetpoint##Name = static_cast<std::uint8_t>(1u << kSetpointBit##Name);
+OSC_SETPOINT_FLAG_LIST(OSC_SETPOINT_FLAG_MASK)
+#undef OSC_SETPOINT_FLAG_MASK
+constexpr std::uint8_t kSetpointFlagsKnown = static_cast<std::uint8_t>((1u << kSetpointFlagCount) - 1u);
+constexpr const char* kSetpointFlagNames[kSetpointFlagCount] = {OSC_SETPOINT_FLAG_LIST(OSC_X_NAME)};
+constexpr const char* kSetpointFlagDocs[kSetpointFlagCount] = {OSC_SETPOINT_FLAG_LIST(OSC_X_DOC)};
+
+/// A stream's period in ticks (1 ms): 1 to kStreamMaxPeriod (1 kHz to 10 Hz), else bad_command.
+constexpr int kStreamMaxPeriod = 100;
 
 /// The bounds a command frame's numbers must be within (else bad_command): each coordinate of
 /// `position` within +-kCommandMaxPosition [m], each angle of `rpy` within +-kCommandMaxAngle [rad]
@@ -63,8 +85,17 @@ constexpr double kCommandMaxAngle = 6.283185307179586;
     "move_to with has_rpy: roll, pitch, yaw of the target orientation, R = Rz(yaw) Ry(pitch) Rx(roll) "       \
     "(with relative: of the rotation applied)")                                                               \
   X(float, limits, [6], "m/s, m/s^2, m/s^3, rad/s, rad/s^2, rad/s^3",                                         \
-    "move_to with has_limits: the move's linear speed, acceleration and jerk, then its angular speed, "       \
-    "acceleration and jerk; each at most the configured maximum (Command checks)")
+    "move_to or stream with has_limits: the linear speed, acceleration and jerk, then the angular speed, "    \
+    "acceleration and jerk; each at most the configured maximum (Command checks)")                            \
+  X(std::uint8_t, period, , "ms", "stream: the setpoints' period, 1 to 100 ms (1 kHz to 10 Hz); other verbs ignore it")
+
+#define OSC_SETPOINT_FIELDS(X)                                                                                    \
+  X(std::uint32_t, id, , "", "the id of the stream command whose stream this is (others' setpoints are dropped)") \
+  X(std::uint8_t, flags, , "", "end, has_rpy (Setpoint flags)")                                                   \
+  X(float, position, [3], "m",                                                                                    \
+    "the wrist centre in the base frame (the stream's relative flag: the offset from where it started)")          \
+  X(float, rpy, [3], "rad",                                                                                       \
+    "with has_rpy: roll, pitch, yaw of the orientation, as move_to's (relative: of the rotation applied)")
 
 #define OSC_ANSWER_FIELDS(X)                                                                                   \
   X(std::uint32_t, id, , "", "the id of the command answered in this tick; 0 when none was")                   \
@@ -87,6 +118,8 @@ constexpr double kCommandMaxAngle = 6.283185307179586;
   X(std::uint8_t, stop, , "", "the stop in effect (Stop categories)")                                         \
   X(std::uint32_t, faults, , "", "the fault bits latched since the last accepted clear (Fault bits)")         \
   X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included")                        \
+  X(std::uint32_t, running_id, , "", "the id of the running motion (move_to, stream, paper); 0: none")        \
+  X(std::uint32_t, dropped, , "", "setpoints dropped since start: no stream of their id running, or bad")     \
   X(float, x_d, [6], "m, rad",                                                                                \
     "the reference pose of the last control step: the wrist centre's position in the base frame, then roll, " \
     "pitch, yaw of the orientation as move_to's absolute rpy")                                                \

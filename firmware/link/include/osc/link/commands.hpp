@@ -39,14 +39,26 @@ inline bool command_numbers_valid(const pil::CommandFrame& f) {
     if (!std::isfinite(l)) return false;
     if ((f.flags & pil::kFlagHasLimits) && !(l > 0.0f)) return false;
   }
+  if (f.verb == static_cast<std::uint8_t>(MotionVerb::kStream) && (f.period < 1 || f.period > pil::kStreamMaxPeriod))
+    return false;
   return true;  // a NaN fails command_within(): !(NaN <= bound)
+}
+
+/// The position and the angles of a setpoint within their bounds, its flags in their list.
+inline bool setpoint_valid(const pil::SetpointFrame& f) {
+  if ((f.flags & ~pil::kSetpointFlagsKnown) != 0) return false;
+  for (int i = 0; i < 3; ++i)
+    if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
+      return false;
+  return true;
 }
 }  // namespace detail
 
 /// Checks a command frame and decodes it: the verb, and for move_to the request (filled for every
 /// verb, so that frame_from_command gives the frame back). A verb or flag bit outside its list, a
 /// non-finite number, a position coordinate beyond +-kCommandMaxPosition, an angle beyond
-/// +-kCommandMaxAngle, or with has_limits a limit not above 0: bad_command, with `verb` the frame's
+/// +-kCommandMaxAngle, with has_limits a limit not above 0, or a stream's period outside 1 to
+/// kStreamMaxPeriod: bad_command, with `verb` the frame's
 /// when its code is in the list (none otherwise) and `req` cleared. The limits against the configured
 /// maxima, the queue and the path are prepare_move's.
 template <class S>
@@ -64,6 +76,7 @@ MotionReason command_from_frame(const pil::CommandFrame& f, MoveRequest<S>& req,
   req.has_rpy = (f.flags & pil::kFlagHasRpy) != 0;
   req.replace = (f.flags & pil::kFlagReplace) != 0;
   req.has_limits = (f.flags & pil::kFlagHasLimits) != 0;
+  req.period = f.period;
   JerkLimits<S>* const lim[2] = {&req.limits.linear, &req.limits.angular};
   for (int k = 0; k < 2; ++k) {
     lim[k]->v = lit<S>(static_cast<double>(f.limits[3 * k]));
@@ -87,8 +100,39 @@ TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const Cartes
     c.refusal = why;
     return c;
   }
-  return verb == MotionVerb::kMoveTo ? prepare_move(gen, max, next_tick, rate_hz, req, f.id)
-                                     : prepare_command<S>(verb, f.id);
+  if (verb == MotionVerb::kMoveTo) return prepare_move(gen, max, next_tick, rate_hz, req, f.id);
+  if (verb == MotionVerb::kStream) return prepare_stream(max, req, f.id);
+  return prepare_command<S>(verb, f.id);
+}
+
+/// A setpoint frame into the task's mailbox (offer_setpoint): false (counted in task.dropped) for
+/// a bad one (a flag outside its list, a number beyond its bound or not finite) or one of no
+/// running stream.
+template <class S>
+bool offer_setpoint_frame(ControlTask<S>& task, const pil::SetpointFrame& f) {
+  if (!detail::setpoint_valid(f)) {
+    ++task.dropped;
+    return false;
+  }
+  Vec3<S> p, rpy;
+  for (int i = 0; i < 3; ++i) {
+    p(i) = lit<S>(static_cast<double>(f.position[i]));
+    rpy(i) = lit<S>(static_cast<double>(f.rpy[i]));
+  }
+  return offer_setpoint(task, f.id, p, rpy, (f.flags & pil::kSetpointHasRpy) != 0, (f.flags & pil::kSetpointEnd) != 0);
+}
+
+/// Host side: a setpoint as a frame.
+template <class S>
+pil::SetpointFrame setpoint_frame(std::uint32_t id, const Vec3<S>& position, const Vec3<S>* rpy, bool end) {
+  pil::SetpointFrame f;
+  f.id = id;
+  f.flags = static_cast<std::uint8_t>((end ? pil::kSetpointEnd : 0) | (rpy ? pil::kSetpointHasRpy : 0));
+  for (int i = 0; i < 3; ++i) {
+    f.position[i] = static_cast<float>(position(i));
+    f.rpy[i] = rpy ? static_cast<float>((*rpy)(i)) : 0.0f;
+  }
+  return f;
 }
 
 /// Host side: a command as a frame (the request's numbers rounded to f32; for verbs other than
@@ -111,6 +155,7 @@ pil::CommandFrame frame_from_command(std::uint32_t id, MotionVerb verb, const Mo
     f.limits[3 * k + 1] = static_cast<float>(lim[k].a);
     f.limits[3 * k + 2] = static_cast<float>(lim[k].j);
   }
+  f.period = static_cast<std::uint8_t>(verb == MotionVerb::kStream ? req.period : 0);
   return f;
 }
 
@@ -176,6 +221,8 @@ pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
   f.faults = task.machine.latched | task.sup.latched;
   const int queued = task.gen.queued();
   f.queued = static_cast<std::uint8_t>(queued > 255 ? 255 : queued);
+  f.running_id = task.gen.running_id();
+  f.dropped = task.dropped;
   const StepOutput<S>& out = task.last;
   if (task.step_timing.count == 0 || out.status != kFaultNone) {
     detail::pose_floats<S>(task.gen.hold_pose().p, task.gen.hold_pose().R, f.x_d);

@@ -41,6 +41,8 @@ struct ControlTask {
   MotionGenerator<S> gen;     // the desired state of each tick (osc/control/motion.hpp)
   CartesianLimits<S> limits;  // the configured maxima of a move
   TaskCommand<S> pending;     // the next tick's command (verb none: no command)
+  StreamSample<S> sample;     // the next tick's stream setpoint (prepare_setpoint)
+  std::uint32_t dropped;      // setpoints dropped (no stream of their id running, bad, or overwritten untaken)
   Vec6<S> q_queue_end;        // the joint angles where the queued moves end (the next path check's seed)
   Data<S> check_data;         // the path check's workspace (command preparation, outside the tick)
   MotionReport report;        // this tick's answer and motion events
@@ -77,6 +79,8 @@ struct ControlTask {
     desired.x.setZero(), desired.xd.setZero(), desired.xdd.setZero();
     q_queue_end = q0;
     pending = {};
+    sample = {};
+    dropped = 0;
     report = {};
     ramp_start = 0;
     ramping = false;
@@ -177,7 +181,8 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured) {
   MotionReason pre = cmd.refusal;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kMoveTo && cmd.epoch != task.gen.epoch())
     pre = MotionReason::kSuperseded;
-  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kPaper && task.gen.source() != MotionSource::kHold)
+  if (pre == MotionReason::kNone && (cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream) &&
+      task.gen.source() != MotionSource::kHold)
     pre = MotionReason::kBusy;
   if (pre == MotionReason::kNone) return verb_command(cmd.verb);
   rep.outcome = CommandOutcome::kRefused;
@@ -211,6 +216,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.q_queue_end = cmd.q_end;
   }
   if (accepted && cmd.verb == MotionVerb::kPaper) task.gen.start_paper(task.gains.trajectory, next, cmd.id);
+  if (accepted && cmd.verb == MotionVerb::kStream) task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
     task.gen.stop(next, params::kControlHz, task.limits);
     task.q_queue_end = q;  // near where the stop ends: the next check's Newton steps start the path there
@@ -282,6 +288,10 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const Vec6<S> q = measured ? angles_from_counts(task.q_start, task.counts_per_rad, counts) : task.q_start;
   const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
   MotionEvents ev;
+  if (task.sample.valid) {
+    task.gen.stream_setpoint(task.sample.x, task.sample.end);
+    task.sample.valid = false;
+  }
   if (stepped) {
     task.desired = task.gen.at_tick(task.tick, params::kControlHz, ev);
     const std::uint32_t s0 = hal.cycles();
@@ -305,8 +315,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
-  const MotionReason limit = stepped ? motion_limits_reached(task, q) : MotionReason::kNone;
-  const bool torque = motion_update(task, faults, measured, q, ev, limit);
+  MotionReason stop_request = stepped ? motion_limits_reached(task, q) : MotionReason::kNone;
+  if (stop_request == MotionReason::kNone && task.gen.stream_stale()) stop_request = MotionReason::kStaleStream;
+  const bool torque = motion_update(task, faults, measured, q, ev, stop_request);
   if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   hal.write_dacs(task.codes);
@@ -346,6 +357,22 @@ TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& 
   c.refusal = path_refusal(pc.status);
   c.q_end = pc.q_end;
   return c;
+}
+
+/// Puts a setpoint of stream `id` into the task's mailbox for the next tick (prepare_setpoint):
+/// false, counted in task.dropped, when no stream of that id runs; a setpoint not yet taken is
+/// replaced (and counted).
+template <class S>
+bool offer_setpoint(ControlTask<S>& task, std::uint32_t id, const Vec3<S>& position, const Vec3<S>& rpy, bool has_rpy,
+                    bool end) {
+  StreamSample<S> s;
+  if (!prepare_setpoint(task.gen, id, position, rpy, has_rpy, end, s)) {
+    ++task.dropped;
+    return false;
+  }
+  if (task.sample.valid) ++task.dropped;
+  task.sample = s;
+  return true;
 }
 
 /// A tick without a new sample in which the I/O layer keeps the outputs (a short, bounded gap, e.g.

@@ -27,7 +27,8 @@ namespace osc {
   X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion") \
   X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                \
   X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")        \
-  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")
+  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")                     \
+  X(Stream, "stream", "follow the setpoint frames that follow, jerk-limited; stale: category-2 stop")
 
 #define OSC_X_PREFIX k
 OSC_MOTION_ENUM(MotionVerb, OSC_MOTION_VERB_LIST);
@@ -42,6 +43,7 @@ constexpr MotionCommand verb_command(MotionVerb v) {
       return MotionCommand::kDisable;
     case MotionVerb::kMoveTo:
     case MotionVerb::kPaper:
+    case MotionVerb::kStream:
       return MotionCommand::kMove;
     case MotionVerb::kStop:
       return MotionCommand::kStop;
@@ -66,6 +68,7 @@ struct MoveRequest {
   bool replace = false;  ///< re-target: brake the running motion along its path, drop the queue, go
   bool has_limits = false;
   CartesianLimits<S> limits{};
+  std::uint32_t period = 1;  ///< stream: the setpoints' period [ticks] (relative, has_limits apply too)
 };
 
 /// A command ready for the next tick.
@@ -78,6 +81,18 @@ struct TaskCommand {
   std::uint32_t epoch = 0;                     ///< the generator's, when the move was planned
   CartesianMove<S> move{};                     ///< move_to: the planned move
   Vec6<S> q_end = Vec6<S>::Zero();             ///< move_to: the joint angles at its end (path check)
+  std::uint32_t period = 1;                    ///< stream: the setpoints' period [ticks]
+  bool relative = false;                       ///< stream: setpoints relative to where it starts
+  CartesianLimits<S> limits{};                 ///< stream: its limits
+};
+
+/// One setpoint of a stream, ready for the next tick (prepare_setpoint): the follower's target in
+/// the controller's coordinates (position; roll, pitch, yaw of R R_ref^T).
+template <class S>
+struct StreamSample {
+  bool valid = false;  ///< waiting for the tick (taken there)
+  bool end = false;    ///< the stream's last
+  Vec6<S> x = Vec6<S>::Zero();
 };
 
 /// What one tick reports: the answer to its command, and a motion's end.
@@ -117,6 +132,11 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
     c.refusal = MotionReason::kOverLimit;
     return c;
   }
+  // A move while a stream runs: its end is not known until the stream ends (stop it, or wait).
+  if (gen.source() == MotionSource::kStream) {
+    c.refusal = MotionReason::kBusy;
+    return c;
+  }
   // A re-target, or a move after the paper's motion, starts where the running motion comes to rest
   // when braked in the tick after the command's.
   c.brake = req.replace || gen.source() == MotionSource::kPaper;
@@ -132,6 +152,38 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
   if (math::take_arithmetic_fault<S>() || st != ProfileStatus::kOk) c.refusal = MotionReason::kOverLimit;
   math::restore_arithmetic_flags<S>(saved);
   return c;
+}
+
+/// Prepares a stream command: its limits against the configured maxima `max` (over_limit). Whether
+/// the generator holds (else busy) is the tick's to decide.
+template <class S>
+TaskCommand<S> prepare_stream(const CartesianLimits<S>& max, const MoveRequest<S>& req, std::uint32_t id) {
+  TaskCommand<S> c;
+  c.verb = MotionVerb::kStream;
+  c.id = id;
+  c.period = req.period;
+  c.relative = req.relative;
+  c.limits = req.has_limits ? req.limits : max;
+  if (!c.limits.within(max)) c.refusal = MotionReason::kOverLimit;
+  return c;
+}
+
+/// Prepares a setpoint of the running stream `id`: false (dropped) when no stream of that id runs.
+/// position, rpy: absolute (base frame), or relative to the pose the stream started at; without
+/// has_rpy the orientation stays as it started.
+template <class S>
+bool prepare_setpoint(const MotionGenerator<S>& gen, std::uint32_t id, const Vec3<S>& position, const Vec3<S>& rpy,
+                      bool has_rpy, bool end, StreamSample<S>& out) {
+  if (gen.source() != MotionSource::kStream || gen.braking() || gen.running_id() != id) return false;
+  const std::uint32_t saved = math::take_arithmetic_flags<S>();
+  MoveRequest<S> req;
+  req.position = position, req.rpy = rpy, req.relative = gen.stream_relative(), req.has_rpy = has_rpy;
+  const Pose<S> to = move_target(gen.hold_pose(), req);
+  out.x << to.p, orientation_coordinates<S>(to.R, gen.reference_orientation());
+  out.end = end;
+  out.valid = !math::take_arithmetic_fault<S>();
+  math::restore_arithmetic_flags<S>(saved);
+  return out.valid;
 }
 
 /// A command without a plan (every verb but move_to): nothing to prepare, the tick decides it (a

@@ -44,22 +44,22 @@ namespace osc {
 /// Why a command was refused or a running motion aborted. The geometric ones are decided by the
 /// motion generator, which refuses with them after this machine accepted; motion_next() decides the
 /// rest.
-#define OSC_MOTION_REASON_LIST(X)                                                                                \
-  X(None, "none", "not refused, not aborted")                                                                    \
-  X(OutOfWorkspace, "out_of_workspace", "the target is outside the workspace (motion generator)")                \
-  X(NearSingular, "near_singular", "the path passes too near a singular pose (motion generator)")                \
-  X(OverLimit, "over_limit", "a joint, speed or acceleration limit would be exceeded (motion generator)")        \
-  X(QueueFull, "queue_full", "no room in the motion queue (motion generator)")                                   \
-  X(NotEnabled, "not_enabled", "a move or a stop while disabled: enable first")                                  \
-  X(Faulted, "faulted", "in fault, or a fault aborted the motion; the cause is in MotionStep::cause")            \
-  X(Stopping, "stopping", "a move during a category-2 stop: sent again once at rest (completion stopped)")       \
-  X(StopCommand, "stop_command", "a stop command aborted the motion")                                            \
-  X(DisableCommand, "disable_command", "a disable command aborted the motion (stop, then disabled)")             \
-  X(StaleStream, "stale_stream", "the runtime stopped the motion: its stream of setpoints went stale")           \
-  X(LimitReached, "limit_reached", "the runtime stopped the motion: a limit was reached")                        \
-  X(Busy, "busy", "a paper command while a motion runs: stop it, or wait until it is done")                      \
-  X(Superseded, "superseded", "a re-target replaced the motion; or the queue changed before the command's tick") \
-  X(BadCommand, "bad_command",                                                                                   \
+#define OSC_MOTION_REASON_LIST(X)                                                                                   \
+  X(None, "none", "not refused, not aborted")                                                                       \
+  X(OutOfWorkspace, "out_of_workspace", "the target is outside the workspace (motion generator)")                   \
+  X(NearSingular, "near_singular", "the path passes too near a singular pose (motion generator)")                   \
+  X(OverLimit, "over_limit", "a joint, speed or acceleration limit would be exceeded (motion generator)")           \
+  X(QueueFull, "queue_full", "no room in the motion queue (motion generator)")                                      \
+  X(NotEnabled, "not_enabled", "a move or a stop while disabled: enable first")                                     \
+  X(Faulted, "faulted", "in fault, or a fault aborted the motion; the cause is in MotionStep::cause")               \
+  X(Stopping, "stopping", "a move during a category-2 stop: sent again once at rest (completion stopped)")          \
+  X(StopCommand, "stop_command", "a stop command aborted the motion")                                               \
+  X(DisableCommand, "disable_command", "a disable command aborted the motion (stop, then disabled)")                \
+  X(StaleStream, "stale_stream", "the runtime stopped the motion: its stream of setpoints went stale")              \
+  X(LimitReached, "limit_reached", "the runtime stopped the motion: a limit was reached")                           \
+  X(Busy, "busy", "a paper or stream command while a motion runs, a move_to while a stream runs: stop it, or wait") \
+  X(Superseded, "superseded", "a re-target replaced the motion; or the queue changed before the command's tick")    \
+  X(BadCommand, "bad_command",                                                                                      \
     "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
