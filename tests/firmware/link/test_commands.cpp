@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "osc/link/command_port.hpp"
 #include "osc/link/commands.hpp"
 #include "osc/link/node.hpp"
 #include "osc/math/fixed.hpp"
@@ -676,6 +677,147 @@ TEST(CommandFrames, StateFrameInEveryScalar) {
   }
   EXPECT_LT((rotation(f.x) - rotation(d.x)).norm(), 1e-3);
   EXPECT_LT((rotation(q.x_d) - rotation(d.x_d)).norm(), 1e-2);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- the command port
+
+namespace {
+
+/// The port between a node's task and a byte stream: frames written by the port are parsed back.
+struct PortFrames : ::testing::Test {
+  std::unique_ptr<Node> node = std::make_unique<Node>();
+  CommandPort<double> port;
+  std::vector<pil::AnswerFrame> answers;
+  std::vector<pil::StateFrame> states;
+  std::uint32_t seq = 0;
+  pil::Parser out;
+
+  void SetUp() override {
+    node->init(joint_vector<double>(robot::kQStart), FrictionMode::kAdaptive, 0);
+    ControlTask<double>& t = node->task;
+    t.init(t.model, t.gains, t.mode, t.q_start, 0, TaskStart::kDisabled);
+  }
+  void write(const std::uint8_t* b, int n) {
+    for (int i = 0; i < n; ++i) {
+      if (out.feed(b[i]) != pil::Parser::kFrame) continue;
+      pil::AnswerFrame a;
+      pil::StateFrame s;
+      if (out.decode(a)) answers.push_back(a);
+      if (out.decode(s)) states.push_back(s);
+    }
+  }
+  /// A frame arriving on the port's transport.
+  template <class F>
+  bool arrive(const F& f) {
+    const pil::Parser p = parsed(bytes_of(f));
+    return port.on_frame(node->task, p, [this](const std::uint8_t* b, int n) { write(b, n); });
+  }
+  void tick() {
+    pil::SensorFrame s;
+    s.seq = seq++;
+    std::uint8_t buf[pil::kMaxFrame];
+    const int n = pil::encode(s, buf);
+    for (int i = 0; i < n; ++i) node->on_byte(buf[i]);
+    node->tick();
+    port.after_tick(node->task, [this](const std::uint8_t* b, int k) { write(b, k); });
+  }
+  static pil::CommandFrame command(std::uint32_t id, MotionVerb v) {
+    pil::CommandFrame f;
+    f.id = id;
+    f.verb = static_cast<std::uint8_t>(v);
+    return f;
+  }
+};
+
+TEST_F(PortFrames, CommandsWaitForTheMailboxInOrderAndAreAnsweredOnce) {
+  for (int k = 0; k < 3; ++k) tick();
+  EXPECT_TRUE(arrive(command(1, MotionVerb::kEnable)));
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kEnable);  // prepared at once: the mailbox was free
+  EXPECT_TRUE(arrive(command(2, MotionVerb::kStop)));
+  EXPECT_TRUE(arrive(command(3, MotionVerb::kDisable)));
+  EXPECT_EQ(port.waiting(), 2);
+  for (int k = 0; k < 4; ++k) tick();
+  ASSERT_EQ(answers.size(), 3u);
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(answers[i].id, i + 1);
+    EXPECT_EQ(answers[i].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+    EXPECT_EQ(answers[i].tick, answers[0].tick + i);  // one per tick, in order
+  }
+  EXPECT_EQ(answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
+  EXPECT_EQ(answers[2].state, static_cast<std::uint8_t>(MotionState::kDisabled));
+  EXPECT_EQ(port.waiting(), 0);
+}
+
+TEST_F(PortFrames, FullFifoAndUnknownVerbAreRefusedAtOnce) {
+  tick();
+  for (std::uint32_t id = 1; id <= 1 + kCommandFifo; ++id) EXPECT_TRUE(arrive(command(id, MotionVerb::kStop)));
+  EXPECT_TRUE(answers.empty());  // one in the mailbox, kCommandFifo waiting
+  EXPECT_TRUE(arrive(command(99, MotionVerb::kStop)));
+  ASSERT_EQ(answers.size(), 1u);
+  EXPECT_EQ(answers[0].id, 99u);
+  EXPECT_EQ(answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kQueueFull));
+  answers.clear();
+  for (int k = 0; k < 1 + kCommandFifo; ++k) tick();
+  ASSERT_EQ(answers.size(), 1u + kCommandFifo);
+  for (const pil::AnswerFrame& a : answers)  // a stop while disabled
+    EXPECT_EQ(a.refusal, static_cast<std::uint8_t>(MotionReason::kNotEnabled));
+  answers.clear();
+  pil::CommandFrame u = command(7, MotionVerb::kNone);
+  u.verb = 200;
+  EXPECT_TRUE(arrive(u));
+  ASSERT_EQ(answers.size(), 1u);
+  EXPECT_EQ(answers[0].id, 7u);
+  EXPECT_EQ(answers[0].verb, static_cast<std::uint8_t>(MotionVerb::kNone));
+  EXPECT_EQ(answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kBadCommand));
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kNone);
+  // Other frame types are the caller's.
+  EXPECT_FALSE(arrive(pil::SensorFrame{}));
+}
+
+TEST_F(PortFrames, StateFramesAtTheirPeriod) {
+  for (int k = 0; k < 100; ++k) tick();
+  ASSERT_EQ(states.size(), 100u / kStatePeriod);
+  for (std::size_t i = 0; i < states.size(); ++i) EXPECT_EQ(states[i].tick, (i + 1) * kStatePeriod - 1);
+  port.state_period = 0;
+  for (int k = 0; k < 100; ++k) tick();
+  EXPECT_EQ(states.size(), 100u / kStatePeriod);
+}
+
+TEST_F(PortFrames, AStreamFollowsItsSetpointsAndIsDone) {
+  tick();
+  arrive(command(1, MotionVerb::kEnable));
+  for (int k = 0; k < 60; ++k) tick();  // past the torque ramp (the arm stays put: the counts are 0)
+  pil::CommandFrame st = command(2, MotionVerb::kStream);
+  st.flags = pil::kFlagRelative;
+  st.period = 10;
+  arrive(st);
+  tick();
+  ASSERT_EQ(answers.back().id, 2u);
+  ASSERT_EQ(answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(node->task.gen.running_id(), 2u);
+  const Vec3<double> p0 = node->task.gen.hold_pose().p;
+  // 2 mm along y at 100 Hz (the encoders stay at 0 here: no plant, so briefly), then a stop.
+  for (int n = 1; n <= 10; ++n) {
+    EXPECT_TRUE(arrive(setpoint_frame<double>(2, Vec3<double>(0, 0.002 * n / 10.0, 0), nullptr, false)));
+    for (int k = 0; k < 10; ++k) tick();
+  }
+  EXPECT_EQ(node->task.dropped, 0u);
+  EXPECT_EQ(node->task.machine.state, MotionState::kMoving);
+  const Vec3<double> d = node->task.desired.x.head<3>() - p0;
+  EXPECT_GT(d(1), 1e-4);  // on its way along +y, one period behind and lagging
+  EXPECT_LT(d(1), 0.002);
+  EXPECT_NEAR(d(0), 0, 1e-9);
+  EXPECT_NEAR(d(2), 0, 1e-9);
+  // A setpoint of another stream: dropped.
+  EXPECT_TRUE(arrive(setpoint_frame<double>(3, Vec3<double>::Zero(), nullptr, false)));
+  EXPECT_EQ(node->task.dropped, 1u);
+  arrive(command(4, MotionVerb::kStop));
+  tick();
+  EXPECT_EQ(answers.back().abort, static_cast<std::uint8_t>(MotionReason::kStopCommand));
+  EXPECT_EQ(answers.back().aborted_id, 2u);
+  EXPECT_EQ(node->task.machine.state, MotionState::kStopping);
 }
 
 }  // namespace

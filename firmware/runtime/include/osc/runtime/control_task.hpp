@@ -344,6 +344,16 @@ constexpr MotionReason path_refusal(PathStatus s) {
   return MotionReason::kOutOfWorkspace;
 }
 
+/// The path check of a move_to prepare_move planned (nothing if it refused it already).
+template <class S>
+void check_prepared_move(ControlTask<S>& task, TaskCommand<S>& c) {
+  if (c.verb != MotionVerb::kMoveTo || c.refusal != MotionReason::kNone) return;
+  const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
+  const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
+  c.refusal = path_refusal(pc.status);
+  c.q_end = pc.q_end;
+}
+
 /// Prepares a move_to in full, outside the tick (a board's main loop, the host's driver): the
 /// limits, the queue and the plan (prepare_move), then the path check (check_path) from the joint
 /// angles where the queue ends, or, for a move that starts where a braked motion comes to rest,
@@ -351,11 +361,7 @@ constexpr MotionReason path_refusal(PathStatus s) {
 template <class S>
 TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& req, std::uint32_t id) {
   TaskCommand<S> c = prepare_move(task.gen, task.limits, task.tick, params::kControlHz, req, id);
-  if (c.refusal != MotionReason::kNone) return c;
-  const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
-  const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
-  c.refusal = path_refusal(pc.status);
-  c.q_end = pc.q_end;
+  check_prepared_move(task, c);
   return c;
 }
 
