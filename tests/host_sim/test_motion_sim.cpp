@@ -366,3 +366,210 @@ TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------- streams
+
+namespace {
+
+/// A path for the streams: 60 mm along x, -40 mm along y, 20 mm up and 10 degrees of yaw, timed
+/// by a cosine over 2.5 s, relative to where the stream starts; its peak rates are within the
+/// follower's per-axis limits (v / sqrt(3): a path faster than those is followed slower and late).
+constexpr double kPathT = 2.5;
+V6 path_at(double t) {
+  const double s = t >= kPathT ? 1 : 0.5 - 0.5 * std::cos(kPi * t / kPathT);
+  V6 x;
+  x << 0.06 * s, -0.04 * s, 0.02 * s, 0, 0, 10 * kPi / 180 * s;
+  return x;
+}
+
+/// What a stream run measured: the reference's own maxima (speed, acceleration, jerk from
+/// differences of the acceleration; angular speed, angular acceleration), its largest distance
+/// from the path's line, the tracking error, the end error of the arm, the outcome.
+struct StreamRun {
+  double v = 0, a = 0, j = 0, w = 0, wd = 0, off_path = 0, tracking = 0, end_error = 0, end_angle = 0;
+  std::uint32_t faults = 0;
+  bool done = false;
+  MotionReason abort = MotionReason::kNone;
+  int ticks = 0;
+};
+
+/// Enable, then stream path_at at rate_hz (relative), the last setpoint ending the stream; or
+/// without setpoints after cut_s. Runs until the stream is done or aborted and the arm holds.
+template <class S>
+StreamRun stream_path(int rate_hz, double cut_s = -1) {
+  MotionSim<S> sim(start_pose());
+  StreamRun out;
+  EXPECT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  run_ticks(sim, 200);
+  MoveRequest<S> req;
+  req.relative = true;
+  req.period = static_cast<std::uint32_t>(1000 / rate_hz);
+  sim.stream(req, 2);
+  sim.tick();
+  EXPECT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+  const V3 p0 = sim.tip();
+  const sim::Mat3 R_ref = sim.task().state.R_ref.template cast<double>();
+  const V6 x0 = sim.pose();
+  Vec3<double> a_prev = Vec3<double>::Zero(), w_prev = Vec3<double>::Zero();
+  const V3 line = path_at(kPathT).head<3>().normalized();
+  for (int k = 0; k < 20000; ++k) {
+    const double t = k * 1e-3;
+    if (k % req.period == 0 && (cut_s < 0 || t <= cut_s)) {
+      const bool end = t >= kPathT;
+      if (t <= kPathT + 1e-9) {
+        const V6 x = path_at(t);
+        const V3 rpy = x.tail<3>();
+        EXPECT_TRUE(sim.setpoint(2, x.head<3>(), &rpy, end)) << t;
+      }
+    }
+    out.faults |= sim.tick();
+    ++out.ticks;
+    const MotionReport& rep = sim.task().report;
+    out.done |= rep.done_id == 2;
+    if (rep.abort != MotionReason::kNone) out.abort = rep.abort;
+    const Desired<S>& d = sim.task().desired;
+    const Vec3<double> v = d.xd.template head<3>().template cast<double>();
+    const Vec3<double> a = d.xdd.template head<3>().template cast<double>();
+    const Vec3<double> phi = d.x.template tail<3>().template cast<double>();
+    const Vec3<double> w = angular_to_phi_rate<double>(phi).inverse() * d.xd.template tail<3>().template cast<double>();
+    out.v = std::max(out.v, v.norm());
+    out.a = std::max(out.a, a.norm());
+    if (k > 0) out.j = std::max(out.j, (a - a_prev).norm() * 1e3), out.wd = std::max(out.wd, (w - w_prev).norm() * 1e3);
+    out.w = std::max(out.w, w.norm());
+    a_prev = a, w_prev = w;
+    const V3 rel = d.x.template head<3>().template cast<double>() - p0;
+    out.off_path = std::max(out.off_path, (rel - rel.dot(line) * line).norm());
+    out.tracking = std::max(out.tracking, (sim.reference().template head<3>() - sim.tip()).norm());
+    if ((out.done || out.abort != MotionReason::kNone) && state_is(sim, MotionState::kHolding)) break;
+  }
+  run_ticks(sim, 500);  // settled, holding
+  const V6 end = path_at(kPathT);
+  out.end_error = (sim.tip() - (p0 + end.head<3>())).norm();
+  const sim::Mat3 R_end = rpy_rotation<double>(end.tail<3>()) * rpy_rotation<double>(x0.tail<3>()) * R_ref;
+  const sim::Mat3 R_now = rpy_rotation<double>(V3(sim.pose().template tail<3>())) * R_ref;
+  V3 axis;
+  rotation_axis_angle<double>(sim::Mat3(R_now * R_end.transpose()), axis, out.end_angle);
+  EXPECT_TRUE(state_is(sim, MotionState::kHolding));
+  return out;
+}
+
+template <class S>
+void stream_at_rates() {
+  const CartesianLimits<double> lim = CartesianLimits<double>::defaults();
+  for (int rate : {10, 50, 1000}) {
+    const StreamRun r = stream_path<S>(rate);
+    const std::string at = std::string(typeid(S).name()) + " at " + std::to_string(rate) + " Hz";
+    EXPECT_TRUE(r.done) << at;
+    EXPECT_EQ(r.abort, MotionReason::kNone) << at;
+    EXPECT_EQ(r.faults, 0u) << at;
+    EXPECT_LE(r.end_error, 1e-3) << at;
+    EXPECT_LE(r.end_angle, 1e-3) << at;
+    EXPECT_LE(r.v, lim.linear.v) << at;
+    EXPECT_LE(r.a, lim.linear.a) << at;
+    EXPECT_LE(r.j, lim.linear.j) << at;
+    EXPECT_LE(r.w, lim.angular.v) << at;
+    EXPECT_LE(r.wd, lim.angular.a) << at;
+    // Not distorted: the reference stays on the path's line (the follower lags along it).
+    EXPECT_LE(r.off_path, 0.2e-3) << at;
+    EXPECT_LE(r.tracking, 2e-3) << at;  // a cold start (theta^ = 0), as the first move's
+    std::printf(
+        "stream %s: end error %.4f mm %.5f rad, off the line %.4f mm, tracking %.3f mm, v %.4f a %.4f j %.3f "
+        "w %.4f wd %.4f, %d ticks\n",
+        at.c_str(), r.end_error * 1e3, r.end_angle, r.off_path * 1e3, r.tracking * 1e3, r.v, r.a, r.j, r.w, r.wd,
+        r.ticks);
+  }
+}
+
+}  // namespace
+
+TEST(MotionSim, StreamAtTenFiftyAndThousandHzEndsAtThePathsEnd) { stream_at_rates<double>(); }
+TEST(MotionSim, StreamInFloat) { stream_at_rates<float>(); }
+TEST(MotionSim, StreamInFixedPoint) { stream_at_rates<Fixed>(); }
+
+TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
+  for (int rate : {10, 50, 1000}) {
+    MotionSim<double> sim(start_pose());
+    answer(sim, MotionVerb::kEnable, 1);
+    run_ticks(sim, 200);
+    MoveRequest<double> req;
+    req.relative = true;
+    req.period = static_cast<std::uint32_t>(1000 / rate);
+    sim.stream(req, 2);
+    sim.tick();
+    ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+    long last = -1, stale_at = -1;
+    std::uint32_t faults = 0;
+    for (long k = 0; k < 10000 && stale_at < 0; ++k) {
+      if (k % req.period == 0 && k * 1e-3 <= 1.0) {
+        const V6 x = path_at(k * 1e-3);
+        sim.setpoint(2, x.head<3>(), nullptr, false);
+        last = k;
+      }
+      faults |= sim.tick();
+      if (sim.task().report.abort == MotionReason::kStaleStream) stale_at = k;
+    }
+    ASSERT_GE(stale_at, 0) << rate;
+    // Stale after max(2 T, 20 ms) without a setpoint: the tick after that.
+    // Stale in the tick that completes max(2 T, 20 ms) without a setpoint after the last one's.
+    const long timeout = std::max<long>(2 * req.period, 20);
+    EXPECT_EQ(stale_at - last, timeout) << rate;
+    EXPECT_EQ(sim.task().report.aborted_id, 2u);
+    EXPECT_TRUE(state_is(sim, MotionState::kStopping));
+    const Trace stop = run_until(
+        sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+    EXPECT_TRUE(stop.ended) << rate;
+    EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
+    const V3 held = sim.tip();
+    const Trace hold = run_ticks(sim, 1000);
+    EXPECT_EQ(faults | stop.faults | hold.faults, 0u) << rate;
+    EXPECT_LE((sim.tip() - held).norm(), 0.2e-3) << rate;
+    EXPECT_TRUE(state_is(sim, MotionState::kHolding));
+  }
+}
+
+TEST(MotionSim, StreamRefusalsAndAStopCommand) {
+  MotionSim<double> sim(start_pose());
+  MoveRequest<double> req;
+  req.period = 20;
+  req.relative = true;
+  sim.stream(req, 1);
+  sim.tick();
+  EXPECT_EQ(sim.task().report.refusal, MotionReason::kNotEnabled);
+  answer(sim, MotionVerb::kEnable, 2);
+  MoveRequest<double> fast = req;
+  fast.has_limits = true;
+  fast.limits = CartesianLimits<double>::defaults();
+  fast.limits.angular.j *= 1.5;
+  sim.stream(fast, 3);
+  sim.tick();
+  EXPECT_EQ(sim.task().report.refusal, MotionReason::kOverLimit);
+  sim.stream(req, 4);
+  sim.tick();
+  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+  // While it runs: another stream, the paper's motion and a move are busy.
+  sim.stream(req, 5);
+  sim.tick();
+  EXPECT_EQ(sim.task().report.refusal, MotionReason::kBusy);
+  EXPECT_EQ(answer(sim, MotionVerb::kPaper, 6).refusal, MotionReason::kBusy);
+  EXPECT_EQ(answer_move(sim, relative<double>(0.01, 0, 0), 7).refusal, MotionReason::kBusy);
+  // Setpoints moving at 20 mm/s along x, then a stop: aborted, decelerated, held.
+  const V3 p0 = sim.tip();
+  for (int k = 0; k < 500; ++k) {
+    if (k % 20 == 0) sim.setpoint(4, V3(0.02 * k * 1e-3, 0, 0), nullptr, false);
+    sim.tick();
+  }
+  const MotionReport stop = answer(sim, MotionVerb::kStop, 8);
+  EXPECT_EQ(stop.abort, MotionReason::kStopCommand);
+  EXPECT_EQ(stop.aborted_id, 4u);
+  // A setpoint after the stop is dropped.
+  const std::uint32_t dropped = sim.task().dropped;
+  EXPECT_FALSE(sim.setpoint(4, V3(0.02, 0, 0), nullptr, false));
+  EXPECT_EQ(sim.task().dropped, dropped + 1);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 5000);
+  EXPECT_TRUE(r.ended);
+  EXPECT_EQ(r.faults, 0u);
+  const double moved = (sim.tip() - p0)(0);
+  EXPECT_GT(moved, 0.005);  // it went along x, and stopped short of where the stream would have gone
+  EXPECT_LT(moved, 0.02);
+}

@@ -103,9 +103,11 @@ void step_axis(jerk_profile::Kin<S>& s, S& lo, S vt, S amax, S j, S dt) {
     w += (left * hz) * vt;
   }
   lo += w;
-  const S move = lo / hz;
-  s.p += move;
-  lo -= move * hz;
+  // What p actually moved by leaves the residual (in float, a step below half of p's ulp does not
+  // move it: it stays in lo until the steps add up to one).
+  const S p = s.p + lo / hz;
+  lo -= (p - s.p) * hz;
+  s.p = p;
 }
 
 template <class S>
@@ -118,6 +120,8 @@ template <class S>
 class StreamFollower {
  public:
   static constexpr std::uint32_t kHz = params::kControlHz;
+  /// 1 / sqrt(3), rounded down (3 axes at this fraction of a limit are within it, in double too).
+  static constexpr double kInvSqrt3 = 0.577350269;
   static constexpr std::uint32_t kExtrapolationTicks = static_cast<std::uint32_t>(kStreamExtrapolation * kHz + 0.5);
 
   explicit StreamFollower(const CartesianLimits<S>& lim = CartesianLimits<S>::defaults()) { set_limits(lim); }
@@ -125,7 +129,7 @@ class StreamFollower {
   /// The limits the reference keeps (before start()).
   void set_limits(const CartesianLimits<S>& lim) {
     const JerkLimits<S> l = rounding_margin(lim.linear), w = rounding_margin(lim.angular);
-    const S kl = lit<S>(0.57735026918962576), kw = lit<S>(0.57735026918962576 / kStreamEBound);
+    const S kl = lit<S>(kInvSqrt3), kw = lit<S>(kInvSqrt3 / kStreamEBound);
     for (int i = 0; i < 6; ++i) {
       const JerkLimits<S>& g = i < 3 ? l : w;
       const S k = i < 3 ? kl : kw;
