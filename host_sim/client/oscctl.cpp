@@ -180,8 +180,11 @@ void build(CLI::App& app, Args& a) {
   app.add_option("--baud", a.baud, "baud rate of a serial device (default 115200)")->check(CLI::Range(50, 4000000));
   app.add_option("--timeout", a.timeout, "seconds to wait for an answer or an end (default 120)")
       ->check(CLI::Range(0.1, 86400.0));
-  for (const char* v : {"state", "enable", "disable", "clear", "paper", "stop"})
-    app.add_subcommand(v, std::string(v == std::string("state") ? "print the state frame" : "send the command"));
+  app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
+  // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
+  for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
+                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop})
+    app.add_subcommand(osc::motion_name(v), osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(v)]);
   CLI::App* mv = app.add_subcommand("move", "a jerk-limited move_to of the wrist centre; waits until done");
   mv->add_option("xyz", a.xyz, "X Y Z [m], base frame")->expected(3)->required();
   mv->add_option("--rpy", a.rpy, "roll pitch yaw [deg] of the target orientation")->expected(3);
