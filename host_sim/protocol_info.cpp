@@ -3,7 +3,9 @@
 // fault catalogue, the supervisor's states, the motion state machine's and the commands' names, the
 // robot's drives, the move limits) and its own encoder (the example frames). scripts/docs_tables.py
 // --kind protocol writes docs/protocol.md's tables from it; ctest docs_tables_protocol fails when
-// they differ.
+// they differ. With --client: what a client of the command protocol needs (the frames' layouts, the
+// flags, the names of every code, the limits), which clients/python/osc_protocol.json holds
+// (scripts/client_protocol.py writes it; ctest client_protocol_json_current fails when it differs).
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -14,6 +16,7 @@
 
 #include "osc/control/gains.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/command_port.hpp"
 #include "osc/link/commands.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/robot.hpp"
@@ -133,6 +136,13 @@ json command_protocol() {
   const auto lim = osc::CartesianLimits<double>::defaults();
   j["limits"] = {{"linear", {lim.linear.v, lim.linear.a, lim.linear.j}},
                  {"angular", {lim.angular.v, lim.angular.a, lim.angular.j}}};
+  j["setpoint_flags"] = json::array();
+  for (int i = 0; i < pil::kSetpointFlagCount; ++i)
+    j["setpoint_flags"].push_back(
+        {{"bit", i}, {"mask", 1 << i}, {"name", pil::kSetpointFlagNames[i]}, {"doc", pil::kSetpointFlagDocs[i]}});
+  j["stream_max_period"] = pil::kStreamMaxPeriod;
+  j["state_period"] = osc::kStatePeriod;
+  j["command_fifo"] = osc::kCommandFifo;
   j["queue_length"] = osc::params::kMoveQueueLength;
   j["max_move_rotation"] = osc::kMaxMoveRotation;
   j["verbs"] = motion_names<osc::MotionVerb>();
@@ -145,12 +155,68 @@ json command_protocol() {
   return j;
 }
 
+template <class E>
+json names() {
+  json out = json::array();
+  for (int i = 0; i < osc::MotionNames<E>::kCount; ++i) out.push_back(osc::MotionNames<E>::kNames[i]);
+  return out;
+}
+
+/// A frame's fields as a client lays them out: name, wire type, count (wire order, no padding).
+json client_fields(const pil::FrameInfo& f) {
+  json out = json::array();
+  for (const pil::FieldInfo& x : std::span(f.fields, static_cast<std::size_t>(f.field_count)))
+    out.push_back({{"name", x.name}, {"type", x.type}, {"count", x.count}});
+  return out;
+}
+
+/// What a client of the command protocol needs, and nothing it does not (no documentation text: the
+/// file changes only when the protocol does).
+json client_protocol() {
+  json j;
+  j["generated_by"] = "osc_protocol --client (scripts/client_protocol.py); do not edit";
+  j["sync"] = {pil::kSync0, pil::kSync1};
+  j["crc"] = {{"poly", 0x1021}, {"init", 0xFFFF}};
+  j["control_hz"] = osc::params::kControlHz;
+  j["types"] = json::array();
+  j["fields"] = json::object();
+  for (const pil::FrameInfo& f : pil::kFrames) {
+    j["types"].push_back({{"name", f.name}, {"code", f.type}, {"payload", f.payload}});
+    j["fields"][f.name] = client_fields(f);
+  }
+  j["command_flags"] = json::array();
+  for (const char* n : pil::kCommandFlagNames) j["command_flags"].push_back(n);
+  j["setpoint_flags"] = json::array();
+  for (const char* n : pil::kSetpointFlagNames) j["setpoint_flags"].push_back(n);
+  j["stream_max_period"] = pil::kStreamMaxPeriod;
+  const auto lim = osc::CartesianLimits<double>::defaults();
+  j["limits"] = {{"linear", {lim.linear.v, lim.linear.a, lim.linear.j}},
+                 {"angular", {lim.angular.v, lim.angular.a, lim.angular.j}}};
+  j["verbs"] = names<osc::MotionVerb>();
+  j["motion_states"] = names<osc::MotionState>();
+  j["reasons"] = names<osc::MotionReason>();
+  j["outcomes"] = names<osc::CommandOutcome>();
+  j["stop_categories"] = names<osc::StopCategory>();
+  j["completions"] = names<osc::MotionCompletion>();
+  j["faults"] = json::array();
+  for (int i = 0; i < osc::kFaultCount; ++i) j["faults"].push_back(osc::kFaultNames[i]);
+  return j;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1) {
-    std::fprintf(stderr, "usage: %s  (prints the link protocol's facts as JSON)\n", argv[0]);
+  const bool client = argc == 2 && std::string(argv[1]) == "--client";
+  if (argc > 1 && !client) {
+    std::fprintf(stderr,
+                 "usage: %s [--client]  (prints the link protocol's facts as JSON; --client: what a client of the "
+                 "command protocol needs)\n",
+                 argv[0]);
     return 2;
+  }
+  if (client) {
+    std::cout << client_protocol().dump(1) << "\n";
+    return 0;
   }
   json j;
   j["sync"] = {pil::kSync0, pil::kSync1};

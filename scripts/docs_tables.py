@@ -757,6 +757,20 @@ def t_protocol_state():
     return field_rows(protocol()["state_fields"])
 
 
+@table("protocol_setpoint", "docs/protocol.md", "protocol")
+def t_protocol_setpoint():
+    return field_rows(protocol()["setpoint_fields"])
+
+
+@table("protocol_setpoint_flags", "docs/protocol.md", "protocol")
+def t_protocol_setpoint_flags():
+    flags = protocol()["command"]["setpoint_flags"]
+    rows = [(f["bit"], f"`{hexs(f['mask'])}`", f"`{f['name']}`", f["doc"]) for f in flags]
+    rows.append(("other", "", "", "0 (a setpoint with another bit set is dropped and counted: the state frame's "
+                 "`dropped`)"))
+    return markdown_table(["bit", "mask", "name", "meaning"], rows)
+
+
 @table("protocol_command_flags", "docs/protocol.md", "protocol")
 def t_protocol_command_flags():
     flags = protocol()["command"]["flags"]

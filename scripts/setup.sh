@@ -4,6 +4,7 @@ set -euo pipefail
 pkgs=(cmake make g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib binutils-arm-none-eabi
       qemu-system-arm python3 python3-matplotlib
+      python3-serial                        # the Python client of the command protocol (clients/python/)
       gdb-multiarch openocd                 # debugging the images (debug_<image>, the QEMU debug test),
                                             # flashing the STM32F4 board (the flash target)
       clang libclang-rt-14-dev llvm-14      # the fuzz preset: clang 14 (Debian 12), its sanitizer and

@@ -1,0 +1,580 @@
+#!/usr/bin/env python3
+"""A client of the controller's command protocol (docs/protocol.md; docs/motion.md, "Clients").
+
+Pure Python 3 with pyserial (Debian's python3-serial). The frame layouts and the names of every code
+are not typed here: they come from osc_protocol.json beside this file, which the firmware's own
+declarations write (osc_protocol --client; scripts/client_protocol.py; ctest
+client_protocol_json_current fails when it is stale).
+
+As a module:
+
+    from osc_client import Client
+    c = Client("/dev/pts/7")
+    c.wait_answer(c.enable())
+    print(c.wait_done(c.move_to((0, 0.02, 0), relative=True)).text())   # done, aborted: stop_command, ...
+
+As a program, the verbs of oscctl, printing the same lines and exiting with the same status (0
+accepted or done, 1 refused, aborted or timed out, 2 a bad command line, port or file):
+
+    python3 clients/python/osc_client.py --port /dev/pts/7 state | enable | disable | clear | paper | stop
+    python3 clients/python/osc_client.py --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative]
+                                         [--v V --a A --j J] [--replace] [--no-wait]
+    python3 clients/python/osc_client.py --port /dev/pts/7 stream FILE.csv --rate HZ [--relative]
+    python3 clients/python/osc_client.py --port /dev/pts/7 watch [--seconds S]
+"""
+import argparse
+import json
+import math
+import os
+import random
+import select
+import struct
+import sys
+import time
+
+PROTOCOL_JSON = os.path.join(os.path.dirname(os.path.abspath(__file__)), "osc_protocol.json")
+WIRE = {"u8": "B", "u32": "I", "i32": "i", "f32": "f"}
+
+
+class ClientError(Exception):
+    """A named error: a bad port, a transport that failed, a bad request or file."""
+
+
+class Protocol:
+    """The command protocol as osc_protocol.json declares it: frame types, layouts, flags, names."""
+
+    def __init__(self, path=PROTOCOL_JSON):
+        try:
+            with open(path) as f:
+                p = json.load(f)
+        except (OSError, ValueError) as e:
+            raise ClientError(f"{path}: cannot read the protocol's description: {e}")
+        self.sync = bytes(p["sync"])
+        self.crc_poly, self.crc_init = p["crc"]["poly"], p["crc"]["init"]
+        self.control_hz = p["control_hz"]
+        self.code = {t["name"]: t["code"] for t in p["types"]}
+        self.name = {t["code"]: t["name"] for t in p["types"]}
+        self.payload = {t["code"]: t["payload"] for t in p["types"]}
+        self.fields = p["fields"]
+        self.format = {}
+        for name, fields in self.fields.items():
+            self.format[name] = "<" + "".join(f"{f['count']}{WIRE[f['type']]}" for f in fields)
+            if struct.calcsize(self.format[name]) != self.payload[self.code[name]]:
+                raise ClientError(f"{path}: the {name} frame's fields do not add up to its payload")
+        self.command_flag = {n: 1 << i for i, n in enumerate(p["command_flags"])}
+        self.setpoint_flag = {n: 1 << i for i, n in enumerate(p["setpoint_flags"])}
+        self.stream_max_period = p["stream_max_period"]
+        self.limits = p["limits"]
+        self.faults = p["faults"]
+        self.names = {k: p[k] for k in ("verbs", "motion_states", "reasons", "outcomes", "stop_categories",
+                                        "completions")}
+
+    def code_of(self, kind, name):
+        return self.names[kind].index(name)
+
+    def name_of(self, kind, code):
+        names = self.names[kind]
+        return names[code] if 0 <= code < len(names) else "?"
+
+    def crc16(self, data):
+        crc = self.crc_init
+        for b in data:
+            crc ^= b << 8
+            for _ in range(8):
+                crc = ((crc << 1) ^ self.crc_poly) if crc & 0x8000 else (crc << 1)
+                crc &= 0xFFFF
+        return crc
+
+    def encode(self, frame, values):
+        """A frame of type `frame` from a dict of its fields (missing ones 0)."""
+        flat = []
+        for f in self.fields[frame]:
+            v = values.get(f["name"], 0)
+            flat += list(v) if f["count"] > 1 else [v]
+            if f["count"] > 1 and len(v) != f["count"]:
+                raise ClientError(f"{frame}.{f['name']}: {f['count']} values, not {len(v)}")
+        payload = struct.pack(self.format[frame], *flat)
+        body = bytes([self.code[frame], len(payload)]) + payload
+        return self.sync + body + struct.pack("<H", self.crc16(body))
+
+    def decode(self, frame, payload):
+        v, out = struct.unpack(self.format[frame], payload), {}
+        for f in self.fields[frame]:
+            n = f["count"]
+            out[f["name"]], v = (v[0] if n == 1 else list(v[:n])), v[n:]
+        return out
+
+    def fault_names(self, bits):
+        if bits == 0:
+            return "none"
+        return ",".join(self.faults[i] if i < len(self.faults) else f"bit{i}" for i in range(32) if bits >> i & 1)
+
+
+class Parser:
+    """Hunts for the sync pair, then type, length, payload and CRC; a bad frame is dropped."""
+
+    def __init__(self, protocol):
+        self.p, self.buf = protocol, b""
+
+    def feed(self, data):
+        """The complete, valid frames in the bytes so far, as (type name, payload)."""
+        self.buf += data
+        out = []
+        while True:
+            i = self.buf.find(self.p.sync)
+            if i < 0:
+                self.buf = self.buf[-1:] if self.buf[-1:] == self.p.sync[:1] else b""
+                return out
+            self.buf = self.buf[i:]
+            if len(self.buf) < 4:
+                return out
+            ftype, n = self.buf[2], self.buf[3]
+            if self.p.payload.get(ftype) != n:
+                self.buf = self.buf[2:]  # an unknown type or a wrong length: hunt again after the pair
+                continue
+            if len(self.buf) < 6 + n:
+                return out
+            body, crc = self.buf[2:4 + n], struct.unpack("<H", self.buf[4 + n:6 + n])[0]
+            if self.p.crc16(body) == crc:
+                out.append((self.p.name[ftype], body[2:]))
+                self.buf = self.buf[6 + n:]
+            else:
+                self.buf = self.buf[2:]
+
+
+class Outcome:
+    """What became of a command: status accepted, done, refused, aborted, timeout or error."""
+
+    def __init__(self, status, cid=0, reason="none", cause=0, error="", answer=None, protocol=None):
+        self.status, self.id, self.reason, self.cause, self.error = status, cid, reason, cause, error
+        self.answer, self._p = answer, protocol
+
+    def ok(self):
+        return self.status in ("accepted", "done")
+
+    def text(self):
+        s = self.status
+        if s in ("refused", "aborted"):
+            s += f": {self.reason}"
+        if self.status == "refused" and self.reason == "faulted":
+            s += f" ({self._p.fault_names(self.cause)})"
+        if s == "error":
+            s += f": {self.error}"
+        return s
+
+
+def read_stream_csv(path):
+    """Rows (t, x, y, z, roll, pitch, yaw) in s, m, rad and whether the path has the orientation: the
+    CSV that puma_experiment's scripts and oscctl read (t, x, y, z[, roll, pitch, yaw] in s, m,
+    degrees; a header row and # comments skipped; t from 0, increasing)."""
+    try:
+        with open(path) as f:
+            lines = f.read().splitlines()
+    except OSError:
+        raise ClientError(f"{path}: cannot be read")
+    rows, columns = [], 0
+    for n, line in enumerate(lines, 1):
+        where = f"{path}:{n}: "
+        s = line.strip(" \t\r")
+        if not s or s.startswith("#"):
+            continue
+        try:
+            v = [float(c) for c in s.split(",")]
+        except ValueError:
+            if not rows and columns == 0:
+                columns = -1  # the header
+                continue
+            raise ClientError(where + "not a row of numbers")
+        if len(v) not in (4, 7):
+            raise ClientError(where + f"{len(v)} columns: t, x, y, z[, roll, pitch, yaw] needs 4 or 7")
+        if columns > 0 and len(v) != columns:
+            raise ClientError(where + f"every row needs the same columns ({columns})")
+        columns = len(v)
+        if not all(math.isfinite(x) for x in v):
+            raise ClientError(where + "not a finite number")
+        r = v[:4] + [math.radians(x) for x in v[4:]] + [0.0] * (7 - len(v))
+        if not rows and r[0] != 0:
+            raise ClientError(where + "the path's time starts at 0")
+        if rows and not r[0] > rows[-1][0]:
+            raise ClientError(where + "t must increase from row to row")
+        rows.append(r)
+    if not rows:
+        raise ClientError(f"{path}: no rows (t, x, y, z[, roll, pitch, yaw])")
+    return rows, columns == 7
+
+
+def resample_path(rows, rate_hz):
+    """The path sampled every 1 / rate_hz s from t = 0, linearly between rows; the last sample is the
+    path's end. A list of (position, rpy)."""
+    out, T, end, i, n = [], 1.0 / rate_hz, rows[-1][0], 1, 0
+    while True:
+        t = n * T
+        last = t >= end - 1e-9
+        while i < len(rows) and rows[i][0] < t:
+            i += 1
+        x = rows[-1]
+        if not last:
+            f = (t - rows[i - 1][0]) / (rows[i][0] - rows[i - 1][0])
+            x = [rows[i - 1][c] + f * (rows[i][c] - rows[i - 1][c]) for c in range(7)]
+        out.append((x[1:4], x[4:7]))
+        if last:
+            return out
+        n += 1
+
+
+class Client:
+    """The command protocol over a serial device or pseudo-terminal (raw mode, any baud rate)."""
+
+    HISTORY = 1024
+
+    def __init__(self, port, baud=115200, protocol=None):
+        self.p = protocol or Protocol()
+        try:
+            import serial
+        except ImportError:
+            raise ClientError("pyserial is missing (Debian: apt-get install python3-serial)")
+        self._serial_error = serial.SerialException
+        try:
+            fd = os.open(port, os.O_RDWR | os.O_NOCTTY | os.O_NONBLOCK)
+        except OSError as e:
+            raise ClientError(f"{port}: {e.strerror}")
+        tty = os.isatty(fd)
+        os.close(fd)
+        if not tty:
+            raise ClientError(f"{port}: not a serial device or terminal")
+        try:
+            self.ser = serial.Serial(port, baud, timeout=0)
+            self.ser.reset_input_buffer()  # an earlier client's unread bytes
+        except (serial.SerialException, ValueError, OSError) as e:
+            raise ClientError(f"{port}: {e}")
+        self.port = port
+        self.parser = Parser(self.p)
+        self.next_id = random.randint(1, 2**30)  # unique across clients: no earlier client's answers
+        self.answers, self.latest_state, self.states_seen = [], None, 0
+        self.on_answer = self.on_state = None
+
+    def close(self):
+        self.ser.close()
+
+    # ------------------------------------------------------------------ commands: each returns its id
+    def command(self, verb, position=(0.0, 0.0, 0.0), rpy=None, relative=False, replace=False, limits=None,
+                period=0):
+        """One command frame. rpy [rad] or None; limits: six numbers (linear v, a, j, angular v, a, j) or None."""
+        cid = self.next_id
+        self.next_id = self.next_id % 0xFFFFFFFF + 1
+        flags = ((self.p.command_flag["relative"] if relative else 0) | (self.p.command_flag["has_rpy"] if rpy else 0)
+                 | (self.p.command_flag["replace"] if replace else 0)
+                 | (self.p.command_flag["has_limits"] if limits else 0))
+        self._write(self.p.encode("command", {
+            "id": cid, "verb": self.p.code_of("verbs", verb), "flags": flags, "position": list(position),
+            "rpy": list(rpy or (0.0, 0.0, 0.0)), "limits": list(limits or [0.0] * 6), "period": period}))
+        return cid
+
+    def enable(self):
+        return self.command("enable")
+
+    def disable(self):
+        return self.command("disable")
+
+    def stop(self):
+        return self.command("stop")
+
+    def clear(self):
+        return self.command("clear")
+
+    def paper(self):
+        return self.command("paper")
+
+    def move_to(self, position, rpy=None, relative=False, replace=False, limits=None):
+        return self.command("move_to", position, rpy, relative, replace, limits)
+
+    def limits(self, v=None, a=None, j=None):
+        """Six limits: the linear ones given, the others the configured maxima (None when none given)."""
+        if v is None and a is None and j is None:
+            return None
+        lin = self.p.limits["linear"]
+        return [v or lin[0], a or lin[1], j or lin[2]] + list(self.p.limits["angular"])
+
+    def stream(self, points, has_rpy, rate_hz, relative=False, limits=None, answer_timeout=10):
+        """The stream command, its answer awaited, then one setpoint per period paced by the wall clock,
+        the last with the end flag. The stream command's answer once every setpoint is sent (accepted:
+        wait_done(outcome.id) for its end), or its refusal, an abort while sending, a timeout."""
+        period = 1000.0 / rate_hz
+        if abs(period - round(period)) > 1e-9 or not 1 <= round(period) <= self.p.stream_max_period:
+            raise ClientError(f"rate {rate_hz:g} Hz: 1000 / N Hz for a whole N from 1 to "
+                              f"{self.p.stream_max_period} (1000, 500, 250, 100, 50, 20, 10 ...)")
+        if not points:
+            raise ClientError("a stream needs at least one setpoint")
+        cid = self.command("stream", relative=relative, limits=limits, period=int(round(period)))
+        o = self.wait_answer(cid, answer_timeout)
+        if o.status != "accepted":
+            return o
+        t0, T = time.monotonic(), 1.0 / rate_hz
+        for n, (pos, rpy) in enumerate(points):
+            if self._read_until(t0 + n * T, lambda: self._evaluate(cid, True).status in ("done", "aborted")):
+                return self._evaluate(cid, True)
+            last = n + 1 == len(points)
+            flags = (self.p.setpoint_flag["end"] if last else 0) | (self.p.setpoint_flag["has_rpy"] if has_rpy else 0)
+            self._write(self.p.encode("setpoint", {"id": cid, "flags": flags, "position": list(pos),
+                                                   "rpy": list(rpy) if has_rpy else [0.0] * 3}))
+        return o
+
+    # ------------------------------------------------------------------ answers and state
+    def state(self, timeout=5.0):
+        """The latest state frame (a dict), received after this call; None on a timeout."""
+        seen = self.states_seen
+        return self.latest_state if self._read_until(time.monotonic() + timeout, lambda: self.states_seen > seen) \
+            else None
+
+    def wait_answer(self, cid, timeout=10.0):
+        """accepted or refused (or timeout)."""
+        box = [None]
+
+        def decided():
+            box[0] = self._evaluate(cid, False)
+            return box[0].status != "timeout"
+        self._read_until(time.monotonic() + timeout, decided)
+        return box[0]
+
+    def wait_done(self, cid, timeout=120.0):
+        """A motion done at rest or aborted (the reason); a stop or disable done at rest; any other
+        command done once accepted; refused (the reason); or timeout."""
+        box = [None]
+
+        def decided():
+            box[0] = self._evaluate(cid, True)
+            return box[0].status not in ("timeout", "accepted")
+        self._read_until(time.monotonic() + timeout, decided)
+        if box[0].status == "accepted":
+            box[0].status = "timeout"
+        return box[0]
+
+    def pump(self, timeout):
+        """Reads and dispatches frames (on_answer, on_state) for timeout seconds."""
+        self._read_until(time.monotonic() + timeout, lambda: False)
+
+    # ------------------------------------------------------------------ inside
+    def _write(self, data):
+        try:
+            self.ser.write(data)
+        except (self._serial_error, OSError) as e:
+            raise ClientError(f"{self.port}: {e}")
+
+    def _read_until(self, deadline, done):
+        while not done():
+            left = deadline - time.monotonic()
+            if left <= 0:
+                return False
+            try:
+                ready = select.select([self.ser.fileno()], [], [], min(left, 0.05))[0]
+                data = self.ser.read(4096) if ready else b""
+            except (self._serial_error, OSError):
+                raise ClientError(f"{self.port}: hung up (the board or the simulator has gone)")
+            for frame, payload in self.parser.feed(data):
+                self._dispatch(frame, payload)
+        return True
+
+    def _dispatch(self, frame, payload):
+        if frame == "answer":
+            a = self.p.decode("answer", payload)
+            self.answers = (self.answers + [a])[-self.HISTORY:]
+            if self.on_answer:
+                self.on_answer(a)
+        elif frame == "state":
+            self.latest_state = self.p.decode("state", payload)
+            self.states_seen += 1
+            if self.on_state:
+                self.on_state(self.latest_state)
+
+    def _evaluate(self, cid, until_done):
+        """The command's answer and end as far as the answers so far tell (timeout: not yet)."""
+        name = self.p.name_of
+        motion_verbs = {self.p.code_of("verbs", v) for v in ("move_to", "paper", "stream")}
+        accepted = wait_rest = motion = False
+        o = Outcome("timeout", cid, protocol=self.p)
+        for a in self.answers:
+            if not accepted:
+                if a["id"] != cid or name("outcomes", a["outcome"]) == "none":
+                    continue
+                o.answer = a
+                if name("outcomes", a["outcome"]) == "refused":
+                    o.status, o.reason, o.cause = "refused", name("reasons", a["refusal"]), a["cause"]
+                    return o
+                accepted, o.status = True, "accepted"
+                if not until_done:
+                    return o
+                motion = a["verb"] in motion_verbs
+                wait_rest = not motion and name("motion_states", a["state"]) == "stopping"
+                if not motion and not wait_rest or motion and a["done_id"] == cid:
+                    o.status = "done"
+                    return o
+                if motion and a["aborted_id"] == cid and name("reasons", a["abort"]) != "none":
+                    o.status, o.reason = "aborted", name("reasons", a["abort"])
+                    return o
+                continue
+            if wait_rest and name("completions", a["completion"]) != "none" or motion and a["done_id"] == cid:
+                o.answer, o.status = a, "done"
+                return o
+            # An abort after ours was accepted ends it too: the running motion, or the one it queued behind.
+            if motion and name("reasons", a["abort"]) != "none":
+                o.answer, o.status, o.reason = a, "aborted", name("reasons", a["abort"])
+                return o
+        return o
+
+    # ------------------------------------------------------------------ text, as oscctl prints it
+    def state_text(self, s):
+        n = self.p.name_of
+
+        def pose(x):
+            d = [math.degrees(v) for v in x[3:]]
+            return f"{x[0]:.4f} {x[1]:.4f} {x[2]:.4f} m, rpy {d[0]:.2f} {d[1]:.2f} {d[2]:.2f} deg"
+        return (f"state: {n('motion_states', s['state'])}\nstop: {n('stop_categories', s['stop'])}\n"
+                f"faults: {self.p.fault_names(s['faults'])}\nqueued: {s['queued']}\nrunning_id: {s['running_id']}\n"
+                f"reference: {pose(s['x_d'])}\nmeasured: {pose(s['x'])}\ndropped: {s['dropped']}\n"
+                f"tick: {s['tick']}\n")
+
+    def answer_text(self, a):
+        n = self.p.name_of
+        t = f"tick {a['tick']}:"
+        if n("outcomes", a["outcome"]) != "none":
+            t += f" {n('verbs', a['verb'])} {a['id']} {n('outcomes', a['outcome'])}"
+            if n("outcomes", a["outcome"]) == "refused":
+                t += f": {n('reasons', a['refusal'])}"
+            if a["cause"]:
+                t += f" ({self.p.fault_names(a['cause'])})"
+            t += ";"
+        if a["done_id"]:
+            t += f" done {a['done_id']};"
+        if n("reasons", a["abort"]) != "none":
+            t += f" aborted {a['aborted_id']}: {n('reasons', a['abort'])};"
+        if n("completions", a["completion"]) != "none":
+            t += f" completion {n('completions', a['completion'])};"
+        return t + f" state {n('motion_states', a['state'])}, queued {a['queued']}"
+
+
+# ---------------------------------------------------------------------- the command line (oscctl's verbs)
+def report(o):
+    print(o.text(), flush=True)
+    return 0 if o.ok() else 2 if o.status == "error" else 1
+
+
+def cmd_simple(c, a):
+    cid = c.command(a.verb)
+    o = c.wait_answer(cid, a.timeout)
+    rc = report(o)
+    if o.status != "accepted":
+        return rc
+    if c.p.name_of("reasons", o.answer["abort"]) != "none":
+        print(f"aborted {o.answer['aborted_id']}: {c.p.name_of('reasons', o.answer['abort'])}", flush=True)
+    if a.verb not in ("stop", "disable"):
+        return rc
+    return report(c.wait_done(cid, a.timeout))
+
+
+def cmd_move(c, a):
+    cid = c.move_to(a.xyz, [math.radians(x) for x in a.rpy] if a.rpy else None, a.relative, a.replace,
+                    c.limits(a.v, a.a, a.j))
+    o = c.wait_answer(cid, a.timeout)
+    print(f"{o.text()} (id {cid})", flush=True)
+    if o.status != "accepted" or a.no_wait:
+        return 0 if o.ok() else 1
+    return report(c.wait_done(cid, a.timeout))
+
+
+def cmd_stream(c, a):
+    rows, has_rpy = read_stream_csv(a.file)
+    o = c.stream(resample_path(rows, a.rate), has_rpy, a.rate, a.relative, c.limits(a.v, a.a, a.j), a.timeout)
+    print(f"{o.text()} (id {o.id})", flush=True)
+    if o.status != "accepted":
+        return 0 if o.ok() else 1
+    return report(c.wait_done(o.id, a.timeout))
+
+
+def cmd_state(c, a):
+    s = c.state(min(a.timeout, 10.0))
+    if s is None:
+        print("osc_client: no state frame within the time (is a controller on the port?)", file=sys.stderr)
+        return 1
+    print(c.state_text(s), end="")
+    return 0
+
+
+def cmd_watch(c, a):
+    last = {}
+
+    def on_state(s):
+        keys = ("state", "stop", "faults", "queued", "running_id")
+        if last and all(s[k] == last[k] for k in keys):
+            return
+        n = c.p.name_of
+        print(f"tick {s['tick']}: state {n('motion_states', s['state'])}, stop {n('stop_categories', s['stop'])}, "
+              f"faults {c.p.fault_names(s['faults'])}, queued {s['queued']}, running_id {s['running_id']}", flush=True)
+        last.update(s)
+    c.on_answer = lambda f: print(c.answer_text(f), flush=True)
+    c.on_state = on_state
+    try:
+        c.pump(a.seconds if a.seconds else float("inf"))
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+def positive(text):
+    v = float(text)
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"{text}: must be above 0")
+    return v
+
+
+def parser():
+    ap = argparse.ArgumentParser(prog="osc_client.py", description=__doc__.split("\n")[0] + " Exit status 0: "
+                                 "accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port "
+                                 "or file.")
+    ap.add_argument("--port", required=True, help="the serial device or pseudo-terminal (e.g. /dev/pts/7)")
+    ap.add_argument("--baud", type=int, default=115200, help="baud rate of a serial device (default 115200)")
+    ap.add_argument("--timeout", type=positive, default=120.0, help="seconds to wait for an answer or an end")
+    sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
+    for v in ("state", "enable", "disable", "clear", "paper", "stop"):
+        sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")
+
+    def limits(p):
+        p.add_argument("--v", type=positive, help="linear speed limit [m/s]")
+        p.add_argument("--a", type=positive, help="linear acceleration limit [m/s^2]")
+        p.add_argument("--j", type=positive, help="linear jerk limit [m/s^3]")
+        p.add_argument("--relative", action="store_true", help="offsets from where the queue ends (or the stream "
+                       "starts)")
+    m = sub.add_parser("move", help="a jerk-limited move_to of the wrist centre; waits until done")
+    m.add_argument("xyz", type=float, nargs=3, metavar="X/Y/Z", help="X Y Z [m], base frame")
+    m.add_argument("--rpy", type=float, nargs=3, metavar=("R", "P", "Y"), help="roll pitch yaw [deg]")
+    m.add_argument("--replace", action="store_true", help="re-target the running motion instead of queueing")
+    m.add_argument("--no-wait", action="store_true", help="return once accepted")
+    limits(m)
+    s = sub.add_parser("stream", help="stream a CSV path (t, x, y, z[, roll, pitch, yaw] in s, m, deg)")
+    s.add_argument("file")
+    s.add_argument("--rate", type=positive, required=True, help="setpoints per second: 1000 / N, N from 1 to 100")
+    limits(s)
+    w = sub.add_parser("watch", help="print state changes and every answer")
+    w.add_argument("--seconds", type=positive, help="for this long (default: until interrupted)")
+    return ap
+
+
+def main(argv):
+    ap = parser()
+    a = ap.parse_args(argv)  # a bad command line: argparse's message, exit status 2
+    if a.verb == "move" and not all(math.isfinite(x) for x in a.xyz + (a.rpy or [])):
+        ap.error("move: X Y Z and --rpy must be finite numbers")
+    if not 50 <= a.baud <= 4000000:
+        ap.error(f"--baud {a.baud}: 50 to 4000000")
+    try:
+        if a.verb == "stream":
+            read_stream_csv(a.file)  # a bad file before the port is touched
+        c = Client(a.port, a.baud)
+        verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch}
+        return verbs.get(a.verb, cmd_simple)(c, a)
+    except ClientError as e:
+        print(f"osc_client: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,404 @@
+#include "osc_client.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <thread>
+
+#include "osc/control/faults.hpp"
+
+namespace osc::client {
+
+bool set_custom_baud(int fd, int baud);  // serial_baud.cpp: termios2, apart from <termios.h>
+
+namespace {
+
+constexpr std::size_t kHistory = 1024;  // answers kept for wait_answer / wait_done
+
+double now_s() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+/// The termios code of a standard baud rate (B0: none).
+speed_t standard_baud(int baud) {
+  static const struct {
+    int baud;
+    speed_t code;
+  } kRates[] = {
+      {50, B50},           {75, B75},           {110, B110},         {134, B134},         {150, B150},
+      {200, B200},         {300, B300},         {600, B600},         {1200, B1200},       {1800, B1800},
+      {2400, B2400},       {4800, B4800},       {9600, B9600},       {19200, B19200},     {38400, B38400},
+      {57600, B57600},     {115200, B115200},   {230400, B230400},   {460800, B460800},   {500000, B500000},
+      {576000, B576000},   {921600, B921600},   {1000000, B1000000}, {1152000, B1152000}, {1500000, B1500000},
+      {2000000, B2000000}, {2500000, B2500000}, {3000000, B3000000}, {3500000, B3500000}, {4000000, B4000000}};
+  for (const auto& r : kRates)
+    if (r.baud == baud) return r.code;
+  return B0;
+}
+
+bool motion_verb(std::uint8_t v) {
+  return v == static_cast<std::uint8_t>(MotionVerb::kMoveTo) || v == static_cast<std::uint8_t>(MotionVerb::kPaper) ||
+         v == static_cast<std::uint8_t>(MotionVerb::kStream);
+}
+
+template <class E>
+const char* name_of(std::uint8_t code) {
+  return motion_name(static_cast<E>(code));
+}
+
+std::string pose_text(const float x[6]) {
+  char buf[160];
+  constexpr double kDeg = 180.0 / kPi;
+  std::snprintf(buf, sizeof buf, "%.4f %.4f %.4f m, rpy %.2f %.2f %.2f deg", x[0], x[1], x[2], x[3] * kDeg, x[4] * kDeg,
+                x[5] * kDeg);
+  return buf;
+}
+
+}  // namespace
+
+// ------------------------------------------------------------------------------------------ transport
+
+std::unique_ptr<SerialTransport> SerialTransport::open(const std::string& path, int baud, std::string& err) {
+  if (baud < 50 || baud > 4000000) return err = "baud " + std::to_string(baud) + ": 50 to 4000000", nullptr;
+  const int fd = ::open(path.c_str(), O_RDWR | O_NOCTTY | O_NONBLOCK);
+  if (fd < 0) return err = path + ": " + std::strerror(errno), nullptr;
+  termios t{};
+  if (!isatty(fd) || tcgetattr(fd, &t) != 0) {
+    close(fd);
+    return err = path + ": not a serial device or terminal", nullptr;
+  }
+  cfmakeraw(&t);
+  t.c_cflag |= CLOCAL | CREAD;
+  t.c_cflag &= ~(CSTOPB | CRTSCTS);
+  t.c_cc[VMIN] = 0;
+  t.c_cc[VTIME] = 0;
+  const speed_t code = standard_baud(baud);
+  if (code != B0) cfsetspeed(&t, code);
+  bool ok = tcsetattr(fd, TCSANOW, &t) == 0;
+  if (ok && code == B0) ok = set_custom_baud(fd, baud);
+  if (!ok) {
+    const std::string why = std::strerror(errno);
+    close(fd);
+    return err = path + ": cannot set raw mode at " + std::to_string(baud) + " baud: " + why, nullptr;
+  }
+  tcflush(fd, TCIOFLUSH);  // an earlier client's unread bytes
+  return std::unique_ptr<SerialTransport>(new SerialTransport(fd, path));
+}
+
+SerialTransport::~SerialTransport() { close(fd_); }
+
+int SerialTransport::read(std::uint8_t* buf, int n, double timeout_s) {
+  pollfd p{fd_, POLLIN, 0};
+  const double t = std::max(0.0, timeout_s);
+  const timespec ts{static_cast<time_t>(t), static_cast<long>((t - std::floor(t)) * 1e9)};
+  const int r = ppoll(&p, 1, &ts, nullptr);
+  if (r < 0 && errno == EINTR) return 0;
+  if (r < 0) return error_ = path_ + ": " + std::strerror(errno), -1;
+  if (r == 0) return 0;
+  const ssize_t k = ::read(fd_, buf, static_cast<std::size_t>(n));
+  if (k > 0) return static_cast<int>(k);
+  if (k < 0 && (errno == EAGAIN || errno == EINTR)) return 0;
+  error_ = path_ + (k == 0 || errno == EIO ? ": hung up (the board or the simulator has gone)"
+                                           : ": " + std::string(std::strerror(errno)));
+  return -1;
+}
+
+bool SerialTransport::write(const std::uint8_t* buf, int n) {
+  while (n > 0) {
+    const ssize_t k = ::write(fd_, buf, static_cast<std::size_t>(n));
+    if (k > 0) {
+      buf += k, n -= static_cast<int>(k);
+      continue;
+    }
+    if (k < 0 && errno != EAGAIN && errno != EINTR) return error_ = path_ + ": " + std::strerror(errno), false;
+    pollfd p{fd_, POLLOUT, 0};
+    if (::poll(&p, 1, 1000) == 0) return error_ = path_ + ": cannot write (nothing reads the other end)", false;
+  }
+  return true;
+}
+
+// ------------------------------------------------------------------------------------------ text
+
+const char* status_name(Status s) {
+  switch (s) {
+    case Status::kAccepted:
+      return "accepted";
+    case Status::kDone:
+      return "done";
+    case Status::kRefused:
+      return "refused";
+    case Status::kAborted:
+      return "aborted";
+    case Status::kTimeout:
+      return "timeout";
+    case Status::kError:
+      return "error";
+  }
+  return "?";
+}
+
+std::string Outcome::text() const {
+  std::string s = status_name(status);
+  if (status == Status::kRefused || status == Status::kAborted) s += std::string(": ") + motion_name(reason);
+  if (status == Status::kRefused && reason == MotionReason::kFaulted) s += " (" + fault_names(cause) + ")";
+  if (status == Status::kError) s += ": " + error;
+  return s;
+}
+
+std::string fault_names(std::uint32_t bits) {
+  if (bits == 0) return "none";
+  std::string s;
+  for (int i = 0; i < 32; ++i) {
+    if (!(bits & (1u << i))) continue;
+    if (!s.empty()) s += ",";
+    s += i < kFaultCount ? kFaultNames[i] : "bit" + std::to_string(i);
+  }
+  return s;
+}
+
+std::string state_text(const pil::StateFrame& s) {
+  std::string t;
+  t += std::string("state: ") + name_of<MotionState>(s.state) + "\n";
+  t += std::string("stop: ") + name_of<StopCategory>(s.stop) + "\n";
+  t += "faults: " + fault_names(s.faults) + "\n";
+  t += "queued: " + std::to_string(s.queued) + "\n";
+  t += "running_id: " + std::to_string(s.running_id) + "\n";
+  t += "reference: " + pose_text(s.x_d) + "\n";
+  t += "measured: " + pose_text(s.x) + "\n";
+  t += "dropped: " + std::to_string(s.dropped) + "\n";
+  t += "tick: " + std::to_string(s.tick) + "\n";
+  return t;
+}
+
+std::string answer_text(const pil::AnswerFrame& a) {
+  // Appended piece by piece: GCC 12's -Wrestrict misreads chained string concatenations.
+  std::string t = "tick ";
+  t += std::to_string(a.tick);
+  t += ":";
+  if (a.outcome != static_cast<std::uint8_t>(CommandOutcome::kNone)) {
+    t += " ";
+    t += name_of<MotionVerb>(a.verb);
+    t += " ";
+    t += std::to_string(a.id);
+    t += " ";
+    t += name_of<CommandOutcome>(a.outcome);
+    if (a.outcome == static_cast<std::uint8_t>(CommandOutcome::kRefused)) {
+      t += ": ";
+      t += name_of<MotionReason>(a.refusal);
+    }
+    if (a.cause != 0) {
+      t += " (";
+      t += fault_names(a.cause);
+      t += ")";
+    }
+    t += ";";
+  }
+  if (a.done_id != 0) {
+    t += " done ";
+    t += std::to_string(a.done_id);
+    t += ";";
+  }
+  if (a.abort != static_cast<std::uint8_t>(MotionReason::kNone)) {
+    t += " aborted ";
+    t += std::to_string(a.aborted_id);
+    t += ": ";
+    t += name_of<MotionReason>(a.abort);
+    t += ";";
+  }
+  if (a.completion != static_cast<std::uint8_t>(MotionCompletion::kNone)) {
+    t += " completion ";
+    t += name_of<MotionCompletion>(a.completion);
+    t += ";";
+  }
+  t += " state ";
+  t += name_of<MotionState>(a.state);
+  t += ", queued ";
+  t += std::to_string(a.queued);
+  return t;
+}
+
+std::vector<StreamPoint> resample_path(const std::vector<std::array<double, 7>>& rows, double rate_hz) {
+  std::vector<StreamPoint> out;
+  if (rows.empty() || !(rate_hz > 0)) return out;
+  const double T = 1.0 / rate_hz, end = rows.back()[0];
+  std::size_t i = 1;
+  for (long n = 0;; ++n) {
+    const double t = static_cast<double>(n) * T;
+    const bool last = t >= end - 1e-9;
+    while (i < rows.size() && rows[i][0] < t) ++i;
+    std::array<double, 7> x = rows.back();
+    if (!last) {
+      const double f = (t - rows[i - 1][0]) / (rows[i][0] - rows[i - 1][0]);
+      for (int c = 1; c < 7; ++c) x[c] = rows[i - 1][c] + f * (rows[i][c] - rows[i - 1][c]);
+    }
+    StreamPoint p;
+    p.position = Vec3<double>(x[1], x[2], x[3]);
+    p.rpy = Vec3<double>(x[4], x[5], x[6]);
+    out.push_back(p);
+    if (last) return out;
+  }
+}
+
+// ------------------------------------------------------------------------------------------ client
+
+Client::Client(std::unique_ptr<Transport> transport) : t_(std::move(transport)) {
+  // Ids unique across clients of one controller: a new client's answers are never an earlier one's.
+  std::random_device rd;
+  next_id_ = (rd() & 0x3FFFFFFFu) + 1;
+}
+
+bool Client::send(const std::uint8_t* buf, int n) {
+  if (t_->write(buf, n)) return true;
+  error_ = t_->error();
+  return false;
+}
+
+std::uint32_t Client::command(MotionVerb verb, const MoveRequest<double>& req) {
+  const std::uint32_t id = next_id_++;
+  if (next_id_ == 0) next_id_ = 1;
+  std::uint8_t buf[pil::kMaxFrame];
+  return send(buf, encode_command(id, verb, req, buf)) ? id : 0;
+}
+
+void Client::dispatch() {
+  pil::AnswerFrame a;
+  pil::StateFrame s;
+  if (parser_.decode(a)) {
+    answers_.push_back(a);
+    if (answers_.size() > kHistory) answers_.pop_front();
+    if (on_answer) on_answer(a);
+  } else if (parser_.decode(s)) {
+    state_ = s;
+    ++states_seen_;
+    if (on_state) on_state(s);
+  }
+}
+
+bool Client::read_until(double deadline, const std::function<bool()>& done) {
+  std::uint8_t buf[256];
+  while (!done()) {
+    const double left = deadline - now_s();
+    if (left <= 0) return false;
+    const int n = t_->read(buf, sizeof buf, std::min(left, 0.05));
+    if (n < 0) return error_ = t_->error(), false;
+    for (int i = 0; i < n; ++i)
+      if (parser_.feed(buf[i]) == pil::Parser::kFrame) dispatch();
+  }
+  return true;
+}
+
+bool Client::pump(double timeout_s) {
+  read_until(now_s() + timeout_s, [] { return false; });
+  return error_.empty();
+}
+
+std::optional<pil::StateFrame> Client::state(double timeout_s) {
+  const std::uint64_t seen = states_seen_;
+  if (!read_until(now_s() + timeout_s, [&] { return states_seen_ > seen; })) return std::nullopt;
+  return state_;
+}
+
+Outcome Client::evaluate(std::uint32_t id, bool until_done) const {
+  Outcome o;
+  o.id = id;
+  bool accepted = false, wait_rest = false, motion = false;
+  for (const pil::AnswerFrame& a : answers_) {
+    if (!accepted) {
+      if (a.id != id || a.outcome == static_cast<std::uint8_t>(CommandOutcome::kNone)) continue;
+      o.answer = a;
+      if (a.outcome == static_cast<std::uint8_t>(CommandOutcome::kRefused)) {
+        o.status = Status::kRefused, o.reason = static_cast<MotionReason>(a.refusal), o.cause = a.cause;
+        return o;
+      }
+      accepted = true;
+      o.status = Status::kAccepted;
+      if (!until_done) return o;
+      motion = motion_verb(a.verb);
+      wait_rest = !motion && a.state == static_cast<std::uint8_t>(MotionState::kStopping);
+      if (!motion && !wait_rest) return o.status = Status::kDone, o;
+      if (motion && a.done_id == id) return o.status = Status::kDone, o;
+      if (motion && a.aborted_id == id && a.abort != 0)
+        return o.status = Status::kAborted, o.reason = static_cast<MotionReason>(a.abort), o;
+      continue;
+    }
+    if (wait_rest && a.completion != static_cast<std::uint8_t>(MotionCompletion::kNone))
+      return o.answer = a, o.status = Status::kDone, o;
+    if (motion && a.done_id == id) return o.answer = a, o.status = Status::kDone, o;
+    // An abort after ours was accepted ends it too: the running motion, or the one it queued behind
+    // (a stop, a re-target and a fault drop the waiting moves with the running one).
+    if (motion && a.abort != static_cast<std::uint8_t>(MotionReason::kNone))
+      return o.answer = a, o.status = Status::kAborted, o.reason = static_cast<MotionReason>(a.abort), o;
+  }
+  o.status = Status::kTimeout;
+  return o;
+}
+
+Outcome Client::wait_answer(std::uint32_t id, double timeout_s) {
+  Outcome o;
+  read_until(now_s() + timeout_s, [&] { return (o = evaluate(id, false)).status != Status::kTimeout; });
+  if (o.status == Status::kTimeout && !error_.empty()) o.status = Status::kError, o.error = error_;
+  return o;
+}
+
+Outcome Client::wait_done(std::uint32_t id, double timeout_s) {
+  Outcome o;
+  read_until(now_s() + timeout_s, [&] {
+    o = evaluate(id, true);
+    return o.status != Status::kTimeout && o.status != Status::kAccepted;
+  });
+  if ((o.status == Status::kTimeout || o.status == Status::kAccepted) && !error_.empty())
+    o.status = Status::kError, o.error = error_;
+  else if (o.status == Status::kAccepted)
+    o.status = Status::kTimeout;
+  return o;
+}
+
+Outcome Client::stream(const std::vector<StreamPoint>& points, bool has_rpy, double rate_hz, bool relative,
+                       const CartesianLimits<double>* limits, double answer_timeout_s) {
+  Outcome o;
+  const double period = 1000.0 / rate_hz;
+  const long ms = std::lround(period);
+  if (!(rate_hz > 0) || std::fabs(period - static_cast<double>(ms)) > 1e-9 || ms < 1 || ms > pil::kStreamMaxPeriod) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "rate %g Hz: 1000 / N Hz for a whole N from 1 to %d (1000, 500, 250, 100, 50, 20, 10 ...)", rate_hz,
+                  pil::kStreamMaxPeriod);
+    o.status = Status::kError;
+    o.error = buf;
+    return o;
+  }
+  if (points.empty()) return o.status = Status::kError, o.error = "a stream needs at least one setpoint", o;
+  MoveRequest<double> req;
+  req.period = static_cast<std::uint32_t>(ms);
+  req.relative = relative;
+  if (limits) req.has_limits = true, req.limits = *limits;
+  const std::uint32_t id = command(MotionVerb::kStream, req);
+  if (id == 0) return o.status = Status::kError, o.error = error_, o;
+  o = wait_answer(id, answer_timeout_s);
+  if (o.status != Status::kAccepted) return o;
+  const double t0 = now_s(), T = 1.0 / rate_hz;
+  for (std::size_t n = 0; n < points.size(); ++n) {
+    // Until this setpoint's time: the answers meanwhile (a stop, a stale stream end it).
+    const bool ended = read_until(t0 + static_cast<double>(n) * T, [&] {
+      const Outcome e = evaluate(id, true);
+      return e.status == Status::kAborted || e.status == Status::kDone;
+    });
+    if (!error_.empty()) return o.status = Status::kError, o.error = error_, o;
+    if (ended) return evaluate(id, true);
+    const bool last = n + 1 == points.size();
+    const pil::SetpointFrame f =
+        setpoint_frame<double>(id, points[n].position, has_rpy ? &points[n].rpy : nullptr, last);
+    std::uint8_t buf[pil::kMaxFrame];
+    if (!send(buf, pil::encode(f, buf))) return o.status = Status::kError, o.error = error_, o;
+  }
+  return o;
+}
+
+}  // namespace osc::client

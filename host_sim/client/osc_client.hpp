@@ -1,0 +1,165 @@
+// A client of the command protocol (docs/protocol.md, "The command protocol"; docs/motion.md,
+// "Clients"): commands to a controller, its answers and state frames back, over any byte transport
+// (a serial line, the simulator's pseudo-terminal: osc_sim --pty). The frames, their encoding and
+// the names of every code are the firmware's own (osc/link/frames.hpp, commands.hpp,
+// osc/runtime/motion_states.hpp): nothing is declared twice.
+//
+//   auto t = osc::client::SerialTransport::open("/dev/pts/7", 115200, err);
+//   osc::client::Client c(std::move(t));
+//   c.wait_answer(c.enable(), 10);
+//   osc::MoveRequest<double> m;
+//   m.position = {0, 0.02, 0};
+//   m.relative = true;
+//   const osc::client::Outcome o = c.wait_done(c.move_to(m), 60);   // o.text(): "done", "aborted: stop_command"
+//
+// No function throws: a transport that fails gives Status::kError with the transport's message
+// (error()), a command not sent gives id 0.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "osc/link/commands.hpp"
+
+namespace osc::client {
+
+/// A byte stream to the controller.
+class Transport {
+ public:
+  virtual ~Transport() = default;
+  /// Reads up to n bytes, waiting at most timeout_s for the first: the count, 0 when none came in
+  /// time, -1 on an error (error() names it).
+  virtual int read(std::uint8_t* buf, int n, double timeout_s) = 0;
+  /// Writes all n bytes; false on an error (error() names it).
+  virtual bool write(const std::uint8_t* buf, int n) = 0;
+  const std::string& error() const { return error_; }
+
+ protected:
+  std::string error_;
+};
+
+/// A serial device or a pseudo-terminal in raw mode: 8 data bits, no parity, one stop bit, no flow
+/// control, any baud rate (the standard ones through termios, others through termios2). Bytes
+/// waiting when it opens are dropped (an earlier client's).
+class SerialTransport : public Transport {
+ public:
+  /// nullptr on failure, with err naming the path and the reason.
+  static std::unique_ptr<SerialTransport> open(const std::string& path, int baud, std::string& err);
+  ~SerialTransport() override;
+  SerialTransport(const SerialTransport&) = delete;
+  SerialTransport& operator=(const SerialTransport&) = delete;
+  int read(std::uint8_t* buf, int n, double timeout_s) override;
+  bool write(const std::uint8_t* buf, int n) override;
+
+ private:
+  SerialTransport(int fd, std::string path) : fd_(fd), path_(std::move(path)) {}
+  int fd_;
+  std::string path_;
+};
+
+/// What became of a command.
+enum class Status : std::uint8_t {
+  kAccepted,  ///< answered: accepted (wait_answer)
+  kDone,      ///< a motion reached its target at rest; any other command accepted (and at rest after a stop)
+  kRefused,   ///< refused: reason (cause: the fault bits behind faulted)
+  kAborted,   ///< its motion was aborted: reason
+  kTimeout,   ///< no decision within the time
+  kError,     ///< the transport failed, or the request was bad (error)
+};
+const char* status_name(Status s);
+
+struct Outcome {
+  Status status = Status::kTimeout;
+  std::uint32_t id = 0;
+  MotionReason reason = MotionReason::kNone;
+  std::uint32_t cause = 0;
+  std::string error;
+  pil::AnswerFrame answer{};  ///< the answer that decided it (kAccepted, kDone, kRefused, kAborted)
+  bool ok() const { return status == Status::kAccepted || status == Status::kDone; }
+  /// "accepted", "done", "refused: not_enabled", "aborted: stop_command", "timeout", "error: ...".
+  std::string text() const;
+};
+
+/// One setpoint of a stream: the wrist centre [m] and roll, pitch, yaw [rad] (base frame; offsets
+/// with a relative stream).
+struct StreamPoint {
+  Vec3<double> position = Vec3<double>::Zero();
+  Vec3<double> rpy = Vec3<double>::Zero();
+};
+
+/// A path's rows (t [s], x, y, z [m], roll, pitch, yaw [rad], as sim::read_stream_csv reads them)
+/// sampled every 1 / rate_hz s from t = 0, linearly between rows; the last sample is the path's end.
+std::vector<StreamPoint> resample_path(const std::vector<std::array<double, 7>>& rows, double rate_hz);
+
+/// The names of fault bits ("none", or "tracking,estop"; a bit outside the catalogue "bitN").
+std::string fault_names(std::uint32_t bits);
+/// A state frame as lines: state, stop, faults, queued, running id, reference and measured pose.
+std::string state_text(const pil::StateFrame& s);
+/// An answer frame as one line: the command answered, a motion done or aborted, a completion.
+std::string answer_text(const pil::AnswerFrame& a);
+
+class Client {
+ public:
+  explicit Client(std::unique_ptr<Transport> transport);
+
+  // Each sends one command frame and returns its id (nonzero); 0 when it could not be sent (error()).
+  std::uint32_t enable() { return command(MotionVerb::kEnable); }
+  std::uint32_t disable() { return command(MotionVerb::kDisable); }
+  std::uint32_t stop() { return command(MotionVerb::kStop); }
+  std::uint32_t clear() { return command(MotionVerb::kClear); }
+  std::uint32_t paper() { return command(MotionVerb::kPaper); }
+  std::uint32_t move_to(const MoveRequest<double>& req) { return command(MotionVerb::kMoveTo, req); }
+  std::uint32_t command(MotionVerb verb, const MoveRequest<double>& req = {});
+
+  /// A stream: the stream command (period 1000 / rate_hz ms, a whole number from 1 to 100; relative;
+  /// limits when given), its answer awaited, then one setpoint frame per period paced by the wall
+  /// clock, the last with the end flag (rpy sent when has_rpy). Returns the stream command's answer
+  /// once every setpoint is sent (kAccepted: wait_done(outcome.id) for its end), or its refusal, its
+  /// abort while the setpoints went out (e.g. a stop), a timeout or an error.
+  Outcome stream(const std::vector<StreamPoint>& points, bool has_rpy, double rate_hz, bool relative,
+                 const CartesianLimits<double>* limits = nullptr, double answer_timeout_s = 10);
+
+  /// The latest state frame, received after this call (waiting up to timeout_s); nullopt on a
+  /// timeout or an error (error()).
+  std::optional<pil::StateFrame> state(double timeout_s = 5);
+  /// The command's answer: kAccepted or kRefused (or kTimeout, kError).
+  Outcome wait_answer(std::uint32_t id, double timeout_s);
+  /// The command's end: a motion (move_to, paper, stream) kDone when it reached its target at rest,
+  /// kAborted with the reason when it (or the running motion it queued behind) was aborted; a stop
+  /// or a disable that stops a motion kDone at rest; any other command kDone once accepted; kRefused
+  /// with the reason; or kTimeout, kError.
+  Outcome wait_done(std::uint32_t id, double timeout_s);
+
+  /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.
+  bool pump(double timeout_s);
+  std::function<void(const pil::AnswerFrame&)> on_answer;
+  std::function<void(const pil::StateFrame&)> on_state;
+
+  /// The last transport error ("" for none).
+  const std::string& error() const { return error_; }
+
+ private:
+  bool send(const std::uint8_t* buf, int n);
+  /// Reads frames until done() or the deadline (steady clock, seconds); false at the deadline or on
+  /// an error.
+  bool read_until(double deadline, const std::function<bool()>& done);
+  void dispatch();
+  /// The command's answer and end as far as the answers so far tell (kTimeout: not yet).
+  Outcome evaluate(std::uint32_t id, bool until_done) const;
+
+  std::unique_ptr<Transport> t_;
+  pil::Parser parser_;
+  std::uint32_t next_id_;
+  std::deque<pil::AnswerFrame> answers_;  // the last kHistory answers
+  std::optional<pil::StateFrame> state_;
+  std::uint64_t states_seen_ = 0;
+  std::string error_;
+};
+
+}  // namespace osc::client

@@ -1,0 +1,257 @@
+// oscctl: commands a controller over the command protocol (docs/motion.md, "Clients"), on a serial
+// device or the simulator's pseudo-terminal (osc_sim --pty):
+//
+//   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop
+//   oscctl --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
+//   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--relative] [--v V --a A --j J]
+//   oscctl --port /dev/pts/7 watch [--seconds S]
+//
+// Each command prints its outcome, one line each: "accepted" or "refused: REASON"; then, for a move,
+// a stream, a stop or a disable it waits for, "done" or "aborted: REASON" (a stop prints the motion it
+// aborted first: "aborted ID: stop_command"). Exit status 0 when accepted or done, 1 when refused,
+// aborted or timed out, 2 for a bad command line, port or file.
+#include <signal.h>
+
+#include <CLI/CLI.hpp>
+
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "motion_script.hpp"
+#include "osc_client.hpp"
+
+namespace {
+
+using osc::client::Client;
+using osc::client::Outcome;
+using osc::client::Status;
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_signal(int) { g_stop = 1; }
+
+struct Args {
+  std::string port, verb, csv;
+  int baud = 115200;
+  double timeout = 120;
+  std::vector<double> xyz, rpy;
+  bool relative = false, replace = false, no_wait = false;
+  double v = 0, a = 0, j = 0, rate = 0, seconds = 0;
+  std::vector<std::array<double, 7>> rows;  // stream: the path
+  bool has_rpy = false;
+};
+
+constexpr double kDeg = osc::kPi / 180.0;
+
+int exit_of(const Outcome& o) { return o.ok() ? 0 : o.status == Status::kError ? 2 : 1; }
+
+/// Prints an outcome; its exit status.
+int report(const Outcome& o) {
+  std::printf("%s\n", o.text().c_str());
+  std::fflush(stdout);
+  return exit_of(o);
+}
+
+/// The limits of --v --a --j over the configured maxima (those not given keep theirs).
+bool limits_of(const Args& a, osc::MoveRequest<double>& m) {
+  m.limits = osc::CartesianLimits<double>::defaults();
+  if (a.v > 0) m.limits.linear.v = a.v, m.has_limits = true;
+  if (a.a > 0) m.limits.linear.a = a.a, m.has_limits = true;
+  if (a.j > 0) m.limits.linear.j = a.j, m.has_limits = true;
+  return m.has_limits;
+}
+
+/// A command without arguments: its answer; a stop or a disable also its end (at rest).
+int simple(Client& c, const Args& a, osc::MotionVerb verb) {
+  const std::uint32_t id = c.command(verb);
+  if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
+  const Outcome o = c.wait_answer(id, a.timeout);
+  const int rc = report(o);
+  if (o.status != Status::kAccepted) return rc;
+  if (o.answer.abort != 0)
+    std::printf("aborted %u: %s\n", o.answer.aborted_id,
+                osc::motion_name(static_cast<osc::MotionReason>(o.answer.abort)));
+  if (verb != osc::MotionVerb::kStop && verb != osc::MotionVerb::kDisable) return rc;
+  return report(c.wait_done(id, a.timeout));
+}
+
+int move(Client& c, const Args& a) {
+  osc::MoveRequest<double> m;
+  m.position = osc::Vec3<double>(a.xyz[0], a.xyz[1], a.xyz[2]);
+  if (!a.rpy.empty()) m.rpy = osc::Vec3<double>(a.rpy[0], a.rpy[1], a.rpy[2]) * kDeg, m.has_rpy = true;
+  m.relative = a.relative;
+  m.replace = a.replace;
+  limits_of(a, m);
+  const std::uint32_t id = c.move_to(m);
+  if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
+  const Outcome o = c.wait_answer(id, a.timeout);
+  std::printf("%s (id %u)\n", o.text().c_str(), id);
+  std::fflush(stdout);
+  if (o.status != Status::kAccepted || a.no_wait) return exit_of(o);
+  return report(c.wait_done(id, a.timeout));
+}
+
+int stream(Client& c, const Args& a) {
+  osc::MoveRequest<double> m;
+  const bool lim = limits_of(a, m);
+  const Outcome o = c.stream(osc::client::resample_path(a.rows, a.rate), a.has_rpy, a.rate, a.relative,
+                             lim ? &m.limits : nullptr, a.timeout);
+  if (o.status == Status::kError) {
+    std::fprintf(stderr, "oscctl: %s\n", o.error.c_str());
+    return 2;
+  }
+  std::printf("%s (id %u)\n", o.status == Status::kAccepted ? "accepted" : o.text().c_str(), o.id);
+  std::fflush(stdout);
+  if (o.status != Status::kAccepted) return exit_of(o);
+  return report(c.wait_done(o.id, a.timeout));
+}
+
+/// A stream's file and rate, checked before the port is opened.
+bool check_stream(Args& a, std::string& err) {
+  if (!sim::read_stream_csv(a.csv, a.rows, a.has_rpy, err)) return false;
+  const double period = 1000.0 / a.rate;
+  if (std::fabs(period - std::round(period)) > 1e-9) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, "--rate %g: not 1000 / N Hz for a whole N (1000, 500, 250, 100, 50, 20, 10 ...)",
+                  a.rate);
+    return err = buf, false;
+  }
+  return true;
+}
+
+int state(Client& c, const Args& a) {
+  const auto s = c.state(std::min(a.timeout, 10.0));
+  if (!s) {
+    std::fprintf(
+        stderr, "oscctl: %s\n",
+        c.error().empty() ? "no state frame within the time (is a controller on the port?)" : c.error().c_str());
+    return c.error().empty() ? 1 : 2;
+  }
+  std::printf("%s", osc::client::state_text(*s).c_str());
+  return 0;
+}
+
+/// Prints every answer and every change of the state frame's state, stop, faults, queue or running id.
+int watch(Client& c, const Args& a) {
+  pil::StateFrame last{};
+  bool first = true;
+  c.on_answer = [](const pil::AnswerFrame& f) {
+    std::printf("%s\n", osc::client::answer_text(f).c_str());
+    std::fflush(stdout);
+  };
+  c.on_state = [&](const pil::StateFrame& s) {
+    if (!first && s.state == last.state && s.stop == last.stop && s.faults == last.faults && s.queued == last.queued &&
+        s.running_id == last.running_id)
+      return;
+    std::printf("tick %u: state %s, stop %s, faults %s, queued %u, running_id %u\n", s.tick,
+                osc::motion_name(static_cast<osc::MotionState>(s.state)),
+                osc::motion_name(static_cast<osc::StopCategory>(s.stop)), osc::client::fault_names(s.faults).c_str(),
+                s.queued, s.running_id);
+    std::fflush(stdout);
+    first = false;
+    last = s;
+  };
+  for (double left = a.seconds > 0 ? a.seconds : 1e18; left > 0 && !g_stop; left -= 0.1)
+    if (!c.pump(std::min(left, 0.1))) {
+      std::fprintf(stderr, "oscctl: %s\n", c.error().c_str());
+      return 2;
+    }
+  return 0;
+}
+
+void add_limits(CLI::App* s, Args& a) {
+  s->add_option("--v", a.v, "linear speed limit [m/s], at most the configured maximum")->check(CLI::PositiveNumber);
+  s->add_option("--a", a.a, "linear acceleration limit [m/s^2]")->check(CLI::PositiveNumber);
+  s->add_option("--j", a.j, "linear jerk limit [m/s^3]")->check(CLI::PositiveNumber);
+  s->add_flag("--relative", a.relative, "offsets from where the queue ends (a stream: from where it starts)");
+}
+
+void build(CLI::App& app, Args& a) {
+  app.description(
+      "Commands a controller over the command protocol (docs/protocol.md) on a serial device or the simulator's "
+      "pseudo-terminal (osc_sim --pty). Exit status 0: accepted or done; 1: refused, aborted or timed out; 2: a bad "
+      "command line, port or file.");
+  app.set_help_flag("-h,--help", "this text");
+  app.require_subcommand(1);
+  app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::Throw);
+  app.add_option("--port", a.port, "the serial device or pseudo-terminal (e.g. /dev/pts/7)")->required();
+  app.add_option("--baud", a.baud, "baud rate of a serial device (default 115200)")->check(CLI::Range(50, 4000000));
+  app.add_option("--timeout", a.timeout, "seconds to wait for an answer or an end (default 120)")
+      ->check(CLI::Range(0.1, 86400.0));
+  app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
+  // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
+  for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
+                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop})
+    app.add_subcommand(osc::motion_name(v), osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(v)]);
+  CLI::App* mv = app.add_subcommand("move", "a jerk-limited move_to of the wrist centre; waits until done");
+  mv->add_option("xyz", a.xyz, "X Y Z [m], base frame")->expected(3)->required();
+  mv->add_option("--rpy", a.rpy, "roll pitch yaw [deg] of the target orientation")->expected(3);
+  mv->add_flag("--replace", a.replace, "re-target the running motion instead of queueing");
+  mv->add_flag("--no-wait", a.no_wait, "return once accepted");
+  add_limits(mv, a);
+  CLI::App* st = app.add_subcommand("stream", "stream a CSV path (t, x, y, z[, roll, pitch, yaw] in s, m, deg)");
+  st->add_option("file", a.csv, "the path, CSV")->required();
+  st->add_option("--rate", a.rate, "setpoints per second: 1000 / N for a whole N from 1 to 100")
+      ->required()
+      ->check(CLI::Range(10.0, 1000.0));
+  add_limits(st, a);
+  CLI::App* w = app.add_subcommand("watch", "print state changes and every answer");
+  w->add_option("--seconds", a.seconds, "for this long (default: until interrupted)")->check(CLI::PositiveNumber);
+}
+
+int run(Client& c, const Args& a) {
+  if (a.verb == "state") return state(c, a);
+  if (a.verb == "move") return move(c, a);
+  if (a.verb == "stream") return stream(c, a);
+  if (a.verb == "watch") return watch(c, a);
+  const osc::MotionVerb verb = a.verb == "enable"    ? osc::MotionVerb::kEnable
+                               : a.verb == "disable" ? osc::MotionVerb::kDisable
+                               : a.verb == "clear"   ? osc::MotionVerb::kClear
+                               : a.verb == "paper"   ? osc::MotionVerb::kPaper
+                                                     : osc::MotionVerb::kStop;
+  return simple(c, a, verb);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("", "oscctl");
+  Args a;
+  build(app, a);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::printf("%s", app.help().c_str());
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    // A word that is no command: CLI11 says only that one is required.
+    const std::vector<std::string> extra = app.remaining();
+    const std::string what = app.get_subcommands().empty() && !extra.empty()
+                                 ? extra.front() +
+                                       ": not a command (state, enable, disable, clear, paper, stop, "
+                                       "move, stream, watch)"
+                                 : e.what();
+    std::fprintf(stderr, "oscctl: %s\n(oscctl --help lists the commands and options)\n", what.c_str());
+    return 2;
+  }
+  a.verb = app.get_subcommands().front()->get_name();
+  std::string err;
+  if (a.verb == "stream" && !check_stream(a, err)) {
+    std::fprintf(stderr, "oscctl: %s\n", err.c_str());
+    return 2;
+  }
+  auto t = osc::client::SerialTransport::open(a.port, a.baud, err);
+  if (!t) {
+    std::fprintf(stderr, "oscctl: --port %s\n", err.c_str());
+    return 2;
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  Client c(std::move(t));
+  return run(c, a);
+}

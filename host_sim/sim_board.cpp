@@ -1,0 +1,304 @@
+// osc_sim --pty: the simulated PUMA 560 as a virtual board. The firmware's control task runs in
+// process over the simulated arm (MotionSim, started disabled) in real time, one tick a millisecond
+// (times --speed), paced by clock_nanosleep on absolute CLOCK_MONOTONIC deadlines, and serves the
+// command protocol (docs/protocol.md, "The command protocol") on a pseudo-terminal through the
+// controller's own end of it (osc/link/command_port.hpp): bytes read each tick into the link's
+// parser, command and setpoint frames into the task's mailboxes, answer frames and a state frame
+// every 1 / --state-hz s back. Its first line on standard output is the terminal's path:
+//
+//   $ osc_sim --pty &
+//   pty: /dev/pts/7
+//   $ oscctl --port /dev/pts/7 enable
+//
+// A tick that starts more than a period after its deadline is an overrun: the loop catches up
+// without sleeping (at most kMaxCatchUpNs of wall time behind; further behind, the schedule
+// restarts from now: a slip) and counts them; the counts are printed at exit. SIGINT and SIGTERM
+// end the run cleanly (exit status 0); a bad option is a named error, exit status 2.
+//
+// The QEMU image as the virtual board (the firmware's own build behind the terminal) is a later step.
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <termios.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include <cerrno>
+#include <cmath>
+#include <csignal>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "motion_sim.hpp"
+#include "osc/link/command_port.hpp"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_signal(int) { g_stop = 1; }
+
+constexpr long kNsPerTick = 1'000'000;       // 1 ms: params::kControlHz
+constexpr long kMaxCatchUpNs = 100'000'000;  // further behind than this: restart the schedule
+constexpr std::size_t kOutputBytes = 8192;   // frames waiting for the terminal; more are dropped
+static_assert(osc::params::kControlHz == 1000, "the virtual board's tick is 1 ms");
+
+struct Options {
+  bool pty = false;
+  std::string scalar = "double";
+  std::vector<double> start_pose;  // degrees
+  int state_hz = 50;
+  double duration = 0;  // simulated seconds; 0: until SIGINT / SIGTERM
+  double speed = 1;
+};
+
+/// The master side of a pseudo-terminal whose slave is in raw mode. Frames are written whole or not
+/// at all (a full buffer drops the frame), and only while a client has the slave open: a frame no
+/// one reads would reach the next client stale.
+class PtyMaster {
+ public:
+  ~PtyMaster() {
+    if (fd_ >= 0) close(fd_);
+  }
+  bool open(std::string& err) {
+    fd_ = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK);
+    if (fd_ < 0) return err = std::string("posix_openpt: ") + std::strerror(errno), false;
+    if (grantpt(fd_) != 0 || unlockpt(fd_) != 0)
+      return err = std::string("grantpt/unlockpt: ") + std::strerror(errno), false;
+    const char* name = ptsname(fd_);
+    if (!name) return err = std::string("ptsname: ") + std::strerror(errno), false;
+    slave_ = name;
+    // Raw mode on the slave's side (no echo, no line editing, 8 bits); the setting stays with the
+    // terminal once this descriptor is closed.
+    const int s = ::open(name, O_RDWR | O_NOCTTY);
+    if (s < 0) return err = slave_ + ": " + std::strerror(errno), false;
+    termios t{};
+    const bool ok = tcgetattr(s, &t) == 0 && (cfmakeraw(&t), tcsetattr(s, TCSANOW, &t) == 0);
+    close(s);
+    if (!ok) return err = slave_ + ": cannot set raw mode: " + std::strerror(errno), false;
+    return true;
+  }
+  const std::string& slave() const { return slave_; }
+
+  /// Whether a client has the slave open now. A new client starts with an empty output buffer.
+  bool poll_client() {
+    pollfd p{fd_, POLLIN, 0};
+    const bool now = ::poll(&p, 1, 0) >= 0 && !(p.revents & POLLHUP);
+    if (now && !connected_) out_.clear();
+    connected_ = now;
+    return now;
+  }
+  /// Bytes from the client (0: none, or no client).
+  int read(std::uint8_t* buf, int n) {
+    if (!connected_) return 0;
+    const ssize_t r = ::read(fd_, buf, static_cast<std::size_t>(n));
+    return r > 0 ? static_cast<int>(r) : 0;
+  }
+  /// A frame for the client: queued whole, or dropped (no client, or the buffer full).
+  void queue(const std::uint8_t* b, int n) {
+    if (!connected_ || out_.size() + static_cast<std::size_t>(n) > kOutputBytes) {
+      ++dropped_;
+      return;
+    }
+    out_.insert(out_.end(), b, b + n);
+  }
+  /// Writes what the terminal takes now.
+  void flush() {
+    if (!connected_ || out_.empty()) return;
+    const ssize_t w = ::write(fd_, out_.data(), out_.size());
+    if (w > 0) out_.erase(out_.begin(), out_.begin() + w);
+  }
+  long dropped() const { return dropped_; }
+
+ private:
+  int fd_ = -1;
+  std::string slave_;
+  bool connected_ = false;
+  std::vector<std::uint8_t> out_;
+  long dropped_ = 0;
+};
+
+/// The real-time schedule: tick k's deadline is start + k period (restarted after a slip).
+class Pacer {
+ public:
+  explicit Pacer(double speed) : period_(std::llround(static_cast<double>(kNsPerTick) / speed)) {
+    clock_gettime(CLOCK_MONOTONIC, &start_);
+  }
+  /// Waits for the next tick's deadline (not at all when behind); false when a signal asked to stop.
+  bool wait() {
+    const long long due = ns(start_) + k_ * period_;
+    const long long now = now_ns();
+    if (now < due) {
+      const timespec d{static_cast<time_t>(due / 1'000'000'000), static_cast<long>(due % 1'000'000'000)};
+      while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &d, nullptr) == EINTR)
+        if (g_stop) return false;
+    } else {
+      const long long lag = now - due;
+      if (lag > period_) ++overruns;
+      if (lag > worst_lag_ns) worst_lag_ns = lag;
+      if (lag > kMaxCatchUpNs) {  // too far behind to catch up: simulated time lags wall time from here
+        ++slips;
+        clock_gettime(CLOCK_MONOTONIC, &start_);
+        k_ = 0;
+      }
+    }
+    ++k_;
+    return !g_stop;
+  }
+  long overruns = 0, slips = 0;
+  long long worst_lag_ns = 0;
+
+ private:
+  static long long ns(const timespec& t) { return static_cast<long long>(t.tv_sec) * 1'000'000'000 + t.tv_nsec; }
+  static long long now_ns() {
+    timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return ns(t);
+  }
+  long long period_;
+  timespec start_{};
+  long long k_ = 0;
+};
+
+double wall_seconds() {
+  timespec t;
+  clock_gettime(CLOCK_MONOTONIC, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+/// Runs the board until the duration or a signal; prints the run's counts on stderr.
+template <class S>
+int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
+  sim::MotionSim<S> sim(q0);
+  osc::CommandPort<S> port;
+  port.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / o.state_hz);
+  pil::Parser parser;
+  const long long ticks = o.duration > 0 ? std::llround(o.duration * osc::params::kControlHz) : -1;
+  const auto write = [&pty](const std::uint8_t* b, int n) { pty.queue(b, n); };
+  Pacer pacer(o.speed);
+  long long k = 0;
+  long frames = 0, other_frames = 0, link_errors = 0;
+  bool had_client = false;
+  const double t0 = wall_seconds();
+  for (; ticks < 0 || k < ticks; ++k) {
+    if (!pacer.wait()) break;
+    const bool client = pty.poll_client();
+    if (client && !had_client) parser.reset();  // a new client: no half frame of the last one's
+    had_client = client;
+    std::uint8_t buf[512];
+    for (int n; (n = pty.read(buf, sizeof buf)) > 0;)
+      for (int i = 0; i < n; ++i) {
+        const pil::Parser::Result r = parser.feed(buf[i]);
+        if (r == pil::Parser::kFrame) {
+          ++frames;
+          if (!port.on_frame(sim.task(), parser, write)) ++other_frames;
+        } else if (r != pil::Parser::kPending) {
+          ++link_errors;
+        }
+      }
+    sim.tick();
+    port.after_tick(sim.task(), write);
+    pty.flush();
+  }
+  const double wall = wall_seconds() - t0;
+  std::fprintf(stderr,
+               "osc_sim: %lld ticks (%.3f s simulated) in %.3f s of wall time; %ld frames in, %ld not commands, "
+               "%ld link errors; %ld frames out dropped (no client, or not read)\n",
+               k, static_cast<double>(k) / osc::params::kControlHz, wall, frames, other_frames, link_errors,
+               pty.dropped());
+  std::fprintf(stderr,
+               "osc_sim: %s%ld overruns (ticks started more than a period late), %ld slips, worst lag %.3f ms\n",
+               pacer.overruns > 0 ? "warning: " : "", pacer.overruns, pacer.slips,
+               static_cast<double>(pacer.worst_lag_ns) * 1e-6);
+  return 0;
+}
+
+/// The start pose [rad]: the robot's, or --start-pose within the joint limits and away from a
+/// singularity (the controller's threshold doubled, as puma_experiment's start_pose).
+bool start_pose(const Options& o, sim::Vec6& q, std::string& err) {
+  for (int i = 0; i < osc::kDof; ++i) q(i) = osc::robot::kQStart[i];
+  if (o.start_pose.empty()) return true;
+  for (int i = 0; i < osc::kDof; ++i) {
+    q(i) = o.start_pose[static_cast<std::size_t>(i)] * osc::kPi / 180.0;
+    if (!(q(i) >= osc::robot::kArm.q_min[i] && q(i) <= osc::robot::kArm.q_max[i]))
+      return err = "--start-pose: joint " + std::to_string(i + 1) + " outside its limits", false;
+  }
+  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
+  osc::Data<double> data;
+  osc::OpSpace<double> os;
+  osc::forward_kinematics(model, data, q);
+  const sim::Mat3 R = data.R[osc::kDof];
+  osc::opspace_update(model, data, os, q, R);
+  if (!(os.Jf.rcond >= 2 * osc::Gains<double>::paper().min_rcond))
+    return err = "--start-pose: too close to a singularity for the controller", false;
+  return true;
+}
+
+void build(CLI::App& app, Options& o) {
+  app.description(
+      "The simulated PUMA 560 as a virtual board: the firmware's control task over the simulated arm, in real "
+      "time, serving the command protocol (docs/protocol.md) on a pseudo-terminal whose path is the first line "
+      "on standard output (\"pty: /dev/pts/N\"). The arm starts disabled. SIGINT or SIGTERM ends it (status 0). "
+      "Only --pty exists so far: the QEMU firmware image as the virtual board is not there yet.");
+  app.set_help_flag("-h,--help", "this text");
+  app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::Throw);
+  app.add_flag("--pty", o.pty, "serve the command protocol on a new pseudo-terminal (required)");
+  app.add_option("--scalar", o.scalar, "the controller's arithmetic: double | float | fixed (default double)")
+      ->check(CLI::IsMember({"double", "float", "fixed"}));
+  app.add_option("--start-pose", o.start_pose, "joint angles q1..q6 at the start [deg] (default: the robot's)")
+      ->expected(6)
+      ->type_name("Q1 .. Q6");
+  app.add_option("--state-hz", o.state_hz, "state frames per simulated second: 1000 / N for a whole N (default 50)")
+      ->check(CLI::Range(1, 1000));
+  app.add_option("--duration", o.duration, "stop after this many simulated seconds (default: run until a signal)")
+      ->check(CLI::Range(0.001, 1e6));
+  app.add_option("--speed", o.speed,
+                 "real-time factor: simulated seconds per wall second (default 1; above 1 for faster runs, "
+                 "e.g. in tests)")
+      ->check(CLI::Range(0.01, 100.0));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app("", "osc_sim");
+  Options o;
+  build(app, o);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp&) {
+    std::printf("%s", app.help().c_str());
+    return 0;
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "osc_sim: %s\n(osc_sim --help lists the options)\n", e.what());
+    return 2;
+  }
+  std::string err;
+  if (!o.pty) err = "--pty is required: the pseudo-terminal is the only virtual board so far (the QEMU image is not)";
+  if (err.empty() && osc::params::kControlHz % o.state_hz != 0)
+    err =
+        "--state-hz " + std::to_string(o.state_hz) + ": not 1000 / N for a whole N (1000, 500, 250, 200, 100, 50, ...)";
+  sim::Vec6 q0;
+  if (err.empty()) start_pose(o, q0, err);
+  PtyMaster pty;
+  if (err.empty()) pty.open(err);
+  if (!err.empty()) {
+    std::fprintf(stderr, "osc_sim: %s\n", err.c_str());
+    return 2;
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  std::printf("pty: %s\n", pty.slave().c_str());
+  std::fflush(stdout);
+  if (o.scalar == "float") return serve<float>(o, q0, pty);
+  if (o.scalar == "fixed") return serve<osc::Fixed>(o, q0, pty);
+  return serve<double>(o, q0, pty);
+}

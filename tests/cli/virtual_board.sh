@@ -1,0 +1,183 @@
+#!/usr/bin/env bash
+# The simulator as a virtual board (osc_sim --pty) and the command protocol's clients: oscctl and the
+# Python client (clients/python/osc_client.py). One check per CASE (tests/cli/CMakeLists.txt):
+#
+#   oscctl_sequence, python_sequence   state (disabled); a move refused not_enabled (exit 1); enable
+#                                      (holding); a relative move of 20 mm done (the reference moved by
+#                                      it); watch shows a move's done and the state changes; a stop while
+#                                      a long move runs (that move aborted stop_command, then holding);
+#                                      disable (disabled); a move refused again
+#   oscctl_stream, python_stream       a small CSV path streamed at 10 Hz ends done where the path ends
+#   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
+#   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
+#   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
+#
+# usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_PY CASE
+# Nothing waits a fixed time for the simulator: each step waits for its answer (generous timeouts).
+set -uo pipefail
+sim=$1 ctl=$2 py=$3 client=$4 case_=$5
+tmp=$(mktemp -d)
+sim_pid=
+port=
+cleanup() {
+  if [ -n "$sim_pid" ]; then
+    kill -TERM "$sim_pid" 2>/dev/null
+    wait "$sim_pid" 2>/dev/null
+  fi
+  rm -rf "$tmp"
+}
+trap cleanup EXIT
+fail() {
+  echo "FAIL: $*"
+  [ -s "$tmp/sim.err" ] && sed 's/^/  osc_sim: /' "$tmp/sim.err"
+  exit 1
+}
+
+# Starts osc_sim --pty with the options given; sets $port from its first line.
+start_sim() {
+  "$sim" --pty "$@" >"$tmp/sim.out" 2>"$tmp/sim.err" &
+  sim_pid=$!
+  for _ in $(seq 600); do
+    port=$(sed -n '1s/^pty: //p' "$tmp/sim.out")
+    [ -n "$port" ] && [ -e "$port" ] && return 0
+    kill -0 "$sim_pid" 2>/dev/null || fail "osc_sim exited before printing its terminal"
+    sleep 0.05
+  done
+  fail "osc_sim printed no 'pty: PATH' line within 30 s"
+}
+
+# SIGTERM ends it cleanly: status 0 and the run's counts, the overruns among them.
+stop_sim() {
+  kill -TERM "$sim_pid"
+  wait "$sim_pid"
+  local rc=$?
+  sim_pid=
+  [ "$rc" -eq 0 ] || fail "osc_sim exited with status $rc on SIGTERM, expected 0"
+  grep -E 'osc_sim: (warning: )?[0-9]+ overruns' "$tmp/sim.err" || fail "osc_sim printed no overrun count at exit"
+}
+
+# expect STATUS PATTERN... -- COMMAND...: runs COMMAND; its exit status must be STATUS and each
+# PATTERN (an extended regular expression) must match a line of its output (stdout and stderr).
+expect() {
+  local want=$1 patterns=()
+  shift
+  while [ "$1" != "--" ]; do
+    patterns+=("$1")
+    shift
+  done
+  shift
+  "$@" >"$tmp/out" 2>&1
+  local rc=$?
+  echo "\$ ${1##*/} ${*:2} -> $rc"
+  sed 's/^/    /' "$tmp/out"
+  [ "$rc" -eq "$want" ] || fail "exit status $rc, expected $want"
+  for p in "${patterns[@]}"; do
+    grep -Eq -- "$p" "$tmp/out" || fail "no line matching '$p'"
+  done
+}
+
+# The y coordinate [m] of the reference pose in the last output (a state printout).
+reference_y() { sed -n 's/^reference: [^ ]* \([^ ]*\) .*/\1/p' "$tmp/out"; }
+reference_z() { sed -n 's/^reference: [^ ]* [^ ]* \([^ ]*\) .*/\1/p' "$tmp/out"; }
+near() { awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; exit !(d <= tol && d >= -tol) }'; }
+
+# The sequence of the issue with one client, given as a command prefix ("$@").
+sequence() {
+  expect 0 '^state: disabled$' '^faults: none$' -- "$@" state
+  expect 1 '^refused: not_enabled' -- "$@" move 0 0.02 0 --relative
+  expect 0 '^accepted$' -- "$@" enable
+  expect 0 '^state: holding$' -- "$@" state
+  local y0 y1
+  y0=$(reference_y)
+  expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" move 0 0.02 0 --relative
+  expect 0 '^state: holding$' -- "$@" state
+  y1=$(reference_y)
+  near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.02 0.0005 ||
+    fail "the reference moved from y = $y0 to $y1, not by 20 mm"
+  # watch: the state changes and the answers of a move sent before it, up to its done.
+  expect 0 '^accepted \(id [0-9]+\)$' -- "$@" move 0 0.03 0 --relative --v 0.01 --no-wait
+  local id
+  id=$(sed -n 's/^accepted (id \([0-9]*\))$/\1/p' "$tmp/out")
+  expect 0 "^tick [0-9]+: state moving" "^tick [0-9]+: done $id; completion finished; state holding" \
+    "^tick [0-9]+: state holding" -- "$@" watch --seconds 12
+  # A stop while a long move (100 mm at 5 mm/s) runs.
+  expect 0 '^accepted \(id [0-9]+\)$' -- "$@" move 0 -0.1 0 --relative --v 0.005 --no-wait
+  id=$(sed -n 's/^accepted (id \([0-9]*\))$/\1/p' "$tmp/out")
+  expect 0 '^state: moving$' "^running_id: $id$" -- "$@" state
+  expect 0 '^accepted$' "^aborted $id: stop_command$" '^done$' -- "$@" stop
+  expect 0 '^state: holding$' '^queued: 0$' -- "$@" state
+  expect 0 '^accepted$' '^done$' -- "$@" disable
+  expect 0 '^state: disabled$' -- "$@" state
+  expect 1 '^refused: not_enabled' -- "$@" move 0 0 0.01 --relative
+}
+
+# A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds.
+stream() {
+  printf 't, x, y, z\n# 10 mm along y, then along z\n0, 0, 0, 0\n0.6, 0, 0.01, 0\n1.2, 0, 0.01, 0.01\n' >"$tmp/path.csv"
+  expect 0 '^accepted$' -- "$@" enable
+  expect 0 '^state: holding$' -- "$@" state
+  local y0 y1 z0 z1
+  y0=$(reference_y) z0=$(reference_z)
+  expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" stream "$tmp/path.csv" --rate 10 --relative
+  expect 0 '^state: holding$' '^dropped: 0$' -- "$@" state
+  y1=$(reference_y) z1=$(reference_z)
+  near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.01 0.0005 &&
+    near "$(awk -v a="$z1" -v b="$z0" 'BEGIN { print a - b }')" 0.01 0.0005 ||
+    fail "the reference moved from (y, z) = ($y0, $z0) to ($y1, $z1), not by the path's (10, 10) mm"
+  expect 0 '^accepted$' '^done$' -- "$@" disable
+}
+
+case "$case_" in
+  oscctl_sequence)
+    start_sim --speed 4
+    sequence "$ctl" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  python_sequence)
+    start_sim --speed 4 --scalar float
+    sequence "$py" "$client" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  oscctl_stream)
+    start_sim --state-hz 100
+    stream "$ctl" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  python_stream)
+    start_sim
+    stream "$py" "$client" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  sim_options)
+    expect 2 'osc_sim: --pty is required' -- "$sim"
+    expect 2 'osc_sim: --scalar: quad not in' -- "$sim" --pty --scalar quad
+    expect 2 'osc_sim: --start-pose: .*6 required' -- "$sim" --pty --start-pose 0 45 -180 0 45
+    expect 2 'osc_sim: --start-pose: joint 2 outside its limits' -- "$sim" --pty --start-pose 0 400 -180 0 45 0
+    expect 2 'osc_sim: --state-hz 30: not 1000 / N' -- "$sim" --pty --state-hz 30
+    expect 2 'osc_sim: --speed' -- "$sim" --pty --speed 0
+    expect 2 'osc_sim: --duration' -- "$sim" --pty --duration -1
+    expect 2 'osc_sim: .*--bogus' -- "$sim" --pty --bogus
+    expect 0 'QEMU' -- "$sim" --help
+    ;;
+  sim_duration)
+    expect 0 '^pty: /dev/pts/[0-9]+$' 'osc_sim: 500 ticks \(0\.500 s simulated\)' 'overruns' -- \
+      "$sim" --pty --duration 0.5 --speed 2 --start-pose 10 30 -170 0 40 0
+    ;;
+  bad_port_and_file)
+    printf 't,x,y,z\n0,0,0,0\n1,0,x,0\n' >"$tmp/bad.csv"
+    for c in "$ctl" "$py $client"; do
+      # shellcheck disable=SC2086  # the Python client is two words
+      expect 2 "--port $tmp/none: No such file or directory|$tmp/none: No such file or directory" -- \
+        $c --port "$tmp/none" state
+      expect 2 "$tmp/bad.csv: not a serial device or terminal" -- $c --port "$tmp/bad.csv" state
+      expect 2 "$tmp/bad.csv:3: not a row of numbers" -- $c --port /dev/null stream "$tmp/bad.csv" --rate 10
+      expect 2 '' -- $c --port /dev/null move 1 2
+      expect 2 'fly' -- $c --port /dev/null fly
+    done
+    ;;
+  *)
+    echo "virtual_board.sh: unknown case $case_"
+    exit 2
+    ;;
+esac
+echo "PASS: $case_"

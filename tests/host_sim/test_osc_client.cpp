@@ -1,0 +1,215 @@
+// The command protocol's C++ client (host_sim/client/osc_client.hpp) against the controller's own
+// end of the protocol (CommandPort over the simulated arm, MotionSim) through an in-process
+// transport that runs the simulator's ticks while the client waits: what the answers mean (done,
+// aborted with a reason, refused), the state frames, the texts with the firmware's names; and the
+// serial transport's named errors, any baud rate and a hang-up on a pseudo-terminal.
+#include <fcntl.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <deque>
+#include <functional>
+
+#include "motion_sim.hpp"
+#include "osc/link/command_port.hpp"
+#include "osc_client.hpp"
+
+namespace {
+
+using osc::client::Client;
+using osc::client::Outcome;
+using osc::client::Status;
+
+/// The controller on the other end: a read runs ticks (1 ms each) until bytes are there or the
+/// timeout has passed in simulated time; a write goes through the port at once, as bytes arriving
+/// between two ticks.
+class SimTransport : public osc::client::Transport {
+ public:
+  SimTransport() : sim_(sim::Vec6(osc::joint_vector<double>(osc::robot::kQStart))) {}
+  int read(std::uint8_t* buf, int n, double timeout_s) override {
+    if (broken) return error_ = "loopback: broken", -1;
+    const long ticks = std::max(1L, std::lround(timeout_s * osc::params::kControlHz));
+    for (long k = 0; out_.empty() && k < ticks; ++k) tick();
+    const int m = std::min(n, static_cast<int>(out_.size()));
+    std::copy_n(out_.begin(), m, buf);
+    out_.erase(out_.begin(), out_.begin() + m);
+    return m;
+  }
+  bool write(const std::uint8_t* b, int n) override {
+    for (int i = 0; i < n; ++i)
+      if (in_.feed(b[i]) == pil::Parser::kFrame) port_.on_frame(sim_.task(), in_, emit());
+    return true;
+  }
+  void tick() {
+    sim_.tick();
+    port_.after_tick(sim_.task(), emit());
+  }
+  sim::MotionSim<double>& sim() { return sim_; }
+  bool broken = false;
+
+ private:
+  std::function<void(const std::uint8_t*, int)> emit() {
+    return [this](const std::uint8_t* b, int n) { out_.insert(out_.end(), b, b + n); };
+  }
+  sim::MotionSim<double> sim_;
+  osc::CommandPort<double> port_;
+  pil::Parser in_;
+  std::deque<std::uint8_t> out_;
+};
+
+struct OscClient : ::testing::Test {
+  SimTransport* t = new SimTransport;
+  Client c{std::unique_ptr<osc::client::Transport>(t)};
+
+  static osc::MoveRequest<double> relative(double dx, double dy, double dz, double v = 0) {
+    osc::MoveRequest<double> m;
+    m.position = osc::Vec3<double>(dx, dy, dz);
+    m.relative = true;
+    if (v > 0) {
+      m.has_limits = true;
+      m.limits = osc::CartesianLimits<double>::defaults();
+      m.limits.linear.v = v;
+    }
+    return m;
+  }
+  void enable() {
+    const Outcome o = c.wait_answer(c.enable(), 10);
+    ASSERT_EQ(o.status, Status::kAccepted) << o.text();
+  }
+};
+
+TEST_F(OscClient, RefusedWhileDisabledThenEnabledAndAMoveDone) {
+  auto s = c.state(1);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->state, static_cast<std::uint8_t>(osc::MotionState::kDisabled));
+  const std::uint32_t refused = c.move_to(relative(0, 0.02, 0));
+  EXPECT_NE(refused, 0u);
+  const Outcome r = c.wait_done(refused, 10);
+  EXPECT_EQ(r.status, Status::kRefused);
+  EXPECT_EQ(r.reason, osc::MotionReason::kNotEnabled);
+  EXPECT_EQ(r.text(), "refused: not_enabled");
+  enable();
+  const float y0 = c.state(1)->x_d[1];
+  const std::uint32_t id = c.move_to(relative(0, 0.02, 0));
+  EXPECT_EQ(c.wait_answer(id, 10).status, Status::kAccepted);
+  const Outcome d = c.wait_done(id, 60);
+  EXPECT_EQ(d.status, Status::kDone) << d.text();
+  EXPECT_EQ(d.answer.done_id, id);
+  s = c.state(1);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->state, static_cast<std::uint8_t>(osc::MotionState::kHolding));
+  EXPECT_NEAR(s->x_d[1] - y0, 0.02, 1e-6);
+  EXPECT_NEAR(s->x[1] - y0, 0.02, 1e-3);  // the simulated arm followed
+}
+
+TEST_F(OscClient, AStopAbortsTheRunningMoveAndTheOneQueuedBehindIt) {
+  enable();
+  const std::uint32_t a = c.move_to(relative(0, 0.05, 0, 0.01));
+  const std::uint32_t b = c.move_to(relative(0, -0.05, 0));
+  EXPECT_EQ(c.wait_answer(a, 10).status, Status::kAccepted);
+  EXPECT_EQ(c.wait_answer(b, 10).status, Status::kAccepted);
+  EXPECT_EQ(c.state(1)->queued, 2);
+  const std::uint32_t stop = c.stop();
+  const Outcome s = c.wait_answer(stop, 10);
+  ASSERT_EQ(s.status, Status::kAccepted);
+  EXPECT_EQ(s.answer.aborted_id, a);
+  for (std::uint32_t id : {a, b}) {
+    const Outcome o = c.wait_done(id, 10);
+    EXPECT_EQ(o.status, Status::kAborted) << id;
+    EXPECT_EQ(o.text(), "aborted: stop_command");
+  }
+  const Outcome rest = c.wait_done(stop, 30);  // a stop is done at rest
+  EXPECT_EQ(rest.status, Status::kDone);
+  EXPECT_EQ(rest.answer.completion, static_cast<std::uint8_t>(osc::MotionCompletion::kStopped));
+  EXPECT_EQ(c.state(1)->state, static_cast<std::uint8_t>(osc::MotionState::kHolding));
+}
+
+TEST_F(OscClient, StateIsAFreshFrameAndAnswersReachTheHandler) {
+  const std::uint32_t t0 = c.state(1)->tick;
+  const std::uint32_t t1 = c.state(1)->tick;
+  EXPECT_GT(t1, t0);
+  std::vector<pil::AnswerFrame> seen;
+  c.on_answer = [&](const pil::AnswerFrame& a) { seen.push_back(a); };
+  const std::uint32_t id = c.enable();
+  ASSERT_TRUE(c.pump(0.5));
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].id, id);
+  const std::string text = osc::client::answer_text(seen[0]);
+  EXPECT_NE(text.find("enable " + std::to_string(id) + " accepted; state holding"), std::string::npos) << text;
+}
+
+TEST_F(OscClient, ATransportErrorIsNamed) {
+  t->broken = true;
+  const Outcome o = c.wait_answer(c.enable(), 1);
+  EXPECT_EQ(o.status, Status::kError);
+  EXPECT_EQ(o.text(), "error: loopback: broken");
+  EXPECT_FALSE(c.state(1));
+  EXPECT_EQ(c.error(), "loopback: broken");
+}
+
+TEST(OscClientText, NamesAreTheFirmwares) {
+  EXPECT_EQ(osc::client::fault_names(0), "none");
+  EXPECT_EQ(osc::client::fault_names(osc::kFaultTracking | osc::kFaultEstop | (1u << 31)), "tracking,estop,bit31");
+  pil::StateFrame s;
+  s.state = static_cast<std::uint8_t>(osc::MotionState::kStopping);
+  s.stop = static_cast<std::uint8_t>(osc::StopCategory::kCategory2);
+  const std::string text = osc::client::state_text(s);
+  EXPECT_NE(text.find("state: stopping\nstop: category_2\nfaults: none\n"), std::string::npos) << text;
+  pil::AnswerFrame a;
+  a.id = 9, a.verb = static_cast<std::uint8_t>(osc::MotionVerb::kMoveTo);
+  a.outcome = static_cast<std::uint8_t>(osc::CommandOutcome::kRefused);
+  a.refusal = static_cast<std::uint8_t>(osc::MotionReason::kOutOfWorkspace);
+  EXPECT_EQ(osc::client::answer_text(a), "tick 0: move_to 9 refused: out_of_workspace; state disabled, queued 0");
+}
+
+TEST(OscClientPath, ResampledLinearlyWithTheLastSampleAtTheEnd) {
+  const std::vector<std::array<double, 7>> rows = {{0, 0, 0, 0, 0, 0, 0}, {0.25, 0.1, 0, 0, 0, 0, 0.2}};
+  const auto p = osc::client::resample_path(rows, 10);
+  ASSERT_EQ(p.size(), 4u);  // 0, 0.1, 0.2, then the end (0.25) instead of 0.3
+  EXPECT_NEAR(p[1].position(0), 0.04, 1e-12);
+  EXPECT_NEAR(p[2].rpy(2), 0.16, 1e-12);
+  EXPECT_EQ(p[3].position(0), 0.1);
+  EXPECT_EQ(osc::client::resample_path({{0, 1, 2, 3, 0, 0, 0}}, 50).size(), 1u);  // one row: one sample
+}
+
+TEST(SerialTransport, BadPathsAreNamed) {
+  std::string err;
+  EXPECT_FALSE(osc::client::SerialTransport::open("/nonexistent/tty", 115200, err));
+  EXPECT_EQ(err, "/nonexistent/tty: No such file or directory");
+  EXPECT_FALSE(osc::client::SerialTransport::open("/dev/null", 115200, err));
+  EXPECT_EQ(err, "/dev/null: not a serial device or terminal");
+  EXPECT_FALSE(osc::client::SerialTransport::open("/dev/null", 7, err));
+  EXPECT_EQ(err, "baud 7: 50 to 4000000");
+}
+
+TEST(SerialTransport, AnyBaudOnAPseudoTerminalAndAHangUpIsNamed) {
+  const int m = posix_openpt(O_RDWR | O_NOCTTY);
+  ASSERT_GE(m, 0);
+  ASSERT_EQ(grantpt(m), 0);
+  ASSERT_EQ(unlockpt(m), 0);
+  const std::string slave = ptsname(m);
+  std::string err;
+  for (int baud : {115200, 123457}) {  // a standard rate, and one only termios2 sets
+    auto t = osc::client::SerialTransport::open(slave, baud, err);
+    ASSERT_TRUE(t) << err;
+    const std::uint8_t hello[3] = {1, 2, 3};
+    ASSERT_TRUE(t->write(hello, 3));
+    std::uint8_t got[8];
+    ASSERT_EQ(::read(m, got, sizeof got), 3);  // raw: no echo, no translation
+    EXPECT_EQ(got[2], 3);
+    EXPECT_EQ(::write(m, hello, 2), 2);
+    EXPECT_EQ(t->read(got, sizeof got, 1.0), 2);
+    EXPECT_EQ(t->read(got, sizeof got, 0.01), 0);  // nothing more: a timeout
+  }
+  auto t = osc::client::SerialTransport::open(slave, 115200, err);
+  ASSERT_TRUE(t);
+  close(m);
+  std::uint8_t got[8];
+  EXPECT_EQ(t->read(got, sizeof got, 1.0), -1);
+  EXPECT_EQ(t->error(), slave + ": hung up (the board or the simulator has gone)");
+}
+
+}  // namespace
