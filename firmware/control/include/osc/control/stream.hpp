@@ -110,6 +110,13 @@ void step_axis(jerk_profile::Kin<S>& s, S& lo, S vt, S amax, S j, S dt) {
   s.p = p;
 }
 
+/// A time [s] as whole ticks, rounded to the nearest.
+constexpr std::uint32_t ticks(double seconds) {
+  const double t = seconds * params::kControlHz;
+  const auto whole = static_cast<std::uint32_t>(t);
+  return t - whole >= 0.5 ? whole + 1 : whole;
+}
+
 template <class S>
 S clamp(S x, S lim) {
   return x > lim ? lim : (x < -lim ? -lim : x);
@@ -122,7 +129,8 @@ class StreamFollower {
   static constexpr std::uint32_t kHz = params::kControlHz;
   /// 1 / sqrt(3), rounded down (3 axes at this fraction of a limit are within it, in double too).
   static constexpr double kInvSqrt3 = 0.577350269;
-  static constexpr std::uint32_t kExtrapolationTicks = static_cast<std::uint32_t>(kStreamExtrapolation * kHz + 0.5);
+  static constexpr std::uint32_t kExtrapolationTicks = stream::ticks(kStreamExtrapolation);
+  static constexpr std::uint32_t kTimeoutMinTicks = stream::ticks(kStreamTimeoutMin);
 
   explicit StreamFollower(const CartesianLimits<S>& lim = CartesianLimits<S>::defaults()) { set_limits(lim); }
 
@@ -141,8 +149,8 @@ class StreamFollower {
   /// to 10 Hz).
   void start(const Vec6<S>& x0, std::uint32_t period_ticks) {
     period_ = period_ticks > 0 ? period_ticks : 1;
-    const std::uint32_t twice = 2 * period_, min = static_cast<std::uint32_t>(kStreamTimeoutMin * kHz + 0.5);
-    timeout_ = twice > min ? twice : min;
+    const std::uint32_t twice = 2 * period_;
+    timeout_ = twice > kTimeoutMinTicks ? twice : kTimeoutMinTicks;
     prev_ = cur_ = x0;
     since_ = 0;
     ended_ = stopping_ = false;
