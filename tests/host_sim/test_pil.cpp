@@ -382,7 +382,7 @@ TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
 
 TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
   healthy(5);
-  expect_zeroed_once(answer(with(frame(), 2, 0x07)), pil::kErrHeader);                       // unknown frame type
+  expect_zeroed_once(answer(with(frame(), 2, 0x70)), pil::kErrHeader);                       // unknown frame type
   EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
 }
 

@@ -266,6 +266,38 @@ void jerk_profile_kernels() {
   check("profile ends at the target", d(s.p), 0.38, 1e-4);
 }
 
+/// A stream (issue 23): setpoints at 50 Hz along 30 mm and 0.1 rad of yaw over 1 s, ending there;
+/// the generator's worst tick (the follower's six axes), and done at the last setpoint.
+MotionGenerator<F> g_stream_gen;
+void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R) {
+  MotionGenerator<F>& gen = g_stream_gen;
+  gen.hold({x0.template head<3>(), R}, R);
+  gen.start_stream(20, false, CartesianLimits<F>::defaults(), 2);
+  std::uint32_t worst = 0;
+  MotionEvents ev;
+  Vec6<F> end = x0;
+  for (std::uint64_t k = 0; k < 4000 && ev.done_id == 0; ++k) {
+    if (k % 20 == 0 && k <= 1000) {
+      const F s = math::ratio<F>(k, 1000);
+      end = x0;
+      end(0) += lit<F>(0.03) * s;
+      end(5) += lit<F>(0.1) * s;
+      gen.stream_setpoint(end, k == 1000);
+    }
+    const std::uint32_t t0 = board::cycles();
+    keep(gen.at_tick(k, params::kControlHz, ev));
+    const std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst) worst = dt;
+  }
+  cortex_m::text::Line()
+      .str("  MotionGenerator::at_tick, a stream, worst tick: ")
+      .u32(worst)
+      .str(" instructions")
+      .emit();
+  check("the stream ends done at its last setpoint",
+        d((gen.hold_pose().p - end.template head<3>()).norm()) + (ev.done_id == 2 ? 0 : 1), 0.0, 1e-4);
+}
+
 /// The motion generator (issue 23): a move's plan and path check (both when a command is prepared,
 /// outside the tick), and the generator's worst tick over the move (a line and a rotation) at 1 ms.
 MotionGenerator<F> g_gen;
@@ -305,6 +337,7 @@ void motion_kernels(const Vec6<F>& q0) {
   check("the move ends done at its target", d((des.x.template head<3>() - to.p).norm()) + (ev.done_id == 1 ? 0 : 1),
         0.0, 1e-4);
   check("no saturation in fixed point", math::take_arithmetic_fault<F>() ? 1.0 : 0.0, 0.0, 0.0);
+  stream_kernels(des.x, from.R);
 }
 
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear.
