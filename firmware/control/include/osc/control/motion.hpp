@@ -24,9 +24,16 @@ struct PaperMotion {
   TrajectorySpec<S> spec;
   Vec3<S> p0;                    ///< the centre of (68): the tip position at the start [m]
   std::uint64_t start_tick = 0;  ///< the sample the motion started at
+  /// The orientation it keeps, as coordinates relative to R_ref (0 in the paper's experiment, which
+  /// starts at R_ref; after a move with a rotation, where that move left it).
+  Vec3<S> phi0 = Vec3<S>::Zero();
 
   /// d at time t [s] since the start.
-  Desired<S> at_time(S t) const { return trajectory(spec, p0, t); }
+  Desired<S> at_time(S t) const {
+    Desired<S> d = trajectory(spec, p0, t);
+    d.x.template tail<3>() = phi0;
+    return d;
+  }
   /// The time since the start at sample `tick` of a clock of rate_hz samples per second, from the
   /// integer sample count (trajectory_time: exact over any uptime).
   S time_at_tick(std::uint64_t tick, std::uint32_t rate_hz) const {
@@ -67,9 +74,11 @@ class MotionGenerator {
     set_hold(pose);
     ++epoch_;
   }
-  /// Starts the paper's motion at sample `tick` about the held position.
-  void start_paper(const TrajectorySpec<S>& spec, std::uint64_t tick, std::uint32_t id = 0) {
-    paper_ = {spec, hold_pose_.p, tick};
+  /// Starts the paper's motion at sample `tick` about the held position, keeping the orientation
+  /// coordinates phi0 (the held ones: held_orientation(); the paper's experiment: 0, R_ref).
+  void start_paper(const TrajectorySpec<S>& spec, std::uint64_t tick, std::uint32_t id = 0,
+                   const Vec3<S>& phi0 = Vec3<S>::Zero()) {
+    paper_ = {spec, hold_pose_.p, tick, phi0};
     paper_id_ = id;
     ++epoch_;
     source_ = MotionSource::kPaper;
@@ -196,6 +205,8 @@ class MotionGenerator {
     return source_ == MotionSource::kPaper ? paper_id_ : 0;
   }
   const Pose<S>& hold_pose() const { return hold_pose_; }
+  /// The held orientation as the controller's coordinates (relative to R_ref).
+  Vec3<S> held_orientation() const { return hold_d_.x.template tail<3>(); }
   const Mat3<S>& reference_orientation() const { return R_ref_; }
 
  private:

@@ -215,7 +215,8 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_moves(next);
     task.q_queue_end = cmd.q_end;
   }
-  if (accepted && cmd.verb == MotionVerb::kPaper) task.gen.start_paper(task.gains.trajectory, next, cmd.id);
+  if (accepted && cmd.verb == MotionVerb::kPaper)
+    task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream) task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
     task.gen.stop(next, params::kControlHz, task.limits);
