@@ -168,8 +168,6 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
   }
   if (app.get_option("--json")->count() > 0 && o.json.empty()) return err = "--json needs a file name", false;
   if (app.get_option("--motion")->count() > 0 && o.motion.empty()) return err = "--motion needs a file name", false;
-  if (!o.motion.empty() && o.qemu)
-    return err = "--motion runs the host-built controller (the command frames to the image are the next step)", false;
   if (o.csv_dir.empty()) return err = "--csv-dir needs a directory", false;
 
   if (o.qemu) {

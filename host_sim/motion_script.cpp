@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -10,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "motion_sim.hpp"
+#include "osc/link/command_port.hpp"
+#include "pil_client.hpp"
 
 namespace sim {
 namespace {
@@ -239,50 +242,205 @@ bool parse_motion_script(const std::string& text, const std::string& name, Motio
 
 namespace {
 
-/// The player: sends the steps in order, keeps each command's record, the state log and the faults.
+/// What the Player sees of one tick, the same from either controller (HostArm, LinkedArm).
+struct TickView {
+  std::vector<osc::MotionReport> reports;  ///< the answers since the tick before, in order (the tick's own last)
+  osc::MotionState state = osc::MotionState::kDisabled;  ///< the motion state after the tick
+  std::uint32_t faults = 0;                              ///< the fault bits the tick detected
+  /// The desired state of the last control step, in the controller's coordinates.
+  Vec6 x_d = Vec6::Zero(), xd_d = Vec6::Zero(), xdd_d = Vec6::Zero();
+  Vec6 pose = Vec6::Zero();  ///< the arm's true pose after the tick's sample, in the same coordinates
+};
+
+/// The controller in process: the firmware's control task over the simulated arm (MotionSim), its
+/// commands through the command port (osc/link/command_port.hpp) as over a link, its answers read
+/// back from the port's answer frames.
 template <class S>
+class HostArm {
+ public:
+  HostArm(const MotionScript& script, const ExperimentConfig& cfg)
+      : sim_(script.start_pose.value_or(cfg.q_start), cfg.injection, cfg.plant, cfg.mode, cfg.gains) {
+    port_.state_period = 0;
+  }
+  bool ok(std::string&) const { return true; }
+  bool command(const pil::CommandFrame& f, std::string&) {
+    port_.enqueue(sim_.task(), f, writer());
+    port_.poll(sim_.task(), writer());
+    return true;
+  }
+  bool setpoint(const pil::SetpointFrame& f, std::string&) {
+    osc::offer_setpoint_frame(sim_.task(), f);
+    return true;
+  }
+  bool tick(TickView& v, std::string&) {
+    v.faults = sim_.tick();
+    port_.after_tick(sim_.task(), writer());
+    port_.poll(sim_.task(), writer());
+    v.reports.swap(reports_);
+    reports_.clear();
+    const osc::ControlTask<S>& t = sim_.task();
+    v.state = t.machine.state;
+    v.x_d = t.desired.x.template cast<double>();
+    v.xd_d = t.desired.xd.template cast<double>();
+    v.xdd_d = t.desired.xdd.template cast<double>();
+    v.pose = sim_.pose();
+    return true;
+  }
+  void finish(MotionRun& run) { run.controller = "in-process"; }
+
+ private:
+  auto writer() {
+    return [this](const std::uint8_t* b, int n) {
+      for (int i = 0; i < n; ++i) {
+        pil::AnswerFrame a;
+        if (parser_.feed(b[i]) == pil::Parser::kFrame && parser_.decode(a))
+          reports_.push_back(osc::report_from_frame(a));
+      }
+    };
+  }
+  MotionSim<S> sim_;
+  osc::CommandPort<S> port_;
+  pil::Parser parser_;
+  std::vector<osc::MotionReport> reports_;
+};
+
+/// The controller of a PIL image (the firmware in QEMU, or any PIL peer) over the link, the
+/// simulated arm here, as the experiment's remote controller (experiment.cpp): one exchange per
+/// tick. The first sensor frame asks the node to start disabled and to trace every tick (its
+/// desired state and reference orientation, its faults and motion state); the commands and the
+/// setpoints go before the sensor frame of the tick that is to take them, as the in-process
+/// controller's go into its mailbox before its tick. The arm's brakes follow the traced state.
+class LinkedArm {
+ public:
+  LinkedArm(const MotionScript& script, const ExperimentConfig& cfg)
+      : timeout_(cfg.pil_timeout),
+        q0_(script.start_pose.value_or(cfg.q_start)),
+        plant_(cfg.plant),
+        hal_(plant_, q0_, osc::robot::kDrives.encoder_counts_per_motor_rev, cfg.injection),
+        config_(static_cast<std::uint8_t>(pil::kConfigStartDisabled | pil::kConfigTrace |
+                                          (cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
+                                          pil::config_adaptation(cfg.gains.adaptation))) {
+    plant_.reset(q0_);
+    plant_.set_brakes(true);
+    ok_ = link_.start(cfg.pil_command, start_error_);
+    command_ = cfg.pil_command.empty() ? "" : cfg.pil_command.front();
+  }
+  bool ok(std::string& err) const { return ok_ || (err = start_error_, false); }
+  bool command(const pil::CommandFrame& f, std::string& err) { return link_.send(f, err); }
+  bool setpoint(const pil::SetpointFrame& f, std::string& err) { return link_.send(f, err); }
+  bool tick(TickView& v, std::string& err) {
+    hal_.begin_sample(plant_.time());
+    pil::SensorFrame s;
+    s.seq = seq_++;
+    hal_.read_encoders(s.counts);
+    if (s.seq == 0) s.inject = config_;
+    pil::ActuatorFrame a = last_;
+    std::string why;
+    const PilClient::Exchange x = link_.exchange(s, a, timeout_, why);
+    hal_.write_dacs(a.codes);
+    if (x == PilClient::Exchange::kLost) return err = "tick " + std::to_string(s.seq) + ": " + why, false;
+    if (x == PilClient::Exchange::kZeroed) {
+      ++zeroed_ticks_;
+      if (first_zeroed_.empty()) first_zeroed_ = "tick " + std::to_string(s.seq) + ": " + why;
+    }
+    last_ = a;
+    const PilReplies r = link_.take_replies();
+    if (r.traces.empty() || r.traces.back().seq != s.seq)
+      return err = "tick " + std::to_string(s.seq) + ": no trace frame", false;
+    const pil::TraceFrame& t = r.traces.back();
+    v.reports.clear();
+    for (const pil::AnswerFrame& f : r.answers) v.reports.push_back(osc::report_from_frame(f));
+    v.state = static_cast<osc::MotionState>(t.state);
+    v.faults = t.faults;
+    Mat3 R_ref;
+    for (int i = 0; i < 6; ++i) v.x_d(i) = t.x_d[i], v.xd_d(i) = t.xd_d[i], v.xdd_d(i) = t.xdd_d[i];
+    for (int i = 0; i < 9; ++i) R_ref(i / 3, i % 3) = t.R_ref[i];
+    // The plant over the sample, as MotionSim::tick: the amplifiers' torque, the brakes by the state.
+    const Vec6 tau = hal_.torque();
+    plant_.set_brakes(!osc::motion_powered(v.state));
+    plant_.advance_sample(tau_before_, tau, osc::params::kDt);
+    tau_before_ = tau;
+    osc::forward_kinematics(model_, data_, plant_.q());
+    v.pose << data_.o[osc::kDof], osc::orientation_coordinates<double>(data_.R[osc::kDof], R_ref);
+    return true;
+  }
+  void finish(MotionRun& run) {
+    run.controller = "pil";
+    run.pil_command = command_;
+    run.link.firmware = last_.link;
+    run.link.host = link_.link_counters();
+    run.link.host_code_range = link_.code_range_errors();
+    run.link.zeroed_ticks = zeroed_ticks_;
+    run.link.first_zeroed = first_zeroed_;
+    run.link.rx_gap_max = last_.rx_gap_max;
+    run.link.rx_long_gaps = last_.rx_long_gaps;
+    link_.stop();
+  }
+
+ private:
+  double timeout_;
+  Vec6 q0_;
+  Plant plant_;
+  PlantHal hal_;
+  std::uint8_t config_;  // the first sensor frame's configuration bits
+  PilClient link_;
+  bool ok_ = false;
+  std::string start_error_, command_;
+  std::uint32_t seq_ = 0;
+  pil::ActuatorFrame last_;
+  std::uint32_t zeroed_ticks_ = 0;
+  std::string first_zeroed_;
+  Vec6 tau_before_ = Vec6::Zero();
+  const osc::Model<double> model_ = osc::Model<double>::of(osc::robot::kArm);
+  osc::Data<double> data_;
+};
+
+/// The player: sends the steps in order as command frames (and a stream's setpoints as setpoint
+/// frames) to a controller, in process or over the link (Arm: HostArm<S>, LinkedArm), and keeps each
+/// command's record, the state log and the faults from what each tick shows (TickView).
+template <class Arm>
 class Player {
  public:
-  Player(const MotionScript& script, const ExperimentConfig& cfg)
-      : script_(script), sim_(script.start_pose.value_or(cfg.q_start), cfg.injection, cfg.plant, cfg.mode, cfg.gains) {}
+  Player(const MotionScript& script, const ExperimentConfig& cfg) : script_(script), arm_(script, cfg) {}
 
   MotionRun run() {
     const double dt = osc::params::kDt;
     double end_at = -1;
+    std::string err;
     log_state(0);
+    if (!arm_.ok(err)) return fail(0, err);
     for (long k = 0;; ++k) {
       const double t = k * dt;
       if (t > script_.timeout) return finish(t, "timeout");
-      if (next_ < script_.steps.size() && due(t)) send(t);
-      stream_setpoint(k);
-      if (next_ == script_.steps.size() && end_at < 0 && at_rest() && sim_.idle()) end_at = t + script_.settle;
+      if (next_ < script_.steps.size() && due(t) && !send(t, err)) return fail(t, err);
+      if (!stream_setpoint(k, err)) return fail(t, err);
+      if (next_ == script_.steps.size() && end_at < 0 && at_rest() && idle()) end_at = t + script_.settle;
       if (end_at >= 0 && t >= end_at) return finish(t, "ok");
-      was_powered_ = osc::motion_powered(sim_.task().machine.state);
-      const std::uint32_t f = sim_.tick();
-      observe(t + dt, f);
-      if (f != 0 && run_.fault_s < 0) run_.fault_s = t;
+      was_powered_ = osc::motion_powered(state_);
+      if (!arm_.tick(view_, err)) return fail(t, err);
+      observe(t + dt);
+      if (view_.faults != 0 && run_.fault_s < 0) run_.fault_s = t;
     }
   }
 
  private:
-  bool at_rest() const {
-    const osc::MotionState s = sim_.task().machine.state;
-    return s != osc::MotionState::kMoving && s != osc::MotionState::kStopping;
-  }
+  bool at_rest() const { return state_ != osc::MotionState::kMoving && state_ != osc::MotionState::kStopping; }
+  /// Every command sent has been answered (the controller's mailbox is free: it holds one command).
+  bool idle() const { return run_.commands.empty() || run_.commands.back().answered_s >= 0; }
   /// The next step's time has come: its at: (or the moment its after: done held first) plus its delay.
   bool due(double t) {
-    if (!sim_.idle()) return false;
+    if (!idle()) return false;
     const MotionStepSpec& s = script_.steps[next_];
     if (ready_s_ < 0) {
-      const bool answered = run_.commands.empty() || run_.commands.back().answered_s >= 0;
       if (!s.after_done && !s.after_answered)
         ready_s_ = s.at;
-      else if (answered && (s.after_answered || at_rest()))
+      else if (s.after_answered || at_rest())
         ready_s_ = t;
     }
     return ready_s_ >= 0 && t >= ready_s_ + s.delay - 1e-9;
   }
-  void send(double t) {
+  /// Sends the next step: its command as a frame (numbers as f32, the protocol's, in every backend).
+  bool send(double t, std::string& err) {
     const MotionStepSpec& s = script_.steps[next_++];
     ready_s_ = -1;
     CommandRecord r;
@@ -290,42 +448,27 @@ class Player {
     r.step = s.text;
     r.id = static_cast<std::uint32_t>(run_.commands.size() + 1);
     r.sent_s = t;
-    if (s.verb == osc::MotionVerb::kMoveTo) {
-      sim_.move_to(cast_request(s.move), r.id);
-    } else if (s.verb == osc::MotionVerb::kStream) {
-      sim_.stream(cast_request(s.move), r.id);
-      stream_ = {&s, r.id, 0, -1};
-    } else
-      sim_.command(s.verb, r.id);
+    if (s.verb == osc::MotionVerb::kStream) stream_ = {&s, r.id, 0, -1};
     run_.commands.push_back(r);
-  }
-  static osc::MoveRequest<S> cast_request(const osc::MoveRequest<double>& m) {
-    osc::MoveRequest<S> r;
-    r.position = m.position.cast<S>();
-    r.rpy = m.rpy.cast<S>();
-    r.relative = m.relative, r.has_rpy = m.has_rpy, r.replace = m.replace, r.has_limits = m.has_limits;
-    r.period = m.period;
-    r.limits = {
-        {static_cast<S>(m.limits.linear.v), static_cast<S>(m.limits.linear.a), static_cast<S>(m.limits.linear.j)},
-        {static_cast<S>(m.limits.angular.v), static_cast<S>(m.limits.angular.a), static_cast<S>(m.limits.angular.j)}};
-    return r;
+    return arm_.command(osc::frame_from_command<double>(r.id, s.verb, s.move), err);
   }
   CommandRecord* record(std::uint32_t id) {
     return id >= 1 && id <= run_.commands.size() ? &run_.commands[id - 1] : nullptr;
   }
-  void observe(double t, std::uint32_t faults);
+  void observe(double t);
+  void observe(double t, const osc::MotionReport& rep);
   /// The running stream's setpoint due before tick k: the n-th, n periods after the tick the stream
   /// started in, at the path's time n T (linear between rows); the last, at the path's end, ends it.
-  void stream_setpoint(long k) {
+  bool stream_setpoint(long k, std::string& err) {
     const MotionStepSpec* s = stream_.step;
     const CommandRecord* r = record(stream_.id);
-    if (!s || !r || r->answered_s < 0) return;
-    if (!r->accepted || r->done_s >= 0 || r->aborted_s >= 0) return void(stream_ = {});
+    if (!s || !r || r->answered_s < 0) return true;
+    if (!r->accepted || r->done_s >= 0 || r->aborted_s >= 0) return stream_ = {}, true;
     if (stream_.first_tick < 0) stream_.first_tick = k;  // the tick after the one that accepted it
     const long period = static_cast<long>(s->move.period);
-    if ((k - stream_.first_tick) % period != 0) return;
+    if ((k - stream_.first_tick) % period != 0) return true;
     const double t = static_cast<double>(stream_.sent) * period * osc::params::kDt;
-    if (s->cut_s >= 0 && t > s->cut_s + 1e-9) return;
+    if (s->cut_s >= 0 && t > s->cut_s + 1e-9) return true;
     const std::vector<std::array<double, 7>>& p = s->path;
     const bool end = t >= p.back()[0] - 1e-9;
     std::size_t i = 1;
@@ -335,25 +478,36 @@ class Player {
       const double f = (t - p[i - 1][0]) / (p[i][0] - p[i - 1][0]);
       for (int c = 1; c < 7; ++c) x[c] = p[i - 1][c] + f * (p[i][c] - p[i - 1][c]);
     }
-    const Vec3 pos(x[1], x[2], x[3]), rpy(x[4], x[5], x[6]);
-    sim_.setpoint(stream_.id, pos, s->path_rpy ? &rpy : nullptr, end);
+    const osc::Vec3<double> pos(x[1], x[2], x[3]), rpy(x[4], x[5], x[6]);
+    const std::uint32_t id = stream_.id;
     ++stream_.sent;
     if (end) stream_.step = nullptr;
+    return arm_.setpoint(osc::setpoint_frame<double>(id, pos, s->path_rpy ? &rpy : nullptr, end), err);
   }
   void track();
   void log_state(double t) {
-    const char* name = osc::motion_name(sim_.task().machine.state);
+    const char* name = osc::motion_name(state_);
     if (run_.states.empty() || run_.states.back().state != name) run_.states.push_back({t, name});
   }
   MotionRun finish(double t, const char* result) {
     run_.duration_s = t;
     run_.result = run_.faults != 0 ? "faulted" : result;
+    arm_.finish(run_);
+    return run_;
+  }
+  /// The controller failed (it did not start, or its link was lost): the run ends there.
+  MotionRun fail(double t, const std::string& err) {
+    run_.error = err;
+    finish(t, "error");
+    run_.result = "error";
     return run_;
   }
 
   const MotionScript& script_;
-  MotionSim<S> sim_;
+  Arm arm_;
+  TickView view_;
   MotionRun run_;
+  osc::MotionState state_ = osc::MotionState::kDisabled;  // after the last tick
   std::size_t next_ = 0;
   double ready_s_ = -1;       // when the next step's condition held first (-1: not yet)
   bool was_powered_ = false;  // the torque was on before this tick (its step ran: a reference to track)
@@ -368,11 +522,19 @@ class Player {
   } stream_;
 };
 
-/// The tick's report into the records: answers, motions done or aborted, stops completed.
-template <class S>
-void Player<S>::observe(double t, std::uint32_t faults) {
-  run_.faults |= faults;
-  const osc::MotionReport& rep = sim_.task().report;
+/// The tick into the records: its answers, motions done or aborted, stops completed; the tracking.
+template <class Arm>
+void Player<Arm>::observe(double t) {
+  state_ = view_.state;
+  run_.faults |= view_.faults;
+  for (const osc::MotionReport& rep : view_.reports) observe(t, rep);
+  track();
+  log_state(t);
+}
+
+/// One answer into the records.
+template <class Arm>
+void Player<Arm>::observe(double t, const osc::MotionReport& rep) {
   if (CommandRecord* r = rep.outcome != osc::CommandOutcome::kNone ? record(rep.id) : nullptr) {
     r->answered_s = t;
     r->accepted = rep.outcome == osc::CommandOutcome::kAccepted;
@@ -381,7 +543,7 @@ void Player<S>::observe(double t, std::uint32_t faults) {
                         rep.verb == osc::MotionVerb::kStream;
     r->running = r->accepted && motion;
     // Done at once unless it started a motion or a stop (a stop or disable from holding has nothing to stop).
-    if (r->accepted && !motion && sim_.task().machine.state != osc::MotionState::kStopping) r->done_s = t;
+    if (r->accepted && !motion && state_ != osc::MotionState::kStopping) r->done_s = t;
   }
   if (CommandRecord* r = record(rep.done_id)) r->done_s = t, r->running = false;
   if (CommandRecord* r = rep.abort != osc::MotionReason::kNone ? record(rep.aborted_id) : nullptr)
@@ -394,26 +556,23 @@ void Player<S>::observe(double t, std::uint32_t faults) {
   if (rep.completion != osc::MotionCompletion::kNone)  // a stop or disable that reached rest
     for (CommandRecord& r : run_.commands)
       if (r.accepted && r.done_s < 0 && (r.cmd == "stop" || r.cmd == "disable")) r.done_s = t;
-  track();
-  log_state(t);
 }
 
 /// Tracking error and the reference's own maxima, into every command whose motion runs.
-template <class S>
-void Player<S>::track() {
-  if (!was_powered_ || !osc::motion_powered(sim_.task().machine.state)) {
+template <class Arm>
+void Player<Arm>::track() {
+  if (!was_powered_ || !osc::motion_powered(state_)) {
     have_prev_ = false;
     return;
   }
-  const osc::Desired<S>& d = sim_.task().desired;
-  const Vec6 x = sim_.pose();
-  const Vec6 xr = d.x.template cast<double>();
+  const Vec6& x = view_.pose;
+  const Vec6& xr = view_.x_d;
   const double e_mm = (xr.head<3>() - x.head<3>()).norm() * 1e3;
   const double e_deg = (xr.tail<3>() - x.tail<3>()).norm() / kDegToRad;
-  const osc::Vec3<double> v = d.xd.template head<3>().template cast<double>();
-  const osc::Vec3<double> a = d.xdd.template head<3>().template cast<double>();
+  const osc::Vec3<double> v = view_.xd_d.head<3>();
+  const osc::Vec3<double> a = view_.xdd_d.head<3>();
   const Mat3 Einv = osc::angular_to_phi_rate<double>(xr.tail<3>());
-  const osc::Vec3<double> w = Einv.inverse() * d.xd.template tail<3>().template cast<double>();
+  const osc::Vec3<double> w = Einv.inverse() * view_.xd_d.tail<3>();
   const double hz = osc::params::kControlHz;
   const double j = have_prev_ ? (a - a_prev_).norm() * hz : 0, wd = have_prev_ ? (w - w_prev_).norm() * hz : 0;
   a_prev_ = a, w_prev_ = w, have_prev_ = true;
@@ -430,9 +589,13 @@ void Player<S>::track() {
 }  // namespace
 
 MotionRun run_motion_script(const MotionScript& script, const ExperimentConfig& cfg) {
-  if (cfg.scalar == Scalar::kFloat) return Player<float>(script, cfg).run();
-  if (cfg.scalar == Scalar::kFixed) return Player<osc::Fixed>(script, cfg).run();
-  return Player<double>(script, cfg).run();
+  const auto wall0 = std::chrono::steady_clock::now();
+  MotionRun run = !cfg.pil_command.empty()       ? Player<LinkedArm>(script, cfg).run()
+                  : cfg.scalar == Scalar::kFloat ? Player<HostArm<float>>(script, cfg).run()
+                  : cfg.scalar == Scalar::kFixed ? Player<HostArm<osc::Fixed>>(script, cfg).run()
+                                                 : Player<HostArm<double>>(script, cfg).run();
+  run.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return run;
 }
 
 std::string motion_run_json(const MotionRun& run, const std::string& script_name, const ExperimentConfig& cfg) {
@@ -450,6 +613,7 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
     if (run.faults & (1u << i)) faults.push_back(osc::kFaultNames[i]);
   j["faults"] = faults;
   j["fault_s"] = run.fault_s >= 0 ? ordered_json(run.fault_s) : ordered_json(nullptr);
+  if (!run.error.empty()) j["error"] = run.error;
   auto time_or_null = [](double t) { return t >= 0 ? ordered_json(t) : ordered_json(nullptr); };
   auto name_or_null = [](const std::string& s) { return s.empty() ? ordered_json(nullptr) : ordered_json(s); };
   ordered_json cmds = ordered_json::array();
@@ -474,6 +638,20 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
   j["limits"] = {{"v", osc::params::kMoveLinear[0]},   {"a", osc::params::kMoveLinear[1]},
                  {"j", osc::params::kMoveLinear[2]},   {"w", osc::params::kMoveAngular[0]},
                  {"wd", osc::params::kMoveAngular[1]}, {"wdd", osc::params::kMoveAngular[2]}};
+  // How the run went, not what it did: the controller's kind and link, the wall-clock time (the
+  // same script's JSON in process and over the link differ in these only).
+  ordered_json ctl = {{"kind", run.controller}};
+  if (run.controller == "pil") {
+    ctl["command"] = run.pil_command;
+    ctl["link"] = {{"clean", run.link.clean()},
+                   {"zeroed_ticks", run.link.zeroed_ticks},
+                   {"first_zeroed", run.link.first_zeroed},
+                   {"firmware_errors", run.link.firmware.total()},
+                   {"host_errors", run.link.host.total()},
+                   {"rx_gap_max_cycles", run.link.rx_gap_max}};
+  }
+  j["controller"] = ctl;
+  j["wall_s"] = run.wall_s;
   return j.dump(2) + "\n";
 }
 

@@ -1,5 +1,7 @@
 // Scripted motions (puma_experiment --motion FILE.yaml): a list of timed commands played in
-// lockstep against the simulated arm (motion_sim.hpp), with what each command did.
+// lockstep against the simulated arm, with what each command did. The controller is the firmware's
+// control task in process (motion_sim.hpp) or a PIL image in QEMU over the link (pil_client.hpp,
+// --qemu); the commands reach either as command frames (osc/link/command_port.hpp).
 //
 // The script (docs/motion.md, "Scripted motions"; examples/*.yaml):
 //   start_pose: [q1, ..., q6]      optional, degrees; the robot's start pose by default
@@ -91,11 +93,19 @@ struct MotionRun {
   std::vector<Transition> states;
   std::uint32_t faults = 0;  ///< every fault bit seen
   double fault_s = -1;
-  std::string result;  ///< "ok", "faulted" or "timeout"
+  std::string result;  ///< "ok", "faulted", "timeout", or "error" (the controller failed: error)
+  std::string error;   ///< why the controller failed (it did not start, its link was lost)
   double duration_s = 0, max_error_mm = 0, max_error_deg = 0;
+  std::string controller;   ///< "in-process", or "pil" (a PIL image or peer over the link)
+  std::string pil_command;  ///< pil: the program that ran it (qemu-system-arm, a peer)
+  LinkReport link;          ///< pil: the link's health
+  double wall_s = 0;        ///< wall-clock time of the run [s]
 };
 
-/// Plays the script in the given scalar against the simulated arm (plant set-up from cfg).
+/// Plays the script against the simulated arm (plant set-up from cfg): with cfg.pil_command, the
+/// controller of that PIL image or peer over the link (docs/motion.md, "Scripted motions"),
+/// otherwise the in-process controller in cfg.scalar. The same script gives the same run either
+/// way when the controller computes the same (fixed point; the host's PIL peer in float).
 MotionRun run_motion_script(const MotionScript& script, const ExperimentConfig& cfg);
 
 /// The run as JSON text (commands[], states[], faults, result).

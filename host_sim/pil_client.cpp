@@ -18,7 +18,7 @@
 
 namespace sim {
 
-RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, FirmwareFrame& f,
                               pil::LinkCounters& counters, std::string& err) {
   while (pos < len) {
     const pil::Parser::Result r = parser.feed(bytes[pos++]);
@@ -29,8 +29,10 @@ RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
         counters[pil::kErrJunk] += static_cast<std::uint32_t>(parser.junk());
         break;
       case pil::Parser::kFrame:
-        if (parser.decode(f)) return RxResult::kFrame;
-        ++counters[pil::kErrHeader];
+        f.type = parser.type();
+        if (parser.decode(f.actuator) || parser.decode(f.answer) || parser.decode(f.state) || parser.decode(f.trace))
+          return RxResult::kFrame;
+        ++counters[pil::kErrHeader];  // a type the host sends
         return err = "unexpected frame type from the firmware", RxResult::kError;
       case pil::Parser::kBadChecksum:
       case pil::Parser::kBadHeader:
@@ -43,6 +45,28 @@ RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
     }
   }
   return RxResult::kNeedMore;
+}
+
+namespace {
+void file_reply(const FirmwareFrame& f, PilReplies& replies) {
+  if (f.type == pil::kAnswerFrame) replies.answers.push_back(f.answer);
+  if (f.type == pil::kStateFrame) replies.states.push_back(f.state);
+  if (f.type == pil::kTraceFrame) replies.traces.push_back(f.trace);
+}
+}  // namespace
+
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+                              pil::LinkCounters& counters, std::string& err, PilReplies* replies) {
+  FirmwareFrame ff;
+  for (;;) {
+    const RxResult r = parse_firmware_bytes(parser, bytes, len, pos, ff, counters, err);
+    if (r != RxResult::kFrame) return r;
+    if (ff.type == pil::kActuatorFrame) {
+      f = ff.actuator;
+      return r;
+    }
+    if (replies) file_reply(ff, *replies);
+  }
 }
 
 PilClient::~PilClient() { stop(); }
@@ -205,6 +229,8 @@ bool PilClient::start(const std::vector<std::string>& argv, std::string& err, do
   signal(SIGPIPE, SIG_IGN);  // a dead peer is an error return, not a signal
   parser_.reset();
   rx_len_ = rx_pos_ = 0;
+  replies_.clear();
+  sensor_sent_ = traced_ = false;
   pil::ActuatorFrame hello;
   if (!receive(hello, ready_timeout_s, err)) return err = "firmware not ready: " + err, false;
   if (hello.seq != pil::kHelloSeq) return err = "firmware did not start with its hello frame", false;
@@ -224,21 +250,48 @@ bool PilClient::send_raw(const std::uint8_t* p, int n, std::string& err) {
   return true;
 }
 
-bool PilClient::send(const pil::SensorFrame& f, std::string& err) {
+template <class F>
+bool PilClient::send_frame(const F& f, std::string& err) {
   std::uint8_t buf[pil::kMaxFrame];
   return send_raw(buf, pil::encode(f, buf), err);
 }
 
+bool PilClient::send(const pil::SensorFrame& f, std::string& err) {
+  if (!sensor_sent_) traced_ = (f.inject & pil::kConfigTrace) != 0;  // the first one configures the session
+  sensor_sent_ = true;
+  return send_frame(f, err);
+}
+bool PilClient::send(const pil::CommandFrame& f, std::string& err) { return send_frame(f, err); }
+bool PilClient::send(const pil::SetpointFrame& f, std::string& err) { return send_frame(f, err); }
+
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
-  return receive_frame(f, timeout_s, err) == Rx::kFrame;
+  return receive_actuator(f, timeout_s, err) == Rx::kFrame;
 }
 
-PilClient::Rx PilClient::receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
+void PilClient::keep(const FirmwareFrame& f) { file_reply(f, replies_); }
+
+PilClient::Rx PilClient::receive_actuator(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    FirmwareFrame ff;
+    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+    const Rx r = receive_frame(ff, std::max(left, 0.0), err);
+    if (r != Rx::kFrame) return r;
+    if (ff.type == pil::kActuatorFrame) {
+      f = ff.actuator;
+      return r;
+    }
+    keep(ff);
+  }
+}
+
+PilClient::Rx PilClient::receive_frame(FirmwareFrame& f, double timeout_s, std::string& err) {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
-    switch (parse_actuator_bytes(parser_, rx_, rx_len_, rx_pos_, f, counters_, err)) {
+    switch (parse_firmware_bytes(parser_, rx_, rx_len_, rx_pos_, f, counters_, err)) {
       case RxResult::kFrame:
         return Rx::kFrame;
       case RxResult::kError:
@@ -285,7 +338,7 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
     for (;;) {
       pil::ActuatorFrame f;
       const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
-      const Rx r = receive_frame(f, std::max(left, 0.0), err);
+      const Rx r = receive_actuator(f, std::max(left, 0.0), err);
       if (r != Rx::kFrame) {
         x = r == Rx::kCorrupt ? Exchange::kZeroed : Exchange::kLost;
         break;
@@ -310,6 +363,27 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
         x = Exchange::kApplied;
       }
       break;
+    }
+  }
+  // A traced session: the tick's frames end with its trace frame (after its answer and state frames).
+  if (traced_ && x != Exchange::kLost) {
+    for (;;) {
+      FirmwareFrame f;
+      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+      std::string why;
+      const Rx r = receive_frame(f, std::max(left, 0.0), why);
+      if (r == Rx::kCorrupt) continue;  // counted; the trace may still come
+      if (r != Rx::kFrame) {
+        err = "no trace frame for sensor frame " + std::to_string(s.seq) + ": " + why;
+        x = Exchange::kLost;
+        break;
+      }
+      if (f.type == pil::kActuatorFrame) {  // a stray answer (counted, not applied)
+        ++counters_[pil::kErrSeq];
+        continue;
+      }
+      keep(f);
+      if (f.type == pil::kTraceFrame && f.trace.seq == s.seq) break;
     }
   }
   if (x != Exchange::kApplied)

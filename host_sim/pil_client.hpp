@@ -3,6 +3,12 @@
 // one sensor frame and one actuator frame per tick. Every wait is bounded; errors are reported as
 // text and counted by kind. exchange() is the amplifiers' input: the codes it returns are those of
 // a valid, in-range answer to the tick's sensor frame, or all zero.
+//
+// The command protocol (docs/protocol.md): send() takes command and setpoint frames too, and the
+// firmware's answer, state and trace frames, interleaved with its actuator frames, are collected
+// (replies(), take_replies()) instead of being errors. When the session's first sensor frame asked
+// for trace frames (pil::kConfigTrace), exchange() waits for the tick's trace frame as well, the last
+// frame the firmware writes for a tick: every frame of the tick is then in replies().
 #pragma once
 
 #include <string>
@@ -27,12 +33,36 @@ bool parse_pil_link(const std::string& text, PilLink& link);
 /// is not a 32-bit little-endian ARM ELF image, or an architecture with no machine here.
 std::string qemu_machine(const std::string& elf, std::string& err);
 
-/// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until an actuator
-/// frame completes (kFrame, decoded into f) or the link is corrupt (kError, message in err); pos
-/// advances past the bytes consumed, so bytes after a frame stay for the next call. Every error and
-/// every junk byte is counted in counters, by kind.
-RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+/// The command protocol's frames from the firmware (answer, state, trace), in the order each type
+/// arrived.
+struct PilReplies {
+  std::vector<pil::AnswerFrame> answers;
+  std::vector<pil::StateFrame> states;
+  std::vector<pil::TraceFrame> traces;
+  bool empty() const { return answers.empty() && states.empty() && traces.empty(); }
+  void clear() { answers.clear(), states.clear(), traces.clear(); }
+};
+
+/// A frame of a type the firmware sends: its type, and the frame of that type decoded.
+struct FirmwareFrame {
+  pil::FrameType type = pil::kActuatorFrame;
+  pil::ActuatorFrame actuator;
+  pil::AnswerFrame answer;
+  pil::StateFrame state;
+  pil::TraceFrame trace;
+};
+
+/// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until a frame of a
+/// type the firmware sends completes (kFrame, decoded into f) or the link is corrupt (kError,
+/// message in err: a bad frame, or a valid frame of a type the host sends); pos advances past the
+/// bytes consumed, so bytes after a frame stay for the next call. Every error and every junk byte
+/// is counted in counters, by kind.
+RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, FirmwareFrame& f,
                               pil::LinkCounters& counters, std::string& err);
+/// The same up to an actuator frame (kFrame, decoded into f): the command protocol's frames before
+/// it go to replies (when not null) and are no error.
+RxResult parse_actuator_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, pil::ActuatorFrame& f,
+                              pil::LinkCounters& counters, std::string& err, PilReplies* replies = nullptr);
 
 class PilClient {
  public:
@@ -52,10 +82,17 @@ class PilClient {
   static std::vector<std::string> qemu_command(const std::string& qemu, const std::string& elf, PilLink link,
                                                std::string& err);
 
+  /// Sends a sensor frame. The session's first one sets what the exchanges wait for: with
+  /// pil::kConfigTrace in its inject byte, every exchange also waits for the tick's trace frame.
   bool send(const pil::SensorFrame& f, std::string& err);
+  /// Sends a command or a setpoint frame (the command protocol: before the sensor frame of the tick
+  /// that is to take it).
+  bool send(const pil::CommandFrame& f, std::string& err);
+  bool send(const pil::SetpointFrame& f, std::string& err);
   bool send_raw(const std::uint8_t* p, int n, std::string& err);
   /// Waits up to timeout_s (wall clock) for one actuator frame; false on a corrupt frame (bad CRC,
-  /// header or length), on silence and when the peer is gone. Junk between frames is skipped.
+  /// header or length), on silence and when the peer is gone. Junk between frames is skipped; the
+  /// command protocol's frames before it are collected in replies().
   bool receive(pil::ActuatorFrame& f, double timeout_s, std::string& err);
 
   enum class Exchange {
@@ -66,8 +103,18 @@ class PilClient {
   /// One tick: sends s and waits up to timeout_s for its answer; earlier answers still in the pipe
   /// (e.g. to a silence) are skipped. a.codes are what the amplifiers apply: the answer's if it is
   /// kApplied, otherwise all zero (err says why; the counters count it). The rest of a is the
-  /// answer's telemetry when a readable answer came, else untouched.
+  /// answer's telemetry when a readable answer came, else untouched. The command protocol's frames
+  /// that came with it are in replies(); in a traced session (send) the exchange ends with the
+  /// tick's trace frame, and a trace that does not come in time makes it kLost.
   Exchange exchange(const pil::SensorFrame& s, pil::ActuatorFrame& a, double timeout_s, std::string& err);
+  /// The command protocol's frames received so far (since the last take_replies()).
+  const PilReplies& replies() const { return replies_; }
+  /// Hands them over and starts collecting anew.
+  PilReplies take_replies() {
+    PilReplies r = std::move(replies_);
+    replies_.clear();
+    return r;
+  }
   /// Every code of a within the DAC range [-kDacMaxCode, kDacMaxCode].
   static bool codes_in_range(const pil::ActuatorFrame& a);
 
@@ -92,9 +139,19 @@ class PilClient {
   int wait_status_ = 0;
   int to_child_ = -1, from_child_ = -1;
   enum class Rx { kFrame, kCorrupt, kSilent, kGone };
-  Rx receive_frame(pil::ActuatorFrame& f, double timeout_s, std::string& err);
+  /// The next frame of a type the firmware sends.
+  Rx receive_frame(FirmwareFrame& f, double timeout_s, std::string& err);
+  /// The next actuator frame; the command protocol's frames before it into replies_.
+  Rx receive_actuator(pil::ActuatorFrame& f, double timeout_s, std::string& err);
+  /// Files a frame of the command protocol into replies_.
+  void keep(const FirmwareFrame& f);
+  template <class F>
+  bool send_frame(const F& f, std::string& err);
 
   pil::Parser parser_;
+  PilReplies replies_;
+  bool sensor_sent_ = false;  // the session's first sensor frame has gone
+  bool traced_ = false;       // it asked for trace frames: an exchange ends with the tick's trace
   pil::LinkCounters counters_;
   std::uint32_t code_range_errors_ = 0;
   std::uint8_t rx_[512];

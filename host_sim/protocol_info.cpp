@@ -131,6 +131,13 @@ json command_protocol() {
   for (int i = 0; i < pil::kCommandFlagCount; ++i)
     j["flags"].push_back(
         {{"bit", i}, {"mask", 1 << i}, {"name", pil::kCommandFlagNames[i]}, {"doc", pil::kCommandFlagDocs[i]}});
+  j["setpoint_flags"] = json::array();
+  for (int i = 0; i < pil::kSetpointFlagCount; ++i)
+    j["setpoint_flags"].push_back(
+        {{"bit", i}, {"mask", 1 << i}, {"name", pil::kSetpointFlagNames[i]}, {"doc", pil::kSetpointFlagDocs[i]}});
+  j["stream_max_period"] = pil::kStreamMaxPeriod;
+  j["state_period"] = osc::kStatePeriod;
+  j["command_fifo"] = osc::kCommandFifo;
   j["max_position"] = pil::kCommandMaxPosition;
   j["max_angle"] = pil::kCommandMaxAngle;
   const auto lim = osc::CartesianLimits<double>::defaults();
@@ -239,6 +246,9 @@ int main(int argc, char** argv) {
       {"poly", 0x1021}, {"init", 0xFFFF}, {"check", pil::crc16(reinterpret_cast<const std::uint8_t*>(check), 9)}};
   j["inject"] = {{"non_finite", pil::kInjectNonFinite},
                  {"overrun", pil::kInjectOverrun},
+                 {"trace", pil::kConfigTrace},
+                 {"state_frames", pil::kConfigStateFrames},
+                 {"start_disabled", pil::kConfigStartDisabled},
                  {"adaptation_shift", pil::kConfigAdaptationShift},
                  {"adaptation_mask", pil::kConfigAdaptationMask},
                  {"no_compensation", pil::kConfigNoCompensation}};

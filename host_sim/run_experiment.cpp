@@ -135,10 +135,15 @@ int prepare(Options& o, int& json_fd) {
     if (access(o.elf.c_str(), R_OK) != 0)
       return fail("firmware image " + o.elf +
                   " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
-    // The M4F firmware computes in float (the M3 image in fixed point: --scalar fixed says so).
-    if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = sim::Scalar::kFloat;
     o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf, o.pil_link, err);
     if (o.base.pil_command.empty()) return fail(err);
+    // The image's scalar: float on the M4F (mps2-an386), fixed point on the M3 (mps2-an385).
+    const sim::Scalar image = sim::qemu_machine(o.elf, err) == "mps2-an385" ? sim::Scalar::kFixed : sim::Scalar::kFloat;
+    if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = image;
+    // A script's JSON names the scalar it ran in, to be compared with the in-process run of it.
+    if (!o.motion.empty() && o.base.scalar != image)
+      return fail(std::string("--scalar ") + sim::kScalarNames[static_cast<int>(o.base.scalar)] + ": the image " +
+                  o.elf + " computes in " + sim::kScalarNames[static_cast<int>(image)]);
   }
   if (o.csv) {
     // No shell: the name is a path, never a command.
@@ -216,8 +221,9 @@ int write_outputs(const Options& o, const std::vector<sim::ExperimentResult>& ru
   return 0;
 }
 
-/// --motion: plays the script on the simulated arm, prints a line per command, writes the JSON. 0: the
-/// script ran without a fault; 1: a fault or a timeout; 2: a bad script or output.
+/// --motion: plays the script on the simulated arm (with --qemu, against the firmware image over the
+/// link), prints a line per command, writes the JSON. 0: the script ran without a fault; 1: a fault,
+/// a timeout or a failed link; 2: a bad script or output.
 int run_motion(const Options& o, int json_fd) {
   std::string text, err;
   {
@@ -232,10 +238,15 @@ int run_motion(const Options& o, int json_fd) {
   if (!sim::parse_motion_script(text, o.motion, script, err)) return fail(err);
   sim::ExperimentConfig cfg = o.base;
   cfg.mode = o.run_adaptive ? osc::FrictionMode::kAdaptive : osc::FrictionMode::kNone;
+  // The image's encoders read zero at the robot's start pose, which it compiles in.
+  if (o.qemu && script.start_pose && *script.start_pose != cfg.q_start)
+    return fail(o.motion + ": start_pose: the firmware image starts at the robot's start pose (not with --qemu)");
   const sim::MotionRun run = sim::run_motion_script(script, cfg);
-  std::printf("motion script %s (%s, %s): %s after %.3f s; max tracking error %.3f mm, %.3f deg\n", o.motion.c_str(),
+  if (!run.error.empty()) std::fprintf(stderr, "puma_experiment: %s\n", run.error.c_str());
+  std::printf("motion script %s (%s, %s, %s): %s after %.3f s (%.1f s wall); max tracking error %.3f mm, %.3f deg\n",
+              o.motion.c_str(), o.qemu ? ("firmware image " + o.elf).c_str() : "in process",
               sim::kScalarNames[static_cast<int>(cfg.scalar)], sim::mode_name(cfg.mode), run.result.c_str(),
-              run.duration_s, run.max_error_mm, run.max_error_deg);
+              run.duration_s, run.wall_s, run.max_error_mm, run.max_error_deg);
   for (const sim::CommandRecord& r : run.commands) {
     std::printf("  %6.3f s  %-8s %-9s", r.sent_s, r.cmd.c_str(),
                 r.accepted ? "accepted" : ("refused " + r.refused).c_str());
@@ -252,7 +263,9 @@ int run_motion(const Options& o, int json_fd) {
     if (!ok) return fail_output(err);
     std::printf("summary: %s\n", o.json.c_str());
   }
-  return run.result == "ok" ? 0 : 1;
+  if (run.controller == "pil" && !run.link.clean())
+    std::fprintf(stderr, "puma_experiment: link errors (%s)\n", run.link.first_zeroed.c_str());
+  return run.result == "ok" && (run.controller != "pil" || run.link.clean()) ? 0 : 1;
 }
 
 }  // namespace

@@ -203,6 +203,7 @@ int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
       }
     sim.tick();
     port.after_tick(sim.task(), write);
+    port.poll(sim.task(), write);  // the next waiting command into the freed mailbox
     pty.flush();
   }
   const double wall = wall_seconds() - t0;

@@ -724,6 +724,12 @@ def t_protocol_flags():
             "tick (the fault it must raise: non_finite, or overflow in fixed point) |",
             f"| 1 | `{hexs(i['overrun'])}` | overrun | test builds: burn more than one control period inside this tick "
             "(the overrun fault) |",
+            f"| 2 | `{hexs(i['trace'])}` | trace | first frame only: a trace frame after every tick, the last of "
+            "the tick's frames (Trace frame) |",
+            f"| 3 | `{hexs(i['state_frames'])}` | state_frames | first frame only: a state frame every "
+            f"{p['command']['state_period']} ticks, after that tick's actuator and answer frames; none otherwise |",
+            f"| 4 | `{hexs(i['start_disabled'])}` | start_disabled | first frame only: the task starts disabled, "
+            "waiting for an enable command; otherwise it runs the paper's motion from the first sample |",
             f"| {shift}-{hi} | `{hexs(mask)}` | adaptation | first frame only: the adaptation law + 1 ({law_values}); "
             f"0 keeps the firmware's default ({p['default_adaptation']}) |",
             f"| 7 | `{hexs(i['no_compensation'])}` | no_compensation | first frame only: run without friction "
@@ -771,6 +777,11 @@ def t_protocol_setpoint_flags():
     return markdown_table(["bit", "mask", "name", "meaning"], rows)
 
 
+@table("protocol_trace", "docs/protocol.md", "protocol")
+def t_protocol_trace():
+    return field_rows(protocol()["trace_fields"])
+
+
 @table("protocol_command_flags", "docs/protocol.md", "protocol")
 def t_protocol_command_flags():
     flags = protocol()["command"]["flags"]
@@ -789,6 +800,7 @@ def t_protocol_command_checks():
             ("`position`", f"each coordinate within ±{c['max_position']:g} m", "`bad_command`"),
             ("`rpy`", f"each angle within ±2π rad (±{c['max_angle']:.6f})", "`bad_command`"),
             ("`limits`, with `has_limits`", "each above 0", "`bad_command`"),
+            ("`period`, with verb stream", f"1 to {c['stream_max_period']} ms", "`bad_command`"),
             ("`limits`, with `has_limits`", f"each at most the configured maximum: linear {lin[0]:g} m/s, "
              f"{lin[1]:g} m/s², {lin[2]:g} m/s³; angular {ang[0]:g} rad/s, {ang[1]:g} rad/s², {ang[2]:g} rad/s³",
              "`over_limit`"),

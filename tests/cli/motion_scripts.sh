@@ -3,6 +3,8 @@
 # --motion (host_sim/motion_script.cpp, docs/motion.md "Scripted motions"): the example tour runs
 # without a fault in each scalar, its references within their limits and its moves tracked within
 # 1 mm; a bad script is exit status 2 with one message naming the step and the key, before any run.
+# With a PIL image (the m4f and m3 presets' tests, boards/common/mps2/mps2.cmake): the tour on the
+# image in QEMU against the in-process run in its scalar (--qemu), and what --qemu refuses.
 # Exit 0: pass; anything else: fail, with the reason.
 set -u
 exe=$1 py=$2 examples=$3 case=$4
@@ -30,14 +32,15 @@ j = json.load(open(sys.argv[1]))
 assert j["result"] == "ok" and j["faults"] == [], (j["result"], j["faults"])
 L = j["limits"]
 cmds = j["commands"]
-assert {c["cmd"] for c in cmds} >= {"enable", "paper", "move_to", "stop", "disable"}, cmds
+assert {c["cmd"] for c in cmds} >= {"enable", "paper", "move_to", "stop", "disable", "stream"}, cmds
 for c in cmds:
     assert c["accepted"] and c["refused"] is None, c
     assert c["done_s"] is not None or c["aborted"] is not None, c
-    if c["cmd"] == "move_to":
+    if c["cmd"] in ("move_to", "stream"):
         for k in ("v", "a", "j", "w", "wd"):
             assert c["reference_max"][k] <= L[k] * (1 + 1e-9), (k, c)
         assert c["max_error_mm"] <= 1.0, c
+assert [c["done_s"] is not None for c in cmds if c["cmd"] == "stream"] == [True], cmds
 aborted = sorted(c["aborted"] for c in cmds if c["aborted"])
 assert aborted == ["stop_command", "stop_command", "superseded"], aborted
 states = [s["state"] for s in j["states"]]
@@ -98,10 +101,77 @@ no_steps)
 - {at: 0, cmd: enable}
 YAML
   ;;
-with_qemu)  # refused until the command frames reach the image
-  out=$("$exe" --motion "$examples/motion_tour.yaml" --qemu 2>&1)
+with_qemu_needs_the_image)  # --qemu plays scripts too; without the image it says so, before anything runs
+  out=$("$exe" --motion "$examples/motion_tour.yaml" --qemu --elf "$d/none.elf" --json "$d/out.json" 2>&1)
   test $? -eq 2 || fail "exit status not 2: $out"
-  grep -qF -- '--motion runs the host-built controller' <<<"$out" || fail "$out"
+  grep -qF -- "firmware image $d/none.elf not found" <<<"$out" || fail "$out"
+  test ! -e "$d/out.json" || fail "a JSON was written"
+  ;;
+qemu_tour)  # ELF SCALAR: the tour on the image in QEMU, and in process in the image's scalar: the same
+  # JSON but for the controller and the wall time; in float (the M4F) the same events at the same
+  # ticks, the figures within the float's spread (docs/motion.md, "Scripts on the QEMU images").
+  elf=$1 scalar=$2
+  "$exe" --motion "$examples/motion_tour.yaml" --scalar "$scalar" --json "$d/host.json" >"$d/host.txt" 2>&1 ||
+    fail "in process: exit $?: $(cat "$d/host.txt")"
+  "$exe" --motion "$examples/motion_tour.yaml" --qemu --elf "$elf" --scalar "$scalar" --json "$d/qemu.json" \
+    >"$d/qemu.txt" 2>&1 || fail "QEMU: exit $?: $(cat "$d/qemu.txt")"
+  cat "$d/qemu.txt"
+  "$py" - "$d/host.json" "$d/qemu.json" "$scalar" <<'PY' || fail "the runs differ"
+import json, sys
+host, qemu = (json.load(open(f)) for f in sys.argv[1:3])
+exact = sys.argv[3] == "fixed"
+assert host["controller"]["kind"] == "in-process", host["controller"]
+assert qemu["controller"]["kind"] == "pil" and qemu["controller"]["link"]["clean"], qemu["controller"]
+assert qemu["result"] == "ok" and qemu["faults"] == [], (qemu["result"], qemu["faults"])
+assert len(qemu["commands"]) == 13 and qemu["commands"][-2]["cmd"] == "stream", qemu["commands"]
+for j in (host, qemu):
+    del j["controller"], j["wall_s"]
+if exact:
+    if host != qemu:
+        for k in host:
+            if host[k] != qemu[k]:
+                print("differs:", k, host[k] if k != "commands" else "", qemu[k] if k != "commands" else "")
+        for a, b in zip(host["commands"], qemu["commands"]):
+            for k in a:
+                if a[k] != b[k]:
+                    print("command", a["id"], k, a[k], b[k])
+        sys.exit(1)
+    print("bit for bit: the tour's JSON in process and on the image,", len(host["commands"]), "commands")
+    sys.exit(0)
+# Float: what happened and when, exactly; the figures within the float's spread.
+events = ("cmd", "step", "id", "sent_s", "answered_s", "accepted", "refused", "done_s", "aborted", "aborted_s")
+for k in ("script", "scalar", "mode", "result", "duration_s", "faults", "fault_s", "states", "limits"):
+    assert host[k] == qemu[k], (k, host[k], qemu[k])
+worst = {"mm": 0.0, "deg": 0.0, "ref": 0.0}
+for a, b in zip(host["commands"], qemu["commands"]):
+    for k in events:
+        assert a[k] == b[k], ("command", a["id"], k, a[k], b[k])
+    worst["mm"] = max(worst["mm"], abs(a["max_error_mm"] - b["max_error_mm"]))
+    worst["deg"] = max(worst["deg"], abs(a["max_error_deg"] - b["max_error_deg"]))
+    for k in ("v", "a", "j", "w", "wd"):
+        worst["ref"] = max(worst["ref"], abs(a["reference_max"][k] - b["reference_max"][k]) / host["limits"][k])
+for a, b in ((host, qemu),):
+    worst["mm"] = max(worst["mm"], abs(a["max_error_mm"] - b["max_error_mm"]))
+    worst["deg"] = max(worst["deg"], abs(a["max_error_deg"] - b["max_error_deg"]))
+print("same events and times; largest differences: tracking %.4f mm, %.4f deg; reference maxima %.2e of the limit"
+      % (worst["mm"], worst["deg"], worst["ref"]))
+assert worst["mm"] <= 0.15 and worst["deg"] <= 0.03 and worst["ref"] <= 1e-3, worst
+PY
+  ;;
+qemu_wrong_scalar)  # ELF WRONG_SCALAR: a script's JSON names its scalar: the image's or nothing
+  out=$("$exe" --motion "$examples/motion_tour.yaml" --qemu --elf "$1" --scalar "$2" 2>&1)
+  test $? -eq 2 || fail "exit status not 2: $out"
+  grep -qF -- "--scalar $2: the image $1 computes in" <<<"$out" || fail "$out"
+  ;;
+qemu_start_pose)  # ELF: the image's encoders read zero at the robot's start pose, which it compiles in
+  cat >"$d/s.yaml" <<'YAML'
+start_pose: [10, 45, -180, 0, 45, 0]
+steps:
+  - {at: 0, cmd: enable}
+YAML
+  out=$("$exe" --motion "$d/s.yaml" --qemu --elf "$1" 2>&1)
+  test $? -eq 2 || fail "exit status not 2: $out"
+  grep -qF -- "start_pose: the firmware image starts at the robot's start pose" <<<"$out" || fail "$out"
   ;;
 *)
   fail "unknown case"

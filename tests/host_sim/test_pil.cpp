@@ -8,9 +8,14 @@
 #include <memory>
 #include <thread>
 
+#include <fstream>
+#include <nlohmann/json.hpp>
+
 #include "experiment.hpp"
 #include "frame_json.hpp"
+#include "motion_script.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/commands.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
@@ -270,6 +275,95 @@ TEST(PilClientAmplifiers, TheRunnerZeroesTheTickAndReportsIt) {
   EXPECT_FALSE(r.link.clean());
 }
 
+// ---------------------------------------------------------------- the command protocol's frames from the peer
+/// A scripted peer that writes frames of any type the firmware sends.
+struct ReplyingPeer : ScriptedPeer {
+  template <class F>
+  void add_frame(const F& f) {
+    std::uint8_t buf[pil::kMaxFrame];
+    bytes.insert(bytes.end(), buf, buf + pil::encode(f, buf));
+  }
+  static pil::AnswerFrame answer_of(std::uint32_t id) {
+    pil::AnswerFrame a;
+    a.id = id;
+    a.outcome = static_cast<std::uint8_t>(osc::CommandOutcome::kAccepted);
+    return a;
+  }
+  static pil::TraceFrame trace_of(std::uint32_t seq) {
+    pil::TraceFrame t;
+    t.seq = seq;
+    t.x_d[0] = 0.5f + static_cast<float>(seq);
+    return t;
+  }
+};
+
+TEST(PilClientReplies, AnswerStateAndTraceFramesComeWithTheExchangeThatEndsWithTheTrace) {
+  using X = PilClient::Exchange;
+  ReplyingPeer peer;
+  peer.add_frame(ReplyingPeer::answer_of(5));  // a refusal at once, before the tick's actuator frame
+  peer.add(ScriptedPeer::answer(0, 10));
+  peer.add_frame(ReplyingPeer::answer_of(6));
+  peer.add_frame(pil::StateFrame{});
+  peer.add_frame(ReplyingPeer::trace_of(0));
+  peer.add(ScriptedPeer::answer(1, 20));
+  peer.add_frame(ReplyingPeer::trace_of(1));
+  peer.add(ScriptedPeer::answer(2, 30));  // no trace: the exchange waits for it in vain
+  PilClient c;
+  std::string err;
+  ASSERT_TRUE(c.start(peer.command(), err, 5.0)) << err;
+  pil::SensorFrame s;
+  s.inject = pil::kConfigTrace;  // the session's first frame asks for traces
+  pil::ActuatorFrame a;
+  ASSERT_EQ(c.exchange(s, a, 2.0, err), X::kApplied) << err;
+  EXPECT_EQ(a.codes[0], 10);
+  PilReplies r = c.take_replies();
+  ASSERT_EQ(r.answers.size(), 2u);
+  EXPECT_EQ(r.answers[0].id, 5u);
+  EXPECT_EQ(r.answers[1].id, 6u);
+  EXPECT_EQ(r.states.size(), 1u);
+  ASSERT_EQ(r.traces.size(), 1u);
+  EXPECT_EQ(r.traces[0].x_d[0], 0.5f);
+  EXPECT_TRUE(c.replies().empty());
+  s.seq = 1;
+  s.inject = 0;
+  ASSERT_EQ(c.exchange(s, a, 2.0, err), X::kApplied) << err;
+  r = c.take_replies();
+  ASSERT_EQ(r.traces.size(), 1u);
+  EXPECT_EQ(r.traces[0].seq, 1u);
+  s.seq = 2;
+  EXPECT_EQ(c.exchange(s, a, 0.3, err), X::kLost);
+  EXPECT_NE(err.find("no trace frame for sensor frame 2"), std::string::npos) << err;
+  for (int e = 0; e < pil::kLinkErrorKinds; ++e) {  // the command protocol's frames are no errors
+    if (e == pil::kErrSilence) continue;
+    EXPECT_EQ(c.link_counters().count[e], 0u) << pil::kLinkErrorNames[e];
+  }
+}
+
+TEST(PilClientReplies, WithoutTracesTheExchangeEndsAtTheActuatorFrameAndAHostFrameTypeIsAnError) {
+  using X = PilClient::Exchange;
+  ReplyingPeer peer;
+  peer.add(ScriptedPeer::answer(0, 10));
+  peer.add_frame(ReplyingPeer::answer_of(6));  // after tick 0's actuator frame: collected with tick 1's
+  peer.add(ScriptedPeer::answer(1, 20));
+  peer.add_frame(pil::CommandFrame{});  // a frame only a host sends: corrupt
+  peer.add(ScriptedPeer::answer(2, 30));
+  PilClient c;
+  std::string err;
+  ASSERT_TRUE(c.start(peer.command(), err, 5.0)) << err;
+  pil::SensorFrame s;
+  pil::ActuatorFrame a;
+  ASSERT_EQ(c.exchange(s, a, 2.0, err), X::kApplied) << err;
+  EXPECT_TRUE(c.replies().empty());
+  s.seq = 1;
+  ASSERT_EQ(c.exchange(s, a, 2.0, err), X::kApplied) << err;
+  ASSERT_EQ(c.replies().answers.size(), 1u);
+  EXPECT_EQ(c.replies().answers[0].id, 6u);
+  s.seq = 2;
+  EXPECT_EQ(c.exchange(s, a, 2.0, err), X::kZeroed);
+  EXPECT_NE(err.find("unexpected frame type"), std::string::npos) << err;
+  EXPECT_EQ(c.link_counters()[pil::kErrHeader], 1u);
+}
+
 // ---------------------------------------------------------------- link with a live peer
 std::vector<std::uint8_t> with(std::vector<std::uint8_t> b, std::size_t at, std::uint8_t xor_mask) {
   b[at] ^= xor_mask;
@@ -382,7 +476,7 @@ TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
 
 TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
   healthy(5);
-  expect_zeroed_once(answer(with(frame(), 2, 0x70)), pil::kErrHeader);                       // unknown frame type
+  expect_zeroed_once(answer(with(frame(), 2, 0x0E)), pil::kErrHeader);                       // type 0x0F: unknown
   EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
 }
 
@@ -581,6 +675,96 @@ TEST(PilQemu, TheMachineIsTheImagesCore) {
   EXPECT_NE(err.find("not a 32-bit little-endian ARM ELF"), std::string::npos) << err;
   EXPECT_EQ(qemu_machine("/nonexistent.elf", err), "");
   EXPECT_NE(err.find("cannot read"), std::string::npos) << err;
+}
+
+// A motion script over the link (puma_experiment --motion --qemu): the same commands, answered in the
+// same ticks, the same states at the same times as in process. The host's peer (float, the same code
+// and compiler) and the M3 image (fixed point, integer arithmetic) give the in-process run bit for
+// bit, every tracking figure included; the M4F image's float differs from the host's in the last bits
+// (contracted multiply-adds, its libm: PilClosedLoop above), and its tracking figures with them.
+TEST(PilMotion, AScriptOverTheLinkRunsAsInProcess) {
+  const PatientPeer patient;
+  const std::string dir = ::testing::TempDir();
+  {
+    std::ofstream csv(dir + "pil_motion_stream.csv");
+    csv << "t, x, y, z\n0, 0, 0, 0\n0.3, 0, 0.01, 0\n0.6, 0, 0.01, 0.01\n";
+  }
+  const std::string yaml = R"(
+steps:
+  - {at: 0.0, cmd: enable}
+  - {at: 0.1, cmd: move_to, position: [0.03, -0.02, 0.01], relative: true, rpy_deg: [0, 0, 5], v: 0.08}
+  - {after: answered, delay: 0.4, cmd: move_to, position: [0.0, 0.02, 0.0], relative: true, replace: true}
+  - {after: answered, cmd: move_to, position: [0.0, 0.0, 0.02], relative: true}
+  - {after: done, cmd: stream, file: pil_motion_stream.csv, rate_hz: 100, relative: true}
+  - {after: done, cmd: move_to, position: [0.0, 0.0, -0.05], relative: true}
+  - {after: answered, delay: 0.2, cmd: stop}
+  - {after: done, cmd: disable}
+settle: 0.2
+)";
+  MotionScript script;
+  std::string err;
+  ASSERT_TRUE(parse_motion_script(yaml, dir + "pil_motion.yaml", script, err)) << err;
+  ExperimentConfig c;
+  c.scalar = peer_scalar();
+  const MotionRun local = run_motion_script(script, c);
+  c.pil_command = peer_command();
+  const MotionRun remote = run_motion_script(script, c);
+  ASSERT_EQ(remote.error, "");
+  EXPECT_TRUE(remote.link.clean()) << remote.link.first_zeroed;
+  EXPECT_EQ(local.result, "ok");
+  EXPECT_EQ(remote.result, "ok");
+  std::printf(
+      "%s: %.3f s simulated, %.2f s wall (in process %.2f s); max tracking %.4f mm over the link, %.4f mm in process\n",
+      remote.pil_command.c_str(), remote.duration_s, remote.wall_s, local.wall_s, remote.max_error_mm,
+      local.max_error_mm);
+  // What happened, and when: exactly the same.
+  ASSERT_EQ(remote.commands.size(), local.commands.size());
+  ASSERT_EQ(local.commands.size(), script.steps.size());
+  for (std::size_t i = 0; i < local.commands.size(); ++i) {
+    const CommandRecord &l = local.commands[i], &r = remote.commands[i];
+    EXPECT_TRUE(l.accepted) << l.cmd << " " << l.refused;
+    EXPECT_EQ(r.accepted, l.accepted) << i;
+    EXPECT_EQ(r.refused, l.refused) << i;
+    EXPECT_EQ(r.sent_s, l.sent_s) << i;
+    EXPECT_EQ(r.answered_s, l.answered_s) << i;
+    EXPECT_EQ(r.done_s, l.done_s) << i;
+    EXPECT_EQ(r.aborted, l.aborted) << i;
+    EXPECT_EQ(r.aborted_s, l.aborted_s) << i;
+  }
+  EXPECT_EQ(local.commands[1].aborted, "superseded");  // the re-target, as the script means it
+  EXPECT_EQ(local.commands[5].aborted, "stop_command");
+  ASSERT_EQ(remote.states.size(), local.states.size());
+  for (std::size_t i = 0; i < local.states.size(); ++i) {
+    EXPECT_EQ(remote.states[i].t, local.states[i].t) << i;
+    EXPECT_EQ(remote.states[i].state, local.states[i].state) << i;
+  }
+  EXPECT_EQ(remote.duration_s, local.duration_s);
+  EXPECT_EQ(remote.faults, 0u);
+  // The figures: bit for bit where the arithmetic is the same; within the float's spread otherwise.
+  const bool same_arithmetic = !std::getenv("PIL_FIRMWARE_ELF") || peer_is_fixed();
+  for (std::size_t i = 0; i < local.commands.size(); ++i) {
+    const CommandRecord &l = local.commands[i], &r = remote.commands[i];
+    if (same_arithmetic) {
+      EXPECT_EQ(r.max_error_mm, l.max_error_mm) << i;
+      EXPECT_EQ(r.max_error_deg, l.max_error_deg) << i;
+      EXPECT_EQ(r.v, l.v) << i;
+      EXPECT_EQ(r.a, l.a) << i;
+      EXPECT_EQ(r.j, l.j) << i;
+      EXPECT_EQ(r.w, l.w) << i;
+      EXPECT_EQ(r.wd, l.wd) << i;
+    } else {
+      EXPECT_NEAR(r.max_error_mm, l.max_error_mm, 0.15) << i;
+      EXPECT_NEAR(r.max_error_deg, l.max_error_deg, 0.03) << i;
+      EXPECT_NEAR(r.v, l.v, 1e-4 * 0.1) << i;
+      EXPECT_NEAR(r.a, l.a, 1e-4 * 0.25) << i;
+      EXPECT_NEAR(r.j, l.j, 1e-2 * 2.5) << i;
+    }
+  }
+  if (same_arithmetic) {
+    EXPECT_EQ(remote.max_error_mm, local.max_error_mm);
+    EXPECT_EQ(remote.max_error_deg, local.max_error_deg);
+  }
+  EXPECT_GT(local.max_error_mm, 0.0);  // there was something to track
 }
 
 // The adaptation law chosen on the host reaches the controller over the link (first frame's

@@ -65,7 +65,34 @@ function(osc_add_mps2_board)
   # The host's PIL tests against pil_firmware, the host controller in PIL_SCALAR; the generated
   # tables of docs/ of kind DOCS_TABLES (scripts/docs_tables.py) current for this build's images.
   osc_add_pil_tests(${B_PIL_SCALAR})
+  osc_add_motion_tests(${B_PIL_SCALAR})
   osc_add_docs_tables_test(${B_DOCS_TABLES})
+endfunction()
+
+# osc_add_motion_tests(SCALAR): scripted motions on this build's pil_firmware in QEMU (the host
+# build's puma_experiment --motion --qemu, docs/motion.md): motion_tour_qemu plays
+# examples/motion_tour.yaml on the image and in process in SCALAR and compares the two JSON outputs
+# (tests/cli/motion_scripts.sh qemu_tour: fixed point bit for bit; float the same events at the same
+# ticks, the figures within the float's spread); motion_qemu_wrong_scalar and
+# motion_qemu_start_pose, what --qemu refuses.
+function(osc_add_motion_tests scalar)
+  osc_host_tool(OSC_PUMA_EXPERIMENT puma_experiment host_sim)
+  find_program(OSC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  if(NOT OSC_SYSTEM_PYTHON)
+    return()
+  endif()
+  set(motion bash ${PROJECT_SOURCE_DIR}/tests/cli/motion_scripts.sh ${OSC_PUMA_EXPERIMENT} ${OSC_SYSTEM_PYTHON}
+             ${PROJECT_SOURCE_DIR}/examples)
+  add_test(NAME motion_tour_qemu COMMAND ${motion} qemu_tour $<TARGET_FILE:pil_firmware> ${scalar})
+  # 37 s simulated: about 15 s under QEMU on an idle machine, a minute on a busy one.
+  set_tests_properties(motion_tour_qemu PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600)
+  if(scalar STREQUAL "fixed")
+    set(wrong float)
+  else()
+    set(wrong fixed)
+  endif()
+  add_test(NAME motion_qemu_wrong_scalar COMMAND ${motion} qemu_wrong_scalar $<TARGET_FILE:pil_firmware> ${wrong})
+  add_test(NAME motion_qemu_start_pose COMMAND ${motion} qemu_start_pose $<TARGET_FILE:pil_firmware>)
 endfunction()
 
 # osc_add_pil_test(NAME SCALAR LINK [ARGS...]): the host's PIL tests (OSC_TEST_PIL: the host build's

@@ -22,6 +22,12 @@
 // The node, the frames, the ticks and what they compute are the same on both: the same run gives
 // the same torques, bit for bit (tests/host_sim/test_pil.cpp, PilQemu).
 //
+// The command protocol (docs/protocol.md): a command or a setpoint frame is no tick (on_byte returns
+// false); the node prepares it here in the main loop (a move's plan and path check, up to about half
+// a million instructions on the M3), never in the control interrupt, whose tick only writes the
+// answer, state and trace frames after its actuator frame. In lockstep nothing else runs meanwhile:
+// the host waits for the tick's frames before it sends the next.
+//
 // The CMSDK watchdog (board.hpp) starts with the link (the first received byte). Its PIL policy
 // (docs/firmware.md, "Watchdog"): it is fed at the end of every healthy tick, and by the main loop
 // while it waits for the host's next frame, once per control period, provided every tick it pended

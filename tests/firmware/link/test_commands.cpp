@@ -2,7 +2,9 @@
 // conversions (osc/link/commands.hpp): the payload lengths, the sensor and actuator frames unchanged
 // byte for byte, round trips of every frame type through the encoder and the parser, every flag,
 // each kind of bad field refused with bad_command, the answer and state frames of a running task
-// (PilNode<double> on a fake board), and a command answered in the tick after it arrives.
+// (PilNode<double> on a fake board), and a command answered in the tick after it arrives; the node's
+// command port: command and setpoint frames over the link, the answer, state and trace frames after
+// each tick's actuator frame, the configuration bits of the first sensor frame.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -52,7 +54,8 @@ F decoded(const pil::Parser& p) {
   pil::AnswerFrame n;
   pil::StateFrame t;
   pil::SetpointFrame sp;
-  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp);
+  pil::TraceFrame tr;
+  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));
@@ -73,11 +76,13 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kAnswerFrame, 4);
   EXPECT_EQ(pil::kStateFrame, 5);
   EXPECT_EQ(pil::kSetpointFrame, 6);
+  EXPECT_EQ(pil::kTraceFrame, 7);
   EXPECT_EQ(pil::kCommandPayload, 4 + 1 + 1 + 12 + 12 + 24 + 1);
   EXPECT_EQ(pil::kSetpointPayload, 4 + 1 + 12 + 12);
   EXPECT_EQ(pil::kAnswerPayload, 4 + 1 + 1 + 1 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 4);
   EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4);
-  ASSERT_EQ(pil::kFrameTypes, 6);
+  EXPECT_EQ(pil::kTracePayload, 4 + 4 + 1 + 3 * 24 + 36);
+  ASSERT_EQ(pil::kFrameTypes, 7);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -86,7 +91,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 7, 8, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 8, 9, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 TEST(CommandFrames, SensorAndActuatorFramesUnchangedByteForByte) {
@@ -159,6 +164,9 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
           break;
         case pil::kSetpointFrame:
           out = bytes_of(decoded<pil::SetpointFrame>(p));
+          break;
+        case pil::kTraceFrame:
+          out = bytes_of(decoded<pil::TraceFrame>(p));
           break;
       }
       ASSERT_EQ(out, in) << info.name;
@@ -681,47 +689,76 @@ TEST(CommandFrames, StateFrameInEveryScalar) {
 
 }  // namespace
 
-// ---------------------------------------------------------------- the command port
+// ---------------------------------------------------------------- the command port in the node
 
 namespace {
 
-/// The port between a node's task and a byte stream: frames written by the port are parsed back.
-struct PortFrames : ::testing::Test {
-  std::unique_ptr<Node> node = std::make_unique<Node>();
-  CommandPort<double> port;
-  std::vector<pil::AnswerFrame> answers;
-  std::vector<pil::StateFrame> states;
-  std::uint32_t seq = 0;
-  pil::Parser out;
-
-  void SetUp() override {
-    node->init(joint_vector<double>(robot::kQStart), FrictionMode::kAdaptive, 0);
-    ControlTask<double>& t = node->task;
-    t.init(t.model, t.gains, t.mode, t.q_start, 0, TaskStart::kDisabled);
+/// A board that records what the node writes, frame by frame (any other byte is counted bad).
+struct RecordingBoard {
+  static inline pil::Parser rx;
+  static inline std::vector<pil::FrameType> types;
+  static inline std::vector<pil::ActuatorFrame> actuators;
+  static inline std::vector<pil::AnswerFrame> answers;
+  static inline std::vector<pil::StateFrame> states;
+  static inline std::vector<pil::TraceFrame> traces;
+  static inline int bad = 0;
+  static void reset() {
+    rx.reset();
+    types.clear(), actuators.clear(), answers.clear(), states.clear(), traces.clear();
+    bad = 0;
   }
-  void write(const std::uint8_t* b, int n) {
+  static void link_write(const std::uint8_t* p, int n) {
     for (int i = 0; i < n; ++i) {
-      if (out.feed(b[i]) != pil::Parser::kFrame) continue;
-      pil::AnswerFrame a;
-      pil::StateFrame s;
-      if (out.decode(a)) answers.push_back(a);
-      if (out.decode(s)) states.push_back(s);
+      const pil::Parser::Result r = rx.feed(p[i]);
+      if (r == pil::Parser::kPending) continue;
+      if (r != pil::Parser::kFrame) {
+        ++bad;
+        continue;
+      }
+      types.push_back(rx.type());
+      pil::ActuatorFrame act;
+      pil::AnswerFrame ans;
+      pil::StateFrame st;
+      pil::TraceFrame tr;
+      if (rx.decode(act)) actuators.push_back(act);
+      if (rx.decode(ans)) answers.push_back(ans);
+      if (rx.decode(st)) states.push_back(st);
+      if (rx.decode(tr)) traces.push_back(tr);
     }
   }
-  /// A frame arriving on the port's transport.
-  template <class F>
-  bool arrive(const F& f) {
-    const pil::Parser p = parsed(bytes_of(f));
-    return port.on_frame(node->task, p, [this](const std::uint8_t* b, int n) { write(b, n); });
+  static std::uint32_t cycles() { return 0; }
+  static std::uint32_t stack_used() { return 0; }
+  static void burn(std::uint32_t) {}
+  static void fault_output(bool) {}
+};
+using RecordingNode = PilNode<double, RecordingBoard>;
+
+/// The node over its link, lockstep: frames arrive byte by byte, a tick whenever on_byte says so.
+struct NodeFrames : ::testing::Test {
+  std::unique_ptr<RecordingNode> node = std::make_unique<RecordingNode>();
+  std::uint32_t seq = 0;
+  std::int32_t counts[kDof] = {};
+
+  void SetUp() override {
+    RecordingBoard::reset();
+    node->init(joint_vector<double>(robot::kQStart), FrictionMode::kAdaptive, 0);
   }
-  void tick() {
+  void TearDown() override { EXPECT_EQ(RecordingBoard::bad, 0); }
+  /// A frame's bytes into the node; the ticks they make due (each run).
+  template <class F>
+  int arrive(const F& f) {
+    int ticks = 0;
+    for (std::uint8_t b : bytes_of(f))
+      if (node->on_byte(b)) ++ticks, node->tick();
+    return ticks;
+  }
+  /// One tick: the next sensor frame (the arm at the start pose, its encoders dithering by a count).
+  void tick(std::uint8_t inject = 0) {
     pil::SensorFrame s;
+    for (int i = 0; i < kDof; ++i) s.counts[i] = counts[i] + static_cast<std::int32_t>(seq & 1u);
     s.seq = seq++;
-    std::uint8_t buf[pil::kMaxFrame];
-    const int n = pil::encode(s, buf);
-    for (int i = 0; i < n; ++i) node->on_byte(buf[i]);
-    node->tick();
-    port.after_tick(node->task, [this](const std::uint8_t* b, int k) { write(b, k); });
+    s.inject = inject;
+    ASSERT_EQ(arrive(s), 1);
   }
   static pil::CommandFrame command(std::uint32_t id, MotionVerb v) {
     pil::CommandFrame f;
@@ -731,62 +768,152 @@ struct PortFrames : ::testing::Test {
   }
 };
 
-TEST_F(PortFrames, CommandsWaitForTheMailboxInOrderAndAreAnsweredOnce) {
-  for (int k = 0; k < 3; ++k) tick();
-  EXPECT_TRUE(arrive(command(1, MotionVerb::kEnable)));
-  EXPECT_EQ(node->task.pending.verb, MotionVerb::kEnable);  // prepared at once: the mailbox was free
-  EXPECT_TRUE(arrive(command(2, MotionVerb::kStop)));
-  EXPECT_TRUE(arrive(command(3, MotionVerb::kDisable)));
-  EXPECT_EQ(port.waiting(), 2);
-  for (int k = 0; k < 4; ++k) tick();
-  ASSERT_EQ(answers.size(), 3u);
-  for (std::uint32_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(answers[i].id, i + 1);
-    EXPECT_EQ(answers[i].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
-    EXPECT_EQ(answers[i].tick, answers[0].tick + i);  // one per tick, in order
-  }
-  EXPECT_EQ(answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
-  EXPECT_EQ(answers[2].state, static_cast<std::uint8_t>(MotionState::kDisabled));
-  EXPECT_EQ(port.waiting(), 0);
+TEST_F(NodeFrames, ACommandIsNeitherATickNorALinkErrorAndIsAnsweredAfterTheActuatorFrame) {
+  tick(pil::kConfigStartDisabled);
+  EXPECT_EQ(arrive(command(1, MotionVerb::kEnable)), 0);  // no tick
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kEnable);
+  tick();
+  EXPECT_EQ(node->link_counters().total(), 0u);
+  ASSERT_EQ(RecordingBoard::answers.size(), 1u);
+  EXPECT_EQ(RecordingBoard::answers[0].id, 1u);
+  EXPECT_EQ(RecordingBoard::answers[0].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(RecordingBoard::answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
+  EXPECT_EQ(RecordingBoard::answers[0].tick, 1u);
+  // Tick 0's actuator frame, then tick 1's, then its answer.
+  const std::vector<pil::FrameType> want = {pil::kActuatorFrame, pil::kActuatorFrame, pil::kAnswerFrame};
+  EXPECT_EQ(RecordingBoard::types, want);
+  EXPECT_EQ(RecordingBoard::actuators.back().link.total(), 0u);
+  // A setpoint frame: not a tick either (no stream runs: dropped and counted).
+  EXPECT_EQ(arrive(setpoint_frame<double>(9, Vec3<double>::Zero(), nullptr, false)), 0);
+  EXPECT_EQ(node->task.dropped, 1u);
+  // A valid frame of a type the host does not send is still a frame of the wrong type: a tick at once.
+  EXPECT_EQ(arrive(pil::AnswerFrame{}), 1);
+  EXPECT_EQ(RecordingBoard::actuators.back().link[pil::kErrHeader], 1u);
 }
 
-TEST_F(PortFrames, FullFifoAndUnknownVerbAreRefusedAtOnce) {
-  tick();
-  for (std::uint32_t id = 1; id <= 1 + kCommandFifo; ++id) EXPECT_TRUE(arrive(command(id, MotionVerb::kStop)));
-  EXPECT_TRUE(answers.empty());  // one in the mailbox, kCommandFifo waiting
-  EXPECT_TRUE(arrive(command(99, MotionVerb::kStop)));
-  ASSERT_EQ(answers.size(), 1u);
-  EXPECT_EQ(answers[0].id, 99u);
-  EXPECT_EQ(answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kQueueFull));
-  answers.clear();
+TEST_F(NodeFrames, CommandsWaitForTheMailboxInOrderAndAreAnsweredOnce) {
+  tick(pil::kConfigStartDisabled);
+  for (int k = 0; k < 2; ++k) tick();
+  arrive(command(1, MotionVerb::kEnable));
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kEnable);  // prepared at once: the mailbox was free
+  arrive(command(2, MotionVerb::kStop));
+  arrive(command(3, MotionVerb::kDisable));
+  EXPECT_EQ(node->port.waiting(), 2);
+  for (int k = 0; k < 4; ++k) tick();
+  ASSERT_EQ(RecordingBoard::answers.size(), 3u);
+  for (std::uint32_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(RecordingBoard::answers[i].id, i + 1);
+    EXPECT_EQ(RecordingBoard::answers[i].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+    EXPECT_EQ(RecordingBoard::answers[i].tick, RecordingBoard::answers[0].tick + i);  // one per tick, in order
+  }
+  EXPECT_EQ(RecordingBoard::answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
+  EXPECT_EQ(RecordingBoard::answers[2].state, static_cast<std::uint8_t>(MotionState::kDisabled));
+  EXPECT_EQ(node->port.waiting(), 0);
+}
+
+TEST_F(NodeFrames, FullFifoAndUnknownVerbAreRefusedAtOnce) {
+  tick(pil::kConfigStartDisabled);
+  for (std::uint32_t id = 1; id <= 1 + kCommandFifo; ++id) arrive(command(id, MotionVerb::kStop));
+  EXPECT_TRUE(RecordingBoard::answers.empty());  // one in the mailbox, kCommandFifo waiting
+  arrive(command(99, MotionVerb::kStop));
+  ASSERT_EQ(RecordingBoard::answers.size(), 1u);
+  EXPECT_EQ(RecordingBoard::answers[0].id, 99u);
+  EXPECT_EQ(RecordingBoard::answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kQueueFull));
+  RecordingBoard::answers.clear();
   for (int k = 0; k < 1 + kCommandFifo; ++k) tick();
-  ASSERT_EQ(answers.size(), 1u + kCommandFifo);
-  for (const pil::AnswerFrame& a : answers)  // a stop while disabled
+  ASSERT_EQ(RecordingBoard::answers.size(), 1u + kCommandFifo);
+  for (const pil::AnswerFrame& a : RecordingBoard::answers)  // a stop while disabled
     EXPECT_EQ(a.refusal, static_cast<std::uint8_t>(MotionReason::kNotEnabled));
-  answers.clear();
+  RecordingBoard::answers.clear();
   pil::CommandFrame u = command(7, MotionVerb::kNone);
   u.verb = 200;
-  EXPECT_TRUE(arrive(u));
-  ASSERT_EQ(answers.size(), 1u);
-  EXPECT_EQ(answers[0].id, 7u);
-  EXPECT_EQ(answers[0].verb, static_cast<std::uint8_t>(MotionVerb::kNone));
-  EXPECT_EQ(answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kBadCommand));
+  arrive(u);
+  ASSERT_EQ(RecordingBoard::answers.size(), 1u);
+  EXPECT_EQ(RecordingBoard::answers[0].id, 7u);
+  EXPECT_EQ(RecordingBoard::answers[0].verb, static_cast<std::uint8_t>(MotionVerb::kNone));
+  EXPECT_EQ(RecordingBoard::answers[0].refusal, static_cast<std::uint8_t>(MotionReason::kBadCommand));
   EXPECT_EQ(node->task.pending.verb, MotionVerb::kNone);
-  // Other frame types are the caller's.
-  EXPECT_FALSE(arrive(pil::SensorFrame{}));
 }
 
-TEST_F(PortFrames, StateFramesAtTheirPeriod) {
-  for (int k = 0; k < 100; ++k) tick();
-  ASSERT_EQ(states.size(), 100u / kStatePeriod);
-  for (std::size_t i = 0; i < states.size(); ++i) EXPECT_EQ(states[i].tick, (i + 1) * kStatePeriod - 1);
-  port.state_period = 0;
-  for (int k = 0; k < 100; ++k) tick();
-  EXPECT_EQ(states.size(), 100u / kStatePeriod);
-}
-
-TEST_F(PortFrames, AStreamFollowsItsSetpointsAndIsDone) {
+TEST_F(NodeFrames, TheTaskStartsDisabledWhenTheFirstFrameAsksAndACommandBeforeItWaitsForIt) {
+  // Without the bit: the paper's motion from the first sample.
   tick();
+  EXPECT_EQ(node->task.machine.state, MotionState::kMoving);
+  EXPECT_EQ(node->task.gen.source(), MotionSource::kPaper);
+  // With it: disabled, zero codes; an enable sent before the first sensor frame is prepared once
+  // that frame has configured the task, and answered by its tick.
+  SetUp();
+  seq = 0;
+  arrive(command(5, MotionVerb::kEnable));
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kNone);  // waiting: not configured yet
+  EXPECT_EQ(node->port.waiting(), 1);
+  tick(pil::kConfigStartDisabled);
+  ASSERT_EQ(RecordingBoard::answers.size(), 1u);
+  EXPECT_EQ(RecordingBoard::answers[0].id, 5u);
+  EXPECT_EQ(RecordingBoard::answers[0].tick, 0u);
+  EXPECT_EQ(RecordingBoard::answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
+  EXPECT_EQ(node->task.gen.source(), MotionSource::kHold);
+  for (std::int32_t c : RecordingBoard::actuators[0].codes) EXPECT_EQ(c, 0);  // the enable's ramp starts after it
+}
+
+TEST_F(NodeFrames, StateFramesOnlyWhenTheFirstFrameAsks) {
+  for (int k = 0; k < 100; ++k) tick();
+  EXPECT_TRUE(RecordingBoard::states.empty());
+  EXPECT_EQ(RecordingBoard::types.size(), 100u);  // actuator frames only, as before the command protocol
+  SetUp();
+  seq = 0;
+  tick(pil::kConfigStateFrames);
+  for (int k = 1; k < 100; ++k) tick();
+  ASSERT_EQ(RecordingBoard::states.size(), 100u / kStatePeriod);
+  for (std::size_t i = 0; i < RecordingBoard::states.size(); ++i)
+    EXPECT_EQ(RecordingBoard::states[i].tick, (i + 1) * kStatePeriod - 1);
+  EXPECT_EQ(RecordingBoard::types[kStatePeriod], pil::kStateFrame);  // after its tick's actuator frame
+  EXPECT_EQ(RecordingBoard::types[kStatePeriod - 1], pil::kActuatorFrame);
+}
+
+TEST_F(NodeFrames, ATraceFrameEndsEveryTickWhenTheFirstFrameAsks) {
+  tick(pil::kConfigTrace);
+  for (int k = 1; k < 30; ++k) tick();
+  ASSERT_EQ(RecordingBoard::traces.size(), 30u);
+  ASSERT_EQ(RecordingBoard::types.size(), 60u);
+  for (std::size_t k = 0; k < 30; ++k) {
+    EXPECT_EQ(RecordingBoard::types[2 * k], pil::kActuatorFrame);
+    EXPECT_EQ(RecordingBoard::types[2 * k + 1], pil::kTraceFrame);
+    EXPECT_EQ(RecordingBoard::traces[k].seq, RecordingBoard::actuators[k].seq);
+    EXPECT_EQ(RecordingBoard::traces[k].faults, 0u);
+  }
+  // The last step's desired state and the reference orientation, as the task has them.
+  const pil::TraceFrame& t = RecordingBoard::traces.back();
+  const ControlTask<double>& task = node->task;
+  EXPECT_EQ(t.state, static_cast<std::uint8_t>(MotionState::kMoving));
+  for (int i = 0; i < 6; ++i) {
+    EXPECT_EQ(t.x_d[i], static_cast<float>(task.desired.x(i))) << i;
+    EXPECT_EQ(t.xd_d[i], static_cast<float>(task.desired.xd(i))) << i;
+    EXPECT_EQ(t.xdd_d[i], static_cast<float>(task.desired.xdd(i))) << i;
+  }
+  for (int i = 0; i < 9; ++i) EXPECT_EQ(t.R_ref[i], static_cast<float>(task.state.R_ref(i / 3, i % 3))) << i;
+  EXPECT_GT(std::abs(t.xd_d[1]) + std::abs(t.xd_d[2]), 0.0f);  // the paper's motion is on its way
+  // The faults the tick detected (the actuator frame carries the latched ones).
+  tick(pil::kInjectNonFinite);
+  EXPECT_EQ(RecordingBoard::traces.back().faults, static_cast<std::uint32_t>(kFaultNonFinite));
+  EXPECT_EQ(RecordingBoard::traces.back().state, static_cast<std::uint8_t>(MotionState::kFault));
+  tick();
+  EXPECT_EQ(RecordingBoard::traces.back().faults, 0u);
+  EXPECT_EQ(RecordingBoard::actuators.back().faults, static_cast<std::uint32_t>(kFaultNonFinite));
+}
+
+TEST_F(NodeFrames, AHostThatNeverCommandsGetsActuatorFramesOnlyEvenWhenTheMotionAborts) {
+  for (int k = 0; k < 5; ++k) tick();
+  counts[0] += 5000;  // an encoder jump: the fault aborts the paper's motion
+  tick();
+  EXPECT_EQ(node->task.report.abort, MotionReason::kFaulted);  // something to say ...
+  for (int k = 0; k < 3; ++k) tick();
+  EXPECT_TRUE(RecordingBoard::answers.empty());  // ... to no one who asked
+  EXPECT_EQ(RecordingBoard::types.size(), 9u);
+}
+
+TEST_F(NodeFrames, AStreamFollowsItsSetpointsAndIsStopped) {
+  tick(pil::kConfigStartDisabled);
   arrive(command(1, MotionVerb::kEnable));
   for (int k = 0; k < 60; ++k) tick();  // past the torque ramp (the arm stays put: the counts are 0)
   pil::CommandFrame st = command(2, MotionVerb::kStream);
@@ -794,13 +921,13 @@ TEST_F(PortFrames, AStreamFollowsItsSetpointsAndIsDone) {
   st.period = 10;
   arrive(st);
   tick();
-  ASSERT_EQ(answers.back().id, 2u);
-  ASSERT_EQ(answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  ASSERT_EQ(RecordingBoard::answers.back().id, 2u);
+  ASSERT_EQ(RecordingBoard::answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
   EXPECT_EQ(node->task.gen.running_id(), 2u);
   const Vec3<double> p0 = node->task.gen.hold_pose().p;
   // 2 mm along y at 100 Hz (the encoders stay at 0 here: no plant, so briefly), then a stop.
   for (int n = 1; n <= 10; ++n) {
-    EXPECT_TRUE(arrive(setpoint_frame<double>(2, Vec3<double>(0, 0.002 * n / 10.0, 0), nullptr, false)));
+    EXPECT_EQ(arrive(setpoint_frame<double>(2, Vec3<double>(0, 0.002 * n / 10.0, 0), nullptr, false)), 0);
     for (int k = 0; k < 10; ++k) tick();
   }
   EXPECT_EQ(node->task.dropped, 0u);
@@ -811,13 +938,64 @@ TEST_F(PortFrames, AStreamFollowsItsSetpointsAndIsDone) {
   EXPECT_NEAR(d(0), 0, 1e-9);
   EXPECT_NEAR(d(2), 0, 1e-9);
   // A setpoint of another stream: dropped.
-  EXPECT_TRUE(arrive(setpoint_frame<double>(3, Vec3<double>::Zero(), nullptr, false)));
+  arrive(setpoint_frame<double>(3, Vec3<double>::Zero(), nullptr, false));
   EXPECT_EQ(node->task.dropped, 1u);
   arrive(command(4, MotionVerb::kStop));
   tick();
-  EXPECT_EQ(answers.back().abort, static_cast<std::uint8_t>(MotionReason::kStopCommand));
-  EXPECT_EQ(answers.back().aborted_id, 2u);
+  EXPECT_EQ(RecordingBoard::answers.back().abort, static_cast<std::uint8_t>(MotionReason::kStopCommand));
+  EXPECT_EQ(RecordingBoard::answers.back().aborted_id, 2u);
   EXPECT_EQ(node->task.machine.state, MotionState::kStopping);
+  EXPECT_EQ(node->link_counters().total(), 0u);
+}
+
+TEST(CommandFrames, AnAnswerFrameReadsBackAsTheReport) {
+  MotionReport r;
+  r.id = 12;
+  r.verb = MotionVerb::kMoveTo;
+  r.outcome = CommandOutcome::kRefused;
+  r.refusal = MotionReason::kNearSingular;
+  r.cause = kFaultSingular;
+  r.done_id = 3;
+  r.aborted_id = 4;
+  r.abort = MotionReason::kSuperseded;
+  r.completion = MotionCompletion::kStopped;
+  const MotionReport b = report_from_frame(frame_from_report(r, MotionState::kStopping, 2, 77));
+  EXPECT_EQ(b.id, r.id);
+  EXPECT_EQ(b.verb, r.verb);
+  EXPECT_EQ(b.outcome, r.outcome);
+  EXPECT_EQ(b.refusal, r.refusal);
+  EXPECT_EQ(b.cause, r.cause);
+  EXPECT_EQ(b.done_id, r.done_id);
+  EXPECT_EQ(b.aborted_id, r.aborted_id);
+  EXPECT_EQ(b.abort, r.abort);
+  EXPECT_EQ(b.completion, r.completion);
+  pil::AnswerFrame bad;
+  bad.verb = 200, bad.outcome = 9, bad.refusal = 99, bad.abort = 99, bad.completion = 7;
+  const MotionReport n = report_from_frame(bad);
+  EXPECT_EQ(n.verb, MotionVerb::kNone);
+  EXPECT_EQ(n.outcome, CommandOutcome::kNone);
+  EXPECT_EQ(n.refusal, MotionReason::kNone);
+  EXPECT_EQ(n.abort, MotionReason::kNone);
+  EXPECT_EQ(n.completion, MotionCompletion::kNone);
+}
+
+TEST(CommandFrames, LimitsAreSentAsTheF32AtMostThem) {
+  MoveRequest<double> req;
+  req.has_limits = true;
+  req.limits = CartesianLimits<double>::defaults();  // 0.1 m/s: above its nearest f32
+  const pil::CommandFrame f = frame_from_command(1, MotionVerb::kMoveTo, req);
+  EXPECT_LE(static_cast<double>(f.limits[0]), 0.1);
+  EXPECT_EQ(f.limits[0], std::nextafter(0.1f, 0.0f));
+  EXPECT_EQ(f.limits[1], 0.25f);  // exact ones stay
+  // A move at the configured maxima is within them in double too (not over_limit).
+  auto task = std::make_unique<ControlTask<double>>();
+  task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
+             joint_vector<double>(robot::kQStart), 0, TaskStart::kDisabled);
+  pil::CommandFrame m = f;
+  m.flags = pil::kFlagRelative | pil::kFlagHasLimits;
+  m.position[2] = 0.01f;
+  const TaskCommand<double> c = prepare_frame_command(task->gen, task->limits, 0, params::kControlHz, m);
+  EXPECT_EQ(c.refusal, MotionReason::kNone);
 }
 
 }  // namespace

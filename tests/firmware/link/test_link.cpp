@@ -144,7 +144,7 @@ const ErrorCase kCases[] = {
     {"BadCrc", pil::kErrCrc, kFaultLinkCorrupt, 1, 0,
      [](LinkNode& t) { return t.lockstep(with(t.frame(), 10, 0x40)); }},
     {"BadHeader", pil::kErrHeader, kFaultLinkCorrupt, 1, 0,
-     [](LinkNode& t) { return t.lockstep(with(t.frame(), 2, 0x70)); }},  // unknown type
+     [](LinkNode& t) { return t.lockstep(with(t.frame(), 2, 0x0E)); }},  // type 0x0F: unknown
     {"BadLength", pil::kErrLength, kFaultLinkCorrupt, 1, 0,
      [](LinkNode& t) { return t.lockstep(with(t.frame(), 3, 0x01)); }},
     {"JunkBetweenFrames", pil::kErrJunk, kFaultLinkCorrupt, 1, 0,
@@ -233,7 +233,7 @@ INSTANTIATE_TEST_SUITE_P(Lockstep, EachLinkError, ::testing::ValuesIn(kCases),
 
 TEST_F(LinkNode, JunkAfterAnErrorBelongsToIt) {
   healthy(3);
-  const Answers a = lockstep(with(frame(), 2, 0x70));  // bad header: answered at its 4th byte
+  const Answers a = lockstep(with(frame(), 2, 0x0E));  // type 0x0F, unknown: answered at its 4th byte
   ASSERT_EQ(a.size(), 1u);
   EXPECT_EQ(node->link_counters()[pil::kErrHeader], 1u);
   EXPECT_EQ(node->link_counters()[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // its rest
@@ -305,7 +305,7 @@ TEST_F(LinkNode, TimerPacedFrameLateWithinTheAllowanceIsNoError) {
 TEST_F(LinkNode, TimerPacedCorruptionZeroesTheNextTick) {
   const std::function<Bytes(LinkNode&)> corrupt[] = {
       [](LinkNode& t) { return with(t.frame(), 10, 0x40); },  // bad CRC
-      [](LinkNode& t) { return with(t.frame(), 2, 0x70); },   // bad header
+      [](LinkNode& t) { return with(t.frame(), 2, 0x0E); },   // bad header (type 0x0F)
       [](LinkNode& t) { return with(t.frame(), 3, 0x01); },   // bad length
       [](LinkNode&) {
         return Bytes{0x01, 0x02, 0x03};

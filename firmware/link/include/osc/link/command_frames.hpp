@@ -6,6 +6,8 @@
 //   answer   controller -> host   a tick's report: the answer to a command, a motion done or aborted
 //   state    controller -> host   the motion state, the latched faults, the reference and measured pose
 //   setpoint host -> controller   one sample of a stream (the stream command started it)
+//   trace    controller -> host   a tick's reference in the controller's own coordinates and its faults,
+//                                 for a host that checks the run against its own (scripts under QEMU)
 //
 // The conversions between these frames and the control task's commands and reports are in
 // osc/link/commands.hpp. Macros and constants only: no dependency beyond the fault catalogue's
@@ -125,5 +127,20 @@ constexpr double kCommandMaxAngle = 6.283185307179586;
     "pitch, yaw of the orientation as move_to's absolute rpy")                                                \
   X(float, x, [6], "m, rad", "the measured pose of the last control step, the same way")                      \
   X(std::uint32_t, tick, , "tick", "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")
+
+// The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
+// (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as
+// the in-process controller's). A Q12.19 number below 32 in magnitude is exact in f32, and so is
+// every value here.
+#define OSC_TRACE_FIELDS(X)                                                                                          \
+  X(std::uint32_t, seq, , "", "the sequence number of the tick's sensor frame (its actuator frame's)")               \
+  X(std::uint32_t, faults, , "", "the fault bits this tick detected (Fault bits); the actuator frame's are latched") \
+  X(std::uint8_t, state, , "", "the motion state after this tick (Motion states)")                                   \
+  X(float, x_d, [6], "m, rad",                                                                                       \
+    "the desired pose of the last control step in the controller's coordinates: the wrist centre's position in "     \
+    "the base frame, then the orientation coordinates relative to R_ref")                                            \
+  X(float, xd_d, [6], "m/s, rad/s", "its velocity, in the same coordinates")                                         \
+  X(float, xdd_d, [6], "m/s^2, rad/s^2", "its acceleration, in the same coordinates")                                \
+  X(float, R_ref, [9], "", "the controller's reference orientation, row by row (x_d's orientation is relative to it)")
 
 }  // namespace pil

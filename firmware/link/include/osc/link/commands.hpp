@@ -4,10 +4,11 @@
 //   controller: command_from_frame (a command frame checked and decoded into a verb and a
 //               MoveRequest; a bad frame is refused: bad_command), prepare_frame_command (the same,
 //               prepared for the task's mailbox), answer_due / answer_frame (a tick's report as an
-//               answer frame), state_frame_from_task;
-//   host:       frame_from_command / encode_command (a command as a frame).
+//               answer frame), state_frame_from_task, trace_frame_from_task;
+//   host:       frame_from_command / encode_command (a command as a frame), setpoint_frame,
+//               report_from_frame (an answer frame as the tick's report).
 //
-// Not yet wired into the link node's exchange (osc/link/node.hpp) or the host's client.
+// The controller's end on a link: osc/link/command_port.hpp (in the PIL node, osc/link/node.hpp).
 #pragma once
 
 #include <cmath>
@@ -135,8 +136,19 @@ pil::SetpointFrame setpoint_frame(std::uint32_t id, const Vec3<S>& position, con
   return f;
 }
 
-/// Host side: a command as a frame (the request's numbers rounded to f32; for verbs other than
-/// move_to a default request gives zeros).
+namespace detail {
+/// The largest f32 not above v: a limit sent as f32 never asks for more than the client's (a limit
+/// at a configured maximum that f32 cannot hold, e.g. 0.1 m/s, stays within it in every scalar).
+template <class S>
+float f32_at_most(const S& v) {
+  const double x = static_cast<double>(v);
+  const float f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -HUGE_VALF) : f;
+}
+}  // namespace detail
+
+/// Host side: a command as a frame (the request's position and angles rounded to the nearest f32,
+/// its limits to the f32 at most them; for verbs other than move_to a default request gives zeros).
 template <class S>
 pil::CommandFrame frame_from_command(std::uint32_t id, MotionVerb verb, const MoveRequest<S>& req = {}) {
   pil::CommandFrame f;
@@ -151,9 +163,9 @@ pil::CommandFrame frame_from_command(std::uint32_t id, MotionVerb verb, const Mo
   }
   const JerkLimits<S> lim[2] = {req.limits.linear, req.limits.angular};
   for (int k = 0; k < 2; ++k) {
-    f.limits[3 * k] = static_cast<float>(lim[k].v);
-    f.limits[3 * k + 1] = static_cast<float>(lim[k].a);
-    f.limits[3 * k + 2] = static_cast<float>(lim[k].j);
+    f.limits[3 * k] = detail::f32_at_most(lim[k].v);
+    f.limits[3 * k + 1] = detail::f32_at_most(lim[k].a);
+    f.limits[3 * k + 2] = detail::f32_at_most(lim[k].j);
   }
   f.period = static_cast<std::uint8_t>(verb == MotionVerb::kStream ? req.period : 0);
   return f;
@@ -198,6 +210,25 @@ pil::AnswerFrame answer_frame(const ControlTask<S>& task) {
   return frame_from_report(task.report, task.machine.state, task.gen.queued(), task.tick - 1);
 }
 
+/// Host side: an answer frame as the report of the tick that sent it (frame_from_report's inverse;
+/// codes outside their lists are none).
+inline MotionReport report_from_frame(const pil::AnswerFrame& a) {
+  auto code = [](std::uint8_t c, auto none) {
+    return c < MotionNames<decltype(none)>::kCount ? static_cast<decltype(none)>(c) : none;
+  };
+  MotionReport r;
+  r.id = a.id;
+  r.verb = code(a.verb, MotionVerb::kNone);
+  r.outcome = code(a.outcome, CommandOutcome::kNone);
+  r.refusal = code(a.refusal, MotionReason::kNone);
+  r.cause = a.cause;
+  r.done_id = a.done_id;
+  r.aborted_id = a.aborted_id;
+  r.abort = code(a.abort, MotionReason::kNone);
+  r.completion = code(a.completion, MotionCompletion::kNone);
+  return r;
+}
+
 namespace detail {
 /// A pose as six f32: the position, then roll, pitch, yaw as a move_to's absolute rpy.
 template <class S>
@@ -233,6 +264,26 @@ pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
   }
   detail::pose_floats<S>(task.state.data.o[kDof], task.state.data.R[kDof], f.x);
   f.tick = static_cast<std::uint32_t>(task.tick - 1);
+  return f;
+}
+
+/// The trace of the tick control_tick() just ran: `seq`, the sequence number of its sensor frame,
+/// `faults`, the bits it detected (control_tick's result), the motion state after it, the desired
+/// state of the last control step (ControlTask::desired) and the reference orientation, as they are
+/// (f32 holds float exactly, and Q12.19 below 32 in magnitude: Q::operator float, no FPU needed).
+template <class S>
+pil::TraceFrame trace_frame_from_task(const ControlTask<S>& task, std::uint32_t seq, std::uint32_t faults) {
+  pil::TraceFrame f;
+  f.seq = seq;
+  f.faults = faults;
+  f.state = static_cast<std::uint8_t>(task.machine.state);
+  for (int i = 0; i < 6; ++i) {
+    f.x_d[i] = static_cast<float>(task.desired.x(i));
+    f.xd_d[i] = static_cast<float>(task.desired.xd(i));
+    f.xdd_d[i] = static_cast<float>(task.desired.xdd(i));
+  }
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) f.R_ref[3 * r + c] = static_cast<float>(task.state.R_ref(r, c));
   return f;
 }
 

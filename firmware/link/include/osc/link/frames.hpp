@@ -1,7 +1,7 @@
 // Processor-in-the-loop link protocol: framed, checksummed, little-endian, lockstep (one sensor
 // frame from the host and one actuator frame back per tick). Shared by the firmware and host_sim.
-// The command protocol's frames (command, answer, state: osc/link/command_frames.hpp) use the same
-// framing.
+// The command protocol's frames (command, answer, state, setpoint, trace: osc/link/command_frames.hpp)
+// use the same framing.
 //
 // Frame:  0xA5 0x5A | type (1) | length (1) | payload (length bytes) | CRC-16/CCITT-FALSE (2, LE)
 // The CRC covers type, length and payload. Each payload is declared once, as a field list
@@ -33,8 +33,13 @@ enum Inject : std::uint8_t {
   kInjectNone = 0,
   kInjectNonFinite = 1u << 0,  ///< poison the observer state with a NaN
   kInjectOverrun = 1u << 1,    ///< burn more than one period inside the tick
-  /// Configuration, honoured in the first frame only: the adaptation law + 1 in bits 5-6 (0: the
+  /// Configuration, honoured in the first frame only: a trace frame after every tick (bit 2), state
+  /// frames every osc::kStatePeriod ticks (bit 3), the task started disabled, waiting for an enable,
+  /// instead of running the paper's motion (bit 4), the adaptation law + 1 in bits 5-6 (0: the
   /// firmware's default), and no friction compensation in bit 7.
+  kConfigTrace = 1u << 2,
+  kConfigStateFrames = 1u << 3,
+  kConfigStartDisabled = 1u << 4,
   kConfigAdaptationShift = 5,
   kConfigAdaptationMask = 3u << 5,
   kConfigNoCompensation = 1u << 7,
@@ -120,7 +125,9 @@ struct LinkCounters {
   X(Answer, 4, "answer", "firmware",                                                                                \
     "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)        \
   X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)  \
-  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)
+  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)         \
+  X(Trace, 7, "trace", "firmware",                                                                                  \
+    "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

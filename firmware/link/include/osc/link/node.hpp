@@ -16,13 +16,23 @@
 // without a sample: zero codes, no control step, no latch. params::kLinkErrorLimit such error ticks
 // within params::kLinkErrorWindow ticks latch link_corrupt (link_lost if the last was a silence).
 // Every error is counted by kind in the actuator frame's telemetry.
+//
+// The command protocol (docs/protocol.md): command and setpoint frames go to the node's CommandPort
+// (osc/link/command_port.hpp), prepared in on_byte() (the board's main loop): they are neither a tick
+// nor a link error. After each tick's actuator frame the port writes the tick's answer (once a
+// command has come), a state frame when one is due (none unless the first sensor frame asked:
+// kConfigStateFrames), then, when the first sensor frame asked for it (kConfigTrace), the tick's
+// trace frame, always the last of the tick's frames. kConfigStartDisabled starts the task disabled,
+// waiting for an enable, instead of running the paper's motion: a host that plays commands. A host
+// that sends sensor frames only gets actuator frames only, as before the command protocol.
 #pragma once
 
 #include <cstdint>
 
-#include "osc/runtime/control_task.hpp"
+#include "osc/link/command_port.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/link/telemetry.hpp"
+#include "osc/runtime/control_task.hpp"
 
 namespace osc {
 
@@ -40,9 +50,13 @@ template <class S, PilBoard Board>
 class PilNode {
  public:
   ControlTask<S> task;
+  CommandPort<S> port;  // the command protocol's frames
 
   void init(const Vec6In<S>& q_start, FrictionMode mode, std::uint32_t period_cycles) {
     task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), mode, q_start, period_cycles);
+    port = {};
+    port.state_period = 0;  // none unless the first sensor frame asks (kConfigStateFrames)
+    trace_ = false;
     parser_.reset();
     frame_ = {};
     counters_ = {};
@@ -83,9 +97,17 @@ class PilNode {
     }
     pil::SensorFrame f;
     if (r != pil::Parser::kFrame) return lost_frame(pil::Parser::error_of(r));
-    if (!parser_.decode(f)) return lost_frame(pil::kErrHeader);  // a valid frame of the wrong type
+    if (!parser_.decode(f)) {
+      // A command or a setpoint: the port's (prepared at once once the first sensor frame has
+      // configured the task). Any other valid frame is of the wrong type.
+      if (!port.receive(task, parser_, LinkWrite{})) return lost_frame(pil::kErrHeader);
+      if (configured_) port.poll(task, LinkWrite{});
+      synced_ = true;
+      return false;
+    }
     if (f.seq != expected_seq_) error(pil::kErrSeq);
     if (!configured_) configure(f.inject);  // the first valid frame configures, once
+    port.poll(task, LinkWrite{});           // a waiting command into the free mailbox, before the tick
     expected_seq_ = f.seq + 1;
     answer_seq_ = f.seq;
     frame_ = f;
@@ -111,6 +133,7 @@ class PilNode {
     if (!fresh_ && errors_ == 0) {  // timer-paced: nothing arrived since the last tick
       if (++silent_ticks_ <= params::kLinkSilenceTicks) {
         hold_tick(task, *this);  // the DACs keep their codes (sent again)
+        tick_frames(0);
         return;
       }
       on_timeout();
@@ -118,10 +141,11 @@ class PilNode {
     sample_ = fresh_ && errors_ == 0;
     if (!sample_) latch_ |= count_error_tick();
     if (sample_ && (frame_.inject & pil::kInjectNonFinite)) task.inject_nonfinite();
-    control_tick(task, *this);
+    const std::uint32_t faults = control_tick(task, *this);
     frame_.inject = 0;
     fresh_ = false;
     errors_ = 0;
+    tick_frames(faults);
   }
 
   /// The link errors counted so far, by kind.
@@ -150,9 +174,28 @@ class PilNode {
   }
 
  private:
+  /// Board::link_write as the port's writer.
+  struct LinkWrite {
+    void operator()(const std::uint8_t* bytes, int n) const { Board::link_write(bytes, n); }
+  };
+
+  /// The command protocol's frames after the tick's actuator frame: the port's answer and state
+  /// frames, then the trace (faults: those the tick detected).
+  void tick_frames(std::uint32_t faults) {
+    port.after_tick(task, LinkWrite{});
+    if (!trace_) return;
+    std::uint8_t buf[pil::kMaxFrame];
+    Board::link_write(buf, pil::encode(trace_frame_from_task(task, answer_seq_, faults), buf));
+  }
+
   /// The first sensor frame's configuration bits.
   void configure(std::uint8_t config) {
     configured_ = true;
+    if (config & pil::kConfigStartDisabled)  // before the mode and the law: init sets them
+      task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), task.mode, Vec6<S>(task.q_start), task.period_cycles,
+                TaskStart::kDisabled);
+    if (config & pil::kConfigStateFrames) port.state_period = kStatePeriod;
+    trace_ = (config & pil::kConfigTrace) != 0;
     if (config & pil::kConfigNoCompensation) task.mode = FrictionMode::kNone;
     const unsigned law = (config & pil::kConfigAdaptationMask) >> pil::kConfigAdaptationShift;
     if (law != 0 && law <= static_cast<unsigned>(kAdaptationLawCount))
@@ -207,6 +250,7 @@ class PilNode {
   bool synced_ = false;                        // the last thing received was a valid frame (junk now is a new error)
   bool sample_ = false;                        // this tick has a valid sample
   bool configured_ = false;
+  bool trace_ = false;                                       // a trace frame after every tick (kConfigTrace)
   int silent_ticks_ = 0;                                     // timer-paced: ticks in a row without a frame
   std::uint32_t latch_ = 0;                                  // link fault for io_faults()
   std::uint64_t error_ticks_[params::kLinkErrorLimit] = {};  // ticks of the latest error ticks

@@ -384,9 +384,11 @@ bool offer_setpoint(ControlTask<S>& task, std::uint32_t id, const Vec3<S>& posit
 
 /// A tick without a new sample in which the I/O layer keeps the outputs (a short, bounded gap, e.g.
 /// a sensor frame not yet in on a timer-paced link): no control step, the DACs get the previous codes
-/// again, the sample clock and the age of the last encoder sample run on.
+/// again, the sample clock and the age of the last encoder sample run on. It takes no command and
+/// reports nothing (an empty report: the previous tick's answer is not given twice).
 template <class S, hal::ControlHal Hal>
 void hold_tick(ControlTask<S>& task, Hal& hal) {
+  task.report = {};
   task.jump.tick();
   hal.write_dacs(task.codes);
   ++task.tick;
