@@ -32,7 +32,7 @@ j = json.load(open(sys.argv[1]))
 assert j["result"] == "ok" and j["faults"] == [], (j["result"], j["faults"])
 L = j["limits"]
 cmds = j["commands"]
-assert {c["cmd"] for c in cmds} >= {"enable", "paper", "move_to", "stop", "disable", "stream"}, cmds
+assert {c["cmd"] for c in cmds} == {"enable", "paper", "move_to", "stop", "disable", "stream", "clear"}, cmds
 for c in cmds:
     assert c["accepted"] and c["refused"] is None, c
     assert c["done_s"] is not None or c["aborted"] is not None, c

@@ -42,7 +42,8 @@ const osc::CartesianLimits<double> kMax = osc::CartesianLimits<double>::defaults
 
 /// The command checks of docs/protocol.md, written from the document (not from the code).
 bool valid_by_the_document(const pil::CommandFrame& f) {
-  if (f.verb > 6 || (f.flags & 0xF0) != 0) return false;
+  if (f.verb > 7 || (f.flags & 0xF0) != 0) return false;
+  if (f.verb == 7 && (f.period < 1 || f.period > 100)) return false;  // stream: 1 to 100 ms
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(f.position[i]) || std::isinf(f.position[i]) || f.position[i] < -10.0f || f.position[i] > 10.0f)
       return false;
@@ -76,6 +77,9 @@ struct Checker {
       }
       case 2:  // the paper's motion: every move brakes it first
         gen.start_paper(osc::Gains<double>::paper().trajectory, 0, 2000);
+        break;
+      case 3:  // a stream running (id 3000): moves are busy, its setpoints are taken
+        gen.start_stream(20, (how & 0x80) != 0, kMax, 3000);
         break;
       default:
         break;
@@ -131,11 +135,35 @@ struct Checker {
     const pil::Parser::Result r = p.feed(byte);
     if (r != pil::Parser::kFrame) return r;
     pil::CommandFrame f;
+    pil::SetpointFrame sp;
     if (p.decode(f))
       command(f);
+    else if (p.decode(sp))
+      setpoint(sp);
     else
-      FUZZ_CHECK(p.type() != pil::kCommandFrame);
+      FUZZ_CHECK(p.type() != pil::kCommandFrame && p.type() != pil::kSetpointFrame);
     return r;
+  }
+
+  /// A setpoint: valid as the document says (flags end and has_rpy only, the bounds of a command's
+  /// numbers), and prepared for the running stream (3000) into finite coordinates near the target.
+  void setpoint(const pil::SetpointFrame& f) {
+    bool valid = (f.flags & 0xFC) == 0;
+    for (int i = 0; i < 3; ++i) {
+      valid &= std::isfinite(f.position[i]) && std::fabs(f.position[i]) <= 10.0f;
+      valid &= std::isfinite(f.rpy[i]) && std::fabs(static_cast<double>(f.rpy[i])) <= 2 * osc::kPi;
+    }
+    FUZZ_CHECK(osc::detail::setpoint_valid(f) == valid);
+    if (!valid) return;
+    osc::StreamSample<double> out;
+    const osc::Vec3<double> p(f.position[0], f.position[1], f.position[2]), rpy(f.rpy[0], f.rpy[1], f.rpy[2]);
+    const bool taken = osc::prepare_setpoint(gen, f.id, p, rpy, (f.flags & 2) != 0, (f.flags & 1) != 0, out);
+    FUZZ_CHECK(taken == (gen.source() == osc::MotionSource::kStream && f.id == 3000));
+    if (!taken) return;
+    FUZZ_CHECK(osc::math::all_finite(out.x));
+    const osc::Vec3<double> at = gen.stream_relative() ? osc::Vec3<double>(gen.hold_pose().p + p) : p;
+    FUZZ_CHECK((out.x.head<3>() - at).norm() <= 1e-9 * (1 + at.norm()));
+    gen.stream_setpoint(out.x, out.end);
   }
 };
 
@@ -166,6 +194,7 @@ pil::CommandFrame frame_from(fuzz::Input& in, bool raw) {
     f.limits[3 * k + 1] = number(in, raw, max[k].a / 50000, false);
     f.limits[3 * k + 2] = number(in, raw, max[k].j / 50000, false);
   }
+  f.period = in.u8();
   return f;
 }
 

@@ -167,7 +167,7 @@ pil::CommandFrame frame_from_command(std::uint32_t id, MotionVerb verb, const Mo
     f.limits[3 * k + 1] = detail::f32_at_most(lim[k].a);
     f.limits[3 * k + 2] = detail::f32_at_most(lim[k].j);
   }
-  f.period = static_cast<std::uint8_t>(verb == MotionVerb::kStream ? req.period : 0);
+  f.period = static_cast<std::uint8_t>(req.period > 255 ? 255 : req.period);  // other verbs ignore it
   return f;
 }
 
