@@ -266,8 +266,9 @@ void jerk_profile_kernels() {
   check("profile ends at the target", d(s.p), 0.38, 1e-4);
 }
 
-/// A stream (issue 23): setpoints at 50 Hz along 30 mm and 0.1 rad of yaw over 1 s, ending there;
-/// the generator's worst tick (the follower's six axes), and done at the last setpoint.
+/// A stream (issue 23): setpoints at 50 Hz, every axis moving (30 mm each, 0.1 rad of each angle) over
+/// 1 s, ending there; the generator's worst tick (the follower's six axes), and done at the last
+/// setpoint.
 MotionGenerator<F> g_stream_gen;
 void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R) {
   MotionGenerator<F>& gen = g_stream_gen;
@@ -280,8 +281,8 @@ void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R) {
     if (k % 20 == 0 && k <= 1000) {
       const F s = math::ratio<F>(k, 1000);
       end = x0;
-      end(0) += lit<F>(0.03) * s;
-      end(5) += lit<F>(0.1) * s;
+      for (int i = 0; i < 3; ++i) end(i) += lit<F>(0.03) * s;
+      for (int i = 3; i < 6; ++i) end(i) += lit<F>(0.1) * s;
       gen.stream_setpoint(end, k == 1000);
     }
     const std::uint32_t t0 = board::cycles();
