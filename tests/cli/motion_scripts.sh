@@ -123,7 +123,7 @@ exact = sys.argv[3] == "fixed"
 assert host["controller"]["kind"] == "in-process", host["controller"]
 assert qemu["controller"]["kind"] == "pil" and qemu["controller"]["link"]["clean"], qemu["controller"]
 assert qemu["result"] == "ok" and qemu["faults"] == [], (qemu["result"], qemu["faults"])
-assert len(qemu["commands"]) == 13 and qemu["commands"][-2]["cmd"] == "stream", qemu["commands"]
+assert len(qemu["commands"]) == 14 and qemu["commands"][-3]["cmd"] == "stream", qemu["commands"]
 for j in (host, qemu):
     del j["controller"], j["wall_s"]
 if exact:
