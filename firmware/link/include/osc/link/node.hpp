@@ -191,9 +191,17 @@ class PilNode {
   /// The first sensor frame's configuration bits.
   void configure(std::uint8_t config) {
     configured_ = true;
-    if (config & pil::kConfigStartDisabled)  // before the mode and the law: init sets them
+    if (config & pil::kConfigStartDisabled) {  // before the mode and the law: init sets them
+      // Ticks may have run before the first valid frame (link errors): their count and a fault they
+      // latched stay (a configuration is no way out of a fault).
+      const Supervisor sup = task.sup;
+      const std::uint64_t tick = task.tick;
       task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), task.mode, Vec6<S>(task.q_start), task.period_cycles,
                 TaskStart::kDisabled);
+      task.sup = sup;
+      task.tick = tick;
+      if (sup.state == SupervisorState::kFault) task.machine = {MotionState::kFault, sup.latched, false};
+    }
     if (config & pil::kConfigStateFrames) port.state_period = kStatePeriod;
     trace_ = (config & pil::kConfigTrace) != 0;
     if (config & pil::kConfigNoCompensation) task.mode = FrictionMode::kNone;
