@@ -94,13 +94,7 @@ class RemoteController {
     res.mean_step_cycles = last_.mean_cycles;
     res.max_tick_cycles = last_.tick_max_cycles;
     res.stack_used = last_.stack_used;
-    res.link.firmware = last_.link;
-    res.link.host = link_.link_counters();
-    res.link.host_code_range = link_.code_range_errors();
-    res.link.zeroed_ticks = zeroed_ticks_;
-    res.link.first_zeroed = first_zeroed_;
-    res.link.rx_gap_max = last_.rx_gap_max;
-    res.link.rx_long_gaps = last_.rx_long_gaps;
+    res.link = LinkReport::of(last_, link_.link_counters(), link_.code_range_errors(), zeroed_ticks_, first_zeroed_);
     link_.stop();
   }
 

@@ -167,6 +167,11 @@ struct LinkReport {
   /// shift=0 = ns of its virtual time], and the gaps longer than params::kLinkSilenceTicks periods.
   std::uint32_t rx_gap_max = 0, rx_long_gaps = 0;
   bool clean() const { return firmware.total() == 0 && host.total() == 0 && host_code_range == 0 && zeroed_ticks == 0; }
+  /// The report of a run: the firmware's counts from its last actuator frame, the host's own.
+  static LinkReport of(const pil::ActuatorFrame& last, const pil::LinkCounters& host, std::uint32_t host_code_range,
+                       std::uint32_t zeroed_ticks, const std::string& first_zeroed) {
+    return {last.link, host, host_code_range, zeroed_ticks, first_zeroed, last.rx_gap_max, last.rx_long_gaps};
+  }
 };
 
 /// The firmware's telemetry and the link's health (PIL only), from the last actuator frame.

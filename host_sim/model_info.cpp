@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "osc/kernels/opspace.hpp"
 #include "osc/robot.hpp"
 
@@ -40,15 +41,7 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(6)
       ->check(CLI::Range(-100.0, 100.0));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::printf("%s", app.help().c_str());
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "osc_model_info: %s\n(osc_model_info --help lists the options)\n", e.what());
-    return 2;
-  }
+  if (const int status = sim::parse_command_line(app, argc, argv, "osc_model_info"); status >= 0) return status;
   const double* named = pose == "qz"   ? puma560::kQz
                         : pose == "qr" ? puma560::kQr
                         : pose == "qs" ? puma560::kQs

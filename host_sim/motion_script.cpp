@@ -274,8 +274,7 @@ class HostArm {
   }
   bool tick(TickView& v, std::string&) {
     v.faults = sim_.tick();
-    port_.after_tick(sim_.task(), writer());
-    port_.poll(sim_.task(), writer());
+    port_.after_tick_and_poll(sim_.task(), writer());
     v.reports.swap(reports_);
     reports_.clear();
     const osc::ControlTask<S>& t = sim_.task();
@@ -367,13 +366,7 @@ class LinkedArm {
   void finish(MotionRun& run) {
     run.controller = "pil";
     run.pil_command = command_;
-    run.link.firmware = last_.link;
-    run.link.host = link_.link_counters();
-    run.link.host_code_range = link_.code_range_errors();
-    run.link.zeroed_ticks = zeroed_ticks_;
-    run.link.first_zeroed = first_zeroed_;
-    run.link.rx_gap_max = last_.rx_gap_max;
-    run.link.rx_long_gaps = last_.rx_long_gaps;
+    run.link = LinkReport::of(last_, link_.link_counters(), link_.code_range_errors(), zeroed_ticks_, first_zeroed_);
     link_.stop();
   }
 

@@ -35,6 +35,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
 
@@ -202,8 +203,7 @@ int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
         }
       }
     sim.tick();
-    port.after_tick(sim.task(), write);
-    port.poll(sim.task(), write);  // the next waiting command into the freed mailbox
+    port.after_tick_and_poll(sim.task(), write);  // the tick's frames; the next command into the freed mailbox
     pty.flush();
   }
   const double wall = wall_seconds() - t0;
@@ -270,15 +270,7 @@ int main(int argc, char** argv) {
   CLI::App app("", "osc_sim");
   Options o;
   build(app, o);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::printf("%s", app.help().c_str());
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "osc_sim: %s\n(osc_sim --help lists the options)\n", e.what());
-    return 2;
-  }
+  if (const int status = sim::parse_command_line(app, argc, argv, "osc_sim"); status >= 0) return status;
   std::string err;
   if (!o.pty) err = "--pty is required: the pseudo-terminal is the only virtual board so far (the QEMU image is not)";
   if (err.empty() && osc::params::kControlHz % o.state_hz != 0)

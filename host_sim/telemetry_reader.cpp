@@ -18,6 +18,7 @@
 #include <cstdio>
 #include <string>
 
+#include "cli_parse.hpp"
 #include "frame_json.hpp"
 #include "osc/control/faults.hpp"
 #include "osc/link/frames.hpp"
@@ -75,7 +76,7 @@ int main(int argc, char** argv) {
   app.add_option("--expect-faults", expect_faults,
                  "fail unless the last frame's latched faults are these (e.g. estop)");
   app.add_option("--expect-frames", expect_frames, "fail unless exactly this many frames came");
-  CLI11_PARSE(app, argc, argv);
+  if (const int status = sim::parse_command_line(app, argc, argv, "osc_telemetry"); status >= 0) return status;
 
   const int fd = open(source.c_str(), O_RDONLY | O_NOCTTY);
   if (fd < 0) {

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_parse.hpp"
 #include "motion_script.hpp"
 #include "osc_client.hpp"
 
@@ -220,22 +221,16 @@ int main(int argc, char** argv) {
   CLI::App app("", "oscctl");
   Args a;
   build(app, a);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp&) {
-    std::printf("%s", app.help().c_str());
-    return 0;
-  } catch (const CLI::ParseError& e) {
-    // A word that is no command: CLI11 says only that one is required.
+  // A word that is no command: CLI11 says only that one is required.
+  auto what = [&](const CLI::ParseError& e) {
     const std::vector<std::string> extra = app.remaining();
-    const std::string what = app.get_subcommands().empty() && !extra.empty()
-                                 ? extra.front() +
-                                       ": not a command (state, enable, disable, clear, paper, stop, "
-                                       "move, stream, watch)"
-                                 : e.what();
-    std::fprintf(stderr, "oscctl: %s\n(oscctl --help lists the commands and options)\n", what.c_str());
-    return 2;
-  }
+    return app.get_subcommands().empty() && !extra.empty()
+               ? extra.front() + ": not a command (state, enable, disable, clear, paper, stop, move, stream, watch)"
+               : std::string(e.what());
+  };
+  if (const int status = sim::parse_command_line(app, argc, argv, "oscctl", "the commands and options", what);
+      status >= 0)
+    return status;
   a.verb = app.get_subcommands().front()->get_name();
   std::string err;
   if (a.verb == "stream" && !check_stream(a, err)) {

@@ -45,8 +45,7 @@ class SimTransport : public osc::client::Transport {
   }
   void tick() {
     sim_.tick();
-    port_.after_tick(sim_.task(), emit());
-    port_.poll(sim_.task(), emit());
+    port_.after_tick_and_poll(sim_.task(), emit());
   }
   sim::MotionSim<double>& sim() { return sim_; }
   bool broken = false;

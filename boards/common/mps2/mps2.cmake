@@ -72,11 +72,15 @@ endfunction()
 # osc_add_motion_tests(SCALAR): scripted motions on this build's pil_firmware in QEMU (the host
 # build's puma_experiment --motion --qemu, docs/motion.md): motion_tour_qemu plays
 # examples/motion_tour.yaml on the image and in process in SCALAR and compares the two JSON outputs
-# (tests/cli/motion_scripts.sh qemu_tour: fixed point bit for bit; float the same events at the same
-# ticks, the figures within the float's spread); motion_qemu_wrong_scalar and
+# bit for bit (tests/cli/motion_scripts.sh qemu_tour; in float with the host-scalar build's
+# puma_experiment, whose float controller has no SIMD, as the M4F's); motion_qemu_wrong_scalar and
 # motion_qemu_start_pose, what --qemu refuses.
 function(osc_add_motion_tests scalar)
-  osc_host_tool(OSC_PUMA_EXPERIMENT puma_experiment host_sim)
+  if(scalar STREQUAL "float")
+    osc_host_tool(OSC_PUMA_EXPERIMENT puma_experiment host_sim ${OSC_HOST_SCALAR_TOOLS_DIR})
+  else()
+    osc_host_tool(OSC_PUMA_EXPERIMENT puma_experiment host_sim)
+  endif()
   find_program(OSC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
   if(NOT OSC_SYSTEM_PYTHON)
     return()

@@ -80,11 +80,20 @@ Mat3<S> axis_rotation(const Vec3<S>& k, S angle) {
   return Mat3<S>::Identity() + s * K + (S(1) - c) * (K * K);
 }
 
-/// The rotation R = Rz(yaw) Ry(pitch) Rx(roll) (the convention of the orientation coordinates).
+/// The rotation R = Rz(yaw) Ry(pitch) Rx(roll) (the convention of the orientation coordinates), its
+/// nine entries in closed form (a third of the instructions of the three rotations' product).
 template <class S>
 Mat3<S> rpy_rotation(const Vec3<S>& rpy) {
-  return axis_rotation<S>(Vec3<S>::UnitZ(), rpy(2)) * axis_rotation<S>(Vec3<S>::UnitY(), rpy(1)) *
-         axis_rotation<S>(Vec3<S>::UnitX(), rpy(0));
+  S sr, cr, sp, cp, sy, cy;
+  math::sincos(rpy(0), sr, cr);
+  math::sincos(rpy(1), sp, cp);
+  math::sincos(rpy(2), sy, cy);
+  const S spsr = sp * sr, spcr = sp * cr;
+  Mat3<S> R;
+  R << cy * cp, cy * spsr - sy * cr, cy * spcr + sy * sr,  //
+      sy * cp, sy * spsr + cy * cr, sy * spcr - cy * sr,   //
+      -sp, cp * sr, cp * cr;
+  return R;
 }
 
 /// The axis k and angle in [0, pi) of the rotation Rd (Rd = Rot(k, angle)); k = x and angle 0 for

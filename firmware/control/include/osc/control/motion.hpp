@@ -212,9 +212,11 @@ class MotionGenerator {
  private:
   static constexpr int kQueueSlots = kQueueLength + 1;  // the running move and those waiting
 
-  void set_hold(const Pose<S>& pose) {
+  void set_hold(const Pose<S>& pose) { set_hold(pose, orientation_coordinates<S>(pose.R, R_ref_)); }
+  /// Holds `pose`, whose orientation coordinates (relative to R_ref) are `phi`.
+  void set_hold(const Pose<S>& pose, const Vec3<S>& phi) {
     hold_pose_ = pose;
-    hold_d_.x << pose.p, orientation_coordinates<S>(pose.R, R_ref_);
+    hold_d_.x << pose.p, phi;
     hold_d_.xd.setZero();
     hold_d_.xdd.setZero();
     source_ = MotionSource::kHold;
@@ -245,8 +247,10 @@ class MotionGenerator {
     const bool done = !braking_ && stream_.settled();
     if (!(braking_ ? stream_.stopped() : done)) return d;
     if (done) ev.done_id = stream_id_;
-    end_at_rest({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)}, ev);
-    hold_d_.x = d.x;  // exactly where the follower is (not the coordinates' round trip through R)
+    // Holds exactly where the follower is (its coordinates, not their round trip through R).
+    (stopping_ ? ev.stopped : ev.finished) = true;
+    set_hold({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)},
+             d.x.template tail<3>());
     return hold_d_;
   }
 

@@ -149,6 +149,7 @@ class StreamFollower {
   /// to 10 Hz).
   void start(const Vec6<S>& x0, std::uint32_t period_ticks) {
     period_ = period_ticks > 0 ? period_ticks : 1;
+    rate_ = math::ratio<S>(kHz, period_);
     const std::uint32_t twice = 2 * period_;
     timeout_ = twice > kTimeoutMinTicks ? twice : kTimeoutMinTicks;
     prev_ = cur_ = x0;
@@ -240,14 +241,14 @@ class StreamFollower {
     const std::uint32_t extrapolated = period_ + kExtrapolationTicks;
     const std::uint32_t cap = ended_ ? period_ : (timeout_ < extrapolated ? timeout_ : extrapolated);
     const std::uint32_t tau = since_ < cap ? since_ : cap;
-    const S f = math::ratio<S>(tau, period_), rate = math::ratio<S>(kHz, period_);
+    const S f = math::ratio<S>(tau, period_);
     Vec6<S> r;
     for (int i = 0; i < 6; ++i) {
       const S dx = cur_(i) - prev_(i);
       r(i) = prev_(i) + dx * f;
       // v_r is clamped to vmax by the follower anyway: the difference is bounded first so that a
       // far sample (2 pi rad at 1 kHz) stays within the fixed-point range.
-      vr(i) = since_ < cap ? stream::clamp(dx, lit<S>(2.0)) * rate : S(0);
+      vr(i) = since_ < cap ? stream::clamp(dx, lit<S>(2.0)) * rate_ : S(0);
     }
     return r;
   }
@@ -257,6 +258,7 @@ class StreamFollower {
   jerk_profile::Kin<S> s_[6]{};
   S lo_[6]{};  ///< the positions' residuals below their resolution (step_axis)
   Vec6<S> prev_ = Vec6<S>::Zero(), cur_ = Vec6<S>::Zero();
+  S rate_ = S(0);  ///< samples per second (start())
   std::uint32_t period_ = 1, timeout_ = 20, since_ = 0;
   bool ended_ = false, stopping_ = false;
 };

@@ -38,6 +38,15 @@ class CommandPort {
   /// A state frame every `period` ticks (0: none).
   std::uint32_t state_period = kStatePeriod;
 
+  /// after_tick(), then poll(): for a transport that ticks and prepares in one thread (the simulator,
+  /// a lockstep loop), the frames of the tick just run and the next waiting command into the freed
+  /// mailbox.
+  template <class Write>
+  void after_tick_and_poll(ControlTask<S>& task, Write&& write) {
+    after_tick(task, write);
+    poll(task, write);
+  }
+
   /// A complete frame from the parser: receive() it, then poll(). A command or a setpoint is taken
   /// (true); any other type is the caller's (false). `write(bytes, n)` sends an answer at once (a
   /// refusal that no tick gives: the FIFO full, a verb code outside the list).

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "osc/math/fixed.hpp"
 
@@ -95,6 +96,39 @@ namespace detail {
   const float s2 = std::bit_cast<float>(static_cast<std::uint32_t>(k2 + 127) << 23);
   return p * s1 * s2;
 }
+/// atan2(y, x) in float, the same instructions on every target (the C libraries' atan2f differ, and
+/// so would a float controller on the host and on the M4F). a = min(|x|, |y|) / max(|x|, |y|) in
+/// [0, 1]; above tan(pi/12), atan a = pi/6 + atan t with t = (a sqrt3 - 1) / (a + sqrt3), so
+/// |t| <= tan(pi/12) = 0.268; atan t = p by its Taylor polynomial to t^13 (truncation below 3e-9).
+/// The octant (pi/2 - r where |y| > |x|, pi - r where x < 0 or -0) and the shift make the result
+/// k pi/6 +- p, k in 0..6, with k pi/6 as a float and its rest: one rounding of the sum. |error|
+/// <= 2e-7 (under one float ulp of pi), tested against double (test_properties, FloatFunctions).
+/// IEEE's zeros (atan2(+-0, -0) = +-pi) and NaNs; both infinite gives the diagonal's angle.
+[[gnu::always_inline]] inline float atan2_float(float y, float x) {
+  constexpr float kHi[7] = {0.0f,           5.235987902e-01f, 1.047197580e+00f, 1.570796371e+00f,
+                            2.094395161e+00f, 2.617993832e+00f, 3.141592741e+00f};
+  constexpr float kLo[7] = {0.0f,            -1.457046339e-08f, -2.914092678e-08f, -4.371139006e-08f,
+                            -5.828185357e-08f, 4.635697293e-08f,  -8.742278013e-08f};
+  if (x != x || y != y) return x + y;
+  const float ax = std::fabs(x), ay = std::fabs(y);
+  const bool steep = ay > ax, negative_x = std::signbit(x);
+  const float mn = steep ? ax : ay, mx = steep ? ay : ax;
+  const float a = mx > 0.0f ? (mn == mx ? 1.0f : mn / mx) : 0.0f;
+  const bool shifted = a > 2.679491937e-01f;
+  const float t = shifted ? (a * 1.732050776f - 1.0f) / (a + 1.732050776f) : a;
+  const float z = t * t;
+  const float p =
+      t + t * z *
+              (-3.33333333e-1f +
+               z * (2.0e-1f + z * (-1.42857143e-1f + z * (1.11111111e-1f + z * (-9.09090909e-2f + z * 7.69230769e-2f)))));
+  // The angle: base + s (shift + p), base 0, pi/2 (steep) or pi (x < 0; pi/2 when both), s = -1
+  // where one of steep and x < 0 reflects r.
+  const bool minus = steep != negative_x;
+  const int base = negative_x ? (steep ? 3 : 6) : (steep ? 3 : 0);
+  const int k = base + (shifted ? (minus ? -1 : 1) : 0);
+  const float r = kHi[k] + ((minus ? -p : p) + kLo[k]);
+  return std::signbit(y) ? -r : r;
+}
 }  // namespace detail
 
 inline float sin(float v) {
@@ -110,8 +144,12 @@ inline float cos(float v) {
 inline float sqrt(float v) { return std::sqrt(v); }
 inline float exp(float v) { return detail::exp_float(v); }
 inline float abs(float v) { return std::fabs(v); }
-inline float atan2(float y, float x) { return std::atan2(y, x); }
-inline float asin(float v) { return std::asin(v); }
+inline float atan2(float y, float x) { return detail::atan2_float(y, x); }
+/// asin v = atan2(v, sqrt((1 - v)(1 + v))) (NaN outside [-1, 1]).
+inline float asin(float v) {
+  if (!(std::fabs(v) <= 1.0f)) return v != v ? v : std::numeric_limits<float>::quiet_NaN();
+  return detail::atan2_float(v, std::sqrt((1.0f - v) * (1.0f + v)));
+}
 inline bool isfinite(float v) { return std::isfinite(v); }
 inline double sin(double v) { return std::sin(v); }
 inline double cos(double v) { return std::cos(v); }
@@ -223,7 +261,10 @@ S ratio(std::uint64_t n, std::uint32_t d) {
   if constexpr (fixed::is_q_v<S>)
     return fixed::ratio<S::kFractionBits>(static_cast<std::int64_t>(n), d);
   else
-    return static_cast<S>(n) * (S(1) / static_cast<S>(d));
+    // n below 2^32 converts as a 32-bit integer (the same value: one instruction on the M4F, where
+    // a 64-bit one is a library call).
+    return (n >> 32 == 0 ? static_cast<S>(static_cast<std::uint32_t>(n)) : static_cast<S>(n)) *
+           (S(1) / static_cast<S>(d));
 }
 
 /// An integer n (encoder counts) divided by a scale of the I/O scalar (counts per radian).
