@@ -75,6 +75,7 @@ def run(c):
     check("disabled after disable", s is not None)
     if s is not None:
         check("no fault", s["faults"] == 0, c.p.fault_names(s["faults"]))
+        check("no setpoint dropped (keep-alive frames are no setpoints)", s["dropped"] == 0, str(s["dropped"]))
     return ok
 
 
@@ -93,7 +94,7 @@ def main(argv):
     try:
         pty = find_pty(proc, time.monotonic() + TIMEOUT)
         print(f"board on {pty}", flush=True)
-        c = osc_client.Client(pty, 460800)
+        c = osc_client.Client(pty, 460800, keepalive=0.1)  # keep-alive frames too: taken as link activity
         ok = run(c)
         c.close()
     except (RuntimeError, osc_client.ClientError) as e:
