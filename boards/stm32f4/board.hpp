@@ -14,8 +14,8 @@
 //   - the cycle counter's rate is QEMU's fixed 168 MHz CPU clock, whatever the RCC set-up reports.
 // Everything else is the board image's code: the bounded clock set-up (which falls back to HSI
 // there, the RCC reading zero), the DAC frames on SPI2, the safety I/O registers, the watchdog's
-// registers, the EXTI E-stop (driven by its software trigger in the smoke test) and the telemetry
-// USART.
+// registers, the EXTI E-stop (driven by its software trigger in the smoke test) and the USART link
+// (commands in, answers, state and telemetry frames out).
 #pragma once
 
 #include <cstdint>
@@ -29,6 +29,7 @@
 #include "dac_bus.hpp"
 #include "encoders.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/command_port.hpp"
 #include "osc/link/frames.hpp"
 #include "pins.hpp"
 #include "safety.hpp"
@@ -57,14 +58,17 @@ constexpr std::uint32_t kControlHz = osc::params::kControlHz;
 
 // ---------------------------------------------------------------- interrupts
 // IRQ numbers: RM0090 table 61. Priorities: the STM32F4 implements 4 priority bits (16 levels, 0 the
-// most urgent); with the reset priority grouping all 4 are pre-emption bits. The E-stop pre-empts the
-// control tick, so that the amplifier falls within microseconds even in the middle of a step; the
-// tick pre-empts the main loop (telemetry transmission). The fault exceptions (HardFault, NMI) are
-// above all of them by the architecture.
+// most urgent); with the reset priority grouping all 4 are pre-emption bits. The E-stop pre-empts
+// everything, so that the amplifier falls within microseconds even in the middle of a step; the
+// USART's receive interrupt pre-empts the control tick (a tick is longer than a byte time: the data
+// register would overrun); the tick pre-empts the main loop (commands, transmission). The main loop
+// masks the tick alone (BASEPRI at kControlPriority: App::masked) around the command mailbox's
+// hand-over. The fault exceptions (HardFault, NMI) are above all of them by the architecture.
 constexpr int kPriorityBits = 4;
 constexpr int kEstopIrq = 7;  // EXTI1
-constexpr int kTim2Irq = 28, kTim6DacIrq = 54;
-constexpr unsigned kEstopPriority = 1, kControlPriority = 2;
+constexpr int kTim2Irq = 28, kUsart2Irq = 38, kTim6DacIrq = 54;
+constexpr unsigned kEstopPriority = 0, kUsartPriority = 1, kControlPriority = 2;
+static_assert(kEstopPriority < kUsartPriority && kUsartPriority < kControlPriority);
 constexpr stm32f4::Timer kControlTimer = kQemu ? stm32f4::Timer::kTim2 : stm32f4::Timer::kTim6;
 constexpr int kControlIrq = kQemu ? kTim2Irq : kTim6DacIrq;
 
@@ -80,12 +84,34 @@ constexpr stm32f4::TimerDivider qemu_control_divider() {
   return stm32f4::control_divider_32bit(kQemuTimerHz, kControlHz);
 }
 
-// ---------------------------------------------------------------- telemetry
+// ---------------------------------------------------------------- the USART link
 constexpr std::uint32_t kTelemetryBaud = 460800;
 /// An actuator frame (pil::kMaxFrame bytes, 10 bits each on the line) every 10th tick: 100 frames a second.
 constexpr std::uint32_t kTelemetryEvery = 10;
-static_assert(10u * pil::kMaxFrame * kControlHz <= kTelemetryBaud * kTelemetryEvery * 6 / 10,
-              "a telemetry frame fills at most 60 % of the line's time between frames");
+/// A state frame every 20th tick (osc::kStatePeriod): 50 a second.
+constexpr std::uint32_t kStateEvery = osc::kStatePeriod;
+static_assert(10u * (pil::kMaxFrame * kControlHz / kTelemetryEvery +
+                     (pil::kStatePayload + pil::kOverhead) * kControlHz / kStateEvery) <=
+                  kTelemetryBaud * 6 / 10,
+              "telemetry and state frames fill at most 60 % of the line: answers have room");
+/// Frames the transmitter queues: a tick gives at most three (answer, state, telemetry), and the
+/// main loop sends none while it checks a move's path (a tick or two).
+constexpr int kTxFrames = 8;
+/// Telemetry is offered only while this many slots stay free: an answer never waits behind it.
+constexpr int kTxAnswerReserve = 3;
+/// Received bytes the ring holds: 512 bytes are 11 ms of the line, far longer than the main loop's
+/// longest busy stretch (a path check, 1 to 2 ms).
+constexpr unsigned kRxBytes = 512;
+
+/// Runs f with the control interrupt held off (BASEPRI at its priority), the E-stop and the USART's
+/// receive interrupt still taken: the main loop's side of what it shares with the tick (the command
+/// mailbox, the transmit queue). Keep f short (a copy, a few stores): the tick waits meanwhile.
+template <class F>
+void with_tick_masked(F&& f) {
+  const std::uint32_t old = cortex_m::basepri_raise(kControlPriority, kPriorityBits);
+  f();
+  cortex_m::basepri_restore(old);
+}
 
 /// The QEMU image's encoders: a still robot.
 struct StillEncoders {
@@ -119,8 +145,8 @@ inline const char* reset_cause_name(std::uint32_t csr) {
 
 using Dac = ad5754r::DacPair<stm32f4::SpiDacBus>;
 using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter>;
-/// The telemetry USART: an actuator frame at a time.
-using TelemetryUart = stm32f4::TelemetryUart<pil::kMaxFrame>;
+/// The USART link: commands in, answer, state and telemetry frames out.
+using Uart = stm32f4::UsartLink<kTxFrames, pil::kMaxFrame, kRxBytes>;
 
 /// The board: its drivers and what the boot found.
 struct Board {
@@ -132,12 +158,12 @@ struct Board {
   stm32f4::SpiDacBus dac_bus;
   Dac dac{dac_bus};
   stm32f4::Safety safety;
-  TelemetryUart uart;
+  Uart uart;
   Hal hal{encoders, dac, safety, chip.timer(kControlTimer)};
 
   /// Boot, with interrupts still off: clocks (bounded, HSI fallback), the reset cause, the cycle
   /// counter, the safety outputs first (amplifier disabled), the DACs at 0 V, the encoders, the
-  /// telemetry USART. A boot fault keeps the torque off for good (Hal::permit_torque).
+  /// USART link. A boot fault keeps the torque off for good (Hal::permit_torque).
   void init() {
     clocks = stm32f4::clock_init(*chip.rcc, *chip.flash);
     note(clocks.fault);
@@ -154,11 +180,14 @@ struct Board {
   }
   /// The independent watchdog: from here on only healthy ticks keep the MCU out of reset.
   void start_watchdog() { note(safety.watchdog_start()); }
-  /// The E-stop interrupt and the 1 kHz control interrupt, with their priorities.
+  /// The E-stop interrupt, the USART's receive interrupt and the 1 kHz control interrupt, with
+  /// their priorities.
   void start_control() {
     cortex_m::irq_priority(kEstopIrq, kEstopPriority, kPriorityBits);
+    cortex_m::irq_priority(kUsart2Irq, kUsartPriority, kPriorityBits);
     cortex_m::irq_priority(kControlIrq, kControlPriority, kPriorityBits);
     cortex_m::irq_enable(kEstopIrq);
+    cortex_m::irq_enable(kUsart2Irq);
     if constexpr (!kQemu) {
       chip.rcc->APB1ENR = chip.rcc->APB1ENR | stm32f4::RccRegs::kTim6En;
       stm32f4::read_back(chip.rcc->APB1ENR);

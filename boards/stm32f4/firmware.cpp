@@ -1,7 +1,9 @@
 // The STM32F407 controller firmware (image stm32f4_firmware): the control task in the 1 kHz TIM6
 // interrupt over the board's encoders and DACs (board.hpp), the E-stop interrupt, the watchdog fed
-// by healthy ticks, and a telemetry frame (the PIL's actuator frame, osc/link/telemetry.hpp) every
-// 10th tick over USART2, sent by the main loop (app.hpp). The QEMU image is qemu_smoke.cpp.
+// by healthy ticks, and the command protocol on USART2 (app.hpp): the board starts disabled and
+// takes commands (enable, move_to, paper, stop, ...), answering them and sending state frames and a
+// telemetry frame (the PIL's actuator frame, osc/link/telemetry.hpp) every 10th tick. The QEMU
+// images are qemu_smoke.cpp and qemu_link.cpp.
 #include "app.hpp"
 
 static_assert(!board::kQemu, "the board's image; the QEMU image is qemu_smoke.cpp");
@@ -11,6 +13,9 @@ board::App g_app;
 }  // namespace
 
 extern "C" void OSC_CONTROL_TIMER_HANDLER() { g_app.control_interrupt(); }
+
+// The USART's receive interrupt: a byte into the ring.
+extern "C" void USART2_Handler() { g_app.uart_interrupt(); }
 
 // The E-stop input's rising edge (EXTI1).
 extern "C" void EXTI1_Handler() { g_app.estop_interrupt(); }

@@ -1,14 +1,15 @@
 // STM32F405/407 external interrupts 0..81 (RM0090 table 61), placed right after the common system
-// vectors (boards/common/cortex_m/startup.cpp). The board uses three (board.hpp, "Interrupts"):
-// EXTI1 (the E-stop), TIM6_DAC (the control interrupt) and TIM2 (the control interrupt of the QEMU
-// image: netduinoplus2 has no TIM6). Every other one is unexpected and traps (Default_Handler: the
-// outputs to their safe state, then a report).
+// vectors (boards/common/cortex_m/startup.cpp). The board uses four (board.hpp, "Interrupts"):
+// EXTI1 (the E-stop), USART2 (the command link's received bytes), TIM6_DAC (the control interrupt)
+// and TIM2 (the control interrupt of the QEMU images: netduinoplus2 has no TIM6). Every other one is unexpected and
+// traps (Default_Handler: the outputs to their safe state, then a report).
 extern "C" {
 void Default_Handler();  // boards/common/cortex_m/startup.cpp
 void Unused_Irq_Handler() { Default_Handler(); }
 void EXTI1_Handler() __attribute__((weak, alias("Unused_Irq_Handler")));
 void TIM2_Handler() __attribute__((weak, alias("Unused_Irq_Handler")));
 void TIM6_DAC_Handler() __attribute__((weak, alias("Unused_Irq_Handler")));
+void USART2_Handler() __attribute__((weak, alias("Unused_Irq_Handler")));
 }
 
 namespace {
@@ -56,8 +57,8 @@ __attribute__((section(".isr_vector.irq"), used)) const Handler g_irq_vectors[kI
     D,
     D,
     D,
-    D,
-    D,  // 30..39: TIM4, I2C1/2, SPI1/2, USART1..3
+    USART2_Handler,
+    D,  // 30..39: TIM4, I2C1/2, SPI1/2, USART1, USART2 (38), USART3
     D,
     D,
     D,

@@ -21,6 +21,12 @@ accepted or done, 1 refused, aborted or timed out, 2 a bad command line, port or
                                          [--v V --a A --j J] [--replace] [--no-wait]
     python3 clients/python/osc_client.py --port /dev/pts/7 stream FILE.csv --rate HZ [--relative]
     python3 clients/python/osc_client.py --port /dev/pts/7 watch [--seconds S]
+
+A board whose encoders are local (the STM32F4 board) stops a running motion (category 2, aborted
+link_silent) when no frame comes from the host for 0.5 s (params::kCommandLinkTimeout): give
+--keepalive SECONDS (e.g. 0.1) there, and the client sends a keep-alive frame (a state frame, which a
+controller takes as link activity and otherwise ignores) whenever it has sent nothing for that long
+while it waits.
 """
 import argparse
 import json
@@ -227,8 +233,9 @@ class Client:
 
     HISTORY = 1024
 
-    def __init__(self, port, baud=115200, protocol=None):
+    def __init__(self, port, baud=115200, protocol=None, keepalive=None):
         self.p = protocol or Protocol()
+        self.keepalive, self._last_write = keepalive, time.monotonic()
         try:
             import serial
         except ImportError:
@@ -359,12 +366,21 @@ class Client:
             self.ser.write(data)
         except (self._serial_error, OSError) as e:
             raise ClientError(f"{self.port}: {e}")
+        self._last_write = time.monotonic()
+
+    def _keep_alive(self):
+        """A state frame (all zero) when nothing was sent for self.keepalive seconds: link activity for a
+        board that stops a motion when its command link goes silent."""
+        if self.keepalive and time.monotonic() - self._last_write >= self.keepalive:
+            self._write(self.p.encode("state", {f["name"]: [0] * f["count"] if f["count"] > 1 else 0
+                                                for f in self.p.fields["state"]}))
 
     def _read_until(self, deadline, done):
         while not done():
             left = deadline - time.monotonic()
             if left <= 0:
                 return False
+            self._keep_alive()
             try:
                 ready = select.select([self.ser.fileno()], [], [], min(left, 0.05))[0]
                 data = self.ser.read(4096) if ready else b""
@@ -533,6 +549,8 @@ def parser():
     ap.add_argument("--port", required=True, help="the serial device or pseudo-terminal (e.g. /dev/pts/7)")
     ap.add_argument("--baud", type=int, default=115200, help="baud rate of a serial device (default 115200)")
     ap.add_argument("--timeout", type=positive, default=120.0, help="seconds to wait for an answer or an end")
+    ap.add_argument("--keepalive", type=positive, help="send a keep-alive frame after this many seconds without "
+                    "one while waiting (a board that stops a motion when its link goes silent: 0.1)")
     sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
     for v in ("state", "enable", "disable", "clear", "paper", "stop"):
         sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")
@@ -568,7 +586,7 @@ def main(argv):
     try:
         if a.verb == "stream":
             read_stream_csv(a.file)  # a bad file before the port is touched
-        c = Client(a.port, a.baud)
+        c = Client(a.port, a.baud, keepalive=a.keepalive)
         verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch}
         return verbs.get(a.verb, cmd_simple)(c, a)
     except ClientError as e:

@@ -44,6 +44,18 @@ inline void sleep_while(Idle idle) {
   if (idle()) __asm__ volatile("dsb\n wfi" ::: "memory");
   __asm__ volatile("cpsie i\n isb" ::: "memory");
 }
+/// Masks every interrupt of priority `level` and below (numerically level and above: BASEPRI,
+/// ARMv7-M B1.4.3; it only ever raises the mask: BASEPRI_MAX); the more urgent ones still come.
+/// Returns the mask before, for basepri_restore(). `prio_bits` as irq_priority's.
+inline std::uint32_t basepri_raise(unsigned level, int prio_bits) {
+  std::uint32_t old;
+  __asm__ volatile("mrs %0, basepri" : "=r"(old)::"memory");
+  const std::uint32_t mask = level << (8 - prio_bits);
+  __asm__ volatile("msr basepri_max, %0\n isb" ::"r"(mask) : "memory");
+  return old;
+}
+/// Puts back the mask basepri_raise() returned.
+inline void basepri_restore(std::uint32_t old) { __asm__ volatile("msr basepri, %0\n isb" ::"r"(old) : "memory"); }
 /// Sets the priority of external interrupt irq: `level` 0 is the most urgent; the device implements
 /// the top `prio_bits` bits of each priority byte (a board constant: 4 on the STM32F4).
 inline void irq_priority(int irq, unsigned level, int prio_bits) {

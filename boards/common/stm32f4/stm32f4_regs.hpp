@@ -143,13 +143,13 @@ static_assert(offsetof(SpiRegs, DR) == 0x0C && offsetof(SpiRegs, I2SPR) == 0x20,
 
 // ---------------------------------------------------------------- USART (RM0090 30.6)
 struct UsartRegs {
-  Reg SR;   // 0x00 RXNE 5, TC 6, TXE 7
+  Reg SR;   // 0x00 ORE 3, RXNE 5, TC 6, TXE 7
   Reg DR;   // 0x04
   Reg BRR;  // 0x08 DIV_Mantissa [15:4], DIV_Fraction [3:0] (16x oversampling)
-  Reg CR1;  // 0x0C RE 2, TE 3, UE 13
+  Reg CR1;  // 0x0C RE 2, TE 3, RXNEIE 5, UE 13
   Reg CR2, CR3, GTPR;
-  static constexpr std::uint32_t kRxne = 1u << 5, kTc = 1u << 6, kTxe = 1u << 7;
-  static constexpr std::uint32_t kRe = 1u << 2, kTe = 1u << 3, kUe = 1u << 13;
+  static constexpr std::uint32_t kOre = 1u << 3, kRxne = 1u << 5, kTc = 1u << 6, kTxe = 1u << 7;
+  static constexpr std::uint32_t kRe = 1u << 2, kTe = 1u << 3, kRxneie = 1u << 5, kUe = 1u << 13;
 };
 static_assert(offsetof(UsartRegs, CR1) == 0x0C && offsetof(UsartRegs, GTPR) == 0x18,
               "USART register map (RM0090 30.6.8)");

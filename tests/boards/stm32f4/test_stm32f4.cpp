@@ -3,8 +3,9 @@
 // RAM (a Chip of zeroed structs the test presets and reads back): the bounded clock set-up and its
 // fallbacks, the encoder unwrap across the 16- and 32-bit counter wraps, the AD5754R frames and the
 // one LDAC per burst, the SPI bus and its bounded waits, the zero-on-fault path, the E-stop latch,
-// the amplifier enable, the watchdog fed only by healthy ticks, the control timer and the telemetry
-// UART. The control task runs for real (ControlTask<double>) over the board's HAL binding.
+// the amplifier enable, the watchdog fed only by healthy ticks, the control timer, the USART link
+// (receive ring, frame queue) and the command link's silence (a category-2 stop, link_silent). The
+// control task runs for real (ControlTask<double>) over the board's HAL binding.
 #include <gtest/gtest.h>
 
 #include <vector>
@@ -15,6 +16,7 @@
 #include "control_timer.hpp"
 #include "dac_bus.hpp"
 #include "encoders.hpp"
+#include "osc/link/command_port.hpp"
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
 #include "pins.hpp"
@@ -549,12 +551,15 @@ TEST(Stm32ControlTimer, OneKilohertzFromEachTimerClock) {
   EXPECT_FALSE(control_timer_pending(t));
 }
 
+/// The board's link: 8 frames queued, a 512-byte receive ring.
+using Link = UsartLink<8, pil::kMaxFrame, 512>;
+
 TEST(Stm32Telemetry, AFrameGoesOutWhileTheTransmitterIsEmptyAndTheNextWaits) {
   FakeChip f;
-  TelemetryUart<pil::kMaxFrame> u;
+  Link u;
   u.init(f.chip(), 42000000, 460800, pins::kUartTx, pins::kUartRx);
   EXPECT_EQ(f.usart2.BRR, 91u);
-  EXPECT_EQ(f.usart2.CR1, UsartRegs::kUe | UsartRegs::kTe | UsartRegs::kRe);
+  EXPECT_EQ(f.usart2.CR1, UsartRegs::kUe | UsartRegs::kTe | UsartRegs::kRe | UsartRegs::kRxneie);
   osc::ControlTask<float> task;
   task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
             osc::joint_vector<float>(osc::robot::kQStart));
@@ -564,12 +569,15 @@ TEST(Stm32Telemetry, AFrameGoesOutWhileTheTransmitterIsEmptyAndTheNextWaits) {
   ASSERT_EQ(n, pil::kMaxFrame);
   ASSERT_TRUE(u.offer(buf, n));
   EXPECT_EQ(u.pump(), 0) << "transmitter full: nothing goes";
-  EXPECT_FALSE(u.offer(buf, n)) << "still busy: the next frame is refused";
-  EXPECT_EQ(u.dropped(), 1u);
+  EXPECT_TRUE(u.offer(buf, n)) << "queued behind the first";
+  EXPECT_EQ(u.queued(), 2);
+  EXPECT_EQ(u.dropped(), 0u);
   f.usart2.SR = UsartRegs::kTxe;
   EXPECT_EQ(u.pump(10), 10);
-  EXPECT_EQ(u.pump(), n - 10);
+  EXPECT_EQ(u.pump(n - 10), n - 10);
   EXPECT_EQ(f.usart2.DR, buf[n - 1]);
+  EXPECT_EQ(u.queued(), 1) << "the first frame out, whole";
+  EXPECT_EQ(u.pump(), n);
   EXPECT_FALSE(u.busy());
   // The bytes are the PIL's actuator frame: the host's parser reads them back.
   pil::Parser p;
@@ -581,6 +589,168 @@ TEST(Stm32Telemetry, AFrameGoesOutWhileTheTransmitterIsEmptyAndTheNextWaits) {
   EXPECT_EQ(a.seq, 7u);
   EXPECT_EQ(a.codes[3], -4);
   EXPECT_EQ(a.stack_used, 1234u);
+}
+
+TEST(Stm32Link, ReceivedBytesGoThroughTheRingAndLostOnesAreCounted) {
+  FakeChip f;
+  Link u;
+  u.init(f.chip(), 42000000, 460800, pins::kUartTx, pins::kUartRx);
+  std::uint8_t b = 0;
+  EXPECT_FALSE(u.read(b));
+  f.usart2.SR = 0;
+  u.on_rx_interrupt();  // no RXNE: nothing read
+  EXPECT_TRUE(u.rx_empty());
+  for (int i = 0; i < 3; ++i) {
+    f.usart2.SR = UsartRegs::kRxne;
+    f.usart2.DR = 0x40u + static_cast<std::uint32_t>(i);
+    u.on_rx_interrupt();
+  }
+  f.usart2.SR = UsartRegs::kRxne | UsartRegs::kOre;  // a byte lost in the USART before this one
+  f.usart2.DR = 0x7Fu;
+  u.on_rx_interrupt();
+  EXPECT_EQ(u.rx_overruns(), 1u);
+  for (std::uint8_t want : {0x40, 0x41, 0x42, 0x7F}) {
+    ASSERT_TRUE(u.read(b));
+    EXPECT_EQ(b, want);
+  }
+  EXPECT_FALSE(u.read(b));
+  // A main loop that falls behind: the ring takes 512 bytes, the rest are counted lost.
+  for (int i = 0; i < 600; ++i) {
+    f.usart2.SR = UsartRegs::kRxne;
+    f.usart2.DR = static_cast<std::uint32_t>(i & 0xFF);
+    u.on_rx_interrupt();
+  }
+  EXPECT_EQ(u.rx_lost(), 88u);
+  int n = 0;
+  for (; u.read(b); ++n) EXPECT_EQ(b, n & 0xFF);
+  EXPECT_EQ(n, 512);
+}
+
+TEST(Stm32Link, TheRingsIndicesRunFreelyAcrossTheirWrap) {
+  ByteRing<16> r;
+  std::uint8_t b = 0;
+  for (int i = 0; i < 1000; ++i) {
+    ASSERT_TRUE(r.push(static_cast<std::uint8_t>(i)));
+    if (i % 3 == 2) {  // the consumer lags, then catches up
+      for (int k = 2; k >= 0; --k) {
+        ASSERT_TRUE(r.pop(b));
+        EXPECT_EQ(b, static_cast<std::uint8_t>(i - k));
+      }
+    }
+  }
+  EXPECT_EQ(r.size(), 1000u % 3);
+  EXPECT_EQ(r.lost(), 0u);
+}
+
+TEST(Stm32Link, AFullQueueDropsAndCountsTheFrameAndKeepsTheOrder) {
+  FrameQueue<3, 8> q;
+  const std::uint8_t a[] = {1, 2}, b[] = {3}, c[] = {4, 5, 6}, d[] = {7};
+  EXPECT_TRUE(q.push(a, 2));
+  EXPECT_TRUE(q.push(b, 1));
+  EXPECT_TRUE(q.push(c, 3));
+  EXPECT_FALSE(q.push(d, 1)) << "full";
+  std::uint8_t big[9] = {};
+  EXPECT_FALSE(q.push(big, 9)) << "longer than a slot";
+  EXPECT_EQ(q.dropped(), 2u);
+  int n = 0;
+  for (const std::uint8_t* want : {a, b, c}) {
+    const std::uint8_t* p = q.front(n);
+    ASSERT_NE(p, nullptr);
+    EXPECT_EQ(p[0], want[0]);
+    q.pop();
+  }
+  EXPECT_EQ(n, 3);
+  EXPECT_EQ(q.front(n), nullptr);
+  EXPECT_TRUE(q.push(d, 1)) << "room again";
+}
+
+TEST(Stm32Link, AnAnswerQueuedBehindTelemetryGoesOutWholeAndParses) {
+  FakeChip f;
+  Link u;
+  u.init(f.chip(), 42000000, 460800, pins::kUartTx, pins::kUartRx);
+  osc::ControlTask<float> task;
+  task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
+            osc::joint_vector<float>(osc::robot::kQStart));
+  const std::int32_t codes[hal::kJoints] = {};
+  std::uint8_t t[pil::kMaxFrame], a[pil::kMaxFrame];
+  const int nt = pil::encode(osc::telemetry_frame(task, codes, 3, 0), t);
+  pil::AnswerFrame ans{};
+  ans.id = 77;
+  const int na = pil::encode(ans, a);
+  ASSERT_TRUE(u.offer(t, nt));
+  ASSERT_TRUE(u.offer(a, na));
+  f.usart2.SR = UsartRegs::kTxe;
+  pil::Parser p;
+  std::vector<pil::FrameType> got;
+  for (int i = 0; i < nt + na; ++i) {
+    ASSERT_EQ(u.pump(1), 1);
+    if (p.feed(static_cast<std::uint8_t>(f.usart2.DR)) == pil::Parser::kFrame) got.push_back(p.type());
+  }
+  EXPECT_FALSE(u.busy());
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0], pil::kActuatorFrame);
+  EXPECT_EQ(got[1], pil::kAnswerFrame);
+  pil::AnswerFrame back;
+  ASSERT_TRUE(p.decode(back));
+  EXPECT_EQ(back.id, 77u);
+}
+
+/// The board's tick with the command link watched, as its control interrupt runs it.
+struct WatchedRig : BoardRig {
+  osc::CommandLinkWatch watch;
+  bool commanded = true;
+  std::uint32_t tick() {
+    watch.before_tick(task, commanded);
+    return BoardRig::tick();
+  }
+  /// Ticks until the motion is aborted (its reason), or `limit` ticks.
+  osc::MotionReason run(int limit, int heard_every = 0) {
+    for (int k = 1; k <= limit; ++k) {
+      if (heard_every && k % heard_every == 0) watch.heard();
+      EXPECT_EQ(tick(), 0u) << k;
+      if (task.report.abort != osc::MotionReason::kNone) return task.report.abort;
+    }
+    return osc::MotionReason::kNone;
+  }
+};
+
+TEST(Stm32CommandLink, ASilentLinkStopsTheMotionCategoryTwoAfterTheTimeout) {
+  auto r = std::make_unique<WatchedRig>();  // the paper's motion runs from the first tick
+  constexpr int kTimeout = static_cast<int>(osc::CommandLinkWatch::kTimeoutTicks);
+  static_assert(kTimeout == 500, "0.5 s at 1 kHz");
+  r->watch.heard();
+  ASSERT_EQ(r->run(kTimeout), osc::MotionReason::kNone) << "not before the timeout";
+  EXPECT_EQ(r->task.machine.state, osc::MotionState::kMoving);
+  EXPECT_EQ(r->run(1), osc::MotionReason::kLinkSilent);
+  EXPECT_EQ(r->task.machine.state, osc::MotionState::kStopping);
+  EXPECT_EQ(osc::state_frame_from_task(r->task).stop, static_cast<std::uint8_t>(osc::StopCategory::kCategory2));
+  EXPECT_EQ(r->task.sup.latched, 0u) << "no fault: a controlled stop";
+  EXPECT_TRUE(r->safety.amplifier_enabled()) << "torque on while it decelerates";
+  EXPECT_EQ(r->watch.stops(), 1u);
+  EXPECT_EQ(r->run(50), osc::MotionReason::kNone) << "aborted once";
+}
+
+TEST(Stm32CommandLink, FramesKeepTheMotionGoingAndNoHostMeansNoStop) {
+  auto r = std::make_unique<WatchedRig>();
+  // (600 ticks at most: the encoders here stand still, and the paper's motion latches encoder_stuck
+  // after about 620.)
+  EXPECT_EQ(r->run(590, 200), osc::MotionReason::kNone) << "a frame every 0.2 s";
+  EXPECT_EQ(r->task.machine.state, osc::MotionState::kMoving);
+  EXPECT_LT(r->watch.silent_ticks(), 200u);
+  auto quiet = std::make_unique<WatchedRig>();
+  quiet->commanded = false;  // no host has sent a command: the paper's motion of a board alone
+  EXPECT_EQ(quiet->run(590), osc::MotionReason::kNone);
+  EXPECT_EQ(quiet->watch.stops(), 0u);
+  EXPECT_EQ(quiet->watch.silent_ticks(), osc::CommandLinkWatch::kTimeoutTicks);
+}
+
+TEST(Stm32CommandLink, AStopRequestOutsideAMotionIsIgnoredAndCleared) {
+  auto r = std::make_unique<WatchedRig>();
+  osc::request_stop(r->task, osc::MotionReason::kLinkSilent);
+  r->task.machine.state = osc::MotionState::kHolding;  // the machine alone decides: nothing to stop
+  EXPECT_EQ(r->BoardRig::tick(), 0u);
+  EXPECT_EQ(r->task.report.abort, osc::MotionReason::kNone);
+  EXPECT_EQ(r->task.stop_request, osc::MotionReason::kNone) << "each tick takes the request it finds";
 }
 
 }  // namespace

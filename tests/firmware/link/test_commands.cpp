@@ -473,9 +473,13 @@ TEST(CommandFrames, SetpointRoundTripsAndBadOnesAreDropped) {
   EXPECT_EQ(task->dropped, 5u);
 }
 
-TEST(CommandFrames, ReasonsListEndsWithBadCommand) {
+TEST(CommandFrames, ReasonsListEndsWithLinkSilentAfterBadCommand) {
+  // Appended only: the codes clients know stay.
   EXPECT_STREQ(motion_name(MotionReason::kBadCommand), "bad_command");
-  EXPECT_EQ(static_cast<int>(MotionReason::kBadCommand) + 1, MotionNames<MotionReason>::kCount);
+  EXPECT_EQ(static_cast<int>(MotionReason::kBadCommand), 14);
+  EXPECT_STREQ(motion_name(MotionReason::kLinkSilent), "link_silent");
+  EXPECT_EQ(static_cast<int>(MotionReason::kLinkSilent), 15);
+  EXPECT_EQ(static_cast<int>(MotionReason::kLinkSilent) + 1, MotionNames<MotionReason>::kCount);
 }
 
 // ---------------------------------------------------------------- preparing
@@ -996,6 +1000,111 @@ TEST(CommandFrames, LimitsAreSentAsTheF32AtMostThem) {
   m.position[2] = 0.01f;
   const TaskCommand<double> c = prepare_frame_command(task->gen, task->limits, 0, params::kControlHz, m);
   EXPECT_EQ(c.refusal, MotionReason::kNone);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- a timer-paced board's poll
+
+namespace {
+
+/// poll_paced() against a task whose ticks the test stands in for: `masked` runs its work and
+/// notes that it did (and may let ticks pass first: late), `wait` lets one tick pass.
+struct PacedRig {
+  std::unique_ptr<ControlTask<double>> task = std::make_unique<ControlTask<double>>();
+  CommandPort<double> port;
+  std::unique_ptr<CommandPort<double>::PacedInputs> in = std::make_unique<CommandPort<double>::PacedInputs>();
+  std::vector<Bytes> written;
+  bool inside = false, wrote_outside = false;
+  int masked_calls = 0, waits = 0;
+  std::uint64_t late_by = 0;  // ticks that pass before the hand-over (the second masked call)
+  explicit PacedRig(TaskStart start) {
+    task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
+               joint_vector<double>(robot::kQStart), 0, start);
+  }
+  void receive(const pil::CommandFrame& f) {
+    ASSERT_TRUE(port.receive(*task, parsed(bytes_of(f)), [&](const std::uint8_t* b, int n) { note(b, n); }));
+  }
+  void poll() {
+    port.poll_paced(
+        *task, *in, [&](const std::uint8_t* b, int n) { note(b, n); },
+        [&](auto&& work) {
+          if (++masked_calls == 2) task->tick += late_by;
+          inside = true;
+          work();
+          inside = false;
+        },
+        [&] {
+          ++waits;
+          ++task->tick;
+        });
+  }
+  void note(const std::uint8_t* b, int n) {
+    wrote_outside |= !inside;
+    written.emplace_back(b, b + n);
+  }
+};
+
+pil::CommandFrame small_move(std::uint32_t id) {
+  MoveRequest<double> req;
+  req.relative = true;
+  req.position(2) = 0.01;
+  return frame_from_command(id, MotionVerb::kMoveTo, req);
+}
+
+TEST(CommandPortPaced, AMoveThatBrakesTheMotionGoesInJustBeforeItsPlannedTick) {
+  PacedRig r(TaskStart::kPaper);  // the paper's motion runs: a move_to brakes it
+  const std::uint64_t t0 = r.task->tick;
+  r.receive(small_move(5));
+  r.poll();
+  EXPECT_EQ(r.task->pending.verb, MotionVerb::kMoveTo);
+  EXPECT_TRUE(r.task->pending.brake);
+  EXPECT_EQ(r.task->pending.refusal, MotionReason::kNone);
+  EXPECT_EQ(r.task->pending.id, 5u);
+  EXPECT_EQ(r.task->tick, t0 + kPacedLeadTicks) << "handed over before the tick it was planned for";
+  EXPECT_EQ(r.waits, static_cast<int>(kPacedLeadTicks));
+  EXPECT_TRUE(r.written.empty());
+  EXPECT_EQ(r.port.waiting(), 0);
+}
+
+TEST(CommandPortPaced, ABrakedMoveWhoseCheckOutlastedItsLeadIsSuperseded) {
+  PacedRig r(TaskStart::kPaper);
+  r.late_by = kPacedLeadTicks + 1;  // the path check took longer than the lead
+  r.receive(small_move(6));
+  r.poll();
+  EXPECT_EQ(r.task->pending.verb, MotionVerb::kMoveTo);
+  EXPECT_EQ(r.task->pending.refusal, MotionReason::kSuperseded) << "the tick that takes it refuses it";
+  EXPECT_EQ(r.waits, 0);
+}
+
+TEST(CommandPortPaced, AQueuedCommandGoesInAtOnceAndTheNextWaitsForTheMailbox) {
+  PacedRig r(TaskStart::kDisabled);
+  r.receive(frame_from_command<double>(1, MotionVerb::kEnable));
+  r.receive(small_move(2));
+  r.poll();
+  EXPECT_EQ(r.task->pending.verb, MotionVerb::kEnable);
+  EXPECT_EQ(r.waits, 0);
+  EXPECT_EQ(r.port.waiting(), 1) << "the mailbox is taken until a tick takes the enable";
+  r.task->pending = {};  // the tick took it
+  r.poll();
+  EXPECT_EQ(r.task->pending.verb, MotionVerb::kMoveTo);
+  EXPECT_FALSE(r.task->pending.brake);
+  EXPECT_EQ(r.task->pending.refusal, MotionReason::kNone);
+  EXPECT_EQ(r.masked_calls, 6) << "each poll: inputs taken, handed over, then the mailbox taken or the FIFO empty";
+}
+
+TEST(CommandPortPaced, ABadVerbIsRefusedAtOnceInsideTheMask) {
+  PacedRig r(TaskStart::kDisabled);
+  pil::CommandFrame f = frame_from_command<double>(9, MotionVerb::kEnable);
+  f.verb = 200;
+  r.receive(f);
+  r.poll();
+  EXPECT_EQ(r.task->pending.verb, MotionVerb::kNone);
+  ASSERT_EQ(r.written.size(), 1u);
+  EXPECT_FALSE(r.wrote_outside);
+  const pil::AnswerFrame a = decoded<pil::AnswerFrame>(parsed(r.written[0]));
+  EXPECT_EQ(a.id, 9u);
+  EXPECT_EQ(a.refusal, static_cast<std::uint8_t>(MotionReason::kBadCommand));
 }
 
 }  // namespace

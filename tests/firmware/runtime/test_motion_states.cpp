@@ -29,7 +29,7 @@ using R = MotionReason;
 constexpr int kStates = MotionNames<S>::kCount;
 constexpr int kCommands = MotionNames<C>::kCount;
 constexpr int kReasons = MotionNames<R>::kCount;
-static_assert(kStates == 5 && kCommands == 6 && kReasons == 15);
+static_assert(kStates == 5 && kCommands == 6 && kReasons == 16);
 static_assert(MotionNames<CommandOutcome>::kCount == 3 && MotionNames<StopCategory>::kCount == 3);
 static_assert(MotionNames<MotionCompletion>::kCount == 3);
 static_assert(sizeof(MotionNames<S>::kDocs) == sizeof(MotionNames<S>::kNames));
@@ -232,7 +232,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   faulting += f != 0;
                   ++cases;
                 }
-  EXPECT_EQ(cases, 6L * 2 * 3 * 7 * 3 * 3 * 15 * 4);
+  EXPECT_EQ(cases, 6L * 2 * 3 * 7 * 3 * 3 * 16 * 4);
   EXPECT_GT(refusals, 0);  // the loop reached every kind of row
   EXPECT_GT(aborts, 0);
   EXPECT_GT(faulting, 0);
@@ -323,6 +323,7 @@ TEST(MotionStates, TheIssuesNamesAreTheNamesInTelemetry) {
   EXPECT_STREQ(motion_name(R::kFaulted), "faulted");
   EXPECT_STREQ(motion_name(R::kStaleStream), "stale_stream");
   EXPECT_STREQ(motion_name(R::kLimitReached), "limit_reached");
+  EXPECT_STREQ(motion_name(R::kLinkSilent), "link_silent");
   EXPECT_STREQ(motion_name(C::kMove), "move");
 }
 
@@ -410,6 +411,19 @@ TEST(MotionSequences, AStaleStreamStopsWithCategoryTwoAndHoldsWithoutAFault) {
   EXPECT_EQ(h.machine.latched, 0u);
   EXPECT_TRUE(h.torque);
   EXPECT_EQ(a.command(C::kMove).outcome, CommandOutcome::kAccepted);  // at rest, a move starts again
+}
+
+TEST(MotionSequences, ASilentCommandLinkStopsWithCategoryTwoOnlyWhileMoving) {
+  Arm a = moving_arm();
+  const MotionStep s = a.tick({.stop_request = R::kLinkSilent});
+  expect_category_2_stop(s, R::kLinkSilent);
+  EXPECT_EQ(a.tick({.stop_request = R::kLinkSilent}).abort, R::kNone);  // reported once
+  const MotionStep h = a.tick({.stopped = true});
+  EXPECT_EQ(h.machine.state, S::kHolding);
+  EXPECT_EQ(h.machine.latched, 0u);
+  EXPECT_EQ(a.tick({.stop_request = R::kLinkSilent}).machine.state, S::kHolding);  // holding: nothing to stop
+  Arm d;
+  EXPECT_EQ(d.tick({.stop_request = R::kLinkSilent}).machine.state, S::kDisabled);
 }
 
 TEST(MotionSequences, DisableWhileMovingStopsFirstThenCutsTheTorque) {

@@ -115,4 +115,13 @@ constexpr double kLinkTimeout = 0.1;
 constexpr int kLinkErrorLimit = 3;
 constexpr int kLinkErrorWindow = 1000;
 
+/// The command link of a board whose encoders are local (the STM32F4 board's USART; not the PIL
+/// link, whose frames carry the encoders): once a host has sent a command, no frame at all for this
+/// long [s] while a motion runs stops the motion, category 2, aborted `link_silent`. Half a second:
+/// far above a healthy host's gaps (a client keeps the link alive every 0.1 s while a motion runs),
+/// yet short against a moving arm's travel: Crazyflie's commander levels the vehicle after 500 ms
+/// without a setpoint (and stops the motors after 2 s), PX4 fails safe after 1 s without offboard
+/// setpoints (COM_OF_LOSS_T). The board counts it in ticks: kCommandLinkTimeout * kControlHz.
+constexpr double kCommandLinkTimeout = 0.5;
+
 }  // namespace osc::params

@@ -18,7 +18,9 @@
 // double on the M3); after_tick() (frames only, no preparation) after the tick, in the control
 // interrupt if the tick runs there. on_frame() is receive() then poll(). In lockstep (the host paces
 // the ticks: the PIL link) nothing else runs between them; a timer-paced board must keep receive()
-// and poll() from racing the tick over the mailbox. Header-only, allocation-free.
+// and poll() from racing the tick over the mailbox: it calls receive() with the control interrupt
+// masked and poll_paced() instead of poll() (below: the mailbox hand-over masked, never the path
+// check), and watches the link's silence with CommandLinkWatch. Header-only, allocation-free.
 #pragma once
 
 #include <cstdint>
@@ -31,12 +33,27 @@ namespace osc {
 constexpr int kCommandFifo = 4;
 /// The default period of the state frames [ticks]: 50 Hz.
 constexpr std::uint32_t kStatePeriod = 20;
+/// A timer-paced board (poll_paced): a move that brakes the running motion (a re-target, a move
+/// after the paper's motion) is planned for the tick this many ticks after its inputs were taken,
+/// and handed to the task just before that tick: enough for its path check (about 165 000
+/// instructions on the M4F, 1 to 2 ms at 168 MHz with the ticks pre-empting it).
+constexpr std::uint32_t kPacedLeadTicks = 10;
 
 template <class S>
 class CommandPort {
  public:
   /// A state frame every `period` ticks (0: none).
   std::uint32_t state_period = kStatePeriod;
+
+  /// What poll_paced() prepares a command from: copied from the task with the control interrupt
+  /// masked.
+  struct PacedInputs {
+    pil::CommandFrame frame;
+    MotionGenerator<S> gen;
+    CartesianLimits<S> limits;
+    std::uint64_t tick = 0;
+    Vec6<S> q_measured, q_queue_end;  // the path check's seeds: a braked move's, a queued one's
+  };
 
   /// after_tick(), then poll(): for a transport that ticks and prepares in one thread (the simulator,
   /// a lockstep loop), the frames of the tick just run and the next waiting command into the freed
@@ -102,6 +119,48 @@ class CommandPort {
     }
   }
 
+  /// poll() for a board whose timer paces the ticks: the control interrupt pre-empts this call at
+  /// any instruction, and the tick reads the mailbox (task.pending) and changes what a preparation
+  /// reads (the generator, the limits, the tick count, the measured angles). So each command goes
+  /// in three steps:
+  ///   1. masked: the mailbox free, the oldest command out of the FIFO, and a copy of what its
+  ///      preparation reads (PacedInputs: the generator, a few kB: microseconds);
+  ///   2. unmasked: prepared on the copy, a move_to's path checked (about a millisecond; ticks run
+  ///      meanwhile, the task's own state untouched: the check's workspace is the main loop's);
+  ///   3. masked: into the mailbox. A move planned from the copy's queue carries its epoch: the tick
+  ///      refuses it (superseded) when the queue changed meanwhile, as in lockstep. A move that
+  ///      brakes the running motion is planned for the tick kPacedLeadTicks after step 1 and goes in
+  ///      just before that tick (calling `wait()` meanwhile: the board pumps its transmitter), or,
+  ///      when the check took longer, is refused superseded by the tick that takes it.
+  /// `masked(f)` runs f with the control interrupt held off; `write` is called only inside it.
+  /// `in`: the copy's room (the board's: a few kB, static rather than on the main stack).
+  template <class Write, class Masked, class Wait>
+  void poll_paced(ControlTask<S>& task, PacedInputs& in, Write&& write, Masked&& masked, Wait&& wait) {
+    for (;;) {
+      bool got = false;
+      masked([&] { got = take_inputs(task, in); });
+      if (!got) return;
+      const std::uint64_t planned = in.tick + kPacedLeadTicks;
+      TaskCommand<S> c = prepare_frame_command(in.gen, in.limits, planned, params::kControlHz, in.frame);
+      if (c.verb == MotionVerb::kNone) {
+        const MotionReason why = c.refusal == MotionReason::kNone ? MotionReason::kBadCommand : c.refusal;
+        masked([&] { refuse_now(task, in.frame, why, write); });
+        continue;
+      }
+      if (c.verb == MotionVerb::kMoveTo && c.refusal == MotionReason::kNone) {
+        const Vec6<S>& seed = c.brake ? in.q_measured : in.q_queue_end;
+        const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, in.gen.reference_orientation(), seed);
+        c.refusal = path_refusal(pc.status);
+        c.q_end = pc.q_end;
+      }
+      const bool timed = c.verb == MotionVerb::kMoveTo && c.brake && c.refusal == MotionReason::kNone;
+      for (bool placed = false; !placed;) {
+        masked([&] { placed = hand_over(task, c, timed ? planned : task.tick); });
+        if (!placed) wait();
+      }
+    }
+  }
+
   /// After each tick (control_tick or a tick without a step): its answer (once a command has come),
   /// then a state frame when due. Prepares nothing (safe in the control interrupt): poll() does.
   template <class Write>
@@ -128,9 +187,73 @@ class CommandPort {
     write(buf, pil::encode(frame_from_report(r, task.machine.state, task.gen.queued(), task.tick - 1), buf));
   }
 
+  /// poll_paced() step 1 (masked): the oldest waiting command and its inputs, when the mailbox is free.
+  bool take_inputs(const ControlTask<S>& task, PacedInputs& in) {
+    if (count_ == 0 || task.pending.verb != MotionVerb::kNone) return false;
+    in.frame = fifo_[head_];
+    head_ = (head_ + 1) % kCommandFifo;
+    --count_;
+    in.gen = task.gen;
+    in.limits = task.limits;
+    in.tick = task.tick;
+    in.q_measured = task.state.adapt.q_prev;
+    in.q_queue_end = task.q_queue_end;
+    return true;
+  }
+
+  /// poll_paced() step 3 (masked): the command into the mailbox now, if the tick about to run is
+  /// `due` (true); not yet before it (false); refused superseded after it (true: the tick answers).
+  static bool hand_over(ControlTask<S>& task, TaskCommand<S>& c, std::uint64_t due) {
+    if (task.tick < due) return false;
+    if (task.tick > due) c.refusal = MotionReason::kSuperseded;
+    task.pending = c;
+    return true;
+  }
+
   pil::CommandFrame fifo_[kCommandFifo] = {};
   int head_ = 0, count_ = 0;
   bool commanded_ = false;
+};
+
+/// The command link's silence on a board whose encoders are local (a board's UART: losing the
+/// command link is a category-2 stop there; on the PIL link the frames carry the encoders and the
+/// node's link supervision applies). The main loop notes every valid frame (heard(), any type); the
+/// tick's context calls before_tick() before each tick: once a host has sent a command, a motion
+/// that runs after params::kCommandLinkTimeout without a frame is stopped, category 2, aborted
+/// link_silent (request_stop: the tick's own stop requests come first). It asks again every
+/// silent tick of a motion; the machine ignores the request once it stops. Lock-free: heard() is
+/// a byte store, and before_tick() runs where the main loop cannot pre-empt it.
+class CommandLinkWatch {
+ public:
+  static constexpr auto kTimeoutTicks =
+      static_cast<std::uint32_t>(params::kCommandLinkTimeout * params::kControlHz + 0.5);
+  static_assert(kTimeoutTicks > 1, "the command link timeout is longer than a tick");
+
+  /// A valid frame came (main loop).
+  void heard() { heard_ = true; }
+  /// Before each tick (its context): counts the silence; true, and a stop requested, when the
+  /// link has been silent for kTimeoutTicks while a commanded motion runs.
+  template <class S>
+  bool before_tick(ControlTask<S>& task, bool commanded) {
+    if (heard_) {
+      heard_ = false;
+      silent_ = 0;
+    } else if (silent_ < kTimeoutTicks) {
+      ++silent_;
+    }
+    if (!commanded || silent_ < kTimeoutTicks || task.machine.state != MotionState::kMoving) return false;
+    request_stop(task, MotionReason::kLinkSilent);
+    ++stops_;
+    return true;
+  }
+  /// Ticks since the last frame (up to kTimeoutTicks).
+  std::uint32_t silent_ticks() const { return silent_; }
+  /// Ticks that asked for a link_silent stop.
+  std::uint32_t stops() const { return stops_; }
+
+ private:
+  volatile bool heard_ = false;
+  std::uint32_t silent_ = 0, stops_ = 0;
 };
 
 }  // namespace osc

@@ -43,6 +43,7 @@ struct ControlTask {
   TaskCommand<S> pending;     // the next tick's command (verb none: no command)
   StreamSample<S> sample;     // the next tick's stream setpoint (prepare_setpoint)
   std::uint32_t dropped;      // setpoints dropped (no stream of their id running, bad, or overwritten untaken)
+  MotionReason stop_request;  // the next tick's category-2 stop asked from outside the tick (e.g. link_silent)
   Vec6<S> q_queue_end;        // the joint angles where the queued moves end (the next path check's seed)
   Data<S> check_data;         // the path check's workspace (command preparation, outside the tick)
   MotionReport report;        // this tick's answer and motion events
@@ -81,6 +82,7 @@ struct ControlTask {
     pending = {};
     sample = {};
     dropped = 0;
+    stop_request = MotionReason::kNone;
     report = {};
     ramp_start = 0;
     ramping = false;
@@ -318,6 +320,8 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
   MotionReason stop_request = stepped ? motion_limits_reached(task, q) : MotionReason::kNone;
   if (stop_request == MotionReason::kNone && task.gen.stream_stale()) stop_request = MotionReason::kStaleStream;
+  if (stop_request == MotionReason::kNone) stop_request = task.stop_request;  // the board's (request_stop)
+  task.stop_request = MotionReason::kNone;
   const bool torque = motion_update(task, faults, measured, q, ev, stop_request);
   if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
@@ -328,6 +332,16 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   task.timing.add(mark[kTickStages] - mark[kStageRead]);
   ++task.tick;
   return faults;
+}
+
+/// Asks the next tick for a category-2 stop of the running motion, for `why` (a reason of the
+/// runtime's, e.g. kLinkSilent): the tick takes it after its own (a reached limit, a stale stream)
+/// and only while moving (motion_next ignores a stop request in any other state). Call it where the
+/// tick runs (the control interrupt), before the tick; each tick takes the request it finds and
+/// clears it.
+template <class S>
+void request_stop(ControlTask<S>& task, MotionReason why) {
+  task.stop_request = why;
 }
 
 /// A path check's result as a refusal (none: the path is clear). A target beyond the arm's reach

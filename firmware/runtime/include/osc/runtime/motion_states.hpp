@@ -60,7 +60,8 @@ namespace osc {
   X(Busy, "busy", "a paper or stream command while a motion runs, a move_to while a stream runs: stop it, or wait") \
   X(Superseded, "superseded", "a re-target replaced the motion; or the queue changed before the command's tick")    \
   X(BadCommand, "bad_command",                                                                                      \
-    "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")
+    "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")    \
+  X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -102,7 +103,7 @@ OSC_MOTION_ENUM(MotionCompletion, OSC_MOTION_COMPLETION_LIST);
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
 static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kFault) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kClear) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kBadCommand) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kLinkSilent) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kStopped) + 1);
@@ -125,7 +126,7 @@ struct MotionInput {
   MotionCommand command = MotionCommand::kNone;
   std::uint32_t faults = 0;  ///< fault bits detected in this tick (category 0), in the catalogue or not
   std::uint32_t causes = 0;  ///< fault conditions still present (e.g. the E-stop held): a clear needs none
-  /// The runtime's category-2 stop of a motion (kStaleStream, kLimitReached); kNone: no request.
+  /// The runtime's category-2 stop of a motion (kStaleStream, kLimitReached, kLinkSilent); kNone: no request.
   MotionReason stop_request = MotionReason::kNone;
   bool motion_finished = false;  ///< the generator's queue ran empty at rest
   bool stopped = false;          ///< the category-2 deceleration reached rest

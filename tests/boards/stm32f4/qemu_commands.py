@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""The STM32F4 board's command link end to end (ctest stm32f4_qemu_commands).
+
+usage: qemu_commands.py CLIENT_DIR QEMU_COMMAND...
+
+Starts QEMU_COMMAND (qemu-system-arm -M netduinoplus2 ... -kernel stm32f4_qemu_link.elf) with the
+board's USART2 on a pseudo-terminal (-serial pty: QEMU names it on its standard output, "char device
+redirected to /dev/pts/N"), and drives it with the project's Python client (CLIENT_DIR/osc_client.py), as a user
+would drive the board over a serial adapter:
+  1. a state frame says disabled (the board starts disabled);
+  2. enable is accepted, and the state becomes holding;
+  3. a move_to far outside the workspace (2 m along x from where the arm holds) is refused
+     out_of_workspace (the board's path check, in its main loop);
+  4. stop is accepted (holding: nothing to stop) and done;
+  5. disable is accepted, and the state becomes disabled.
+The encoders do not move in QEMU, so no motion is run. No timing is asserted: every wait is generous
+(the machine may be busy). Prints one line per step; exit 0 when all pass, 1 otherwise.
+"""
+import re
+import subprocess
+import sys
+import threading
+import time
+
+TIMEOUT = 60.0  # seconds for each answer or state: QEMU on a loaded machine
+
+
+def find_pty(proc, deadline):
+    """The pseudo-terminal QEMU names on its standard output; the rest of it is echoed by a thread."""
+    lines = []
+    while time.monotonic() < deadline:
+        line = proc.stdout.readline()
+        if not line:
+            break
+        lines.append(line)
+        m = re.search(r"char device redirected to (/dev/pts/\d+)", line)
+        if m:
+            threading.Thread(target=lambda: [sys.stdout.write(x) for x in proc.stdout], daemon=True).start()
+            return m.group(1)
+    raise RuntimeError("QEMU named no pseudo-terminal: " + "".join(lines))
+
+
+def wait_state(c, name, timeout=TIMEOUT):
+    """The first state frame whose motion state is `name` (None after the timeout)."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        s = c.state(timeout=deadline - time.monotonic())
+        if s is not None and c.p.name_of("motion_states", s["state"]) == name:
+            return s
+    return None
+
+
+def run(c):
+    ok = True
+
+    def check(what, good, detail=""):
+        nonlocal ok
+        ok &= bool(good)
+        print(f"{'ok  ' if good else 'FAIL'} {what}{': ' + detail if detail else ''}", flush=True)
+
+    s = c.state(timeout=TIMEOUT)
+    check("boots disabled", s is not None and c.p.name_of("motion_states", s["state"]) == "disabled",
+          c.p.name_of("motion_states", s["state"]) if s else "no state frame")
+    o = c.wait_answer(c.enable(), TIMEOUT)
+    check("enable accepted", o.status == "accepted", o.text())
+    check("holding after enable", wait_state(c, "holding") is not None)
+    o = c.wait_answer(c.move_to((2.0, 0.0, 0.0), relative=True), TIMEOUT)
+    check("a move_to outside the workspace refused out_of_workspace",
+          o.status == "refused" and o.reason == "out_of_workspace", o.text())
+    o = c.wait_done(c.stop(), TIMEOUT)
+    check("stop accepted and done (holding)", o.status == "done", o.text())
+    o = c.wait_answer(c.disable(), TIMEOUT)
+    check("disable accepted", o.status == "accepted", o.text())
+    s = wait_state(c, "disabled")
+    check("disabled after disable", s is not None)
+    if s is not None:
+        check("no fault", s["faults"] == 0, c.p.fault_names(s["faults"]))
+        check("no setpoint dropped (keep-alive frames are no setpoints)", s["dropped"] == 0, str(s["dropped"]))
+    return ok
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    sys.path.insert(0, argv[0])
+    import osc_client
+    cmd = argv[1:] + ["-serial", "pty"] if "-kernel" not in argv[1:] else None
+    if cmd is None:  # the serial port before -kernel, as the other QEMU tests give theirs
+        k = argv.index("-kernel")
+        cmd = argv[1:k] + ["-serial", "pty"] + argv[k:]
+    proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                            text=True)
+    try:
+        pty = find_pty(proc, time.monotonic() + TIMEOUT)
+        print(f"board on {pty}", flush=True)
+        c = osc_client.Client(pty, 460800, keepalive=0.1)  # keep-alive frames too: taken as link activity
+        ok = run(c)
+        c.close()
+    except (RuntimeError, osc_client.ClientError) as e:
+        print(f"FAIL {e}", flush=True)
+        ok = False
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+    print("stm32f4_qemu_commands: " + ("pass" if ok else "FAIL"), flush=True)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
