@@ -23,10 +23,10 @@ accepted or done, 1 refused, aborted or timed out, 2 a bad command line, port or
     python3 clients/python/osc_client.py --port /dev/pts/7 watch [--seconds S]
 
 A board whose encoders are local (the STM32F4 board) stops a running motion (category 2, aborted
-link_silent) when no frame comes from the host for 0.5 s (params::kCommandLinkTimeout): give
---keepalive SECONDS (e.g. 0.1) there, and the client sends a keep-alive frame (a state frame, which a
-controller takes as link activity and otherwise ignores) whenever it has sent nothing for that long
-while it waits.
+link_silent) when no frame comes from the host for 0.5 s (params::kCommandLinkTimeout): while it
+waits, the client sends a keep-alive frame (a state frame, which a controller takes as link activity
+and otherwise ignores) whenever it has sent nothing for --keepalive SECONDS (default 0.1, as oscctl;
+0: none).
 """
 import argparse
 import json
@@ -233,7 +233,9 @@ class Client:
 
     HISTORY = 1024
 
-    def __init__(self, port, baud=115200, protocol=None, keepalive=None):
+    KEEPALIVE = 0.1  # seconds, as oscctl's default
+
+    def __init__(self, port, baud=115200, protocol=None, keepalive=KEEPALIVE):
         self.p = protocol or Protocol()
         self.keepalive, self._last_write = keepalive, time.monotonic()
         try:
@@ -542,6 +544,13 @@ def positive(text):
     return v
 
 
+def keepalive_seconds(text):
+    v = float(text)
+    if not 0 <= v <= 0.4:
+        raise argparse.ArgumentTypeError(f"{text}: must be from 0 (none) to 0.4 (below the board's 0.5 s timeout)")
+    return v
+
+
 def parser():
     ap = argparse.ArgumentParser(prog="osc_client.py", description=__doc__.split("\n")[0] + " Exit status 0: "
                                  "accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port "
@@ -549,8 +558,9 @@ def parser():
     ap.add_argument("--port", required=True, help="the serial device or pseudo-terminal (e.g. /dev/pts/7)")
     ap.add_argument("--baud", type=int, default=115200, help="baud rate of a serial device (default 115200)")
     ap.add_argument("--timeout", type=positive, default=120.0, help="seconds to wait for an answer or an end")
-    ap.add_argument("--keepalive", type=positive, help="send a keep-alive frame after this many seconds without "
-                    "one while waiting (a board that stops a motion when its link goes silent: 0.1)")
+    ap.add_argument("--keepalive", type=keepalive_seconds, default=Client.KEEPALIVE,
+                    help="while waiting, a keep-alive frame after this many seconds without a frame sent (default "
+                         "0.1; 0: none): a board with local encoders stops a motion after 0.5 s of link silence")
     sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
     for v in ("state", "enable", "disable", "clear", "paper", "stop"):
         sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")

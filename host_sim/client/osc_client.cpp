@@ -255,6 +255,7 @@ Client::Client(std::unique_ptr<Transport> transport) : t_(std::move(transport)) 
 }
 
 bool Client::send(const std::uint8_t* buf, int n) {
+  last_write_s_ = now_s();
   if (t_->write(buf, n)) return true;
   error_ = t_->error();
   return false;
@@ -286,7 +287,11 @@ bool Client::read_until(double deadline, const std::function<bool()>& done) {
   while (!done()) {
     const double left = deadline - now_s();
     if (left <= 0) return false;
-    const int n = t_->read(buf, sizeof buf, std::min(left, 0.05));
+    if (keepalive_s > 0 && now_s() - last_write_s_ >= keepalive_s) {
+      std::uint8_t frame[pil::kMaxFrame];
+      if (!send(frame, pil::encode(pil::StateFrame{}, frame))) return false;
+    }
+    const int n = t_->read(buf, sizeof buf, std::min({left, 0.05, keepalive_s > 0 ? keepalive_s : 0.05}));
     if (n < 0) return error_ = t_->error(), false;
     for (int i = 0; i < n; ++i)
       if (parser_.feed(buf[i]) == pil::Parser::kFrame) dispatch();

@@ -144,6 +144,13 @@ class Client {
   /// The last transport error ("" for none).
   const std::string& error() const { return error_; }
 
+  /// While it waits, a keep-alive frame (a state frame of zeros, which a controller takes as link
+  /// activity and otherwise ignores) whenever nothing was sent for this long [s]; 0: none. A board
+  /// whose encoders are local stops a motion when its command link is silent for
+  /// params::kCommandLinkTimeout (0.5 s): the default, 0.1 s, keeps a waiting client's link alive.
+  double keepalive_s = kKeepAliveDefault;
+  static constexpr double kKeepAliveDefault = 0.1;
+
  private:
   bool send(const std::uint8_t* buf, int n);
   /// Reads frames until done() or the deadline (steady clock, seconds); false at the deadline or on
@@ -160,6 +167,7 @@ class Client {
   std::optional<pil::StateFrame> state_;
   std::uint64_t states_seen_ = 0;
   std::string error_;
+  double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)
 };
 
 }  // namespace osc::client

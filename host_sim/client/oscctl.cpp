@@ -37,6 +37,7 @@ struct Args {
   std::string port, verb, csv;
   int baud = 115200;
   double timeout = 120;
+  double keepalive = Client::kKeepAliveDefault;
   std::vector<double> xyz, rpy;
   bool relative = false, replace = false, no_wait = false;
   double v = 0, a = 0, j = 0, rate = 0, seconds = 0;
@@ -181,6 +182,10 @@ void build(CLI::App& app, Args& a) {
   app.add_option("--baud", a.baud, "baud rate of a serial device (default 115200)")->check(CLI::Range(50, 4000000));
   app.add_option("--timeout", a.timeout, "seconds to wait for an answer or an end (default 120)")
       ->check(CLI::Range(0.1, 86400.0));
+  app.add_option("--keepalive", a.keepalive,
+                 "while waiting, a keep-alive frame after this many seconds without a frame sent (default 0.1; 0: "
+                 "none): a board with local encoders stops a motion after 0.5 s of silence on its link")
+      ->check(CLI::Range(0.0, 0.4));
   app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
   // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
   for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
@@ -248,5 +253,6 @@ int main(int argc, char** argv) {
   sigaction(SIGINT, &sa, nullptr);
   sigaction(SIGTERM, &sa, nullptr);
   Client c(std::move(t));
+  c.keepalive_s = a.keepalive;
   return run(c, a);
 }
