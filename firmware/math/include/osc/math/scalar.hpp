@@ -105,10 +105,15 @@ namespace detail {
 /// <= 2e-7 (under one float ulp of pi), tested against double (test_properties, FloatFunctions).
 /// IEEE's zeros (atan2(+-0, -0) = +-pi) and NaNs; both infinite gives the diagonal's angle.
 [[gnu::always_inline]] inline float atan2_float(float y, float x) {
-  constexpr float kHi[7] = {0.0f,           5.235987902e-01f, 1.047197580e+00f, 1.570796371e+00f,
-                            2.094395161e+00f, 2.617993832e+00f, 3.141592741e+00f};
-  constexpr float kLo[7] = {0.0f,            -1.457046339e-08f, -2.914092678e-08f, -4.371139006e-08f,
-                            -5.828185357e-08f, 4.635697293e-08f,  -8.742278013e-08f};
+  constexpr float kHi[7] = {
+      0.0f, 5.235987902e-01f, 1.047197580e+00f, 1.570796371e+00f, 2.094395161e+00f, 2.617993832e+00f, 3.141592741e+00f};
+  constexpr float kLo[7] = {0.0f,
+                            -1.457046339e-08f,
+                            -2.914092678e-08f,
+                            -4.371139006e-08f,
+                            -5.828185357e-08f,
+                            4.635697293e-08f,
+                            -8.742278013e-08f};
   if (x != x || y != y) return x + y;
   const float ax = std::fabs(x), ay = std::fabs(y);
   const bool steep = ay > ax, negative_x = std::signbit(x);
@@ -118,9 +123,10 @@ namespace detail {
   const float t = shifted ? (a * 1.732050776f - 1.0f) / (a + 1.732050776f) : a;
   const float z = t * t;
   const float p =
-      t + t * z *
-              (-3.33333333e-1f +
-               z * (2.0e-1f + z * (-1.42857143e-1f + z * (1.11111111e-1f + z * (-9.09090909e-2f + z * 7.69230769e-2f)))));
+      t +
+      t * z *
+          (-3.33333333e-1f +
+           z * (2.0e-1f + z * (-1.42857143e-1f + z * (1.11111111e-1f + z * (-9.09090909e-2f + z * 7.69230769e-2f)))));
   // The angle: base + s (shift + p), base 0, pi/2 (steep) or pi (x < 0; pi/2 when both), s = -1
   // where one of steep and x < 0 reflects r.
   const bool minus = steep != negative_x;
