@@ -2,7 +2,7 @@
 // protocol's port on the USART link, and what the interrupts and the main loop do with them. firmware.cpp (image
 // stm32f4_firmware) is the board's firmware: these in its interrupts and main loop, nothing else. qemu_smoke.cpp (image
 // stm32f4_qemu) is the boot smoke test for QEMU's netduinoplus2: the same boot and ticks, with its
-// record and checks around them; qemu_link.cpp (image stm32f4_qemu_link) is this firmware on QEMU's
+// record and checks around them; image stm32f4_qemu_link is firmware.cpp on QEMU's
 // machine, driven over its USART by the Python client (ctest stm32f4_qemu_commands).
 //
 // The command link (docs/protocol.md, "The command protocol"; docs/stm32f4.md, "Commands"): the
