@@ -154,9 +154,11 @@ class CommandPort {
         c.q_end = pc.q_end;
       }
       const bool timed = c.verb == MotionVerb::kMoveTo && c.brake && c.refusal == MotionReason::kNone;
-      for (bool placed = false; !placed;) {
+      bool placed = false;
+      for (;;) {
         masked([&] { placed = hand_over(task, c, timed ? planned : task.tick); });
-        if (!placed) wait();
+        if (placed) break;
+        wait();
       }
     }
   }
