@@ -35,9 +35,12 @@ constexpr int kCommandFifo = 4;
 constexpr std::uint32_t kStatePeriod = 20;
 /// A timer-paced board (poll_paced): a move that brakes the running motion (a re-target, a move
 /// after the paper's motion) is planned for the tick this many ticks after its inputs were taken,
-/// and handed to the task just before that tick: enough for its path check (about 165 000
-/// instructions on the M4F, 1 to 2 ms at 168 MHz with the ticks pre-empting it).
-constexpr std::uint32_t kPacedLeadTicks = 10;
+/// and handed to the task just before that tick: enough for its path check (about 188 000
+/// instructions on the M4F, 1.1 ms at 168 MHz, 1.2 ms with the ticks' 13 000 of every 168 000
+/// cycles pre-empting it; flash wait states may double that), and short enough that such a
+/// command changes the setpoint within issue 23's 10 ms of its arrival (at the tick after the
+/// planned one: 6 ms).
+constexpr std::uint32_t kPacedLeadTicks = 5;
 
 template <class S>
 class CommandPort {
