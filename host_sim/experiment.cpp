@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "osc/runtime/control_task.hpp"
-#include "pil_client.hpp"
+#include "linked_arm.hpp"
 #include "plant_hal.hpp"
 
 namespace sim {
@@ -60,53 +60,34 @@ class LocalController {
 class RemoteController {
  public:
   RemoteController(const ExperimentConfig& cfg, std::string& err)
-      : timeout_(cfg.pil_timeout),
-        config_(static_cast<std::uint8_t>((cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
-                                          pil::config_adaptation(cfg.gains.adaptation))) {
-    ok_ = link_.start(cfg.pil_command, err);
+      : session_(cfg.pil_timeout,
+                 static_cast<std::uint8_t>((cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
+                                           pil::config_adaptation(cfg.gains.adaptation))) {
+    ok_ = session_.start(cfg.pil_command, err);
   }
   bool ok() const { return ok_; }
-  /// One exchange. The simulated amplifiers apply the codes of a valid, in-range answer to this
-  /// tick's sensor frame, and zero on anything else (counted, the first such error kept); a lost
-  /// link (no answer in time, the peer gone) also ends the run.
+  /// One exchange (PilSession::exchange): the codes of a valid, in-range answer, else zero.
   bool tick(PlantHal& hal, TickReport& r, std::string& err) {
-    pil::SensorFrame s;
-    s.seq = seq_++;
-    hal.read_encoders(s.counts);
-    if (s.seq == 0) s.inject = config_;
-    pil::ActuatorFrame a = last_;
-    std::string why;
-    const PilClient::Exchange x = link_.exchange(s, a, timeout_, why);
-    hal.write_dacs(a.codes);
-    if (x == PilClient::Exchange::kLost) return err = why, false;
-    if (x == PilClient::Exchange::kZeroed) {
-      ++zeroed_ticks_;
-      if (first_zeroed_.empty()) first_zeroed_ = "tick " + std::to_string(s.seq) + ": " + why;
-    }
-    last_ = a;
+    if (!session_.exchange(hal, err)) return false;
+    const pil::ActuatorFrame& a = session_.last();
     r.faults = a.faults;
     for (int i = 0; i < 6; ++i) r.tau_f_hat[i] = a.tau_f_hat[i];
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = a.theta_hat[i];
     return true;
   }
   void finish(ExperimentResult& res) {
-    res.max_step_cycles = last_.max_cycles;
-    res.mean_step_cycles = last_.mean_cycles;
-    res.max_tick_cycles = last_.tick_max_cycles;
-    res.stack_used = last_.stack_used;
-    res.link = LinkReport::of(last_, link_.link_counters(), link_.code_range_errors(), zeroed_ticks_, first_zeroed_);
-    link_.stop();
+    const pil::ActuatorFrame& last = session_.last();
+    res.max_step_cycles = last.max_cycles;
+    res.mean_step_cycles = last.mean_cycles;
+    res.max_tick_cycles = last.tick_max_cycles;
+    res.stack_used = last.stack_used;
+    res.link = session_.link_report();
+    session_.link().stop();
   }
 
  private:
-  PilClient link_;
-  double timeout_;
-  std::uint8_t config_;  // configuration bits of the first sensor frame
+  PilSession session_;
   bool ok_ = false;
-  std::uint32_t seq_ = 0;
-  pil::ActuatorFrame last_;
-  std::uint32_t zeroed_ticks_ = 0;
-  std::string first_zeroed_;
 };
 
 /// The true plant's errors, through double kinematics: the tracking error e against the task

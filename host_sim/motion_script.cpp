@@ -10,9 +10,9 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "linked_arm.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
-#include "pil_client.hpp"
 
 namespace sim {
 namespace {
@@ -242,16 +242,6 @@ bool parse_motion_script(const std::string& text, const std::string& name, Motio
 
 namespace {
 
-/// What the Player sees of one tick, the same from either controller (HostArm, LinkedArm).
-struct TickView {
-  std::vector<osc::MotionReport> reports;  ///< the answers since the tick before, in order (the tick's own last)
-  osc::MotionState state = osc::MotionState::kDisabled;  ///< the motion state after the tick
-  std::uint32_t faults = 0;                              ///< the fault bits the tick detected
-  /// The desired state of the last control step, in the controller's coordinates.
-  Vec6 x_d = Vec6::Zero(), xd_d = Vec6::Zero(), xdd_d = Vec6::Zero();
-  Vec6 pose = Vec6::Zero();  ///< the arm's true pose after the tick's sample, in the same coordinates
-};
-
 /// The controller in process: the firmware's control task over the simulated arm (MotionSim), its
 /// commands through the command port (osc/link/command_port.hpp) as over a link, its answers read
 /// back from the port's answer frames.
@@ -303,93 +293,22 @@ class HostArm {
   std::vector<osc::MotionReport> reports_;
 };
 
-/// The controller of a PIL image (the firmware in QEMU, or any PIL peer) over the link, the
-/// simulated arm here, as the experiment's remote controller (experiment.cpp): one exchange per
-/// tick. The first sensor frame asks the node to start disabled and to trace every tick (its
-/// desired state and reference orientation, its faults and motion state); the commands and the
-/// setpoints go before the sensor frame of the tick that is to take them, as the in-process
-/// controller's go into its mailbox before its tick. The arm's brakes follow the traced state.
-class LinkedArm {
+/// The controller of a PIL image over the link (linked_arm.hpp) as the player's: the script's start
+/// pose, the link's health into the run.
+class ScriptLinkedArm : public LinkedArm {
  public:
-  LinkedArm(const MotionScript& script, const ExperimentConfig& cfg)
-      : timeout_(cfg.pil_timeout),
-        q0_(script.start_pose.value_or(cfg.q_start)),
-        plant_(cfg.plant),
-        hal_(plant_, q0_, osc::robot::kDrives.encoder_counts_per_motor_rev, cfg.injection),
-        config_(static_cast<std::uint8_t>(pil::kConfigStartDisabled | pil::kConfigTrace |
-                                          (cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
-                                          pil::config_adaptation(cfg.gains.adaptation))) {
-    plant_.reset(q0_);
-    plant_.set_brakes(true);
-    ok_ = link_.start(cfg.pil_command, start_error_);
-    command_ = cfg.pil_command.empty() ? "" : cfg.pil_command.front();
-  }
-  bool ok(std::string& err) const { return ok_ || (err = start_error_, false); }
-  bool command(const pil::CommandFrame& f, std::string& err) { return link_.send(f, err); }
-  bool setpoint(const pil::SetpointFrame& f, std::string& err) { return link_.send(f, err); }
-  bool tick(TickView& v, std::string& err) {
-    hal_.begin_sample(plant_.time());
-    pil::SensorFrame s;
-    s.seq = seq_++;
-    hal_.read_encoders(s.counts);
-    if (s.seq == 0) s.inject = config_;
-    pil::ActuatorFrame a = last_;
-    std::string why;
-    const PilClient::Exchange x = link_.exchange(s, a, timeout_, why);
-    hal_.write_dacs(a.codes);
-    if (x == PilClient::Exchange::kLost) return err = "tick " + std::to_string(s.seq) + ": " + why, false;
-    if (x == PilClient::Exchange::kZeroed) {
-      ++zeroed_ticks_;
-      if (first_zeroed_.empty()) first_zeroed_ = "tick " + std::to_string(s.seq) + ": " + why;
-    }
-    last_ = a;
-    const PilReplies r = link_.take_replies();
-    if (r.traces.empty() || r.traces.back().seq != s.seq)
-      return err = "tick " + std::to_string(s.seq) + ": no trace frame", false;
-    const pil::TraceFrame& t = r.traces.back();
-    v.reports.clear();
-    for (const pil::AnswerFrame& f : r.answers) v.reports.push_back(osc::report_from_frame(f));
-    v.state = static_cast<osc::MotionState>(t.state);
-    v.faults = t.faults;
-    Mat3 R_ref;
-    for (int i = 0; i < 6; ++i) v.x_d(i) = t.x_d[i], v.xd_d(i) = t.xd_d[i], v.xdd_d(i) = t.xdd_d[i];
-    for (int i = 0; i < 9; ++i) R_ref(i / 3, i % 3) = t.R_ref[i];
-    // The plant over the sample, as MotionSim::tick: the amplifiers' torque, the brakes by the state.
-    const Vec6 tau = hal_.torque();
-    plant_.set_brakes(!osc::motion_powered(v.state));
-    plant_.advance_sample(tau_before_, tau, osc::params::kDt);
-    tau_before_ = tau;
-    osc::forward_kinematics(model_, data_, plant_.q());
-    v.pose << data_.o[osc::kDof], osc::orientation_coordinates<double>(data_.R[osc::kDof], R_ref);
-    return true;
-  }
+  ScriptLinkedArm(const MotionScript& script, const ExperimentConfig& cfg)
+      : LinkedArm(script.start_pose.value_or(cfg.q_start), cfg) {}
   void finish(MotionRun& run) {
     run.controller = "pil";
-    run.pil_command = command_;
-    run.link = LinkReport::of(last_, link_.link_counters(), link_.code_range_errors(), zeroed_ticks_, first_zeroed_);
-    link_.stop();
+    run.pil_command = program();
+    run.link = link_report();
+    stop();
   }
-
- private:
-  double timeout_;
-  Vec6 q0_;
-  Plant plant_;
-  PlantHal hal_;
-  std::uint8_t config_;  // the first sensor frame's configuration bits
-  PilClient link_;
-  bool ok_ = false;
-  std::string start_error_, command_;
-  std::uint32_t seq_ = 0;
-  pil::ActuatorFrame last_;
-  std::uint32_t zeroed_ticks_ = 0;
-  std::string first_zeroed_;
-  Vec6 tau_before_ = Vec6::Zero();
-  const osc::Model<double> model_ = osc::Model<double>::of(osc::robot::kArm);
-  osc::Data<double> data_;
 };
 
 /// The player: sends the steps in order as command frames (and a stream's setpoints as setpoint
-/// frames) to a controller, in process or over the link (Arm: HostArm<S>, LinkedArm), and keeps each
+/// frames) to a controller, in process or over the link (Arm: HostArm<S>, ScriptLinkedArm), and keeps each
 /// command's record, the state log and the faults from what each tick shows (TickView).
 template <class Arm>
 class Player {
@@ -583,7 +502,7 @@ void Player<Arm>::track() {
 
 MotionRun run_motion_script(const MotionScript& script, const ExperimentConfig& cfg) {
   const auto wall0 = std::chrono::steady_clock::now();
-  MotionRun run = !cfg.pil_command.empty()       ? Player<LinkedArm>(script, cfg).run()
+  MotionRun run = !cfg.pil_command.empty()       ? Player<ScriptLinkedArm>(script, cfg).run()
                   : cfg.scalar == Scalar::kFloat ? Player<HostArm<float>>(script, cfg).run()
                   : cfg.scalar == Scalar::kFixed ? Player<HostArm<osc::Fixed>>(script, cfg).run()
                                                  : Player<HostArm<double>>(script, cfg).run();

@@ -19,6 +19,7 @@
 #include "config.hpp"
 #include "experiment.hpp"
 #include "experiment_cli.hpp"
+#include "linked_arm.hpp"
 #include "motion_script.hpp"
 #include "summary.hpp"
 #include "output_file.hpp"
@@ -132,13 +133,8 @@ bool write_csv(const std::string& dir, const sim::ExperimentResult& r, const sim
 int prepare(Options& o, int& json_fd) {
   std::string err;
   if (o.qemu) {
-    if (access(o.elf.c_str(), R_OK) != 0)
-      return fail("firmware image " + o.elf +
-                  " not found: build it with 'cmake --preset m4f && cmake --build --preset m4f'");
-    o.base.pil_command = sim::PilClient::qemu_command("qemu-system-arm", o.elf, o.pil_link, err);
-    if (o.base.pil_command.empty()) return fail(err);
-    // The image's scalar: float on the M4F (mps2-an386), fixed point on the M3 (mps2-an385).
-    const sim::Scalar image = sim::qemu_machine(o.elf, err) == "mps2-an385" ? sim::Scalar::kFixed : sim::Scalar::kFloat;
+    sim::Scalar image = sim::Scalar::kFloat;
+    if (!sim::pil_image(o.elf, o.pil_link, o.base.pil_command, image, err)) return fail(err);
     if (o.base.scalar == sim::Scalar::kDouble) o.base.scalar = image;
     // A script's JSON names the scalar it ran in, to be compared with the in-process run of it.
     if (!o.motion.empty() && o.base.scalar != image)

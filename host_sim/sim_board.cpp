@@ -15,7 +15,13 @@
 // restarts from now: a slip) and counts them; the counts are printed at exit. SIGINT and SIGTERM
 // end the run cleanly (exit status 0); a bad option is a named error, exit status 2.
 //
-// The QEMU image as the virtual board (the firmware's own build behind the terminal) is a later step.
+// With --qemu the controller is the PIL firmware image (boards/common/mps2/pil_firmware.cpp) in QEMU
+// instead, in lockstep over the PIL link (linked_arm.hpp), the simulated arm still here, paced the
+// same way (QEMU runs a tick faster than real time): the client's command and setpoint frames go
+// over the link before the next tick's sensor frame, the image's answer and state frames (it sends
+// one every osc::kStatePeriod ticks) come back to the terminal. Nothing else from the client goes on
+// the link: its keep-alive state frames are dropped (counted with the frames that are not commands),
+// as a host's state frame is a link error to the PIL node. A lost link ends the run (status 1).
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
@@ -36,6 +42,7 @@
 #include <vector>
 
 #include "cli_parse.hpp"
+#include "linked_arm.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
 
@@ -56,6 +63,8 @@ struct Options {
   int state_hz = 50;
   double duration = 0;  // simulated seconds; 0: until SIGINT / SIGTERM
   double speed = 1;
+  bool qemu = false;
+  std::string elf = OSC_DEFAULT_PIL_ELF;  // the image puma_experiment --qemu runs by default
 };
 
 /// The master side of a pseudo-terminal whose slave is in raw mode. Frames are written whole or not
@@ -172,12 +181,86 @@ double wall_seconds() {
   return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
 }
 
-/// Runs the board until the duration or a signal; prints the run's counts on stderr.
+/// The controller in process: the firmware's control task over the simulated arm (MotionSim), the
+/// client's frames through its command port.
 template <class S>
-int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
-  sim::MotionSim<S> sim(q0);
-  osc::CommandPort<S> port;
-  port.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / o.state_hz);
+class InProcessBoard {
+ public:
+  InProcessBoard(const sim::Vec6& q0, int state_hz) : sim_(q0) {
+    port_.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / state_hz);
+  }
+  /// A complete frame from the client: a command or a setpoint is taken (true), any other type not.
+  template <class Write>
+  bool on_frame(const pil::Parser& p, Write&& write) {
+    return port_.on_frame(sim_.task(), p, write);
+  }
+  /// One tick; its frames to write (an answer, a state frame when due).
+  template <class Write>
+  bool tick(Write&& write, std::string&) {
+    sim_.tick();
+    port_.after_tick_and_poll(sim_.task(), write);  // the tick's frames; the next command into the freed mailbox
+    return true;
+  }
+  bool report() const { return true; }
+
+ private:
+  sim::MotionSim<S> sim_;
+  osc::CommandPort<S> port_;
+};
+
+/// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
+/// client's command and setpoint frames onto the link before the next tick's sensor frame, the
+/// image's answer and state frames of each tick back. No other frame goes on the link.
+class QemuBoard {
+ public:
+  QemuBoard(const sim::ExperimentConfig& cfg, const std::string& elf)
+      : arm_(cfg.q_start, cfg, pil::kConfigStateFrames), elf_(elf) {}
+  bool ok(std::string& err) const { return arm_.ok(err); }
+  template <class Write>
+  bool on_frame(const pil::Parser& p, Write&&) {
+    pil::CommandFrame c;
+    pil::SetpointFrame s;
+    if (p.decode(c)) {
+      if (err_.empty()) arm_.command(c, err_);
+      return true;
+    }
+    if (p.decode(s)) {
+      if (err_.empty()) arm_.setpoint(s, err_);
+      return true;
+    }
+    return false;  // a keep-alive (a state frame) or a frame no controller takes: dropped
+  }
+  template <class Write>
+  bool tick(Write&& write, std::string& err) {
+    if (!err_.empty()) return err = err_, false;
+    if (!arm_.tick(view_, err)) return false;
+    std::uint8_t buf[pil::kMaxFrame];
+    for (const pil::AnswerFrame& f : arm_.replies().answers) write(buf, pil::encode(f, buf));
+    for (const pil::StateFrame& f : arm_.replies().states) write(buf, pil::encode(f, buf));
+    return true;
+  }
+  /// The link's health on stderr; whether it was clean.
+  bool report() const {
+    const sim::LinkReport r = arm_.link_report();
+    std::fprintf(stderr,
+                 "osc_sim: firmware image %s: link %s: %u errors counted by the firmware, %u by the host, %u "
+                 "out-of-range answers, %u zeroed ticks%s%s\n",
+                 elf_.c_str(), r.clean() ? "clean" : "not clean", r.firmware.total(), r.host.total(), r.host_code_range,
+                 r.zeroed_ticks, r.first_zeroed.empty() ? "" : "; the first: ", r.first_zeroed.c_str());
+    return r.clean();
+  }
+
+ private:
+  sim::LinkedArm arm_;
+  std::string elf_;
+  std::string err_;  // a command or setpoint that could not be sent: the link is gone
+  sim::TickView view_;
+};
+
+/// Runs the board until the duration or a signal; prints the run's counts on stderr. Status 0, or 1
+/// when the controller failed (its link lost) before a signal asked to stop.
+template <class Board>
+int serve(const Options& o, Board& board, PtyMaster& pty) {
   pil::Parser parser;
   const long long ticks = o.duration > 0 ? std::llround(o.duration * osc::params::kControlHz) : -1;
   const auto write = [&pty](const std::uint8_t* b, int n) { pty.queue(b, n); };
@@ -185,6 +268,7 @@ int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
   long long k = 0;
   long frames = 0, other_frames = 0, link_errors = 0;
   bool had_client = false;
+  std::string err;
   const double t0 = wall_seconds();
   for (; ticks < 0 || k < ticks; ++k) {
     if (!pacer.wait()) break;
@@ -197,26 +281,28 @@ int serve(const Options& o, const sim::Vec6& q0, PtyMaster& pty) {
         const pil::Parser::Result r = parser.feed(buf[i]);
         if (r == pil::Parser::kFrame) {
           ++frames;
-          if (!port.on_frame(sim.task(), parser, write)) ++other_frames;
+          if (!board.on_frame(parser, write)) ++other_frames;
         } else if (r != pil::Parser::kPending) {
           ++link_errors;
         }
       }
-    sim.tick();
-    port.after_tick_and_poll(sim.task(), write);  // the tick's frames; the next command into the freed mailbox
+    if (!board.tick(write, err)) break;
     pty.flush();
   }
   const double wall = wall_seconds() - t0;
   std::fprintf(stderr,
-               "osc_sim: %lld ticks (%.3f s simulated) in %.3f s of wall time; %ld frames in, %ld not commands, "
-               "%ld link errors; %ld frames out dropped (no client, or not read)\n",
+               "osc_sim: %lld ticks (%.3f s simulated) in %.3f s of wall time; %ld frames in, %ld not commands "
+               "(keep-alives among them: dropped), %ld link errors; %ld frames out dropped (no client, or not read)\n",
                k, static_cast<double>(k) / osc::params::kControlHz, wall, frames, other_frames, link_errors,
                pty.dropped());
   std::fprintf(stderr,
                "osc_sim: %s%ld overruns (ticks started more than a period late), %ld slips, worst lag %.3f ms\n",
                pacer.overruns > 0 ? "warning: " : "", pacer.overruns, pacer.slips,
                static_cast<double>(pacer.worst_lag_ns) * 1e-6);
-  return 0;
+  board.report();
+  if (err.empty() || g_stop) return 0;
+  std::fprintf(stderr, "osc_sim: the controller failed: %s\n", err.c_str());
+  return 1;
 }
 
 /// The start pose [rad]: the robot's, or --start-pose within the joint limits and away from a
@@ -245,16 +331,22 @@ void build(CLI::App& app, Options& o) {
       "The simulated PUMA 560 as a virtual board: the firmware's control task over the simulated arm, in real "
       "time, serving the command protocol (docs/protocol.md) on a pseudo-terminal whose path is the first line "
       "on standard output (\"pty: /dev/pts/N\"). The arm starts disabled. SIGINT or SIGTERM ends it (status 0). "
-      "Only --pty exists so far: the QEMU firmware image as the virtual board is not there yet.");
+      "The controller runs in process, or with --qemu as the PIL firmware image in QEMU over the PIL link "
+      "(the arm simulated here, the frames relayed).");
   app.set_help_flag("-h,--help", "this text");
   app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::Throw);
   app.add_flag("--pty", o.pty, "serve the command protocol on a new pseudo-terminal (required)");
-  app.add_option("--scalar", o.scalar, "the controller's arithmetic: double | float | fixed (default double)")
+  app.add_option("--scalar", o.scalar,
+                 "the controller's arithmetic: double | float | fixed (default double; with --qemu the image's, "
+                 "which it must match: float on the M4F, fixed on the M3)")
       ->check(CLI::IsMember({"double", "float", "fixed"}));
-  app.add_option("--start-pose", o.start_pose, "joint angles q1..q6 at the start [deg] (default: the robot's)")
+  app.add_option("--start-pose", o.start_pose,
+                 "joint angles q1..q6 at the start [deg] (default: the robot's; not with --qemu)")
       ->expected(6)
       ->type_name("Q1 .. Q6");
-  app.add_option("--state-hz", o.state_hz, "state frames per simulated second: 1000 / N for a whole N (default 50)")
+  app.add_option("--state-hz", o.state_hz,
+                 "state frames per simulated second: 1000 / N for a whole N (default 50; with --qemu the "
+                 "image's 50 only)")
       ->check(CLI::Range(1, 1000));
   app.add_option("--duration", o.duration, "stop after this many simulated seconds (default: run until a signal)")
       ->check(CLI::Range(0.001, 1e6));
@@ -262,6 +354,66 @@ void build(CLI::App& app, Options& o) {
                  "real-time factor: simulated seconds per wall second (default 1; above 1 for faster runs, "
                  "e.g. in tests)")
       ->check(CLI::Range(0.01, 100.0));
+  app.add_flag("--qemu", o.qemu,
+               "the controller is the PIL firmware image in qemu-system-arm (lockstep over its link, the "
+               "semihosting console), the arm simulated here; a lost link ends the run (status 1)");
+  app.add_option("--elf", o.elf, "the firmware image for --qemu (default: the m4f build's pil_firmware.elf)")
+      ->type_name("FILE");
+}
+
+/// The options that the in-process controller and the image constrain differently; err on the first
+/// bad one. With --qemu: the image's command line and scalar into cfg.
+bool check_options(const CLI::App& app, Options& o, sim::ExperimentConfig& cfg, std::string& err) {
+  if (!o.pty) return err = "--pty is required: the pseudo-terminal is the virtual board (in process, or --qemu)", false;
+  if (osc::params::kControlHz % o.state_hz != 0)
+    return err = "--state-hz " + std::to_string(o.state_hz) +
+                 ": not 1000 / N for a whole N (1000, 500, 250, 200, 100, 50, ...)",
+           false;
+  if (!o.qemu) {
+    if (app.count("--elf") > 0) return err = "--elf applies with --qemu only", false;
+    return start_pose(o, cfg.q_start, err);
+  }
+  constexpr int kImageStateHz = static_cast<int>(osc::params::kControlHz / osc::kStatePeriod);
+  if (o.state_hz != kImageStateHz)
+    return err = "--state-hz " + std::to_string(o.state_hz) + ": the firmware image sends " +
+                 std::to_string(kImageStateHz) + " state frames a second (not with --qemu)",
+           false;
+  if (!o.start_pose.empty())
+    return err = "--start-pose: the firmware image starts at the robot's start pose (not with --qemu)", false;
+  if (o.elf.empty()) return err = "--elf needs a file name", false;
+  sim::Scalar image = sim::Scalar::kFloat;
+  if (!sim::pil_image(o.elf, sim::PilLink::kSemihosting, cfg.pil_command, image, err)) return false;
+  const char* name = sim::kScalarNames[static_cast<int>(image)];
+  if (app.count("--scalar") > 0 && o.scalar != name)
+    return err = "--scalar " + o.scalar + ": the image " + o.elf + " computes in " + name, false;
+  o.scalar = name;
+  cfg.scalar = image;
+  return true;
+}
+
+/// Opens the terminal, prints its path and serves it with the board until the end.
+template <class Board>
+int run(const Options& o, Board& board) {
+  PtyMaster pty;
+  std::string err;
+  if (!pty.open(err)) {
+    std::fprintf(stderr, "osc_sim: %s\n", err.c_str());
+    return 1;
+  }
+  struct sigaction sa {};
+  sa.sa_handler = on_signal;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, nullptr);
+  sigaction(SIGTERM, &sa, nullptr);
+  std::printf("pty: %s\n", pty.slave().c_str());
+  std::fflush(stdout);
+  return serve(o, board, pty);
+}
+
+template <class S>
+int run_in_process(const Options& o, const sim::Vec6& q0) {
+  InProcessBoard<S> board(q0, o.state_hz);
+  return run(o, board);
 }
 
 }  // namespace
@@ -272,26 +424,20 @@ int main(int argc, char** argv) {
   build(app, o);
   if (const int status = sim::parse_command_line(app, argc, argv, "osc_sim"); status >= 0) return status;
   std::string err;
-  if (!o.pty) err = "--pty is required: the pseudo-terminal is the only virtual board so far (the QEMU image is not)";
-  if (err.empty() && osc::params::kControlHz % o.state_hz != 0)
-    err =
-        "--state-hz " + std::to_string(o.state_hz) + ": not 1000 / N for a whole N (1000, 500, 250, 200, 100, 50, ...)";
-  sim::Vec6 q0;
-  if (err.empty()) start_pose(o, q0, err);
-  PtyMaster pty;
-  if (err.empty()) pty.open(err);
-  if (!err.empty()) {
+  sim::ExperimentConfig cfg;
+  if (!check_options(app, o, cfg, err)) {
     std::fprintf(stderr, "osc_sim: %s\n", err.c_str());
     return 2;
   }
-  struct sigaction sa {};
-  sa.sa_handler = on_signal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  std::printf("pty: %s\n", pty.slave().c_str());
-  std::fflush(stdout);
-  if (o.scalar == "float") return serve<float>(o, q0, pty);
-  if (o.scalar == "fixed") return serve<osc::Fixed>(o, q0, pty);
-  return serve<double>(o, q0, pty);
+  if (o.qemu) {
+    QemuBoard board(cfg, o.elf);  // the image started, its hello received, before the terminal opens
+    if (!board.ok(err)) {
+      std::fprintf(stderr, "osc_sim: the firmware image %s did not start: %s\n", o.elf.c_str(), err.c_str());
+      return 1;
+    }
+    return run(o, board);
+  }
+  if (o.scalar == "float") return run_in_process<float>(o, cfg.q_start);
+  if (o.scalar == "fixed") return run_in_process<osc::Fixed>(o, cfg.q_start);
+  return run_in_process<double>(o, cfg.q_start);
 }

@@ -8,14 +8,19 @@
 #                                      a long move runs (that move aborted stop_command, then holding);
 #                                      disable (disabled); a move refused again
 #   oscctl_stream, python_stream       a small CSV path streamed at 10 Hz ends done where the path ends
+#   qemu_sequence IMAGE [SCALAR]       osc_sim --pty --qemu --elf IMAGE (the PIL firmware in QEMU, the arm
+#                                      here, at speed 1): the sequence above with oscctl, then with the
+#                                      Python client (the watch given 20 s); the link clean at the end,
+#                                      the clients' keep-alives dropped, not relayed; a --scalar other than
+#                                      SCALAR (the image's; default float) refused first
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
 #   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
 #
-# usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_PY CASE
+# usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_PY CASE [IMAGE [SCALAR]]
 # Nothing waits a fixed time for the simulator: each step waits for its answer (generous timeouts).
 set -uo pipefail
-sim=$1 ctl=$2 py=$3 client=$4 case_=$5
+sim=$1 ctl=$2 py=$3 client=$4 case_=$5 image=${6:-} image_scalar=${7:-float}
 tmp=$(mktemp -d)
 sim_pid=
 port=
@@ -33,17 +38,18 @@ fail() {
   exit 1
 }
 
-# Starts osc_sim --pty with the options given; sets $port from its first line.
+# Starts osc_sim --pty with the options given; sets $port from its first line (with --qemu, once the
+# image has started).
 start_sim() {
   "$sim" --pty "$@" >"$tmp/sim.out" 2>"$tmp/sim.err" &
   sim_pid=$!
-  for _ in $(seq 600); do
+  for _ in $(seq 1200); do
     port=$(sed -n '1s/^pty: //p' "$tmp/sim.out")
     [ -n "$port" ] && [ -e "$port" ] && return 0
     kill -0 "$sim_pid" 2>/dev/null || fail "osc_sim exited before printing its terminal"
     sleep 0.05
   done
-  fail "osc_sim printed no 'pty: PATH' line within 30 s"
+  fail "osc_sim printed no 'pty: PATH' line within 60 s"
 }
 
 # SIGTERM ends it cleanly: status 0 and the run's counts, the overruns among them.
@@ -76,12 +82,20 @@ expect() {
   done
 }
 
+# refuse PATTERN -- COMMAND...: expect 2 PATTERN -- COMMAND..., and no terminal opened (no pty: line).
+refuse() {
+  expect 2 "$@"
+  ! grep -q '^pty:' "$tmp/out" || fail "a terminal was opened"
+}
+
 # The y coordinate [m] of the reference pose in the last output (a state printout).
 reference_y() { sed -n 's/^reference: [^ ]* \([^ ]*\) .*/\1/p' "$tmp/out"; }
 reference_z() { sed -n 's/^reference: [^ ]* [^ ]* \([^ ]*\) .*/\1/p' "$tmp/out"; }
 near() { awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; exit !(d <= tol && d >= -tol) }'; }
 
-# The sequence of the issue with one client, given as a command prefix ("$@").
+# The sequence of the issue with one client, given as a command prefix ("$@"); watch_s: how long the
+# watch step watches (a 30 mm move at 10 mm/s in it).
+watch_s=12
 sequence() {
   expect 0 '^state: disabled$' '^faults: none$' -- "$@" state
   expect 1 '^refused: not_enabled' -- "$@" move 0 0.02 0 --relative
@@ -99,7 +113,7 @@ sequence() {
   local id
   id=$(sed -n 's/^accepted (id \([0-9]*\))$/\1/p' "$tmp/out")
   expect 0 "^tick [0-9]+: state moving" "^tick [0-9]+: done $id; completion finished; state holding" \
-    "^tick [0-9]+: state holding" -- "$@" watch --seconds 12
+    "^tick [0-9]+: state holding" -- "$@" watch --seconds "$watch_s"
   # A stop while a long move (100 mm at 5 mm/s) runs.
   expect 0 '^accepted \(id [0-9]+\)$' -- "$@" move 0 -0.1 0 --relative --v 0.005 --no-wait
   id=$(sed -n 's/^accepted (id \([0-9]*\))$/\1/p' "$tmp/out")
@@ -148,6 +162,21 @@ case "$case_" in
     stream "$py" "$client" --port "$port" --timeout 60
     stop_sim
     ;;
+  qemu_sequence)
+    [ -r "$image" ] || fail "no firmware image: virtual_board.sh ... qemu_sequence IMAGE [SCALAR]"
+    wrong=fixed
+    [ "$image_scalar" = fixed ] && wrong=float
+    refuse "osc_sim: --scalar $wrong: the image $image computes in $image_scalar" -- \
+      "$sim" --pty --qemu --elf "$image" --scalar "$wrong"
+    start_sim --qemu --elf "$image" --scalar "$image_scalar"
+    watch_s=20
+    sequence "$ctl" --port "$port" --timeout 120
+    sequence "$py" "$client" --port "$port" --timeout 120
+    stop_sim
+    # The clients' keep-alives (state frames) reached osc_sim and stayed off the PIL link: it is clean.
+    grep -E 'osc_sim: [0-9]+ ticks .* [1-9][0-9]* not commands' "$tmp/sim.err" || fail "no keep-alive counted"
+    grep -E "osc_sim: firmware image .*: link clean" "$tmp/sim.err" || fail "the PIL link was not clean"
+    ;;
   sim_options)
     expect 2 'osc_sim: --pty is required' -- "$sim"
     expect 2 'osc_sim: --scalar: quad not in' -- "$sim" --pty --scalar quad
@@ -157,6 +186,15 @@ case "$case_" in
     expect 2 'osc_sim: --speed' -- "$sim" --pty --speed 0
     expect 2 'osc_sim: --duration' -- "$sim" --pty --duration -1
     expect 2 'osc_sim: .*--bogus' -- "$sim" --pty --bogus
+    # --qemu's: the image named with --qemu only, present, an MPS2 PIL image; what it compiles in.
+    refuse 'osc_sim: --elf applies with --qemu only' -- "$sim" --pty --elf "$sim"
+    refuse "osc_sim: firmware image $tmp/none.elf not found" -- "$sim" --pty --qemu --elf "$tmp/none.elf"
+    refuse "osc_sim: firmware image $sim is not a 32-bit little-endian ARM ELF file" -- \
+      "$sim" --pty --qemu --elf "$sim"
+    refuse 'osc_sim: --state-hz 100: the firmware image sends 50 state frames a second' -- \
+      "$sim" --pty --qemu --elf "$tmp/none.elf" --state-hz 100
+    refuse "osc_sim: --start-pose: the firmware image starts at the robot's start pose" -- \
+      "$sim" --pty --qemu --elf "$tmp/none.elf" --start-pose 10 30 -170 0 40 0
     expect 0 'QEMU' -- "$sim" --help
     ;;
   sim_duration)

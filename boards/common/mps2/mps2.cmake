@@ -66,7 +66,27 @@ function(osc_add_mps2_board)
   # tables of docs/ of kind DOCS_TABLES (scripts/docs_tables.py) current for this build's images.
   osc_add_pil_tests(${B_PIL_SCALAR})
   osc_add_motion_tests(${B_PIL_SCALAR})
+  osc_add_virtual_board_test(${B_PIL_SCALAR})
   osc_add_docs_tables_test(${B_DOCS_TABLES})
+endfunction()
+
+# osc_add_virtual_board_test(SCALAR): virtual_board_qemu_sequence: the host build's osc_sim --pty
+# --qemu serves this build's pil_firmware (computing in SCALAR) on a pseudo-terminal in real time,
+# driven by the host build's oscctl and the Python client (tests/cli/virtual_board.sh qemu_sequence;
+# docs/motion.md, "The virtual board").
+function(osc_add_virtual_board_test scalar)
+  osc_host_tool(OSC_SIM_BOARD osc_sim host_sim)
+  osc_host_tool(OSC_OSCCTL oscctl host_sim)
+  find_program(OSC_SYSTEM_PYTHON NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH)
+  if(NOT OSC_SYSTEM_PYTHON)
+    return()
+  endif()
+  add_test(NAME virtual_board_qemu_sequence
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/cli/virtual_board.sh ${OSC_SIM_BOARD} ${OSC_OSCCTL}
+                   ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py qemu_sequence
+                   $<TARGET_FILE:pil_firmware> ${scalar})
+  # About 20 s simulated, in real time (slower on a busy machine: QEMU then falls behind).
+  set_tests_properties(virtual_board_qemu_sequence PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600)
 endfunction()
 
 # osc_add_motion_tests(SCALAR): scripted motions on this build's pil_firmware in QEMU (the host
