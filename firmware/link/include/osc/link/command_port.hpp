@@ -230,8 +230,7 @@ class CommandPort {
 /// a byte store, and before_tick() runs where the main loop cannot pre-empt it.
 class CommandLinkWatch {
  public:
-  static constexpr auto kTimeoutTicks =
-      static_cast<std::uint32_t>(params::kCommandLinkTimeout * params::kControlHz + 0.5);
+  static constexpr std::uint32_t kTimeoutTicks = stream::ticks(params::kCommandLinkTimeout);
   static_assert(kTimeoutTicks > 1, "the command link timeout is longer than a tick");
 
   /// A valid frame came (main loop).
