@@ -10,7 +10,7 @@
 #   oscctl_stream, python_stream       a small CSV path streamed at 10 Hz ends done where the path ends
 #   qemu_sequence IMAGE [SCALAR]       osc_sim --pty --qemu --elf IMAGE (the PIL firmware in QEMU, the arm
 #                                      here, at speed 1): the sequence above with oscctl, then with the
-#                                      Python client (the watch given 20 s); the link clean at the end,
+#                                      Python client (the watch given 10 s); the link clean at the end,
 #                                      the clients' keep-alives dropped, not relayed; a --scalar other than
 #                                      SCALAR (the image's; default float) refused first
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
@@ -169,7 +169,7 @@ case "$case_" in
     refuse "osc_sim: --scalar $wrong: the image $image computes in $image_scalar" -- \
       "$sim" --pty --qemu --elf "$image" --scalar "$wrong"
     start_sim --qemu --elf "$image" --scalar "$image_scalar"
-    watch_s=20
+    watch_s=10  # the watched move takes 3.3 s simulated; QEMU keeps real time within 0.11 s (docs/motion.md)
     sequence "$ctl" --port "$port" --timeout 120
     sequence "$py" "$client" --port "$port" --timeout 120
     stop_sim
