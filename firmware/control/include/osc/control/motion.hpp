@@ -225,8 +225,12 @@ class MotionGenerator {
   }
   /// The motion came to rest at `end`: stopped (a stop) or finished, holding there.
   Desired<S> end_at_rest(const Pose<S>& end, MotionEvents& ev) {
+    return end_at_rest(end, orientation_coordinates<S>(end.R, R_ref_), ev);
+  }
+  /// The same, the end's orientation coordinates given (`phi`).
+  Desired<S> end_at_rest(const Pose<S>& end, const Vec3<S>& phi, MotionEvents& ev) {
     (stopping_ ? ev.stopped : ev.finished) = true;
-    set_hold(end);
+    set_hold(end, phi);
     return hold_d_;
   }
 
@@ -248,10 +252,8 @@ class MotionGenerator {
     if (!(braking_ ? stream_.stopped() : done)) return d;
     if (done) ev.done_id = stream_id_;
     // Holds exactly where the follower is (its coordinates, not their round trip through R).
-    (stopping_ ? ev.stopped : ev.finished) = true;
-    set_hold({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)},
-             d.x.template tail<3>());
-    return hold_d_;
+    return end_at_rest({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)},
+                       d.x.template tail<3>(), ev);
   }
 
   Desired<S> paper_at(std::uint64_t tick, std::uint32_t rate_hz, MotionEvents& ev) {
