@@ -76,6 +76,7 @@ class LinkedArm {
   /// A command or a setpoint frame, for the next tick.
   bool command(const pil::CommandFrame& f, std::string& err) { return session_.link().send(f, err); }
   bool setpoint(const pil::SetpointFrame& f, std::string& err) { return session_.link().send(f, err); }
+  bool setpoint(const pil::SetpointVelocityFrame& f, std::string& err) { return session_.link().send(f, err); }
   /// One tick: the sensor frame, the answer's codes to the amplifiers, the plant over the sample.
   /// False when the link was lost (err: the tick and why).
   bool tick(TickView& v, std::string& err);

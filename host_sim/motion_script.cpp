@@ -10,6 +10,7 @@
 #include <sstream>
 #include <nlohmann/json.hpp>
 
+#include "client/stream_path.hpp"
 #include "linked_arm.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
@@ -56,7 +57,8 @@ bool triple(const YAML::Node& n, const std::string& key, osc::Vec3<double>& out,
 bool known_key(const std::string& k, osc::MotionVerb v) {
   if (k == "at" || k == "after" || k == "cmd" || k == "delay") return true;
   if (v == osc::MotionVerb::kStream)
-    return k == "file" || k == "rate_hz" || k == "relative" || k == "cut_s" || k == "v" || k == "a" || k == "j";
+    return k == "file" || k == "rate_hz" || k == "relative" || k == "cut_s" || k == "velocity" || k == "v" ||
+           k == "a" || k == "j";
   if (v != osc::MotionVerb::kMoveTo) return false;
   return k == "position" || k == "rpy_deg" || k == "relative" || k == "replace" || k == "v" || k == "a" || k == "j";
 }
@@ -107,6 +109,11 @@ bool parse_stream(const YAML::Node& n, const std::string& where, const std::stri
   if (n["cut_s"]) {
     if (!number(n["cut_s"], where + ".cut_s", s.cut_s, err)) return false;
     if (s.cut_s < 0) return err = where + ".cut_s: a time from the stream's start, at least 0", false;
+  }
+  try {
+    if (n["velocity"]) s.velocity = n["velocity"].as<bool>();
+  } catch (const YAML::Exception&) {
+    return err = where + ".velocity: takes true or false", false;
   }
   std::filesystem::path file = n["file"].as<std::string>("");
   if (file.is_relative()) file = std::filesystem::path(script_name).parent_path() / file;
@@ -258,7 +265,8 @@ class HostArm {
     port_.poll(sim_.task(), writer());
     return true;
   }
-  bool setpoint(const pil::SetpointFrame& f, std::string&) {
+  template <class Frame>
+  bool setpoint(const Frame& f, std::string&) {
     osc::offer_setpoint_frame(sim_.task(), f);
     return true;
   }
@@ -381,20 +389,15 @@ class Player {
     if ((k - stream_.first_tick) % period != 0) return true;
     const double t = static_cast<double>(stream_.sent) * period * osc::params::kDt;
     if (s->cut_s >= 0 && t > s->cut_s + 1e-9) return true;
-    const std::vector<std::array<double, 7>>& p = s->path;
-    const bool end = t >= p.back()[0] - 1e-9;
     std::size_t i = 1;
-    while (i < p.size() && p[i][0] < t) ++i;
-    std::array<double, 7> x = p.back();
-    if (!end) {
-      const double f = (t - p[i - 1][0]) / (p[i][0] - p[i - 1][0]);
-      for (int c = 1; c < 7; ++c) x[c] = p[i - 1][c] + f * (p[i][c] - p[i - 1][c]);
-    }
-    const osc::Vec3<double> pos(x[1], x[2], x[3]), rpy(x[4], x[5], x[6]);
+    bool end = false;
+    const osc::client::StreamPoint x = osc::client::path_at(s->path, t, i, end);
+    const osc::Vec3<double>* rpy = s->path_rpy ? &x.rpy : nullptr;
     const std::uint32_t id = stream_.id;
     ++stream_.sent;
     if (end) stream_.step = nullptr;
-    return arm_.setpoint(osc::setpoint_frame<double>(id, pos, s->path_rpy ? &rpy : nullptr, end), err);
+    if (s->velocity) return arm_.setpoint(osc::setpoint_velocity_frame<double>(id, x.position, rpy, x.velocity, end), err);
+    return arm_.setpoint(osc::setpoint_frame<double>(id, x.position, rpy, end), err);
   }
   void track();
   void log_state(double t) {

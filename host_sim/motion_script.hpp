@@ -29,6 +29,8 @@
 //       rate_hz: 10 .. 1000        the setpoints' rate: the path sampled (linearly between its rows)
 //                                  every 1 / rate_hz s; the last one, at the path's end, ends the stream
 //       cut_s: SECONDS             optional: no setpoint after this time (a stale stream: its stop)
+//       velocity: true             optional: each setpoint with the path's velocity there (the slope
+//                                  between its rows; setpoint_velocity frames): no delay of one period
 #pragma once
 
 #include <array>
@@ -55,6 +57,7 @@ struct MotionStepSpec {
   std::vector<std::array<double, 7>> path;
   bool path_rpy = false;
   double cut_s = -1;
+  bool velocity = false;  ///< stream: setpoint_velocity frames, with the path's velocity
 };
 
 /// Reads a stream's path (CSV: t, x, y, z[, roll, pitch, yaw] in s, m, degrees; a header row and

@@ -45,10 +45,13 @@ class MotionSim {
   void stream(const osc::MoveRequest<S>& req, std::uint32_t id) {
     task_->pending = osc::prepare_stream(task_->limits, req, id);
   }
-  /// A setpoint of stream `id` for the next tick (rpy: null keeps the orientation); false: dropped.
-  bool setpoint(std::uint32_t id, const Vec3& position, const Vec3* rpy, bool end) {
+  /// A setpoint of stream `id` for the next tick (rpy: null keeps the orientation; velocity: the
+  /// linear and angular velocity, or none); false: dropped.
+  bool setpoint(std::uint32_t id, const Vec3& position, const Vec3* rpy, bool end, const Vec6* velocity = nullptr) {
     const osc::Vec3<S> r = rpy ? osc::Vec3<S>(rpy->cast<S>()) : osc::Vec3<S>::Zero();
-    return osc::offer_setpoint(*task_, id, osc::Vec3<S>(position.cast<S>()), r, rpy != nullptr, end);
+    const osc::Vec6<S> v = velocity ? osc::Vec6<S>(velocity->cast<S>()) : osc::Vec6<S>::Zero();
+    return osc::offer_setpoint(*task_, id, osc::Vec3<S>(position.cast<S>()), r, rpy != nullptr, end,
+                               velocity ? &v : nullptr);
   }
   /// Whether the mailbox is free for the next command.
   bool idle() const { return task_->pending.verb == osc::MotionVerb::kNone; }

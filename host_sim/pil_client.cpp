@@ -263,6 +263,7 @@ bool PilClient::send(const pil::SensorFrame& f, std::string& err) {
 }
 bool PilClient::send(const pil::CommandFrame& f, std::string& err) { return send_frame(f, err); }
 bool PilClient::send(const pil::SetpointFrame& f, std::string& err) { return send_frame(f, err); }
+bool PilClient::send(const pil::SetpointVelocityFrame& f, std::string& err) { return send_frame(f, err); }
 
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
   return receive_actuator(f, timeout_s, err) == Rx::kFrame;

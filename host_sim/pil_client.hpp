@@ -89,6 +89,7 @@ class PilClient {
   /// that is to take it).
   bool send(const pil::CommandFrame& f, std::string& err);
   bool send(const pil::SetpointFrame& f, std::string& err);
+  bool send(const pil::SetpointVelocityFrame& f, std::string& err);
   bool send_raw(const std::uint8_t* p, int n, std::string& err);
   /// Waits up to timeout_s (wall clock) for one actuator frame; false on a corrupt frame (bad CRC,
   /// header or length), on silence and when the peer is gone. Junk between frames is skipped; the

@@ -140,16 +140,10 @@ json command_protocol() {
   j["command_fifo"] = osc::kCommandFifo;
   j["max_position"] = pil::kCommandMaxPosition;
   j["max_angle"] = pil::kCommandMaxAngle;
+  j["max_velocity"] = pil::kCommandMaxVelocity;
   const auto lim = osc::CartesianLimits<double>::defaults();
   j["limits"] = {{"linear", {lim.linear.v, lim.linear.a, lim.linear.j}},
                  {"angular", {lim.angular.v, lim.angular.a, lim.angular.j}}};
-  j["setpoint_flags"] = json::array();
-  for (int i = 0; i < pil::kSetpointFlagCount; ++i)
-    j["setpoint_flags"].push_back(
-        {{"bit", i}, {"mask", 1 << i}, {"name", pil::kSetpointFlagNames[i]}, {"doc", pil::kSetpointFlagDocs[i]}});
-  j["stream_max_period"] = pil::kStreamMaxPeriod;
-  j["state_period"] = osc::kStatePeriod;
-  j["command_fifo"] = osc::kCommandFifo;
   j["queue_length"] = osc::params::kMoveQueueLength;
   j["max_move_rotation"] = osc::kMaxMoveRotation;
   j["verbs"] = motion_names<osc::MotionVerb>();

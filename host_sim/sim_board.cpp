@@ -220,12 +220,17 @@ class QemuBoard {
   bool on_frame(const pil::Parser& p, Write&&) {
     pil::CommandFrame c;
     pil::SetpointFrame s;
+    pil::SetpointVelocityFrame sv;
     if (p.decode(c)) {
       if (err_.empty()) arm_.command(c, err_);
       return true;
     }
     if (p.decode(s)) {
       if (err_.empty()) arm_.setpoint(s, err_);
+      return true;
+    }
+    if (p.decode(sv)) {
+      if (err_.empty()) arm_.setpoint(sv, err_);
       return true;
     }
     return false;  // a keep-alive (a state frame) or a frame no controller takes: dropped

@@ -768,6 +768,23 @@ def t_protocol_setpoint():
     return field_rows(protocol()["setpoint_fields"])
 
 
+@table("protocol_setpoint_velocity", "docs/protocol.md", "protocol")
+def t_protocol_setpoint_velocity():
+    return field_rows(protocol()["setpoint_velocity_fields"])
+
+
+@table("protocol_setpoint_checks", "docs/protocol.md", "protocol")
+def t_protocol_setpoint_checks():
+    c = protocol()["command"]
+    rows = [("every `f32`", "finite (no NaN, no infinity)"),
+            ("`flags`", "bits of Setpoint flags only"),
+            ("`position`", f"each coordinate within ±{c['max_position']:g} m"),
+            ("`rpy`", f"each angle within ±2π rad (±{c['max_angle']:.6f})"),
+            ("`velocity` (setpoint_velocity)", f"each within ±{c['max_velocity']:g} m/s or rad/s"),
+            ("`id`", "the running stream's (a setpoint comes after its accepted stream command)")]
+    return markdown_table(["what", "must be, else the setpoint is dropped and counted (`dropped`)"], rows)
+
+
 @table("protocol_setpoint_flags", "docs/protocol.md", "protocol")
 def t_protocol_setpoint_flags():
     flags = protocol()["command"]["setpoint_flags"]

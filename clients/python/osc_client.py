@@ -19,7 +19,7 @@ accepted or done, 1 refused, aborted or timed out, 2 a bad command line, port or
     python3 clients/python/osc_client.py --port /dev/pts/7 state | enable | disable | clear | paper | stop
     python3 clients/python/osc_client.py --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative]
                                          [--v V --a A --j J] [--replace] [--no-wait]
-    python3 clients/python/osc_client.py --port /dev/pts/7 stream FILE.csv --rate HZ [--relative]
+    python3 clients/python/osc_client.py --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
     python3 clients/python/osc_client.py --port /dev/pts/7 watch [--seconds S]
 
 A board whose encoders are local (the STM32F4 board) stops a running motion (category 2, aborted
@@ -209,20 +209,33 @@ def read_stream_csv(path):
     return rows, columns == 7
 
 
+def angular_velocity(rpy, rpy_rate):
+    """The base angular velocity w = E(rpy) rpy_dot of R = Rz(yaw) Ry(pitch) Rx(roll)
+    (osc::phi_rate_to_angular)."""
+    sb, cb, sg, cg = math.sin(rpy[1]), math.cos(rpy[1]), math.sin(rpy[2]), math.cos(rpy[2])
+    r = rpy_rate
+    return [cg * cb * r[0] - sg * r[1], sg * cb * r[0] + cg * r[1], -sb * r[0] + r[2]]
+
+
 def resample_path(rows, rate_hz):
-    """The path sampled every 1 / rate_hz s from t = 0, linearly between rows; the last sample is the
-    path's end. A list of (position, rpy)."""
+    """The path sampled every 1 / rate_hz s from t = 0, linearly between rows, with its velocity
+    there (the segment's slope: linear, then angular in the base frame; zero at the end); the last
+    sample is the path's end. A list of (position, rpy, velocity) (osc::client::resample_path)."""
     out, T, end, i, n = [], 1.0 / rate_hz, rows[-1][0], 1, 0
     while True:
         t = n * T
         last = t >= end - 1e-9
         while i < len(rows) and rows[i][0] < t:
             i += 1
-        x = rows[-1]
+        x, v = rows[-1], [0.0] * 6
         if not last:
-            f = (t - rows[i - 1][0]) / (rows[i][0] - rows[i - 1][0])
-            x = [rows[i - 1][c] + f * (rows[i][c] - rows[i - 1][c]) for c in range(7)]
-        out.append((x[1:4], x[4:7]))
+            a, b = rows[i - 1], rows[i]
+            dt = b[0] - a[0]
+            f = (t - a[0]) / dt
+            x = [a[c] + f * (b[c] - a[c]) for c in range(7)]
+            rate = [(b[c] - a[c]) / dt for c in range(1, 7)]
+            v = rate[:3] + angular_velocity(x[4:7], rate[3:])
+        out.append((x[1:4], x[4:7], v))
         if last:
             return out
         n += 1
@@ -304,10 +317,12 @@ class Client:
         lin = self.p.limits["linear"]
         return [v or lin[0], a or lin[1], j or lin[2]] + list(self.p.limits["angular"])
 
-    def stream(self, points, has_rpy, rate_hz, relative=False, limits=None, answer_timeout=10):
+    def stream(self, points, has_rpy, rate_hz, relative=False, limits=None, answer_timeout=10, velocity=False):
         """The stream command, its answer awaited, then one setpoint per period paced by the wall clock,
-        the last with the end flag. The stream command's answer once every setpoint is sent (accepted:
-        wait_done(outcome.id) for its end), or its refusal, an abort while sending, a timeout."""
+        the last with the end flag; points: (position, rpy) or (position, rpy, velocity) each (with
+        velocity=True, setpoint_velocity frames: no delay of one period). The stream command's answer
+        once every setpoint is sent (accepted: wait_done(outcome.id) for its end), or its refusal, an
+        abort while sending, a timeout."""
         period = 1000.0 / rate_hz
         if abs(period - round(period)) > 1e-9 or not 1 <= round(period) <= self.p.stream_max_period:
             raise ClientError(f"rate {rate_hz:g} Hz: 1000 / N Hz for a whole N from 1 to "
@@ -319,13 +334,16 @@ class Client:
         if o.status != "accepted":
             return o
         t0, T = time.monotonic(), 1.0 / rate_hz
-        for n, (pos, rpy) in enumerate(points):
+        for n, point in enumerate(points):
             if self._read_until(t0 + n * T, lambda: self._evaluate(cid, True).status in ("done", "aborted")):
                 return self._evaluate(cid, True)
+            pos, rpy = point[0], point[1]
             last = n + 1 == len(points)
             flags = (self.p.setpoint_flag["end"] if last else 0) | (self.p.setpoint_flag["has_rpy"] if has_rpy else 0)
-            self._write(self.p.encode("setpoint", {"id": cid, "flags": flags, "position": list(pos),
-                                                   "rpy": list(rpy) if has_rpy else [0.0] * 3}))
+            values = {"id": cid, "flags": flags, "position": list(pos), "rpy": list(rpy) if has_rpy else [0.0] * 3}
+            if velocity:
+                values["velocity"] = list(point[2])
+            self._write(self.p.encode("setpoint_velocity" if velocity else "setpoint", values))
         return o
 
     # ------------------------------------------------------------------ answers and state
@@ -501,7 +519,8 @@ def cmd_move(c, a):
 
 def cmd_stream(c, a):
     rows, has_rpy = read_stream_csv(a.file)
-    o = c.stream(resample_path(rows, a.rate), has_rpy, a.rate, a.relative, c.limits(a.v, a.a, a.j), a.timeout)
+    o = c.stream(resample_path(rows, a.rate), has_rpy, a.rate, a.relative, c.limits(a.v, a.a, a.j), a.timeout,
+                 a.velocity)
     print(f"{o.text()} (id {o.id})", flush=True)
     if o.status != "accepted":
         return 0 if o.ok() else 1
@@ -580,6 +599,8 @@ def parser():
     s = sub.add_parser("stream", help="stream a CSV path (t, x, y, z[, roll, pitch, yaw] in s, m, deg)")
     s.add_argument("file")
     s.add_argument("--rate", type=positive, required=True, help="setpoints per second: 1000 / N, N from 1 to 100")
+    s.add_argument("--velocity", action="store_true",
+                   help="send each setpoint with the path's velocity (its slope between rows): no delay of one period")
     limits(s)
     w = sub.add_parser("watch", help="print state changes and every answer")
     w.add_argument("--seconds", type=positive, help="for this long (default: until interrupted)")

@@ -224,28 +224,6 @@ std::string answer_text(const pil::AnswerFrame& a) {
   return t;
 }
 
-std::vector<StreamPoint> resample_path(const std::vector<std::array<double, 7>>& rows, double rate_hz) {
-  std::vector<StreamPoint> out;
-  if (rows.empty() || !(rate_hz > 0)) return out;
-  const double T = 1.0 / rate_hz, end = rows.back()[0];
-  std::size_t i = 1;
-  for (long n = 0;; ++n) {
-    const double t = static_cast<double>(n) * T;
-    const bool last = t >= end - 1e-9;
-    while (i < rows.size() && rows[i][0] < t) ++i;
-    std::array<double, 7> x = rows.back();
-    if (!last) {
-      const double f = (t - rows[i - 1][0]) / (rows[i][0] - rows[i - 1][0]);
-      for (int c = 1; c < 7; ++c) x[c] = rows[i - 1][c] + f * (rows[i][c] - rows[i - 1][c]);
-    }
-    StreamPoint p;
-    p.position = Vec3<double>(x[1], x[2], x[3]);
-    p.rpy = Vec3<double>(x[4], x[5], x[6]);
-    out.push_back(p);
-    if (last) return out;
-  }
-}
-
 // ------------------------------------------------------------------------------------------ client
 
 Client::Client(std::unique_ptr<Transport> transport) : t_(std::move(transport)) {
@@ -366,7 +344,7 @@ Outcome Client::wait_done(std::uint32_t id, double timeout_s) {
 }
 
 Outcome Client::stream(const std::vector<StreamPoint>& points, bool has_rpy, double rate_hz, bool relative,
-                       const CartesianLimits<double>* limits, double answer_timeout_s) {
+                       const CartesianLimits<double>* limits, double answer_timeout_s, bool velocity) {
   Outcome o;
   const double period = 1000.0 / rate_hz;
   const long ms = std::lround(period);
@@ -398,10 +376,13 @@ Outcome Client::stream(const std::vector<StreamPoint>& points, bool has_rpy, dou
     if (!error_.empty()) return o.status = Status::kError, o.error = error_, o;
     if (ended) return evaluate(id, true);
     const bool last = n + 1 == points.size();
-    const pil::SetpointFrame f =
-        setpoint_frame<double>(id, points[n].position, has_rpy ? &points[n].rpy : nullptr, last);
+    const StreamPoint& p = points[n];
     std::uint8_t buf[pil::kMaxFrame];
-    if (!send(buf, pil::encode(f, buf))) return o.status = Status::kError, o.error = error_, o;
+    const int len =
+        velocity ? pil::encode(setpoint_velocity_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, p.velocity, last),
+                               buf)
+                 : pil::encode(setpoint_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, last), buf);
+    if (!send(buf, len)) return o.status = Status::kError, o.error = error_, o;
   }
   return o;
 }

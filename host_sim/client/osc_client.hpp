@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "osc/link/commands.hpp"
+#include "stream_path.hpp"  // StreamPoint, resample_path
 
 namespace osc::client {
 
@@ -86,16 +87,6 @@ struct Outcome {
   std::string text() const;
 };
 
-/// One setpoint of a stream: the wrist centre [m] and roll, pitch, yaw [rad] (base frame; offsets
-/// with a relative stream).
-struct StreamPoint {
-  Vec3<double> position = Vec3<double>::Zero();
-  Vec3<double> rpy = Vec3<double>::Zero();
-};
-
-/// A path's rows (t [s], x, y, z [m], roll, pitch, yaw [rad], as sim::read_stream_csv reads them)
-/// sampled every 1 / rate_hz s from t = 0, linearly between rows; the last sample is the path's end.
-std::vector<StreamPoint> resample_path(const std::vector<std::array<double, 7>>& rows, double rate_hz);
 
 /// The names of fault bits ("none", or "tracking,estop"; a bit outside the catalogue "bitN").
 std::string fault_names(std::uint32_t bits);
@@ -119,11 +110,12 @@ class Client {
 
   /// A stream: the stream command (period 1000 / rate_hz ms, a whole number from 1 to 100; relative;
   /// limits when given), its answer awaited, then one setpoint frame per period paced by the wall
-  /// clock, the last with the end flag (rpy sent when has_rpy). Returns the stream command's answer
+  /// clock, the last with the end flag (rpy sent when has_rpy; with `velocity`, setpoint_velocity
+  /// frames with each point's velocity: no delay of one period). Returns the stream command's answer
   /// once every setpoint is sent (kAccepted: wait_done(outcome.id) for its end), or its refusal, its
   /// abort while the setpoints went out (e.g. a stop), a timeout or an error.
   Outcome stream(const std::vector<StreamPoint>& points, bool has_rpy, double rate_hz, bool relative,
-                 const CartesianLimits<double>* limits = nullptr, double answer_timeout_s = 10);
+                 const CartesianLimits<double>* limits = nullptr, double answer_timeout_s = 10, bool velocity = false);
 
   /// The latest state frame, received after this call (waiting up to timeout_s); nullopt on a
   /// timeout or an error (error()).

@@ -3,7 +3,7 @@
 //
 //   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop
 //   oscctl --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
-//   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--relative] [--v V --a A --j J]
+//   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative] [--v V --a A --j J]
 //   oscctl --port /dev/pts/7 watch [--seconds S]
 //
 // Each command prints its outcome, one line each: "accepted" or "refused: REASON"; then, for a move,
@@ -39,7 +39,7 @@ struct Args {
   double timeout = 120;
   double keepalive = Client::kKeepAliveDefault;
   std::vector<double> xyz, rpy;
-  bool relative = false, replace = false, no_wait = false;
+  bool relative = false, replace = false, no_wait = false, velocity = false;
   double v = 0, a = 0, j = 0, rate = 0, seconds = 0;
   std::vector<std::array<double, 7>> rows;  // stream: the path
   bool has_rpy = false;
@@ -99,7 +99,7 @@ int stream(Client& c, const Args& a) {
   osc::MoveRequest<double> m;
   const bool lim = limits_of(a, m);
   const Outcome o = c.stream(osc::client::resample_path(a.rows, a.rate), a.has_rpy, a.rate, a.relative,
-                             lim ? &m.limits : nullptr, a.timeout);
+                             lim ? &m.limits : nullptr, a.timeout, a.velocity);
   if (o.status == Status::kError) {
     std::fprintf(stderr, "oscctl: %s\n", o.error.c_str());
     return 2;
@@ -202,6 +202,8 @@ void build(CLI::App& app, Args& a) {
   st->add_option("--rate", a.rate, "setpoints per second: 1000 / N for a whole N from 1 to 100")
       ->required()
       ->check(CLI::Range(10.0, 1000.0));
+  st->add_flag("--velocity", a.velocity,
+               "send each setpoint with the path's velocity (its slope between rows): no delay of one period");
   add_limits(st, a);
   CLI::App* w = app.add_subcommand("watch", "print state changes and every answer");
   w->add_option("--seconds", a.seconds, "for this long (default: until interrupted)")->check(CLI::PositiveNumber);

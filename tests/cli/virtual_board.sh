@@ -7,7 +7,8 @@
 #                                      it); watch shows a move's done and the state changes; a stop while
 #                                      a long move runs (that move aborted stop_command, then holding);
 #                                      disable (disabled); a move refused again
-#   oscctl_stream, python_stream       a small CSV path streamed at 10 Hz ends done where the path ends
+#   oscctl_stream, python_stream       a small CSV path streamed at 10 Hz ends done where the path ends,
+#                                      plain and with the path's velocity
 #   qemu_sequence IMAGE [SCALAR]       osc_sim --pty --qemu --elf IMAGE (the PIL firmware in QEMU, the arm
 #                                      here, at speed 1): the sequence above with oscctl, then with the
 #                                      Python client (the watch given 10 s); the link clean at the end,
@@ -125,19 +126,22 @@ sequence() {
   expect 1 '^refused: not_enabled' -- "$@" move 0 0 0.01 --relative
 }
 
-# A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds.
+# A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
+# setpoints, then again (from where that ended) with the path's velocity (--velocity).
 stream() {
   printf 't, x, y, z\n# 10 mm along y, then along z\n0, 0, 0, 0\n0.6, 0, 0.01, 0\n1.2, 0, 0.01, 0.01\n' >"$tmp/path.csv"
   expect 0 '^accepted$' -- "$@" enable
   expect 0 '^state: holding$' -- "$@" state
-  local y0 y1 z0 z1
-  y0=$(reference_y) z0=$(reference_z)
-  expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" stream "$tmp/path.csv" --rate 10 --relative
-  expect 0 '^state: holding$' '^dropped: 0$' -- "$@" state
-  y1=$(reference_y) z1=$(reference_z)
-  near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.01 0.0005 &&
-    near "$(awk -v a="$z1" -v b="$z0" 'BEGIN { print a - b }')" 0.01 0.0005 ||
-    fail "the reference moved from (y, z) = ($y0, $z0) to ($y1, $z1), not by the path's (10, 10) mm"
+  local y0 y1 z0 z1 opt
+  for opt in "" --velocity; do
+    y0=$(reference_y) z0=$(reference_z)
+    expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" stream "$tmp/path.csv" --rate 10 --relative $opt
+    expect 0 '^state: holding$' '^dropped: 0$' -- "$@" state
+    y1=$(reference_y) z1=$(reference_z)
+    near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.01 0.0005 &&
+      near "$(awk -v a="$z1" -v b="$z0" 'BEGIN { print a - b }')" 0.01 0.0005 ||
+      fail "stream $opt: the reference moved from (y, z) = ($y0, $z0) to ($y1, $z1), not by the path's (10, 10) mm"
+  done
   expect 0 '^accepted$' '^done$' -- "$@" disable
 }
 

@@ -10,7 +10,8 @@
 //   0  raw bytes, fed to the parser; every command frame it completes is checked;
 //   1  frames built from the input: op (bits 0-2: garbage bytes before the frame; bit 3: the numbers
 //      as raw f32 bits, NaNs and infinities included, else as 16-bit integers scaled into and around
-//      the bounds; bit 4: one bit of the frame flipped), id, verb, flags, the numbers.
+//      the bounds; bit 4: one bit of the frame flipped; bits 5-6: 1 a setpoint frame, 2 a setpoint
+//      with velocity, else a command frame), id, verb, flags, the numbers.
 //
 // Invariants:
 //  - a command frame is refused exactly when the specification (docs/protocol.md, Command checks:
@@ -19,6 +20,9 @@
 //    frame with a flipped bit, is no command;
 //  - prepare_frame_command keeps the id, the verb (none for a verb outside the list) and a refusal
 //    of the reason list, bad_command exactly when decoding refused;
+//  - a setpoint, with its velocity or not, is dropped exactly when the specification says it is bad
+//    (Setpoint flags, the command's bounds, the velocities'); a good one for the running stream is
+//    prepared into finite coordinates and rates, and the generator's next reference is finite;
 //  - an accepted move's duration is finite; its reference (CartesianMove::at) is finite at a dozen
 //    times over its duration and beyond, and its linear speed never exceeds the configured maximum
 //    (CartesianLimits<double>::defaults().linear.v), nor the request's own limit, by more than
@@ -27,6 +31,7 @@
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <type_traits>
 
 #include "fuzz_util.hpp"
 #include "osc/control/gains.hpp"
@@ -136,34 +141,52 @@ struct Checker {
     if (r != pil::Parser::kFrame) return r;
     pil::CommandFrame f;
     pil::SetpointFrame sp;
+    pil::SetpointVelocityFrame sv;
     if (p.decode(f))
       command(f);
     else if (p.decode(sp))
-      setpoint(sp);
+      setpoint(sp, nullptr);
+    else if (p.decode(sv))
+      setpoint(sv, sv.velocity);
     else
-      FUZZ_CHECK(p.type() != pil::kCommandFrame && p.type() != pil::kSetpointFrame);
+      FUZZ_CHECK(p.type() != pil::kCommandFrame && p.type() != pil::kSetpointFrame &&
+                 p.type() != pil::kSetpointVelocityFrame);
     return r;
   }
 
-  /// A setpoint: valid as the document says (flags end and has_rpy only, the bounds of a command's
-  /// numbers), and prepared for the running stream (3000) into finite coordinates near the target.
-  void setpoint(const pil::SetpointFrame& f) {
+  /// A setpoint, with its velocity or not: valid as the document says (flags end and has_rpy only,
+  /// the bounds of a command's numbers, each velocity finite within 10), and prepared for the running
+  /// stream (3000) into finite coordinates near the target and finite rates (0 with end, the angular
+  /// ones 0 without has_rpy); then the generator's next tick is finite.
+  template <class Frame>
+  void setpoint(const Frame& f, const float* velocity) {
     bool valid = (f.flags & 0xFC) == 0;
     for (int i = 0; i < 3; ++i) {
       valid &= std::isfinite(f.position[i]) && std::fabs(f.position[i]) <= 10.0f;
       valid &= std::isfinite(f.rpy[i]) && std::fabs(static_cast<double>(f.rpy[i])) <= 2 * osc::kPi;
     }
+    for (int i = 0; velocity && i < 6; ++i) valid &= std::isfinite(velocity[i]) && std::fabs(velocity[i]) <= 10.0f;
     FUZZ_CHECK(osc::detail::setpoint_valid(f) == valid);
     if (!valid) return;
     osc::StreamSample<double> out;
     const osc::Vec3<double> p(f.position[0], f.position[1], f.position[2]), rpy(f.rpy[0], f.rpy[1], f.rpy[2]);
-    const bool taken = osc::prepare_setpoint(gen, f.id, p, rpy, (f.flags & 2) != 0, (f.flags & 1) != 0, out);
+    osc::Vec6<double> v = osc::Vec6<double>::Zero();
+    for (int i = 0; velocity && i < 6; ++i) v(i) = velocity[i];
+    const bool has_rpy = (f.flags & 2) != 0, end = (f.flags & 1) != 0;
+    const bool taken = osc::prepare_setpoint(gen, f.id, p, rpy, has_rpy, end, out, velocity ? &v : nullptr);
     FUZZ_CHECK(taken == (gen.source() == osc::MotionSource::kStream && f.id == 3000));
     if (!taken) return;
     FUZZ_CHECK(osc::math::all_finite(out.x));
+    FUZZ_CHECK(osc::math::all_finite(out.v));
+    FUZZ_CHECK(out.has_velocity == (velocity != nullptr));
+    if (end || !velocity) FUZZ_CHECK(out.v.norm() == 0);
+    if (!has_rpy) FUZZ_CHECK(out.v.tail<3>().norm() == 0);
     const osc::Vec3<double> at = gen.stream_relative() ? osc::Vec3<double>(gen.hold_pose().p + p) : p;
     FUZZ_CHECK((out.x.head<3>() - at).norm() <= 1e-9 * (1 + at.norm()));
-    gen.stream_setpoint(out.x, out.end);
+    gen.stream_setpoint(out.x, out.end, out.has_velocity ? &out.v : nullptr);
+    osc::MotionEvents ev;
+    const osc::Desired<double> d = gen.at_tick(next_tick, kHz, ev);
+    FUZZ_CHECK(osc::math::all_finite(d.x) && osc::math::all_finite(d.xd) && osc::math::all_finite(d.xdd));
   }
 };
 
@@ -177,6 +200,20 @@ float number(fuzz::Input& in, bool raw, double unit, bool is_signed = true) {
   }
   const std::uint16_t u = in.u16();
   return static_cast<float>((is_signed ? static_cast<std::int16_t>(u) : u) * unit);
+}
+
+/// A setpoint frame from the input (for the running stream, id 3000, when bit 0 of its first byte is
+/// set): positions to +-16 m, angles to +-8 rad, with velocity each to +-16 m/s or rad/s.
+template <class Frame>
+Frame setpoint_from(fuzz::Input& in, bool raw) {
+  Frame f;
+  f.id = (in.u8() & 1) ? 3000u : in.u32();
+  f.flags = in.u8();
+  for (float& p : f.position) p = number(in, raw, 1.0 / 2048);
+  for (float& r : f.rpy) r = number(in, raw, 1.0 / 4096);
+  if constexpr (std::is_same_v<Frame, pil::SetpointVelocityFrame>)
+    for (float& v : f.velocity) v = number(in, raw, 1.0 / 2048);
+  return f;
 }
 
 pil::CommandFrame frame_from(fuzz::Input& in, bool raw) {
@@ -214,7 +251,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::uint8_t op = in.u8();
     for (int k = op & 7; k > 0; --k) c->feed(parser, in.u8());
     std::uint8_t buf[pil::kMaxFrame];
-    const int len = pil::encode(frame_from(in, (op & 8) != 0), buf);
+    const bool raw = (op & 8) != 0;
+    const int kind = (op >> 5) & 3;  // a command frame, a setpoint, a setpoint with velocity
+    const int len = kind == 1   ? pil::encode(setpoint_from<pil::SetpointFrame>(in, raw), buf)
+                    : kind == 2 ? pil::encode(setpoint_from<pil::SetpointVelocityFrame>(in, raw), buf)
+                                : pil::encode(frame_from(in, raw), buf);
     const bool flip = (op & 0x10) != 0;
     if (flip) buf[4 + in.u8() % (len - 4)] ^= static_cast<std::uint8_t>(1u << (in.u8() & 7));
     const bool idle = !parser.in_frame();

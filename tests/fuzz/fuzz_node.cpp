@@ -112,7 +112,8 @@ struct Driver {
     const bool due = node.on_byte(b);
     // A command or a setpoint is the command port's: no tick, no link error (the node may answer a
     // command at once: a refusal no tick gives).
-    if (r == pil::Parser::kFrame && (shadow.type() == pil::kCommandFrame || shadow.type() == pil::kSetpointFrame)) {
+    if (r == pil::Parser::kFrame && (shadow.type() == pil::kCommandFrame || shadow.type() == pil::kSetpointFrame ||
+                                     shadow.type() == pil::kSetpointVelocityFrame)) {
       FUZZ_CHECK(!due);
       take_frames(false);
       synced = true;

@@ -284,6 +284,31 @@ void command() {
     append(raw, sensor(3, 1));
   }
   put("fuzz_command", "raw_frames", raw);
+  // A stream running (how 3): its setpoints (op bits 5-6: 1 plain, 2 with velocity; the selector byte's
+  // bit 0: the stream's id 3000), the last with end; one with a NaN velocity, one of another stream.
+  Bytes stream{static_cast<std::uint8_t>(1 | (3 << 1))};
+  const auto setpoint_op = [&stream](std::uint8_t op, int n, std::uint8_t flags, bool mine) {
+    stream.push_back(op);
+    stream.push_back(mine ? 1 : 0);
+    if (!mine) u32(stream, 77);
+    stream.push_back(flags);
+    const bool raw = (op & 8) != 0;
+    const double pos[3] = {0.001 * n, -0.0005 * n, 0}, rpy[3] = {0, 0, 0.002 * n};
+    for (double p : pos) raw ? f32(stream, p) : u16(stream, static_cast<int>(std::lround(p * 2048)));
+    for (double r : rpy) raw ? f32(stream, r) : u16(stream, static_cast<int>(std::lround(r * 4096)));
+    if ((op >> 5) == 2)
+      for (double v : {0.02, -0.01, 0.0, 0.0, 0.0, 0.04}) raw ? f32(stream, v) : u16(stream, static_cast<int>(std::lround(v * 2048)));
+  };
+  for (int n = 1; n <= 4; ++n) setpoint_op(0x20, n, pil::kSetpointHasRpy, true);
+  for (int n = 5; n <= 8; ++n) setpoint_op(0x40, n, pil::kSetpointHasRpy, true);
+  setpoint_op(0x40, 9, 0, false);
+  stream.push_back(0x48);  // raw numbers, a NaN velocity
+  stream.push_back(1);
+  stream.push_back(0);
+  for (int i = 0; i < 6; ++i) f32(stream, 0.0);
+  for (int i = 0; i < 6; ++i) f32(stream, i == 2 ? std::nan("") : 0.0);
+  setpoint_op(0x40, 10, pil::kSetpointHasRpy | pil::kSetpointEnd, true);
+  put("fuzz_command", "stream_setpoints", stream);
 }
 
 void cli() {

@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <deque>
 #include <functional>
@@ -173,6 +175,29 @@ TEST(OscClientPath, ResampledLinearlyWithTheLastSampleAtTheEnd) {
   EXPECT_NEAR(p[2].rpy(2), 0.16, 1e-12);
   EXPECT_EQ(p[3].position(0), 0.1);
   EXPECT_EQ(osc::client::resample_path({{0, 1, 2, 3, 0, 0, 0}}, 50).size(), 1u);  // one row: one sample
+}
+
+// The velocity of each sample: the segment's slope, its angular part the angular velocity of
+// R(rpy(t)) = Rz Ry Rx (checked against differences of R itself: w^ = R_dot R^T); zero at the end.
+TEST(OscClientPath, EachSampleCarriesThePathsVelocity) {
+  const std::vector<std::array<double, 7>> rows = {{0, 0, 0, 0, 0.1, 0.2, 0.3}, {0.5, 0.05, -0.02, 0.01, 0.3, -0.1, 0.6}};
+  const auto p = osc::client::resample_path(rows, 10);
+  ASSERT_EQ(p.size(), 6u);
+  const auto R = [](const osc::Vec3<double>& a) {
+    return osc::Mat3<double>(Eigen::AngleAxisd(a(2), osc::Vec3<double>::UnitZ()) *
+                             Eigen::AngleAxisd(a(1), osc::Vec3<double>::UnitY()) *
+                             Eigen::AngleAxisd(a(0), osc::Vec3<double>::UnitX()));
+  };
+  for (std::size_t k = 0; k + 1 < p.size(); ++k) {
+    EXPECT_NEAR(p[k].velocity(0), 0.1, 1e-12);
+    EXPECT_NEAR(p[k].velocity(1), -0.04, 1e-12);
+    EXPECT_NEAR(p[k].velocity(2), 0.02, 1e-12);
+    const osc::Vec3<double> rate(0.4, -0.6, 0.6), a = p[k].rpy;
+    const double h = 1e-6;
+    const osc::Mat3<double> W = (R(a + h * rate) - R(a - h * rate)) / (2 * h) * R(a).transpose();
+    EXPECT_LE((p[k].velocity.tail<3>() - osc::Vec3<double>(W(2, 1), W(0, 2), W(1, 0))).norm(), 1e-8) << k;
+  }
+  EXPECT_EQ(p.back().velocity.norm(), 0.0);
 }
 
 TEST(SerialTransport, BadPathsAreNamed) {

@@ -36,6 +36,14 @@ Vec6<double> path(double t) {
   x << kP0 + 0.15 * s * kDir, kPhi0 + 0.2 * s * kAxis;
   return x;
 }
+/// Its derivative (the rates of the coordinates), analytic.
+Vec6<double> path_rate(double t) {
+  const double u = t / kPathTime;
+  const double sd = u < 0 || u > 1 ? 0.0 : 0.5 * kPi / kPathTime * std::sin(kPi * u);
+  Vec6<double> v;
+  v << 0.15 * sd * kDir, 0.2 * sd * kAxis;
+  return v;
+}
 
 /// The base angular velocity of a reference: w = E(phi) phi_dot, E = (E^{-1})^{-1} numerically.
 Vec3<double> omega(const Desired<double>& d) {
@@ -46,6 +54,7 @@ Vec3<double> omega(const Desired<double>& d) {
 struct Trace {
   double v = 0, a = 0, j = 0, w = 0, wd = 0, phij = 0;
   double lag = 0, off_line = 0;  // against the path delayed by T; distance from its straight line
+  double lag_now = 0;            // against the path itself (not delayed)
   int ticks = 0;
   Desired<double> last{}, prev{};
   Vec3<double> w_prev = Vec3<double>::Zero();
@@ -84,10 +93,11 @@ Desired<double> to_double(const Desired<S>& d) {
   return {d.x.template cast<double>(), d.xd.template cast<double>(), d.xdd.template cast<double>()};
 }
 
-/// Streams path() at rate_hz from tick 0 (sample k at tick k P, the path's time k P dt), until
-/// `cut` [s] (then nothing more) or to its end and then end(); runs `total` ticks.
+/// Streams path() at rate_hz from tick 0 (sample k at tick k P, the path's time k P dt; with
+/// `velocity`, each with the path's rate), until `cut` [s] (then nothing more) or to its end and
+/// then end(); runs `total` ticks.
 template <class S>
-Trace stream_path(StreamFollower<S>& f, std::uint32_t rate_hz, int total, double cut = 1e9) {
+Trace stream_path(StreamFollower<S>& f, std::uint32_t rate_hz, int total, double cut = 1e9, bool velocity = false) {
   const std::uint32_t P = kHz / rate_hz;
   f.start(path(0).cast<S>(), P);
   Trace tr;
@@ -95,7 +105,10 @@ Trace stream_path(StreamFollower<S>& f, std::uint32_t rate_hz, int total, double
   for (int n = 0; n < total; ++n) {
     const double t = n * kDt;
     if (n % P == 0 && t < cut && !ended) {
-      f.push(path(t).cast<S>());
+      if (velocity)
+        f.push(path(t).cast<S>(), path_rate(t).cast<S>());
+      else
+        f.push(path(t).cast<S>());
       if (t >= kPathTime) f.end(), ended = true;
     }
     const Desired<double> d = to_double(f.tick());
@@ -103,6 +116,7 @@ Trace stream_path(StreamFollower<S>& f, std::uint32_t rate_hz, int total, double
     // The target is the path delayed by T; the reference is one tick on.
     const Vec6<double> r = path((n + 1) * kDt - P * kDt);
     tr.lag = std::max(tr.lag, (d.x.head<3>() - r.head<3>()).norm());
+    tr.lag_now = std::max(tr.lag_now, (d.x.head<3>() - path((n + 1) * kDt).head<3>()).norm());
     const Vec3<double> q = d.x.head<3>() - kP0;
     tr.off_line = std::max(tr.off_line, (q - kDir * q.dot(kDir)).norm());
   }
@@ -125,6 +139,59 @@ TEST(StreamFollower, FollowsASmoothPathAtEachRateWithinTheLimits) {
     EXPECT_LE(ew, 1e-3) << rate;
     EXPECT_LE(tr.lag, 2e-3) << rate;
     EXPECT_LE(tr.off_line, 2e-4) << rate;
+  }
+}
+
+// Samples with their velocity: no delay. At 10 Hz, without velocities the reference lags the path
+// by about v T = 7.9 mm (the delay); with them it is on the path to within the prediction's error
+// (a T^2 / 2) and the follower's lag.
+TEST(StreamFollower, SamplesWithVelocityFollowThePathWithoutTheDelay) {
+  const Vec6<double> end = path(kPathTime);
+  for (std::uint32_t rate : {10u, 50u, 1000u}) {
+    StreamFollower<double> plain, with_v;
+    const Trace tp = stream_path(plain, rate, 6000);
+    const Trace tv = stream_path(with_v, rate, 6000, 1e9, true);
+    expect_within_limits(tv);
+    std::printf("%4u Hz: lag to the path without velocities %.2f mm, with %.2f mm; off the line %.3f mm\n", rate,
+                1e3 * tp.lag_now, 1e3 * tv.lag_now, 1e3 * tv.off_line);
+    EXPECT_LE((tv.last.x - end).norm(), 1e-3) << rate;
+    EXPECT_LE(tv.last.xd.norm(), 1e-6) << rate;  // at rest at the end sample
+    EXPECT_LE(tv.lag_now, 2e-3) << rate;
+    EXPECT_LE(tv.off_line, 3e-4) << rate;
+    // The delay it removes: at 10 Hz a fifth of the lag or less.
+    if (rate == 10u) {
+      EXPECT_GE(tp.lag_now, 5 * tv.lag_now);
+    }
+  }
+}
+
+// A velocity that disagrees with the samples (a client's error: the path moves, the velocities say
+// still, or twice the speed): the target is continuous all the same, and the reference within the
+// limits and at the end sample in the end.
+TEST(StreamFollower, InconsistentVelocitiesStayWithinTheLimits) {
+  for (double scale : {0.0, 2.0, -1.0}) {
+    StreamFollower<double> f;
+    const std::uint32_t P = 50;
+    f.start(path(0), P);
+    Trace tr;
+    Vec6<double> prev_r = path(0), vr;
+    double jump = 0;
+    for (int n = 0; n < 8000; ++n) {
+      const double t = n * kDt;
+      if (n % P == 0 && t <= kPathTime) {
+        f.push(path(t), scale * path_rate(t));
+        if (t >= kPathTime) f.end();
+      }
+      const Vec6<double> r = f.target(vr);
+      jump = std::max(jump, (r - prev_r).norm());
+      prev_r = r;
+      tr.add(f.tick());
+    }
+    expect_within_limits(tr);
+    EXPECT_LE((tr.last.x - path(kPathTime)).norm(), 1e-3) << scale;
+    // Continuous: a tick's step of the target is a speed times 1 ms, a tenth of the 4 mm between
+    // two samples (a jump between two samples' lines would be of that order).
+    EXPECT_LE(jump, 4e-4) << scale;
   }
 }
 
@@ -202,9 +269,10 @@ TEST(StreamFollower, ACutStreamGoesStaleAndStopsWithinTheLimits) {
   }
 }
 
-/// The same stream in S and double (double at the limits S uses, less its rounding margin).
+/// The same stream in S and double (double at the limits S uses, less its rounding margin), its
+/// samples without and with velocities.
 template <class S>
-void compare_scalar(double tol_pos, double tol_vel) {
+void compare_scalar(double tol_pos, double tol_vel, bool velocity) {
   const CartesianLimits<S> ls = CartesianLimits<S>::defaults();
   const auto margin = [](const JerkLimits<S>& l) {
     const JerkLimits<S> m = rounding_margin(l);
@@ -212,26 +280,32 @@ void compare_scalar(double tol_pos, double tol_vel) {
   };
   StreamFollower<double> fd(CartesianLimits<double>{margin(ls.linear), margin(ls.angular)});
   StreamFollower<S> fs;
-  const Trace td = stream_path(fd, 50, 5000);
-  const Trace ts = stream_path(fs, 50, 5000);
+  const Trace td = stream_path(fd, 50, 5000, 1e9, velocity);
+  const Trace ts = stream_path(fs, 50, 5000, 1e9, velocity);
   expect_within_limits(ts);
   // Step by step.
   fd.start(path(0), 20), fs.start(path(0).cast<S>(), 20);
   double ep = 0, ev = 0;
   for (int n = 0; n < 5000; ++n) {
-    if (n % 20 == 0) fd.push(path(n * kDt)), fs.push(path(n * kDt).cast<S>());
+    const double t = n * kDt;
+    if (n % 20 == 0 && velocity) fd.push(path(t), path_rate(t)), fs.push(path(t).cast<S>(), path_rate(t).cast<S>());
+    if (n % 20 == 0 && !velocity) fd.push(path(t)), fs.push(path(t).cast<S>());
     const Desired<double> d = fd.tick(), s = to_double(fs.tick());
     ep = std::max(ep, (s.x - d.x).norm());
     ev = std::max(ev, (s.xd - d.xd).norm());
   }
-  std::printf("against double: x %.2e, xd %.2e\n", ep, ev);
+  std::printf("against double%s: x %.2e, xd %.2e\n", velocity ? " (with velocities)" : "", ep, ev);
   EXPECT_LE(ep, tol_pos);
   EXPECT_LE(ev, tol_vel);
   EXPECT_LE((ts.last.x - td.last.x).norm(), tol_pos);
 }
 
-TEST(StreamFollower, FloatAgreesWithDouble) { compare_scalar<float>(2e-5, 1e-4); }
-TEST(StreamFollower, FixedAgreesWithDouble) { compare_scalar<Fixed>(1e-4, 1e-3); }
+TEST(StreamFollower, FloatAgreesWithDouble) {
+  for (bool velocity : {false, true}) compare_scalar<float>(2e-5, 1e-4, velocity);
+}
+TEST(StreamFollower, FixedAgreesWithDouble) {
+  for (bool velocity : {false, true}) compare_scalar<Fixed>(1e-4, 1e-3, velocity);
+}
 
 /// The host time of tick() (and push() every 20 ticks) alone, per scalar: for the record only.
 template <class S>

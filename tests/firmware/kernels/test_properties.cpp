@@ -16,9 +16,11 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cstdio>
 #include <limits>
+#include <random>
 
 #include "osc/kernels/friction.hpp"
 #include "osc/kernels/opspace.hpp"
@@ -107,6 +109,27 @@ TEST_F(Props, AnalyticJacobianAndJdotMatchFiniteDifferences) {
   std::printf("analytic Jacobian vs central differences: %.2e; analytic Jdot qd: %.2e (relative)\n", worst_J, worst_Jd);
   EXPECT_LT(worst_J, 1e-7);
   EXPECT_LT(worst_Jd, 1e-6);
+}
+
+// E(phi) (phi_rate_to_angular) against the angular velocity of R(phi(t)) = Rz Ry Rx by central
+// differences, w^ = R_dot R^T; and E^{-1} (angular_to_phi_rate) its inverse.
+TEST(OrientationRates, EMapsRollPitchYawRatesToTheAngularVelocity) {
+  const auto R = [](const Vec3<double>& p) {
+    return Mat3<double>(Eigen::AngleAxisd(p(2), Vec3<double>::UnitZ()) * Eigen::AngleAxisd(p(1), Vec3<double>::UnitY()) *
+                        Eigen::AngleAxisd(p(0), Vec3<double>::UnitX()));
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.4, 1.4);
+  for (int k = 0; k < 50; ++k) {
+    const Vec3<double> phi(u(rng), u(rng), u(rng)), rate(u(rng), u(rng), u(rng));
+    const double h = 1e-6;
+    const Mat3<double> W = (R(phi + h * rate) - R(phi - h * rate)) / (2 * h) * R(phi).transpose();
+    const Vec3<double> w(W(2, 1), W(0, 2), W(1, 0));
+    EXPECT_LE((phi_rate_to_angular<double>(phi) * rate - w).norm(), 1e-8) << k;
+    EXPECT_LE((angular_to_phi_rate<double>(phi) * phi_rate_to_angular<double>(phi) - Mat3<double>::Identity()).norm(),
+              1e-12)
+        << k;
+  }
 }
 
 TEST_F(Props, LambdaDotMinusTwoPsiIsSkewSymmetric) {

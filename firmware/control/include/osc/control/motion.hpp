@@ -97,11 +97,14 @@ class MotionGenerator {
     stopping_ = braking_ = false;
     count_ = 0;
   }
-  /// A setpoint of the running stream (the follower's target x, in the controller's coordinates),
-  /// for this tick; `end`: its last.
-  void stream_setpoint(const Vec6<S>& x, bool end) {
+  /// A setpoint of the running stream (the follower's target x, in the controller's coordinates,
+  /// with its rates v or none), for this tick; `end`: its last.
+  void stream_setpoint(const Vec6<S>& x, bool end, const Vec6<S>* v = nullptr) {
     if (source_ != MotionSource::kStream) return;
-    stream_.push(x);
+    if (v)
+      stream_.push(x, *v);
+    else
+      stream_.push(x);
     if (end) stream_.end();
   }
   /// The running stream has gone stale (no setpoint for max(2 periods, 20 ms), not ended, not

@@ -115,6 +115,18 @@ Mat3<S> angular_to_phi_rate(const Vec3<S>& phi) {
   return phi_rate(phi).Einv;
 }
 
+/// E(phi) itself: maps phi_dot to the base angular velocity, w = E(phi) phi_dot (defined at every
+/// phi; a client's rates of roll, pitch, yaw as the angular velocity a setpoint carries).
+template <class S>
+Mat3<S> phi_rate_to_angular(const Vec3<S>& phi) {
+  S sb, cb, sg, cg;
+  math::sincos(phi(1), sb, cb);
+  math::sincos(phi(2), sg, cg);
+  Mat3<S> E;
+  E << cg * cb, -sg, S(0), sg * cb, cg, S(0), -sb, S(0), S(1);
+  return E;
+}
+
 /// Analytic Jacobian Ja = blockdiag(I, E^{-1}(phi)) J, so that x_dot = Ja q_dot.
 template <class S>
 Mat6<S> analytic_jacobian(const Mat6<S>& J, const PhiRate<S>& E) {

@@ -72,6 +72,9 @@ constexpr int kStreamMaxPeriod = 100;
 /// (2 pi), every number finite, and with has_limits every limit above 0.
 constexpr double kCommandMaxPosition = 10.0;
 constexpr double kCommandMaxAngle = 6.283185307179586;
+/// A setpoint_velocity frame's velocities within +-kCommandMaxVelocity [m/s, rad/s] (else the
+/// setpoint is bad: dropped and counted).
+constexpr double kCommandMaxVelocity = 10.0;
 
 // The field lists, X(type, name, extent, unit, meaning) as in frames.hpp. The references in
 // parentheses name the protocol document's tables.
@@ -98,6 +101,14 @@ constexpr double kCommandMaxAngle = 6.283185307179586;
     "the wrist centre in the base frame (the stream's relative flag: the offset from where it started)")          \
   X(float, rpy, [3], "rad",                                                                                       \
     "with has_rpy: roll, pitch, yaw of the orientation, as move_to's (relative: of the rotation applied)")
+
+// The setpoint with its velocity: the setpoint frame's fields, then the velocity.
+#define OSC_SETPOINT_VELOCITY_FIELDS(X)                                                                        \
+  OSC_SETPOINT_FIELDS(X)                                                                                       \
+  X(float, velocity, [6], "m/s, rad/s",                                                                        \
+    "the setpoint's velocity: the wrist centre's, then the angular velocity, both in the base frame (relative: " \
+    "of the offset and of the rotation applied); each within +-kCommandMaxVelocity; without has_rpy the "        \
+    "angular velocity is taken as 0, with end all of it")
 
 #define OSC_ANSWER_FIELDS(X)                                                                                   \
   X(std::uint32_t, id, , "", "the id of the command answered in this tick; 0 when none was")                   \

@@ -92,6 +92,11 @@ class CommandPort {
       offer_setpoint_frame(task, s);
       return true;
     }
+    pil::SetpointVelocityFrame sv;
+    if (p.decode(sv)) {
+      offer_setpoint_frame(task, sv);
+      return true;
+    }
     return false;
   }
 

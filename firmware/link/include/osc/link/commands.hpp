@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "osc/link/frames.hpp"
 #include "osc/runtime/control_task.hpp"
@@ -51,6 +52,16 @@ inline bool setpoint_valid(const pil::SetpointFrame& f) {
   for (int i = 0; i < 3; ++i)
     if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
       return false;
+  return true;
+}
+/// ... and of a setpoint with velocity, its velocities within +-kCommandMaxVelocity too.
+inline bool setpoint_valid(const pil::SetpointVelocityFrame& f) {
+  if ((f.flags & ~pil::kSetpointFlagsKnown) != 0) return false;
+  for (int i = 0; i < 3; ++i)
+    if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
+      return false;
+  for (float v : f.velocity)
+    if (!command_within(v, pil::kCommandMaxVelocity)) return false;
   return true;
 }
 }  // namespace detail
@@ -109,8 +120,11 @@ TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const Cartes
 /// A setpoint frame into the task's mailbox (offer_setpoint): false (counted in task.dropped) for
 /// a bad one (a flag outside its list, a number beyond its bound or not finite) or one of no
 /// running stream.
-template <class S>
-bool offer_setpoint_frame(ControlTask<S>& task, const pil::SetpointFrame& f) {
+/// A setpoint frame, or a setpoint_velocity frame, into the task's mailbox (offer_setpoint): false
+/// (counted in task.dropped) for a bad one (a flag outside its list, a number beyond its bound or
+/// not finite) or one of no running stream.
+template <class S, class Frame>
+bool offer_setpoint_frame(ControlTask<S>& task, const Frame& f) {
   if (!detail::setpoint_valid(f)) {
     ++task.dropped;
     return false;
@@ -120,7 +134,14 @@ bool offer_setpoint_frame(ControlTask<S>& task, const pil::SetpointFrame& f) {
     p(i) = lit<S>(static_cast<double>(f.position[i]));
     rpy(i) = lit<S>(static_cast<double>(f.rpy[i]));
   }
-  return offer_setpoint(task, f.id, p, rpy, (f.flags & pil::kSetpointHasRpy) != 0, (f.flags & pil::kSetpointEnd) != 0);
+  const bool has_rpy = (f.flags & pil::kSetpointHasRpy) != 0, end = (f.flags & pil::kSetpointEnd) != 0;
+  if constexpr (std::is_same_v<Frame, pil::SetpointVelocityFrame>) {
+    Vec6<S> v;
+    for (int i = 0; i < 6; ++i) v(i) = lit<S>(static_cast<double>(f.velocity[i]));
+    return offer_setpoint(task, f.id, p, rpy, has_rpy, end, &v);
+  } else {
+    return offer_setpoint(task, f.id, p, rpy, has_rpy, end);
+  }
 }
 
 /// Host side: a setpoint as a frame.
@@ -133,6 +154,18 @@ pil::SetpointFrame setpoint_frame(std::uint32_t id, const Vec3<S>& position, con
     f.position[i] = static_cast<float>(position(i));
     f.rpy[i] = rpy ? static_cast<float>((*rpy)(i)) : 0.0f;
   }
+  return f;
+}
+/// Host side: a setpoint with its velocity (the wrist centre's, then the angular velocity, base
+/// frame) as a frame.
+template <class S>
+pil::SetpointVelocityFrame setpoint_velocity_frame(std::uint32_t id, const Vec3<S>& position, const Vec3<S>* rpy,
+                                                   const Vec6<S>& velocity, bool end) {
+  const pil::SetpointFrame s = setpoint_frame(id, position, rpy, end);
+  pil::SetpointVelocityFrame f;
+  f.id = s.id, f.flags = s.flags;
+  for (int i = 0; i < 3; ++i) f.position[i] = s.position[i], f.rpy[i] = s.rpy[i];
+  for (int i = 0; i < 6; ++i) f.velocity[i] = static_cast<float>(velocity(i));
   return f;
 }
 

@@ -127,7 +127,11 @@ struct LinkCounters {
   X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)  \
   X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)         \
   X(Trace, 7, "trace", "firmware",                                                                                  \
-    "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS)
+    "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS) \
+  X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                               \
+    "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "      \
+    "line without the setpoints' delay)",                                                                           \
+    OSC_SETPOINT_VELOCITY_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

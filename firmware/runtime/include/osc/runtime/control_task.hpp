@@ -292,7 +292,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
   MotionEvents ev;
   if (task.sample.valid) {
-    task.gen.stream_setpoint(task.sample.x, task.sample.end);
+    task.gen.stream_setpoint(task.sample.x, task.sample.end, task.sample.has_velocity ? &task.sample.v : nullptr);
     task.sample.valid = false;
   }
   if (stepped) {
@@ -380,14 +380,15 @@ TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& 
   return c;
 }
 
-/// Puts a setpoint of stream `id` into the task's mailbox for the next tick (prepare_setpoint):
+/// Puts a setpoint of stream `id` (with its velocity, or none) into the task's mailbox for the next
+/// tick (prepare_setpoint):
 /// false, counted in task.dropped, when no stream of that id runs; a setpoint not yet taken is
 /// replaced (and counted).
 template <class S>
 bool offer_setpoint(ControlTask<S>& task, std::uint32_t id, const Vec3<S>& position, const Vec3<S>& rpy, bool has_rpy,
-                    bool end) {
+                    bool end, const Vec6<S>* velocity = nullptr) {
   StreamSample<S> s;
-  if (!prepare_setpoint(task.gen, id, position, rpy, has_rpy, end, s)) {
+  if (!prepare_setpoint(task.gen, id, position, rpy, has_rpy, end, s, velocity)) {
     ++task.dropped;
     return false;
   }

@@ -90,9 +90,11 @@ struct TaskCommand {
 /// the controller's coordinates (position; roll, pitch, yaw of R R_ref^T).
 template <class S>
 struct StreamSample {
-  bool valid = false;  ///< waiting for the tick (taken there)
-  bool end = false;    ///< the stream's last
+  bool valid = false;         ///< waiting for the tick (taken there)
+  bool end = false;           ///< the stream's last
+  bool has_velocity = false;  ///< v is the sample's velocity (else none was given)
   Vec6<S> x = Vec6<S>::Zero();
+  Vec6<S> v = Vec6<S>::Zero();  ///< the rates of x (position; roll, pitch, yaw)
 };
 
 /// What one tick reports: the answer to its command, and a motion's end.
@@ -170,10 +172,13 @@ TaskCommand<S> prepare_stream(const CartesianLimits<S>& max, const MoveRequest<S
 
 /// Prepares a setpoint of the running stream `id`: false (dropped) when no stream of that id runs.
 /// position, rpy: absolute (base frame), or relative to the pose the stream started at; without
-/// has_rpy the orientation stays as it started.
+/// has_rpy the orientation stays as it started. `velocity` (or none): the wrist centre's velocity
+/// and the angular velocity w, base frame (relative: of the offset and of the rotation applied, the
+/// same), as the rates of the follower's coordinates: phi_dot = E^{-1}(phi) w (0 without has_rpy;
+/// all 0 with end).
 template <class S>
 bool prepare_setpoint(const MotionGenerator<S>& gen, std::uint32_t id, const Vec3<S>& position, const Vec3<S>& rpy,
-                      bool has_rpy, bool end, StreamSample<S>& out) {
+                      bool has_rpy, bool end, StreamSample<S>& out, const Vec6<S>* velocity = nullptr) {
   if (gen.source() != MotionSource::kStream || gen.braking() || gen.running_id() != id) return false;
   const std::uint32_t saved = math::take_arithmetic_flags<S>();
   MoveRequest<S> req;
@@ -181,6 +186,13 @@ bool prepare_setpoint(const MotionGenerator<S>& gen, std::uint32_t id, const Vec
   const Pose<S> to = move_target(gen.hold_pose(), req);
   out.x << to.p, orientation_coordinates<S>(to.R, gen.reference_orientation());
   out.end = end;
+  out.has_velocity = velocity != nullptr;
+  out.v.setZero();
+  if (velocity && !end) {
+    out.v.template head<3>() = velocity->template head<3>();
+    // The orientation's coordinates are those of R R_ref^T, R_ref fixed: its angular velocity is R's.
+    if (has_rpy) out.v.template tail<3>() = angular_to_phi_rate<S>(out.x.template tail<3>()) * velocity->template tail<3>();
+  }
   out.valid = !math::take_arithmetic_fault<S>();
   math::restore_arithmetic_flags<S>(saved);
   return out.valid;
