@@ -396,7 +396,8 @@ class Player {
     const std::uint32_t id = stream_.id;
     ++stream_.sent;
     if (end) stream_.step = nullptr;
-    if (s->velocity) return arm_.setpoint(osc::setpoint_velocity_frame<double>(id, x.position, rpy, x.velocity, end), err);
+    if (s->velocity)
+      return arm_.setpoint(osc::setpoint_velocity_frame<double>(id, x.position, rpy, x.velocity, end), err);
     return arm_.setpoint(osc::setpoint_frame<double>(id, x.position, rpy, end), err);
   }
   void track();

@@ -379,9 +379,10 @@ Outcome Client::stream(const std::vector<StreamPoint>& points, bool has_rpy, dou
     const StreamPoint& p = points[n];
     std::uint8_t buf[pil::kMaxFrame];
     const int len =
-        velocity ? pil::encode(setpoint_velocity_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, p.velocity, last),
-                               buf)
-                 : pil::encode(setpoint_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, last), buf);
+        velocity
+            ? pil::encode(setpoint_velocity_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, p.velocity, last),
+                          buf)
+            : pil::encode(setpoint_frame<double>(id, p.position, has_rpy ? &p.rpy : nullptr, last), buf);
     if (!send(buf, len)) return o.status = Status::kError, o.error = error_, o;
   }
   return o;

@@ -87,7 +87,6 @@ struct Outcome {
   std::string text() const;
 };
 
-
 /// The names of fault bits ("none", or "tracking,estop"; a bit outside the catalogue "bitN").
 std::string fault_names(std::uint32_t bits);
 /// A state frame as lines: state, stop, faults, queued, running id, reference and measured pose.

@@ -297,7 +297,8 @@ void command() {
     for (double p : pos) raw ? f32(stream, p) : u16(stream, static_cast<int>(std::lround(p * 2048)));
     for (double r : rpy) raw ? f32(stream, r) : u16(stream, static_cast<int>(std::lround(r * 4096)));
     if ((op >> 5) == 2)
-      for (double v : {0.02, -0.01, 0.0, 0.0, 0.0, 0.04}) raw ? f32(stream, v) : u16(stream, static_cast<int>(std::lround(v * 2048)));
+      for (double v : {0.02, -0.01, 0.0, 0.0, 0.0, 0.04})
+        raw ? f32(stream, v) : u16(stream, static_cast<int>(std::lround(v * 2048)));
   };
   for (int n = 1; n <= 4; ++n) setpoint_op(0x20, n, pil::kSetpointHasRpy, true);
   for (int n = 5; n <= 8; ++n) setpoint_op(0x40, n, pil::kSetpointHasRpy, true);

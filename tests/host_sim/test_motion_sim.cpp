@@ -487,8 +487,8 @@ void stream_at_rates(bool velocity = false) {
     std::printf(
         "stream %s: end error %.4f mm %.5f rad, off the line %.4f mm, lag %.3f mm, tracking %.3f mm, v %.4f a %.4f "
         "j %.3f w %.4f wd %.4f, %d ticks\n",
-        at.c_str(), r.end_error * 1e3, r.end_angle, r.off_path * 1e3, r.lag * 1e3, r.tracking * 1e3, r.v, r.a, r.j,
-        r.w, r.wd, r.ticks);
+        at.c_str(), r.end_error * 1e3, r.end_angle, r.off_path * 1e3, r.lag * 1e3, r.tracking * 1e3, r.v, r.a, r.j, r.w,
+        r.wd, r.ticks);
   }
 }
 
@@ -507,8 +507,8 @@ TEST(MotionSim, StreamWithVelocitiesInEachScalar) {
 // lags the path by v T without them (about 4.5 mm here), by a fraction of it with them.
 TEST(MotionSim, StreamWithVelocitiesAtTenHzLagsAFifthOrLess) {
   const StreamRun plain = stream_path<double>(10), with_v = stream_path<double>(10, -1, true);
-  std::printf("10 Hz: the reference's lag behind the path %.2f mm without velocities, %.2f mm with\n",
-              plain.lag * 1e3, with_v.lag * 1e3);
+  std::printf("10 Hz: the reference's lag behind the path %.2f mm without velocities, %.2f mm with\n", plain.lag * 1e3,
+              with_v.lag * 1e3);
   EXPECT_GE(plain.lag, 3e-3);
   EXPECT_LE(with_v.lag, plain.lag / 5);
 }

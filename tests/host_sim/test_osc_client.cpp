@@ -180,7 +180,8 @@ TEST(OscClientPath, ResampledLinearlyWithTheLastSampleAtTheEnd) {
 // The velocity of each sample: the segment's slope, its angular part the angular velocity of
 // R(rpy(t)) = Rz Ry Rx (checked against differences of R itself: w^ = R_dot R^T); zero at the end.
 TEST(OscClientPath, EachSampleCarriesThePathsVelocity) {
-  const std::vector<std::array<double, 7>> rows = {{0, 0, 0, 0, 0.1, 0.2, 0.3}, {0.5, 0.05, -0.02, 0.01, 0.3, -0.1, 0.6}};
+  const std::vector<std::array<double, 7>> rows = {{0, 0, 0, 0, 0.1, 0.2, 0.3},
+                                                   {0.5, 0.05, -0.02, 0.01, 0.3, -0.1, 0.6}};
   const auto p = osc::client::resample_path(rows, 10);
   ASSERT_EQ(p.size(), 6u);
   const auto R = [](const osc::Vec3<double>& a) {

@@ -267,23 +267,24 @@ void jerk_profile_kernels() {
 }
 
 /// A stream (issue 23): setpoints at 50 Hz, every axis moving (30 mm each, 0.1 rad of each angle) over
-/// 1 s, ending there; the generator's worst tick (the follower's six axes), and done at the last
-/// setpoint.
+/// 1 s, ending there, without or with their velocities; the generator's worst tick (the follower's
+/// six axes), and done at the last setpoint.
 MotionGenerator<F> g_stream_gen;
-void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R) {
+void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R, bool velocity) {
   MotionGenerator<F>& gen = g_stream_gen;
   gen.hold({x0.template head<3>(), R}, R);
   gen.start_stream(20, false, CartesianLimits<F>::defaults(), 2);
   std::uint32_t worst = 0;
   MotionEvents ev;
-  Vec6<F> end = x0;
+  Vec6<F> end = x0, v;
+  v << lit<F>(0.03), lit<F>(0.03), lit<F>(0.03), lit<F>(0.1), lit<F>(0.1), lit<F>(0.1);
   for (std::uint64_t k = 0; k < 4000 && ev.done_id == 0; ++k) {
     if (k % 20 == 0 && k <= 1000) {
       const F s = math::ratio<F>(k, 1000);
       end = x0;
       for (int i = 0; i < 3; ++i) end(i) += lit<F>(0.03) * s;
       for (int i = 3; i < 6; ++i) end(i) += lit<F>(0.1) * s;
-      gen.stream_setpoint(end, k == 1000);
+      gen.stream_setpoint(end, k == 1000, velocity ? &v : nullptr);
     }
     const std::uint32_t t0 = board::cycles();
     keep(gen.at_tick(k, params::kControlHz, ev));
@@ -291,7 +292,8 @@ void stream_kernels(const Vec6<F>& x0, const Mat3<F>& R) {
     if (dt > worst) worst = dt;
   }
   cortex_m::text::Line()
-      .str("  MotionGenerator::at_tick, a stream, worst tick: ")
+      .str(velocity ? "  MotionGenerator::at_tick, a stream with velocities, worst tick: "
+                    : "  MotionGenerator::at_tick, a stream, worst tick: ")
       .u32(worst)
       .str(" instructions")
       .emit();
@@ -338,7 +340,8 @@ void motion_kernels(const Vec6<F>& q0) {
   check("the move ends done at its target", d((des.x.template head<3>() - to.p).norm()) + (ev.done_id == 1 ? 0 : 1),
         0.0, 1e-4);
   check("no saturation in fixed point", math::take_arithmetic_fault<F>() ? 1.0 : 0.0, 0.0, 0.0);
-  stream_kernels(des.x, from.R);
+  stream_kernels(des.x, from.R, false);
+  stream_kernels(des.x, from.R, true);
 }
 
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear.

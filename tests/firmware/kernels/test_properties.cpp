@@ -115,7 +115,8 @@ TEST_F(Props, AnalyticJacobianAndJdotMatchFiniteDifferences) {
 // differences, w^ = R_dot R^T; and E^{-1} (angular_to_phi_rate) its inverse.
 TEST(OrientationRates, EMapsRollPitchYawRatesToTheAngularVelocity) {
   const auto R = [](const Vec3<double>& p) {
-    return Mat3<double>(Eigen::AngleAxisd(p(2), Vec3<double>::UnitZ()) * Eigen::AngleAxisd(p(1), Vec3<double>::UnitY()) *
+    return Mat3<double>(Eigen::AngleAxisd(p(2), Vec3<double>::UnitZ()) *
+                        Eigen::AngleAxisd(p(1), Vec3<double>::UnitY()) *
                         Eigen::AngleAxisd(p(0), Vec3<double>::UnitX()));
   };
   std::mt19937 rng(7);

@@ -56,8 +56,8 @@ F decoded(const pil::Parser& p) {
   pil::SetpointFrame sp;
   pil::TraceFrame tr;
   pil::SetpointVelocityFrame sv;
-  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
-                 p.decode(sv);
+  const int ok =
+      p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) + p.decode(sv);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));
@@ -513,10 +513,10 @@ TEST(CommandFrames, SetpointWithVelocityRoundTripsAndBadOnesAreDropped) {
   ASSERT_TRUE(offer_setpoint_frame(*task, h));
   EXPECT_EQ(task->sample.v.norm(), 0.0);
   const std::uint32_t replaced = task->dropped;  // a setpoint not yet taken, replaced: counted
-  for (auto spoil : {+[](pil::SetpointVelocityFrame& s) { s.velocity[3] = kNaN; },
-                     +[](pil::SetpointVelocityFrame& s) { s.velocity[0] = 10.5f; },
-                     +[](pil::SetpointVelocityFrame& s) { s.flags = 4; },
-                     +[](pil::SetpointVelocityFrame& s) { s.rpy[2] = 7.0f; }}) {
+  for (auto spoil :
+       {+[](pil::SetpointVelocityFrame& s) { s.velocity[3] = kNaN; },
+        +[](pil::SetpointVelocityFrame& s) { s.velocity[0] = 10.5f; },
+        +[](pil::SetpointVelocityFrame& s) { s.flags = 4; }, +[](pil::SetpointVelocityFrame& s) { s.rpy[2] = 7.0f; }}) {
     pil::SetpointVelocityFrame b = f;
     spoil(b);
     EXPECT_FALSE(offer_setpoint_frame(*task, b));

@@ -19,9 +19,9 @@
 // position and velocity continuous at every sample; beyond T it goes on along the line, as the
 // extrapolation above. For a path sampled with its derivative the target is the path itself up to
 // the prediction's error (a T^2 / 2 at acceleration a): on test_stream's path at 10 Hz the
-// reference is within 1.4 mm of the path, against 8.2 mm (about v T) for samples without velocity. The end sample's velocity is
-// taken as zero (the arm comes to rest at it). A sample's velocity is clamped to
-// +-kStreamMaxSampleVelocity per axis (far above any speed limit).
+// reference is within 1.4 mm of the path, against 8.2 mm (about v T) for samples without velocity.
+// The end sample's velocity is taken as zero (the arm comes to rest at it). A sample's velocity is
+// clamped to +-kStreamMaxSampleVelocity per axis (far above any speed limit).
 //
 // Follower, per axis, each tick: the velocity it aims at
 //   v* = v_r + clamp(kp e, +-sqrt(2 a_b |e|)),  e = r - p,  clamped to +-vmax,

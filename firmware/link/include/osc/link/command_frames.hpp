@@ -103,9 +103,9 @@ constexpr double kCommandMaxVelocity = 10.0;
     "with has_rpy: roll, pitch, yaw of the orientation, as move_to's (relative: of the rotation applied)")
 
 // The setpoint with its velocity: the setpoint frame's fields, then the velocity.
-#define OSC_SETPOINT_VELOCITY_FIELDS(X)                                                                        \
-  OSC_SETPOINT_FIELDS(X)                                                                                       \
-  X(float, velocity, [6], "m/s, rad/s",                                                                        \
+#define OSC_SETPOINT_VELOCITY_FIELDS(X)                                                                          \
+  OSC_SETPOINT_FIELDS(X)                                                                                         \
+  X(float, velocity, [6], "m/s, rad/s",                                                                          \
     "the setpoint's velocity: the wrist centre's, then the angular velocity, both in the base frame (relative: " \
     "of the offset and of the rotation applied); each within +-kCommandMaxVelocity; without has_rpy the "        \
     "angular velocity is taken as 0, with end all of it")

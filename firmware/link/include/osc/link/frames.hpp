@@ -117,20 +117,20 @@ struct LinkCounters {
 // makes the struct NameFrame (its fields, in wire order), kNameFrame (its type code), kNameFields
 // (its fields as the document lists them), kNamePayload (its payload length), encode(),
 // Parser::decode() and for_each_field().
-#define OSC_FRAME_LIST(X)                                                                                           \
-  X(Sensor, 1, "sensor", "host", "one per control tick: the tick's encoder counts", OSC_SENSOR_FIELDS)              \
-  X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",            \
-    OSC_ACTUATOR_FIELDS)                                                                                            \
-  X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS) \
-  X(Answer, 4, "answer", "firmware",                                                                                \
-    "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)        \
-  X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)  \
-  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)         \
-  X(Trace, 7, "trace", "firmware",                                                                                  \
+#define OSC_FRAME_LIST(X)                                                                                             \
+  X(Sensor, 1, "sensor", "host", "one per control tick: the tick's encoder counts", OSC_SENSOR_FIELDS)                \
+  X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",              \
+    OSC_ACTUATOR_FIELDS)                                                                                              \
+  X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS)   \
+  X(Answer, 4, "answer", "firmware",                                                                                  \
+    "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)          \
+  X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)    \
+  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)           \
+  X(Trace, 7, "trace", "firmware",                                                                                    \
     "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS) \
-  X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                               \
-    "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "      \
-    "line without the setpoints' delay)",                                                                           \
+  X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                                 \
+    "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "        \
+    "line without the setpoints' delay)",                                                                             \
     OSC_SETPOINT_VELOCITY_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,

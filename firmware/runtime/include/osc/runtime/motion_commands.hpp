@@ -191,7 +191,8 @@ bool prepare_setpoint(const MotionGenerator<S>& gen, std::uint32_t id, const Vec
   if (velocity && !end) {
     out.v.template head<3>() = velocity->template head<3>();
     // The orientation's coordinates are those of R R_ref^T, R_ref fixed: its angular velocity is R's.
-    if (has_rpy) out.v.template tail<3>() = angular_to_phi_rate<S>(out.x.template tail<3>()) * velocity->template tail<3>();
+    if (has_rpy)
+      out.v.template tail<3>() = angular_to_phi_rate<S>(out.x.template tail<3>()) * velocity->template tail<3>();
   }
   out.valid = !math::take_arithmetic_fault<S>();
   math::restore_arithmetic_flags<S>(saved);
