@@ -628,8 +628,10 @@ BENCH_ROWS = [("FK, all frames", "forward_kinematics", "kdl/forward_kinematics",
 @table("host_benchmarks", "docs/benchmarks.md", "long")
 def host_benchmarks():
     """CPU time per call (Google Benchmark); wall-clock figures, so never checked."""
-    p = subprocess.run([os.path.join(HOST, "tests", "osc_bench"), "--benchmark_min_time=0.2",
-                        "--benchmark_format=json"], capture_output=True, text=True)
+    exe = os.path.join(HOST, "tests", "osc_bench")
+    if not os.access(exe, os.X_OK):
+        raise RuntimeError(f"{exe} is not built (cmake --build --preset host --target osc_bench)")
+    p = subprocess.run([exe, "--benchmark_min_time=0.2", "--benchmark_format=json"], capture_output=True, text=True)
     if p.returncode != 0:
         raise RuntimeError(p.stderr)
     ns = {b["name"]: b["cpu_time"] for b in json.loads(p.stdout)["benchmarks"]}

@@ -46,20 +46,20 @@ inline bool command_numbers_valid(const pil::CommandFrame& f) {
   return true;  // a NaN fails command_within(): !(NaN <= bound)
 }
 
-/// The position and the angles of a setpoint within their bounds, its flags in their list.
-inline bool setpoint_valid(const pil::SetpointFrame& f) {
+/// The position and the angles of a setpoint (either frame) within their bounds, its flags in their
+/// list.
+template <class Frame>
+bool setpoint_pose_valid(const Frame& f) {
   if ((f.flags & ~pil::kSetpointFlagsKnown) != 0) return false;
   for (int i = 0; i < 3; ++i)
     if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
       return false;
   return true;
 }
+inline bool setpoint_valid(const pil::SetpointFrame& f) { return setpoint_pose_valid(f); }
 /// ... and of a setpoint with velocity, its velocities within +-kCommandMaxVelocity too.
 inline bool setpoint_valid(const pil::SetpointVelocityFrame& f) {
-  if ((f.flags & ~pil::kSetpointFlagsKnown) != 0) return false;
-  for (int i = 0; i < 3; ++i)
-    if (!command_within(f.position[i], pil::kCommandMaxPosition) || !command_within(f.rpy[i], pil::kCommandMaxAngle))
-      return false;
+  if (!setpoint_pose_valid(f)) return false;
   for (float v : f.velocity)
     if (!command_within(v, pil::kCommandMaxVelocity)) return false;
   return true;
@@ -117,9 +117,6 @@ TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const Cartes
   return prepare_command<S>(verb, f.id);
 }
 
-/// A setpoint frame into the task's mailbox (offer_setpoint): false (counted in task.dropped) for
-/// a bad one (a flag outside its list, a number beyond its bound or not finite) or one of no
-/// running stream.
 /// A setpoint frame, or a setpoint_velocity frame, into the task's mailbox (offer_setpoint): false
 /// (counted in task.dropped) for a bad one (a flag outside its list, a number beyond its bound or
 /// not finite) or one of no running stream.
