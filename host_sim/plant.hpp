@@ -70,6 +70,9 @@ class Plant {
   double energy() const;
 
   const Vec6& q() const { return q_; }
+  /// The motors' angles, each referred to its joint through its gears: what the encoders count and
+  /// where the index pulses fire. The joint angles themselves on today's rigid, uncoupled plant.
+  Vec6 motor_angles() const { return q_; }
   const Vec6& qd() const { return qd_; }
   double time() const { return t_; }
   const PlantConfig& config() const { return cfg_; }

@@ -160,7 +160,7 @@ struct StuckRig {
   std::uint32_t step(bool moved_all) {
     bool moved[kDof];
     for (bool& b : moved) b = moved_all;
-    return m.check(out, moved, tick++, lit<S>(params::kDt), cpr);
+    return m.check(out.tau, out.qd_ref, moved, tick++, lit<S>(params::kDt), cpr);
   }
 };
 

@@ -37,6 +37,55 @@ struct DriveParams {
   double max_joint_speed[kDof];         ///< [rad/s]
 };
 
+/// One off-diagonal term of a coupling matrix C: joint `row`'s angle gains `c` times motor channel
+/// `col`'s (row > col: C is unit lower triangular).
+struct CouplingTerm {
+  int row, col;
+  double c;  ///< [rad/rad]
+};
+constexpr int kMaxCouplingTerms = 6;
+
+/// How the motor encoders read the joints. Channel i counts its motor's shaft angle; referred to
+/// the joint through the motor's gears it is e_i = counts_i / counts_per_rad[i]. The joint angles
+/// are q = q_start + C e, C unit lower triangular (its off-diagonal terms listed; none: each
+/// encoder reads its own joint). Joint torques reach the motors through the transpose: the
+/// channels' torques, referred to the joints, are tau_m = C^T tau (the same power, tau^T qd).
+struct EncoderMap {
+  const char* name;
+  double counts_per_rad[kDof];  ///< counts per radian of the motor angle referred to its joint
+  int coupling_terms;
+  CouplingTerm coupling[kMaxCouplingTerms];
+};
+
+/// Encoders of one resolution on every motor shaft, each reading its own joint.
+constexpr EncoderMap uniform_encoders(const char* name, const ArmDescription& arm, double counts_per_motor_rev) {
+  EncoderMap m{name, {}, 0, {}};
+  for (int i = 0; i < kDof; ++i) {
+    const double G = arm.links[i].gear_ratio < 0 ? -arm.links[i].gear_ratio : arm.links[i].gear_ratio;
+    m.counts_per_rad[i] = counts_per_motor_rev * G / (2 * kPi);
+  }
+  return m;
+}
+
+/// A set of motor inertias [kg m^2], motor side.
+struct MotorInertias {
+  const char* name;
+  double jm[kDof];
+};
+
+/// The drive train of a real arm, as published (or estimated, where its table says so): the
+/// motors, the encoders on their shafts, the amplifiers' limits, a potentiometer on every joint,
+/// an index pulse once per motor revolution.
+struct DriveTrain {
+  EncoderMap encoders;                  ///< the arm's own encoders and coupling
+  MotorInertias motor_inertia_alt;      ///< a second published set (the first: ArmDescription's links)
+  double torque_constant[kDof];         ///< K_m [N m / A]
+  double motor_torque_limit[kDof];      ///< the amplifier's current limit times K_m [N m], motor side
+  int pot_bits;                         ///< the potentiometers' ADC: codes 0 .. 2^bits - 1
+  double pot_min[kDof], pot_max[kDof];  ///< joint angle at code 0 and at full scale [rad]
+  double index_angle[kDof];  ///< the motor shaft's angle at its index pulse [rad, 0..2 pi), from its angle at q = 0
+};
+
 /// Joint friction of model (2), link side: viscous, Coulomb and Stribeck coefficients.
 struct FrictionCoefficients {
   const char* name;

@@ -34,7 +34,7 @@ struct ControlTask {
   Gains<S> gains;
   FrictionMode mode;
   Vec6<S> q_start;                            // joint angles at which the encoders read zero
-  Vec6<math::io_scalar_t<S>> counts_per_rad;  // encoder counts per joint radian (the robot's drives by default)
+  IoMap<S> io;                                // encoders and coupling (robot::kEncodersUniform by default)
   std::uint64_t tick;                         // samples since start (64 bits: never wraps in service)
   ControllerState<S> state;
   MotionMachine machine;      // the motion state machine (osc/runtime/motion_states.hpp)
@@ -90,42 +90,51 @@ struct ControlTask {
     jump.reset();
     stuck.reset();
     saturation.reset();
-    set_encoder_resolution(robot::kDrives.encoder_counts_per_motor_rev);
+    set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
     timing = {};
     step_timing = {};
     stages = {};
   }
-  /// Encoders of another resolution than the robot table's (counts per motor revolution, after
-  /// quadrature decoding): the count scaling and the plausible step per tick follow it.
-  void set_encoder_resolution(double counts_per_motor_rev) {
+  /// The encoders and coupling of the arm (osc/robots/arm.hpp, EncoderMap): the angles, the
+  /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
+  void set_encoders(const EncoderMap& map) {
+    io = IoMap<S>::of(map);
+    double q0[kDof];
+    for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
     for (int i = 0; i < kDof; ++i) {
-      const double c = osc::counts_per_rad(i, counts_per_motor_rev);
-      counts_per_rad(i) = lit<math::io_scalar_t<S>>(c);
-      jump.set(i, c);
-      range.set(i, static_cast<double>(q_start(i)), c);
+      const double c = map.counts_per_rad[i];
+      if (io.coupled()) {
+        jump.set(i, c, io.inverse);
+        range.set(i, q0, c, io.inverse);
+      } else {
+        jump.set(i, c);
+        range.set(i, q0[i], c);
+      }
     }
   }
+  /// Encoders of another resolution than the robot table's on every joint (counts per motor
+  /// revolution, after quadrature decoding), uncoupled.
+  void set_encoder_resolution(double counts_per_motor_rev) {
+    set_encoders(uniform_encoders("uniform", robot::kArm, counts_per_motor_rev));
+  }
+  /// Encoder counts per radian of channel i (its motor angle referred to its joint).
+  double counts_per_rad(int i) const { return static_cast<double>(io.counts_per_rad(i)); }
   /// Test hook (fault injection): poisons the observer state with a NaN.
   void inject_nonfinite() { state.obs.y(0) = S(0) / S(0); }
 };
-
-/// Encoder counts to joint angles.
-template <class S>
-Vec6<S> angles_from_counts(const Vec6<S>& q_start, const Vec6<math::io_scalar_t<S>>& counts_per_rad,
-                           const std::int32_t counts[kDof]) {
-  Vec6<S> q;
-  for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(counts[i], counts_per_rad(i), q_start(i));
-  return q;
-}
 
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
 /// stuck-encoder, tracking and friction-estimate monitors (osc/runtime/monitors.hpp).
 template <class S>
 std::uint32_t step_monitor_faults(ControlTask<S>& task, const bool moved[kDof]) {
   const StepOutput<S>& out = task.last;
-  std::uint32_t faults = task.stuck.check(out, moved, task.tick, task.gains.dt, task.counts_per_rad);
+  // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
+  std::uint32_t faults =
+      task.io.coupled() ? task.stuck.check(motor_torques(task.io, out.tau), motor_rates(task.io, out.qd_ref), moved,
+                                           task.tick, task.gains.dt, task.io.counts_per_rad)
+                        : task.stuck.check(out.tau, out.qd_ref, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check(task.state.adapt.theta_hat, task.gains.theta_max);
@@ -288,7 +297,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   // The angles of a sample that passed the checks (the others are not converted: a wild count
   // would saturate a fixed-point angle); the start pose otherwise, unused.
   const bool measured = sampled && faults == 0;
-  const Vec6<S> q = measured ? angles_from_counts(task.q_start, task.counts_per_rad, counts) : task.q_start;
+  const Vec6<S> q = measured ? angles_from_counts(task.q_start, task.io, counts) : task.q_start;
   const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
   MotionEvents ev;
   if (task.sample.valid) {
@@ -308,9 +317,12 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageOutput] = hal.cycles();
   // output
   if (stepped && task.ramping) ramp_torque(task);
-  if (stepped)
-    for (int i = 0; i < kDof; ++i)
-      faults |= task.saturation.check(i, torque_to_code(i, task.last.tau(i), task.codes[i]));
+  if (stepped) {
+    // Each DAC drives a motor: C^T tau where the drive train couples the joints.
+    Vec6<S> tau_m;
+    const Vec6<S>& tau = task.io.coupled() ? (tau_m = motor_torques(task.io, task.last.tau)) : task.last.tau;
+    for (int i = 0; i < kDof; ++i) faults |= task.saturation.check(i, torque_to_code(i, tau(i), task.codes[i]));
+  }
   // A fixed-point saturation in the monitors or the torque conversion (the step reports its own).
   if (math::take_arithmetic_fault<S>()) faults |= kFaultOverflow;
   // The step's own duration against the period (the next tick would have arrived).

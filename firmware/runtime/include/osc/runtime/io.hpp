@@ -20,6 +20,14 @@ constexpr double counts_per_rad(int joint, double counts_per_motor_rev = robot::
 constexpr double counts_per_tick_at_max_speed(int joint, double counts_per_rad) {
   return robot::kDrives.max_joint_speed[joint] * params::kDt * counts_per_rad;
 }
+/// The same for a motor channel of a coupled drive train, inverse = C^-1: its motor turns with
+/// (C^-1 qd)_i, at most sum_j |C^-1_ij| times joint j's maximum speed.
+inline double counts_per_tick_at_max_speed(int channel, double counts_per_rad, const double (&inverse)[kDof][kDof]) {
+  double speed = robot::kDrives.max_joint_speed[channel];
+  for (int j = 0; j < kDof; ++j)
+    if (j != channel) speed += abs_of(inverse[channel][j]) * robot::kDrives.max_joint_speed[j];
+  return speed * params::kDt * counts_per_rad;
+}
 /// Largest DAC code magnitude of the robot's drives.
 constexpr long kDacMaxCode = dac_max_code(robot::kDrives);
 
@@ -33,6 +41,89 @@ S counts_to_angle(std::int32_t counts, math::io_scalar_t<S> counts_per_rad, S q_
 template <class S>
 S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
   return counts_to_angle<S>(counts, lit<math::io_scalar_t<S>>(counts_per_rad(joint)), q_at_zero);
+}
+
+/// An encoder map (osc/robots/arm.hpp, EncoderMap) in the task's scalars: each channel's counts per
+/// radian (the I/O scalar), the coupling's terms, and those of its inverse (the motors' rates from
+/// the joints', for the monitors). Built at initialisation, in double: C^-1 of a unit lower
+/// triangular C by forward substitution.
+template <class S>
+struct IoMap {
+  static constexpr int kMaxInverseTerms = kDof * (kDof - 1) / 2;
+  Vec6<math::io_scalar_t<S>> counts_per_rad;
+  int terms, inverse_terms;
+  std::int8_t row[kMaxCouplingTerms], col[kMaxCouplingTerms];
+  S c[kMaxCouplingTerms];
+  std::int8_t inverse_row[kMaxInverseTerms], inverse_col[kMaxInverseTerms];
+  S inverse_c[kMaxInverseTerms];
+  double inverse[kDof][kDof];  // C^-1, for the monitors' set-up
+
+  bool coupled() const { return terms != 0; }
+
+  static IoMap of(const EncoderMap& map) {
+    IoMap m{};
+    double C[kDof][kDof] = {};
+    for (int i = 0; i < kDof; ++i) {
+      m.counts_per_rad(i) = lit<math::io_scalar_t<S>>(map.counts_per_rad[i]);
+      C[i][i] = 1;
+    }
+    m.terms = map.coupling_terms;
+    for (int k = 0; k < map.coupling_terms; ++k) {
+      const CouplingTerm& t = map.coupling[k];
+      m.row[k] = static_cast<std::int8_t>(t.row);
+      m.col[k] = static_cast<std::int8_t>(t.col);
+      m.c[k] = lit<S>(t.c);
+      C[t.row][t.col] += t.c;
+    }
+    // C X = I, column by column, rows top down (C unit lower triangular).
+    for (int j = 0; j < kDof; ++j)
+      for (int i = 0; i < kDof; ++i) {
+        double x = i == j ? 1.0 : 0.0;
+        for (int k = 0; k < i; ++k) x -= C[i][k] * m.inverse[k][j];
+        m.inverse[i][j] = x;
+      }
+    m.inverse_terms = 0;
+    for (int i = 0; i < kDof; ++i)
+      for (int j = 0; j < i; ++j)
+        if (m.inverse[i][j] != 0) {
+          const int k = m.inverse_terms++;
+          m.inverse_row[k] = static_cast<std::int8_t>(i);
+          m.inverse_col[k] = static_cast<std::int8_t>(j);
+          m.inverse_c[k] = lit<S>(m.inverse[i][j]);
+        }
+    return m;
+  }
+};
+
+/// Encoder counts to joint angles: q = q_start + C e, e_i = counts_i / counts_per_rad_i.
+template <class S>
+Vec6<S> angles_from_counts(const Vec6<S>& q_start, const IoMap<S>& io, const std::int32_t counts[kDof]) {
+  Vec6<S> q;
+  if (!io.coupled()) {
+    for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(counts[i], io.counts_per_rad(i), q_start(i));
+    return q;
+  }
+  Vec6<S> e;
+  for (int i = 0; i < kDof; ++i) e(i) = math::quotient<S>(counts[i], io.counts_per_rad(i));
+  q = q_start + e;
+  for (int k = 0; k < io.terms; ++k) q(io.row[k]) += io.c[k] * e(io.col[k]);
+  return q;
+}
+
+/// The motors' torques, referred to their joints, that give joint torques tau: C^T tau.
+template <class S>
+Vec6<S> motor_torques(const IoMap<S>& io, const Vec6<S>& tau) {
+  Vec6<S> t = tau;
+  for (int k = 0; k < io.terms; ++k) t(io.col[k]) += io.c[k] * tau(io.row[k]);
+  return t;
+}
+
+/// The motors' rates, referred to their joints, of joint rates qd: C^-1 qd.
+template <class S>
+Vec6<S> motor_rates(const IoMap<S>& io, const Vec6<S>& qd) {
+  Vec6<S> r = qd;
+  for (int k = 0; k < io.inverse_terms; ++k) r(io.inverse_row[k]) += io.inverse_c[k] * qd(io.inverse_col[k]);
+  return r;
 }
 
 /// The DAC scale [codes per N m] and torque limit [N m] of each joint in the scalar W, built at

@@ -30,6 +30,19 @@ struct EncoderRangeMonitor {
     max_counts[i] =
         static_cast<std::int64_t>((robot::kArm.q_max[i] + params::kJointLimitMargin - q0) * counts_per_rad) + 1;
   }
+  /// Channel i of a coupled drive train (inverse = C^-1, q0 the start pose): its motor angle
+  /// e_i = sum_j C^-1_ij (q_j - q0_j) over the joints' box of limits plus the margin.
+  void set(int i, const double (&q0)[kDof], double counts_per_rad, const double (&inverse)[kDof][kDof]) {
+    double lo = 0, hi = 0;
+    for (int j = 0; j < kDof; ++j) {
+      const double a = inverse[i][j] * (robot::kArm.q_min[j] - params::kJointLimitMargin - q0[j]);
+      const double b = inverse[i][j] * (robot::kArm.q_max[j] + params::kJointLimitMargin - q0[j]);
+      lo += a < b ? a : b;
+      hi += a < b ? b : a;
+    }
+    min_counts[i] = static_cast<std::int64_t>(lo * counts_per_rad) - 1;
+    max_counts[i] = static_cast<std::int64_t>(hi * counts_per_rad) + 1;
+  }
   std::uint32_t check(const std::int32_t counts[kDof]) const {
     std::uint32_t faults = 0;
     for (int i = 0; i < kDof; ++i)
@@ -55,6 +68,10 @@ struct EncoderJumpMonitor {
   /// Joint i's largest plausible step: the speed limit over one sample, plus one count of quantisation.
   void set(int i, double counts_per_rad) {
     max_step[i] = static_cast<std::int32_t>(counts_per_tick_at_max_speed(i, counts_per_rad)) + 1;
+  }
+  /// Channel i of a coupled drive train (inverse = C^-1).
+  void set(int i, double counts_per_rad, const double (&inverse)[kDof][kDof]) {
+    max_step[i] = static_cast<std::int32_t>(counts_per_tick_at_max_speed(i, counts_per_rad, inverse)) + 1;
   }
   /// A tick went by (with or without a sample).
   void tick() { ++age; }
@@ -116,8 +133,10 @@ struct StuckEncoderMonitor {
       move_interval[i] = kStuckIntervalCap;
     }
   }
-  /// After the step of tick `tick` that commanded `out`; `moved` from EncoderJumpMonitor.
-  std::uint32_t check(const StepOutput<S>& out, const bool moved[kDof], std::uint64_t tick, S dt,
+  /// After the step of tick `tick` that commanded the motor torques `tau` and reference motor rates
+  /// `qd_ref` (both per encoder channel: the joints' own where each encoder reads its joint);
+  /// `moved` from EncoderJumpMonitor.
+  std::uint32_t check(const Vec6<S>& tau, const Vec6<S>& qd_ref, const bool moved[kDof], std::uint64_t tick, S dt,
                       const Vec6<math::io_scalar_t<S>>& counts_per_rad) {
     static constexpr std::array<S, kDof> kTorque = lit_array<S>(params::kStuckTorque);
     static constexpr std::array<S, kDof> kTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
@@ -132,13 +151,13 @@ struct StuckEncoderMonitor {
         move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
         last_move_tick[i] = tick;
         m = S(0);
-        tau_at_move(i) = out.tau(i);
+        tau_at_move(i) = tau(i);
         continue;
       }
-      const S dtau = math::abs(out.tau(i) - tau_at_move(i));
+      const S dtau = math::abs(tau(i) - tau_at_move(i));
       if (dtau > dtau_peak(i)) dtau_peak(i) = dtau;
       if (dtau > kTorque[i]) faults |= kFaultEncoderStuck;
-      m += math::abs(out.qd_ref(i)) * dt * counts_per_rad(i);
+      m += math::abs(qd_ref(i)) * dt * counts_per_rad(i);
       if (m > kMotionBound) m = kMotionBound;
       // Silent for many times its recent interval: a joint that was slowing down, as at a reversal
       // held by static friction, had long intervals already.

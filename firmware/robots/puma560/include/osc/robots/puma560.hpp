@@ -8,15 +8,20 @@
 
 namespace osc::puma560 {
 
+/// Motor inertias [kg m^2]: the toolbox's (Corke/Armstrong-Helouvry consensus, RTB `mdl_puma560`),
+/// the model's own (kArm), and AKB86's (RTB `mdl_puma560akb`): +45 / +105 / +50 % on J1-J3.
+constexpr MotorInertias kMotorInertiaToolbox = {"toolbox", {200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6}};
+constexpr MotorInertias kMotorInertiaAkb86 = {"akb86", {291e-6, 409e-6, 299e-6, 35e-6, 35e-6, 35e-6}};
+
 constexpr ArmDescription kArm = {
     "PUMA 560",
     {
-        {0.0, 0.0, kPi / 2, 0.0, {0, 0, 0}, {0, 0.35, 0}, 200e-6, -62.6111},
-        {0.4318, 0.0, 0.0, 17.4, {-0.3638, 0.006, 0.2275}, {0.13, 0.524, 0.539}, 200e-6, 107.815},
-        {0.0203, 0.15005, -kPi / 2, 4.8, {-0.0203, -0.0141, 0.070}, {0.066, 0.086, 0.0125}, 200e-6, -53.7063},
-        {0.0, 0.4318, kPi / 2, 0.82, {0, 0.019, 0}, {1.8e-3, 1.3e-3, 1.8e-3}, 33e-6, 76.0364},
-        {0.0, 0.0, -kPi / 2, 0.34, {0, 0, 0}, {0.3e-3, 0.4e-3, 0.3e-3}, 33e-6, 71.923},
-        {0.0, 0.0, 0.0, 0.09, {0, 0, 0.032}, {0.15e-3, 0.15e-3, 0.04e-3}, 33e-6, 76.686},
+        {0.0, 0.0, kPi / 2, 0.0, {0, 0, 0}, {0, 0.35, 0}, kMotorInertiaToolbox.jm[0], -62.6111},
+        {0.4318, 0.0, 0.0, 17.4, {-0.3638, 0.006, 0.2275}, {0.13, 0.524, 0.539}, kMotorInertiaToolbox.jm[1], 107.815},
+        {0.0203, 0.15005, -kPi / 2, 4.8, {-0.0203, -0.0141, 0.070}, {0.066, 0.086, 0.0125}, kMotorInertiaToolbox.jm[2], -53.7063},
+        {0.0, 0.4318, kPi / 2, 0.82, {0, 0.019, 0}, {1.8e-3, 1.3e-3, 1.8e-3}, kMotorInertiaToolbox.jm[3], 76.0364},
+        {0.0, 0.0, -kPi / 2, 0.34, {0, 0, 0}, {0.3e-3, 0.4e-3, 0.3e-3}, kMotorInertiaToolbox.jm[4], 71.923},
+        {0.0, 0.0, 0.0, 0.09, {0, 0, 0.032}, {0.15e-3, 0.15e-3, 0.04e-3}, kMotorInertiaToolbox.jm[5], 76.686},
     },
     9.81,
     // Joint limits (WC91 set, as in the MATLAB toolbox model).
@@ -39,6 +44,43 @@ constexpr double kQStart[kDof] = {0, kPi / 4, -kPi, 0, kPi / 4, 0};
 /// DACs: 16-bit bipolar, full scale = the joint torque limit (assumed peak amplifier torques).
 /// Plausible joint speeds: about twice the PUMA 560's maximum joint speeds.
 constexpr DriveParams kDrives = {1000, 16, {97.6, 186.4, 89.4, 24.2, 20.1, 21.3}, {8.0, 8.0, 8.0, 16.0, 16.0, 16.0}};
+
+/// The encoders of the model's drives (kDrives): 1000 counts per motor revolution on every joint,
+/// each encoder reading its own joint. The default of the firmware and of the `ideal` plant.
+constexpr EncoderMap kEncodersUniform = uniform_encoders("uniform", kArm, kDrives.encoder_counts_per_motor_rev);
+
+/// The PUMA 560's own drive train (../shared/reference/puma560.md section 9; sources per field).
+constexpr DriveTrain kDriveTrain = {
+    // Encoders: the Trident PUMA interface code (ROBOT.C v4.3, Mark III boards), its joint scales
+    // [rad/count] 1.0035e-4, 7.3156e-5, 1.17e-4, 8.2663e-5, 8.7376e-5, 8.1885e-5: 1000 counts per
+    // motor revolution on J1 and J3-J6, about 797 on J2. Wrist coupling: its wristCouplingG,
+    // q5 = e5 - 0.0139037 e4, q6 = e6 + 0.0130401 e4 - 0.180556 e5.
+    {"trident",
+     {1 / 1.0035e-4, 1 / 7.3156e-5, 1 / 1.17e-4, 1 / 8.2663e-5, 1 / 8.7376e-5, 1 / 8.1885e-5},
+     3,
+     {{4, 3, -0.0139037}, {5, 3, 0.0130401}, {5, 4, -0.180556}}},
+    kMotorInertiaAkb86,
+    // K_m: 0.228 N m/A on J2 (Corke, RVC3). J1 and J3: estimated the same (the same motor inertia,
+    // 200e-6, in the toolbox: the same motor). J4-J6: not found; estimated from the wrist motors'
+    // torque limit below over the same full-scale current, 0.9 / 0.228 = 3.95 A.
+    {0.228, 0.228, 0.228, 24.2 / 76.0364 / (0.9 / 0.228), 20.1 / 71.923 / (0.9 / 0.228), 21.3 / 76.686 / (0.9 / 0.228)},
+    // Motor torque limit: 0.9 N m on J2 (Corke, RVC3), about 97 N m at the joint. J1 and J3:
+    // estimated the same (the same motor). J4-J6: not found; estimated as the DAC full-scale joint
+    // torques over |G| (AKB86's 24.2 / 20.1 / 21.3 N m), so that the wrist's amplifiers limit where its
+    // DACs do.
+    {0.9, 0.9, 0.9, 24.2 / 76.0364, 20.1 / 71.923, 21.3 / 76.686},
+    // Potentiometers: one per joint, read by a 12-bit ADC (Trident ROBOT.C, options POT, POT6).
+    // Their span is not found: estimated as the joint's travel (the WC91 limits) plus 10 degrees at
+    // each end.
+    12,
+    {-170 * kPi / 180, -55 * kPi / 180, -235 * kPi / 180, -120 * kPi / 180, -110 * kPi / 180, -276 * kPi / 180},
+    {170 * kPi / 180, 235 * kPi / 180, 55 * kPi / 180, 180 * kPi / 180, 110 * kPi / 180, 276 * kPi / 180},
+    // Index pulses: one per motor revolution (Trident ROBOT.H, INDEX6). Where on the shaft is not
+    // found, and differs from arm to arm: estimated, spread over the turn so that no test relies on
+    // one place.
+    {0.7, 2.1, 4.0, 1.3, 5.5, 3.1},
+};
+static_assert(kDriveTrain.encoders.coupling_terms <= kMaxCouplingTerms);
 
 /// Toolbox (Corke/Armstrong-Helouvry) motor-side friction: viscous B and Coulomb Tc(+), Tc(-).
 constexpr double kMotorViscous[kDof] = {1.48e-3, 0.817e-3, 1.38e-3, 71.2e-6, 82.6e-6, 36.7e-6};
