@@ -140,7 +140,7 @@ template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
-  PlantHal hal(plant, q0, cfg.encoder_counts_per_motor_rev, cfg.injection);
+  PlantHal hal(plant, q0, sensors_with_resolution(cfg.encoder_counts_per_motor_rev), cfg.injection);
   GroundTruth truth(q0, cfg.gains.trajectory);
   const double dt = osc::params::kDt;
   const long n = std::lround(cfg.duration / dt);

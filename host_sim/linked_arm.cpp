@@ -27,7 +27,7 @@ bool PilSession::exchange(PlantHal& hal, std::string& err) {
 LinkedArm::LinkedArm(const Vec6& q0, const ExperimentConfig& cfg, std::uint8_t config)
     : q0_(q0),
       plant_(cfg.plant),
-      hal_(plant_, q0_, osc::robot::kDrives.encoder_counts_per_motor_rev, cfg.injection),
+      hal_(plant_, q0_, SensorConfig{}, cfg.injection),
       session_(cfg.pil_timeout,
                static_cast<std::uint8_t>(config | pil::kConfigStartDisabled | pil::kConfigTrace |
                                          (cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |

@@ -25,9 +25,7 @@ class MotionSim {
   explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
                      osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
                      const osc::Gains<double>& gains = osc::Gains<double>::paper())
-      : plant_(pc),
-        hal_(plant_, q0, osc::robot::kDrives.encoder_counts_per_motor_rev, inj),
-        task_(new osc::ControlTask<S>) {
+      : plant_(pc), hal_(plant_, q0, SensorConfig{}, inj), task_(new osc::ControlTask<S>) {
     plant_.reset(q0);
     plant_.set_brakes(true);
     task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(), PlantHal::kPeriodNs,

@@ -1,6 +1,7 @@
 // HAL binding of the firmware's encoder and DAC interfaces (hal/hal.hpp) to the simulated plant,
-// with the simulated hardware's faults (injection.hpp): stuck, jumping, garbage or noisy encoders,
-// a stuck amplifier, an overrunning tick, the E-stop input.
+// with the simulated hardware's sensors (SensorConfig: the encoders' resolution, coupling and edge
+// jitter, the DAC's resolution, the potentiometers, the index pulses) and faults (injection.hpp):
+// stuck, jumping, garbage or noisy encoders, a stuck amplifier, an overrunning tick, the E-stop input.
 #pragma once
 
 #include <cmath>
@@ -17,19 +18,173 @@
 
 namespace sim {
 
+/// The simulated hardware's sensors: encoder resolution and coupling, encoder edge jitter, the
+/// DAC's resolution, potentiometer noise and offsets. The default is the ideal plant's hardware,
+/// bit for bit: uniform 1000-count encoders without coupling or jitter, 16-bit DACs.
+struct SensorConfig {
+  /// The encoders' resolution and coupling. They count the plant's motor_angles(): a coupled map
+  /// reads the joints through C only on a plant whose motors turn as C^-1 q.
+  osc::EncoderMap encoders = osc::robot::kEncodersUniform;
+  /// Encoder edge jitter: each sample's edge positions move by up to +-this fraction of a count
+  /// (uniform, fresh each sample); 0: none.
+  double encoder_jitter = 0;
+  /// The amplifiers see only the top dac_bits bits of the 16-bit codes (a coarser board's DAC,
+  /// dac_quantise: to nearest); 16: today.
+  int dac_bits = 16;
+  double pot_noise = 0;        ///< potentiometer noise, standard deviation [ADC codes]
+  double pot_offset[6] = {};   ///< potentiometer offset per joint [ADC codes]
+  std::uint32_t seed = 12345;  ///< the noise generators' seed (runs are reproducible)
+};
+
+/// Uniform encoders of counts_per_motor_rev on every motor, no coupling, the rest as the default.
+inline SensorConfig sensors_with_resolution(double counts_per_motor_rev) {
+  SensorConfig s;
+  s.encoders = osc::uniform_encoders("uniform", osc::robot::kArm, counts_per_motor_rev);
+  return s;
+}
+
+/// The coupling of an encoder map: C, unit lower triangular (q - q_start = C e), its inverse by
+/// forward substitution, and the maps of angles and torques through them.
+struct EncoderCoupling {
+  double c[hal::kJoints][hal::kJoints] = {};
+  double inverse[hal::kJoints][hal::kJoints] = {};
+  bool coupled = false;
+
+  explicit EncoderCoupling(const osc::EncoderMap& map) {
+    for (int i = 0; i < hal::kJoints; ++i) c[i][i] = 1;
+    for (int k = 0; k < map.coupling_terms; ++k) c[map.coupling[k].row][map.coupling[k].col] += map.coupling[k].c;
+    coupled = map.coupling_terms != 0;
+    // C X = I column by column, rows top down.
+    for (int j = 0; j < hal::kJoints; ++j)
+      for (int i = 0; i < hal::kJoints; ++i) {
+        double x = i == j ? 1.0 : 0.0;
+        for (int k = 0; k < i; ++k) x -= c[i][k] * inverse[k][j];
+        inverse[i][j] = x;
+      }
+  }
+  /// The motor angles (referred to their joints) of joint angles q: C^-1 q (q itself uncoupled).
+  Vec6 motor_from_joint(const Vec6& q) const {
+    if (!coupled) return q;
+    Vec6 e;
+    for (int i = 0; i < hal::kJoints; ++i) {
+      e(i) = q(i);
+      for (int k = 0; k < i; ++k) e(i) -= c[i][k] * e(k);
+    }
+    return e;
+  }
+  /// The joint torques that motor torques tau_m (referred to their joints) produce: C^-T tau_m
+  /// (what a coupled plant applies), by back substitution of C^T tau = tau_m.
+  Vec6 joint_from_motor_torques(const Vec6& tau_m) const {
+    if (!coupled) return tau_m;
+    Vec6 tau;
+    for (int i = hal::kJoints - 1; i >= 0; --i) {
+      tau(i) = tau_m(i);
+      for (int k = i + 1; k < hal::kJoints; ++k) tau(i) -= c[k][i] * tau(k);
+    }
+    return tau;
+  }
+};
+
+/// One encoder channel's count: floor((e - e_start) * counts_per_rad + edge_shift), e the motor's
+/// angle referred to its joint, e_start the same at the start pose, edge_shift the sample's edge
+/// jitter [counts] (0: the ideal encoder).
+inline std::int32_t encoder_count(double e, double e_start, double counts_per_rad, double edge_shift = 0) {
+  const double x = (e - e_start) * counts_per_rad;
+  return static_cast<std::int32_t>(std::floor(edge_shift == 0 ? x : x + edge_shift));
+}
+
+/// A DAC code as a board whose DAC has only the top `bits` of the 16-bit codes outputs it: to the
+/// nearest multiple of 2^(16 - bits) (ties up), within that DAC's symmetric range
+/// +-(2^15 - 2^(16 - bits)). 16 bits: the code itself.
+inline std::int32_t dac_quantise(std::int32_t code, int bits) {
+  if (bits >= 16) return code;
+  const int shift = 16 - (bits < 1 ? 1 : bits);
+  const std::int32_t step = std::int32_t{1} << shift, top = 32768 - step;
+  const std::int32_t q = ((code + step / 2) >> shift) * step;  // >>: floor (C++20)
+  return q > top ? top : (q < -top ? -top : q);
+}
+
+/// The potentiometer's ADC: full scale 2^pot_bits - 1 codes.
+inline constexpr double kPotFullScale = static_cast<double>((1 << osc::robot::kDriveTrain.pot_bits) - 1);
+/// A joint angle's exact (unrounded, noise-free) potentiometer code.
+inline double pot_scale(int joint, double q) {
+  const auto& d = osc::robot::kDriveTrain;
+  return (q - d.pot_min[joint]) / (d.pot_max[joint] - d.pot_min[joint]) * kPotFullScale;
+}
+/// The joint angle of a potentiometer code: the inverse of pot_scale.
+inline double pot_to_angle(int joint, double code) {
+  const auto& d = osc::robot::kDriveTrain;
+  return d.pot_min[joint] + code / kPotFullScale * (d.pot_max[joint] - d.pot_min[joint]);
+}
+
+/// One motor's index pulse: fires where the shaft angle theta = G e passes index_angle + 2 pi k,
+/// either direction. Each sample latches the encoder count at the last crossing since the previous
+/// sample, interpolated linearly between the two samples' counts and rounded.
+class IndexPulse {
+ public:
+  explicit IndexPulse(double index_angle = 0) : angle_(index_angle) {}
+  /// One sample: the shaft angle [rad, from its angle at q = 0] and the encoder count.
+  void sample(double theta, std::int32_t count) {
+    if (!std::isfinite(theta)) return;  // a diverged plant: no sample
+    const long long n = turn(theta);
+    if (primed_ && n != n_) {
+      const long long crossed = n > n_ ? n - n_ : n_ - n;
+      // The last level crossed: moving up, the top one (turn n); moving down, the bottom one (n + 1).
+      const double level = angle_ + 2 * osc::kPi * static_cast<double>(n > n_ ? n : n + 1);
+      const double s = (level - theta_) / (theta - theta_);
+      latched_ = static_cast<std::int32_t>(
+          std::lround(static_cast<double>(count_) + s * (static_cast<double>(count) - static_cast<double>(count_))));
+      pending_ = true;
+      pulses_ += crossed;
+    }
+    primed_ = true;
+    n_ = n;
+    theta_ = theta;
+    count_ = count;
+  }
+  /// True once per latched pulse (the last latch in count); false when none since the last take.
+  bool take(std::int32_t& count) {
+    if (!pending_) return false;
+    count = latched_;
+    pending_ = false;
+    return true;
+  }
+  /// Pulses seen since construction (each level crossing, either direction).
+  long long pulses() const { return pulses_; }
+
+ private:
+  /// The index level below theta (levels angle_ + 2 pi k): theta in [level k, level k + 1).
+  long long turn(double theta) const { return static_cast<long long>(std::floor((theta - angle_) / (2 * osc::kPi))); }
+  double angle_;
+  bool primed_ = false, pending_ = false;
+  long long n_ = 0, pulses_ = 0;
+  double theta_ = 0;
+  std::int32_t count_ = 0, latched_ = 0;
+};
+
 class PlantHal {
  public:
   /// Virtual nanoseconds per control period (the overrun budget the host-built task is given).
   static constexpr std::uint32_t kPeriodNs = 1000000000u / osc::params::kControlHz;
 
-  /// counts_per_motor_rev: the encoders' resolution (default: the robot table's).
-  PlantHal(Plant& plant, const Vec6& q_start,
-           double counts_per_motor_rev = osc::robot::kDrives.encoder_counts_per_motor_rev, Injection inj = {})
-      : plant_(plant), q_start_(q_start), inj_(inj) {
+  /// The encoders are zeroed at q_start; sensors: their resolution, coupling and noise (default:
+  /// the ideal plant's); inj: a simulated hardware fault.
+  PlantHal(Plant& plant, const Vec6& q_start, const SensorConfig& sensors = {}, Injection inj = {})
+      : plant_(plant),
+        sensors_(sensors),
+        coupling_(sensors.encoders),
+        e_start_(coupling_.motor_from_joint(q_start)),
+        inj_(inj),
+        rng_(sensors.seed),
+        jitter_rng_(generator(sensors.seed, 1)),
+        pot_rng_(generator(sensors.seed, 2)) {
     for (int i = 0; i < hal::kJoints; ++i) {
-      counts_per_rad_[i] = osc::counts_per_rad(i, counts_per_motor_rev);
-      // The encoder change per tick at the joint's maximum speed (the firmware's bound, less one count).
-      step_[i] = osc::counts_per_tick_at_max_speed(i, counts_per_rad_[i]);
+      counts_per_rad_[i] = sensors.encoders.counts_per_rad[i];
+      // The encoder change per tick at the joint's maximum speed (the firmware's bound, less one
+      // count); a coupled channel's motor turns with the other joints too.
+      step_[i] = coupling_.coupled ? osc::counts_per_tick_at_max_speed(i, counts_per_rad_[i], coupling_.inverse)
+                                   : osc::counts_per_tick_at_max_speed(i, counts_per_rad_[i]);
+      index_[i] = IndexPulse(osc::robot::kDriveTrain.index_angle[i]);
     }
   }
 
@@ -43,11 +198,18 @@ class PlantHal {
   }
   bool injection_active() const { return active_; }
 
-  /// Incremental encoders zeroed at q_start: counts = floor((q - q_start) * counts_per_rad). Every
-  /// tick has a sample.
+  /// Incremental encoders on the motors, zeroed at q_start: channel i counts
+  /// floor((e_i - e_start_i) * counts_per_rad_i + u), e the plant's motor angles (referred to their
+  /// joints), e_start theirs at q_start, u the edge jitter. Every tick has a sample; each samples the
+  /// index pulses too (on the counts before an injected fault: the board's counter latches them).
   bool read_encoders(std::int32_t counts[hal::kJoints]) {
+    const Vec6 e = plant_.motor_angles();
+    const double a = sensors_.encoder_jitter > 0 ? sensors_.encoder_jitter : 0.0;
+    std::uniform_real_distribution<double> jitter(-a, a);
     for (int i = 0; i < hal::kJoints; ++i) {
-      counts[i] = static_cast<std::int32_t>(std::floor((plant_.q()(i) - q_start_(i)) * counts_per_rad_[i]));
+      const double shift = a > 0 ? jitter(jitter_rng_) : 0.0;
+      counts[i] = encoder_count(e(i), e_start_(i), counts_per_rad_[i], shift);
+      index_[i].sample(osc::robot::kArm.links[i].gear_ratio * e(i), counts[i]);
       if (!active_ || !inj_.hits(i)) continue;
       switch (inj_.kind) {
         case InjectionKind::kEncoderStuck:
@@ -62,8 +224,8 @@ class PlantHal {
           break;
         case InjectionKind::kEncoderNoise:
           if (t_ < t_inj_ + kNoiseBurst) {
-            std::uniform_real_distribution<double> u(-step_[i], step_[i]);
-            counts[i] += static_cast<std::int32_t>(std::lround(u(rng_)));
+            std::uniform_real_distribution<double> noise(-step_[i], step_[i]);
+            counts[i] += static_cast<std::int32_t>(std::lround(noise(rng_)));
           }
           break;
         default:
@@ -88,21 +250,53 @@ class PlantHal {
   }
   void fault_output(bool active) { fault_ = active; }
   bool fault() const { return fault_; }
-  /// Joint torques the amplifiers produce from the last DAC codes. The fault line disables the
+  /// The channels' (motor) torques, referred to their joints, that the amplifiers produce from the
+  /// last DAC codes, as the board's DAC resolves them (dac_quantise). The fault line disables the
   /// amplifiers (as a board's amplifier-enable output does): zero torque whatever the codes.
   Vec6 torque() const {
     Vec6 t;
     if (fault_) return Vec6::Zero();
-    for (int i = 0; i < hal::kJoints; ++i) t(i) = osc::code_to_torque(i, codes_[i]);
+    for (int i = 0; i < hal::kJoints; ++i) t(i) = osc::code_to_torque(i, dac_quantise(codes_[i], sensors_.dac_bits));
     return t;
   }
 
+  /// The potentiometers: code = clamp(round(pot_scale(q) + offset + noise), 0, full scale), q the
+  /// plant's joint angles, the noise Gaussian of standard deviation pot_noise.
+  void read_pots(std::uint16_t codes[hal::kJoints]) {
+    const Vec6& q = plant_.q();
+    for (int i = 0; i < hal::kJoints; ++i) {
+      double x = pot_scale(i, q(i)) + sensors_.pot_offset[i];
+      if (sensors_.pot_noise > 0) x += sensors_.pot_noise * gauss_(pot_rng_);
+      x = std::round(x);
+      codes[i] = static_cast<std::uint16_t>(!(x > 0) ? 0.0 : (x >= kPotFullScale ? kPotFullScale : x));
+    }
+  }
+
+  /// The index pulse latched on a channel since the last call: true once per latch, with the
+  /// encoder count at the pulse (the last one when several fired).
+  bool take_index(int channel, std::int32_t& count) { return index_[channel].take(count); }
+  /// Index pulses a channel has seen (either direction).
+  long long index_pulses(int channel) const { return index_[channel].pulses(); }
+
+  const SensorConfig& sensors() const { return sensors_; }
+  const EncoderCoupling& coupling() const { return coupling_; }
+  /// The motor angles at q_start (referred to their joints): where the encoders count from.
+  const Vec6& motor_start() const { return e_start_; }
+
  private:
   static constexpr double kNoiseBurst = 0.05;  // [s]
+  /// A generator of its own per noise source (the encoders' jitter does not move the pots' noise).
+  static std::mt19937 generator(std::uint32_t seed, std::uint32_t stream) {
+    std::seed_seq seq{seed, stream};
+    return std::mt19937(seq);
+  }
   Plant& plant_;
-  Vec6 q_start_;
+  SensorConfig sensors_;
+  EncoderCoupling coupling_;
+  Vec6 e_start_;
   double counts_per_rad_[hal::kJoints];
   double step_[hal::kJoints];
+  IndexPulse index_[hal::kJoints];
   std::int32_t codes_[hal::kJoints] = {0, 0, 0, 0, 0, 0};
   bool fault_ = false;
   Injection inj_;
@@ -111,7 +305,10 @@ class PlantHal {
   std::int32_t frozen_[hal::kJoints] = {};
   std::uint32_t clock_ = 0;
   int overrun_reads_ = 0;
-  std::mt19937 rng_{12345};
+  std::mt19937 rng_;         // the injected encoder noise
+  std::mt19937 jitter_rng_;  // the encoders' edge jitter
+  std::mt19937 pot_rng_;     // the potentiometers' noise
+  std::normal_distribution<double> gauss_{0.0, 1.0};
 };
 static_assert(hal::ControlHal<PlantHal>);
 
