@@ -1,10 +1,13 @@
 #include "plant.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
 
 #include "osc/kernels/dynamics.hpp"
 #include "osc/kernels/friction.hpp"
-#include "osc/robot.hpp"
 #include "osc/robot.hpp"
 
 namespace sim {
@@ -36,7 +39,46 @@ Vec6 cross_force(const Vec6& v, const Vec6& f) {
   return join(v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>()));
 }
 
+constexpr double kNoArmature[6] = {0, 0, 0, 0, 0, 0};
+
+/// The coupling C of the arm's encoders (q = C e), unit lower triangular.
+Mat6 coupling_matrix() {
+  const osc::EncoderMap& map = osc::robot::kDriveTrain.encoders;
+  Mat6 C = Mat6::Identity();
+  for (int k = 0; k < map.coupling_terms; ++k) C(map.coupling[k].row, map.coupling[k].col) += map.coupling[k].c;
+  return C;
+}
+
+/// The joints with a motor-side state: J1-J3 when elastic or with backlash.
+bool is_elastic(const PlantConfig& cfg, int i) { return i < 3 && (cfg.elastic_hz > 0 || cfg.backlash > 0); }
+
+/// G^2 Jm of channel i, joint-referred, from the configured set.
+double motor_armature(const PlantConfig& cfg, int i) {
+  const osc::LinkParams& L = osc::robot::kArm.links[i];
+  const double jm = cfg.motor_inertia ? cfg.motor_inertia->jm[i] : L.motor_inertia;
+  return L.gear_ratio * L.gear_ratio * jm;
+}
+
+/// The plant's articulated body: the model's (ideal drives), else the scalar armature of each rigid,
+/// uncoupled joint (an elastic joint's motor is a state of its own; with the coupling the armature is a
+/// full matrix, solved by the composite-rigid-body path instead).
+ArticulatedBody make_body(const PlantConfig& cfg) {
+  if (cfg.ideal_drives()) return ArticulatedBody(cfg.link_scale);
+  double a[6];
+  for (int i = 0; i < 6; ++i) a[i] = cfg.coupling || is_elastic(cfg, i) ? 0.0 : motor_armature(cfg, i);
+  return ArticulatedBody(cfg.link_scale, a);
+}
+
+int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
+
 }  // namespace
+
+bool PlantConfig::ideal_drives() const {
+  for (int i = 0; i < 6; ++i)
+    if (amp_gain_error[i] != 0 || amp_offset[i] != 0) return false;
+  return motor_inertia == nullptr && !coupling && amp_lag == 0 && !amp_current_limit && ripple == 0 &&
+         friction_drift == 0 && elastic_hz == 0 && backlash == 0;
+}
 
 ArticulatedBody::ArticulatedBody(double link_scale) {
   const osc::LinkParams* kLinks = osc::robot::kArm.links;
@@ -114,20 +156,305 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
   return qdd;
 }
 
+ArticulatedBody::ArticulatedBody(double link_scale, const double armature[6]) : ArticulatedBody(link_scale) {
+  for (int i = 0; i < 6; ++i) armature_[i] = armature[i];
+}
+
+namespace {
+/// A spatial inertia at the base origin in its compact form: mass m, first moment h = m c (c the
+/// centre of mass) and the rotational inertia I about the origin; I [w; v] = [I w + h x v; m v - h x w].
+/// Sums and products at 13 and 24 numbers instead of a 6 x 6 matrix's 36.
+struct RigidInertia {
+  double m;
+  Vec3 h;
+  Mat3 I;
+  Vec6 operator*(const Vec6& s) const {
+    const Vec3 w = s.head<3>(), v = s.tail<3>();
+    return join(I * w + h.cross(v), m * v - h.cross(w));
+  }
+  RigidInertia& operator+=(const RigidInertia& o) {
+    m += o.m;
+    h += o.h;
+    I += o.I;
+    return *this;
+  }
+};
+}  // namespace
+
+void ArticulatedBody::inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, Vec6& h) const {
+  RigidInertia Ic[6];
+  Vec6 S[6], f[6];
+  // Pass 1, base to tip, as in forward_dynamics(): axes, velocities, link inertias at the base
+  // origin; the accelerations at q_dd = 0 (gravity as an upward base acceleration, plus the
+  // velocity products) and each link's force I a + V x* I V (recursive Newton-Euler).
+  Mat3 W = Mat3::Identity();
+  Vec3 o = Vec3::Zero();
+  Vec6 V = Vec6::Zero();
+  Vec6 a;
+  a << 0, 0, 0, 0, 0, osc::robot::kArm.gravity;
+  for (int i = 0; i < 6; ++i) {
+    o += W * pos_fixed_[i];
+    const double cq = std::cos(q(i)), sq = std::sin(q(i));
+    Mat3 Rz;
+    Rz << cq, -sq, 0, sq, cq, 0, 0, 0, 1;
+    W = W * rot_fixed_[i] * Rz;
+    const Vec3 z = W.col(2);
+    S[i] = join(z, o.cross(z));
+    const Vec6 vJ = S[i] * qd(i);
+    V += vJ;
+    a += cross_motion(V, vJ);
+    const Body& b = body_[i];
+    const Vec3 com = o + W * b.com;
+    RigidInertia& I = Ic[i];
+    I.m = b.mass;
+    I.h = b.mass * com;
+    // About the origin: the inertia about the COM plus m (|c|^2 1 - c c^T) (parallel axes).
+    I.I = W * b.inertia * W.transpose() - b.mass * com * com.transpose();
+    I.I.diagonal().array() += b.mass * com.squaredNorm();
+    f[i] = I * a + cross_force(V, I * V);
+  }
+  // Pass 2, tip to base: composite inertias and forces (all at the base origin: no transforms);
+  // M_ji = S_j . Ic_i S_i for j <= i, h_i = S_i . F_i.
+  for (int i = 5; i >= 0; --i) {
+    if (i < 5) {
+      Ic[i] += Ic[i + 1];
+      f[i] += f[i + 1];
+    }
+    h(i) = S[i].dot(f[i]);
+    const Vec6 U = Ic[i] * S[i];
+    M(i, i) = S[i].dot(U) + armature_[i];
+    for (int j = 0; j < i; ++j) M(i, j) = M(j, i) = S[j].dot(U);
+  }
+}
+
+Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau, const Mat6& armature) const {
+  Mat6 M;
+  Vec6 h;
+  inertia_and_bias(q, qd, M, h);
+  M += armature;
+  return Eigen::LLT<Mat6>(M).solve(tau - h);
+}
+
 Plant::Plant(const PlantConfig& cfg)
-    : cfg_(cfg), body_(cfg.link_scale), friction_(osc::FrictionParams<double>::from(cfg.friction, cfg.tau_dec)) {}
+    : cfg_(cfg),
+      ideal_(cfg.ideal_drives()),
+      body_(make_body(cfg)),
+      links_(cfg.link_scale, kNoArmature),
+      friction_(osc::FrictionParams<double>::from(cfg.friction, cfg.tau_dec)) {
+  if (ideal_) return;
+  coupled_ = cfg.coupling;
+  if (coupled_) {
+    const Mat6 C = coupling_matrix();
+    c_inv_ = C.triangularView<Eigen::UnitLower>().solve(Mat6::Identity());
+    c_inv_t_ = c_inv_.transpose();
+  }
+  Vec6 D = Vec6::Zero();  // G^2 Jm of the rigid joints' motors (the elastic joints' are their own state)
+  for (int i = 0; i < 6; ++i) {
+    elastic_[i] = is_elastic(cfg, i);
+    motor_inertia_(i) = motor_armature(cfg, i);
+    if (!elastic_[i]) D(i) = motor_inertia_(i);
+    const osc::LinkParams& L = osc::robot::kArm.links[i];
+    limit_(i) = osc::robot::kDriveTrain.motor_torque_limit[i] * std::abs(L.gear_ratio);
+    // Coulomb and Stribeck terms switch sign with the rate: RK4 must not step across their reversal.
+    sign_sensitive_[i] = friction_.cou(i) != 0 || friction_.sti(i) != 0;
+  }
+  // The motors turn at e_dot = C^-1 q_dot: their kinetic energy 1/2 e_dot^T D e_dot is the joint-space
+  // armature C^-T D C^-1 (diagonal without the coupling).
+  armature_rigid_ = c_inv_t_ * D.asDiagonal() * c_inv_;
+  armature_all_ = c_inv_t_ * motor_inertia_.asDiagonal() * c_inv_;
+  if (elastic_[0] || elastic_[1] || elastic_[2]) {
+    // The coupling must leave J1-J3 alone (it does on the PUMA: wrist terms only), or their motors'
+    // states would enter the wrist's equations.
+    for (int k = 0; k < osc::robot::kDriveTrain.encoders.coupling_terms && coupled_; ++k)
+      if (osc::robot::kDriveTrain.encoders.coupling[k].col < 3 || osc::robot::kDriveTrain.encoders.coupling[k].row < 3)
+        throw std::invalid_argument("Plant: the coupling involves an elastic joint");
+    // Stiffness from the locked-motor resonance: the joint alone (the other joints held) on its spring,
+    // K = (2 pi f)^2 M_ii(kQStart), M_ii the links' inertia about the joint at the start pose without
+    // any armature (the plant's own composite-rigid-body inertia). With backlash alone, a stiff mesh
+    // (kBacklashStiffHz) for the dead band to act through.
+    Mat6 M;
+    Vec6 h;
+    links_.inertia_and_bias(osc::joint_vector<double>(osc::robot::kQStart), Vec6::Zero(), M, h);
+    const double f = cfg.elastic_hz > 0 ? cfg.elastic_hz : kBacklashStiffHz;
+    const double w = 2 * osc::kPi * f;
+    for (int i = 0; i < 3; ++i)
+      if (elastic_[i]) stiffness_(i) = w * w * M(i, i);
+    half_band_ = cfg.backlash / 2;
+  }
+}
 
 void Plant::reset(const Vec6& q0, const Vec6& qd0) {
   q_ = q0;
   qd_ = qd0;
   t_ = 0;
+  if (ideal_) return;
+  amp_.setZero();
+  cmd_.setZero();
+  th_ = q0;
+  thd_ = qd0;
+  if (stiffness_.any()) {
+    // The static deflection: each spring holds its link's gravity torque g(q0), theta = q0 + dz^-1(g / K)
+    // (on the flank that carries the load, where there is backlash).
+    Mat6 M;
+    Vec6 g;
+    links_.inertia_and_bias(q0, Vec6::Zero(), M, g);
+    for (int i = 0; i < 3; ++i)
+      if (elastic_[i]) th_(i) = q0(i) + g(i) / stiffness_(i) + half_band_ * sign_of(g(i));
+  }
 }
 
-Vec6 Plant::friction(const Vec6& qd) const { return osc::friction_torque(friction_, qd); }
+void Plant::set_motor_state(const Vec6& theta, const Vec6& theta_d) {
+  for (int i = 0; i < 6; ++i)
+    if (elastic_[i]) {
+      th_(i) = theta(i);
+      thd_(i) = theta_d(i);
+    }
+}
+
+Vec6 Plant::friction(const Vec6& qd) const {
+  if (ideal_) return osc::friction_torque(friction_, qd);
+  const Vec6 f = friction_scale(t_) * osc::friction_torque(friction_, coupled_ ? Vec6(c_inv_ * qd) : qd);
+  return coupled_ ? Vec6(c_inv_t_ * f) : f;
+}
 
 Vec6 Plant::acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const {
   ++evaluations_;
-  return body_.forward_dynamics(q, qd, tau - friction(qd));
+  if (ideal_) return body_.forward_dynamics(q, qd, tau - friction(qd));
+  return links_.forward_dynamics(q, qd, Vec6(c_inv_t_ * tau) - friction(qd), armature_all_);
+}
+
+Vec6 Plant::motor_angles() const { return ideal_ ? q_ : motor_angles_of(State{q_, qd_, th_, thd_}); }
+Vec6 Plant::motor_velocities() const { return ideal_ ? qd_ : motor_rates_of(State{q_, qd_, th_, thd_}); }
+
+Vec6 Plant::motor_torques() const {
+  if (ideal_) return cmd_;
+  return delivered(cfg_.amp_lag > 0 ? amp_ : cmd_, State{q_, qd_, th_, thd_});
+}
+
+Vec6 Plant::spring_torques() const {
+  Vec6 t = Vec6::Zero();
+  for (int i = 0; i < 3; ++i)
+    if (elastic_[i]) t(i) = spring(i, th_(i) - q_(i));
+  return t;
+}
+
+Vec6 Plant::motor_angles_of(const State& x) const {
+  Vec6 e = x.q;
+  for (int i = 0; i < 3; ++i)
+    if (elastic_[i]) e(i) = x.th(i);
+  return coupled_ ? Vec6(c_inv_ * e) : e;
+}
+
+Vec6 Plant::motor_rates_of(const State& x) const {
+  Vec6 r = x.v;
+  for (int i = 0; i < 3; ++i)
+    if (elastic_[i]) r(i) = x.w(i);
+  return coupled_ ? Vec6(c_inv_ * r) : r;
+}
+
+double Plant::friction_scale(double t) const {
+  if (cfg_.friction_drift == 0) return 1.0;
+  return 1.0 + cfg_.friction_drift * std::sin(2 * osc::kPi * t / cfg_.friction_drift_period);
+}
+
+double Plant::spring(int i, double stretch) const {
+  const double x = stretch > half_band_ ? stretch - half_band_ : (stretch < -half_band_ ? stretch + half_band_ : 0.0);
+  return stiffness_(i) * x;
+}
+
+Vec6 Plant::amplifier(const Vec6& u, double s) const {
+  if (cfg_.amp_lag <= 0) return u;
+  // First order, exact for a held command: a(s) = u + (a(0) - u) exp(-s / T).
+  return u + (amp_ - u) * std::exp(-s / cfg_.amp_lag);
+}
+
+Vec6 Plant::delivered(const Vec6& amp, const State& x) const {
+  Vec6 t = amp;
+  if (cfg_.amp_current_limit) t = t.cwiseMax(-limit_).cwiseMin(limit_);
+  for (int i = 0; i < 6; ++i) t(i) = (1 + cfg_.amp_gain_error[i]) * t(i) + cfg_.amp_offset[i];
+  if (cfg_.ripple != 0) {
+    // The motor's pole frequency: ripple_cycles periods per shaft revolution, shaft angle G e.
+    const Vec6 e = motor_angles_of(x);
+    for (int i = 0; i < 6; ++i)
+      t(i) *= 1 + cfg_.ripple * std::sin(cfg_.ripple_cycles * osc::robot::kArm.links[i].gear_ratio * e(i));
+  }
+  return t;
+}
+
+Plant::State Plant::derivative(const State& x, double t, const Vec6& amp) const {
+  ++evaluations_;
+  // The channels' net torques on their motors (joint-referred): produced minus the motors' friction,
+  // model (2) on the motor rates (with its drift).
+  const Vec6 net = delivered(amp, x) - friction_scale(t) * osc::friction_torque(friction_, motor_rates_of(x));
+  // To the joints through C^-T; an elastic joint's link is driven by its spring instead, its motor by
+  // the net torque less the spring's.
+  Vec6 tau = coupled_ ? Vec6(c_inv_t_ * net) : net;
+  State d;
+  d.q = x.v;
+  d.th.setZero();
+  d.w.setZero();
+  for (int i = 0; i < 3; ++i)
+    if (elastic_[i]) {
+      const double ts = spring(i, x.th(i) - x.q(i));
+      tau(i) = ts;
+      d.th(i) = x.w(i);
+      d.w(i) = (net(i) - ts) / motor_inertia_(i);
+    }
+  d.v = coupled_ ? links_.forward_dynamics(x.q, x.v, tau, armature_rigid_) : body_.forward_dynamics(x.q, x.v, tau);
+  return d;
+}
+
+std::uint64_t Plant::regime(const State& x, const Vec6& amp) const {
+  std::uint64_t code = 1;  // never 0 unless a rate is
+  const Vec6 r = motor_rates_of(x);
+  for (int i = 0; i < 6; ++i) {
+    if (!sign_sensitive_[i]) continue;
+    if (r(i) == 0) return 0;
+    code |= std::uint64_t{r(i) > 0 ? 1u : 2u} << (2 * i + 1);
+  }
+  if (half_band_ > 0)
+    for (int i = 0; i < 3; ++i) {
+      if (!elastic_[i]) continue;
+      const double s = x.th(i) - x.q(i);
+      code |= std::uint64_t{s > half_band_ ? 1u : (s < -half_band_ ? 2u : 3u)} << (2 * i + 13);
+    }
+  if (cfg_.amp_current_limit)
+    for (int i = 0; i < 6; ++i)
+      code |= std::uint64_t{amp(i) > limit_(i) ? 1u : (amp(i) < -limit_(i) ? 2u : 3u)} << (2 * i + 19);
+  return code;
+}
+
+bool Plant::step(const Vec6& u, double h, bool smooth) {
+  const Vec6 a0 = amplifier(u, 0), am = amplifier(u, 0.5 * h), a1 = amplifier(u, h);
+  const auto axpy = [](const State& x, double c, const State& k) {
+    return State{x.q + c * k.q, x.v + c * k.v, x.th + c * k.th, x.w + c * k.w};
+  };
+  const State x0{q_, qd_, th_, thd_};
+  const std::uint64_t r0 = smooth ? regime(x0, a0) : 0;
+  if (smooth && r0 == 0) return false;
+  // Classic RK4; in a smooth step every stage (and the end) must stay in the start's regime, else the
+  // caller redoes the interval at the fine substep. Checked as the stages are formed, to stop early.
+  const State k1 = derivative(x0, t_, a0);
+  const State x2 = axpy(x0, 0.5 * h, k1);
+  if (smooth && regime(x2, am) != r0) return false;
+  const State k2 = derivative(x2, t_ + 0.5 * h, am);
+  const State x3 = axpy(x0, 0.5 * h, k2);
+  if (smooth && regime(x3, am) != r0) return false;
+  const State k3 = derivative(x3, t_ + 0.5 * h, am);
+  const State x4 = axpy(x0, h, k3);
+  if (smooth && regime(x4, a1) != r0) return false;
+  const State k4 = derivative(x4, t_ + h, a1);
+  const State x1{x0.q + h / 6 * (k1.q + 2 * k2.q + 2 * k3.q + k4.q), x0.v + h / 6 * (k1.v + 2 * k2.v + 2 * k3.v + k4.v),
+                 x0.th + h / 6 * (k1.th + 2 * k2.th + 2 * k3.th + k4.th),
+                 x0.w + h / 6 * (k1.w + 2 * k2.w + 2 * k3.w + k4.w)};
+  if (smooth && regime(x1, a1) != r0) return false;
+  q_ = x1.q;
+  qd_ = x1.v;
+  th_ = x1.th;
+  thd_ = x1.w;
+  amp_ = a1;
+  t_ += h;
+  return true;
 }
 
 void Plant::rk4(const Vec6& tau, double h) {
@@ -162,9 +489,21 @@ bool Plant::rk4_smooth(const Vec6& tau, double h) {
 }
 
 void Plant::integrate(const Vec6& tau, double duration) {
+  cmd_ = tau;
   if (duration <= 0) return;
   const int n = static_cast<int>(std::ceil(duration / cfg_.substep - 1e-9));
   const double h = duration / n;
+  if (!ideal_) {
+    // The same chunks with the drive train's state: the fine substep through any event (a friction
+    // reversal of a motor, a backlash contact change, a current limit engaging or releasing).
+    for (int k = 0; k < n;) {
+      const int m = std::min(cfg_.smooth_steps, n - k);
+      if (m < 2 || !step(tau, m * h, true))
+        for (int j = 0; j < m; ++j) step(tau, h, false);
+      k += m;
+    }
+    return;
+  }
   // Chunks of up to smooth_steps substeps: one RK4 step over the chunk where the friction is
   // smooth, the fixed substep through a velocity reversal (where sgn() makes RK4 first order).
   for (int k = 0; k < n;) {
@@ -178,6 +517,13 @@ void Plant::integrate(const Vec6& tau, double duration) {
 void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) {
   if (braked_) {  // the brakes hold every joint: time passes, nothing moves
     qd_.setZero();
+    if (!ideal_) {  // the motors held too; the amplifiers follow their commands
+      thd_.setZero();
+      const double d = std::min(cfg_.compute_delay, dt);
+      amp_ = amplifier(tau_old, d);
+      amp_ = amplifier(tau_new, dt - d);
+      cmd_ = tau_new;
+    }
     t_ += dt;
     return;
   }
@@ -188,13 +534,23 @@ void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) 
 
 double Plant::energy() const {
   // Uses the kernels' CRBA only as an energy probe; the dynamics above never call it.
-  const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm, cfg_.link_scale - 1.0);
+  osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm, cfg_.link_scale - 1.0);
+  if (!ideal_) model.armature.setZero();  // the links alone; the drive train's armature below
   osc::Data<double> data;
   osc::forward_kinematics(model, data, q_);
   osc::joint_inertia(model, data);
   double V = 0;
   for (int i = 1; i <= 6; ++i) V += model.link[i - 1].mass * model.gravity * data.com[i].z();
-  return 0.5 * qd_.dot(data.A * qd_) + V;
+  if (ideal_) return 0.5 * qd_.dot(data.A * qd_) + V;
+  // The rigid joints' motors (armature C^-T D C^-1), the elastic joints' motors and springs.
+  double E = 0.5 * qd_.dot((data.A + armature_rigid_) * qd_) + V;
+  for (int i = 0; i < 3; ++i)
+    if (elastic_[i]) {
+      const double s = spring(i, th_(i) - q_(i));
+      E += 0.5 * motor_inertia_(i) * thd_(i) * thd_(i);
+      if (stiffness_(i) > 0) E += 0.5 * s * s / stiffness_(i);
+    }
+  return E;
 }
 
 }  // namespace sim

@@ -1,8 +1,13 @@
 // Simulated PUMA 560: rigid-body dynamics (1) in double by the articulated-body algorithm (its own
 // code path, independent of the controller's CRBA/RNEA/operational-space kernels), true friction
 // by model (2), RK4 integration at a fine step, zero-order-hold torques applied after the
-// controller's computation delay inside each sample.
+// controller's computation delay inside each sample. Optionally (PlantConfig, issue 24) the drive
+// train's own dynamics: a motor inertia set, the wrist coupling, the amplifiers (current loop lag,
+// current limit, gain error, offset), torque ripple, friction drift, elastic joints and backlash on
+// J1-J3; all off, the plant is the rigid one above, bit for bit.
 #pragma once
+
+#include <cstdint>
 
 #include <Eigen/Core>
 
@@ -26,7 +31,42 @@ struct PlantConfig {
   int smooth_steps = 8;
   double compute_delay = 0.2e-3;  ///< from the encoder sample to the DAC update [s]
   double link_scale = 1.0;        ///< scales every link mass and inertia (model-error studies)
+
+  // The drive train's dynamics (issue 24), each off by default; all off, the plant computes exactly
+  // what it did without them (the articulated-body path, bit for bit). The inputs of advance_sample()
+  // and integrate() are the amplifier channels' torques, each referred to its joint (what the DACs
+  // command): the joint torques themselves unless `coupling` is on.
+  /// Motor inertias of the armature G^2 Jm: nullptr, the model's own (kArm.links[i].motor_inertia);
+  /// or e.g. &osc::robot::kMotorInertiaAkb86.
+  const osc::MotorInertias* motor_inertia = nullptr;
+  /// The wrist coupling (kDriveTrain.encoders: q = C e) in the dynamics: the motors turn at
+  /// e_dot = C^-1 q_dot, the channels' torques reach the joints as C^-T tau_m, the motors' inertias
+  /// and friction act on the motor side.
+  bool coupling = false;
+  double amp_lag = 0;              ///< amplifier current loop, first-order time constant [s]; 0: none
+  bool amp_current_limit = false;  ///< each channel limited at kDriveTrain.motor_torque_limit |G| (joint-referred)
+  double amp_gain_error[6] = {};   ///< relative, per channel: torque = (1 + err) command + offset
+  double amp_offset[6] = {};       ///< [N m] joint-referred, per channel
+  double ripple = 0;               ///< torque ripple, relative amplitude: tau (1 + ripple sin(cycles G e))
+  int ripple_cycles = 0;           ///< ripple periods per motor revolution (the motor's pole frequency)
+  /// Friction scales by (1 + friction_drift sin(2 pi t / friction_drift_period)), t the plant's time.
+  double friction_drift = 0;
+  double friction_drift_period = 3600;  ///< [s]
+  /// Joint elasticity on J1-J3: the locked-motor resonance [Hz] at the start pose (kQStart), each joint
+  /// alone (the others held: K = (2 pi f)^2 M_ii(kQStart)); 0: rigid. With all three elastic and every
+  /// motor held, J1-J3 are inertially coupled: at 20 Hz their modes are 16.8, 19.4 and 27.7 Hz.
+  double elastic_hz = 0;
+  /// Gear backlash on J1-J3: the total dead band at the joint [rad]; 0: none. Without elasticity the
+  /// gears are then a stiff spring (kBacklashStiffHz) with that dead band.
+  double backlash = 0;
+
+  /// True when every drive-train feature above is at its neutral value (the rigid, ideal drive train).
+  bool ideal_drives() const;
 };
+
+/// The locked-motor resonance of the gear mesh when backlash is on and elastic_hz is 0 [Hz]: stiff
+/// enough to be far above the control bandwidth, soft enough for the plant's RK4 step.
+constexpr double kBacklashStiffHz = 60.0;
 
 /// Articulated-body forward dynamics of the PUMA 560 (armature on each joint's scalar inertia),
 /// Featherstone's algorithm with every spatial quantity expressed at the base origin in base axes,
@@ -34,8 +74,17 @@ struct PlantConfig {
 class ArticulatedBody {
  public:
   explicit ArticulatedBody(double link_scale = 1.0);
+  /// With a given armature (joint-referred, on each joint's scalar inertia) instead of the model's G^2 Jm.
+  ArticulatedBody(double link_scale, const double armature[6]);
   /// q_dd for joint torques tau (friction already subtracted), gravity along -z0.
   Vec6 forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
+  /// The composite-rigid-body inertia M(q) (this body's scalar armature on its diagonal) and the bias
+  /// h(q, qd) = C(q, qd) qd + g(q), from the same spatial quantities as forward_dynamics().
+  void inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, Vec6& h) const;
+  /// q_dd with a full joint-space armature matrix added to M(q): (M + armature) q_dd = tau - h,
+  /// solved by Cholesky (for an armature that is not diagonal, e.g. the coupled wrist's).
+  Vec6 forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau, const Mat6& armature) const;
+  double armature(int i) const { return armature_[i]; }
 
  private:
   struct Body {
@@ -49,47 +98,112 @@ class ArticulatedBody {
   double armature_[6];
 };
 
-/// The robot: state, friction, integration.
+/// The robot: state, drive train, friction, integration.
 class Plant {
  public:
   explicit Plant(const PlantConfig& cfg = {});
+  /// Joint state q0, qd0, at time 0. Elastic joints start with the static deflection that holds the
+  /// links against gravity at q0 (motor angle q0 + dz^-1(g(q0) / K), its rate qd0), so that an arm whose
+  /// motors hold the gravity torques does not ring at the start; the amplifiers start at zero torque.
   void reset(const Vec6& q0, const Vec6& qd0 = Vec6::Zero());
   /// Advances one control sample of length dt: tau_old is held for the computation delay, then tau_new.
+  /// The torques are the amplifier channels' commands, each referred to its joint.
   void advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt);
   /// The holding brakes: engaged, advance_sample() keeps every joint where it is, at rest (a PUMA's
   /// brakes hold the arm while its power is off; the commanded-motion simulation engages them while
-  /// the controller is disabled or in fault).
+  /// the controller is disabled or in fault). Elastic joints' motors are held too; the amplifiers
+  /// still follow their commands.
   void set_brakes(bool engaged) { braked_ = engaged; }
   bool brakes() const { return braked_; }
-  /// Integrates for duration with constant torque tau.
+  /// Integrates for duration with constant command tau (the amplifier channels', joint-referred).
   void integrate(const Vec6& tau, double duration);
 
+  /// The joint torques of the drive train's friction at joint rates qd (model (2); with the coupling,
+  /// C^-T f(C^-1 qd), the motors' friction referred to the joints; with the drift, at the plant's
+  /// time; on an elastic joint, the friction its motor would have at the joint's rate).
   Vec6 friction(const Vec6& qd) const;
+  /// The joint accelerations for the amplifier channels' torques tau, as delivered to the motors, at
+  /// (q, qd): the rigid plant (today's articulated body) or, with drive-train features, the rigid
+  /// drive train with the configured armature, coupling and friction (elastic joints taken rigid).
   Vec6 acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
-  /// Kinetic plus potential energy (for integration checks).
+  /// Kinetic plus potential energy (for integration checks): links and armature, and with elastic
+  /// joints their motors' kinetic energy and the springs' energy.
   double energy() const;
 
   const Vec6& q() const { return q_; }
   /// The motors' angles, each referred to its joint through its gears: what the encoders count and
-  /// where the index pulses fire. The joint angles themselves on today's rigid, uncoupled plant.
-  Vec6 motor_angles() const { return q_; }
+  /// where the index pulses fire. C^-1 q with the coupling; an elastic joint's motor-side angle; the
+  /// joint angles themselves on the rigid, uncoupled plant.
+  Vec6 motor_angles() const;
+  /// The motors' rates, referred to their joints, likewise.
+  Vec6 motor_velocities() const;
   const Vec6& qd() const { return qd_; }
   double time() const { return t_; }
   const PlantConfig& config() const { return cfg_; }
-  /// Articulated-body evaluations since construction (cost accounting for tests and benchmarks).
+  /// Dynamics evaluations since construction (cost accounting for tests and benchmarks): the
+  /// articulated-body (or, with the coupling, composite-rigid-body) solves, one per RK4 stage.
   long evaluations() const { return evaluations_; }
 
+  /// False on the ideal plant (every drive-train feature off: today's path, bit for bit).
+  bool drive_dynamics() const { return !ideal_; }
+  /// The torques the motors produce now (joint-referred, per channel) for the last command: after
+  /// the amplifiers' lag, current limit, gain error and offset, and the ripple.
+  Vec6 motor_torques() const;
+  /// The elastic joints' spring torques K dz(theta - q) (zero on rigid joints).
+  Vec6 spring_torques() const;
+  /// The elastic joints' stiffness K [N m/rad] (zero on rigid joints).
+  const Vec6& stiffness() const { return stiffness_; }
+  /// The motor-side state of the elastic joints (angles and rates referred to the joints; the other
+  /// entries are ignored), e.g. to start a test from a given gear contact.
+  void set_motor_state(const Vec6& theta, const Vec6& theta_d);
+
  private:
+  /// The state of the plant with drive-train dynamics: joints, and the elastic joints' motors (the
+  /// entries of th and w of rigid joints are not used).
+  struct State {
+    Vec6 q, v, th, w;
+  };
   void rk4(const Vec6& tau, double h);
   /// One RK4 step of h if no joint velocity changes sign at any stage; otherwise leaves the state.
   bool rk4_smooth(const Vec6& tau, double h);
+
+  // The drive-train path (ideal_ false).
+  State derivative(const State& x, double t, const Vec6& amp) const;
+  /// One RK4 step of h for command u; with `smooth`, only if no event (regime()) happens in it.
+  bool step(const Vec6& u, double h, bool smooth);
+  /// What must not change within a smooth step: the sign of every friction-carrying motor rate, the
+  /// gear contact of every backlash, the current limit's state of every channel. 0: a rate is zero.
+  std::uint64_t regime(const State& x, const Vec6& amp) const;
+  Vec6 delivered(const Vec6& amp, const State& x) const;
+  Vec6 motor_angles_of(const State& x) const;
+  Vec6 motor_rates_of(const State& x) const;
+  double friction_scale(double t) const;
+  double spring(int i, double stretch) const;
+  /// The amplifiers' output after s more seconds of command u, from their state now.
+  Vec6 amplifier(const Vec6& u, double s) const;
+
   PlantConfig cfg_;
-  ArticulatedBody body_;
+  bool ideal_;
+  ArticulatedBody body_;                  // ideal: the model; else the armature of the rigid joints (none if coupled)
+  ArticulatedBody links_;                 // the links alone (no armature): inertia, bias, the coupled solve
   osc::FrictionParams<double> friction_;  // the true friction, model (2) (the kernels' friction_torque)
   Vec6 q_ = Vec6::Zero(), qd_ = Vec6::Zero();
   double t_ = 0;
   bool braked_ = false;
   mutable long evaluations_ = 0;
+
+  // Drive train (ideal_ false).
+  bool coupled_ = false, elastic_[6] = {}, sign_sensitive_[6] = {};
+  Mat6 c_inv_ = Mat6::Identity(), c_inv_t_ = Mat6::Identity();
+  // The rigid joints' armature, C^-T diag(G^2 Jm) C^-1 (zero on elastic joints); every channel's.
+  Mat6 armature_rigid_ = Mat6::Zero(), armature_all_ = Mat6::Zero();
+  Vec6 motor_inertia_ = Vec6::Zero();  // G^2 Jm, joint-referred
+  Vec6 stiffness_ = Vec6::Zero();
+  Vec6 limit_ = Vec6::Zero();                    // current limits, joint-referred
+  double half_band_ = 0;                         // backlash / 2
+  Vec6 th_ = Vec6::Zero(), thd_ = Vec6::Zero();  // elastic joints' motors
+  Vec6 amp_ = Vec6::Zero();                      // the amplifiers' output (with amp_lag)
+  Vec6 cmd_ = Vec6::Zero();                      // the last command
 };
 
 }  // namespace sim
