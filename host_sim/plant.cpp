@@ -4,8 +4,6 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/Cholesky>
-
 #include "osc/kernels/dynamics.hpp"
 #include "osc/kernels/friction.hpp"
 #include "osc/robot.hpp"
@@ -90,6 +88,11 @@ ArticulatedBody::ArticulatedBody(double link_scale) {
     const Mat3 Ic = Ra * Vec3(L.inertia[0], L.inertia[1], L.inertia[2]).asDiagonal() * Ra.transpose() * link_scale;
     const double m = L.mass * link_scale;
     body_[i] = Body{m, c, Ic};
+    axes_cs_[i][0] = std::cos(L.alpha);
+    axes_cs_[i][1] = std::sin(L.alpha);
+    moments_[i] = Vec3(L.inertia[0], L.inertia[1], L.inertia[2]) * link_scale;
+    fixed_cs_[i][0] = i == 0 ? 1.0 : std::cos(kLinks[i - 1].alpha);
+    fixed_cs_[i][1] = i == 0 ? 0.0 : std::sin(kLinks[i - 1].alpha);
     armature_[i] = L.gear_ratio * L.gear_ratio * L.motor_inertia;
     if (i == 0) {
       rot_fixed_[i] = Mat3::Identity();
@@ -181,37 +184,63 @@ struct RigidInertia {
 };
 }  // namespace
 
+namespace {
+/// W Rx(a) for Rx given as (cos a, sin a): the columns 1 and 2 of W turned, 12 products instead of 27.
+void turn_x(Mat3& W, double c, double s) {
+  const Vec3 w1 = W.col(1), w2 = W.col(2);
+  W.col(1) = c * w1 + s * w2;
+  W.col(2) = c * w2 - s * w1;
+}
+/// W Rz(q), likewise with the columns 0 and 1.
+void turn_z(Mat3& W, double c, double s) {
+  const Vec3 w0 = W.col(0), w1 = W.col(1);
+  W.col(0) = c * w0 + s * w1;
+  W.col(1) = c * w1 - s * w0;
+}
+}  // namespace
+
 void ArticulatedBody::inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, Vec6& h) const {
   RigidInertia Ic[6];
   Vec6 S[6], f[6];
-  // Pass 1, base to tip, as in forward_dynamics(): axes, velocities, link inertias at the base
-  // origin; the accelerations at q_dd = 0 (gravity as an upward base acceleration, plus the
-  // velocity products) and each link's force I a + V x* I V (recursive Newton-Euler).
+  // Pass 1, base to tip, as in forward_dynamics() (every quantity at the base origin, in base axes):
+  // axes S = [z; o x z], velocities V = [w; v], link inertias; the accelerations at q_dd = 0 (gravity
+  // as an upward base acceleration, plus the velocity products V x S qd) and each link's force
+  // I a + V x* I V (recursive Newton-Euler). The rotations turn two columns at a time (turn_x,
+  // turn_z) and a link's rotational inertia is built from its principal axes.
   Mat3 W = Mat3::Identity();
-  Vec3 o = Vec3::Zero();
-  Vec6 V = Vec6::Zero();
-  Vec6 a;
-  a << 0, 0, 0, 0, 0, osc::robot::kArm.gravity;
+  Vec3 o = Vec3::Zero(), w = Vec3::Zero(), v = Vec3::Zero();
+  Vec3 aw = Vec3::Zero(), av(0, 0, osc::robot::kArm.gravity);
   for (int i = 0; i < 6; ++i) {
     o += W * pos_fixed_[i];
-    const double cq = std::cos(q(i)), sq = std::sin(q(i));
-    Mat3 Rz;
-    Rz << cq, -sq, 0, sq, cq, 0, 0, 0, 1;
-    W = W * rot_fixed_[i] * Rz;
-    const Vec3 z = W.col(2);
-    S[i] = join(z, o.cross(z));
-    const Vec6 vJ = S[i] * qd(i);
-    V += vJ;
-    a += cross_motion(V, vJ);
+    turn_x(W, fixed_cs_[i][0], fixed_cs_[i][1]);
+    turn_z(W, std::cos(q(i)), std::sin(q(i)));
+    const Vec3 z = W.col(2), oz = o.cross(z);
+    S[i] = join(z, oz);
+    const Vec3 wJ = z * qd(i), vJ = oz * qd(i);
+    w += wJ;
+    v += vJ;
+    aw += w.cross(wJ);
+    av += w.cross(vJ) + v.cross(wJ);
     const Body& b = body_[i];
     const Vec3 com = o + W * b.com;
     RigidInertia& I = Ic[i];
     I.m = b.mass;
     I.h = b.mass * com;
-    // About the origin: the inertia about the COM plus m (|c|^2 1 - c c^T) (parallel axes).
-    I.I = W * b.inertia * W.transpose() - b.mass * com * com.transpose();
-    I.I.diagonal().array() += b.mass * com.squaredNorm();
-    f[i] = I * a + cross_force(V, I * V);
+    // About the origin: U diag(moments) U^T (U = W Rx(alpha_i), the principal axes) plus
+    // m (|c|^2 1 - c c^T) (parallel axes).
+    Mat3 U = W;
+    turn_x(U, axes_cs_[i][0], axes_cs_[i][1]);
+    const Vec3& d = moments_[i];
+    const double cc = b.mass * com.squaredNorm();
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) {
+        const double e = d(0) * U(r, 0) * U(c, 0) + d(1) * U(r, 1) * U(c, 1) + d(2) * U(r, 2) * U(c, 2) -
+                         b.mass * com(r) * com(c) + (r == c ? cc : 0.0);
+        I.I(r, c) = I.I(c, r) = e;
+      }
+    // f = I a + V x* (I V): I [w; v] = [I w + h x v; m v - h x w].
+    const Vec3 Lw = I.I * w + I.h.cross(v), Lv = I.m * v - I.h.cross(w);
+    f[i] = join(I.I * aw + I.h.cross(av) + w.cross(Lw) + v.cross(Lv), I.m * av - I.h.cross(aw) + w.cross(Lv));
   }
   // Pass 2, tip to base: composite inertias and forces (all at the base origin: no transforms);
   // M_ji = S_j . Ic_i S_i for j <= i, h_i = S_i . F_i.
@@ -221,9 +250,9 @@ void ArticulatedBody::inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, V
       f[i] += f[i + 1];
     }
     h(i) = S[i].dot(f[i]);
-    const Vec6 U = Ic[i] * S[i];
-    M(i, i) = S[i].dot(U) + armature_[i];
-    for (int j = 0; j < i; ++j) M(i, j) = M(j, i) = S[j].dot(U);
+    const Vec6 Us = Ic[i] * S[i];
+    M(i, i) = S[i].dot(Us) + armature_[i];
+    for (int j = 0; j < i; ++j) M(i, j) = M(j, i) = S[j].dot(Us);
   }
 }
 
@@ -232,7 +261,31 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
   Vec6 h;
   inertia_and_bias(q, qd, M, h);
   M += armature;
-  return Eigen::LLT<Mat6>(M).solve(tau - h);
+  // Cholesky, M = L L^T (M symmetric positive definite: the links' inertia plus the motors'), then
+  // L y = tau - h, L^T q_dd = y; written out on the 6 x 6 (a third of Eigen's general LLT's time).
+  double L[6][6], y[6];
+  const Vec6 b = tau - h;
+  for (int j = 0; j < 6; ++j) {
+    double d = M(j, j);
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    L[j][j] = std::sqrt(d);
+    const double inv = 1.0 / L[j][j];
+    for (int i = j + 1; i < 6; ++i) {
+      double e = M(i, j);
+      for (int k = 0; k < j; ++k) e -= L[i][k] * L[j][k];
+      L[i][j] = e * inv;
+    }
+    double r = b(j);
+    for (int k = 0; k < j; ++k) r -= L[j][k] * y[k];
+    y[j] = r * inv;
+  }
+  Vec6 x;
+  for (int j = 5; j >= 0; --j) {
+    double r = y[j];
+    for (int k = j + 1; k < 6; ++k) r -= L[k][j] * x(k);
+    x(j) = r / L[j][j];
+  }
+  return x;
 }
 
 Plant::Plant(const PlantConfig& cfg)

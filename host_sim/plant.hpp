@@ -96,6 +96,10 @@ class ArticulatedBody {
   Mat3 rot_fixed_[6];  // rotation of F_{i-1} in B_{i-1}: Rx(alpha_{i-1})
   Vec3 pos_fixed_[6];  // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1})
   double armature_[6];
+  // The composite-rigid-body path's own view of the same links: the rotations Rx(alpha) as their
+  // cosine and sine (of rot_fixed_, and of each link's principal axes in B_i), the principal moments.
+  double fixed_cs_[6][2], axes_cs_[6][2];
+  Vec3 moments_[6];
 };
 
 /// The robot: state, drive train, friction, integration.
