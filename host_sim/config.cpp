@@ -42,6 +42,7 @@ struct Entry {
   double lo = 0, hi = 0;           // kNumber, and each element of a kList
   std::vector<std::string> names;  // kName: the values allowed
   bool paper = true;               // part of the paper's set-up (differences_from_paper)
+  bool feature = false;            // a feature of the plant, which plant.preset sets (differences_from_preset)
   std::function<json(const Settings&)> get = nullptr;
   std::function<std::string(Settings&, const json&)> put = nullptr;
   std::function<bool(const Settings&)> shown = nullptr;  // printed only when true (null: always)
@@ -287,7 +288,125 @@ void add_plant_friction_entries(std::vector<Entry>& t) {
   }
 }
 
+/// A name entry of two values, off and on, for a flag.
+void flag(std::vector<Entry>& t, std::string key, std::string doc, std::function<bool&(Settings&)> ref) {
+  name(
+      t, std::move(key), std::move(doc), {"off", "on"}, true,
+      [ref](const Settings& s) { return std::string(ref(const_cast<Settings&>(s)) ? "on" : "off"); },
+      [ref](Settings& s, const std::string& v) { ref(s) = v == "on"; });
+}
+
+/// A list of six numbers stored in a plain array.
+void array6(std::vector<Entry>& t, std::string key, std::string doc, double lo, double hi,
+            std::function<double*(Settings&)> ref) {
+  Entry e{std::move(key), std::move(doc), Kind::kList, lo, hi, {}, true};
+  e.get = [ref](const Settings& s) { return vec_json(ref(const_cast<Settings&>(s)), 6); };
+  e.put = [ref](Settings& s, const json& v) {
+    for (int i = 0; i < 6; ++i) ref(s)[i] = v[i].get<double>();
+    return std::string();
+  };
+  t.push_back(e);
+}
+
+/// The plant's features (docs/experiment.md, "The realistic plant"): the preset first, then each
+/// feature, so that a file read in its printed order applies the preset and then its differences.
+void add_plant_feature_entries(std::vector<Entry>& t) {
+  const std::size_t first = t.size() + 1;  // after plant.preset
+  name(
+      t, "plant.preset",
+      "the simulated arm: ideal (rigid, uncoupled, ideal drives: the paper's tables) or realistic (every feature "
+      "below at its mid value); setting it sets every feature below",
+      plant_preset_names(), true, [](const Settings& s) { return s.plant_preset; },
+      [](Settings& s, const std::string& n) {
+        apply_plant_preset(n, s.base);
+        s.plant_preset = n;
+      });
+  name(
+      t, "plant.encoders",
+      "encoder resolution: uniform (plant.encoder_cpr on every motor) or trident (the PUMA's own, per joint: 1000 "
+      "counts per motor revolution, about 797 on J2)",
+      {"uniform", "trident"}, true,
+      [](const Settings& s) { return std::string(s.base.published_encoders ? "trident" : "uniform"); },
+      [](Settings& s, const std::string& v) { s.base.published_encoders = v == "trident"; });
+  flag(t, "plant.coupling",
+       "the wrist coupling (q5 = e5 - 0.0139 e4, q6 = e6 + 0.0130 e4 - 0.1806 e5): the encoders count motor "
+       "angles, the DACs command motor torques (C^T tau), the motor inertias and friction act on the motors",
+       [](Settings& s) -> bool& { return s.base.plant.coupling; });
+  name(
+      t, "plant.motor_inertia",
+      "the plant's motor inertias: toolbox (the controller's model) or akb86 (+45/+105/+50 % on J1-J3)",
+      {"toolbox", "akb86"}, true,
+      [](const Settings& s) {
+        return std::string(s.base.plant.motor_inertia ? s.base.plant.motor_inertia->name : "toolbox");
+      },
+      [](Settings& s, const std::string& v) {
+        s.base.plant.motor_inertia = v == "akb86" ? &osc::robot::kMotorInertiaAkb86 : nullptr;
+      });
+  number(t, "plant.amp_lag",
+         "the amplifiers' current loops, first-order time constant [s] (0: none; tried 0.2e-3..0.5e-3)", 0, 5e-3, true,
+         [](Settings& s) -> double& { return s.base.plant.amp_lag; });
+  flag(t, "plant.amp_current_limit", "the amplifiers' current limits (the drive train's motor torque limits)",
+       [](Settings& s) -> bool& { return s.base.plant.amp_current_limit; });
+  array6(t, "plant.amp_gain_error", "the amplifiers' gain errors per channel, relative", -0.2, 0.2,
+         [](Settings& s) { return s.base.plant.amp_gain_error; });
+  array6(t, "plant.amp_offset", "the amplifiers' offsets per channel, joint-referred [N m]", -10, 10,
+         [](Settings& s) { return s.base.plant.amp_offset; });
+  Entry d{"plant.dac_bits",
+          "the DACs' resolution the amplifiers see [bits] (the board's AD5754R: 16)",
+          Kind::kNumber,
+          8,
+          16,
+          {},
+          true};
+  d.get = [](const Settings& s) { return json(s.base.sensors.dac_bits); };
+  d.put = [](Settings& s, const json& v) {
+    const double n = v.get<double>();
+    if (n != std::floor(n)) return number_text(n) + " is not a whole number";
+    s.base.sensors.dac_bits = static_cast<int>(n);
+    return std::string();
+  };
+  t.push_back(d);
+  number(t, "plant.ripple", "torque ripple, relative amplitude (0: none; tried 0.01..0.05)", 0, 0.2, true,
+         [](Settings& s) -> double& { return s.base.plant.ripple; });
+  Entry r{"plant.ripple_cycles",
+          "ripple periods per motor revolution (the motor's pole frequency)",
+          Kind::kNumber,
+          0,
+          64,
+          {},
+          true};
+  r.get = [](const Settings& s) { return json(s.base.plant.ripple_cycles); };
+  r.put = [](Settings& s, const json& v) {
+    const double n = v.get<double>();
+    if (n != std::floor(n)) return number_text(n) + " is not a whole number";
+    s.base.plant.ripple_cycles = static_cast<int>(n);
+    return std::string();
+  };
+  t.push_back(r);
+  number(t, "plant.backlash", "gear backlash on J1-J3, the dead band at the joint [rad] (0: none; tried 0.1e-3..1e-3)",
+         0, 5e-3, true, [](Settings& s) -> double& { return s.base.plant.backlash; });
+  number(t, "plant.elastic_hz",
+         "joint elasticity on J1-J3: the locked-motor resonance at the start pose [Hz] (0: rigid; tried 15..25)", 0,
+         200, true, [](Settings& s) -> double& { return s.base.plant.elastic_hz; });
+  number(t, "plant.encoder_jitter", "encoder edge jitter, the edges' spread [counts] (0: none)", 0, 0.5, true,
+         [](Settings& s) -> double& { return s.base.sensors.encoder_jitter; });
+  number(t, "plant.pot_noise", "potentiometer noise, standard deviation [ADC codes]", 0, 100, true,
+         [](Settings& s) -> double& { return s.base.sensors.pot_noise; });
+  array6(t, "plant.pot_offset", "potentiometer offsets per joint [ADC codes]", -500, 500,
+         [](Settings& s) { return s.base.sensors.pot_offset; });
+  number(t, "plant.friction_drift",
+         "friction's drift with temperature, relative amplitude over plant.friction_drift_period (0: none)", 0, 0.9,
+         true, [](Settings& s) -> double& { return s.base.plant.friction_drift; });
+  number(t, "plant.friction_drift_period", "the period of friction's drift [s]", 60, 86400, true,
+         [](Settings& s) -> double& { return s.base.plant.friction_drift_period; });
+  // The plant's preset and features model the paper's robot more or less closely: they do not change
+  // the paper's set-up (the outputs name them apart: Provenance::plant).
+  t[first - 1].paper = false;
+  for (std::size_t i = first; i < t.size(); ++i) t[i].feature = true, t[i].paper = false;
+}
+
 void add_plant_entries(std::vector<Entry>& t) {
+  add_plant_feature_entries(t);
   add_plant_friction_entries(t);
   number(t, "plant.tau_dec", "the simulated robot's Stribeck decay tau_dec [s^2/rad^2]", 0.01, 100, true,
          [](Settings& s) -> double& { return s.base.plant.tau_dec; });
@@ -536,6 +655,34 @@ json config_json(const Settings& s) {
     (*node)[parts.back()] = e.get(s);
   }
   return root;
+}
+
+namespace {
+/// Does the entry's value differ between a and b (lists compared to 1e-9, relative: degrees of the
+/// same radians)?
+bool differs(const Entry& e, const Settings& s, const Settings& ref) {
+  const json a = e.get(s), b = e.get(ref);
+  if (a == b) return false;
+  if (!(a.is_array() && b.is_array() && a.size() == b.size())) return true;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (std::abs(a[i].get<double>() - b[i].get<double>()) > 1e-9 * (1 + std::abs(b[i].get<double>()))) return true;
+  return false;
+}
+/// The settings of s's plant preset, everything else as the paper's.
+Settings preset_of(const Settings& s) {
+  Settings ref;
+  apply_plant_preset(s.plant_preset, ref.base);
+  ref.plant_preset = s.plant_preset;
+  return ref;
+}
+}  // namespace
+
+std::vector<std::string> differences_from_preset(const Settings& s) {
+  const Settings ref = preset_of(s);
+  std::vector<std::string> keys;
+  for (const Entry& e : entries())
+    if (e.feature && differs(e, s, ref)) keys.push_back(e.key);
+  return keys;
 }
 
 std::vector<std::string> differences_from_paper(const Settings& s) {

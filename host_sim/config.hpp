@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "experiment.hpp"
+#include "plant_preset.hpp"
 
 namespace sim {
 
@@ -21,6 +22,7 @@ namespace sim {
 struct Settings {
   ExperimentConfig base;
   bool run_adaptive = true, run_none = true;
+  std::string plant_preset = "ideal";  ///< the plant's preset (plant_preset.hpp); its features may then differ
 };
 
 /// Applies a YAML document (the text of `source`, a file name for messages) to s. Unknown keys,
@@ -48,6 +50,9 @@ nlohmann::ordered_json config_json(const Settings& s);
 /// change the set-up (the modes, the arithmetic, the adaptation law, the statistics window, the
 /// plant's integration step) are not listed.
 std::vector<std::string> differences_from_paper(const Settings& s);
+
+/// The plant's features (plant.*) whose values differ from its preset's.
+std::vector<std::string> differences_from_preset(const Settings& s);
 
 /// A short stable hash of a text (FNV-1a, 64 bit, as 16 hex digits).
 std::string text_hash(const std::string& text);

@@ -26,7 +26,7 @@ class LocalController {
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
     task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode,
                 q0.cast<S>(), PlantHal::kPeriodNs);
-    task_->set_encoder_resolution(cfg.encoder_counts_per_motor_rev);
+    task_->set_encoders(cfg.encoder_map());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
       task_->state.obs.x_hat(i) += static_cast<S>(cfg.observer_offset[i]);
@@ -140,7 +140,7 @@ template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
-  PlantHal hal(plant, q0, sensors_with_resolution(cfg.encoder_counts_per_motor_rev), cfg.injection);
+  PlantHal hal(plant, q0, cfg.sensor_config(), cfg.injection);
   GroundTruth truth(q0, cfg.gains.trajectory);
   const double dt = osc::params::kDt;
   const long n = std::lround(cfg.duration / dt);
@@ -172,6 +172,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     res.each([&s](auto& m) {
       if constexpr (requires { m.observe(s); }) m.observe(s);
     });
+    plant.set_amplifiers(!hal.fault());
     plant.advance_sample(s.tau_before, s.tau, dt);
     s.tau_before = s.tau;
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);

@@ -13,6 +13,7 @@
 #include "osc/control/gains.hpp"
 #include "osc/link/frames.hpp"
 #include "plant.hpp"
+#include "plant_hal.hpp"
 
 namespace sim {
 
@@ -27,8 +28,33 @@ struct ExperimentConfig {
   osc::FrictionMode mode = osc::FrictionMode::kAdaptive;
   Scalar scalar = Scalar::kDouble;  ///< controller arithmetic
   PlantConfig plant{};
-  /// Encoder resolution of plant and controller alike (in-process controller only) [counts/motor rev].
+  /// Encoder resolution of plant and controller alike (in-process controller only) [counts/motor rev],
+  /// on every motor: the uniform encoders.
   double encoder_counts_per_motor_rev = osc::robot::kDrives.encoder_counts_per_motor_rev;
+  /// The arm's own encoders instead (osc::robot::kDriveTrain.encoders' resolutions).
+  bool published_encoders = false;
+  /// The plant's sensors: jitter, DAC resolution, potentiometers (the encoders' map is encoder_map()'s).
+  SensorConfig sensors{};
+  /// The encoders of plant and controller alike: uniform or the arm's own, coupled as the plant is
+  /// (plant.coupling).
+  osc::EncoderMap encoder_map() const {
+    osc::EncoderMap m = published_encoders
+                            ? osc::robot::kDriveTrain.encoders
+                            : osc::uniform_encoders("uniform", osc::robot::kArm, encoder_counts_per_motor_rev);
+    if (published_encoders) m.name = plant.coupling ? "trident" : "trident, uncoupled";
+    if (!plant.coupling) m.coupling_terms = 0;
+    if (plant.coupling && !published_encoders) {
+      m.coupling_terms = osc::robot::kDriveTrain.encoders.coupling_terms;
+      for (int k = 0; k < m.coupling_terms; ++k) m.coupling[k] = osc::robot::kDriveTrain.encoders.coupling[k];
+    }
+    return m;
+  }
+  /// The plant's sensors with encoder_map()'s encoders.
+  SensorConfig sensor_config() const {
+    SensorConfig s = sensors;
+    s.encoders = encoder_map();
+    return s;
+  }
   double model_error = 0.0;    ///< controller's link mass/inertia relative error
   double log_period = 0.01;    ///< time-series decimation [s]
   double final_window = 20.0;  ///< "last 20 s" statistics [s]

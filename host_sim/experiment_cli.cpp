@@ -26,6 +26,9 @@ constexpr Shorthand kShorthands[] = {
     {"--scalar", "run.scalar", "the controller's arithmetic: double | float | fixed (default double)"},
     {"--adaptation", "run.adaptation", "friction adaptation law: paper | robust (default robust)"},
     {"--final-window", "run.final_window", "length of the \"last\" statistics in seconds (default 20; 1..3600)"},
+    {"--plant", "plant.preset",
+     "the simulated arm: ideal (the paper's tables) | realistic (every feature of docs/experiment.md's plant "
+     "table at its mid value) (default ideal)"},
     {"--friction", "plant.friction.preset", "plant friction preset: paper | corke | none (default paper)"},
     {"--model-error", "controller.model_error", "controller link mass/inertia relative error (default 0; -0.5..0.5)"},
     {"--encoder-cpr", "plant.encoder_cpr", "encoder counts per motor revolution, plant and controller (default 1000)"},
@@ -44,6 +47,7 @@ constexpr const char* kHostOnlyKeys[] = {
 struct Parsed {
   std::vector<std::pair<const Shorthand*, std::string>> shorthands;
   std::vector<std::string> sets;
+  std::vector<std::string> plant_sets;
   std::string inject;
   std::string pil_link;
 };
@@ -59,6 +63,11 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
   app.add_option("--set", p.sets,
                  "set one configuration key, after --config and the options below "
                  "(e.g. --set trajectory.amplitude=0.1); repeatable")
+      ->type_name("KEY=VALUE")
+      ->allow_extra_args(false);
+  app.add_option("--plant-set", p.plant_sets,
+                 "set one of the plant's keys, after --plant (e.g. --plant-set elastic_hz=20 for plant.elastic_hz; "
+                 "--print-config lists them); repeatable")
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("--print-config", o.print_config, "print the effective configuration as YAML and exit");
@@ -154,6 +163,8 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
       if (err.rfind(key + ":", 0) == 0) err = std::string(s->flag) + err.substr(key.size()) + " (" + key + ")";
       return false;
     }
+  for (const std::string& a : p.plant_sets)
+    if (!apply_setting("plant." + a, o, err)) return err = "--plant-set: " + err, false;
   for (const std::string& a : p.sets)
     if (!apply_setting(a, o, err)) return err = "--set: " + err, false;
   if (!validate_settings(o, err)) return false;
@@ -180,6 +191,12 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
                        " applies to the host-built controller only, not with --qemu (the firmware image "
                        "compiles in its defaults)",
                  false;
+    // The image reads its encoders as the uniform, uncoupled ones it compiles in.
+    if (o.base.published_encoders || o.base.plant.coupling)
+      return err = std::string(o.base.plant.coupling ? "plant.coupling" : "plant.encoders") +
+                   " applies to the host-built controller only, not with --qemu (the firmware image compiles in "
+                   "uniform, uncoupled encoders)",
+             false;
     if (o.base.injection.enabled && !info(o.base.injection.kind).per_joint)
       return err = std::string("--inject ") + info(o.base.injection.kind).name +
                    " applies to the host-built controller only, not with --qemu",

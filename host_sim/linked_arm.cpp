@@ -56,6 +56,7 @@ bool LinkedArm::tick(TickView& v, std::string& err) {
   // The plant over the sample, as MotionSim::tick: the amplifiers' torque, the brakes by the state.
   const Vec6 tau = hal_.torque();
   plant_.set_brakes(!osc::motion_powered(v.state));
+  plant_.set_amplifiers(!hal_.fault());
   plant_.advance_sample(tau_before_, tau, osc::params::kDt);
   tau_before_ = tau;
   osc::forward_kinematics(model_, data_, plant_.q());

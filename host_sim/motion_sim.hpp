@@ -61,6 +61,7 @@ class MotionSim {
     const std::uint32_t faults = osc::control_tick(*task_, hal_);
     const Vec6 tau = hal_.torque();
     plant_.set_brakes(!osc::motion_powered(task_->machine.state));
+    plant_.set_amplifiers(!hal_.fault());
     plant_.advance_sample(tau_before_, tau, osc::params::kDt);
     tau_before_ = tau;
     return faults;

@@ -422,6 +422,7 @@ Vec6 Plant::amplifier(const Vec6& u, double s) const {
 }
 
 Vec6 Plant::delivered(const Vec6& amp, const State& x) const {
+  if (!amplifiers_on_) return Vec6::Zero();  // disabled: no current at all, offsets included
   Vec6 t = amp;
   if (cfg_.amp_current_limit) t = t.cwiseMax(-limit_).cwiseMin(limit_);
   for (int i = 0; i < 6; ++i) t(i) = (1 + cfg_.amp_gain_error[i]) * t(i) + cfg_.amp_offset[i];

@@ -119,6 +119,9 @@ class Plant {
   /// still follow their commands.
   void set_brakes(bool engaged) { braked_ = engaged; }
   bool brakes() const { return braked_; }
+  /// The amplifiers' enable line (a board's fault output disables them): off, they deliver no
+  /// torque at all, their offsets included (category 0).
+  void set_amplifiers(bool on) { amplifiers_on_ = on; }
   /// Integrates for duration with constant command tau (the amplifier channels', joint-referred).
   void integrate(const Vec6& tau, double duration);
 
@@ -194,6 +197,7 @@ class Plant {
   Vec6 q_ = Vec6::Zero(), qd_ = Vec6::Zero();
   double t_ = 0;
   bool braked_ = false;
+  bool amplifiers_on_ = true;
   mutable long evaluations_ = 0;
 
   // Drive train (ideal_ false).

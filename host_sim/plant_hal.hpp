@@ -173,7 +173,9 @@ class PlantHal {
       : plant_(plant),
         sensors_(sensors),
         coupling_(sensors.encoders),
-        e_start_(coupling_.motor_from_joint(q_start)),
+        // Zeroed where the motors stand: an elastic joint's motor sits off its link by the
+        // deflection that holds the arm (zero on a rigid plant, and before the plant's reset).
+        e_start_(coupling_.motor_from_joint(q_start) + (plant.motor_angles() - coupling_.motor_from_joint(plant.q()))),
         inj_(inj),
         rng_(sensors.seed),
         jitter_rng_(generator(sensors.seed, 1)),

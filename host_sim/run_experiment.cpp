@@ -287,6 +287,8 @@ int main(int argc, char** argv) {
   prov.config_text = sim::config_yaml(o);
   prov.config_hash = sim::text_hash(prov.config_text);
   prov.differs = sim::differences_from_paper(o);
+  prov.plant = o.plant_preset;
+  prov.plant_differs = sim::differences_from_preset(o);
   if (o.csv) {
     prov.config_file = o.csv_dir + "/config.yaml";
     if (!sim::write_output(prov.config_file, prov.config_text, err)) return fail_output(err);

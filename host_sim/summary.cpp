@@ -39,6 +39,7 @@ json summary_json(const std::vector<ExperimentResult>& runs, const Settings& cfg
   root["config"] = config_json(cfg);
   root["paper_setup"] = prov.differs.empty();
   root["differs_from_paper"] = prov.differs;
+  root["plant"] = {{"preset", prov.plant}, {"differs_from_preset", prov.plant_differs}};
   root["paper"] = {{"table1_max_error_mm_deg", json_array(kPaperTable1, 6)},
                    {"table3_max_error_mm_deg", json_array(kPaperTable3, 6)}};
   json a = json::array();

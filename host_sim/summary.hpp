@@ -18,15 +18,19 @@ using json = nlohmann::ordered_json;
 /// full text) and how it differs from the paper's set-up.
 struct Provenance {
   std::string revision, config_text, config_hash, config_file;
-  std::vector<std::string> differs;  // keys that differ from the paper's set-up
+  std::vector<std::string> differs;        // keys that differ from the paper's set-up
+  std::string plant = "ideal";             // the plant's preset
+  std::vector<std::string> plant_differs;  // its features that differ from the preset's
   std::string line() const {
     std::string s = "puma_experiment " + revision + ", configuration " + config_hash;
     if (!config_file.empty()) s += " (" + config_file + ")";
     return s;
   }
   std::string setup() const {
-    if (differs.empty()) return "the paper's set-up";
-    std::string s = "differs from the paper's set-up in";
+    std::string s = "plant " + plant;
+    for (size_t i = 0; i < plant_differs.size(); ++i) s += (i ? ", " : " but ") + plant_differs[i];
+    if (differs.empty()) return s + "; the paper's set-up";
+    s += "; differs from the paper's set-up in";
     for (size_t i = 0; i < differs.size(); ++i) s += (i ? ", " : " ") + differs[i];
     return s;
   }

@@ -60,6 +60,8 @@ struct App {
     board.init();
     task.init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
               osc::joint_vector<float>(osc::robot::kQStart), board.cycle_hz() / kControlHz, osc::TaskStart::kDisabled);
+    // The arm's own encoders: per-joint resolution and the wrist coupling (robot::kDriveTrain).
+    task.set_encoders(osc::robot::kDriveTrain.encoders);
     port.state_period = kStateEvery;
     cortex_m::text::Line banner;
     board.describe(banner.str("osc stm32f4: "));

@@ -161,6 +161,77 @@ TEST(Config, CommandLineAppliesFileThenOptionsThenSet) {
   EXPECT_NE(err.find("trajectory.amplitude applies to the host-built controller only"), std::string::npos) << err;
 }
 
+// The plant's preset sets every feature; a feature set after it is a difference from the preset,
+// named in the outputs; the printed configuration reads back to the same plant.
+TEST(Config, PlantPresetSetsEveryFeatureAndDifferencesAreNamed) {
+  Settings s;
+  std::string err;
+  EXPECT_EQ(sim::config_json(s)["plant"]["preset"].get<std::string>(), "ideal");
+  EXPECT_TRUE(sim::differences_from_preset(s).empty());
+  ASSERT_TRUE(sim::apply_setting("plant.preset=realistic", s, err)) << err;
+  EXPECT_TRUE(s.base.published_encoders);
+  EXPECT_TRUE(s.base.plant.coupling);
+  ASSERT_NE(s.base.plant.motor_inertia, nullptr);
+  EXPECT_STREQ(s.base.plant.motor_inertia->name, "akb86");
+  EXPECT_GT(s.base.plant.amp_lag, 0.2e-3);
+  EXPECT_LT(s.base.plant.amp_lag, 0.5e-3);
+  EXPECT_GE(s.base.plant.elastic_hz, 15);
+  EXPECT_LE(s.base.plant.elastic_hz, 25);
+  EXPECT_GE(s.base.plant.backlash, 0.1e-3);
+  EXPECT_LE(s.base.plant.backlash, 1e-3);
+  EXPECT_GT(s.base.sensors.pot_noise, 0);
+  EXPECT_TRUE(sim::differences_from_preset(s).empty());
+  // The plant models the paper's robot: it leaves the paper's set-up (and its tables) comparable.
+  EXPECT_TRUE(sim::differences_from_paper(s).empty());
+  // The encoders of plant and controller: the arm's own, coupled.
+  const osc::EncoderMap m = s.base.encoder_map();
+  EXPECT_EQ(m.coupling_terms, 3);
+  EXPECT_EQ(m.counts_per_rad[1], osc::robot::kDriveTrain.encoders.counts_per_rad[1]);
+  // One feature changed: named as a difference from the preset.
+  ASSERT_TRUE(sim::apply_setting("plant.elastic_hz=12", s, err)) << err;
+  EXPECT_EQ(sim::differences_from_preset(s), std::vector<std::string>{"plant.elastic_hz"});
+  const std::string text = sim::config_yaml(s);
+  Settings back;
+  ASSERT_TRUE(sim::apply_config(text, "printed", back, err)) << err;
+  EXPECT_EQ(sim::config_yaml(back), text);
+  EXPECT_EQ(back.base.plant.elastic_hz, 12);
+  EXPECT_EQ(sim::differences_from_preset(back), std::vector<std::string>{"plant.elastic_hz"});
+  // Back to ideal: every feature off again, the paper's plant bit for bit.
+  ASSERT_TRUE(sim::apply_setting("plant.preset=ideal", s, err)) << err;
+  EXPECT_EQ(sim::config_yaml(s), sim::config_yaml(Settings{}));
+  // A bad preset or feature value is an error naming the key.
+  EXPECT_FALSE(sim::apply_setting("plant.preset=real", s, err));
+  EXPECT_NE(err.find("plant.preset: expected ideal or realistic"), std::string::npos) << err;
+  EXPECT_FALSE(sim::apply_setting("plant.dac_bits=12.5", s, err));
+  EXPECT_NE(err.find("plant.dac_bits: 12.5 is not a whole number"), std::string::npos) << err;
+  EXPECT_FALSE(sim::apply_setting("plant.coupling=yes", s, err));
+  EXPECT_NE(err.find("plant.coupling: expected off or on"), std::string::npos) << err;
+}
+
+TEST(Config, PlantOptionsOnTheCommandLine) {
+  char prog[] = "puma_experiment", a1[] = "--plant", a2[] = "realistic", a3[] = "--plant-set", a4[] = "backlash=0",
+       a5[] = "--plant-set", a6[] = "coupling=off";
+  char* argv[] = {prog, a1, a2, a3, a4, a5, a6};
+  sim::ExperimentOptions o;
+  std::string err;
+  ASSERT_TRUE(sim::parse_experiment_args(7, argv, o, err)) << err;
+  EXPECT_EQ(o.plant_preset, "realistic");
+  EXPECT_EQ(o.base.plant.backlash, 0.0);
+  EXPECT_FALSE(o.base.plant.coupling);
+  EXPECT_EQ(sim::differences_from_preset(o), (std::vector<std::string>{"plant.coupling", "plant.backlash"}));
+  char b1[] = "--plant-set", b2[] = "nothing=1";
+  char* bad[] = {prog, b1, b2};
+  sim::ExperimentOptions o2;
+  EXPECT_FALSE(sim::parse_experiment_args(3, bad, o2, err));
+  EXPECT_EQ(err, "--plant-set: unknown key 'plant.nothing' (--print-config lists the keys)");
+  // The image in QEMU reads its encoders as uniform and uncoupled: the arm's own are refused.
+  char c1[] = "--qemu";
+  char* q[] = {prog, c1, a1, a2};
+  sim::ExperimentOptions o3;
+  EXPECT_FALSE(sim::parse_experiment_args(4, q, o3, err));
+  EXPECT_NE(err.find("plant.coupling applies to the host-built controller only"), std::string::npos) << err;
+}
+
 // --pil-link names the transport to the image in QEMU; semihosting unless it says uart.
 TEST(Config, PilLinkIsSemihostingOrUartAndNeedsQemu) {
   char prog[] = "puma_experiment", q[] = "--qemu", l[] = "--pil-link", uart[] = "uart", spi[] = "spi";

@@ -10,8 +10,8 @@ namespace osc::puma560 {
 
 /// Motor inertias [kg m^2]: the toolbox's (Corke/Armstrong-Helouvry consensus, RTB `mdl_puma560`),
 /// the model's own (kArm), and AKB86's (RTB `mdl_puma560akb`): +45 / +105 / +50 % on J1-J3.
-constexpr MotorInertias kMotorInertiaToolbox = {"toolbox", {200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6}};
-constexpr MotorInertias kMotorInertiaAkb86 = {"akb86", {291e-6, 409e-6, 299e-6, 35e-6, 35e-6, 35e-6}};
+inline constexpr MotorInertias kMotorInertiaToolbox = {"toolbox", {200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6}};
+inline constexpr MotorInertias kMotorInertiaAkb86 = {"akb86", {291e-6, 409e-6, 299e-6, 35e-6, 35e-6, 35e-6}};
 
 constexpr ArmDescription kArm = {
     "PUMA 560",
