@@ -343,8 +343,8 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
         s.base.plant.motor_inertia = v == "akb86" ? &osc::robot::kMotorInertiaAkb86 : nullptr;
       });
   number(t, "plant.amp_lag",
-         "the amplifiers' current loops, first-order time constant [s] (0: none; tried 0.2e-3..0.5e-3)", 0, 5e-3, true,
-         [](Settings& s) -> double& { return s.base.plant.amp_lag; });
+         "the amplifiers' current loops, first-order time constant [s] (0: none; estimate: 0.2e-3..0.5e-3)", 0, 5e-3,
+         true, [](Settings& s) -> double& { return s.base.plant.amp_lag; });
   flag(t, "plant.amp_current_limit", "the amplifiers' current limits (the drive train's motor torque limits)",
        [](Settings& s) -> bool& { return s.base.plant.amp_current_limit; });
   array6(t, "plant.amp_gain_error", "the amplifiers' gain errors per channel, relative", -0.2, 0.2,
@@ -366,7 +366,7 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
     return std::string();
   };
   t.push_back(d);
-  number(t, "plant.ripple", "torque ripple, relative amplitude (0: none; tried 0.01..0.05)", 0, 0.2, true,
+  number(t, "plant.ripple", "torque ripple, relative amplitude (0: none; estimate: 0.01..0.05)", 0, 0.2, true,
          [](Settings& s) -> double& { return s.base.plant.ripple; });
   Entry r{"plant.ripple_cycles",
           "ripple periods per motor revolution (the motor's pole frequency)",
@@ -383,10 +383,11 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
     return std::string();
   };
   t.push_back(r);
-  number(t, "plant.backlash", "gear backlash on J1-J3, the dead band at the joint [rad] (0: none; tried 0.1e-3..1e-3)",
-         0, 5e-3, true, [](Settings& s) -> double& { return s.base.plant.backlash; });
+  number(t, "plant.backlash",
+         "gear backlash on J1-J3, the dead band at the joint [rad] (0: none; estimate: 0.1e-3..1e-3)", 0, 5e-3, true,
+         [](Settings& s) -> double& { return s.base.plant.backlash; });
   number(t, "plant.elastic_hz",
-         "joint elasticity on J1-J3: the locked-motor resonance at the start pose [Hz] (0: rigid; tried 15..25)", 0,
+         "joint elasticity on J1-J3: the locked-motor resonance at the start pose [Hz] (0: rigid; estimate: 15..25)", 0,
          200, true, [](Settings& s) -> double& { return s.base.plant.elastic_hz; });
   number(t, "plant.encoder_jitter", "encoder edge jitter, the edges' spread [counts] (0: none)", 0, 0.5, true,
          [](Settings& s) -> double& { return s.base.sensors.encoder_jitter; });

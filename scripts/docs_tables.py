@@ -574,6 +574,177 @@ def monitors_hour():
     return "\n".join(lines)
 
 
+# ---------------------------------------------------------------- the realistic plant (issue 24)
+
+
+_configs = {}
+
+
+def printed_config(*args):
+    """puma_experiment --print-config with these arguments: {key: (value, comment)} (cached)."""
+    key = tuple(args)
+    if key not in _configs:
+        import yaml
+        text = subprocess.run([EXPERIMENT, "--print-config", *args], capture_output=True, text=True,
+                              check=True).stdout
+        values = {}
+
+        def walk(node, prefix):
+            for k, v in node.items():
+                if isinstance(v, dict):
+                    walk(v, prefix + k + ".")
+                else:
+                    values[prefix + k] = v
+        walk(yaml.safe_load(text), "")
+        comments, path = {}, []
+        for line in text.splitlines():
+            m = re.match(r"^( *)([A-Za-z_0-9]+):(.*?)(?:\s+#\s*(.*))?$", line)
+            if not m or line.lstrip().startswith("#"):
+                continue
+            depth = len(m.group(1)) // 2
+            path = path[:depth] + [m.group(2)]
+            if m.group(4):
+                comments[".".join(path)] = m.group(4)
+        _configs[key] = {k: (v, comments.get(k, "")) for k, v in values.items()}
+    return _configs[key]
+
+
+def plant_feature_keys():
+    """The plant's features, in the configuration's order: the keys --plant realistic changes, and
+    the ones the presets share (after plant.preset, before plant.friction)."""
+    ideal = printed_config()
+    keys = list(ideal)
+    first, last = keys.index("plant.preset") + 1, keys.index("plant.friction.preset")
+    return keys[first:last]
+
+
+def config_value(v):
+    if isinstance(v, bool):  # YAML reads off / on as false / true
+        return "on" if v else "off"
+    if isinstance(v, list):
+        return "[" + ", ".join(f"{x:g}" for x in v) + "]"
+    return f"{v:g}" if isinstance(v, (int, float)) else str(v)
+
+
+@table("plant_features", "docs/experiment.md", "host")
+def plant_features():
+    ideal, real = printed_config(), printed_config("--plant", "realistic")
+    lines = ["| key (`--plant-set` without `plant.`) | what, unit; range | `ideal` | `realistic` |", "|---|---|---|---|"]
+    for k in plant_feature_keys():
+        doc = real[k][1].replace("|", "\\|")
+        lines.append(f"| `{k}` | {doc} | {config_value(ideal[k][0])} | {config_value(real[k][0])} |")
+    return "\n".join(lines)
+
+
+def feature_settings():
+    """One --plant-set per feature that moves the dynamics or the encoders, at its realistic value
+    (on the ideal plant); the ripple with its cycles, the drift with its period."""
+    ideal, real = printed_config(), printed_config("--plant", "realistic")
+    groups = []
+    for k in plant_feature_keys():
+        if ideal[k][0] == real[k][0] or k in ("plant.ripple_cycles", "plant.friction_drift_period"):
+            continue
+        sets = [k]
+        if k == "plant.ripple":
+            sets.append("plant.ripple_cycles")
+        if k == "plant.friction_drift":
+            sets.append("plant.friction_drift_period")
+        args = []
+        for key in sets:
+            v = real[key][0]
+            args += ["--plant-set", key[len("plant."):] + "=" + (config_value(v).replace(" ", "") if isinstance(v, list)
+                                                                   else config_value(v))]
+        groups.append((k[len("plant."):], tuple(args)))
+    return groups
+
+
+FIDELITY = ("--duration", "120")
+
+
+@table("plant_fidelity", "docs/experiment.md", "long")
+def plant_fidelity():
+    feats = feature_settings()
+    runs = [FIDELITY, FIDELITY + ("--plant", "realistic")] + [FIDELITY + a for _, a in feats]
+    prefetch(runs)
+    base = experiment(*FIDELITY)
+    t1, t3 = base["paper"]["table1_max_error_mm_deg"], base["paper"]["table3_max_error_mm_deg"]
+    head = ("| plant | with compensation, last 20 s: x / y / z mm | φx / φy / φz ° | without compensation, "
+            "last 20 s: x / y / z mm | φx / φy / φz ° | faults |")
+    lines = [head, "|---|---|---|---|---|---|"]
+
+    def cells(s):
+        ad, no = run_of(s, "adaptive"), run_of(s, "none")
+        a, n = errors(ad, "last"), errors(no, "last")
+        faults = ", ".join(sorted(set(ad["faults"] + no["faults"]))) or "none"
+        return (f"{a[0]:.3f} / {a[1]:.3f} / {a[2]:.3f} | {a[3]:.3f} / {a[4]:.3f} / {a[5]:.3f} | "
+                f"{n[0]:.3f} / {n[1]:.3f} / {n[2]:.3f} | {n[3]:.3f} / {n[4]:.3f} / {n[5]:.3f} | {faults}")
+    lines.append(f"| **the paper's PUMA 560** (Tables I, III) | **{t1[0]} / {t1[1]} / {t1[2]}** | "
+                 f"**{t1[3]} / {t1[4]} / {t1[5]}** | **{t3[0]} / {t3[1]} / {t3[2]}** | **{t3[3]} / {t3[4]} / {t3[5]}** | |")
+    lines.append("| `ideal` | " + cells(base) + " |")
+    lines.append("| `realistic` | " + cells(experiment(*runs[1])) + " |")
+    for (name, args), r in zip(feats, runs[2:]):
+        lines.append(f"| `ideal` + {name} | " + cells(experiment(*r)) + " |")
+    # The estimates' ranges (the keys' texts state them): each end, alone on the ideal plant.
+    ends = [FIDELITY + ("--plant-set", f"{k}={v}") + extra for k, lo, hi, extra in ESTIMATE_RANGES for v in (lo, hi)]
+    prefetch(ends)
+    for k, lo, hi, extra in ESTIMATE_RANGES:
+        for v in (lo, hi):
+            lines.append(f"| `ideal` + {k} = {v:g} | " + cells(experiment(*(FIDELITY + ("--plant-set", f"{k}={v}") + extra)))
+                         + " |")
+    return "\n".join(lines)
+
+
+# The ends of the estimated features' ranges (as their keys' texts state them), tried in the fidelity
+# table; extra: what the feature needs beside it.
+ESTIMATE_RANGES = [("amp_lag", 0.2e-3, 0.5e-3, ()), ("ripple", 0.01, 0.05, ("--plant-set", "ripple_cycles=8")),
+                   ("backlash", 0.1e-3, 1e-3, ()), ("elastic_hz", 15, 25, ())]
+
+
+RESONANCE_HZ = [25, 20, 15, 12, 10, 8, 6, 5, 4, 3]
+RESONANCE = ("--duration", "60", "--mode", "adaptive", "--plant", "realistic")
+
+
+@table("plant_resonance", "docs/experiment.md", "long")
+def plant_resonance():
+    lines = ["| J1–J3 locked-motor resonance | max \\|e\\| whole run, x / y / z mm | last 20 s, x / y / z mm | "
+             "faults (time) |", "|---|---|---|---|"]
+    for hz in RESONANCE_HZ:
+        args = RESONANCE + ("--plant-set", f"elastic_hz={hz}")
+        EXPECTED_FAULTS.add(args)
+        r = run_of(experiment(*args), "adaptive")
+        a, l = errors(r, "all"), errors(r, "last")
+        fault = (", ".join(r["faults"]) + f" ({r['fault_time_s']:.3f} s)") if r["faults"] else "none"
+        last = "—" if r["faults"] else f"{l[0]:.3f} / {l[1]:.3f} / {l[2]:.3f}"
+        lines.append(f"| {hz} Hz | {a[0]:.3f} / {a[1]:.3f} / {a[2]:.3f} | {last} | {fault} |")
+        if r["faults"]:
+            break
+    return "\n".join(lines)
+
+
+@table("plant_hour", "docs/experiment.md", "long")
+def plant_hour():
+    runs = [("`realistic`, double", HOUR + ("--plant", "realistic")),
+            ("`realistic`, float", HOUR + ("--plant", "realistic", "--scalar", "float")),
+            ("`realistic`, fixed (Q12.19)", HOUR + ("--plant", "realistic", "--scalar", "fixed"))]
+    text = adaptation_rows(runs)
+    counts_max = parse_params("kStuckMotionCounts", 1)[0]
+    dtau, silent = parse_params("kStuckTorque", 6), parse_params("kStuckTorqueSilent", 6)
+    lines = ["", "| monitor, worst over the hour (threshold) | " + " | ".join(n for n, _ in runs) + " |",
+             "|---|---|---|---|"]
+    rs = [run_of(experiment(*a), "adaptive") for _, a in runs]
+
+    def peaks(key, lim):
+        return " | ".join(", ".join(f"{v:.1f}" for v in r[key]) + f" ({max(v / t for v, t in zip(r[key], lim)):.2f} "
+                          "of a threshold)" for r in rs)
+    lines.append(f"| reference motion while still, gated, J1..J6 [counts] ({counts_max:g}) | "
+                 + peaks("stuck_monitor_peak_counts", [counts_max] * 6) + " |")
+    lines.append(f"| torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau)}) | "
+                 + peaks("stuck_monitor_peak_dtau_Nm", dtau) + " |")
+    lines.append(f"| torque change, moving joint silent, J1..J6 [N m] ({', '.join(f'{v:g}' for v in silent)}) | "
+                 + peaks("stuck_monitor_peak_dtau_silent_Nm", silent) + " |")
+    return text + "\n".join(lines)
+
+
 MONITOR_PERTURBATIONS = [(), ("--delay", "1e-4"), ("--delay", "3e-4"), ("--model-error", "-0.05"),
                          ("--model-error", "0.05"), ("--set", "plant.smooth_steps=1")]
 

@@ -508,7 +508,9 @@ TEST(PlantSensors, InjectedEncoderFaultsStayOnTheirChannel) {
   SensorConfig s;
   s.encoders = osc::robot::kDriveTrain.encoders;
   const Vec6 q0 = q_start();
-  Plant plant;
+  PlantConfig pc;
+  pc.coupling = true;  // the motors turn as C^-1 q: what the coupled map reads
+  Plant plant(pc);
   plant.reset(q0);
   Injection stuck;
   stuck.enabled = true;
