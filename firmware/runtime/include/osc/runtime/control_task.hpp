@@ -99,7 +99,7 @@ struct ControlTask {
   }
   /// The encoders and coupling of the arm (osc/robots/arm.hpp, EncoderMap): the angles, the
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
-  void set_encoders(const EncoderMap& map) {
+  [[gnu::cold]] void set_encoders(const EncoderMap& map) {  // set-up, in double: compiled for size
     io = IoMap<S>::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
@@ -131,10 +131,11 @@ template <class S>
 std::uint32_t step_monitor_faults(ControlTask<S>& task, const bool moved[kDof]) {
   const StepOutput<S>& out = task.last;
   // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
-  std::uint32_t faults =
-      task.io.coupled() ? task.stuck.check(motor_torques(task.io, out.tau), motor_rates(task.io, out.qd_ref), moved,
-                                           task.tick, task.gains.dt, task.io.counts_per_rad)
-                        : task.stuck.check(out.tau, out.qd_ref, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
+  Vec6<S> tau_m, rate_m;
+  const bool coupled = task.io.coupled();
+  const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
+  const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
+  std::uint32_t faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check(task.state.adapt.theta_hat, task.gains.theta_max);

@@ -60,7 +60,7 @@ struct IoMap {
 
   bool coupled() const { return terms != 0; }
 
-  static IoMap of(const EncoderMap& map) {
+  [[gnu::cold]] static IoMap of(const EncoderMap& map) {
     IoMap m{};
     double C[kDof][kDof] = {};
     for (int i = 0; i < kDof; ++i) {
