@@ -887,10 +887,15 @@ TEST(PlantDynamics, SmoothChunksAgreeWithTheFixedStep) {
   };
   long n1 = 0, n8 = 0;
   const double dq = (open(1, &n1) - open(8, &n8)).cwiseAbs().maxCoeff();
-  PlantConfig fixed = all_on(), half = all_on();
+  // In closed loop without the AKB86 motor inertias: that model error alone trips the
+  // trajectory-tuned stuck-encoder monitor within seconds (docs/experiment.md, the fidelity table),
+  // and the integrator, not the monitor, is under test here.
+  PlantConfig chunks = all_on();
+  chunks.motor_inertia = nullptr;
+  PlantConfig fixed = chunks, half = chunks;
   fixed.smooth_steps = half.smooth_steps = 1;
   half.substep = fixed.substep / 2;
-  const LoopResult a = motor_encoder_loop(fixed, 10), b = motor_encoder_loop(all_on(), 10),
+  const LoopResult a = motor_encoder_loop(fixed, 10), b = motor_encoder_loop(chunks, 10),
                    c = motor_encoder_loop(half, 10);
   auto differ = [](const LoopResult& x, const LoopResult& y, int from) {
     double d = 0;
