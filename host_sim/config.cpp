@@ -308,49 +308,8 @@ void array6(std::vector<Entry>& t, std::string key, std::string doc, double lo, 
   t.push_back(e);
 }
 
-/// The plant's features (docs/experiment.md, "The realistic plant"): the preset first, then each
-/// feature, so that a file read in its printed order applies the preset and then its differences.
-void add_plant_feature_entries(std::vector<Entry>& t) {
-  const std::size_t first = t.size() + 1;  // after plant.preset
-  name(
-      t, "plant.preset",
-      "the simulated arm: ideal (rigid, uncoupled, ideal drives: the paper's tables) or realistic (every feature "
-      "below at its mid value); setting it sets every feature below",
-      plant_preset_names(), true, [](const Settings& s) { return s.plant_preset; },
-      [](Settings& s, const std::string& n) {
-        apply_plant_preset(n, s.base);
-        s.plant_preset = n;
-      });
-  name(
-      t, "plant.encoders",
-      "encoder resolution: uniform (plant.encoder_cpr on every motor) or trident (the PUMA's own, per joint: 1000 "
-      "counts per motor revolution, about 797 on J2)",
-      {"uniform", "trident"}, true,
-      [](const Settings& s) { return std::string(s.base.published_encoders ? "trident" : "uniform"); },
-      [](Settings& s, const std::string& v) { s.base.published_encoders = v == "trident"; });
-  flag(t, "plant.coupling",
-       "the wrist coupling (q5 = e5 - 0.0139 e4, q6 = e6 + 0.0130 e4 - 0.1806 e5): the encoders count motor "
-       "angles, the DACs command motor torques (C^T tau), the motor inertias and friction act on the motors",
-       [](Settings& s) -> bool& { return s.base.plant.coupling; });
-  name(
-      t, "plant.motor_inertia",
-      "the plant's motor inertias: toolbox (the controller's model) or akb86 (+45/+105/+50 % on J1-J3)",
-      {"toolbox", "akb86"}, true,
-      [](const Settings& s) {
-        return std::string(s.base.plant.motor_inertia ? s.base.plant.motor_inertia->name : "toolbox");
-      },
-      [](Settings& s, const std::string& v) {
-        s.base.plant.motor_inertia = v == "akb86" ? &osc::robot::kMotorInertiaAkb86 : nullptr;
-      });
-  number(t, "plant.amp_lag",
-         "the amplifiers' current loops, first-order time constant [s] (0: none; estimate: 0.2e-3..0.5e-3)", 0, 5e-3,
-         true, [](Settings& s) -> double& { return s.base.plant.amp_lag; });
-  flag(t, "plant.amp_current_limit", "the amplifiers' current limits (the drive train's motor torque limits)",
-       [](Settings& s) -> bool& { return s.base.plant.amp_current_limit; });
-  array6(t, "plant.amp_gain_error", "the amplifiers' gain errors per channel, relative", -0.2, 0.2,
-         [](Settings& s) { return s.base.plant.amp_gain_error; });
-  array6(t, "plant.amp_offset", "the amplifiers' offsets per channel, joint-referred [N m]", -10, 10,
-         [](Settings& s) { return s.base.plant.amp_offset; });
+/// The plant's features from the DAC on: its resolution, the ripple, the gears, the sensors, the drift.
+void add_plant_feature_tail(std::vector<Entry>& t) {
   Entry d{"plant.dac_bits",
           "the DACs' resolution the amplifiers see [bits] (the board's AD5754R: 16)",
           Kind::kNumber,
@@ -400,6 +359,52 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
          true, [](Settings& s) -> double& { return s.base.plant.friction_drift; });
   number(t, "plant.friction_drift_period", "the period of friction's drift [s]", 60, 86400, true,
          [](Settings& s) -> double& { return s.base.plant.friction_drift_period; });
+}
+
+/// The plant's features (docs/experiment.md, "The realistic plant"): the preset first, then each
+/// feature, so that a file read in its printed order applies the preset and then its differences.
+void add_plant_feature_entries(std::vector<Entry>& t) {
+  const std::size_t first = t.size() + 1;  // after plant.preset
+  name(
+      t, "plant.preset",
+      "the simulated arm: ideal (rigid, uncoupled, ideal drives: the paper's tables) or realistic (every feature "
+      "below at its mid value); setting it sets every feature below",
+      plant_preset_names(), true, [](const Settings& s) { return s.plant_preset; },
+      [](Settings& s, const std::string& n) {
+        apply_plant_preset(n, s.base);
+        s.plant_preset = n;
+      });
+  name(
+      t, "plant.encoders",
+      "encoder resolution: uniform (plant.encoder_cpr on every motor) or trident (the PUMA's own, per joint: 1000 "
+      "counts per motor revolution, about 797 on J2)",
+      {"uniform", "trident"}, true,
+      [](const Settings& s) { return std::string(s.base.published_encoders ? "trident" : "uniform"); },
+      [](Settings& s, const std::string& v) { s.base.published_encoders = v == "trident"; });
+  flag(t, "plant.coupling",
+       "the wrist coupling (q5 = e5 - 0.0139 e4, q6 = e6 + 0.0130 e4 - 0.1806 e5): the encoders count motor "
+       "angles, the DACs command motor torques (C^T tau), the motor inertias and friction act on the motors",
+       [](Settings& s) -> bool& { return s.base.plant.coupling; });
+  name(
+      t, "plant.motor_inertia",
+      "the plant's motor inertias: toolbox (the controller's model) or akb86 (+45/+105/+50 % on J1-J3)",
+      {"toolbox", "akb86"}, true,
+      [](const Settings& s) {
+        return std::string(s.base.plant.motor_inertia ? s.base.plant.motor_inertia->name : "toolbox");
+      },
+      [](Settings& s, const std::string& v) {
+        s.base.plant.motor_inertia = v == "akb86" ? &osc::robot::kMotorInertiaAkb86 : nullptr;
+      });
+  number(t, "plant.amp_lag",
+         "the amplifiers' current loops, first-order time constant [s] (0: none; estimate: 0.2e-3..0.5e-3)", 0, 5e-3,
+         true, [](Settings& s) -> double& { return s.base.plant.amp_lag; });
+  flag(t, "plant.amp_current_limit", "the amplifiers' current limits (the drive train's motor torque limits)",
+       [](Settings& s) -> bool& { return s.base.plant.amp_current_limit; });
+  array6(t, "plant.amp_gain_error", "the amplifiers' gain errors per channel, relative", -0.2, 0.2,
+         [](Settings& s) { return s.base.plant.amp_gain_error; });
+  array6(t, "plant.amp_offset", "the amplifiers' offsets per channel, joint-referred [N m]", -10, 10,
+         [](Settings& s) { return s.base.plant.amp_offset; });
+  add_plant_feature_tail(t);
   // The plant's preset and features model the paper's robot more or less closely: they do not change
   // the paper's set-up (the outputs name them apart: Provenance::plant).
   t[first - 1].paper = false;

@@ -629,7 +629,8 @@ def config_value(v):
 @table("plant_features", "docs/experiment.md", "host")
 def plant_features():
     ideal, real = printed_config(), printed_config("--plant", "realistic")
-    lines = ["| key (`--plant-set` without `plant.`) | what, unit; range | `ideal` | `realistic` |", "|---|---|---|---|"]
+    lines = ["| key (`--plant-set` without `plant.`) | what, unit; range | `ideal` | `realistic` |",
+             "|---|---|---|---|"]
     for k in plant_feature_keys():
         doc = real[k][1].replace("|", "\\|")
         lines.append(f"| `{k}` | {doc} | {config_value(ideal[k][0])} | {config_value(real[k][0])} |")
@@ -652,8 +653,8 @@ def feature_settings():
         args = []
         for key in sets:
             v = real[key][0]
-            args += ["--plant-set", key[len("plant."):] + "=" + (config_value(v).replace(" ", "") if isinstance(v, list)
-                                                                   else config_value(v))]
+            text = config_value(v).replace(" ", "") if isinstance(v, list) else config_value(v)
+            args += ["--plant-set", key[len("plant."):] + "=" + text]
         groups.append((k[len("plant."):], tuple(args)))
     return groups
 
@@ -683,11 +684,13 @@ def plant_fidelity():
         if ad["faults"] or no["faults"]:  # the last 20 s of a faulted run are no result
             a = [float("nan")] * 6 if ad["faults"] else a
             n = [float("nan")] * 6 if no["faults"] else n
+
         def f3(v):
             return " / ".join("—" if math.isnan(x) else f"{x:.3f}" for x in v)
         return f"{f3(a[:3])} | {f3(a[3:])} | {f3(n[:3])} | {f3(n[3:])} | {faults}"
     lines.append(f"| **the paper's PUMA 560** (Tables I, III) | **{t1[0]} / {t1[1]} / {t1[2]}** | "
-                 f"**{t1[3]} / {t1[4]} / {t1[5]}** | **{t3[0]} / {t3[1]} / {t3[2]}** | **{t3[3]} / {t3[4]} / {t3[5]}** | |")
+                 f"**{t1[3]} / {t1[4]} / {t1[5]}** | **{t3[0]} / {t3[1]} / {t3[2]}** | "
+                 f"**{t3[3]} / {t3[4]} / {t3[5]}** | |")
     lines.append("| `ideal` | " + cells(base) + " |")
     lines.append("| `realistic` | " + cells(experiment(*runs[1])) + " |")
     for (name, args), r in zip(feats, runs[2:]):
@@ -696,8 +699,8 @@ def plant_fidelity():
     prefetch(ends)
     for k, lo, hi, extra in ESTIMATE_RANGES:
         for v in (lo, hi):
-            lines.append(f"| `ideal` + {k} = {v:g} | " + cells(experiment(*(FIDELITY + ("--plant-set", f"{k}={v}") + extra)))
-                         + " |")
+            run = experiment(*(FIDELITY + ("--plant-set", f"{k}={v}") + extra))
+            lines.append(f"| `ideal` + {k} = {v:g} | " + cells(run) + " |")
     return "\n".join(lines)
 
 
@@ -719,9 +722,9 @@ def plant_resonance():
         args = RESONANCE + ("--plant-set", f"elastic_hz={hz}")
         EXPECTED_FAULTS.add(args)
         r = run_of(experiment(*args), "adaptive")
-        a, l = errors(r, "all"), errors(r, "last")
+        a, fin = errors(r, "all"), errors(r, "last")
         fault = (", ".join(r["faults"]) + f" ({r['fault_time_s']:.3f} s)") if r["faults"] else "none"
-        last = "—" if r["faults"] else f"{l[0]:.3f} / {l[1]:.3f} / {l[2]:.3f}"
+        last = "—" if r["faults"] else f"{fin[0]:.3f} / {fin[1]:.3f} / {fin[2]:.3f}"
         lines.append(f"| {hz} Hz | {a[0]:.3f} / {a[1]:.3f} / {a[2]:.3f} | {last} | {fault} |")
         if r["faults"]:
             break
@@ -739,7 +742,8 @@ def plant_hour():
     for _, a in runs:  # when each fault came
         r = run_of(experiment(*a), "adaptive")
         if r["faults"]:
-            text = text.replace(f"| {', '.join(r['faults'])} |", f"| {', '.join(r['faults'])} at {r['fault_time_s']:.1f} s |", 1)
+            names = ", ".join(r["faults"])
+            text = text.replace(f"| {names} |", f"| {names} at {r['fault_time_s']:.1f} s |", 1)
     counts_max = parse_params("kStuckMotionCounts", 1)[0]
     dtau, silent = parse_params("kStuckTorque", 6), parse_params("kStuckTorqueSilent", 6)
     lines = ["", "| monitor, worst over the hour (threshold) | " + " | ".join(n for n, _ in runs) + " |",

@@ -33,9 +33,9 @@ struct ControlTask {
   Model<S> model;
   Gains<S> gains;
   FrictionMode mode;
-  Vec6<S> q_start;                            // joint angles at which the encoders read zero
-  IoMap<S> io;                                // encoders and coupling (robot::kEncodersUniform by default)
-  std::uint64_t tick;                         // samples since start (64 bits: never wraps in service)
+  Vec6<S> q_start;     // joint angles at which the encoders read zero
+  IoMap<S> io;         // encoders and coupling (robot::kEncodersUniform by default)
+  std::uint64_t tick;  // samples since start (64 bits: never wraps in service)
   ControllerState<S> state;
   MotionMachine machine;      // the motion state machine (osc/runtime/motion_states.hpp)
   MotionGenerator<S> gen;     // the desired state of each tick (osc/control/motion.hpp)
