@@ -50,17 +50,8 @@ struct EncoderCoupling {
   double inverse[hal::kJoints][hal::kJoints] = {};
   bool coupled = false;
 
-  explicit EncoderCoupling(const osc::EncoderMap& map) {
-    for (int i = 0; i < hal::kJoints; ++i) c[i][i] = 1;
-    for (int k = 0; k < map.coupling_terms; ++k) c[map.coupling[k].row][map.coupling[k].col] += map.coupling[k].c;
-    coupled = map.coupling_terms != 0;
-    // C X = I column by column, rows top down.
-    for (int j = 0; j < hal::kJoints; ++j)
-      for (int i = 0; i < hal::kJoints; ++i) {
-        double x = i == j ? 1.0 : 0.0;
-        for (int k = 0; k < i; ++k) x -= c[i][k] * inverse[k][j];
-        inverse[i][j] = x;
-      }
+  explicit EncoderCoupling(const osc::EncoderMap& map) : coupled(map.coupling_terms != 0) {
+    osc::coupling_matrices(map, c, inverse);
   }
   /// The motor angles (referred to their joints) of joint angles q: C^-1 q (q itself uncoupled).
   Vec6 motor_from_joint(const Vec6& q) const {

@@ -57,6 +57,20 @@ struct EncoderMap {
   CouplingTerm coupling[kMaxCouplingTerms];
 };
 
+/// A map's coupling matrix C (unit lower triangular, from its terms) and C^-1, by forward
+/// substitution (C X = I column by column, rows top down).
+constexpr void coupling_matrices(const EncoderMap& map, double (&C)[kDof][kDof], double (&inverse)[kDof][kDof]) {
+  for (int i = 0; i < kDof; ++i)
+    for (int j = 0; j < kDof; ++j) C[i][j] = i == j ? 1.0 : 0.0;
+  for (int k = 0; k < map.coupling_terms; ++k) C[map.coupling[k].row][map.coupling[k].col] += map.coupling[k].c;
+  for (int j = 0; j < kDof; ++j)
+    for (int i = 0; i < kDof; ++i) {
+      double x = i == j ? 1.0 : 0.0;
+      for (int k = 0; k < i; ++k) x -= C[i][k] * inverse[k][j];
+      inverse[i][j] = x;
+    }
+}
+
 /// Encoders of one resolution on every motor shaft, each reading its own joint.
 constexpr EncoderMap uniform_encoders(const char* name, const ArmDescription& arm, double counts_per_motor_rev) {
   EncoderMap m{name, {}, 0, {}};

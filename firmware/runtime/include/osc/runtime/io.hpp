@@ -62,26 +62,16 @@ struct IoMap {
 
   [[gnu::cold]] static IoMap of(const EncoderMap& map) {
     IoMap m{};
-    double C[kDof][kDof] = {};
-    for (int i = 0; i < kDof; ++i) {
-      m.counts_per_rad(i) = lit<math::io_scalar_t<S>>(map.counts_per_rad[i]);
-      C[i][i] = 1;
-    }
+    for (int i = 0; i < kDof; ++i) m.counts_per_rad(i) = lit<math::io_scalar_t<S>>(map.counts_per_rad[i]);
     m.terms = map.coupling_terms;
     for (int k = 0; k < map.coupling_terms; ++k) {
       const CouplingTerm& t = map.coupling[k];
       m.row[k] = static_cast<std::int8_t>(t.row);
       m.col[k] = static_cast<std::int8_t>(t.col);
       m.c[k] = lit<S>(t.c);
-      C[t.row][t.col] += t.c;
     }
-    // C X = I, column by column, rows top down (C unit lower triangular).
-    for (int j = 0; j < kDof; ++j)
-      for (int i = 0; i < kDof; ++i) {
-        double x = i == j ? 1.0 : 0.0;
-        for (int k = 0; k < i; ++k) x -= C[i][k] * m.inverse[k][j];
-        m.inverse[i][j] = x;
-      }
+    double C[kDof][kDof];
+    coupling_matrices(map, C, m.inverse);
     m.inverse_terms = 0;
     for (int i = 0; i < kDof; ++i)
       for (int j = 0; j < i; ++j)
