@@ -145,6 +145,12 @@ void add_run_entries(std::vector<Entry>& t) {
       std::vector<std::string>(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount), false,
       [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
       [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
+  name(
+      t, "run.residual_monitor",
+      "trial: the residual monitor is computed and reported, the stuck-encoder monitor raises encoder_stuck; on: the "
+      "residual monitor raises encoder_stuck, drive_fault and collision in its place (docs/safety.md)",
+      {"trial", "on"}, false, [](const Settings& s) { return std::string(s.base.residual_monitor ? "on" : "trial"); },
+      [](Settings& s, const std::string& m) { s.base.residual_monitor = m == "on"; });
   number(t, "run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
          true, [](Settings& s) -> double& { return s.base.final_window; });
   number(t, "run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,

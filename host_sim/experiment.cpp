@@ -26,6 +26,7 @@ class LocalController {
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
     task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode,
                 q0.cast<S>(), PlantHal::kPeriodNs);
+    task_->residual.armed = cfg.residual_monitor;
     task_->set_encoders(cfg.encoder_map());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
@@ -43,6 +44,16 @@ class LocalController {
       r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
     }
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
+    const osc::ResidualMonitor<S>& m = task_->residual;
+    for (int i = 0; i < 6; ++i) {
+      const double th = static_cast<double>(m.threshold(i)), ri = std::abs(static_cast<double>(m.r(i)));
+      if (m.primed && th > 0 && ri / th > residual_.residual_peak_ratio[i]) {
+        residual_.residual_peak_ratio[i] = ri / th;
+        residual_.residual_peak_s[i] = static_cast<double>(task_->tick - 1) / osc::params::kControlHz;
+        residual_.residual_peak_Nm[i] = ri;
+        residual_.residual_threshold_Nm[i] = th;
+      }
+    }
     return true;
   }
   void skip_ticks(std::uint64_t n) { task_->tick += n; }
@@ -50,10 +61,23 @@ class LocalController {
     for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck.peak(i));
     for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck.dtau_peak(i));
     for (int i = 0; i < 6; ++i) res.stuck_dtau_silent_peak[i] = static_cast<double>(task_->stuck.dtau_gated_peak(i));
+    for (int i = 0; i < 6; ++i) {
+      res.residual_peak_ratio[i] = residual_.residual_peak_ratio[i];
+      res.residual_peak_s[i] = residual_.residual_peak_s[i];
+      res.residual_peak_Nm[i] = residual_.residual_peak_Nm[i];
+      res.residual_threshold_Nm[i] = residual_.residual_threshold_Nm[i];
+    }
+    const osc::ResidualMonitor<S>& m = task_->residual;
+    if (m.detected != 0) {
+      res.residual_detected_s = static_cast<double>(m.detected_tick) / osc::params::kControlHz;
+      res.residual_fault = m.detected;
+      res.residual_joint = m.joint;
+    }
   }
 
  private:
   std::unique_ptr<osc::ControlTask<S>> task_;  // large: keep off the stack
+  StuckMonitorPeaks residual_;                 // the residual monitor's peaks so far
 };
 
 /// The firmware image (or any PIL peer) over the link, one exchange per tick.

@@ -55,7 +55,10 @@ struct ExperimentConfig {
     s.encoders = encoder_map();
     return s;
   }
-  double model_error = 0.0;    ///< controller's link mass/inertia relative error
+  double model_error = 0.0;  ///< controller's link mass/inertia relative error
+  /// The residual monitor raises the faults in place of the stuck-encoder monitor (in-process
+  /// controller only; otherwise it runs as a trial: computed and reported, docs/safety.md).
+  bool residual_monitor = false;
   double log_period = 0.01;    ///< time-series decimation [s]
   double final_window = 20.0;  ///< "last 20 s" statistics [s]
   double window = 60.0;        ///< length of the per-window maxima [s]

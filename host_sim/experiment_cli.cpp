@@ -197,6 +197,11 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
                    " applies to the host-built controller only, not with --qemu (the firmware image compiles in "
                    "uniform, uncoupled encoders)",
              false;
+    if (o.base.residual_monitor)
+      return err =
+                 "run.residual_monitor=on applies to the host-built controller only, not with --qemu (the "
+                 "firmware image runs the residual monitor as a trial)",
+             false;
     if (o.base.injection.enabled && !info(o.base.injection.kind).per_joint)
       return err = std::string("--inject ") + info(o.base.injection.kind).name +
                    " applies to the host-built controller only, not with --qemu",

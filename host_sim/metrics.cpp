@@ -239,6 +239,14 @@ void StuckMonitorPeaks::to_json(Json& j) const {
   j["stuck_monitor_peak_counts"] = json_array(stuck_peak, 6);
   j["stuck_monitor_peak_dtau_Nm"] = json_array(stuck_dtau_peak, 6);
   j["stuck_monitor_peak_dtau_silent_Nm"] = json_array(stuck_dtau_silent_peak, 6);
+  j["residual_monitor_peak_ratio"] = json_array(residual_peak_ratio, 6);
+  j["residual_monitor_peak_s"] = json_array(residual_peak_s, 6);
+  j["residual_monitor_peak_Nm"] = json_array(residual_peak_Nm, 6);
+  j["residual_monitor_threshold_at_peak_Nm"] = json_array(residual_threshold_Nm, 6);
+  j["residual_monitor_detection"] = residual_detected_s < 0 ? Json(nullptr)
+                                                            : Json{{"t_s", residual_detected_s},
+                                                                   {"fault", osc::fault_name(residual_fault)},
+                                                                   {"joint", residual_joint + 1}};
 }
 
 // ---- FirmwareReport

@@ -153,6 +153,13 @@ struct StuckMonitorPeaks {
   double stuck_peak[6] = {};              ///< [counts]
   double stuck_dtau_peak[6] = {};         ///< the largest torque change [N m]
   double stuck_dtau_silent_peak[6] = {};  ///< ... while the encoder was also silent (kStuckTorqueSilent) [N m]
+  double residual_peak_ratio[6] = {};     ///< the residual monitor's largest |r| / threshold per joint
+  double residual_peak_s[6] = {};         ///< ... and when [s]
+  double residual_peak_Nm[6] = {};        ///< ... |r| then [N m]
+  double residual_threshold_Nm[6] = {};   ///< ... its threshold then [N m]
+  double residual_detected_s = -1;        ///< the residual monitor's first detection [s] (-1: none)
+  std::uint32_t residual_fault = 0;       ///< ... its fault
+  int residual_joint = -1;                ///< ... its joint (0-based)
   void to_json(Json& j) const;
 };
 

@@ -269,8 +269,10 @@ TEST(Uptime, TrackingAfterLongUptimesEqualsTrackingAtStart) {
 }
 
 // Fault injection into the simulated hardware (docs/safety.md), as puma_experiment --inject does.
-ExperimentResult inject(const char* spec, double duration, osc::FrictionMode mode = osc::FrictionMode::kAdaptive) {
+ExperimentResult inject(const char* spec, double duration, osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
+                        bool residual_monitor = false) {
   ExperimentConfig c = config(duration, mode, osc::robot::kFrictionPaper);
+  c.residual_monitor = residual_monitor;
   std::string err;
   EXPECT_TRUE(parse_injection(spec, c.injection, err)) << err;
   const ExperimentResult r = run_experiment(c);
@@ -331,6 +333,22 @@ TEST(Injection, StuckAmplifierIsCaughtAndDisabledByTheFaultLine) {
   EXPECT_EQ(r.injection.max_torque_after, 0.0);
 }
 
+// The residual monitor in place of the stuck-encoder monitor (run.residual_monitor=on, a trial:
+// docs/safety.md): a stuck joint-2 encoder mid-motion is isolated as a stuck encoder, a stuck
+// joint-2 amplifier as a drive fault.
+TEST(Injection, ResidualMonitorIsolatesAStuckEncoderAndAStuckDrive) {
+  const ExperimentResult e = inject("encoder-stuck:2@21.25", 21.6, osc::FrictionMode::kAdaptive, true);
+  ASSERT_GE(e.injection.detected, 0);
+  EXPECT_LE(e.injection.detected - 21.25, 0.1);
+  EXPECT_EQ(e.injection.faults, static_cast<std::uint32_t>(osc::kFaultEncoderStuck));
+  EXPECT_EQ(e.residual_joint, 1);
+  const ExperimentResult d = inject("dac-stuck:2@21.25", 21.8, osc::FrictionMode::kAdaptive, true);
+  ASSERT_GE(d.injection.detected, 0);
+  EXPECT_LE(d.injection.detected - 21.25, 0.5);
+  EXPECT_EQ(d.injection.faults, static_cast<std::uint32_t>(osc::kFaultDriveFault));
+  EXPECT_EQ(d.residual_joint, 1);
+}
+
 TEST(Injection, ParserRejectsBadSpecifications) {
   Injection inj;
   std::string err;
@@ -369,6 +387,13 @@ TEST(Monitors, NoFalseFaultWithOrWithoutCompensation) {
         EXPECT_LT(r.stuck_dtau_peak[j], 0.8 * osc::params::kStuckTorque[j]) << fr->name << " J" << j + 1;
         EXPECT_LT(r.stuck_dtau_silent_peak[j], 0.8 * osc::params::kStuckTorqueSilent[j]) << fr->name << " J" << j + 1;
       }
+      // The residual monitor, a trial here: it would not have faulted either.
+      std::printf("; residual / threshold:");
+      for (int j = 0; j < 6; ++j) {
+        std::printf(" %.2f", r.residual_peak_ratio[j]);
+        EXPECT_LT(r.residual_peak_ratio[j], 1.0) << fr->name << " J" << j + 1;
+      }
+      EXPECT_LT(r.residual_detected_s, 0) << osc::fault_name(r.residual_fault) << " J" << r.residual_joint + 1;
       const double pos = std::max({r.max_error[0], r.max_error[1], r.max_error[2]});
       std::printf("; worst position error %.2f mm\n", pos);
       EXPECT_LT(pos, 0.5 * osc::params::kTrackingLimitPosition * 1e3);

@@ -249,4 +249,167 @@ TEST(TickStages, EveryStageTimedAndTheyAddUpToTheTick) {
   EXPECT_STREQ(kTickStageNames[kStageStep], "step");
 }
 
+// ---- The residual monitor (docs/safety.md, "The residual monitor")
+
+/// A rigid arm frozen at the start pose's inertia, gravity torques and no friction, simulated
+/// exactly in double: A qdd = tau + tau_ext - g. The monitor gets the true velocity as its q^dot, so
+/// the residual is the external torque through the first-order filter alone:
+/// r_n = tau_ext (1 - (1 - K dt)^n), exactly.
+template <class S>
+struct ResidualRig {
+  Mat6<double> A;
+  Vec6<double> g, qd = Vec6<double>::Zero(), tau = Vec6<double>::Zero();
+  std::int32_t counts[kDof] = {};
+  ResidualMonitor<S> m;
+  IoMap<S> io = IoMap<S>::of(robot::kEncodersUniform);
+  std::uint64_t tick = 0;
+  double dt = params::kDt;
+
+  ResidualRig() {
+    Model<double> model = Model<double>::of(robot::kArm);
+    Data<double> data;
+    forward_kinematics(model, data, joint_vector<double>(robot::kQStart));
+    joint_inertia(model, data);
+    A = data.A;
+    g << 0, 40, 10, 0.1, 0.5, 0.01;
+    tau = g;  // holds the arm
+    Vec6<S> quantum;
+    for (int i = 0; i < kDof; ++i) quantum(i) = lit<S>(1 / counts_per_rad(i));
+    m.reset();
+    m.set(quantum, Gains<S>::paper().k);
+  }
+  /// One tick: the encoders of `counting` joints advance one count (every tick: moving steadily),
+  /// the others stand still. Free: the arm moves under tau + tau_ext. Held: it stays at rest under
+  /// tau = g while the monitor is told tau - tau_ext was commanded (drives that do not deliver what
+  /// was asked of them, or a contact that holds the arm against the difference).
+  std::uint32_t step(const Vec6<double>& tau_ext, const bool counting[kDof], bool free = true) {
+    bool moved[kDof];
+    for (int i = 0; i < kDof; ++i) {
+      moved[i] = counting[i] || tick == 0;
+      if (counting[i]) ++counts[i];
+    }
+    const Mat6<S> As = A.cast<S>();
+    const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
+    Vec6<S> decay = Vec6<S>::Ones();
+    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr};
+    const std::uint32_t f = m.check(in, io, counts, moved, tick, lit<S>(dt));
+    m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
+    if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);
+    ++tick;
+    return f;
+  }
+};
+
+TYPED_TEST(Monitors, ResidualIsTheExternalTorqueThroughAFirstOrderFilter) {
+  using S = TypeParam;
+  ResidualRig<S> rig;
+  const bool still[kDof] = {};
+  Vec6<double> ext;
+  ext << 3, -5, 2, 0.5, -0.3, 0.2;
+  const double tol = std::is_same_v<S, double> ? 1e-9 : std::is_same_v<S, float> ? 2e-3 : 0.05;
+  rig.step(Vec6<double>::Zero(), still);  // primes it
+  for (int n = 1; n <= 100; ++n) {
+    rig.step(ext, still);
+    for (int i = 0; i < kDof; ++i) {
+      const double K = params::kResidualGain[i];
+      // The arm moves from the prime on: the first period's torque shows in the next check.
+      const double expect = ext(i) * (1 - std::pow(1 - K * params::kDt, n - 1));
+      ASSERT_NEAR(static_cast<double>(rig.m.r(i)), expect, tol + 1e-6 * std::abs(expect)) << "J" << i + 1 << " n " << n;
+    }
+  }
+}
+
+// A still joint is judged against its whole static-friction band (Coulomb plus Stribeck at the
+// band's top, robot::kModelErrorBounds), which every friction preset of the arm lies within.
+TEST(Residual, AStillJointsThresholdCoversTheStaticFrictionOfEveryPreset) {
+  ResidualRig<double> rig;
+  const bool still[kDof] = {};
+  rig.step(Vec6<double>::Zero(), still);
+  for (int i = 0; i < kDof; ++i) {
+    for (const FrictionCoefficients* p : {&robot::kFrictionPaper, &robot::kFrictionCorke})
+      EXPECT_GT(rig.m.threshold(i), params::kResidualPeakFactor[i] * (p->cou[i] + p->sti[i]) * 1.3) << i;
+    EXPECT_GE(rig.m.threshold(i), params::kResidualPeakFactor[i] * (robot::kModelErrorBounds.friction_hi.cou[i] +
+                                                                    robot::kModelErrorBounds.friction_hi.sti[i]))
+        << i;
+  }
+  // The band is the presets' range widened by the drift: Corke's J1 Coulomb is the largest.
+  EXPECT_NEAR(robot::kModelErrorBounds.friction_hi.cou[0], robot::kFrictionCorke.cou[0] * 1.3, 1e-12);
+  EXPECT_NEAR(robot::kModelErrorBounds.friction_lo.cou[0], robot::kFrictionPaper.cou[0] * 0.7, 1e-12);
+}
+
+/// Ticks until the monitor reports a fault under a constant external torque (-1: none in 200).
+template <class S>
+int ticks_to_fault(ResidualRig<S>& rig, const Vec6<double>& ext, const bool counting[kDof], std::uint32_t& kind) {
+  kind = 0;
+  for (int n = 0; n < 200; ++n)
+    if ((kind = rig.step(n == 0 ? Vec6<double>::Zero() : ext, counting, false)) != 0) return n;
+  return -1;
+}
+
+TYPED_TEST(Monitors, ResidualIsolatesDriveCollisionAndStuckEncoder) {
+  using S = TypeParam;
+  const bool all[kDof] = {true, true, true, true, true, true};
+  {  // Three times the threshold on J2 alone, every encoder counting: a drive that does not deliver.
+    ResidualRig<S> rig;
+    rig.m.armed = true;
+    rig.step(Vec6<double>::Zero(), all);
+    Vec6<double> ext = Vec6<double>::Zero();
+    ext(1) = 3 * static_cast<double>(rig.m.threshold(1));
+    std::uint32_t kind = 0;
+    const int n = ticks_to_fault(rig, ext, all, kind);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultDriveFault));
+    // Beyond the threshold once 1 - (1 - K dt)^n > 1/3 (n >= 9 at 50 /s), then for 3 ticks.
+    EXPECT_GE(n, params::kResidualQualifyTicks + 5);
+    EXPECT_LE(n, 15);
+    EXPECT_EQ(rig.m.joint, 1);
+  }
+  {  // The same on J1, J2 and J3 together: a contact.
+    ResidualRig<S> rig;
+    rig.m.armed = true;
+    rig.step(Vec6<double>::Zero(), all);
+    Vec6<double> ext = Vec6<double>::Zero();
+    for (int i = 0; i < 3; ++i) ext(i) = (i == 1 ? -3 : 3) * static_cast<double>(rig.m.threshold(i));
+    std::uint32_t kind = 0;
+    EXPECT_GT(ticks_to_fault(rig, ext, all, kind), 0);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultCollision));
+  }
+  {  // J2's encoder counts every tick, then stops while its joint is pushed on: a stuck encoder.
+    ResidualRig<S> rig;
+    rig.m.armed = true;
+    for (int n = 0; n < 20; ++n) rig.step(Vec6<double>::Zero(), all);
+    bool j2_silent[kDof] = {true, true, true, true, true, true};
+    j2_silent[1] = false;
+    Vec6<double> ext = Vec6<double>::Zero();
+    ext(1) = 3 * static_cast<double>(rig.m.threshold(1));
+    std::uint32_t kind = 0;
+    EXPECT_GT(ticks_to_fault(rig, ext, j2_silent, kind), params::kStuckIntervals);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultEncoderStuck));
+  }
+  {  // Not armed: the detection is recorded, never returned.
+    ResidualRig<S> rig;
+    rig.step(Vec6<double>::Zero(), all);
+    Vec6<double> ext = Vec6<double>::Zero();
+    ext(1) = 3 * static_cast<double>(rig.m.threshold(1));
+    std::uint32_t kind = 0;
+    EXPECT_EQ(ticks_to_fault(rig, ext, all, kind), -1);
+    EXPECT_EQ(rig.m.detected, static_cast<std::uint32_t>(kFaultDriveFault));
+    EXPECT_EQ(rig.m.joint, 1);
+  }
+}
+
+// Below its threshold nothing is reported, however long it lasts.
+TYPED_TEST(Monitors, ResidualBelowItsThresholdNeverFaults) {
+  using S = TypeParam;
+  ResidualRig<S> rig;
+  rig.m.armed = true;
+  const bool still[kDof] = {};
+  rig.step(Vec6<double>::Zero(), still);
+  Vec6<double> ext;
+  for (int i = 0; i < kDof; ++i) ext(i) = (i % 2 ? -0.8 : 0.8) * static_cast<double>(rig.m.threshold(i));
+  for (int n = 0; n < 1000; ++n) ASSERT_EQ(rig.step(ext, still, false), 0u) << n;
+  EXPECT_EQ(rig.m.detected, 0u);
+  // Close to 0.8: the thresholds grew a little with the torque commanded (the amplifiers' share).
+  for (int i = 0; i < kDof; ++i) EXPECT_GT(rig.m.peak_ratio(i), lit<S>(0.7)) << i;
+}
+
 }  // namespace

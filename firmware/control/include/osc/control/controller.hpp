@@ -44,6 +44,7 @@ struct StepOutput {
   Vec6<S> xd_hat;     // observed velocity (21)
   Vec6<S> tau_f_hat;  // estimated friction (30)
   Vec6<S> qd_ref;     // joint velocity the reference commands, J^{-1} x_d dot (stuck-encoder monitor)
+  Vec6<S> tau_bias;   // c(q, q^dot) + g(q) + tau_f^ at the observed velocity (the residual monitor)
   S rcond;
   std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular / kFaultOverflow (then tau = 0)
 };
@@ -111,6 +112,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.xd_hat.setZero();
   out.tau_f_hat.setZero();
   out.qd_ref.setZero();
+  out.tau_bias.setZero();
   out.rcond = S(0);
   out.status = kFaultNone;
   if (!math::all_finite(q) || !math::all_finite(d.x) || !math::all_finite(d.xd) || !math::all_finite(d.xdd)) {
@@ -155,6 +157,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.xd_hat = ob.xd_hat;
   out.tau_f_hat = tau_f_hat;
   out.qd_ref = os.Jf.solve(d.xd);
+  out.tau_bias = c.bias.tau;
   return out;
 }
 

@@ -28,7 +28,10 @@ namespace osc {
   X(Overflow, "overflow",                                                                                      \
     "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \
   X(DacBus, "dac_bus",                                                                                         \
-    "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")
+    "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")         \
+  X(DriveFault, "drive_fault",                                                                                 \
+    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the residual monitor")  \
+  X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

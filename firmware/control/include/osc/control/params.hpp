@@ -84,6 +84,18 @@ constexpr int kStuckFastInterval = 5;
 /// ... and the encoder has been silent for more than this many of its recent intervals between
 /// counts.
 constexpr int kStuckIntervals = 10;
+/// The residual monitor (osc/runtime/monitors.hpp; docs/safety.md, "The residual monitor"):
+/// - the bandwidth of its first-order filter per joint [1/s]: 50 on J1-J3 (a torque step of three
+///   times a threshold crosses it within 8 ms); 20 on the wrist, whose velocity estimate comes from
+///   the observer's rotational rows, underdamped (k = 32, k_i = 3000: damping 0.1-0.4), and a faster
+///   filter would pass their ringing;
+/// - the largest response of the residual to a unit step of unexplained torque, through the
+///   observer and that filter (the L1 norm of their impulse response over the arm's range of
+///   Lambda^-1 k_i, scripts/residual_gain.py): each threshold is scaled by it;
+/// - the ticks a residual must stay beyond its threshold before it is a fault.
+constexpr double kResidualGain[6] = {50, 50, 50, 20, 20, 20};
+constexpr double kResidualPeakFactor[6] = {1.1, 1.1, 1.1, 1.2, 1.2, 1.2};
+constexpr int kResidualQualifyTicks = 3;
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
 /// heavier (corke) friction preset (7.0 mm, 0.43 deg).

@@ -109,6 +109,37 @@ constexpr FrictionCoefficients kFrictionNone = {"none", {0, 0, 0, 0, 0, 0}, {0, 
 
 constexpr double abs_of(double v) { return v < 0 ? -v : v; }
 
+/// What a model-based monitor may assume about the arm it runs on: bounds on how far the arm can
+/// differ from its model, each the robot description's statement (docs/safety.md derives the
+/// residual monitor's thresholds from them).
+struct ModelErrorBounds {
+  double link_inertia;  ///< every link's inertial parameters (mass, first and second moments), relative
+  double amp_gain;      ///< an amplifier's gain error, relative to the torque commanded
+  double amp_offset;    ///< an amplifier's offset, relative to its channel's full-scale torque
+  double ripple;        ///< torque ripple, relative to the torque commanded
+  FrictionCoefficients friction_lo, friction_hi;  ///< the band the arm's friction lies in, drift included
+};
+
+/// The band of friction coefficients that covers every preset in `presets` (each coefficient's
+/// smallest and largest), widened by a relative drift: [min (1 - drift), max (1 + drift)].
+template <int N>
+constexpr void friction_band(const FrictionCoefficients* const (&presets)[N], double drift, FrictionCoefficients& lo,
+                             FrictionCoefficients& hi) {
+  for (int i = 0; i < kDof; ++i) {
+    double v[3][2] = {{1e300, 0}, {1e300, 0}, {1e300, 0}};  // per coefficient: min, max
+    for (const FrictionCoefficients* p : presets) {
+      const double c[3] = {p->vis[i], p->cou[i], p->sti[i]};
+      for (int k = 0; k < 3; ++k) {
+        if (c[k] < v[k][0]) v[k][0] = c[k];
+        if (c[k] > v[k][1]) v[k][1] = c[k];
+      }
+    }
+    lo.vis[i] = v[0][0] * (1 - drift), hi.vis[i] = v[0][1] * (1 + drift);
+    lo.cou[i] = v[1][0] * (1 - drift), hi.cou[i] = v[1][1] * (1 + drift);
+    lo.sti[i] = v[2][0] * (1 - drift), hi.sti[i] = v[2][1] * (1 + drift);
+  }
+}
+
 /// Largest DAC code magnitude.
 constexpr long dac_max_code(const DriveParams& drives) { return (1L << (drives.dac_bits - 1)) - 1; }
 

@@ -55,6 +55,7 @@ struct ControlTask {
   EncoderRangeMonitor range;  // the encoder checks (osc/runtime/monitors.hpp)
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
+  ResidualMonitor<S> residual;
   SaturationMonitor saturation;
   Supervisor sup;
   std::uint32_t period_cycles;  // overrun budget per step (0: not checked)
@@ -89,6 +90,7 @@ struct ControlTask {
     for (int i = 0; i < kDof; ++i) codes[i] = 0;
     jump.reset();
     stuck.reset();
+    residual.reset();
     saturation.reset();
     set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
@@ -103,6 +105,15 @@ struct ControlTask {
     io = IoMap<S>::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
+    double C[kDof][kDof], inverse[kDof][kDof];
+    coupling_matrices(map, C, inverse);
+    Vec6<S> quantum;  // each joint's angle quantum: sum_c |C_jc| / counts_per_rad_c
+    for (int j = 0; j < kDof; ++j) {
+      double d = 0;
+      for (int c = 0; c < kDof; ++c) d += abs_of(C[j][c]) / map.counts_per_rad[c];
+      quantum(j) = lit<S>(d);
+    }
+    residual.set(quantum, gains.k);
     for (int i = 0; i < kDof; ++i) {
       const double c = map.counts_per_rad[i];
       if (io.coupled()) {
@@ -128,18 +139,45 @@ struct ControlTask {
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
 /// stuck-encoder, tracking and friction-estimate monitors (osc/runtime/monitors.hpp).
 template <class S>
-std::uint32_t step_monitor_faults(ControlTask<S>& task, const bool moved[kDof]) {
+std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t counts[kDof], const bool moved[kDof]) {
   const StepOutput<S>& out = task.last;
   // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
   Vec6<S> tau_m, rate_m;
   const bool coupled = task.io.coupled();
   const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
   const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
-  std::uint32_t faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
+  // The stuck-encoder monitor, unless the residual monitor is armed in its place (a trial: docs/safety.md).
+  const std::uint32_t stuck = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
+  std::uint32_t faults = task.residual.armed ? 0u : stuck;
+  const AdaptationState<S>& ad = task.state.adapt;
+  const bool adaptive = task.mode == FrictionMode::kAdaptive;
+  const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
+  const ResidualInput<S> in{task.state.data.A,
+                            task.state.os.g,
+                            out.tau_bias,
+                            out.tau_f_hat,
+                            ad.qd_hat_prev,
+                            decay,
+                            adaptive ? &ad.theta_hat : nullptr};
+  faults |= task.residual.check(in, task.io, counts, moved, task.tick, task.gains.dt);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check(task.state.adapt.theta_hat, task.gains.theta_max);
   return faults;
+}
+
+/// The joint torque the DAC codes of this tick command (C^-T of each channel's, for a coupled
+/// drive train): the step's torque where a code was clipped at its range.
+template <class S>
+Vec6<S> applied_torque(const ControlTask<S>& task) {
+  static constexpr std::array<S, kDof> kLimit = lit_array<S>(robot::kDrives.torque_limit);
+  constexpr auto kMax = static_cast<std::int32_t>(kDacMaxCode);
+  Vec6<S> tau_m = task.io.coupled() ? motor_torques(task.io, task.last.tau) : task.last.tau;
+  for (int i = 0; i < kDof; ++i) {
+    if (task.codes[i] >= kMax) tau_m(i) = kLimit[i];
+    if (task.codes[i] <= -kMax) tau_m(i) = -kLimit[i];
+  }
+  return task.io.coupled() ? joint_torques_of_motors(task.io, tau_m) : tau_m;
 }
 
 /// The states in which the control step runs and torque reaches the DACs.
@@ -214,6 +252,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
     task.q_queue_end = q;
     task.stuck.reset(true);
+    task.residual.reset();
     task.ramping = true;
     task.ramp_start = next;
   }
@@ -237,6 +276,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (accepted && cmd.verb == MotionVerb::kClear) {
     task.sup = {SupervisorState::kInit, 0};
     task.stuck.reset();
+    task.residual.reset();
     task.saturation.reset();
   }
   if (!motion_powered(st.machine.state)) task.ramping = false;
@@ -314,15 +354,20 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   }
   mark[kStageMonitors] = hal.cycles();
   // monitors
-  if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, moved);
+  if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
   mark[kStageOutput] = hal.cycles();
   // output
   if (stepped && task.ramping) ramp_torque(task);
+  bool clipped = false;
   if (stepped) {
     // Each DAC drives a motor: C^T tau where the drive train couples the joints.
     Vec6<S> tau_m;
     const Vec6<S>& tau = task.io.coupled() ? (tau_m = motor_torques(task.io, task.last.tau)) : task.last.tau;
-    for (int i = 0; i < kDof; ++i) faults |= task.saturation.check(i, torque_to_code(i, tau(i), task.codes[i]));
+    for (int i = 0; i < kDof; ++i) {
+      const bool c = torque_to_code(i, tau(i), task.codes[i]);
+      clipped = clipped || c;
+      faults |= task.saturation.check(i, c);
+    }
   }
   // A fixed-point saturation in the monitors or the torque conversion (the step reports its own).
   if (math::take_arithmetic_fault<S>()) faults |= kFaultOverflow;
@@ -338,6 +383,10 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const bool torque = motion_update(task, faults, measured, q, ev, stop_request);
   if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
+  if (!stepped || !torque_enabled(task.sup) || !torque)
+    task.residual.unprime();
+  else
+    task.residual.applied(clipped ? applied_torque(task) : task.last.tau);
   hal.write_dacs(task.codes);
   hal.fault_output(task.sup.state == SupervisorState::kFault);
   mark[kTickStages] = hal.cycles();

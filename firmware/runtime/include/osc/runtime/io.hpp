@@ -116,6 +116,14 @@ Vec6<S> motor_rates(const IoMap<S>& io, const Vec6<S>& qd) {
   return r;
 }
 
+/// The joint torques that motor torques tau_m (referred to their joints) give: C^-T tau_m.
+template <class S>
+Vec6<S> joint_torques_of_motors(const IoMap<S>& io, const Vec6<S>& tau_m) {
+  Vec6<S> t = tau_m;
+  for (int k = 0; k < io.inverse_terms; ++k) t(io.inverse_col[k]) += io.inverse_c[k] * tau_m(io.inverse_row[k]);
+  return t;
+}
+
 /// The DAC scale [codes per N m] and torque limit [N m] of each joint in the scalar W, built at
 /// compile time: the conversion in the tick then calls no double-precision routine (on a core
 /// without a double-precision FPU each would be a library call).

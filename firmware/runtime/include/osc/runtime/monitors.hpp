@@ -173,6 +173,248 @@ struct StuckEncoderMonitor {
   }
 };
 
+/// The residual monitor's constants of the arm, in the scalar S (robot::kModelErrorBounds, the
+/// drive train's motor-inertia sets, the DACs' full scale): built at compile time.
+template <class S>
+struct ResidualConstants {
+  S vis_lo[kDof], vis_hi[kDof], cou_lo[kDof], cou_hi[kDof], sti_lo[kDof], sti_hi[kDof];
+  S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
+  S offset[kDof];          // an amplifier's offset bound [N m]
+  S full_scale[kDof];      // a channel's full-scale torque [N m]
+  S link_inertia, gain_ripple;
+  constexpr ResidualConstants()
+      : vis_lo{},
+        vis_hi{},
+        cou_lo{},
+        cou_hi{},
+        sti_lo{},
+        sti_hi{},
+        armature_delta{},
+        offset{},
+        full_scale{},
+        link_inertia{},
+        gain_ripple{} {
+    const ModelErrorBounds& b = robot::kModelErrorBounds;
+    for (int i = 0; i < kDof; ++i) {
+      vis_lo[i] = lit<S>(b.friction_lo.vis[i]), vis_hi[i] = lit<S>(b.friction_hi.vis[i]);
+      cou_lo[i] = lit<S>(b.friction_lo.cou[i]), cou_hi[i] = lit<S>(b.friction_hi.cou[i]);
+      sti_lo[i] = lit<S>(b.friction_lo.sti[i]), sti_hi[i] = lit<S>(b.friction_hi.sti[i]);
+      const double G = abs_of(robot::kArm.links[i].gear_ratio);
+      armature_delta[i] =
+          lit<S>(abs_of(robot::kDriveTrain.motor_inertia_alt.jm[i] - robot::kArm.links[i].motor_inertia) * G * G);
+      offset[i] = lit<S>(b.amp_offset * robot::kDrives.torque_limit[i]);
+      full_scale[i] = lit<S>(robot::kDrives.torque_limit[i]);
+    }
+    link_inertia = lit<S>(b.link_inertia);
+    gain_ripple = lit<S>(b.amp_gain + b.ripple);
+  }
+};
+template <class S>
+inline constexpr ResidualConstants<S> kResidualConstants{};
+
+/// What the residual monitor reads of a completed step (joint space).
+template <class S>
+struct ResidualInput {
+  const Mat6<S>& A;       // joint inertia A(q), armature included
+  const Vec6<S>& g;       // gravity torques g(q)
+  const Vec6<S>& bias;    // c(q, q^dot) + g + tau_f^ (StepOutput::tau_bias)
+  const Vec6<S>& tau_f;   // tau_f^
+  const Vec6<S>& qd;      // the observed joint velocity q^dot (28)
+  const Vec6<S>& decay;   // |exp(-tau_dec q^dot^2)| where q^dot != 0 (the regressor's Stribeck column)
+  const Vec18<S>* theta;  // theta^, or nullptr without compensation (tau_f^ = 0)
+};
+
+/// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone;
+/// Haddadin, De Luca and Albu-Schaeffer 2017) in its sampled, acceleration-free form. Per joint,
+/// the torque the model does not explain, A(q) q^dot' + c + g + tau_f^ - tau, through a first-order
+/// filter of bandwidth K = params::kResidualGain:
+///   r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})],
+/// n = c + g + tau_f^, tau_{k-1} the torque applied over the last period, q^dot the observer's (no
+/// numerical differentiation: the velocity difference is integrated). On a healthy arm r is the
+/// model's error, and each joint's threshold bounds it from the arm's stated error bounds
+/// (robot::kModelErrorBounds): friction (a still joint: anywhere in its static band; a moving one:
+/// the band's distance from theta^), link inertia, motor inertia, the amplifiers, and the encoder
+/// quantum through the velocity estimate (docs/safety.md derives each term). A residual beyond its
+/// threshold for params::kResidualQualifyTicks ticks in a row is a fault, isolated by joint and
+/// kind:
+///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for
+///    more than params::kStuckIntervals of its recent intervals between counts);
+///  - drive_fault: the residual is on this drive alone (every other joint below half its threshold);
+///  - collision: an external torque on several joints, as a contact gives.
+template <class S>
+struct ResidualMonitor {
+  Vec6<S> r;                             // the residual [N m]
+  Vec6<S> bound;                         // the model-error bound's filtered pointwise terms [N m]
+  Vec6<S> acc;                           // the joint accelerations, filtered as r [rad/s^2]
+  Vec6<S> threshold;                     // this tick's thresholds [N m]
+  Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
+  Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
+  S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
+  Vec6<S> peak_ratio;                    // the largest |r| / threshold seen per joint
+  std::uint64_t last_move_tick[kDof];    // tick of each encoder's last change
+  std::uint32_t move_interval[kDof];     // ticks between its last two changes
+  std::int32_t last_counts[kDof];        // each encoder's reading at its last change
+  std::int8_t direction[kDof];           // the sign of its last change
+  bool steady[kDof];                     // its last two changes had the same sign
+  std::uint8_t over[kDof];               // consecutive ticks beyond the threshold
+  std::uint32_t detected;                // the first detection's fault (kept while not armed too)
+  std::uint64_t detected_tick;           // ... its tick
+  std::int8_t joint;                     // ... its joint (0-based), -1 none
+  bool primed;                           // a previous step is on record
+  bool armed = false;  // its detections are faults, in place of StuckEncoderMonitor's (else only recorded)
+
+  /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
+  /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
+  /// mean) times the largest k.
+  void set(const Vec6<S>& quantum, const Vec6<S>& k) {
+    k_max = k.maxCoeff();
+    lag = S(1) / k.minCoeff();
+    velocity_noise = (lit<S>(0.5) * k_max) * quantum;
+  }
+  /// Clears the filters and the record: the next check primes it (an enable, a restart).
+  void reset() {
+    r.setZero();
+    bound.setZero();
+    acc.setZero();
+    threshold.setZero();
+    tau_prev.setZero();
+    peak_ratio.setZero();
+    for (int i = 0; i < kDof; ++i) {
+      last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0;
+      last_counts[i] = 0, direction[i] = 0, steady[i] = false;
+    }
+    joint = -1;
+    detected = 0;
+    detected_tick = 0;
+    primed = false;
+  }
+  /// The next step starts afresh (a tick without a step: the torque was off).
+  void unprime() { primed = false; }
+  /// The joint torque that reached the arm over the period that follows this tick.
+  void applied(const Vec6<S>& tau) { tau_prev = tau; }
+
+  /// The encoders' activity (EncoderJumpMonitor's moved), per channel.
+  void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
+    for (int i = 0; i < kDof; ++i) {
+      if (!moved[i]) continue;
+      const std::int8_t d = counts[i] > last_counts[i] ? 1 : -1;
+      steady[i] = d == direction[i];
+      direction[i] = d;
+      last_counts[i] = counts[i];
+      const std::uint64_t gap = tick - last_move_tick[i];
+      move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
+      last_move_tick[i] = tick;
+    }
+  }
+  /// Channel c's encoder counts one way at its recent pace: its last two changes in the direction
+  /// `sign`, the last within twice the interval between them.
+  bool counting(int c, S sign, std::uint64_t tick) const {
+    return steady[c] && (direction[c] > 0) == (sign > S(0)) && move_interval[c] < kStuckIntervalCap &&
+           tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
+  }
+  /// Channel c's encoder fell silent at once: more than kStuckIntervals of its recent intervals.
+  bool silent(int c, std::uint64_t tick) const {
+    const std::uint64_t quiet = tick - last_move_tick[c];
+    return move_interval[c] < kStuckIntervalCap &&
+           quiet > static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[c];
+  }
+
+  /// The residual of this step and its faults (see the type's comment).
+  std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
+                      const bool moved[kDof], std::uint64_t tick, S dt) {
+    track(counts, moved, tick);
+    if (!primed) {
+      qd_prev = in.qd;
+      bias_prev = in.bias;
+      r.setZero();
+      acc.setZero();
+      bound = pointwise_bound(in, tick);
+      update_thresholds(in.A);
+      for (int i = 0; i < kDof; ++i) over[i] = 0;
+      primed = true;
+      return 0;
+    }
+    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
+    const Vec6<S> dqd = in.qd - qd_prev;
+    const Vec6<S> u = in.A * dqd + dt * (bias_prev - tau_prev), b = pointwise_bound(in, tick);
+    for (int i = 0; i < kDof; ++i) {
+      const S K = kGain[i], Kdt = K * dt;
+      r(i) += K * u(i) - Kdt * r(i);
+      acc(i) += K * dqd(i) - Kdt * acc(i);
+      bound(i) += Kdt * (b(i) - bound(i));
+    }
+    update_thresholds(in.A);
+    qd_prev = in.qd;
+    bias_prev = in.bias;
+    int worst = -1;
+    S worst_ratio = S(0);
+    for (int i = 0; i < kDof; ++i) {
+      const S ratio = math::abs(r(i)) / threshold(i);
+      if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
+      over[i] = ratio > S(1) ? static_cast<std::uint8_t>(over[i] < 255 ? over[i] + 1 : 255) : std::uint8_t{0};
+      if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
+    }
+    if (worst < 0) return 0;
+    const std::uint32_t kind = classify(worst, io, tick);
+    if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick;
+    return armed ? kind : 0u;
+  }
+
+ private:
+  /// Per joint, the bound on the unexplained torque that changes with the state (then filtered as
+  /// r): friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
+  Vec6<S> pointwise_bound(const ResidualInput<S>& in, std::uint64_t tick) const {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    Vec6<S> b;
+    for (int i = 0; i < kDof; ++i) {
+      const S v = math::abs(in.qd(i));
+      // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
+      const S moving = velocity_noise(i) + lag * math::abs(acc(i));
+      S friction;
+      if (v > moving && counting(i, in.qd(i), tick)) {
+        // The band's distance from the estimate, coefficient by coefficient.
+        const S th_v = in.theta ? (*in.theta)(i) : S(0), th_c = in.theta ? (*in.theta)(kDof + i) : S(0),
+                th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
+        const auto larger = [](S x, S y) { return x > y ? x : y; };
+        const S dv = larger(c.vis_hi[i] - th_v, th_v - c.vis_lo[i]);
+        const S dc = larger(c.cou_hi[i] - th_c, th_c - c.cou_lo[i]);
+        const S ds = larger(c.sti_hi[i] - th_s, th_s - c.sti_lo[i]);
+        friction = v * dv + dc + in.decay(i) * ds + c.vis_hi[i] * velocity_noise(i);
+      } else {
+        // Static friction anywhere within the band, against whatever the estimate says.
+        friction = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
+      }
+      const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
+      b(i) = friction + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
+             c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
+    }
+    return b;
+  }
+  /// The thresholds: the filtered bound, the inertias' error on the filtered accelerations, and the
+  /// velocity estimate's noise through A and the filter.
+  void update_thresholds(const Mat6<S>& A) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
+    static constexpr std::array<S, kDof> kPeak = lit_array<S>(params::kResidualPeakFactor);
+    const Vec6<S> a = acc.cwiseAbs();
+    const Mat6<S> absA = A.cwiseAbs();
+    const Vec6<S> inertia = absA * a, noise = absA * (S(2) * velocity_noise);
+    for (int i = 0; i < kDof; ++i)
+      threshold(i) =
+          kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i)) + kGain[i] * noise(i);
+  }
+  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
+    // A stuck encoder: joint i's own encoder or one the coupling adds to it.
+    bool stuck = silent(i, tick);
+    for (int k = 0; k < io.terms; ++k)
+      if (io.row[k] == i && silent(io.col[k], tick)) stuck = true;
+    if (stuck) return kFaultEncoderStuck;
+    for (int j = 0; j < kDof; ++j)
+      if (j != i && math::abs(r(j)) > lit<S>(0.5) * threshold(j)) return kFaultCollision;
+    return kFaultDriveFault;
+  }
+};
+
 /// tracking: the measured tracking error e (36) beyond params::kTrackingLimitPosition (its
 /// translation's norm) or params::kTrackingLimitOrientation (each orientation component).
 template <class S>
