@@ -71,7 +71,7 @@ class LocalController {
     if (m.detected != 0) {
       res.residual_detected_s = static_cast<double>(m.detected_tick) / osc::params::kControlHz;
       res.residual_fault = m.detected;
-      res.residual_joint = m.joint;
+      res.residual_joint = static_cast<unsigned char>(m.joint);  // set: 0..5
     }
   }
 
