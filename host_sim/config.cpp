@@ -123,6 +123,12 @@ void name(std::vector<Entry>& t, std::string key, std::string doc, std::vector<s
   t.push_back(e);
 }
 
+/// The names of an enumeration of motion_states.hpp, in code order.
+template <class E>
+std::vector<std::string> names_of() {
+  return {std::begin(osc::MotionNames<E>::kNames), std::end(osc::MotionNames<E>::kNames)};
+}
+
 void add_run_entries(std::vector<Entry>& t) {
   number(t, "run.duration", "simulated seconds per run [s]", 1, 86400, true,
          [](Settings& s) -> double& { return s.base.duration; });
@@ -151,6 +157,29 @@ void add_run_entries(std::vector<Entry>& t) {
       "residual monitor raises encoder_stuck, drive_fault and collision in its place (docs/safety.md)",
       {"trial", "on"}, false, [](const Settings& s) { return std::string(s.base.residual_monitor ? "on" : "trial"); },
       [](Settings& s, const std::string& m) { s.base.residual_monitor = m == "on"; });
+  name(
+      t, "run.collision_reaction", "what a collision does, with run.residual_monitor=on (docs/safety.md)",
+      names_of<osc::CollisionReaction>(), false,
+      [](const Settings& s) { return std::string(osc::motion_name(s.base.collision_reaction)); },
+      [](Settings& s, const std::string& m) {
+        for (int i = 0; i < osc::MotionNames<osc::CollisionReaction>::kCount; ++i)
+          if (m == osc::MotionNames<osc::CollisionReaction>::kNames[i])
+            s.base.collision_reaction = static_cast<osc::CollisionReaction>(i);
+      });
+  Entry c{"run.collision_threshold",
+          "each joint's collision threshold [N m]: a collision is reported once a residual is beyond it too (0: "
+          "the derived threshold alone; at most the joint's full-scale torque)",
+          Kind::kList, 0, 1e9, {}, false};
+  c.get = [](const Settings& s) { return vec_json(s.base.collision_threshold, 6); };
+  c.put = [](Settings& s, const json& v) {
+    for (int i = 0; i < 6; ++i) s.base.collision_threshold[i] = v[i].get<double>();
+    return std::string();
+  };
+  c.element_range = [](const Settings&, double& lo, double& hi, int i) {
+    lo = 0;
+    hi = osc::robot::kDrives.torque_limit[i];
+  };
+  t.push_back(c);
   number(t, "run.final_window", "length of the \"last\" statistics at the end of each run [s] (Table I: 20)", 1, 3600,
          true, [](Settings& s) -> double& { return s.base.final_window; });
   number(t, "run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,
@@ -608,6 +637,11 @@ bool validate_settings(const Settings& s, std::string& err) {
                   static_cast<double>(os.Jf.rcond), 2 * s.base.gains.min_rcond);
     return err = buf, false;
   }
+  // A collision's settings act through the armed residual monitor alone.
+  bool collision_set = s.base.collision_reaction != osc::CollisionReaction::kCategory0;
+  for (double t : s.base.collision_threshold) collision_set = collision_set || t != 0;
+  if (collision_set && !s.base.residual_monitor)
+    return err = "run.collision_reaction and run.collision_threshold apply with run.residual_monitor=on", false;
   return true;
 }
 

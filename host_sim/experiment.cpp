@@ -26,7 +26,7 @@ class LocalController {
   explicit LocalController(const ExperimentConfig& cfg, const Vec6& q0) : task_(new osc::ControlTask<S>) {
     task_->init(osc::Model<S>::of(osc::robot::kArm, cfg.model_error), cfg.gains.template cast<S>(), cfg.mode,
                 q0.cast<S>(), PlantHal::kPeriodNs);
-    task_->residual.armed = cfg.residual_monitor;
+    configure_monitors(*task_, cfg);
     task_->set_encoders(cfg.encoder_map());
     // Optional observer start error, with y(0) = -k x~(0) as (21) prescribes.
     for (int i = 0; i < 6; ++i) {
@@ -46,9 +46,15 @@ class LocalController {
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
     const osc::ResidualMonitor<S>& m = task_->residual;
     for (int i = 0; i < 6; ++i) {
-      const double th = static_cast<double>(m.threshold(i)), ri = std::abs(static_cast<double>(m.r(i)));
-      if (m.primed && th > 0 && ri / th > residual_.residual_peak_ratio[i]) {
-        residual_.residual_peak_ratio[i] = ri / th;
+      // The channel nearer its threshold: the residual or its change (monitors.hpp); in double,
+      // so that a fixed-point division here cannot raise the controller's arithmetic flag.
+      const double r_abs = std::abs(static_cast<double>(m.r(i))), th_abs = static_cast<double>(m.threshold(i));
+      const double d_abs = std::abs(static_cast<double>(m.d(i))), th_d = static_cast<double>(m.change_threshold(i));
+      const bool change = d_abs * th_abs > r_abs * th_d;
+      const double th = change ? th_d : th_abs, ri = change ? d_abs : r_abs;
+      const double ratio = th > 0 ? ri / th : 0;
+      if (m.primed && th > 0 && ratio > residual_.residual_peak_ratio[i]) {
+        residual_.residual_peak_ratio[i] = ratio;
         residual_.residual_peak_s[i] = static_cast<double>(task_->tick - 1) / osc::params::kControlHz;
         residual_.residual_peak_Nm[i] = ri;
         residual_.residual_threshold_Nm[i] = th;

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <functional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@
 #include "metrics.hpp"
 #include "osc/control/gains.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/runtime/motion_states.hpp"
 #include "plant.hpp"
 #include "plant_hal.hpp"
 
@@ -59,6 +61,10 @@ struct ExperimentConfig {
   /// The residual monitor raises the faults in place of the stuck-encoder monitor (in-process
   /// controller only; otherwise it runs as a trial: computed and reported, docs/safety.md).
   bool residual_monitor = false;
+  /// What a collision does, and each joint's collision threshold [N m] (0: the derived threshold
+  /// alone); with residual_monitor only (osc::ControlTask::set_collision).
+  osc::CollisionReaction collision_reaction = osc::CollisionReaction::kCategory0;
+  double collision_threshold[6] = {0, 0, 0, 0, 0, 0};
   double log_period = 0.01;    ///< time-series decimation [s]
   double final_window = 20.0;  ///< "last 20 s" statistics [s]
   double window = 60.0;        ///< length of the per-window maxima [s]
@@ -80,6 +86,15 @@ struct ExperimentConfig {
   std::vector<std::string> pil_command;
   double pil_timeout = 10.0;  ///< wall-clock wait per actuator frame [s]
 };
+
+/// The residual monitor's settings of a run on the task of a host-built controller
+/// (osc::ControlTask): armed or a trial, the collision's reaction and thresholds.
+template <class Task>
+void configure_monitors(Task& task, const ExperimentConfig& cfg) {
+  task.residual.armed = cfg.residual_monitor;
+  if (!task.set_collision(cfg.collision_reaction, cfg.collision_threshold))
+    throw std::invalid_argument("run.collision_threshold: outside [0, the joint's full-scale torque]");
+}
 
 /// A run: its name and set-up, then its metrics (metrics.hpp), in the order of its JSON and console
 /// lines. A new per-run metric is one more name in this list.

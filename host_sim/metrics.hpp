@@ -155,7 +155,7 @@ struct StuckMonitorPeaks {
   double stuck_dtau_silent_peak[6] = {};  ///< ... while the encoder was also silent (kStuckTorqueSilent) [N m]
   double residual_peak_ratio[6] = {};     ///< the residual monitor's largest |r| / threshold per joint
   double residual_peak_s[6] = {};         ///< ... and when [s]
-  double residual_peak_Nm[6] = {};        ///< ... |r| then [N m]
+  double residual_peak_Nm[6] = {};        ///< ... |r| or |r - r_slow| then, the channel nearer its threshold [N m]
   double residual_threshold_Nm[6] = {};   ///< ... its threshold then [N m]
   double residual_detected_s = -1;        ///< the residual monitor's first detection [s] (-1: none)
   std::uint32_t residual_fault = 0;       ///< ... its fault

@@ -257,6 +257,7 @@ class HostArm {
  public:
   HostArm(const MotionScript& script, const ExperimentConfig& cfg)
       : sim_(script.start_pose.value_or(cfg.q_start), cfg.injection, cfg.plant, cfg.mode, cfg.gains) {
+    configure_monitors(sim_.task(), cfg);
     port_.state_period = 0;
   }
   bool ok(std::string&) const { return true; }

@@ -29,7 +29,7 @@ using R = MotionReason;
 constexpr int kStates = MotionNames<S>::kCount;
 constexpr int kCommands = MotionNames<C>::kCount;
 constexpr int kReasons = MotionNames<R>::kCount;
-static_assert(kStates == 5 && kCommands == 6 && kReasons == 16);
+static_assert(kStates == 6 && kCommands == 6 && kReasons == 18);
 static_assert(MotionNames<CommandOutcome>::kCount == 3 && MotionNames<StopCategory>::kCount == 3);
 static_assert(MotionNames<MotionCompletion>::kCount == 3);
 static_assert(sizeof(MotionNames<S>::kDocs) == sizeof(MotionNames<S>::kNames));
@@ -54,9 +54,9 @@ constexpr Cell go(S to, Pending p = Pending::kKeep) { return {to, R::kNone, R::k
 constexpr Cell refuse(S stay, R why) { return {stay, why, R::kNone, Pending::kKeep, false}; }
 constexpr Cell abort_to_stopping(R why, Pending p) { return {S::kStopping, R::kNone, why, p, false}; }
 
-// Rows: disabled, holding, moving, stopping; columns: enable, disable, move, stop (clear: accepted,
-// nothing changes, outside fault).
-constexpr Cell kTable[4][4] = {
+// Rows: disabled, holding, moving, stopping, (fault: the fault rules decide), yielding; columns:
+// enable, disable, move, stop (clear: accepted, nothing changes, outside fault).
+constexpr Cell kTable[6][4] = {
     {{S::kHolding, R::kNone, R::kNone, Pending::kCancel, true},
      go(S::kDisabled),
      refuse(S::kDisabled, R::kNotEnabled),
@@ -66,6 +66,9 @@ constexpr Cell kTable[4][4] = {
      abort_to_stopping(R::kStopCommand, Pending::kKeep)},
     {go(S::kStopping, Pending::kCancel), go(S::kStopping, Pending::kSet), refuse(S::kStopping, R::kStopping),
      go(S::kStopping)},
+    {refuse(S::kFault, R::kFaulted), refuse(S::kFault, R::kFaulted), refuse(S::kFault, R::kFaulted),
+     refuse(S::kFault, R::kFaulted)},
+    {go(S::kHolding), go(S::kDisabled), refuse(S::kYielding, R::kYielding), go(S::kHolding)},
 };
 
 int code(S s) { return static_cast<int>(s); }
@@ -96,7 +99,11 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
   // Events: the generator's reports, then the runtime's stop request.
   S s = m.state;
   bool pending = s == S::kStopping && m.disable_at_rest;
-  if (s == S::kMoving && in.motion_finished) {
+  if (in.yield && s != S::kDisabled) {
+    if (s == S::kMoving) w.abort = R::kCollision;
+    s = S::kYielding;
+    pending = false;
+  } else if (s == S::kMoving && in.motion_finished) {
     s = S::kHolding;
     w.completion = MotionCompletion::kFinished;
   } else if (s == S::kMoving && in.stop_request != R::kNone) {
@@ -143,10 +150,10 @@ std::string describe(const MotionMachine& m, const MotionInput& in) {
          " command=" + motion_name(in.command) + "(" + std::to_string(code(in.command)) +
          ") faults=" + std::to_string(in.faults) + " causes=" + std::to_string(in.causes) +
          " stop_request=" + motion_name(in.stop_request) + " finished=" + std::to_string(in.motion_finished) +
-         " stopped=" + std::to_string(in.stopped);
+         " stopped=" + std::to_string(in.stopped) + " yield=" + std::to_string(in.yield);
 }
 
-bool torque_state(S s) { return s == S::kHolding || s == S::kMoving || s == S::kStopping; }
+bool torque_state(S s) { return s == S::kHolding || s == S::kMoving || s == S::kStopping || s == S::kYielding; }
 
 /// The safety properties of one tick, whatever the table says.
 void check_properties(const MotionMachine& m, const MotionInput& in, const MotionStep& t) {
@@ -178,14 +185,23 @@ void check_properties(const MotionMachine& m, const MotionInput& in, const Motio
     ASSERT_EQ(t.refusal, R::kFaulted);
     ASSERT_EQ(t.cause, in.faults | in.causes);  // the refusal names the cause still present
   }
-  // No tick reaches moving from disabled or fault: only an enabled machine moves.
+  // No tick reaches moving from disabled, fault or yielding: only an enabled machine moves, and a
+  // yielding one holds first.
   ASSERT_TRUE(to != S::kMoving || m.state == S::kHolding || m.state == S::kMoving || m.state == S::kStopping);
+  // A collision to yield to leaves every powered state yielding, in the same tick, unless a command
+  // of that tick holds or disables; a fault still wins.
+  if (in.yield && in.faults == 0 && !was_fault && torque_state(m.state) && in.command != C::kEnable &&
+      in.command != C::kStop && in.command != C::kDisable) {
+    ASSERT_EQ(to, S::kYielding);
+  }
+  ASSERT_TRUE(to != S::kYielding || (in.yield && !was_fault) || m.state == S::kYielding);
   // Every command gets an outcome; every refusal has a name, one the machine decides.
   ASSERT_EQ(t.outcome == CommandOutcome::kNone, code(in.command) == 0 || code(in.command) >= kCommands);
   ASSERT_EQ(t.outcome == CommandOutcome::kRefused, t.refusal != R::kNone);
   if (t.outcome == CommandOutcome::kRefused) {
     ASSERT_STRNE(motion_name(t.refusal), "?");
-    ASSERT_TRUE(t.refusal == R::kNotEnabled || t.refusal == R::kFaulted || t.refusal == R::kStopping);
+    ASSERT_TRUE(t.refusal == R::kNotEnabled || t.refusal == R::kFaulted || t.refusal == R::kStopping ||
+                t.refusal == R::kYielding);
   }
   ASSERT_TRUE(t.cause == 0 || t.refusal == R::kFaulted);  // a cause comes with a refusal `faulted` alone
   // Only a motion in progress is aborted, with a name; the pose is captured on entering holding.
@@ -214,7 +230,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
           for (std::uint32_t f : faults)
             for (std::uint32_t cause : causes)
               for (int req = 0; req < kReasons; ++req)
-                for (int ev = 0; ev < 4; ++ev) {
+                for (int ev = 0; ev < 8; ++ev) {
                   const MotionMachine m{static_cast<S>(st), latched, pending != 0};
                   MotionInput in{};
                   in.command = static_cast<C>(cmd);
@@ -223,6 +239,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   in.stop_request = static_cast<R>(req);
                   in.motion_finished = (ev & 1) != 0;
                   in.stopped = (ev & 2) != 0;
+                  in.yield = (ev & 4) != 0;
                   const MotionStep got = motion_next(m, in);
                   ASSERT_EQ(describe(got), describe(oracle(m, in))) << describe(m, in);
                   check_properties(m, in, got);
@@ -232,7 +249,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   faulting += f != 0;
                   ++cases;
                 }
-  EXPECT_EQ(cases, 6L * 2 * 3 * 7 * 3 * 3 * 16 * 4);
+  EXPECT_EQ(cases, 7L * 2 * 3 * 7 * 3 * 3 * 18 * 8);
   EXPECT_GT(refusals, 0);  // the loop reached every kind of row
   EXPECT_GT(aborts, 0);
   EXPECT_GT(faulting, 0);
@@ -254,9 +271,9 @@ std::set<int> reachable(C left_out) {
     for (int cmd = 0; cmd < kCommands; ++cmd)
       for (std::uint32_t f : {0u, static_cast<std::uint32_t>(kFaultEstop)})
         for (int req = 0; req < kReasons; ++req)
-          for (int ev = 0; ev < 4; ++ev) {
+          for (int ev = 0; ev < 8; ++ev) {
             if (static_cast<C>(cmd) == left_out) continue;
-            MotionInput in{static_cast<C>(cmd), f, f, static_cast<R>(req), (ev & 1) != 0, (ev & 2) != 0};
+            MotionInput in{static_cast<C>(cmd), f, f, static_cast<R>(req), (ev & 1) != 0, (ev & 2) != 0, (ev & 4) != 0};
             todo.push_back(motion_next(m, in).machine);
             in.causes = 0;
             todo.push_back(motion_next(m, in).machine);
@@ -270,7 +287,8 @@ TEST(MotionStates, NoPathReachesMovingWithoutEnable) {
   // The search is a real one: with enable every state is reachable.
   EXPECT_EQ(reachable(C::kNone).size(), static_cast<std::size_t>(kStates));
   // And without move no motion starts, so nothing stops.
-  EXPECT_EQ(reachable(C::kMove), (std::set<int>{code(S::kDisabled), code(S::kHolding), code(S::kFault)}));
+  EXPECT_EQ(reachable(C::kMove),
+            (std::set<int>{code(S::kDisabled), code(S::kHolding), code(S::kFault), code(S::kYielding)}));
 }
 
 TEST(MotionStates, AFaultIsCategoryZeroWithTorqueOffInTheSameTickFromEveryState) {
@@ -314,7 +332,7 @@ TEST(MotionStates, EveryEntryOfEveryListHasAUniqueNameAndAMeaning) {
 
 TEST(MotionStates, TheIssuesNamesAreTheNamesInTelemetry) {
   const std::vector<std::string> states(std::begin(MotionNames<S>::kNames), std::end(MotionNames<S>::kNames));
-  EXPECT_EQ(states, (std::vector<std::string>{"disabled", "holding", "moving", "stopping", "fault"}));
+  EXPECT_EQ(states, (std::vector<std::string>{"disabled", "holding", "moving", "stopping", "fault", "yielding"}));
   EXPECT_STREQ(motion_name(R::kOutOfWorkspace), "out_of_workspace");
   EXPECT_STREQ(motion_name(R::kNearSingular), "near_singular");
   EXPECT_STREQ(motion_name(R::kOverLimit), "over_limit");
@@ -324,6 +342,11 @@ TEST(MotionStates, TheIssuesNamesAreTheNamesInTelemetry) {
   EXPECT_STREQ(motion_name(R::kStaleStream), "stale_stream");
   EXPECT_STREQ(motion_name(R::kLimitReached), "limit_reached");
   EXPECT_STREQ(motion_name(R::kLinkSilent), "link_silent");
+  EXPECT_STREQ(motion_name(R::kCollision), "collision");
+  EXPECT_STREQ(motion_name(R::kYielding), "yielding");
+  EXPECT_STREQ(motion_name(CollisionReaction::kCategory0), "category_0");
+  EXPECT_STREQ(motion_name(CollisionReaction::kCategory2), "category_2");
+  EXPECT_STREQ(motion_name(CollisionReaction::kYield), "yield");
   EXPECT_STREQ(motion_name(C::kMove), "move");
 }
 
@@ -493,3 +516,31 @@ TEST(MotionSequences, AnUnreadableStateCodeFaults) {
 }
 
 }  // namespace
+
+TEST(MotionSequences, AYieldAbortsTheMotionWithCollisionAndAStopHoldsThePoseItReached) {
+  MotionMachine m{S::kMoving, 0, false};
+  MotionStep t = motion_next(m, {.yield = true});
+  EXPECT_EQ(t.machine.state, S::kYielding);
+  EXPECT_EQ(t.abort, R::kCollision);
+  EXPECT_TRUE(t.torque);
+  EXPECT_EQ(t.stop, StopCategory::kNone);  // a reaction, not a stop
+  m = t.machine;
+  t = motion_next(m, {.command = C::kMove});
+  EXPECT_EQ(t.refusal, R::kYielding);
+  EXPECT_EQ(t.machine.state, S::kYielding);
+  t = motion_next(m, {.command = C::kStop});
+  EXPECT_EQ(t.outcome, CommandOutcome::kAccepted);
+  EXPECT_EQ(t.machine.state, S::kHolding);
+  EXPECT_TRUE(t.capture_pose);
+  EXPECT_FALSE(t.enabling);  // the observer runs on: it was never stopped
+  // A fault while yielding is category 0 like anywhere else.
+  t = motion_next(m, {.faults = kFaultEstop});
+  EXPECT_EQ(t.machine.state, S::kFault);
+  EXPECT_FALSE(t.torque);
+  // A stop to disable that meets a collision yields; the pending disable is dropped.
+  t = motion_next({S::kStopping, 0, true}, {.yield = true});
+  EXPECT_EQ(t.machine.state, S::kYielding);
+  EXPECT_FALSE(t.machine.disable_at_rest);
+  // Disabled, nothing yields: no torque to yield with.
+  EXPECT_EQ(motion_next({}, {.yield = true}).machine.state, S::kDisabled);
+}

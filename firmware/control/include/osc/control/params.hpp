@@ -96,6 +96,16 @@ constexpr int kStuckIntervals = 10;
 constexpr double kResidualGain[6] = {50, 50, 50, 20, 20, 20};
 constexpr double kResidualPeakFactor[6] = {1.1, 1.1, 1.1, 1.2, 1.2, 1.2};
 constexpr int kResidualQualifyTicks = 3;
+/// The residual monitor's change channel: the bandwidth of the slow filter whose output the change
+/// residual r - r_slow leaves out [1/s]. A model error that changes more slowly than this (a friction
+/// coefficient off by a constant, an inertia error under a smooth motion) stays out of it, while a
+/// step of external torque passes: 0.55 of it at 17 ms (with kResidualGain 50).
+constexpr double kResidualSlowGain = 5;
+/// Each threshold is this many times the bound derived from the model's error (both channels): a
+/// healthy residual stays within its bound, at most 1 / kResidualMargin of the threshold, and the
+/// sweep of healthy runs checks exactly that (docs/safety.md); the rest is room for what the bounds
+/// leave out.
+constexpr double kResidualMargin = 2;
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
 /// heavier (corke) friction preset (7.0 mm, 0.43 deg).

@@ -28,6 +28,14 @@ static_assert(has_spherical_wrist(robot::kArm),
 /// the paper's run), or disabled, waiting for an enable.
 enum class TaskStart : std::uint8_t { kPaper, kDisabled };
 
+/// Collision thresholds a user may set [N m]: each finite, from 0 (the derived threshold alone) to
+/// the joint's full-scale torque (a residual beyond it could not be told from a saturated drive).
+constexpr bool collision_thresholds_valid(const double threshold_nm[kDof]) {
+  for (int i = 0; i < kDof; ++i)
+    if (!(threshold_nm[i] >= 0 && threshold_nm[i] <= robot::kDrives.torque_limit[i])) return false;
+  return true;
+}
+
 template <class S>
 struct ControlTask {
   Model<S> model;
@@ -56,6 +64,8 @@ struct ControlTask {
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
   ResidualMonitor<S> residual;
+  CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
+  bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
   Supervisor sup;
   std::uint32_t period_cycles;  // overrun budget per step (0: not checked)
@@ -91,6 +101,9 @@ struct ControlTask {
     jump.reset();
     stuck.reset();
     residual.reset();
+    residual.collision_floor.setZero();
+    collision_reaction = CollisionReaction::kCategory0;
+    contact = false;
     saturation.reset();
     set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
@@ -130,6 +143,17 @@ struct ControlTask {
   void set_encoder_resolution(double counts_per_motor_rev) {
     set_encoders(uniform_encoders("uniform", robot::kArm, counts_per_motor_rev));
   }
+  /// A collision's reaction and each joint's collision threshold [N m] (ResidualMonitor::
+  /// collision_floor), at run time: false, nothing changed, for a reaction outside its list or a
+  /// threshold outside [0, the joint's full-scale torque] (collision_thresholds_valid).
+  bool set_collision(CollisionReaction reaction, const double threshold_nm[kDof]) {
+    if (static_cast<int>(reaction) >= MotionNames<CollisionReaction>::kCount ||
+        !collision_thresholds_valid(threshold_nm))
+      return false;
+    collision_reaction = reaction;
+    for (int i = 0; i < kDof; ++i) residual.collision_floor(i) = lit<S>(threshold_nm[i]);
+    return true;
+  }
   /// Encoder counts per radian of channel i (its motor angle referred to its joint).
   double counts_per_rad(int i) const { return static_cast<double>(io.counts_per_rad(i)); }
   /// Test hook (fault injection): poisons the observer state with a NaN.
@@ -146,9 +170,17 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const bool coupled = task.io.coupled();
   const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
   const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
-  // The stuck-encoder monitor, unless the residual monitor is armed in its place (a trial: docs/safety.md).
-  const std::uint32_t stuck = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
-  std::uint32_t faults = task.residual.armed ? 0u : stuck;
+  // The stuck-encoder monitor; a backstop without its tightest criterion where the residual
+  // monitor is armed (docs/safety.md).
+  task.stuck.backstop = task.residual.armed;
+  // Yielding, the reference follows the arm and the torque follows gravity; against a contact the
+  // torque holds a joint that cannot move: neither says where the arm must go, so the stuck-encoder
+  // monitor waits, from a collision reacted to until the next motion (the residual monitor runs on).
+  std::uint32_t faults = 0;
+  if (task.machine.state == MotionState::kYielding || task.contact)
+    task.stuck.reset(true);
+  else
+    faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
@@ -182,7 +214,23 @@ Vec6<S> applied_torque(const ControlTask<S>& task) {
 
 /// The states in which the control step runs and torque reaches the DACs.
 constexpr bool motion_powered(MotionState s) {
-  return s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping;
+  return s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping ||
+         s == MotionState::kYielding;
+}
+
+/// The reference of a yielding arm (a collision's reaction yield): the arm's own pose and observed
+/// velocity one sample old, no acceleration. Then e = x_{k-1} - x_k and eta = x^dot^_{k-1} - x^dot^_k +
+/// k_s e are of the order of one sample's motion, and (32) reduces to the bias force of (35) (gravity,
+/// Coriolis and the friction estimate) with the observer's correction and a damping of
+/// (k_s + k_nd) k_s dt (about 21 N s/m on x, y, z): no stiffness holds the arm where it was, and the
+/// observer (22) still integrates the force that is applied.
+template <class S>
+Desired<S> yield_reference(const ControlTask<S>& task) {
+  Desired<S> d;
+  d.x = task.last.x;
+  d.xd = task.last.xd_hat;
+  d.xdd.setZero();
+  return d;
 }
 
 /// The limits checked every tick of a motion (a category-2 stop when one is reached): each joint
@@ -247,12 +295,16 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   const std::uint64_t next = task.tick + 1;
   const bool accepted = st.outcome == CommandOutcome::kAccepted;
   const TaskCommand<S>& cmd = task.pending;
+  if (accepted && (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper ||
+                   cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kClear))
+    task.contact = false;
   if (st.enabling) {
     controller_restart(task.model, task.state, q);
     task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
     task.q_queue_end = q;
     task.stuck.reset(true);
     task.residual.reset();
+    task.contact = false;
     task.ramping = true;
     task.ramp_start = next;
   }
@@ -269,6 +321,11 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (accepted && cmd.verb == MotionVerb::kPaper)
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream) task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id);
+  // Into yielding, the motion is dropped; out of it, the pose reached is held.
+  if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) {
+    task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+    task.q_queue_end = q;
+  }
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
     task.gen.stop(next, params::kControlHz, task.limits);
     task.q_queue_end = q;  // near where the stop ends: the next check's Newton steps start the path there
@@ -287,12 +344,13 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
 /// torque may reach the DACs in this tick.
 template <class S>
 bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, const Vec6<S>& q, const MotionEvents& ev,
-                   MotionReason stop_request) {
+                   MotionReason stop_request, bool yield) {
   task.report = {};
   MotionInput in;
   in.command = motion_command_of_tick(task, measured);
   in.faults = faults;
   in.stop_request = stop_request;
+  in.yield = yield;
   in.motion_finished = ev.finished;
   in.stopped = ev.stopped;
   const MotionState before = task.machine.state;
@@ -346,7 +404,8 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
     task.sample.valid = false;
   }
   if (stepped) {
-    task.desired = task.gen.at_tick(task.tick, params::kControlHz, ev);
+    const bool yielding = task.machine.state == MotionState::kYielding;
+    task.desired = yielding ? yield_reference(task) : task.gen.at_tick(task.tick, params::kControlHz, ev);
     const std::uint32_t s0 = hal.cycles();
     task.last = control_step(task.model, task.gains, task.mode, task.state, q, task.desired);
     task.step_timing.add(hal.cycles() - s0);
@@ -355,6 +414,13 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageMonitors] = hal.cycles();
   // monitors
   if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
+  // A collision whose reaction is not category 0 is no fault: a category-2 stop, or yielding.
+  MotionReason collision = MotionReason::kNone;
+  if ((faults & kFaultCollision) != 0 && task.collision_reaction != CollisionReaction::kCategory0) {
+    faults &= ~static_cast<std::uint32_t>(kFaultCollision);
+    collision = MotionReason::kCollision;
+    task.contact = true;  // until the next motion starts: the contact may last
+  }
   mark[kStageOutput] = hal.cycles();
   // output
   if (stepped && task.ramping) ramp_torque(task);
@@ -376,11 +442,13 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
-  MotionReason stop_request = stepped ? motion_limits_reached(task, q) : MotionReason::kNone;
+  const bool yield = collision != MotionReason::kNone && task.collision_reaction == CollisionReaction::kYield;
+  MotionReason stop_request = yield ? MotionReason::kNone : collision;
+  if (stop_request == MotionReason::kNone && stepped) stop_request = motion_limits_reached(task, q);
   if (stop_request == MotionReason::kNone && task.gen.stream_stale()) stop_request = MotionReason::kStaleStream;
   if (stop_request == MotionReason::kNone) stop_request = task.stop_request;  // the board's (request_stop)
   task.stop_request = MotionReason::kNone;
-  const bool torque = motion_update(task, faults, measured, q, ev, stop_request);
+  const bool torque = motion_update(task, faults, measured, q, ev, stop_request, yield);
   if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (!stepped || !torque_enabled(task.sup) || !torque)

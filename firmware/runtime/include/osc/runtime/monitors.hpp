@@ -118,6 +118,9 @@ struct StuckEncoderMonitor {
   Vec6<S> dtau_gated_peak;             // ... while it was silent for kStuckIntervals of its intervals
   Vec6<S> peak;                        // the largest motion seen
   bool restart = false;                // the next check takes every encoder as just changed
+  /// A backstop behind the armed residual monitor: the silent-torque criterion (kStuckTorqueSilent,
+  /// the tightest of the trajectory-tuned ones and the one that trips on the realistic plant) is off.
+  bool backstop = false;
 
   /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
   /// the torque jumps from zero to what holds the arm, and no encoder needs to count for that).
@@ -165,7 +168,7 @@ struct StuckEncoderMonitor {
       if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[i]) continue;
       if (m > peak(i)) peak(i) = m;
       if (m > kMotionCounts) faults |= kFaultEncoderStuck;
-      if (move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
+      if (backstop || move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
       if (dtau > dtau_gated_peak(i)) dtau_gated_peak(i) = dtau;
       if (dtau > kTorqueSilent[i]) faults |= kFaultEncoderStuck;
     }
@@ -181,7 +184,7 @@ struct ResidualConstants {
   S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
   S offset[kDof];          // an amplifier's offset bound [N m]
   S full_scale[kDof];      // a channel's full-scale torque [N m]
-  S link_inertia, gain_ripple;
+  S link_inertia, gain_ripple, amp_gain, ripple;
   constexpr ResidualConstants()
       : vis_lo{},
         vis_hi{},
@@ -193,7 +196,9 @@ struct ResidualConstants {
         offset{},
         full_scale{},
         link_inertia{},
-        gain_ripple{} {
+        gain_ripple{},
+        amp_gain{},
+        ripple{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       vis_lo[i] = lit<S>(b.friction_lo.vis[i]), vis_hi[i] = lit<S>(b.friction_hi.vis[i]);
@@ -207,6 +212,8 @@ struct ResidualConstants {
     }
     link_inertia = lit<S>(b.link_inertia);
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
+    amp_gain = lit<S>(b.amp_gain);
+    ripple = lit<S>(b.ripple);
   }
 };
 template <class S>
@@ -243,10 +250,26 @@ struct ResidualInput {
 ///  - collision: an external torque on several joints, as a contact gives.
 template <class S>
 struct ResidualMonitor {
+  /// The model error's regressors, each filtered as r, then slowly (the change channel): the
+  /// friction model's three columns, gravity, the Coriolis torque, the applied torque and its size.
+  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kRegressors };
+  /// One joint's friction against the band (robot::kModelErrorBounds): moving, the band's distance
+  /// from theta^ per coefficient; not moving, the static band's extent plus |tau_f^| (still).
+  struct FrictionError {
+    S dv, dc, ds, still;
+    bool moving;
+  };
+
   Vec6<S> r;                             // the residual [N m]
   Vec6<S> bound;                         // the model-error bound's filtered pointwise terms [N m]
   Vec6<S> acc;                           // the joint accelerations, filtered as r [rad/s^2]
   Vec6<S> threshold;                     // this tick's thresholds [N m]
+  Vec6<S> d;                             // the change residual r - r_slow [N m]
+  Vec6<S> change_threshold;              // its thresholds [N m]
+  Vec6<S> r_slow, acc_slow;              // r and acc through the slow filter (params::kResidualSlowGain)
+  Vec6<S> reg[kRegressors];              // the regressors filtered as r
+  Vec6<S> reg_slow[kRegressors];         // ... then slowly
+  Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
   Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
   Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
   S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
@@ -257,11 +280,16 @@ struct ResidualMonitor {
   std::int8_t direction[kDof];           // the sign of its last change
   bool steady[kDof];                     // its last two changes had the same sign
   std::uint8_t over[kDof];               // consecutive ticks beyond the threshold
+  std::uint64_t over_since[kDof];        // the tick the current run of them began
   std::uint32_t detected;                // the first detection's fault (kept while not armed too)
   std::uint64_t detected_tick;           // ... its tick
   std::int8_t joint;                     // ... its joint (0-based), -1 none
   bool primed;                           // a previous step is on record
   bool armed = false;  // its detections are faults, in place of StuckEncoderMonitor's (else only recorded)
+  /// The user's collision thresholds [N m] (ControlTask::set_collision): a collision is reported
+  /// only once some joint's qualified residual is beyond its own too; 0, the default, leaves the derived
+  /// thresholds alone. They never lower a derived threshold, nor touch the sensor and drive faults.
+  Vec6<S> collision_floor = Vec6<S>::Zero();
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
   /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
@@ -277,10 +305,12 @@ struct ResidualMonitor {
     bound.setZero();
     acc.setZero();
     threshold.setZero();
+    prime_change();
+    change_threshold.setZero();
     tau_prev.setZero();
     peak_ratio.setZero();
     for (int i = 0; i < kDof; ++i) {
-      last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0;
+      last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0, over_since[i] = 0;
       last_counts[i] = 0, direction[i] = 0, steady[i] = false;
     }
     joint = -1;
@@ -297,9 +327,9 @@ struct ResidualMonitor {
   void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
     for (int i = 0; i < kDof; ++i) {
       if (!moved[i]) continue;
-      const std::int8_t d = counts[i] > last_counts[i] ? 1 : -1;
-      steady[i] = d == direction[i];
-      direction[i] = d;
+      const std::int8_t way = counts[i] > last_counts[i] ? 1 : -1;
+      steady[i] = way == direction[i];
+      direction[i] = way;
       last_counts[i] = counts[i];
       const std::uint64_t gap = tick - last_move_tick[i];
       move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
@@ -323,94 +353,181 @@ struct ResidualMonitor {
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
                       const bool moved[kDof], std::uint64_t tick, S dt) {
     track(counts, moved, tick);
+    FrictionError fe[kDof];
+    for (int i = 0; i < kDof; ++i) fe[i] = friction_error(in, i, tick);
     if (!primed) {
       qd_prev = in.qd;
       bias_prev = in.bias;
       r.setZero();
       acc.setZero();
-      bound = pointwise_bound(in, tick);
-      update_thresholds(in.A);
+      prime_change();
+      bound = pointwise_bound(in, fe);
+      update_thresholds(in.A, fe, in.theta);
       for (int i = 0; i < kDof; ++i) over[i] = 0;
       primed = true;
       return 0;
     }
     static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
     const Vec6<S> dqd = in.qd - qd_prev;
-    const Vec6<S> u = in.A * dqd + dt * (bias_prev - tau_prev), b = pointwise_bound(in, tick);
+    const Vec6<S> u = in.A * dqd + dt * (bias_prev - tau_prev), b = pointwise_bound(in, fe);
     for (int i = 0; i < kDof; ++i) {
       const S K = kGain[i], Kdt = K * dt;
       r(i) += K * u(i) - Kdt * r(i);
       acc(i) += K * dqd(i) - Kdt * acc(i);
       bound(i) += Kdt * (b(i) - bound(i));
     }
-    update_thresholds(in.A);
+    update_change(in, fe, dt);
+    update_thresholds(in.A, fe, in.theta);
     qd_prev = in.qd;
     bias_prev = in.bias;
     int worst = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) {
-      const S ratio = math::abs(r(i)) / threshold(i);
+      const S ratio = ratio_of(i);
       if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
+      if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
       over[i] = ratio > S(1) ? static_cast<std::uint8_t>(over[i] < 255 ? over[i] + 1 : 255) : std::uint8_t{0};
       if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
     }
     if (worst < 0) return 0;
     const std::uint32_t kind = classify(worst, io, tick);
+    if (kind == kFaultCollision && !beyond_collision_floor()) return 0;
     if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick;
     return armed ? kind : 0u;
   }
 
+  /// Joint i's residual against its threshold: the larger of the two channels' ratios.
+  S ratio_of(int i) const {
+    const S a = math::abs(r(i)) / threshold(i), c = math::abs(d(i)) / change_threshold(i);
+    return a > c ? a : c;
+  }
+
  private:
+  void prime_change() {
+    d.setZero();
+    r_slow.setZero();
+    acc_slow.setZero();
+    for (int k = 0; k < kRegressors; ++k) reg[k].setZero(), reg_slow[k].setZero();
+    stillness.setOnes();  // until each joint is seen moving, its static friction may change at any time
+  }
+  bool beyond_collision_floor() const {
+    for (int j = 0; j < kDof; ++j)
+      if (over[j] >= params::kResidualQualifyTicks && math::abs(r(j)) > collision_floor(j)) return true;
+    return false;
+  }
+  /// Joint i's friction against the band (FrictionError).
+  FrictionError friction_error(const ResidualInput<S>& in, int i, std::uint64_t tick) const {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    const S v = math::abs(in.qd(i));
+    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
+    const S moving = velocity_noise(i) + lag * math::abs(acc(i));
+    const S th_v = in.theta ? (*in.theta)(i) : S(0), th_c = in.theta ? (*in.theta)(kDof + i) : S(0),
+            th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
+    const auto larger = [](S x, S y) { return x > y ? x : y; };
+    FrictionError e;
+    e.dv = larger(c.vis_hi[i] - th_v, th_v - c.vis_lo[i]);
+    e.dc = larger(c.cou_hi[i] - th_c, th_c - c.cou_lo[i]);
+    e.ds = larger(c.sti_hi[i] - th_s, th_s - c.sti_lo[i]);
+    // Static friction anywhere within the band, against whatever the estimate says.
+    e.still = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
+    e.moving = v > moving && counting(i, in.qd(i), tick);
+    return e;
+  }
   /// Per joint, the bound on the unexplained torque that changes with the state (then filtered as
   /// r): friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
-  Vec6<S> pointwise_bound(const ResidualInput<S>& in, std::uint64_t tick) const {
+  Vec6<S> pointwise_bound(const ResidualInput<S>& in, const FrictionError (&fe)[kDof]) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     Vec6<S> b;
     for (int i = 0; i < kDof; ++i) {
-      const S v = math::abs(in.qd(i));
-      // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
-      const S moving = velocity_noise(i) + lag * math::abs(acc(i));
-      S friction;
-      if (v > moving && counting(i, in.qd(i), tick)) {
-        // The band's distance from the estimate, coefficient by coefficient.
-        const S th_v = in.theta ? (*in.theta)(i) : S(0), th_c = in.theta ? (*in.theta)(kDof + i) : S(0),
-                th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
-        const auto larger = [](S x, S y) { return x > y ? x : y; };
-        const S dv = larger(c.vis_hi[i] - th_v, th_v - c.vis_lo[i]);
-        const S dc = larger(c.cou_hi[i] - th_c, th_c - c.cou_lo[i]);
-        const S ds = larger(c.sti_hi[i] - th_s, th_s - c.sti_lo[i]);
-        friction = v * dv + dc + in.decay(i) * ds + c.vis_hi[i] * velocity_noise(i);
-      } else {
-        // Static friction anywhere within the band, against whatever the estimate says.
-        friction = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
-      }
+      const FrictionError& e = fe[i];
+      // Moving: the band's distance from the estimate, coefficient by coefficient.
+      const S friction = e.moving ? math::abs(in.qd(i)) * e.dv + e.dc + in.decay(i) * e.ds +
+                                        c.vis_hi[i] * velocity_noise(i)
+                                  : e.still;
       const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
       b(i) = friction + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
              c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
     }
     return b;
   }
+  /// The change channel: each regressor of the model's error filtered as r, then slowly. A model
+  /// error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
+  /// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
+  /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
+  /// anything within its static band, and keeps it in the change threshold until the slow filter
+  /// forgets it.
+  void update_change(const ResidualInput<S>& in, const FrictionError (&fe)[kDof], S dt) {
+    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
+    static constexpr S kSlow = lit<S>(params::kResidualSlowGain);
+    const S Ks = kSlow * dt;
+    for (int i = 0; i < kDof; ++i) {
+      const S Kdt = kGain[i] * dt;
+      const S sign = in.qd(i) > S(0) ? S(1) : (in.qd(i) < S(0) ? S(-1) : S(0));
+      const S phi[kRegressors] = {in.qd(i),
+                                  sign,
+                                  sign * in.decay(i),
+                                  in.tau_f(i),
+                                  in.g(i),
+                                  in.bias(i) - in.g(i) - in.tau_f(i),
+                                  tau_prev(i),
+                                  math::abs(tau_prev(i))};
+      for (int k = 0; k < kRegressors; ++k) {
+        reg[k](i) += Kdt * (phi[k] - reg[k](i));
+        reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));
+      }
+      acc_slow(i) += Ks * (acc(i) - acc_slow(i));
+      r_slow(i) += Ks * (r(i) - r_slow(i));
+      d(i) = r(i) - r_slow(i);
+      stillness(i) = fe[i].moving ? stillness(i) - Ks * stillness(i) : S(1);
+    }
+  }
+  /// The regressor k's change in joint i (its filtered value less its slow part).
+  S signed_change(int k, int i) const { return reg[k](i) - reg_slow[k](i); }
+  S change(int k, int i) const { return math::abs(signed_change(k, i)); }
   /// The thresholds: the filtered bound, the inertias' error on the filtered accelerations, and the
   /// velocity estimate's noise through A and the filter.
-  void update_thresholds(const Mat6<S>& A) {
+  void update_thresholds(const Mat6<S>& A, const FrictionError (&fe)[kDof], const Vec18<S>* theta) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
     static constexpr std::array<S, kDof> kPeak = lit_array<S>(params::kResidualPeakFactor);
-    const Vec6<S> a = acc.cwiseAbs();
+    static constexpr S kMargin = lit<S>(params::kResidualMargin);
+    const Vec6<S> a = acc.cwiseAbs(), da = (acc - acc_slow).cwiseAbs();
     const Mat6<S> absA = A.cwiseAbs();
-    const Vec6<S> inertia = absA * a, noise = absA * (S(2) * velocity_noise);
-    for (int i = 0; i < kDof; ++i)
+    const Vec6<S> inertia = absA * a, inertia_change = absA * da, noise = absA * (S(2) * velocity_noise);
+    for (int i = 0; i < kDof; ++i) {
+      const S quantum = kGain[i] * noise(i);
       threshold(i) =
-          kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i)) + kGain[i] * noise(i);
+          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i)) + quantum);
+      const FrictionError& e = fe[i];
+      // The friction error (theta - theta^)^T w: the band's distances times the regressors'
+      // changes at the estimate of now, plus what the estimate's own change added.
+      const S th_v = theta ? (*theta)(i) : S(0), th_c = theta ? (*theta)(kDof + i) : S(0),
+              th_s = theta ? (*theta)(2 * kDof + i) : S(0);
+      const S learnt = signed_change(kEstimate, i) - th_v * signed_change(kVis, i) - th_c * signed_change(kCou, i) -
+                       th_s * signed_change(kSti, i);
+      const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) +
+                         math::abs(learnt) + c.vis_hi[i] * velocity_noise(i) + stillness(i) * e.still;
+      const S model = c.link_inertia * (inertia_change(i) + change(kGravity, i) + change(kCoriolis, i)) +
+                      c.armature_delta[i] * da(i);
+      const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i);
+      change_threshold(i) = kMargin * (kPeak[i] * (friction + model + amplifier) + quantum);
+    }
   }
+  /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
+  /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
+  bool silent_first(int c, int i, std::uint64_t tick) const {
+    constexpr std::uint64_t kWindow = params::kControlHz / 4;  // a residual rises within 250 ms of it
+    return silent(c, tick) && last_move_tick[c] <= over_since[i] && over_since[i] - last_move_tick[c] <= kWindow;
+  }
+  /// The kind of a qualified residual on joint i (the worst).
   std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
     // A stuck encoder: joint i's own encoder or one the coupling adds to it.
-    bool stuck = silent(i, tick);
+    bool stuck = silent_first(i, i, tick);
     for (int k = 0; k < io.terms; ++k)
-      if (io.row[k] == i && silent(io.col[k], tick)) stuck = true;
+      if (io.row[k] == i && silent_first(io.col[k], i, tick)) stuck = true;
     if (stuck) return kFaultEncoderStuck;
     for (int j = 0; j < kDof; ++j)
-      if (j != i && math::abs(r(j)) > lit<S>(0.5) * threshold(j)) return kFaultCollision;
+      if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
     return kFaultDriveFault;
   }
 };

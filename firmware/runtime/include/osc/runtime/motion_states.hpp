@@ -31,7 +31,8 @@ namespace osc {
   X(Holding, "holding", "torque on, holding the pose captured on entry, the observer running") \
   X(Moving, "moving", "following the motion generator (move_to, stream, paper, queued moves)") \
   X(Stopping, "stopping", "category-2 stop: decelerating along the path to rest, torque on")   \
-  X(Fault, "fault", "category-0 stop: zero torque, amplifiers off; sticky until a clear")
+  X(Fault, "fault", "category-0 stop: zero torque, amplifiers off; sticky until a clear")      \
+  X(Yielding, "yielding", "a collision's reaction yield: gravity, Coriolis and friction compensated, no stiffness")
 
 #define OSC_MOTION_COMMAND_LIST(X)                                                      \
   X(None, "none", "no command this tick (a code outside this list counts as none)")     \
@@ -61,7 +62,9 @@ namespace osc {
   X(Superseded, "superseded", "a re-target replaced the motion; or the queue changed before the command's tick")    \
   X(BadCommand, "bad_command",                                                                                      \
     "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")    \
-  X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")
+  X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")        \
+  X(Collision, "collision", "the runtime stopped the motion: a collision, its reaction category_2 or yield")        \
+  X(Yielding, "yielding", "a move while yielding to a collision: a stop or an enable holds the pose first")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -77,6 +80,13 @@ namespace osc {
   X(None, "none", "nothing completed this tick")                                                   \
   X(Finished, "finished", "the motion finished: the generator's queue ran empty at rest; holding") \
   X(Stopped, "stopped", "a category-2 stop reached rest; holding, or disabled after a disable")
+
+/// What a detected collision does (the residual monitor's collision, osc/runtime/monitors.hpp); an
+/// encoder or a drive fault is always category 0.
+#define OSC_COLLISION_REACTION_LIST(X)                                                                   \
+  X(Category0, "category_0", "a fault: zero torque and amplifiers off in this tick (the default)")       \
+  X(Category2, "category_2", "a moving arm decelerates along its path within the limits, then holds")    \
+  X(Yield, "yield", "gravity, Coriolis and friction compensation only, so that a person can push the arm away")
 
 /// The names, meanings and count of an enumeration declared by OSC_MOTION_ENUM, in code order.
 template <class E>
@@ -98,15 +108,17 @@ OSC_MOTION_ENUM(MotionReason, OSC_MOTION_REASON_LIST);
 OSC_MOTION_ENUM(CommandOutcome, OSC_COMMAND_OUTCOME_LIST);
 OSC_MOTION_ENUM(StopCategory, OSC_STOP_CATEGORY_LIST);
 OSC_MOTION_ENUM(MotionCompletion, OSC_MOTION_COMPLETION_LIST);
+OSC_MOTION_ENUM(CollisionReaction, OSC_COLLISION_REACTION_LIST);
 #undef OSC_X_PREFIX  // OSC_MOTION_ENUM stays defined: motion_commands.hpp declares its verbs with it
 
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
-static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kFault) + 1);
+static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kYielding) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kClear) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kLinkSilent) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kYielding) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kStopped) + 1);
+static_assert(MotionNames<CollisionReaction>::kCount == static_cast<int>(CollisionReaction::kYield) + 1);
 
 /// The name of a code of one of these enumerations ("?" for a code outside its list).
 template <class E>
@@ -130,6 +142,7 @@ struct MotionInput {
   MotionReason stop_request = MotionReason::kNone;
   bool motion_finished = false;  ///< the generator's queue ran empty at rest
   bool stopped = false;          ///< the category-2 deceleration reached rest
+  bool yield = false;            ///< a collision whose reaction is yield (CollisionReaction::kYield)
 };
 
 /// The next machine and what the tick does.
@@ -175,7 +188,11 @@ constexpr MotionStep motion_fault_tick(const MotionMachine& m, const MotionInput
 constexpr MotionStep motion_events(const MotionMachine& m, const MotionInput& in) {
   MotionStep r{};
   r.machine = {m.state, 0, m.state == MotionState::kStopping && m.disable_at_rest};
-  if (m.state == MotionState::kMoving && in.motion_finished) {
+  if (in.yield && m.state != MotionState::kDisabled) {
+    // A collision to yield to: whatever the arm did (a motion, its stop), it now gives way.
+    r.machine = {MotionState::kYielding, 0, false};
+    if (m.state == MotionState::kMoving) r.abort = MotionReason::kCollision;
+  } else if (m.state == MotionState::kMoving && in.motion_finished) {
     r.machine.state = MotionState::kHolding;
     r.completion = MotionCompletion::kFinished;
   } else if (m.state == MotionState::kMoving && in.stop_request != MotionReason::kNone) {
@@ -207,22 +224,24 @@ constexpr void motion_command(MotionStep& r, MotionCommand c) {
   switch (c) {
     case MotionCommand::kEnable:
       r.enabling = disabled;
-      if (disabled) m.state = MotionState::kHolding;
+      if (disabled || m.state == MotionState::kYielding) m.state = MotionState::kHolding;
       m.disable_at_rest = false;
       return;
     case MotionCommand::kDisable:
-      if (m.state == MotionState::kHolding) m.state = MotionState::kDisabled;
+      if (m.state == MotionState::kHolding || m.state == MotionState::kYielding) m.state = MotionState::kDisabled;
       if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kDisableCommand);
       m.disable_at_rest = m.state == MotionState::kStopping;
       return;
     case MotionCommand::kMove:
       if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
       if (m.state == MotionState::kStopping) return motion_refuse(r, MotionReason::kStopping);
+      if (m.state == MotionState::kYielding) return motion_refuse(r, MotionReason::kYielding);
       m.state = MotionState::kMoving;
       return;
     case MotionCommand::kStop:
       if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
       if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kStopCommand);
+      if (m.state == MotionState::kYielding) m.state = MotionState::kHolding;
       return;
     case MotionCommand::kNone:
     case MotionCommand::kClear:
@@ -245,16 +264,19 @@ constexpr void motion_command(MotionStep& r, MotionCommand c) {
 ///   moving, stop requested (reason r)    -> stopping, category 2, motion aborted: r
 ///   stopping, stopped                    -> holding (pose captured), or disabled if a disable is
 ///                                           pending; completion stopped
+///   holding, moving, stopping, yielding, yield (a collision, reaction yield; before the events above)
+///                                        -> yielding, a pending disable dropped; moving: aborted collision
 ///   commands (= : stays, accepted; a command code outside the list is none):
 ///              enable            disable                  move                 stop
 ///   disabled   holding, enabling =                        refused not_enabled  refused not_enabled
 ///   holding    =                 disabled                 moving               =
 ///   moving     =                 stopping, pending [1]    = (re-target/queue)  stopping [2]
 ///   stopping   =, not pending    =, pending               refused stopping     =
+///   yielding   holding           disabled                 refused yielding     holding
 ///   clear: = in every state but fault.
 ///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
-/// Torque is on in holding, moving, stopping; the stop in effect is category 0 in fault, 2 in
-/// stopping. The pose is captured whenever holding is entered (enable, finished, stopped).
+/// Torque is on in holding, moving, stopping, yielding; the stop in effect is category 0 in fault, 2 in
+/// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable, finished, stopped).
 /// Decisions: a command whose end state already holds is accepted and does nothing (enable when
 /// enabled, disable when disabled, stop when holding or stopping, clear outside fault): repeating
 /// one is harmless. A move or a stop while disabled is refused (not_enabled): nothing holds the arm,
@@ -276,7 +298,8 @@ constexpr MotionStep motion_next(const MotionMachine& m, const MotionInput& in) 
   detail::motion_command(r, c);
   const MotionState s = r.machine.state;
   r.stop = s == MotionState::kStopping ? StopCategory::kCategory2 : StopCategory::kNone;
-  r.torque = s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping;
+  r.torque = s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping ||
+             s == MotionState::kYielding;
   r.capture_pose = s == MotionState::kHolding && m.state != MotionState::kHolding;
   return r;
 }

@@ -1,0 +1,166 @@
+// A collision's reactions (issue 25; osc/runtime/control_task.hpp, set_collision): the residual
+// monitor armed, the paper's motion running on the simulated PUMA 560, and a 50 N force at the tip
+// (the wrist centre) from 10 s on, entering the plant as J_v^T F. Category 0 cuts the torque in the
+// tick of the detection; category 2 stops along the path and holds, without a fault; yield gives
+// way to the force until a stop holds the pose reached. A user's collision threshold above the
+// contact's torque lets it pass; one outside its bounds is refused.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+
+#include "osc/runtime/control_task.hpp"
+#include "plant.hpp"
+#include "plant_hal.hpp"
+
+using namespace osc;
+using V3 = sim::Vec3;
+using V6 = sim::Vec6;
+
+namespace {
+
+constexpr double kContactAt = 10.0;  // [s]
+
+/// The closed loop with a constant force at the tip from kContactAt on (none before).
+class ContactRun {
+ public:
+  ContactRun(CollisionReaction reaction, const V3& force, const double floor_nm[kDof] = nullptr)
+      : force_(force), task_(new ControlTask<double>), hal_(plant_, q0(), sim::SensorConfig{}, sim::Injection{}) {
+    plant_.reset(q0());
+    task_->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive, q0(),
+                sim::PlantHal::kPeriodNs);
+    task_->residual.armed = true;
+    const double none[kDof] = {};
+    EXPECT_TRUE(task_->set_collision(reaction, floor_nm ? floor_nm : none));
+  }
+  static V6 q0() { return joint_vector<double>(robot::kQStart); }
+
+  /// One tick and one sample of the plant; the tick's faults.
+  std::uint32_t tick() {
+    const double t = static_cast<double>(k_) * params::kDt;
+    hal_.begin_sample(t);
+    const std::uint32_t f = control_tick(*task_, hal_);
+    V6 tau = hal_.torque();
+    if (t >= kContactAt) tau += jacobian().topRows<3>().transpose() * force_;
+    plant_.set_amplifiers(!hal_.fault());
+    plant_.advance_sample(tau_before_, tau, params::kDt);
+    tau_before_ = tau;
+    ++k_;
+    return f;
+  }
+  /// Runs until `seconds` of simulated time.
+  std::uint32_t run_to(double seconds) {
+    std::uint32_t f = 0;
+    while (static_cast<double>(k_) * params::kDt < seconds) f |= tick();
+    return f;
+  }
+  double now() const { return static_cast<double>(k_) * params::kDt; }
+  V3 tip() {
+    forward_kinematics(model_, data_, plant_.q());
+    return data_.o[kDof];
+  }
+  ControlTask<double>& task() { return *task_; }
+  void stop_force() { force_.setZero(); }
+
+ private:
+  const Mat6<double>& jacobian() {
+    forward_kinematics(model_, data_, plant_.q());
+    geometric_jacobian(data_);
+    return data_.J;
+  }
+  V3 force_;
+  std::unique_ptr<ControlTask<double>> task_;  // large: off the stack
+  sim::Plant plant_;
+  sim::PlantHal hal_;
+  Model<double> model_ = Model<double>::of(robot::kArm);
+  Data<double> data_;
+  V6 tau_before_ = V6::Zero();
+  long k_ = 0;
+};
+
+/// Down, the direction whose contact shows on J2 and J3 together at this phase of the motion.
+const V3 kDown(0, 0, -50);
+
+TEST(CollisionReaction, CategoryZeroCutsTheTorqueInTheTickOfTheDetection) {
+  ContactRun run(CollisionReaction::kCategory0, kDown);
+  ASSERT_EQ(run.run_to(kContactAt), 0u) << "no fault before the contact";
+  std::uint32_t f = 0;
+  while (f == 0 && run.now() < kContactAt + 0.1) f = run.tick();
+  EXPECT_EQ(f & kFaultCollision, static_cast<std::uint32_t>(kFaultCollision));
+  EXPECT_LE(run.now() - kContactAt, 0.020) << "detected within 20 ms";
+  EXPECT_EQ(run.task().machine.state, MotionState::kFault);
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(run.task().codes[i], 0) << "zero torque in the same tick";
+}
+
+TEST(CollisionReaction, CategoryTwoStopsAlongThePathAndHoldsWithoutAFault) {
+  ContactRun run(CollisionReaction::kCategory2, kDown);
+  ASSERT_EQ(run.run_to(kContactAt), 0u);
+  MotionReason abort = MotionReason::kNone;
+  double aborted_at = -1;
+  bool stopped = false;
+  std::uint32_t faults = 0;
+  while (run.now() < kContactAt + 3 && !stopped) {
+    faults |= run.tick();
+    const MotionReport& rep = run.task().report;
+    if (rep.abort != MotionReason::kNone && aborted_at < 0) abort = rep.abort, aborted_at = run.now();
+    stopped = rep.completion == MotionCompletion::kStopped;
+  }
+  EXPECT_EQ(faults, 0u) << fault_name(faults);
+  EXPECT_EQ(abort, MotionReason::kCollision);
+  EXPECT_LE(aborted_at - kContactAt, 0.020);
+  EXPECT_TRUE(stopped) << "the category-2 stop reaches rest";
+  EXPECT_EQ(run.task().machine.state, MotionState::kHolding);
+  // Holding against the force: the tip stays where the stop ended.
+  const V3 rest = run.tip();
+  EXPECT_EQ(run.run_to(run.now() + 1), 0u);
+  EXPECT_LT((run.tip() - rest).norm(), 2e-3);
+}
+
+TEST(CollisionReaction, YieldGivesWayToTheForceUntilAStopHoldsThePoseReached) {
+  ContactRun run(CollisionReaction::kYield, kDown);
+  ASSERT_EQ(run.run_to(kContactAt), 0u);
+  std::uint32_t faults = 0;
+  while (run.task().machine.state != MotionState::kYielding && run.now() < kContactAt + 0.1) faults |= run.tick();
+  EXPECT_EQ(faults, 0u) << fault_name(faults);
+  ASSERT_EQ(run.task().machine.state, MotionState::kYielding);
+  EXPECT_LE(run.now() - kContactAt, 0.020);
+  // No stiffness holds the arm: 50 N pushes the tip down, by far more than a holding arm gives way.
+  const V3 at = run.tip();
+  EXPECT_EQ(run.run_to(run.now() + 0.3), 0u);
+  EXPECT_LT(run.tip().z() - at.z(), -0.02) << "the tip gave way";
+  EXPECT_EQ(run.task().machine.state, MotionState::kYielding);
+  // The force gone, a stop holds the pose the arm has then, and refuses nothing more.
+  run.stop_force();
+  EXPECT_EQ(run.run_to(run.now() + 0.3), 0u);
+  run.task().pending = prepare_command<double>(MotionVerb::kStop, 7);
+  EXPECT_EQ(run.tick(), 0u);
+  EXPECT_EQ(run.task().report.outcome, CommandOutcome::kAccepted);
+  EXPECT_EQ(run.task().machine.state, MotionState::kHolding);
+  const V3 held = run.tip();
+  EXPECT_EQ(run.run_to(run.now() + 1), 0u);
+  EXPECT_LT((run.tip() - held).norm(), 3e-3);
+}
+
+TEST(CollisionReaction, AThresholdAboveTheContactsTorqueLetsItPass) {
+  const double floor[kDof] = {60, 60, 60, 20, 20, 20};  // above the 50 N contact's joint torques
+  ContactRun run(CollisionReaction::kCategory0, kDown, floor);
+  EXPECT_EQ(run.run_to(kContactAt + 0.2) & kFaultCollision, 0u);
+}
+
+TEST(CollisionReaction, ThresholdsOutsideTheirBoundsAreRefusedAndChangeNothing) {
+  std::unique_ptr<ControlTask<double>> task(new ControlTask<double>);
+  task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
+             joint_vector<double>(robot::kQStart));
+  const double ok[kDof] = {10, 10, 10, 5, 5, 5};
+  ASSERT_TRUE(task->set_collision(CollisionReaction::kYield, ok));
+  double bad[kDof] = {10, 10, 10, 5, 5, 5};
+  for (const double v : {-1.0, std::nan(""), robot::kDrives.torque_limit[4] * 1.01}) {
+    bad[4] = v;
+    EXPECT_FALSE(task->set_collision(CollisionReaction::kCategory2, bad)) << v;
+    EXPECT_EQ(task->collision_reaction, CollisionReaction::kYield);
+    EXPECT_EQ(task->residual.collision_floor(4), 5.0);
+  }
+  EXPECT_FALSE(task->set_collision(static_cast<CollisionReaction>(3), ok));
+}
+
+}  // namespace
