@@ -276,7 +276,7 @@ struct ResidualRig {
     Vec6<S> quantum;
     for (int i = 0; i < kDof; ++i) quantum(i) = lit<S>(1 / counts_per_rad(i));
     m.reset();
-    m.set(quantum, Gains<S>::paper().k);
+    m.set(quantum, Gains<S>::paper().k, io.inverse);
   }
   /// One tick: the encoders of `counting` joints advance one count (every tick: moving steadily),
   /// the others stand still. Free: the arm moves under tau + tau_ext. Held: it stays at rest under

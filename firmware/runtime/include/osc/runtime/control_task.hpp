@@ -126,7 +126,7 @@ struct ControlTask {
       for (int c = 0; c < kDof; ++c) d += abs_of(C[j][c]) / map.counts_per_rad[c];
       quantum(j) = lit<S>(d);
     }
-    residual.set(quantum, gains.k);
+    residual.set(quantum, gains.k, io.inverse);
     for (int i = 0; i < kDof; ++i) {
       const double c = map.counts_per_rad[i];
       if (io.coupled()) {

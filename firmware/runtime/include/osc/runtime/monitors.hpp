@@ -272,6 +272,7 @@ struct ResidualMonitor {
   Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
   Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
   Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
+  Vec6<S> cross_friction;                // set-up: the other motors' static friction a coupling adds [N m]
   S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
   Vec6<S> peak_ratio;                    // the largest |r| / threshold seen per joint
   std::uint64_t last_move_tick[kDof];    // tick of each encoder's last change
@@ -294,10 +295,20 @@ struct ResidualMonitor {
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
   /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
   /// mean) times the largest k.
-  void set(const Vec6<S>& quantum, const Vec6<S>& k) {
+  /// With a coupled drive train (inverse = C^-1, the identity without one), each motor's friction
+  /// reaches joint i as C^-T f_m: the model's per-joint friction leaves out the other motors'
+  /// shares, sum over c != i of |C^-1_ci| times their static band, which a reversal of motor c flips.
+  void set(const Vec6<S>& quantum, const Vec6<S>& k, const double (&inverse)[kDof][kDof]) {
     k_max = k.maxCoeff();
     lag = S(1) / k.minCoeff();
     velocity_noise = (lit<S>(0.5) * k_max) * quantum;
+    const ModelErrorBounds& b = robot::kModelErrorBounds;
+    for (int i = 0; i < kDof; ++i) {
+      double cross = 0;
+      for (int c = 0; c < kDof; ++c)
+        if (c != i) cross += abs_of(inverse[c][i]) * (b.friction_hi.cou[c] + b.friction_hi.sti[c]);
+      cross_friction(i) = lit<S>(cross);
+    }
   }
   /// Clears the filters and the record: the next check primes it (an enable, a restart).
   void reset() {
@@ -445,7 +456,7 @@ struct ResidualMonitor {
                                         c.vis_hi[i] * velocity_noise(i)
                                   : e.still;
       const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
-      b(i) = friction + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
+      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
              c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
     }
     return b;
@@ -506,7 +517,8 @@ struct ResidualMonitor {
       const S learnt = signed_change(kEstimate, i) - th_v * signed_change(kVis, i) - th_c * signed_change(kCou, i) -
                        th_s * signed_change(kSti, i);
       const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) +
-                         math::abs(learnt) + c.vis_hi[i] * velocity_noise(i) + stillness(i) * e.still;
+                         math::abs(learnt) + c.vis_hi[i] * velocity_noise(i) + stillness(i) * e.still +
+                         S(2) * cross_friction(i);
       const S model = c.link_inertia * (inertia_change(i) + change(kGravity, i) + change(kCoriolis, i)) +
                       c.armature_delta[i] * da(i);
       const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i);
