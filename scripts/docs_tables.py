@@ -574,6 +574,91 @@ def monitors_hour():
     return "\n".join(lines)
 
 
+# ---------------------------------------------------------------- the residual monitor (issue 25)
+
+
+ARMED = ("--set", "run.residual_monitor=on")
+RESIDUAL_HEALTHY = [
+    ("paper friction, 300 s", ("--duration", "300", "--friction", "paper")),
+    ("corke friction, 300 s", ("--duration", "300", "--friction", "corke")),
+    ("float, paper friction, 120 s", ("--duration", "120", "--scalar", "float")),
+    ("fixed, paper friction, 120 s", ("--duration", "120", "--scalar", "fixed")),
+    ("realistic plant, 120 s", ("--duration", "120", "--plant", "realistic")),
+    ("paper friction, 0.3 ms delay, 120 s", ("--duration", "120", "--delay", "3e-4")),
+    ("paper friction, controller model +10 %, 120 s", ("--duration", "120", "--set", "controller.model_error=0.1")),
+]
+
+
+@table("residual_healthy", "docs/safety.md", "long")
+def residual_healthy():
+    """Healthy runs with the residual monitor armed: per joint, the worst |r| / threshold of either
+    channel (at most 1 / kResidualMargin = 0.5 is the design: the residual within its derived bound)."""
+    runs = [a + ARMED for _, a in RESIDUAL_HEALTHY]
+    prefetch(runs)
+    lines = ["| healthy run, armed | mode | J1 | J2 | J3 | J4 | J5 | J6 | detection |", "|---|---|" + "---:|" * 6 + "---|"]
+    for (label, _), a in zip(RESIDUAL_HEALTHY, runs):
+        for r in experiment(*a)["runs"]:
+            det = r["residual_monitor_detection"]
+            mode = "compensated" if r["mode"] == "adaptive" else "none"
+            lines.append(row(f"{label} | {mode}", r["residual_monitor_peak_ratio"], 2)
+                         + f" {'none' if det is None else det['fault'] + ' J' + str(det['joint'])} |")
+    return "\n".join(lines)
+
+
+RESIDUAL_HOUR = ("--plant", "realistic", "--duration", "3600", "--mode", "adaptive", "--window", "600") + ARMED
+
+
+@table("residual_hour", "docs/safety.md", "long")
+def residual_hour():
+    """The realistic plant's hour, armed: faults, the worst ratio per joint, the worst error per window."""
+    r = experiment(*RESIDUAL_HOUR)["runs"][0]
+    det = r["residual_monitor_detection"]
+    lines = ["| realistic plant, one hour, armed | J1 | J2 | J3 | J4 | J5 | J6 |", "|---|" + "---:|" * 6,
+             row("worst \\|r\\| / threshold", r["residual_monitor_peak_ratio"], 2),
+             row("... at [s]", r["residual_monitor_peak_s"], 0),
+             f"| faults, detection | {', '.join(r['faults']) or 'none'} | "
+             f"{'none' if det is None else det['fault']} | | | | |"]
+    for k, w in enumerate(r["window_max_error"]):
+        t0 = k * r["window_s"]
+        lines.append(row(f"{t0:g}–{t0 + r['window_s']:g} s: max \\|e\\| x, y, z [mm], φ [°]", w, 3))
+    return "\n".join(lines)
+
+
+RESIDUAL_TIMES = [20.0, 21.25, 22.5, 23.75]
+
+
+def armed_injection(spec, at, extra=()):
+    """One armed run with an injection, ending 1.5 s after it; its `injection` record."""
+    r = experiment("--duration", f"{at + 1.5:g}", "--mode", "adaptive", "--inject", spec, *ARMED, *extra)
+    return r["runs"][0]
+
+
+def detection_cell(r):
+    inj = r["injection"]
+    if inj.get("detected_s") is None:
+        return "not detected"
+    ms = (inj["detected_s"] - inj["at_s"]) * 1e3
+    by = "" if r["residual_monitor_detection"] else " (backstop)"
+    return f"{inj['fault']}{by} {ms:.0f} ms, {inj['excursion_mm']:.1f} mm"
+
+
+@table("residual_injection", "docs/safety.md", "long")
+def residual_injection():
+    """Armed, the paper's motion: each joint's encoder stuck at four phases of one period; each drive
+    stuck at its last code. Cell: the fault raised (by the residual monitor, or by the stuck-encoder
+    backstop), ms after the injection, and the true tip's excursion."""
+    specs = [(f"{k}:{j}@{t:g}", t) for k in ("encoder-stuck", "dac-stuck") for j in range(1, 7)
+             for t in RESIDUAL_TIMES]
+    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s, *ARMED) for s, t in specs])
+    lines = ["| kind | joint | " + " | ".join(f"at {t:g} s" for t in RESIDUAL_TIMES) + " |",
+             "|---|---|" + "---|" * len(RESIDUAL_TIMES)]
+    for k in ("encoder-stuck", "dac-stuck"):
+        for j in range(1, 7):
+            cells = [detection_cell(armed_injection(f"{k}:{j}@{t:g}", t)) for t in RESIDUAL_TIMES]
+            lines.append(f"| `{k}` | J{j} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- the realistic plant (issue 24)
 
 

@@ -117,6 +117,7 @@ struct ModelErrorBounds {
   double amp_gain;      ///< an amplifier's gain error, relative to the torque commanded
   double amp_offset;    ///< an amplifier's offset, relative to its channel's full-scale torque
   double ripple;        ///< torque ripple, relative to the torque commanded
+  double amp_lag;       ///< an amplifier's current loop, its first-order time constant at most [s]
   FrictionCoefficients friction_lo, friction_hi;  ///< the band the arm's friction lies in, drift included
 };
 

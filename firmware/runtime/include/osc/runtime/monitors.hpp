@@ -118,8 +118,10 @@ struct StuckEncoderMonitor {
   Vec6<S> dtau_gated_peak;             // ... while it was silent for kStuckIntervals of its intervals
   Vec6<S> peak;                        // the largest motion seen
   bool restart = false;                // the next check takes every encoder as just changed
-  /// A backstop behind the armed residual monitor: the silent-torque criterion (kStuckTorqueSilent,
-  /// the tightest of the trajectory-tuned ones and the one that trips on the realistic plant) is off.
+  /// A backstop behind the armed residual monitor: the torque criterion alone (kStuckTorque, beyond
+  /// the torque that breaks any joint away from its static friction). The criteria tuned on the
+  /// paper's trajectory are off: the reference motion while silent trips on slow moves of a joint
+  /// that static friction holds (Corke's J1), the silent-torque one on the realistic plant.
   bool backstop = false;
 
   /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
@@ -167,8 +169,9 @@ struct StuckEncoderMonitor {
       const std::uint64_t silent = tick - last_move_tick[i];
       if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[i]) continue;
       if (m > peak(i)) peak(i) = m;
+      if (backstop) continue;
       if (m > kMotionCounts) faults |= kFaultEncoderStuck;
-      if (backstop || move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
+      if (move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
       if (dtau > dtau_gated_peak(i)) dtau_gated_peak(i) = dtau;
       if (dtau > kTorqueSilent[i]) faults |= kFaultEncoderStuck;
     }
@@ -185,6 +188,7 @@ struct ResidualConstants {
   S offset[kDof];          // an amplifier's offset bound [N m]
   S full_scale[kDof];      // a channel's full-scale torque [N m]
   S link_inertia, gain_ripple, amp_gain, ripple;
+  S lag_ticks;  // the current loop's time constant in periods: its error is lag_ticks times a tick's torque step
   constexpr ResidualConstants()
       : vis_lo{},
         vis_hi{},
@@ -198,7 +202,8 @@ struct ResidualConstants {
         link_inertia{},
         gain_ripple{},
         amp_gain{},
-        ripple{} {
+        ripple{},
+        lag_ticks{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       vis_lo[i] = lit<S>(b.friction_lo.vis[i]), vis_hi[i] = lit<S>(b.friction_hi.vis[i]);
@@ -214,6 +219,7 @@ struct ResidualConstants {
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
     amp_gain = lit<S>(b.amp_gain);
     ripple = lit<S>(b.ripple);
+    lag_ticks = lit<S>(b.amp_lag / params::kDt);
   }
 };
 template <class S>
@@ -252,7 +258,7 @@ template <class S>
 struct ResidualMonitor {
   /// The model error's regressors, each filtered as r, then slowly (the change channel): the
   /// friction model's three columns, gravity, the Coriolis torque, the applied torque and its size.
-  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kRegressors };
+  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kTorqueStep, kRegressors };
   /// One joint's friction against the band (robot::kModelErrorBounds): moving, the band's distance
   /// from theta^ per coefficient; not moving, the static band's extent plus |tau_f^| (still).
   struct FrictionError {
@@ -271,6 +277,7 @@ struct ResidualMonitor {
   Vec6<S> reg_slow[kRegressors];         // ... then slowly
   Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
   Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
+  Vec6<S> tau_step;                      // the change of the applied torque at the last tick
   Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
   Vec6<S> cross_friction;                // set-up: the other motors' static friction a coupling adds [N m]
   S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
@@ -319,6 +326,7 @@ struct ResidualMonitor {
     prime_change();
     change_threshold.setZero();
     tau_prev.setZero();
+    tau_step.setZero();
     peak_ratio.setZero();
     for (int i = 0; i < kDof; ++i) {
       last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0, over_since[i] = 0;
@@ -332,7 +340,10 @@ struct ResidualMonitor {
   /// The next step starts afresh (a tick without a step: the torque was off).
   void unprime() { primed = false; }
   /// The joint torque that reached the arm over the period that follows this tick.
-  void applied(const Vec6<S>& tau) { tau_prev = tau; }
+  void applied(const Vec6<S>& tau) {
+    tau_step = (tau - tau_prev).cwiseAbs();
+    tau_prev = tau;
+  }
 
   /// The encoders' activity (EncoderJumpMonitor's moved), per channel.
   void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
@@ -456,7 +467,8 @@ struct ResidualMonitor {
                                         c.vis_hi[i] * velocity_noise(i)
                                   : e.still;
       const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
-      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
+      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.lag_ticks * tau_step(i) +
+             c.offset[i] +
              c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
     }
     return b;
@@ -481,7 +493,8 @@ struct ResidualMonitor {
                                   in.g(i),
                                   in.bias(i) - in.g(i) - in.tau_f(i),
                                   tau_prev(i),
-                                  math::abs(tau_prev(i))};
+                                  math::abs(tau_prev(i)),
+                                  tau_step(i)};
       for (int k = 0; k < kRegressors; ++k) {
         reg[k](i) += Kdt * (phi[k] - reg[k](i));
         reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));
@@ -521,7 +534,8 @@ struct ResidualMonitor {
                          S(2) * cross_friction(i);
       const S model = c.link_inertia * (inertia_change(i) + change(kGravity, i) + change(kCoriolis, i)) +
                       c.armature_delta[i] * da(i);
-      const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i);
+      const S amplifier =
+          c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i) + c.lag_ticks * reg[kTorqueStep](i);
       change_threshold(i) = kMargin * (kPeak[i] * (friction + model + amplifier) + quantum);
     }
   }

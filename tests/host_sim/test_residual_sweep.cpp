@@ -1,0 +1,127 @@
+// The residual monitor's healthy sweep (issue 25; docs/safety.md, "The residual monitor"): armed,
+// on random point-to-point moves at up to the configured limits, the worst residual of either
+// channel stays within its derived bound (at most 1 / params::kResidualMargin of its threshold)
+// and nothing faults. The moves come from a seed the test prints; OSC_SWEEP_SEED=N replays one,
+// OSC_SWEEP_MOVES=N sets how many (default: 12 here, 200 in the long sweep).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+
+#include "motion_sim.hpp"
+
+using namespace osc;
+using sim::MotionSim;
+using V6 = sim::Vec6;
+
+namespace {
+
+unsigned env_or(const char* name, unsigned fallback) {
+  const char* v = std::getenv(name);
+  return v ? static_cast<unsigned>(std::strtoul(v, nullptr, 10)) : fallback;
+}
+
+struct SweepResult {
+  double worst[kDof] = {};
+  std::string detail;  // who raised a fault
+  std::uint32_t faults = 0;
+  int moves = 0, refused = 0;
+};
+
+/// Runs `sim` until its report names `id` done, a fault, or `max_ticks`.
+template <class S>
+std::uint32_t run_to_done(MotionSim<S>& sim, std::uint32_t id, int max_ticks) {
+  std::uint32_t f = 0;
+  for (int k = 0; k < max_ticks && f == 0; ++k) {
+    f = sim.tick();
+    if (sim.task().report.done_id == id) break;
+  }
+  return f;
+}
+
+/// A random move from where the arm is: up to 15 cm along each axis, up to 0.3 rad about z, at a
+/// random share (30-100 %) of the configured linear limits.
+template <class S>
+MoveRequest<S> random_move(std::mt19937& rng) {
+  std::uniform_real_distribution<double> d(-0.15, 0.15), a(-0.3, 0.3), share(0.3, 1.0);
+  MoveRequest<S> r;
+  r.relative = true;
+  r.position = Vec3<S>(static_cast<S>(d(rng)), static_cast<S>(d(rng)), static_cast<S>(d(rng)));
+  r.has_rpy = true;
+  r.rpy = Vec3<S>(S(0), S(0), static_cast<S>(a(rng)));
+  r.has_limits = true;
+  r.limits = CartesianLimits<S>::defaults();
+  const double k = share(rng);
+  r.limits.linear.v = static_cast<S>(params::kMoveLinear[0] * k);
+  r.limits.linear.a = static_cast<S>(params::kMoveLinear[1] * k);
+  return r;
+}
+
+template <class S>
+SweepResult sweep(unsigned seed, int moves, const sim::PlantConfig& plant, FrictionMode mode) {
+  std::mt19937 rng(seed);
+  SweepResult out;
+  V6 q0;
+  for (int i = 0; i < kDof; ++i) q0(i) = robot::kQStart[i];
+  MotionSim<S> sim(q0, {}, plant, mode);
+  sim.task().residual.armed = true;
+  sim.command(MotionVerb::kEnable, 1);
+  for (int k = 0; k < 500; ++k) out.faults |= sim.tick();
+  for (std::uint32_t id = 2; out.moves + out.refused < moves && out.faults == 0; ++id) {
+    sim.move_to(random_move<S>(rng), id);
+    out.faults |= sim.tick();
+    if (sim.task().report.outcome != CommandOutcome::kAccepted) {
+      ++out.refused;  // out of the workspace or near a singular pose: the path check's refusal
+      continue;
+    }
+    ++out.moves;
+    out.faults |= run_to_done(sim, id, 20000);
+    for (int k = 0; k < 200 && out.faults == 0; ++k) out.faults |= sim.tick();  // hold a little
+  }
+  for (int i = 0; i < kDof; ++i) out.worst[i] = static_cast<double>(sim.task().residual.peak_ratio(i));
+  const auto& m = sim.task().residual;
+  const auto& b = sim.task().stuck.dtau_peak;
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "residual: %s J%d; backstop torque-change peaks %.1f %.1f %.1f %.1f %.1f %.1f",
+                m.detected ? fault_name(m.detected) : "none", m.joint + 1, static_cast<double>(b(0)),
+                static_cast<double>(b(1)), static_cast<double>(b(2)), static_cast<double>(b(3)),
+                static_cast<double>(b(4)), static_cast<double>(b(5)));
+  out.detail = buf;
+  return out;
+}
+
+template <class S>
+void check_sweep(const char* label, const osc::FrictionCoefficients& friction, FrictionMode mode, int moves) {
+  const unsigned seed = env_or("OSC_SWEEP_SEED", 25);
+  sim::PlantConfig plant;
+  plant.friction = friction;
+  const SweepResult r = sweep<S>(seed, moves, plant, mode);
+  std::printf("residual sweep %s, seed %u (OSC_SWEEP_SEED=%u replays it): %d moves (%d refused), worst ratio", label,
+              seed, seed, r.moves, r.refused);
+  for (double w : r.worst) std::printf(" %.3f", w);
+  std::printf("\n");
+  EXPECT_EQ(r.faults, 0u) << fault_name(r.faults) << " (seed " << seed << "): " << r.detail;
+  EXPECT_GE(r.moves, moves / 2) << "most random moves are accepted";
+  for (int i = 0; i < kDof; ++i)
+    EXPECT_LE(r.worst[i], 1 / params::kResidualMargin) << "J" << i + 1 << " (seed " << seed << ")";
+}
+
+const int kMoves = static_cast<int>(env_or("OSC_SWEEP_MOVES", 12));
+
+TEST(ResidualSweep, RandomMovesPaperFrictionCompensated) {
+  check_sweep<double>("double, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+}
+TEST(ResidualSweep, RandomMovesCorkeFrictionUncompensated) {
+  check_sweep<double>("double, corke, none", robot::kFrictionCorke, FrictionMode::kNone, kMoves);
+}
+TEST(ResidualSweep, RandomMovesInFloat) {
+  check_sweep<float>("float, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+}
+TEST(ResidualSweep, RandomMovesInFixedPoint) {
+  check_sweep<Fixed>("fixed, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+}
+
+}  // namespace
