@@ -169,7 +169,11 @@ void add_run_entries(std::vector<Entry>& t) {
   Entry c{"run.collision_threshold",
           "each joint's collision threshold [N m]: a collision is reported once a residual is beyond it too (0: "
           "the derived threshold alone; at most the joint's full-scale torque)",
-          Kind::kList, 0, 1e9, {}, false};
+          Kind::kList,
+          0,
+          1e9,
+          {},
+          false};
   c.get = [](const Settings& s) { return vec_json(s.base.collision_threshold, 6); };
   c.put = [](Settings& s, const json& v) {
     for (int i = 0; i < 6; ++i) s.base.collision_threshold[i] = v[i].get<double>();

@@ -595,7 +595,8 @@ def residual_healthy():
     channel (at most 1 / kResidualMargin = 0.5 is the design: the residual within its derived bound)."""
     runs = [a + ARMED for _, a in RESIDUAL_HEALTHY]
     prefetch(runs)
-    lines = ["| healthy run, armed | mode | J1 | J2 | J3 | J4 | J5 | J6 | detection |", "|---|---|" + "---:|" * 6 + "---|"]
+    lines = ["| healthy run, armed | mode | J1 | J2 | J3 | J4 | J5 | J6 | detection |",
+             "|---|---|" + "---:|" * 6 + "---|"]
     for (label, _), a in zip(RESIDUAL_HEALTHY, runs):
         for r in experiment(*a)["runs"]:
             det = r["residual_monitor_detection"]

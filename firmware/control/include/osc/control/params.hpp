@@ -99,8 +99,8 @@ constexpr int kResidualQualifyTicks = 3;
 /// The residual monitor's change channel: the bandwidth of the slow filter whose output the change
 /// residual r - r_slow leaves out [1/s]. A model error that changes more slowly than this (a friction
 /// coefficient off by a constant, an inertia error under a smooth motion) stays out of it, while a
-/// step of external torque passes: 0.55 of it at 17 ms (with kResidualGain 50).
-constexpr double kResidualSlowGain = 5;
+/// step of external torque passes: 0.52 of it at 17 ms (with kResidualGain 50).
+constexpr double kResidualSlowGain = 10;
 /// Each threshold is this many times the bound derived from the model's error (both channels): a
 /// healthy residual stays within its bound, at most 1 / kResidualMargin of the threshold, and the
 /// sweep of healthy runs checks exactly that (docs/safety.md); the rest is room for what the bounds

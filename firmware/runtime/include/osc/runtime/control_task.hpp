@@ -247,6 +247,30 @@ MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q)
   return MotionReason::kNone;
 }
 
+/// A collision whose reaction is not category 0 is no fault: taken out of `faults`, it is that
+/// reaction's (a category-2 stop or a yield), and the contact is noted until the next motion. Else
+/// category 0: the fault stays, or there was no collision.
+template <class S>
+CollisionReaction take_collision(ControlTask<S>& task, std::uint32_t& faults) {
+  if ((faults & kFaultCollision) == 0 || task.collision_reaction == CollisionReaction::kCategory0)
+    return CollisionReaction::kCategory0;
+  faults &= ~static_cast<std::uint32_t>(kFaultCollision);
+  task.contact = true;  // the contact may last
+  return task.collision_reaction;
+}
+
+/// The tick's category-2 stop request, the first of: a collision (reaction category 2), a reached
+/// limit, a stale stream, the board's (request_stop), which it takes.
+template <class S>
+MotionReason tick_stop_request(ControlTask<S>& task, bool stepped, const Vec6<S>& q, CollisionReaction collision) {
+  MotionReason r = collision == CollisionReaction::kCategory2 ? MotionReason::kCollision : MotionReason::kNone;
+  if (r == MotionReason::kNone && stepped) r = motion_limits_reached(task, q);
+  if (r == MotionReason::kNone && task.gen.stream_stale()) r = MotionReason::kStaleStream;
+  if (r == MotionReason::kNone) r = task.stop_request;
+  task.stop_request = MotionReason::kNone;
+  return r;
+}
+
 /// Enable's torque ramp: the torque beyond the gravity the model predicts at q is ramped in over
 /// params::kEnableRamp, tau = g + r (tau - g), r from 0 to 1.
 template <class S>
@@ -414,13 +438,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageMonitors] = hal.cycles();
   // monitors
   if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
-  // A collision whose reaction is not category 0 is no fault: a category-2 stop, or yielding.
-  MotionReason collision = MotionReason::kNone;
-  if ((faults & kFaultCollision) != 0 && task.collision_reaction != CollisionReaction::kCategory0) {
-    faults &= ~static_cast<std::uint32_t>(kFaultCollision);
-    collision = MotionReason::kCollision;
-    task.contact = true;  // until the next motion starts: the contact may last
-  }
+  const CollisionReaction collision = take_collision(task, faults);
   mark[kStageOutput] = hal.cycles();
   // output
   if (stepped && task.ramping) ramp_torque(task);
@@ -442,13 +460,9 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
-  const bool yield = collision != MotionReason::kNone && task.collision_reaction == CollisionReaction::kYield;
-  MotionReason stop_request = yield ? MotionReason::kNone : collision;
-  if (stop_request == MotionReason::kNone && stepped) stop_request = motion_limits_reached(task, q);
-  if (stop_request == MotionReason::kNone && task.gen.stream_stale()) stop_request = MotionReason::kStaleStream;
-  if (stop_request == MotionReason::kNone) stop_request = task.stop_request;  // the board's (request_stop)
-  task.stop_request = MotionReason::kNone;
-  const bool torque = motion_update(task, faults, measured, q, ev, stop_request, yield);
+  const MotionReason stop_request = tick_stop_request(task, stepped, q, collision);
+  const bool torque =
+      motion_update(task, faults, measured, q, ev, stop_request, collision == CollisionReaction::kYield);
   if (!torque_enabled(task.sup) || !torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (!stepped || !torque_enabled(task.sup) || !torque)

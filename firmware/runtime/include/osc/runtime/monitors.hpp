@@ -188,7 +188,7 @@ struct ResidualConstants {
   S offset[kDof];          // an amplifier's offset bound [N m]
   S full_scale[kDof];      // a channel's full-scale torque [N m]
   S link_inertia, gain_ripple, amp_gain, ripple;
-  S lag_ticks;  // the current loop's time constant in periods: its error is lag_ticks times a tick's torque step
+  S amp_lag;  // the current loop's time constant [s]
   constexpr ResidualConstants()
       : vis_lo{},
         vis_hi{},
@@ -203,7 +203,7 @@ struct ResidualConstants {
         gain_ripple{},
         amp_gain{},
         ripple{},
-        lag_ticks{} {
+        amp_lag{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       vis_lo[i] = lit<S>(b.friction_lo.vis[i]), vis_hi[i] = lit<S>(b.friction_hi.vis[i]);
@@ -219,7 +219,7 @@ struct ResidualConstants {
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
     amp_gain = lit<S>(b.amp_gain);
     ripple = lit<S>(b.ripple);
-    lag_ticks = lit<S>(b.amp_lag / params::kDt);
+    amp_lag = lit<S>(b.amp_lag);
   }
 };
 template <class S>
@@ -258,7 +258,7 @@ template <class S>
 struct ResidualMonitor {
   /// The model error's regressors, each filtered as r, then slowly (the change channel): the
   /// friction model's three columns, gravity, the Coriolis torque, the applied torque and its size.
-  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kTorqueStep, kRegressors };
+  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kRegressors };
   /// One joint's friction against the band (robot::kModelErrorBounds): moving, the band's distance
   /// from theta^ per coefficient; not moving, the static band's extent plus |tau_f^| (still).
   struct FrictionError {
@@ -277,7 +277,6 @@ struct ResidualMonitor {
   Vec6<S> reg_slow[kRegressors];         // ... then slowly
   Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
   Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
-  Vec6<S> tau_step;                      // the change of the applied torque at the last tick
   Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
   Vec6<S> cross_friction;                // set-up: the other motors' static friction a coupling adds [N m]
   S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
@@ -326,7 +325,6 @@ struct ResidualMonitor {
     prime_change();
     change_threshold.setZero();
     tau_prev.setZero();
-    tau_step.setZero();
     peak_ratio.setZero();
     for (int i = 0; i < kDof; ++i) {
       last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0, over_since[i] = 0;
@@ -340,10 +338,7 @@ struct ResidualMonitor {
   /// The next step starts afresh (a tick without a step: the torque was off).
   void unprime() { primed = false; }
   /// The joint torque that reached the arm over the period that follows this tick.
-  void applied(const Vec6<S>& tau) {
-    tau_step = (tau - tau_prev).cwiseAbs();
-    tau_prev = tau;
-  }
+  void applied(const Vec6<S>& tau) { tau_prev = tau; }
 
   /// The encoders' activity (EncoderJumpMonitor's moved), per channel.
   void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
@@ -463,12 +458,10 @@ struct ResidualMonitor {
     for (int i = 0; i < kDof; ++i) {
       const FrictionError& e = fe[i];
       // Moving: the band's distance from the estimate, coefficient by coefficient.
-      const S friction = e.moving ? math::abs(in.qd(i)) * e.dv + e.dc + in.decay(i) * e.ds +
-                                        c.vis_hi[i] * velocity_noise(i)
-                                  : e.still;
+      const S friction =
+          e.moving ? math::abs(in.qd(i)) * e.dv + e.dc + in.decay(i) * e.ds + c.vis_hi[i] * velocity_noise(i) : e.still;
       const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
-      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.lag_ticks * tau_step(i) +
-             c.offset[i] +
+      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
              c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
     }
     return b;
@@ -477,8 +470,8 @@ struct ResidualMonitor {
   /// error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
   /// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
   /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
-  /// anything within its static band, and keeps it in the change threshold until the slow filter
-  /// forgets it.
+  /// anything within its static band, from one end to the other (twice the band), and keeps it in
+  /// the change threshold until the slow filter forgets it.
   void update_change(const ResidualInput<S>& in, const FrictionError (&fe)[kDof], S dt) {
     static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
     static constexpr S kSlow = lit<S>(params::kResidualSlowGain);
@@ -493,8 +486,7 @@ struct ResidualMonitor {
                                   in.g(i),
                                   in.bias(i) - in.g(i) - in.tau_f(i),
                                   tau_prev(i),
-                                  math::abs(tau_prev(i)),
-                                  tau_step(i)};
+                                  math::abs(tau_prev(i))};
       for (int k = 0; k < kRegressors; ++k) {
         reg[k](i) += Kdt * (phi[k] - reg[k](i));
         reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));
@@ -520,8 +512,10 @@ struct ResidualMonitor {
     const Vec6<S> inertia = absA * a, inertia_change = absA * da, noise = absA * (S(2) * velocity_noise);
     for (int i = 0; i < kDof; ++i) {
       const S quantum = kGain[i] * noise(i);
+      // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
+      const S loop = c.amp_lag * kGain[i] * math::abs(tau_prev(i) - reg[kTorque](i));
       threshold(i) =
-          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i)) + quantum);
+          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i) + loop) + quantum);
       const FrictionError& e = fe[i];
       // The friction error (theta - theta^)^T w: the band's distances times the regressors'
       // changes at the estimate of now, plus what the estimate's own change added.
@@ -529,13 +523,11 @@ struct ResidualMonitor {
               th_s = theta ? (*theta)(2 * kDof + i) : S(0);
       const S learnt = signed_change(kEstimate, i) - th_v * signed_change(kVis, i) - th_c * signed_change(kCou, i) -
                        th_s * signed_change(kSti, i);
-      const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) +
-                         math::abs(learnt) + c.vis_hi[i] * velocity_noise(i) + stillness(i) * e.still +
-                         S(2) * cross_friction(i);
+      const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) + math::abs(learnt) +
+                         c.vis_hi[i] * velocity_noise(i) + S(2) * stillness(i) * e.still + S(2) * cross_friction(i);
       const S model = c.link_inertia * (inertia_change(i) + change(kGravity, i) + change(kCoriolis, i)) +
                       c.armature_delta[i] * da(i);
-      const S amplifier =
-          c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i) + c.lag_ticks * reg[kTorqueStep](i);
+      const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i) + loop;
       change_threshold(i) = kMargin * (kPeak[i] * (friction + model + amplifier) + quantum);
     }
   }

@@ -62,7 +62,7 @@ namespace osc {
   X(Superseded, "superseded", "a re-target replaced the motion; or the queue changed before the command's tick")    \
   X(BadCommand, "bad_command",                                                                                      \
     "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")    \
-  X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")        \
+  X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")          \
   X(Collision, "collision", "the runtime stopped the motion: a collision, its reaction category_2 or yield")        \
   X(Yielding, "yielding", "a move while yielding to a collision: a stop or an enable holds the pose first")
 
@@ -83,9 +83,9 @@ namespace osc {
 
 /// What a detected collision does (the residual monitor's collision, osc/runtime/monitors.hpp); an
 /// encoder or a drive fault is always category 0.
-#define OSC_COLLISION_REACTION_LIST(X)                                                                   \
-  X(Category0, "category_0", "a fault: zero torque and amplifiers off in this tick (the default)")       \
-  X(Category2, "category_2", "a moving arm decelerates along its path within the limits, then holds")    \
+#define OSC_COLLISION_REACTION_LIST(X)                                                                \
+  X(Category0, "category_0", "a fault: zero torque and amplifiers off in this tick (the default)")    \
+  X(Category2, "category_2", "a moving arm decelerates along its path within the limits, then holds") \
   X(Yield, "yield", "gravity, Coriolis and friction compensation only, so that a person can push the arm away")
 
 /// The names, meanings and count of an enumeration declared by OSC_MOTION_ENUM, in code order.
@@ -276,8 +276,8 @@ constexpr void motion_command(MotionStep& r, MotionCommand c) {
 ///   clear: = in every state but fault.
 ///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
 /// Torque is on in holding, moving, stopping, yielding; the stop in effect is category 0 in fault, 2 in
-/// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable, finished, stopped).
-/// Decisions: a command whose end state already holds is accepted and does nothing (enable when
+/// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable,
+/// finished, stopped). Decisions: a command whose end state already holds is accepted and does nothing (enable when
 /// enabled, disable when disabled, stop when holding or stopping, clear outside fault): repeating
 /// one is harmless. A move or a stop while disabled is refused (not_enabled): nothing holds the arm,
 /// and the client must know. A move while stopping is refused (stopping): the stop must reach rest first, or a
