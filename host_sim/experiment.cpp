@@ -170,6 +170,7 @@ template <class Controller>
 void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, ExperimentResult& res) {
   Plant plant(cfg.plant);
   plant.reset(q0);
+  plant.set_contact(Contact::of(cfg.injection));
   PlantHal hal(plant, q0, cfg.sensor_config(), cfg.injection);
   GroundTruth truth(q0, cfg.gains.trajectory);
   const double dt = osc::params::kDt;
@@ -208,6 +209,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
     if (cfg.progress && k % progress_every == 0) cfg.progress(static_cast<double>(k) / n);
   }
   res.plant_evaluations = plant.evaluations();
+  res.injection.peak_contact_force = plant.peak_contact_force();
   res.each([](auto& m) {
     if constexpr (requires { m.end(); }) m.end();
   });

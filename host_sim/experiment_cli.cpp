@@ -52,6 +52,14 @@ struct Parsed {
   std::string pil_link;
 };
 
+/// --inject's help, its kinds from SIM_INJECTION_LIST.
+std::string inject_help() {
+  std::string kinds;
+  for (const InjectionInfo& k : kInjections) kinds += std::string(kinds.empty() ? "" : " | ") + k.name + syntax(k.form);
+  return "inject a fault of the simulated hardware, or a contact at the tip, at S seconds: " + kinds +
+         " (JOINT 1..6, default every joint; DIR +x -x +y -y +z -z, base frame; docs/safety.md)";
+}
+
 void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vector<std::string>>& values) {
   app.description(
       "The paper's experiment (Section VI) on the simulated PUMA 560, with adaptive friction compensation and "
@@ -91,11 +99,7 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
   app.add_option("--json", o.json, "write the summary as JSON")->type_name("FILE");
   app.add_option("--csv-dir", o.csv_dir, "write time series CSV files and config.yaml there (default: out)")
       ->type_name("DIR");
-  app.add_option("--inject", p.inject,
-                 "inject a fault into the simulated hardware at S seconds, on joint J (1..6; default every joint): "
-                 "encoder-stuck | encoder-jump | encoder-garbage | encoder-noise | dac-stuck | overrun | estop "
-                 "(docs/safety.md)")
-      ->type_name("KIND[:J]@S");
+  app.add_option("--inject", p.inject, inject_help())->type_name("KIND[:ARGS]@S");
   app.add_flag(
       "--no-csv", [&o](std::int64_t) { o.csv = false; }, "do not write time series");
   app.add_flag(
@@ -119,6 +123,14 @@ bool read_file(const std::string& path, std::string& text, std::string& err) {
 }
 
 }  // namespace
+
+bool qemu_takes(const Injection& inj, const std::string& where, std::string& err) {
+  if (!inj.enabled || info(inj.kind).qemu) return true;
+  return err = where + " " + info(inj.kind).name +
+               " applies to the host-built controller only, not with --qemu (it acts on the task's tick clock or "
+               "E-stop input; the image has its own, which the link's injection requests reach)",
+         false;
+}
 
 std::string experiment_usage() {
   CLI::App app("", "puma_experiment");
@@ -202,10 +214,7 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
                  "run.residual_monitor=on applies to the host-built controller only, not with --qemu (the "
                  "firmware image runs the residual monitor as a trial)",
              false;
-    if (o.base.injection.enabled && !info(o.base.injection.kind).per_joint)
-      return err = std::string("--inject ") + info(o.base.injection.kind).name +
-                   " applies to the host-built controller only, not with --qemu",
-             false;
+    if (!qemu_takes(o.base.injection, "--inject", err)) return false;
   }
   return true;
 }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "config.hpp"
+#include "injection.hpp"
 #include "pil_client.hpp"
 
 namespace sim {
@@ -24,6 +25,11 @@ struct ExperimentOptions : Settings {
 
 /// The largest configuration file --config reads.
 constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;
+
+/// Whether an injection (from `where`: --inject, a script's inject:) can act on a run with --qemu:
+/// the plant, the encoders and the amplifiers are the host's, the tick's clock and E-stop input the
+/// image's. False with err naming the kind.
+bool qemu_takes(const Injection& inj, const std::string& where, std::string& err);
 
 /// The generated help text.
 std::string experiment_usage();

@@ -33,6 +33,7 @@ LinkedArm::LinkedArm(const Vec6& q0, const ExperimentConfig& cfg, std::uint8_t c
                                          (cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |
                                          pil::config_adaptation(cfg.gains.adaptation))) {
   plant_.reset(q0_);
+  plant_.set_contact(Contact::of(cfg.injection));
   plant_.set_brakes(true);
   ok_ = session_.start(cfg.pil_command, start_error_);
   command_ = cfg.pil_command.empty() ? "" : cfg.pil_command.front();

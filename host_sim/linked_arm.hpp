@@ -88,6 +88,8 @@ class LinkedArm {
   const std::string& program() const { return command_; }
   /// Stops the controller's process.
   void stop() { session_.link().stop(); }
+  /// The simulated arm.
+  const Plant& plant() const { return plant_; }
 
  private:
   Vec6 q0_;

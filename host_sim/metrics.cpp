@@ -328,7 +328,8 @@ void InjectionTracking::to_json(Json& j) const {
                     {"faults", json_faults(ir.faults)},
                     {"zero_torque_s", json_time(ir.zero_torque)},
                     {"excursion_mm", ir.excursion_mm},
-                    {"max_torque_after_detection_Nm", ir.max_torque_after}};
+                    {"max_torque_after_detection_Nm", ir.max_torque_after},
+                    {"peak_contact_force_N", ir.peak_contact_force}};
 }
 
 void InjectionTracking::print(const ExperimentResult& run) const {
@@ -343,8 +344,9 @@ void InjectionTracking::print(const ExperimentResult& run) const {
     std::printf(", torque never zero");
   else
     std::printf(", zero torque after %.1f ms", (ir.zero_torque - ir.injection.at) * 1e3);
-  std::printf(", tip excursion %.2f mm, largest torque after detection %.2f N m\n", ir.excursion_mm,
-              ir.max_torque_after);
+  std::printf(", tip excursion %.2f mm, largest torque after detection %.2f N m", ir.excursion_mm, ir.max_torque_after);
+  if (ir.injection.contact()) std::printf(", peak contact force %.1f N", ir.peak_contact_force);
+  std::printf("\n");
 }
 
 // ---- RunCost

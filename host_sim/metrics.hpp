@@ -194,12 +194,13 @@ struct FirmwareReport {
 /// What an injected fault did (ExperimentConfig::injection).
 struct InjectionResult {
   Injection injection;
-  double detected = -1;         ///< [s] first tick with a fault at or after the injection (-1: never)
-  std::uint32_t faults = 0;     ///< the fault bits raised in that tick
-  double zero_torque = -1;      ///< [s] first sample from which every amplifier torque is zero (-1: never)
-  double excursion_mm = 0;      ///< largest |p - p_d| of the true tip from injection to zero torque (or the end)
-  double max_torque_after = 0;  ///< largest |tau| an amplifier applied after detection [N m]
-  int max_torque_joint = -1;    ///< its joint (0-based)
+  double detected = -1;           ///< [s] first tick with a fault at or after the injection (-1: never)
+  std::uint32_t faults = 0;       ///< the fault bits raised in that tick
+  double zero_torque = -1;        ///< [s] first sample from which every amplifier torque is zero (-1: never)
+  double excursion_mm = 0;        ///< largest |p - p_d| of the true tip from injection to zero torque (or the end)
+  double max_torque_after = 0;    ///< largest |tau| an amplifier applied after detection [N m]
+  int max_torque_joint = -1;      ///< its joint (0-based)
+  double peak_contact_force = 0;  ///< largest |F| of an injected contact (collision, wall) [N]; 0: none
 };
 
 /// The injected fault's detection, torque cut-off and tip excursion.

@@ -157,8 +157,15 @@ bool parse_step(const YAML::Node& n, const std::string& where, const std::string
 bool parse_top(const YAML::Node& root, MotionScript& script, std::string& err) {
   for (const auto& kv : root) {
     const std::string k = kv.first.as<std::string>("");
-    if (k != "steps" && k != "start_pose" && k != "timeout" && k != "settle")
-      return err = k + ": not a key of a motion script (steps, start_pose, timeout, settle)", false;
+    if (k != "steps" && k != "start_pose" && k != "timeout" && k != "settle" && k != "inject")
+      return err = k + ": not a key of a motion script (steps, start_pose, timeout, settle, inject)", false;
+  }
+  if (root["inject"]) {
+    const YAML::Node n = root["inject"];
+    if (!n.IsScalar()) return err = "inject: needs KIND[:ARGS]@SECONDS, as --inject takes it", false;
+    // parse_injection's messages name --inject; here the key.
+    if (!parse_injection(n.Scalar(), script.injection, err))
+      return err = "inject: " + (err.rfind("--inject: ", 0) == 0 ? err.substr(10) : err), false;
   }
   if (root["timeout"] && !number(root["timeout"], "timeout", script.timeout, err)) return false;
   if (root["settle"] && !number(root["settle"], "settle", script.settle, err)) return false;
@@ -284,7 +291,10 @@ class HostArm {
     v.pose = sim_.pose();
     return true;
   }
-  void finish(MotionRun& run) { run.controller = "in-process"; }
+  void finish(MotionRun& run) {
+    run.controller = "in-process";
+    run.peak_contact_force = sim_.plant().peak_contact_force();
+  }
 
  private:
   auto writer() {
@@ -312,6 +322,7 @@ class ScriptLinkedArm : public LinkedArm {
     run.controller = "pil";
     run.pil_command = program();
     run.link = link_report();
+    run.peak_contact_force = plant().peak_contact_force();
     stop();
   }
 };
@@ -530,6 +541,8 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
     if (run.faults & (1u << i)) faults.push_back(osc::kFaultNames[i]);
   j["faults"] = faults;
   j["fault_s"] = run.fault_s >= 0 ? ordered_json(run.fault_s) : ordered_json(nullptr);
+  if (cfg.injection.enabled)
+    j["injection"] = {{"spec", to_string(cfg.injection)}, {"peak_contact_force_N", run.peak_contact_force}};
   if (!run.error.empty()) j["error"] = run.error;
   auto time_or_null = [](double t) { return t >= 0 ? ordered_json(t) : ordered_json(nullptr); };
   auto name_or_null = [](const std::string& s) { return s.empty() ? ordered_json(nullptr) : ordered_json(s); };

@@ -7,6 +7,9 @@
 //   start_pose: [q1, ..., q6]      optional, degrees; the robot's start pose by default
 //   timeout: SECONDS               optional, 600: a run that has not ended by then is a timeout
 //   settle: SECONDS                optional, 1: how long the run goes on after the last step
+//   inject: "KIND[:ARGS]@SECONDS"  optional: a fault or a contact, as puma_experiment --inject takes
+//                                  it (docs/safety.md), e.g. "wall:-z:5@2" to put a wall in the path
+//                                  of a move; not together with --inject
 //   steps:
 //     - at: SECONDS | after: done | after: answered
 //                                  when it is sent: at that time (and after the step before it); once
@@ -69,6 +72,7 @@ struct MotionScript {
   std::vector<MotionStepSpec> steps;
   std::optional<Vec6> start_pose;  ///< [rad]
   double timeout = 600, settle = 1;
+  Injection injection;  ///< inject: (none unless given)
 };
 
 /// Parses a script (YAML text); false with one message naming the step and the key on error.
@@ -99,13 +103,15 @@ struct MotionRun {
   std::string result;  ///< "ok", "faulted", "timeout", or "error" (the controller failed: error)
   std::string error;   ///< why the controller failed (it did not start, its link was lost)
   double duration_s = 0, max_error_mm = 0, max_error_deg = 0;
-  std::string controller;   ///< "in-process", or "pil" (a PIL image or peer over the link)
-  std::string pil_command;  ///< pil: the program that ran it (qemu-system-arm, a peer)
-  LinkReport link;          ///< pil: the link's health
-  double wall_s = 0;        ///< wall-clock time of the run [s]
+  std::string controller;         ///< "in-process", or "pil" (a PIL image or peer over the link)
+  std::string pil_command;        ///< pil: the program that ran it (qemu-system-arm, a peer)
+  LinkReport link;                ///< pil: the link's health
+  double wall_s = 0;              ///< wall-clock time of the run [s]
+  double peak_contact_force = 0;  ///< an injected contact's largest |F| (Plant::peak_contact_force) [N]
 };
 
-/// Plays the script against the simulated arm (plant set-up from cfg): with cfg.pil_command, the
+/// Plays the script against the simulated arm (plant set-up and injection from cfg: the caller puts
+/// the script's inject: there, run_experiment.cpp's run_motion): with cfg.pil_command, the
 /// controller of that PIL image or peer over the link (docs/motion.md, "Scripted motions"),
 /// otherwise the in-process controller in cfg.scalar. The same script gives the same run either
 /// way when the controller computes the same (fixed point; the host's PIL peer in float).

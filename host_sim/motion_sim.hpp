@@ -21,12 +21,13 @@ template <class S>
 class MotionSim {
  public:
   /// The arm at rest at q0, its encoders zeroed there (the task's q_start), the controller disabled.
-  /// inj: a simulated hardware fault (injection.hpp), none by default.
+  /// inj: a simulated hardware fault or a contact (injection.hpp), none by default.
   explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
                      osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
                      const osc::Gains<double>& gains = osc::Gains<double>::paper())
       : plant_(pc), hal_(plant_, q0, SensorConfig{}, inj), task_(new osc::ControlTask<S>) {
     plant_.reset(q0);
+    plant_.set_contact(Contact::of(inj));  // a collision or a wall acts in the plant, the rest in the HAL
     plant_.set_brakes(true);
     task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(), PlantHal::kPeriodNs,
                 osc::TaskStart::kDisabled);

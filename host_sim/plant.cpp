@@ -4,8 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 
+#include <limits>
+
 #include "osc/kernels/dynamics.hpp"
 #include "osc/kernels/friction.hpp"
+#include "osc/kernels/kinematics.hpp"
 #include "osc/robot.hpp"
 
 namespace sim {
@@ -69,7 +72,31 @@ ArticulatedBody make_body(const PlantConfig& cfg) {
 
 int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
 
+/// A contact's switch within this much of an interval's end happens at that end [s]: a sample's
+/// bound, at its time as the sum of its substeps rounds it.
+constexpr double kContactEdge = 1e-9;
+
 }  // namespace
+
+Contact Contact::of(const Injection& inj) {
+  Contact c;
+  if (!inj.enabled || !inj.contact()) return c;
+  c.direction = Vec3::Unit(inj.direction / 2) * (inj.direction % 2 != 0 ? -1.0 : 1.0);
+  c.at = inj.at;
+  if (inj.kind == InjectionKind::kCollision) {
+    c.kind = Kind::kForce;
+    c.force = inj.magnitude;
+    c.duration = inj.duration;
+    return c;
+  }
+  c.kind = Kind::kWall;
+  c.distance = inj.magnitude * 1e-3;
+  if (inj.stiffness > 0) {
+    c.stiffness = inj.stiffness;
+    c.damping = default_damping(c.stiffness);
+  }
+  return c;
+}
 
 bool PlantConfig::ideal_drives() const {
   for (int i = 0; i < 6; ++i)
@@ -340,6 +367,8 @@ void Plant::reset(const Vec6& q0, const Vec6& qd0) {
   q_ = q0;
   qd_ = qd0;
   t_ = 0;
+  contact_phase_ = 0;
+  peak_contact_ = 0;
   if (ideal_) return;
   amp_.setZero();
   cmd_.setZero();
@@ -372,8 +401,73 @@ Vec6 Plant::friction(const Vec6& qd) const {
 
 Vec6 Plant::acceleration(const Vec6& q, const Vec6& qd, const Vec6& tau) const {
   ++evaluations_;
-  if (ideal_) return body_.forward_dynamics(q, qd, tau - friction(qd));
-  return links_.forward_dynamics(q, qd, Vec6(c_inv_t_ * tau) - friction(qd), armature_all_);
+  Vec6 ext;
+  const bool pushed = external(q, qd, ext);
+  if (ideal_) return body_.forward_dynamics(q, qd, pushed ? Vec6(tau - friction(qd) + ext) : Vec6(tau - friction(qd)));
+  const Vec6 net = Vec6(c_inv_t_ * tau) - friction(qd);
+  return links_.forward_dynamics(q, qd, pushed ? Vec6(net + ext) : net, armature_all_);
+}
+
+void Plant::set_contact(const Contact& c) {
+  contact_ = c;
+  contact_phase_ = 0;
+  peak_contact_ = 0;
+}
+
+Vec3 Plant::force_at(const Vec6& qd) const {
+  if (contact_phase_ != 1 || contact_.kind == Contact::Kind::kNone) return Vec3::Zero();
+  const Vec3& n = contact_.direction;
+  if (contact_.kind == Contact::Kind::kForce) return contact_.force * n;
+  // The wall: the penetration d and its rate n . J_v qd; it pushes back along -n and never pulls.
+  const double d = n.dot(kin_.o[osc::kDof]) - wall_plane_;
+  if (d <= 0) return Vec3::Zero();
+  const double d_dot = n.dot(kin_.J.topRows<3>() * qd);
+  return -std::max(0.0, contact_.stiffness * d + contact_.damping * d_dot) * n;
+}
+
+Vec3 Plant::contact_force(const Vec6& q, const Vec6& qd) const {
+  if (contact_phase_ != 1) return Vec3::Zero();
+  // The kernels' kinematics (the dynamics stay the plant's own; test_contact checks J_v^T F against KDL).
+  osc::forward_kinematics(kin_model_, kin_, q);
+  osc::geometric_jacobian(kin_);
+  return force_at(qd);
+}
+
+bool Plant::external(const Vec6& q, const Vec6& qd, Vec6& tau_ext) const {
+  if (contact_phase_ != 1) return false;
+  const Vec3 f = contact_force(q, qd);
+  if ((f.array() == 0.0).all()) return false;
+  tau_ext = kin_.J.topRows<3>().transpose() * f;
+  return true;
+}
+
+Vec6 Plant::external_torque(const Vec6& q, const Vec6& qd) const {
+  Vec6 t = Vec6::Zero();
+  external(q, qd, t);
+  return t;
+}
+
+int Plant::contact_regime(const Vec6& q, const Vec6& qd) const {
+  if (contact_phase_ != 1 || contact_.kind != Contact::Kind::kWall) return 0;
+  osc::forward_kinematics(kin_model_, kin_, q);
+  osc::geometric_jacobian(kin_);
+  if (contact_.direction.dot(kin_.o[osc::kDof]) - wall_plane_ <= 0) return 1;
+  return force_at(qd).squaredNorm() > 0 ? 2 : 3;
+}
+
+double Plant::contact_edge() const {
+  if (contact_.kind == Contact::Kind::kNone) return std::numeric_limits<double>::infinity();
+  if (contact_phase_ == 0) return contact_.at;
+  if (contact_phase_ == 1 && contact_.kind == Contact::Kind::kForce && contact_.duration >= 0)
+    return contact_.at + contact_.duration;
+  return std::numeric_limits<double>::infinity();
+}
+
+void Plant::next_contact_phase() {
+  ++contact_phase_;
+  if (contact_phase_ != 1 || contact_.kind != Contact::Kind::kWall) return;
+  osc::forward_kinematics(kin_model_, kin_, q_);
+  wall_plane_ = contact_.direction.dot(kin_.o[osc::kDof]) + contact_.distance;
 }
 
 Vec6 Plant::motor_angles() const { return ideal_ ? q_ : motor_angles_of(State{q_, qd_, th_, thd_}); }
@@ -454,6 +548,8 @@ Plant::State Plant::derivative(const State& x, double t, const Vec6& amp) const 
       d.th(i) = x.w(i);
       d.w(i) = (net(i) - ts) / motor_inertia_(i);
     }
+  Vec6 ext;
+  if (external(x.q, x.v, ext)) tau += ext;  // the contact acts on the links
   d.v = coupled_ ? links_.forward_dynamics(x.q, x.v, tau, armature_rigid_) : body_.forward_dynamics(x.q, x.v, tau);
   return d;
 }
@@ -475,7 +571,7 @@ std::uint64_t Plant::regime(const State& x, const Vec6& amp) const {
   if (cfg_.amp_current_limit)
     for (int i = 0; i < 6; ++i)
       code |= std::uint64_t{amp(i) > limit_(i) ? 1u : (amp(i) < -limit_(i) ? 2u : 3u)} << (2 * i + 19);
-  return code;
+  return code | std::uint64_t(contact_regime(x.q, x.v)) << 31;
 }
 
 bool Plant::step(const Vec6& u, double h, bool smooth) {
@@ -527,6 +623,14 @@ bool Plant::rk4_smooth(const Vec6& tau, double h) {
   const Vec6 k3q = qd_ + 0.5 * h * k2v, k3v = acceleration(q_ + 0.5 * h * k2q, k3q, tau);
   const Vec6 k4q = qd_ + h * k3v, k4v = acceleration(q_ + h * k3q, k4q, tau);
   const Vec6 qd1 = qd_ + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  // A wall's force has a kink where the tip meets it (and where its clamp engages): the same rule.
+  if (contact_.kind == Contact::Kind::kWall && contact_phase_ == 1) {
+    const int r = contact_regime(q_, qd_);
+    if (contact_regime(q_ + 0.5 * h * k1q, k2q) != r || contact_regime(q_ + 0.5 * h * k2q, k3q) != r ||
+        contact_regime(q_ + h * k3q, k4q) != r ||
+        contact_regime(q_ + h / 6 * (k1q + 2 * k2q + 2 * k3q + k4q), qd1) != r)
+      return false;
+  }
   // Friction (2) is smooth along the step only if every velocity it was evaluated at, and the
   // end velocity, has the start's strict sign.
   for (int i = 0; i < 6; ++i) {
@@ -545,6 +649,20 @@ bool Plant::rk4_smooth(const Vec6& tau, double h) {
 void Plant::integrate(const Vec6& tau, double duration) {
   cmd_ = tau;
   if (duration <= 0) return;
+  // A contact that starts or ends inside the interval cuts it there: no RK4 step straddles the switch.
+  double left = duration;
+  for (double e = contact_edge(); e < t_ + left - kContactEdge; e = contact_edge()) {
+    if (e > t_ + kContactEdge) {
+      const double end = t_ + left;
+      integrate_span(tau, e - t_);
+      left = end - t_;
+    }
+    next_contact_phase();
+  }
+  integrate_span(tau, left);
+}
+
+void Plant::integrate_span(const Vec6& tau, double duration) {
   const int n = static_cast<int>(std::ceil(duration / cfg_.substep - 1e-9));
   const double h = duration / n;
   if (!ideal_) {
@@ -578,12 +696,14 @@ void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) 
       amp_ = amplifier(tau_new, dt - d);
       cmd_ = tau_new;
     }
+    while (contact_edge() < t_ + dt - kContactEdge) next_contact_phase();
     t_ += dt;
-    return;
+  } else {
+    const double d = std::min(cfg_.compute_delay, dt);
+    integrate(tau_old, d);
+    integrate(tau_new, dt - d);
   }
-  const double d = std::min(cfg_.compute_delay, dt);
-  integrate(tau_old, d);
-  integrate(tau_new, dt - d);
+  if (contact_phase_ == 1) peak_contact_ = std::max(peak_contact_, contact_force(q_, qd_).norm());
 }
 
 double Plant::energy() const {

@@ -4,15 +4,19 @@
 // controller's computation delay inside each sample. Optionally (PlantConfig, issue 24) the drive
 // train's own dynamics: a motor inertia set, the wrist coupling, the amplifiers (current loop lag,
 // current limit, gain error, offset), torque ripple, friction drift, elastic joints and backlash on
-// J1-J3; all off, the plant is the rigid one above, bit for bit.
+// J1-J3; all off, the plant is the rigid one above, bit for bit. Optionally (Contact) a contact at
+// the tip: a force step or pulse, or a stiff wall; none, the plant is the one above, bit for bit.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include <Eigen/Core>
 
+#include "injection.hpp"
 #include "osc/control/params.hpp"
 #include "osc/kernels/friction.hpp"
+#include "osc/kernels/model.hpp"
 #include "osc/robot.hpp"
 
 namespace sim {
@@ -62,6 +66,35 @@ struct PlantConfig {
 
   /// True when every drive-train feature above is at its neutral value (the rigid, ideal drive train).
   bool ideal_drives() const;
+};
+
+/// A contact at the tip (the frame-6 origin: the wrist centre the controller tracks) from time `at`
+/// on: a force F on the tip, base frame, that acts on the arm as the joint torques J_v(q)^T F (J_v the
+/// geometric Jacobian's translational rows), evaluated at every RK4 stage from the stage's state.
+/// A force step or pulse along `direction`, or a stiff wall normal to it.
+struct Contact {
+  enum class Kind : std::uint8_t { kNone, kForce, kWall };
+  /// The wall's default stiffness [N/m]: 1 mm of penetration per 100 N.
+  static constexpr double kWallStiffness = 1e5;
+  /// The wall's default damping for stiffness k [N s/m]: 2 zeta sqrt(m k), an estimate with zeta =
+  /// 0.2 on an effective tip mass m = 10 kg (the translational rows of Lambda span about 0.2 to 40 kg
+  /// over the arm's range): the contact rings and decays within a few periods.
+  static double default_damping(double k) { return 2 * 0.2 * std::sqrt(10 * k); }
+
+  Kind kind = Kind::kNone;
+  Vec3 direction = Vec3::UnitZ();  ///< unit, base frame
+  double at = 0;                   ///< from this time of the plant's on [s]
+  double force = 0;                ///< kForce: along direction [N]
+  double duration = -1;            ///< kForce: a pulse's length [s]; negative: for good
+  /// kWall: the plane's distance from the tip at `at`, along direction [m]. The tip penetrates by
+  /// d = direction . p - plane; for d > 0 the wall pushes back along -direction with
+  /// max(0, stiffness d + damping d_dot): it never pulls.
+  double distance = 0;
+  double stiffness = kWallStiffness;                 ///< kWall [N/m]
+  double damping = default_damping(kWallStiffness);  ///< kWall [N s/m]
+
+  /// The contact of a collision or wall injection (injection.hpp); none for the other kinds.
+  static Contact of(const Injection& inj);
 };
 
 /// The locked-motor resonance of the gear mesh when backlash is on and elastic_hz is 0 [Hz]: stiff
@@ -125,6 +158,17 @@ class Plant {
   /// Integrates for duration with constant command tau (the amplifier channels', joint-referred).
   void integrate(const Vec6& tau, double duration);
 
+  /// A contact at the tip (none by default); reset() takes it back to before its start.
+  void set_contact(const Contact& c);
+  const Contact& contact() const { return contact_; }
+  /// The contact's force on the tip at state (q, qd) as it acts now [N, base frame]: zero before its
+  /// start, after a pulse, and off the wall.
+  Vec3 contact_force(const Vec6& q, const Vec6& qd) const;
+  /// Its joint torques J_v(q)^T F at (q, qd): tau_ext.
+  Vec6 external_torque(const Vec6& q, const Vec6& qd) const;
+  /// The largest |F| of the contact since reset(), sampled at the end of each advance_sample() [N].
+  double peak_contact_force() const { return peak_contact_; }
+
   /// The joint torques of the drive train's friction at joint rates qd (model (2); with the coupling,
   /// C^-T f(C^-1 qd), the motors' friction referred to the joints; with the drift, at the plant's
   /// time; on an elastic joint, the friction its motor would have at the joint's rate).
@@ -185,6 +229,20 @@ class Plant {
   Vec6 motor_angles_of(const State& x) const;
   Vec6 motor_rates_of(const State& x) const;
   double friction_scale(double t) const;
+  // The contact.
+  /// J_v(q)^T F into tau_ext; false (tau_ext untouched) when F is zero, so that a contact that does
+  /// not push leaves every sum as it was without one.
+  bool external(const Vec6& q, const Vec6& qd, Vec6& tau_ext) const;
+  /// The contact's force at (q, qd) with the tip kinematics (kin_) already at q.
+  Vec3 force_at(const Vec6& qd) const;
+  /// What must not change within a smooth step: off the wall, pushed, in it but not pushed (0: no wall).
+  int contact_regime(const Vec6& q, const Vec6& qd) const;
+  /// The next time the contact switches (its start, a pulse's end); infinity when none is left.
+  double contact_edge() const;
+  /// Switches to the contact's next phase (a wall's plane is placed from where the tip is now).
+  void next_contact_phase();
+  /// RK4 over duration with the contact as it is (integrate() cuts the interval at its switches).
+  void integrate_span(const Vec6& tau, double duration);
   double spring(int i, double stretch) const;
   /// The amplifiers' output after s more seconds of command u, from their state now.
   Vec6 amplifier(const Vec6& u, double s) const;
@@ -212,6 +270,14 @@ class Plant {
   Vec6 th_ = Vec6::Zero(), thd_ = Vec6::Zero();  // elastic joints' motors
   Vec6 amp_ = Vec6::Zero();                      // the amplifiers' output (with amp_lag)
   Vec6 cmd_ = Vec6::Zero();                      // the last command
+
+  // The contact.
+  Contact contact_;
+  int contact_phase_ = 0;    // 0 before its start, 1 acting, 2 after a pulse
+  double wall_plane_ = 0;    // direction . p on the wall's surface [m]
+  double peak_contact_ = 0;  // [N]
+  osc::Model<double> kin_model_ = osc::Model<double>::of(osc::robot::kArm);  // the tip's kinematics
+  mutable osc::Data<double> kin_;
 };
 
 }  // namespace sim

@@ -1,7 +1,9 @@
 // HAL binding of the firmware's encoder and DAC interfaces (hal/hal.hpp) to the simulated plant,
 // with the simulated hardware's sensors (SensorConfig: the encoders' resolution, coupling and edge
 // jitter, the DAC's resolution, the potentiometers, the index pulses) and faults (injection.hpp):
-// stuck, jumping, garbage or noisy encoders, a stuck amplifier, an overrunning tick, the E-stop input.
+// stuck, jumping, garbage or noisy encoders, an amplifier whose input is stuck, zero or full scale,
+// an amplifier off, an overrunning tick, the E-stop input. (A contact at the tip acts in the plant:
+// Plant::set_contact.)
 #pragma once
 
 #include <cmath>
@@ -227,10 +229,30 @@ class PlantHal {
     }
     return true;
   }
+  /// The codes the amplifiers receive: the controller's, unless a DAC fault holds a channel's at its
+  /// last value (dac-stuck), at zero (dac-zero) or at the positive full scale (dac-full).
   void write_dacs(const std::int32_t codes[hal::kJoints]) {
-    for (int i = 0; i < hal::kJoints; ++i)
-      if (!(active_ && inj_.kind == InjectionKind::kDacStuck && inj_.hits(i))) codes_[i] = codes[i];
+    for (int i = 0; i < hal::kJoints; ++i) {
+      if (!active_ || !inj_.hits(i)) {
+        codes_[i] = codes[i];
+        continue;
+      }
+      switch (inj_.kind) {
+        case InjectionKind::kDacStuck:  // the code it had
+          break;
+        case InjectionKind::kDacZero:
+          codes_[i] = 0;
+          break;
+        case InjectionKind::kDacFull:
+          codes_[i] = static_cast<std::int32_t>(osc::kDacMaxCode);
+          break;
+        default:
+          codes_[i] = codes[i];
+      }
+    }
   }
+  /// The code amplifier i receives now.
+  std::int32_t code(int i) const { return codes_[i]; }
   /// A virtual clock: one nanosecond per read, and three periods more inside an injected overrun.
   std::uint32_t cycles() {
     clock_ += 1;
@@ -245,11 +267,15 @@ class PlantHal {
   bool fault() const { return fault_; }
   /// The channels' (motor) torques, referred to their joints, that the amplifiers produce from the
   /// last DAC codes, as the board's DAC resolves them (dac_quantise). The fault line disables the
-  /// amplifiers (as a board's amplifier-enable output does): zero torque whatever the codes.
+  /// amplifiers (as a board's amplifier-enable output does): zero torque whatever the codes; so does
+  /// an amplifier that is off (amp-off), on its own channel.
   Vec6 torque() const {
     Vec6 t;
     if (fault_) return Vec6::Zero();
-    for (int i = 0; i < hal::kJoints; ++i) t(i) = osc::code_to_torque(i, dac_quantise(codes_[i], sensors_.dac_bits));
+    for (int i = 0; i < hal::kJoints; ++i) {
+      const bool off = active_ && inj_.kind == InjectionKind::kAmpOff && inj_.hits(i);
+      t(i) = off ? 0.0 : osc::code_to_torque(i, dac_quantise(codes_[i], sensors_.dac_bits));
+    }
     return t;
   }
 

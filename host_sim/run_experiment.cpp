@@ -234,6 +234,13 @@ int run_motion(const Options& o, int json_fd) {
   if (!sim::parse_motion_script(text, o.motion, script, err)) return fail(err);
   sim::ExperimentConfig cfg = o.base;
   cfg.mode = o.run_adaptive ? osc::FrictionMode::kAdaptive : osc::FrictionMode::kNone;
+  if (script.injection.enabled) {
+    if (cfg.injection.enabled)
+      return fail(o.motion + ": inject: and --inject both given (" + sim::to_string(script.injection) + ", " +
+                  sim::to_string(cfg.injection) + "): one injection per run");
+    if (o.qemu && !sim::qemu_takes(script.injection, o.motion + ": inject:", err)) return fail(err);
+    cfg.injection = script.injection;
+  }
   // The image's encoders read zero at the robot's start pose, which it compiles in.
   if (o.qemu && script.start_pose && *script.start_pose != cfg.q_start)
     return fail(o.motion + ": start_pose: the firmware image starts at the robot's start pose (not with --qemu)");

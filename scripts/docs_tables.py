@@ -660,6 +660,31 @@ def residual_injection():
     return "\n".join(lines)
 
 
+DIRECTIONS = ["+x", "-x", "+y", "-y", "+z", "-z"]
+
+
+def contact_cell(r):
+    force = r["injection"].get("peak_contact_force_N") or 0
+    return detection_cell(r) + (f", {force:.0f} N" if force else "")
+
+
+@table("residual_contact", "docs/safety.md", "long")
+def residual_contact():
+    """Armed: a 50 N step at the tip and a wall 5 mm away in each direction; each drive fault on each
+    joint. Two phases of the paper's motion."""
+    times = RESIDUAL_TIMES[:2]
+    rows = [(f"`collision:{d}:50`", f"collision:{d}:50") for d in DIRECTIONS]
+    rows += [(f"`wall:{d}:5`", f"wall:{d}:5") for d in DIRECTIONS]
+    rows += [(f"`{k}:{j}`", f"{k}:{j}") for k in ("dac-zero", "dac-full", "amp-off") for j in range(1, 7)]
+    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", f"{spec}@{t:g}", *ARMED)
+              for _, spec in rows for t in times])
+    lines = ["| injection | " + " | ".join(f"at {t:g} s" for t in times) + " |", "|---|" + "---|" * len(times)]
+    for label, spec in rows:
+        lines.append(f"| {label} | " + " | ".join(contact_cell(armed_injection(f"{spec}@{t:g}", t)) for t in times)
+                     + " |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- the realistic plant (issue 24)
 
 

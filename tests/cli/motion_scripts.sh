@@ -101,6 +101,38 @@ no_steps)
 - {at: 0, cmd: enable}
 YAML
   ;;
+inject_names_the_key)  # a bad inject: is the parser's message under the script's key
+  bad_script "inject: wall: stiffness must be a finite number of N/m > 0, got '0'" <<'YAML'
+inject: "wall:-z:5:0@1"
+steps:
+  - {at: 0, cmd: enable}
+YAML
+  ;;
+inject_and_flag_both)  # one injection per run: the script's or --inject's, not both
+  printf 'inject: "wall:-z:5@1"\nsteps:\n  - {at: 0, cmd: enable}\n' >"$d/s.yaml"
+  out=$("$exe" --motion "$d/s.yaml" --inject dac-zero:2@1 --json "$d/out.json" 2>&1)
+  test $? -eq 2 || fail "exit status not 2: $out"
+  grep -qF -- "inject: and --inject both given" <<<"$out" || fail "$out"
+  test ! -e "$d/out.json" || fail "a JSON was written"
+  ;;
+wall_in_the_path)  # a wall 5 mm below the tip stops a move 10 mm down: the plant's contact, in the JSON
+  cat >"$d/s.yaml" <<'YAML'
+inject: "wall:-z:5@0"
+settle: 0.5
+steps:
+  - {at: 0, cmd: enable}
+  - {at: 0.1, cmd: move_to, position: [0, 0, -0.010], relative: true}
+YAML
+  "$exe" --motion "$d/s.yaml" --json "$d/r.json" >"$d/out.txt" 2>&1
+  "$py" - "$d/r.json" <<'PY' || fail "$(cat "$d/out.txt")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+inj = j["injection"]
+assert inj["spec"] == "wall:-z:5@0", inj
+assert inj["peak_contact_force_N"] > 0, inj
+print("result", j["result"], j["faults"], "peak contact force", inj["peak_contact_force_N"], "N")
+PY
+  ;;
 with_qemu_needs_the_image)  # --qemu plays scripts too; without the image it says so, before anything runs
   out=$("$exe" --motion "$examples/motion_tour.yaml" --qemu --elf "$d/none.elf" --json "$d/out.json" 2>&1)
   test $? -eq 2 || fail "exit status not 2: $out"
