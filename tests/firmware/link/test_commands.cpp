@@ -524,13 +524,18 @@ TEST(CommandFrames, SetpointWithVelocityRoundTripsAndBadOnesAreDropped) {
   EXPECT_EQ(task->dropped, replaced + 4u);
 }
 
-TEST(CommandFrames, ReasonsListEndsWithLinkSilentAfterBadCommand) {
+TEST(CommandFrames, ReasonsListKeepsItsCodesAndEndsWithTheCollisionReasons) {
   // Appended only: the codes clients know stay.
   EXPECT_STREQ(motion_name(MotionReason::kBadCommand), "bad_command");
   EXPECT_EQ(static_cast<int>(MotionReason::kBadCommand), 14);
   EXPECT_STREQ(motion_name(MotionReason::kLinkSilent), "link_silent");
   EXPECT_EQ(static_cast<int>(MotionReason::kLinkSilent), 15);
-  EXPECT_EQ(static_cast<int>(MotionReason::kLinkSilent) + 1, MotionNames<MotionReason>::kCount);
+  EXPECT_EQ(static_cast<int>(MotionReason::kCollision), 16);
+  EXPECT_EQ(static_cast<int>(MotionReason::kYielding), 17);
+  EXPECT_EQ(static_cast<int>(MotionReason::kYielding) + 1, MotionNames<MotionReason>::kCount);
+  // The states too: yielding after fault.
+  EXPECT_EQ(static_cast<int>(MotionState::kFault), 4);
+  EXPECT_EQ(static_cast<int>(MotionState::kYielding), 5);
 }
 
 // ---------------------------------------------------------------- preparing
