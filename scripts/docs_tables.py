@@ -606,7 +606,7 @@ def residual_healthy():
     return "\n".join(lines)
 
 
-RESIDUAL_HOUR = ("--plant", "realistic", "--duration", "3600", "--mode", "adaptive", "--window", "600") + ARMED
+RESIDUAL_HOUR = ("--plant", "realistic", "--duration", "3600", "--mode", "adaptive", "--set", "run.window=600") + ARMED
 
 
 @table("residual_hour", "docs/safety.md", "long")
@@ -639,7 +639,7 @@ def detection_cell(r):
     if inj.get("detected_s") is None:
         return "not detected"
     ms = (inj["detected_s"] - inj["at_s"]) * 1e3
-    by = "" if r["residual_monitor_detection"] else " (backstop)"
+    by = "" if r["residual_monitor_detection"] else " (other monitor)"
     return f"{inj['fault']}{by} {ms:.0f} ms, {inj['excursion_mm']:.1f} mm"
 
 

@@ -489,7 +489,7 @@ struct ResidualMonitor {
                                   math::abs(tau_prev(i))};
       for (int k = 0; k < kRegressors; ++k) {
         reg[k](i) += Kdt * (phi[k] - reg[k](i));
-        reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));
+        if (k != kTorqueSize) reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));  // |tau|: its size alone
       }
       acc_slow(i) += Ks * (acc(i) - acc_slow(i));
       r_slow(i) += Ks * (r(i) - r_slow(i));
@@ -508,14 +508,18 @@ struct ResidualMonitor {
     static constexpr std::array<S, kDof> kPeak = lit_array<S>(params::kResidualPeakFactor);
     static constexpr S kMargin = lit<S>(params::kResidualMargin);
     const Vec6<S> a = acc.cwiseAbs(), da = (acc - acc_slow).cwiseAbs();
-    const Mat6<S> absA = A.cwiseAbs();
-    const Vec6<S> inertia = absA * a, inertia_change = absA * da, noise = absA * (S(2) * velocity_noise);
     for (int i = 0; i < kDof; ++i) {
-      const S quantum = kGain[i] * noise(i);
+      // |A| times the accelerations, their changes and the velocity noise, in one pass over A's row.
+      S inertia = S(0), inertia_change = S(0), noise = S(0);
+      for (int j = 0; j < kDof; ++j) {
+        const S aij = math::abs(A(i, j));
+        inertia += aij * a(j), inertia_change += aij * da(j), noise += aij * velocity_noise(j);
+      }
+      const S quantum = S(2) * kGain[i] * noise;
       // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
       const S loop = c.amp_lag * kGain[i] * math::abs(tau_prev(i) - reg[kTorque](i));
       threshold(i) =
-          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia(i) + c.armature_delta[i] * a(i) + loop) + quantum);
+          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia + c.armature_delta[i] * a(i) + loop) + quantum);
       const FrictionError& e = fe[i];
       // The friction error (theta - theta^)^T w: the band's distances times the regressors'
       // changes at the estimate of now, plus what the estimate's own change added.
@@ -525,8 +529,8 @@ struct ResidualMonitor {
                        th_s * signed_change(kSti, i);
       const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) + math::abs(learnt) +
                          c.vis_hi[i] * velocity_noise(i) + S(2) * stillness(i) * e.still + S(2) * cross_friction(i);
-      const S model = c.link_inertia * (inertia_change(i) + change(kGravity, i) + change(kCoriolis, i)) +
-                      c.armature_delta[i] * da(i);
+      const S model =
+          c.link_inertia * (inertia_change + change(kGravity, i) + change(kCoriolis, i)) + c.armature_delta[i] * da(i);
       const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i) + loop;
       change_threshold(i) = kMargin * (kPeak[i] * (friction + model + amplifier) + quantum);
     }
