@@ -300,20 +300,33 @@ struct ResidualRig {
   }
 };
 
+/// The external torque of the residual's closed-form tests [N m], and each scalar's tolerance.
+Vec6<double> closed_form_torque() {
+  Vec6<double> ext;
+  ext << 3, -5, 2, 0.5, -0.3, 0.2;
+  return ext;
+}
+template <class S>
+constexpr double kClosedFormTol = std::is_same_v<S, double>  ? 1e-9
+                                  : std::is_same_v<S, float> ? 2e-3
+                                                             : 0.05;
+/// Joint i's residual n checks after a constant torque `ext` began (the check after the prime is
+/// n = 1): the arm moves from the prime on, so the first period's torque shows in the next check.
+double closed_form_residual(double ext, int i, int n) {
+  return ext * (1 - std::pow(1 - params::kResidualGain[i] * params::kDt, n - 1));
+}
+
 TYPED_TEST(Monitors, ResidualIsTheExternalTorqueThroughAFirstOrderFilter) {
   using S = TypeParam;
   ResidualRig<S> rig;
   const bool still[kDof] = {};
-  Vec6<double> ext;
-  ext << 3, -5, 2, 0.5, -0.3, 0.2;
-  const double tol = std::is_same_v<S, double> ? 1e-9 : std::is_same_v<S, float> ? 2e-3 : 0.05;
+  const Vec6<double> ext = closed_form_torque();
+  const double tol = kClosedFormTol<S>;
   rig.step(Vec6<double>::Zero(), still);  // primes it
   for (int n = 1; n <= 100; ++n) {
     rig.step(ext, still);
     for (int i = 0; i < kDof; ++i) {
-      const double K = params::kResidualGain[i];
-      // The arm moves from the prime on: the first period's torque shows in the next check.
-      const double expect = ext(i) * (1 - std::pow(1 - K * params::kDt, n - 1));
+      const double expect = closed_form_residual(ext(i), i, n);
       ASSERT_NEAR(static_cast<double>(rig.m.r(i)), expect, tol + 1e-6 * std::abs(expect)) << "J" << i + 1 << " n " << n;
     }
   }
@@ -325,16 +338,15 @@ TYPED_TEST(Monitors, TheChangeResidualIsTheResidualLessItsSlowPart) {
   using S = TypeParam;
   ResidualRig<S> rig;
   const bool still[kDof] = {};
-  Vec6<double> ext;
-  ext << 3, -5, 2, 0.5, -0.3, 0.2;
-  const double tol = std::is_same_v<S, double> ? 1e-9 : std::is_same_v<S, float> ? 2e-3 : 0.05;
+  const Vec6<double> ext = closed_form_torque();
+  const double tol = kClosedFormTol<S>;
   const double Ks = params::kResidualSlowGain * params::kDt;
   Vec6<double> slow = Vec6<double>::Zero();
   rig.step(Vec6<double>::Zero(), still);
   for (int n = 1; n <= 400; ++n) {
     rig.step(ext, still);
     for (int i = 0; i < kDof; ++i) {
-      const double r = ext(i) * (1 - std::pow(1 - params::kResidualGain[i] * params::kDt, n - 1));
+      const double r = closed_form_residual(ext(i), i, n);
       slow(i) += Ks * (r - slow(i));
       ASSERT_NEAR(static_cast<double>(rig.m.d(i)), r - slow(i), tol + 1e-6 * std::abs(r)) << "J" << i + 1 << " n " << n;
     }

@@ -170,17 +170,15 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const bool coupled = task.io.coupled();
   const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
   const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
-  // The stuck-encoder monitor; a backstop without its tightest criterion where the residual
-  // monitor is armed (docs/safety.md).
-  task.stuck.backstop = task.residual.armed;
-  // Yielding, the reference follows the arm and the torque follows gravity; against a contact the
-  // torque holds a joint that cannot move: neither says where the arm must go, so the stuck-encoder
+  // The stuck-encoder monitor; a backstop with its torque criterion alone where the residual
+  // monitor is armed (docs/safety.md). Yielding, the reference follows the arm and the torque follows gravity; against
+  // a contact the torque holds a joint that cannot move: neither says where the arm must go, so the stuck-encoder
   // monitor waits, from a collision reacted to until the next motion (the residual monitor runs on).
   std::uint32_t faults = 0;
   if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
   else
-    faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad);
+    faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad, task.residual.armed);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
@@ -312,6 +310,13 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured) {
   return MotionCommand::kNone;
 }
 
+/// The generator holds the pose the last step measured (the next move's path starts at q).
+template <class S>
+void hold_measured_pose(ControlTask<S>& task, const Vec6<S>& q) {
+  task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+  task.q_queue_end = q;
+}
+
 /// What an accepted command and the machine's step ask of the generator and the controller, from
 /// the next tick on.
 template <class S>
@@ -324,8 +329,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.contact = false;
   if (st.enabling) {
     controller_restart(task.model, task.state, q);
-    task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
-    task.q_queue_end = q;
+    hold_measured_pose(task, q);
     task.stuck.reset(true);
     task.residual.reset();
     task.contact = false;
@@ -346,10 +350,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream) task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id);
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
-  if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) {
-    task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
-    task.q_queue_end = q;
-  }
+  if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
     task.gen.stop(next, params::kControlHz, task.limits);
     task.q_queue_end = q;  // near where the stop ends: the next check's Newton steps start the path there

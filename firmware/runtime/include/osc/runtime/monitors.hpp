@@ -118,11 +118,6 @@ struct StuckEncoderMonitor {
   Vec6<S> dtau_gated_peak;             // ... while it was silent for kStuckIntervals of its intervals
   Vec6<S> peak;                        // the largest motion seen
   bool restart = false;                // the next check takes every encoder as just changed
-  /// A backstop behind the armed residual monitor: the torque criterion alone (kStuckTorque, beyond
-  /// the torque that breaks any joint away from its static friction). The criteria tuned on the
-  /// paper's trajectory are off: the reference motion while silent trips on slow moves of a joint
-  /// that static friction holds (Corke's J1), the silent-torque one on the realistic plant.
-  bool backstop = false;
 
   /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
   /// the torque jumps from zero to what holds the arm, and no encoder needs to count for that).
@@ -140,9 +135,13 @@ struct StuckEncoderMonitor {
   }
   /// After the step of tick `tick` that commanded the motor torques `tau` and reference motor rates
   /// `qd_ref` (both per encoder channel: the joints' own where each encoder reads its joint);
-  /// `moved` from EncoderJumpMonitor.
+  /// `moved` from EncoderJumpMonitor. backstop: behind the armed residual monitor, the torque
+  /// criterion alone (kStuckTorque, beyond the torque that breaks any joint away from its static
+  /// friction); the criteria tuned on the paper's trajectory are off (the reference motion while
+  /// silent trips on slow moves of a joint that static friction holds, Corke's J1; the silent-torque
+  /// one on the realistic plant).
   std::uint32_t check(const Vec6<S>& tau, const Vec6<S>& qd_ref, const bool moved[kDof], std::uint64_t tick, S dt,
-                      const Vec6<math::io_scalar_t<S>>& counts_per_rad) {
+                      const Vec6<math::io_scalar_t<S>>& counts_per_rad, bool backstop = false) {
     static constexpr std::array<S, kDof> kTorque = lit_array<S>(params::kStuckTorque);
     static constexpr std::array<S, kDof> kTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
     static constexpr S kMotionBound = lit<S>(kStuckMotionBound), kMotionCounts = lit<S>(params::kStuckMotionCounts);
@@ -262,6 +261,7 @@ struct ResidualMonitor {
   /// One joint's friction against the band (robot::kModelErrorBounds): moving, the band's distance
   /// from theta^ per coefficient; not moving, the static band's extent plus |tau_f^| (still).
   struct FrictionError {
+    S th_v, th_c, th_s;  // theta^'s coefficients of the joint (0 without compensation)
     S dv, dc, ds, still;
     bool moving;
   };
@@ -379,7 +379,7 @@ struct ResidualMonitor {
       acc.setZero();
       prime_change();
       bound = pointwise_bound(in, fe);
-      update_thresholds(in.A, fe, in.theta);
+      update_thresholds(in.A, fe);
       for (int i = 0; i < kDof; ++i) over[i] = 0;
       primed = true;
       return 0;
@@ -394,7 +394,7 @@ struct ResidualMonitor {
       bound(i) += Kdt * (b(i) - bound(i));
     }
     update_change(in, fe, dt);
-    update_thresholds(in.A, fe, in.theta);
+    update_thresholds(in.A, fe);
     qd_prev = in.qd;
     bias_prev = in.bias;
     int worst = -1;
@@ -438,13 +438,14 @@ struct ResidualMonitor {
     const S v = math::abs(in.qd(i));
     // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
     const S moving = velocity_noise(i) + lag * math::abs(acc(i));
-    const S th_v = in.theta ? (*in.theta)(i) : S(0), th_c = in.theta ? (*in.theta)(kDof + i) : S(0),
-            th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
     const auto larger = [](S x, S y) { return x > y ? x : y; };
     FrictionError e;
-    e.dv = larger(c.vis_hi[i] - th_v, th_v - c.vis_lo[i]);
-    e.dc = larger(c.cou_hi[i] - th_c, th_c - c.cou_lo[i]);
-    e.ds = larger(c.sti_hi[i] - th_s, th_s - c.sti_lo[i]);
+    e.th_v = in.theta ? (*in.theta)(i) : S(0);
+    e.th_c = in.theta ? (*in.theta)(kDof + i) : S(0);
+    e.th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
+    e.dv = larger(c.vis_hi[i] - e.th_v, e.th_v - c.vis_lo[i]);
+    e.dc = larger(c.cou_hi[i] - e.th_c, e.th_c - c.cou_lo[i]);
+    e.ds = larger(c.sti_hi[i] - e.th_s, e.th_s - c.sti_lo[i]);
     // Static friction anywhere within the band, against whatever the estimate says.
     e.still = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
     e.moving = v > moving && counting(i, in.qd(i), tick);
@@ -502,7 +503,7 @@ struct ResidualMonitor {
   S change(int k, int i) const { return math::abs(signed_change(k, i)); }
   /// The thresholds: the filtered bound, the inertias' error on the filtered accelerations, and the
   /// velocity estimate's noise through A and the filter.
-  void update_thresholds(const Mat6<S>& A, const FrictionError (&fe)[kDof], const Vec18<S>* theta) {
+  void update_thresholds(const Mat6<S>& A, const FrictionError (&fe)[kDof]) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
     static constexpr std::array<S, kDof> kPeak = lit_array<S>(params::kResidualPeakFactor);
@@ -523,10 +524,8 @@ struct ResidualMonitor {
       const FrictionError& e = fe[i];
       // The friction error (theta - theta^)^T w: the band's distances times the regressors'
       // changes at the estimate of now, plus what the estimate's own change added.
-      const S th_v = theta ? (*theta)(i) : S(0), th_c = theta ? (*theta)(kDof + i) : S(0),
-              th_s = theta ? (*theta)(2 * kDof + i) : S(0);
-      const S learnt = signed_change(kEstimate, i) - th_v * signed_change(kVis, i) - th_c * signed_change(kCou, i) -
-                       th_s * signed_change(kSti, i);
+      const S learnt = signed_change(kEstimate, i) - e.th_v * signed_change(kVis, i) - e.th_c * signed_change(kCou, i) -
+                       e.th_s * signed_change(kSti, i);
       const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) + math::abs(learnt) +
                          c.vis_hi[i] * velocity_noise(i) + S(2) * stillness(i) * e.still + S(2) * cross_friction(i);
       const S model =
