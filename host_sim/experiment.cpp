@@ -44,6 +44,14 @@ class LocalController {
       r.tau_f_hat[i] = static_cast<double>(out.tau_f_hat(i));
     }
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
+    r.has_identification = task_->gains.adaptation == osc::AdaptationLaw::kMomentum;
+    if (r.has_identification) {
+      const osc::FrictionIdentifier<S>& id = task_->identifier;
+      for (int i = 0; i < 6; ++i) {
+        for (int c = 0; c < 3; ++c) r.theta_sd[6 * c + i] = std::sqrt(static_cast<double>(id.variance(i, c)));
+        r.breakaway_sd[i] = std::sqrt(std::max(0.0, static_cast<double>(id.breakaway_variance(i))));
+      }
+    }
     const osc::ResidualMonitor<S>& m = task_->residual;
     for (int i = 0; i < 6; ++i) {
       // The channel nearer its threshold: the residual or its change (monitors.hpp); in double,

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "experiment.hpp"
+#include "osc/control/identification.hpp"
 
 namespace sim {
 namespace {
@@ -194,7 +195,12 @@ void FrictionEstimates::begin(const ExperimentConfig& cfg) {
 }
 
 void FrictionEstimates::observe(const Sample& s) {
-  if (!frozen_) std::copy(s.rep.theta_hat, s.rep.theta_hat + 18, theta_hat);
+  if (!frozen_) {
+    std::copy(s.rep.theta_hat, s.rep.theta_hat + 18, theta_hat);
+    has_identification = s.rep.has_identification;
+    std::copy(s.rep.theta_sd, s.rep.theta_sd + 18, theta_sd);
+    std::copy(s.rep.breakaway_sd, s.rep.breakaway_sd + 6, breakaway_sd);
+  }
   frozen_ = !s.counting;
   if (!s.counting) return;
   for (int i = 0; i < 18; ++i) {
@@ -208,6 +214,17 @@ void FrictionEstimates::to_json(Json& j) const {
   j["theta_true"] = json_array(theta_true, 18);
   j["theta_min_seen"] = json_array(theta_min_seen, 18);
   j["theta_max_seen"] = json_array(theta_max_seen, 18);
+  if (!has_identification) return;
+  // The excitation monitor's verdicts (osc::friction_identified): per coefficient, then per joint's
+  // Coulomb + Stribeck sum.
+  Json id;
+  id["theta_sd"] = json_array(theta_sd, 18);
+  id["breakaway_sd"] = json_array(breakaway_sd, 6);
+  for (int i = 0; i < 18; ++i) id["theta_identified"].push_back(osc::friction_identified(theta_hat[i], theta_sd[i]));
+  for (int i = 0; i < 6; ++i)
+    id["breakaway_identified"].push_back(
+        osc::friction_identified(theta_hat[6 + i] + theta_hat[12 + i], breakaway_sd[i]));
+  j["identification"] = id;
 }
 
 // ---- FrictionRms

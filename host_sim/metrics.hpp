@@ -41,6 +41,9 @@ struct TickReport {
   double xd_hat[6] = {};  // the observer's velocity estimate: m/s, rad/s (in-process only)
   double tau_f_hat[6] = {};
   double theta_hat[18] = {};
+  bool has_identification = false;  // the `momentum` law's covariance is available (in-process only)
+  double theta_sd[18] = {};          // its standard deviation per coefficient
+  double breakaway_sd[6] = {};       // ... of each joint's Coulomb + Stribeck sum
 };
 
 /// One control sample as the metrics see it: the true plant, the controller's report, the torques.
@@ -126,6 +129,9 @@ struct FrictionEstimates {
   double theta_true[18] = {};
   double theta_min_seen[18] = {};
   double theta_max_seen[18] = {};
+  bool has_identification = false;  // the `momentum` law's report below is set
+  double theta_sd[18] = {};         // each coefficient's standard deviation at the end
+  double breakaway_sd[6] = {};      // ... each joint's Coulomb + Stribeck sum's
   void begin(const ExperimentConfig& cfg);
   void observe(const Sample& s);
   void to_json(Json& j) const;

@@ -289,6 +289,8 @@ class HostArm {
     v.xd_d = t.desired.xd.template cast<double>();
     v.xdd_d = t.desired.xdd.template cast<double>();
     v.pose = sim_.pose();
+    v.has_theta = true;
+    for (int i = 0; i < 18; ++i) v.theta_hat[i] = static_cast<double>(t.state.adapt.theta_hat(i));
     return true;
   }
   void finish(MotionRun& run) {
@@ -380,6 +382,7 @@ class Player {
     r.step = s.text;
     r.id = static_cast<std::uint32_t>(run_.commands.size() + 1);
     r.sent_s = t;
+    if (view_.has_theta) r.theta_at_sent.assign(view_.theta_hat, view_.theta_hat + 18);
     if (s.verb == osc::MotionVerb::kStream) stream_ = {&s, r.id, 0, -1};
     run_.commands.push_back(r);
     return arm_.command(osc::frame_from_command<double>(r.id, s.verb, s.move), err);
@@ -561,6 +564,10 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
                     {"max_error_mm", r.max_error_mm},
                     {"max_error_deg", r.max_error_deg},
                     {"reference_max", {{"v", r.v}, {"a", r.a}, {"j", r.j}, {"w", r.w}, {"wd", r.wd}}}});
+  // In process, the friction estimates when each command was sent (a hold's or a repeated move's
+  // effect on them: docs/adaptation.md).
+  for (std::size_t k = 0; k < run.commands.size(); ++k)
+    if (!run.commands[k].theta_at_sent.empty()) cmds[k]["theta_hat_at_sent"] = run.commands[k].theta_at_sent;
   j["commands"] = cmds;
   ordered_json states = ordered_json::array();
   for (const auto& s : run.states) states.push_back({{"t", s.t}, {"state", s.state}});

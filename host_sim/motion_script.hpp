@@ -89,6 +89,7 @@ struct CommandRecord {
   double max_error_mm = 0, max_error_deg = 0;  ///< tracking while the command's motion ran
   double v = 0, a = 0, j = 0, w = 0, wd = 0;   ///< the reference's own maxima while it ran
   bool running = false;                        ///< its motion is on (accepted, not yet ended)
+  std::vector<double> theta_at_sent;           ///< in process: theta^ when it was sent (18; else empty)
 };
 
 struct MotionRun {

@@ -20,6 +20,7 @@
 #include "experiment.hpp"
 #include "experiment_cli.hpp"
 #include "linked_arm.hpp"
+#include "osc/control/identification.hpp"
 #include "motion_script.hpp"
 #include "summary.hpp"
 #include "output_file.hpp"
@@ -100,6 +101,26 @@ void print_friction_table(const sim::ExperimentResult& ad) {
   for (int k = 0; k < 3; ++k) {
     std::printf("%-20s", names[k]);
     for (int j = 0; j < 6; ++j) std::printf(" %6.2f / %5.2f", ad.theta_hat[6 * k + j], ad.theta_true[6 * k + j]);
+    std::printf("\n");
+  }
+  if (ad.has_identification) {
+    // The excitation monitor (momentum law): each coefficient's standard deviation, * where it is
+    // identified (osc::friction_identified), and the Coulomb + Stribeck sums'.
+    std::printf("standard deviations of the estimates (*: identified)\n");
+    static const char* sd_names[3] = {"  sd vis", "  sd cou", "  sd sti"};
+    for (int k = 0; k < 3; ++k) {
+      std::printf("%-20s", sd_names[k]);
+      for (int j = 0; j < 6; ++j) {
+        const int c = 6 * k + j;
+        std::printf(" %13.3f%c", ad.theta_sd[c], osc::friction_identified(ad.theta_hat[c], ad.theta_sd[c]) ? '*' : ' ');
+      }
+      std::printf("\n");
+    }
+    std::printf("%-20s", "  cou + sti");
+    for (int j = 0; j < 6; ++j) {
+      const double sum = ad.theta_hat[6 + j] + ad.theta_hat[12 + j];
+      std::printf(" %5.2f+-%5.3f%c", sum, ad.breakaway_sd[j], osc::friction_identified(sum, ad.breakaway_sd[j]) ? '*' : ' ');
+    }
     std::printf("\n");
   }
   if (!ad.status)

@@ -66,9 +66,12 @@ Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const
   return theta;
 }
 
-/// theta^(t) by the law the gains select; unchanged until the law has the samples it needs.
+/// theta^(t) by the law the gains select; unchanged until the law has the samples it needs. The
+/// `momentum` law leaves it as it is: the control task identifies it from the residual monitor
+/// (osc/control/identification.hpp), which needs the torque the drives applied.
 template <class S>
 Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
+  if (G.adaptation == AdaptationLaw::kMomentum) return a.theta_hat;
   if (G.adaptation == AdaptationLaw::kRobust) return a.samples >= 2 ? adaptation_robust(G, a, q) : a.theta_hat;
   return a.samples >= 1 ? adaptation_paper(G, a, q) : a.theta_hat;
 }

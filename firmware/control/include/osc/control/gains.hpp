@@ -20,9 +20,11 @@ enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
 enum class AdaptationLaw : std::uint8_t {
   kPaper,   ///< the paper's sampled law (67), exactly
   kRobust,  ///< (67)'s error with the regressor one sample older, projection, leakage (the default)
+  kMomentum,  ///< identified from the residual monitor's momentum residual, a Kalman filter per joint
+              ///< (osc/control/identification.hpp): the control step holds theta^, the task updates it
 };
 /// Names of the laws, in enum order (command lines, logs).
-constexpr const char* kAdaptationLawNames[] = {"paper", "robust"};
+constexpr const char* kAdaptationLawNames[] = {"paper", "robust", "momentum"};
 constexpr int kAdaptationLawCount = sizeof(kAdaptationLawNames) / sizeof(kAdaptationLawNames[0]);
 
 constexpr const char* adaptation_law_name(AdaptationLaw law) { return kAdaptationLawNames[static_cast<int>(law)]; }

@@ -106,6 +106,27 @@ constexpr double kResidualSlowGain = 10;
 /// sweep of healthy runs checks exactly that (docs/safety.md); the rest is room for what the bounds
 /// leave out.
 constexpr double kResidualMargin = 2;
+/// Friction identified from the residual (the `momentum` law, osc/control/identification.hpp;
+/// docs/adaptation.md, "Identification from the residual"):
+/// - each joint's Kalman update comes every kIdentifyEvery ticks, the joints in turn (the filtered
+///   samples are correlated over 1/kResidualGain = 20-50 ms: a sample every 6 ms loses little);
+/// - a joint's sample counts once it has moved, encoder counting, for kIdentifySettle of the
+///   residual filter's time constants (the filter then holds no standstill, where friction is not
+///   the model's W theta);
+/// - and while its residual is at most kIdentifyMaxRatio of its threshold (a contact's torque is no
+///   friction), and its innovation within kIdentifyGate standard deviations;
+/// - the coefficients drift: a random walk of kIdentifyDrift times the band's top per hour (the
+///   band's own +-30 % with temperature, robot::kModelErrorBounds).
+constexpr int kIdentifyEvery = 6;
+constexpr double kIdentifySettle = 3;
+constexpr double kIdentifyMaxRatio = 0.5;
+constexpr double kIdentifyGate = 4;
+constexpr double kIdentifyDrift = 0.3;
+/// The samples the identification's noise measure averages over (its mean squared innovation), per
+/// joint: about 1.5 s of updates.
+constexpr int kIdentifyNoiseSamples = 256;
+/// A coefficient is reported identified when its standard deviation is at most this fraction of it.
+constexpr double kIdentifiedFraction = 0.025;
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
 /// heavier (corke) friction preset (7.0 mm, 0.43 deg).

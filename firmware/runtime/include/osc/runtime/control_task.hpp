@@ -64,6 +64,7 @@ struct ControlTask {
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
   ResidualMonitor<S> residual;
+  FrictionIdentifier<S> identifier;  // the `momentum` law's (osc/control/identification.hpp)
   CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
@@ -102,6 +103,7 @@ struct ControlTask {
     stuck.reset();
     residual.reset();
     residual.collision_floor.setZero();
+    identifier.reset();
     collision_reaction = CollisionReaction::kCategory0;
     contact = false;
     saturation.reset();
@@ -160,6 +162,29 @@ struct ControlTask {
   void inject_nonfinite() { state.obs.y(0) = S(0) / S(0); }
 };
 
+/// The `momentum` law's update of the joint whose turn it is (FrictionIdentifier), from the sample the
+/// residual monitor took. The sample's noise is at most the residual's quantisation bound taken as
+/// twice its standard deviation; samples params::kIdentifyEvery ticks apart that the filter
+/// correlates over 1 / K count as 2 / (K dt kIdentifyEvery) times fewer independent ones (the
+/// integral scale of a first-order filter's correlation exp(-K |t|) is 2 / K).
+template <class S>
+void identify_friction(ControlTask<S>& task) {
+  static constexpr std::array<S, kDof> kCorrelation = [] {
+    std::array<S, kDof> c{};
+    for (int i = 0; i < kDof; ++i) {
+      const double f = 2.0 / (params::kResidualGain[i] * params::kDt * params::kIdentifyEvery);
+      c[i] = lit<S>(f > 1 ? f : 1);
+    }
+    return c;
+  }();
+  static constexpr S kMaxRatio = lit<S>(params::kIdentifyMaxRatio);
+  ResidualMonitor<S>& m = task.residual;
+  const int i = m.sample_joint;
+  const S half = lit<S>(0.5) * m.noise_bound(i);
+  task.identifier.update(i, m.sample, m.ratio_of(i) <= kMaxRatio, half * half, kCorrelation[i],
+                         task.state.adapt.theta_hat, task.gains.theta_max);
+}
+
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
 /// stuck-encoder, tracking and friction-estimate monitors (osc/runtime/monitors.hpp).
 template <class S>
@@ -189,7 +214,10 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             ad.qd_hat_prev,
                             decay,
                             adaptive ? &ad.theta_hat : nullptr};
+  const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
+  task.residual.sample_joint = identify ? task.identifier.take_turn() : -1;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick, task.gains.dt);
+  if (identify) identify_friction(task);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check(task.state.adapt.theta_hat, task.gains.theta_max);

@@ -14,6 +14,7 @@
 #include <cstdint>
 
 #include "osc/control/controller.hpp"
+#include "osc/control/identification.hpp"
 #include "osc/runtime/io.hpp"
 
 namespace osc {
@@ -297,6 +298,11 @@ struct ResidualMonitor {
   /// only once some joint's qualified residual is beyond its own too; 0, the default, leaves the derived
   /// thresholds alone. They never lower a derived threshold, nor touch the sensor and drive faults.
   Vec6<S> collision_floor = Vec6<S>::Zero();
+  /// The friction identification's sample (osc/control/identification.hpp): the joint whose sample
+  /// the next check takes (-1: none), and the sample it took.
+  int sample_joint = -1;
+  FrictionSample<S> sample{};
+  Vec6<S> noise_bound;  // this tick's bound on the velocity estimate's quantisation noise in r [N m]
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
   /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
@@ -319,6 +325,7 @@ struct ResidualMonitor {
   /// Clears the filters and the record: the next check primes it (an enable, a restart).
   void reset() {
     r.setZero();
+    noise_bound.setZero();
     bound.setZero();
     acc.setZero();
     threshold.setZero();
@@ -370,6 +377,7 @@ struct ResidualMonitor {
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
                       const bool moved[kDof], std::uint64_t tick, S dt) {
     track(counts, moved, tick);
+    sample.settled = false;
     FrictionError fe[kDof];
     for (int i = 0; i < kDof; ++i) fe[i] = friction_error(in, i, tick);
     if (!primed) {
@@ -393,6 +401,7 @@ struct ResidualMonitor {
       acc(i) += K * dqd(i) - Kdt * acc(i);
       bound(i) += Kdt * (b(i) - bound(i));
     }
+    if (sample_joint >= 0) take_sample(sample_joint, fe[sample_joint]);
     update_change(in, fe, dt);
     update_thresholds(in.A, fe);
     qd_prev = in.qd;
@@ -426,6 +435,26 @@ struct ResidualMonitor {
     acc_slow.setZero();
     for (int k = 0; k < kRegressors; ++k) reg[k].setZero(), reg_slow[k].setZero();
     stillness.setOnes();  // until each joint is seen moving, its static friction may change at any time
+  }
+  /// Joint i's friction sample: r is this tick's, the filtered regressors still the last tick's, as
+  /// the friction in r is the last period's (n_{k-1}). Settled: moving, its encoder counting, since
+  /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that far).
+  void take_sample(int i, const FrictionError& e) {
+    static constexpr std::array<S, kDof> kSettled = settled_stillness();
+    sample.y = reg[kEstimate](i) - r(i);
+    sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
+    sample.settled = e.moving && stillness(i) <= kSettled[i];
+  }
+  /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
+  static constexpr std::array<S, kDof> settled_stillness() {
+    std::array<S, kDof> s{};
+    for (int i = 0; i < kDof; ++i) {
+      const int ticks = static_cast<int>(params::kIdentifySettle * params::kControlHz / params::kResidualGain[i] + 0.5);
+      double v = 1;
+      for (int t = 0; t < ticks; ++t) v *= 1 - params::kResidualSlowGain * params::kDt;
+      s[i] = lit<S>(v);
+    }
+    return s;
   }
   bool beyond_collision_floor() const {
     for (int j = 0; j < kDof; ++j)
@@ -517,6 +546,7 @@ struct ResidualMonitor {
         inertia += aij * a(j), inertia_change += aij * da(j), noise += aij * velocity_noise(j);
       }
       const S quantum = S(2) * kGain[i] * noise;
+      noise_bound(i) = quantum;
       // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
       const S loop = c.amp_lag * kGain[i] * math::abs(tau_prev(i) - reg[kTorque](i));
       threshold(i) =

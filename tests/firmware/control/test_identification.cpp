@@ -1,0 +1,175 @@
+// The friction identifier of the `momentum` law (osc/control/identification.hpp), alone: its Kalman
+// correction against the batch least-squares solution it must equal, its projection against the
+// closed form, its gates, its noise measure and its random walk.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <random>
+
+#include "osc/control/gains.hpp"
+#include "osc/control/identification.hpp"
+
+using namespace osc;
+
+namespace {
+
+struct Regression {
+  std::vector<Vec3<double>> phi;
+  std::vector<double> y;
+};
+
+/// A joint's samples: the regressor columns of a sinusoidal velocity through a first-order filter
+/// (as the residual monitor's), y = phi^T theta + noise.
+Regression samples(const Vec3<double>& theta, double noise, int n, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> gauss(0.0, noise);
+  Regression r;
+  Vec3<double> f = Vec3<double>::Zero();
+  for (int k = 0; k < n; ++k) {
+    const double t = 0.006 * k, v = 0.4 * std::sin(1.3 * t) + 0.05 * std::sin(5.1 * t);
+    const double sign = v > 0 ? 1 : -1;
+    const Vec3<double> w(v, sign, sign * std::exp(-v * v));
+    f += 0.3 * (w - f);  // 50 /s over 6 ms
+    r.phi.push_back(f);
+    r.y.push_back(f.dot(theta) + gauss(rng));
+  }
+  return r;
+}
+
+}  // namespace
+
+// The sequential correction from the prior (theta^ = 0, covariance P0) equals the batch solution of
+// the regularised least squares (P0^-1 + Phi^T Phi / R) theta = Phi^T y / R, and its covariance the
+// inverse of that information matrix: solved here with Eigen's LDLT, independently.
+TEST(FrictionIdentifier, CorrectionEqualsBatchLeastSquares) {
+  const Vec3<double> truth(5.8, 4.9, 4.1);
+  const double R = 0.04;
+  const Regression d = samples(truth, std::sqrt(R), 3000, 1);
+  FrictionIdentifier<double> id;
+  id.reset();
+  const int joint = 0;
+  const Mat3<double> P0 = id.P[joint];
+  Vec3<double> th = Vec3<double>::Zero();
+  Mat3<double> info = P0.inverse();  // 3x3, diagonal
+  Vec3<double> rhs = Vec3<double>::Zero();
+  for (std::size_t k = 0; k < d.y.size(); ++k) {
+    const Vec3<double> Pphi = id.P[joint] * d.phi[k];
+    const double var = d.phi[k].dot(Pphi) + R;
+    const double innovation = d.y[k] - d.phi[k].dot(th);
+    th += id.correct(joint, Pphi, var) * innovation;
+    info += d.phi[k] * d.phi[k].transpose() / R;
+    rhs += d.phi[k] * d.y[k] / R;
+  }
+  const Vec3<double> batch = info.ldlt().solve(rhs);
+  const Mat3<double> cov = info.ldlt().solve(Mat3<double>::Identity());
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(th(c), batch(c), 1e-9 * (1 + std::abs(batch(c)))) << c;
+    for (int e = 0; e < 3; ++e) EXPECT_NEAR(id.P[joint](c, e), cov(c, e), 1e-9 * std::abs(cov(c, c))) << c << e;
+  }
+  // And the regression is unbiased: within four of its standard deviations of the truth.
+  for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(th(c) - truth(c)), 4 * std::sqrt(cov(c, c))) << c;
+}
+
+// The projection in the metric of P^-1: a coefficient below 0 is set to 0 and the others move by
+// P's column over its diagonal times the excess. With Coulomb and Stribeck strongly anti-correlated
+// (their sum well known), a Coulomb of -1 becomes 0 and the Stribeck term gives up what keeps the
+// sum: the closed form, and the sum kept to the correlation's shortfall.
+TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
+  FrictionIdentifier<double> id;
+  id.reset();
+  Mat3<double>& P = id.P[2];
+  P << 0.5, 0.0, 0.0,  //
+      0.0, 4.0, -3.96,  //
+      0.0, -3.96, 4.0;
+  const Vec18<double> theta_max = Gains<double>::paper().theta_max;
+  const Vec3<double> th(2.0, -1.0, 4.0);
+  const Vec3<double> p = id.project(2, th, theta_max);
+  EXPECT_DOUBLE_EQ(p(0), 2.0);
+  EXPECT_DOUBLE_EQ(p(1), 0.0);
+  EXPECT_NEAR(p(2), 4.0 - (-3.96 / 4.0) * (-1.0), 1e-12);  // 3.01
+  EXPECT_NEAR(p(1) + p(2), th(1) + th(2), 0.02);           // the sum 3.0 kept within 1 %
+  // A per-coefficient clip would have raised the sum by the whole excess.
+  EXPECT_GT(std::abs((0.0 + 4.0) - (th(1) + th(2))), 0.9);
+  // Above a bound: the same rule, from the other side.
+  const Vec3<double> high(2.0, theta_max(kDof + 2) + 1.0, 0.5);
+  const Vec3<double> q = id.project(2, high, theta_max);
+  EXPECT_DOUBLE_EQ(q(1), theta_max(kDof + 2));
+  EXPECT_NEAR(q(2), std::min(theta_max(2 * kDof + 2), 0.5 + 0.99), 1e-12);
+}
+
+// Gates: a sample that has not settled, or whose residual is high, changes nothing but P's random
+// walk; an innovation beyond kIdentifyGate standard deviations is counted and refused.
+TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
+  FrictionIdentifier<double> id;
+  id.reset();
+  const Vec18<double> theta_max = Gains<double>::paper().theta_max;
+  Vec18<double> theta = Vec18<double>::Constant(1.0);
+  const Vec18<double> before = theta;
+  FrictionSample<double> s{10.0, Vec3<double>(0.2, 1.0, 0.98), false};
+  EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kNotSettled);
+  s.settled = true;
+  EXPECT_EQ(id.update(1, s, false, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kResidualHigh);
+  EXPECT_EQ(theta, before);
+  EXPECT_EQ(id.updates[1], 0u);
+  // Shrink joint 1's covariance to a known, small one: an innovation of 10 N m is then an outlier.
+  id.P[1] = Mat3<double>::Identity() * 1e-4;
+  EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kOutlier);
+  EXPECT_EQ(id.outliers[1], 1u);
+  EXPECT_EQ(theta, before);
+  // Within the gate it learns.
+  s.y = theta(1) * 0.2 + theta(kDof + 1) * 1.0 + theta(2 * kDof + 1) * 0.98 + 0.05;
+  EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kUpdated);
+  EXPECT_NE(theta, before);
+  for (int i = 0; i < 18; ++i) {
+    if (i % kDof != 1) {
+      EXPECT_EQ(theta(i), before(i)) << "only joint 1's coefficients move";
+    }
+  }
+}
+
+// The random walk: P's diagonal grows by (kIdentifyDrift times the band's top)^2 per hour of
+// updates, and never beyond the prior.
+TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
+  FrictionIdentifier<double> id;
+  id.reset();
+  const Mat3<double> prior = FrictionIdentifier<double>::prior(0);
+  id.P[0] = Mat3<double>::Zero();
+  const Vec18<double> theta_max = Gains<double>::paper().theta_max;
+  Vec18<double> theta = Vec18<double>::Zero();
+  const FrictionSample<double> still{0, Vec3<double>::Zero(), false};
+  const int per_hour = static_cast<int>(FrictionIdentifier<double>::kPerHour);
+  for (int k = 0; k < per_hour; ++k) id.update(0, still, true, 0.01, 1.0, theta, theta_max);
+  const double drift = params::kIdentifyDrift * params::kIdentifyDrift;
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(id.P[0](c, c), drift * prior(c, c), 1e-6 * prior(c, c)) << c;
+  for (int k = 0; k < 20 * per_hour; ++k) id.update(0, still, true, 0.01, 1.0, theta, theta_max);
+  for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(id.P[0](c, c), prior(c, c)) << c;
+  EXPECT_EQ(theta, Vec18<double>::Zero());
+}
+
+// The noise measure: from samples of known noise, the identifier's variance settles near it (the
+// mean squared innovation less what P explains), and the estimate converges within its own
+// standard deviations; in float too.
+template <class S>
+void converges_on_noisy_samples() {
+  const Vec3<double> truth(3.7, 4.8, 4.3);
+  const double sd = 0.3;
+  const Regression d = samples(truth, sd, 20000, 7);
+  FrictionIdentifier<S> id;
+  id.reset();
+  const Vec18<S> theta_max = Gains<double>::paper().theta_max.template cast<S>();
+  Vec18<S> theta = Vec18<S>::Zero();
+  int updated = 0;
+  for (std::size_t k = 0; k < d.y.size(); ++k) {
+    const FrictionSample<S> s{S(d.y[k]), d.phi[k].template cast<S>(), true};
+    updated += id.update(1, s, true, S(1.0), S(1.0), theta, theta_max) == IdentifyOutcome::kUpdated;
+  }
+  EXPECT_GT(updated, 19900);  // a 4-sigma gate refuses almost none of gaussian noise
+  EXPECT_NEAR(static_cast<double>(id.innovation2(1)), sd * sd, 0.3 * sd * sd);
+  const double sum = static_cast<double>(theta(kDof + 1) + theta(2 * kDof + 1));
+  const double sum_sd = std::sqrt(static_cast<double>(id.breakaway_variance(1)));
+  EXPECT_LT(std::abs(sum - (truth(1) + truth(2))), 4 * sum_sd);
+  EXPECT_LT(std::abs(static_cast<double>(theta(1)) - truth(0)), 4 * std::sqrt(static_cast<double>(id.variance(1, 0))));
+  EXPECT_TRUE(friction_identified(sum, sum_sd)) << sum_sd;
+}
+TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
+TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }

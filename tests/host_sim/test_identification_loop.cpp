@@ -1,0 +1,105 @@
+// Issue 26 in the closed loop: the `momentum` law (friction identified from the residual monitor's
+// momentum residual, osc/control/identification.hpp) against the robust law on the paper's 120 s
+// experiment, and on a frictionless plant. About a second of CPU per run in double.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "experiment.hpp"
+#include "osc/control/identification.hpp"
+
+using namespace sim;
+
+namespace {
+
+ExperimentConfig config(osc::AdaptationLaw law, const osc::FrictionCoefficients& friction, double duration = 120) {
+  ExperimentConfig c;
+  c.duration = duration;
+  c.mode = osc::FrictionMode::kAdaptive;
+  c.plant.friction = friction;
+  c.gains.adaptation = law;
+  c.window = 5;  // the windows after the first are "t >= 5 s"
+  return c;
+}
+
+/// The worst |e| over the windows after the first (t >= the window's length) per axis [mm, deg].
+std::array<double, 6> after_first_window(const ExperimentResult& r) {
+  std::array<double, 6> worst{};
+  for (std::size_t w = 1; w < r.window_max.size(); ++w)
+    for (int a = 0; a < 6; ++a) worst[a] = std::max(worst[a], r.window_max[w][a]);
+  return worst;
+}
+
+}  // namespace
+
+// The robust law's slowness, the issue's test: 120 s into the paper's experiment its viscous
+// estimate of J1 is still below half the plant's (0.62 of 5.8); the momentum law's is within 10 %.
+// The same criterion (at least half the truth) fails on one law and passes on the other.
+TEST(FrictionIdentification, RobustLawIsSlowWhereTheMomentumLawIsNot) {
+  const ExperimentResult robust = run_experiment(config(osc::AdaptationLaw::kRobust, osc::robot::kFrictionPaper));
+  const ExperimentResult momentum = run_experiment(config(osc::AdaptationLaw::kMomentum, osc::robot::kFrictionPaper));
+  const double truth = osc::robot::kFrictionPaper.vis[0];
+  std::printf("theta^_vis,J1 after 120 s: robust %.2f, momentum %.2f (plant %.2f)\n", robust.theta_hat[0],
+              momentum.theta_hat[0], truth);
+  ASSERT_EQ(robust.status, 0u);
+  ASSERT_EQ(momentum.status, 0u);
+  EXPECT_LT(robust.theta_hat[0], 0.5 * truth);
+  EXPECT_GE(momentum.theta_hat[0], 0.5 * truth);
+  EXPECT_NEAR(momentum.theta_hat[0], truth, 0.1 * truth);
+}
+
+// The 120 s criteria of issue 26 on the default plant: tracking from t = 5 s at or below half of
+// Table I, the last 20 s at or below 0.08 mm; each joint's Coulomb + Stribeck sum identified and
+// within 10 % of the plant's; every coefficient the excitation monitor calls identified within 10 %.
+TEST(FrictionIdentification, PaperExperimentMeetsTheIssuesCriteria) {
+  const ExperimentResult r = run_experiment(config(osc::AdaptationLaw::kMomentum, osc::robot::kFrictionPaper));
+  ASSERT_EQ(r.status, 0u);
+  ASSERT_TRUE(r.has_identification);
+  const std::array<double, 6> after = after_first_window(r);
+  for (int a = 0; a < 3; ++a) {
+    std::printf("axis %d: max |e| from 5 s %.3f mm (half of Table I %.3f), last 20 s %.3f mm\n", a, after[a],
+                kPaperTable1[a] / 2, r.final_max_error[a]);
+    EXPECT_LE(after[a], kPaperTable1[a] / 2) << "axis " << a;
+    EXPECT_LE(r.final_max_error[a], 0.08) << "axis " << a;
+  }
+  for (int j = 0; j < 6; ++j) {
+    const double sum = r.theta_hat[6 + j] + r.theta_hat[12 + j], truth = r.theta_true[6 + j] + r.theta_true[12 + j];
+    EXPECT_TRUE(osc::friction_identified(sum, r.breakaway_sd[j])) << "J" << j + 1 << " sd " << r.breakaway_sd[j];
+    EXPECT_NEAR(sum, truth, 0.1 * truth) << "J" << j + 1;
+  }
+  for (int c = 0; c < 18; ++c) {
+    if (osc::friction_identified(r.theta_hat[c], r.theta_sd[c])) {
+      EXPECT_NEAR(r.theta_hat[c], r.theta_true[c], 0.1 * r.theta_true[c]) << "coefficient " << c;
+    }
+  }
+}
+
+// A frictionless plant: the momentum law's predicted friction stays at most 0.3 N m rms (the issue's
+// bound; measured about 0.02), its estimates within [0, theta_max], no joint's breakaway sum
+// identified (there is none to identify: its standard deviation is not small against 0).
+TEST(FrictionIdentification, FrictionlessPlantPredictsNoFriction) {
+  ExperimentConfig c = config(osc::AdaptationLaw::kMomentum, osc::kFrictionNone);
+  c.final_window = 60;
+  const ExperimentResult r = run_experiment(c);
+  ASSERT_EQ(r.status, 0u);
+  std::printf("frictionless plant: predicted friction rms %.3f N m over the last 60 s\n", r.friction_rms_error);
+  EXPECT_LT(r.friction_rms_error, 0.3);
+  for (int i = 0; i < 18; ++i) {
+    EXPECT_GE(r.theta_min_seen[i], 0.0) << i;
+    EXPECT_LE(r.theta_max_seen[i], osc::params::kThetaMax[i]) << i;
+  }
+  for (int j = 0; j < 3; ++j) EXPECT_LT(r.final_max_error[j], 0.08) << "axis " << j;
+}
+
+// Corke's friction (a Coulomb level five times the paper's on J1, no Stribeck term): the same
+// identification without retuning, each breakaway sum within 5 %.
+TEST(FrictionIdentification, CorkeFrictionIsIdentifiedToo) {
+  const ExperimentResult r = run_experiment(config(osc::AdaptationLaw::kMomentum, osc::robot::kFrictionCorke));
+  ASSERT_EQ(r.status, 0u);
+  for (int j = 0; j < 6; ++j) {
+    const double sum = r.theta_hat[6 + j] + r.theta_hat[12 + j], truth = r.theta_true[6 + j] + r.theta_true[12 + j];
+    EXPECT_NEAR(sum, truth, 0.05 * truth) << "J" << j + 1;
+  }
+  const std::array<double, 6> after = after_first_window(r);
+  for (int a = 0; a < 3; ++a) EXPECT_LE(after[a], kPaperTable1[a] / 2) << "axis " << a;
+}
