@@ -13,27 +13,34 @@ using namespace osc;
 
 namespace {
 
+using Vec4 = FrictionIdentifier<double>::Vec4;
+using Mat4 = FrictionIdentifier<double>::Mat4;
+
 struct Regression {
-  std::vector<Vec3<double>> phi;
+  std::vector<Vec4> phi;  // vis, cou, sti, the model's gravity torque
   std::vector<double> y;
 };
 
 /// A joint's samples: the regressor columns of a sinusoidal velocity through a first-order filter
-/// (as the residual monitor's), y = phi^T theta + noise.
-Regression samples(const Vec3<double>& theta, double noise, int n, unsigned seed) {
+/// (as the residual monitor's), a gravity torque that changes with the pose, y = phi^T theta + noise
+/// (theta's fourth coefficient: the model's relative gravity error).
+Regression samples(const Vec4& theta, double noise, int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, noise);
   Regression r;
-  Vec3<double> f = Vec3<double>::Zero();
+  Vec4 f = Vec4::Zero();
   for (int k = 0; k < n; ++k) {
     const double t = 0.006 * k, v = 0.4 * std::sin(1.3 * t) + 0.05 * std::sin(5.1 * t);
-    const double sign = v > 0 ? 1 : -1;
-    const Vec3<double> w(v, sign, sign * std::exp(-v * v));
+    const double sign = v > 0 ? 1 : -1, q = 0.4 * (1 - std::cos(1.3 * t)) / 1.3;
+    const Vec4 w(v, sign, sign * std::exp(-v * v), 40.0 * std::cos(q));
     f += 0.3 * (w - f);  // 50 /s over 6 ms
     r.phi.push_back(f);
     r.y.push_back(f.dot(theta) + gauss(rng));
   }
   return r;
+}
+FrictionSample<double> sample_of(const Regression& d, std::size_t k) {
+  return {d.y[k], d.phi[k].head<3>(), d.phi[k](3), true};
 }
 
 }  // namespace
@@ -42,32 +49,33 @@ Regression samples(const Vec3<double>& theta, double noise, int n, unsigned seed
 // the regularised least squares (P0^-1 + Phi^T Phi / R) theta = Phi^T y / R, and its covariance the
 // inverse of that information matrix: solved here with Eigen's LDLT, independently.
 TEST(FrictionIdentifier, CorrectionEqualsBatchLeastSquares) {
-  const Vec3<double> truth(5.8, 4.9, 4.1);
+  const Vec4 truth(5.8, 4.9, 4.1, 0.05);
   const double R = 0.04;
   const Regression d = samples(truth, std::sqrt(R), 3000, 1);
   FrictionIdentifier<double> id;
   id.reset();
   const int joint = 0;
-  const Mat3<double> P0 = id.P[joint];
-  Vec3<double> th = Vec3<double>::Zero();
-  Mat3<double> info = P0.inverse();  // 3x3, diagonal
-  Vec3<double> rhs = Vec3<double>::Zero();
+  const Mat4 P0 = id.P[joint];
+  Vec4 th = Vec4::Zero();
+  Mat4 info = P0.inverse();  // diagonal
+  Vec4 rhs = Vec4::Zero();
   for (std::size_t k = 0; k < d.y.size(); ++k) {
-    const Vec3<double> Pphi = id.P[joint] * d.phi[k];
+    const Vec4 Pphi = id.P[joint] * d.phi[k];
     const double var = d.phi[k].dot(Pphi) + R;
     const double innovation = d.y[k] - d.phi[k].dot(th);
     th += id.correct(joint, Pphi, var) * innovation;
     info += d.phi[k] * d.phi[k].transpose() / R;
     rhs += d.phi[k] * d.y[k] / R;
   }
-  const Vec3<double> batch = info.ldlt().solve(rhs);
-  const Mat3<double> cov = info.ldlt().solve(Mat3<double>::Identity());
-  for (int c = 0; c < 3; ++c) {
+  const Vec4 batch = info.ldlt().solve(rhs);
+  const Mat4 cov = info.ldlt().solve(Mat4::Identity());
+  for (int c = 0; c < 4; ++c) {
     EXPECT_NEAR(th(c), batch(c), 1e-9 * (1 + std::abs(batch(c)))) << c;
-    for (int e = 0; e < 3; ++e) EXPECT_NEAR(id.P[joint](c, e), cov(c, e), 1e-9 * std::abs(cov(c, c))) << c << e;
+    for (int e = 0; e < 4; ++e)
+      EXPECT_NEAR(id.P[joint](c, e), cov(c, e), 1e-8 * std::sqrt(cov(c, c) * cov(e, e))) << c << e;
   }
   // And the regression is unbiased: within four of its standard deviations of the truth.
-  for (int c = 0; c < 3; ++c) EXPECT_LT(std::abs(th(c) - truth(c)), 4 * std::sqrt(cov(c, c))) << c;
+  for (int c = 0; c < 4; ++c) EXPECT_LT(std::abs(th(c) - truth(c)), 4 * std::sqrt(cov(c, c))) << c;
 }
 
 // The projection in the metric of P^-1: a coefficient below 0 is set to 0 and the others move by
@@ -77,13 +85,15 @@ TEST(FrictionIdentifier, CorrectionEqualsBatchLeastSquares) {
 TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
   FrictionIdentifier<double> id;
   id.reset();
-  Mat3<double>& P = id.P[2];
-  P << 0.5, 0.0, 0.0,  //
-      0.0, 4.0, -3.96,  //
-      0.0, -3.96, 4.0;
+  Mat4& P = id.P[2];
+  P << 0.5, 0.0, 0.0, 0.0,  //
+      0.0, 4.0, -3.96, 0.0,  //
+      0.0, -3.96, 4.0, 0.0,  //
+      0.0, 0.0, 0.0, 0.01;
   const Vec18<double> theta_max = Gains<double>::paper().theta_max;
-  const Vec3<double> th(2.0, -1.0, 4.0);
-  const Vec3<double> p = id.project(2, th, theta_max);
+  const Vec4 th(2.0, -1.0, 4.0, -0.3);
+  const Vec4 p = id.project(2, th, theta_max);
+  EXPECT_DOUBLE_EQ(p(3), -0.3);  // the gravity error is not bounded
   EXPECT_DOUBLE_EQ(p(0), 2.0);
   EXPECT_DOUBLE_EQ(p(1), 0.0);
   EXPECT_NEAR(p(2), 4.0 - (-3.96 / 4.0) * (-1.0), 1e-12);  // 3.01
@@ -91,8 +101,8 @@ TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
   // A per-coefficient clip would have raised the sum by the whole excess.
   EXPECT_GT(std::abs((0.0 + 4.0) - (th(1) + th(2))), 0.9);
   // Above a bound: the same rule, from the other side.
-  const Vec3<double> high(2.0, theta_max(kDof + 2) + 1.0, 0.5);
-  const Vec3<double> q = id.project(2, high, theta_max);
+  const Vec4 high(2.0, theta_max(kDof + 2) + 1.0, 0.5, 0.0);
+  const Vec4 q = id.project(2, high, theta_max);
   EXPECT_DOUBLE_EQ(q(1), theta_max(kDof + 2));
   EXPECT_NEAR(q(2), std::min(theta_max(2 * kDof + 2), 0.5 + 0.99), 1e-12);
 }
@@ -105,14 +115,14 @@ TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
   const Vec18<double> theta_max = Gains<double>::paper().theta_max;
   Vec18<double> theta = Vec18<double>::Constant(1.0);
   const Vec18<double> before = theta;
-  FrictionSample<double> s{10.0, Vec3<double>(0.2, 1.0, 0.98), false};
+  FrictionSample<double> s{10.0, Vec3<double>(0.2, 1.0, 0.98), 0.0, false};
   EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kNotSettled);
   s.settled = true;
   EXPECT_EQ(id.update(1, s, false, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kResidualHigh);
   EXPECT_EQ(theta, before);
   EXPECT_EQ(id.updates[1], 0u);
   // Shrink joint 1's covariance to a known, small one: an innovation of 10 N m is then an outlier.
-  id.P[1] = Mat3<double>::Identity() * 1e-4;
+  id.P[1] = Mat4::Identity() * 1e-4;
   EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kOutlier);
   EXPECT_EQ(id.outliers[1], 1u);
   EXPECT_EQ(theta, before);
@@ -132,17 +142,17 @@ TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
 TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
   FrictionIdentifier<double> id;
   id.reset();
-  const Mat3<double> prior = FrictionIdentifier<double>::prior(0);
-  id.P[0] = Mat3<double>::Zero();
+  const Mat4 prior = FrictionIdentifier<double>::prior(0);
+  id.P[0] = Mat4::Zero();
   const Vec18<double> theta_max = Gains<double>::paper().theta_max;
   Vec18<double> theta = Vec18<double>::Zero();
-  const FrictionSample<double> still{0, Vec3<double>::Zero(), false};
+  const FrictionSample<double> still{0, Vec3<double>::Zero(), 0, false};
   const int per_hour = static_cast<int>(FrictionIdentifier<double>::kPerHour);
   for (int k = 0; k < per_hour; ++k) id.update(0, still, true, 0.01, 1.0, theta, theta_max);
   const double drift = params::kIdentifyDrift * params::kIdentifyDrift;
-  for (int c = 0; c < 3; ++c) EXPECT_NEAR(id.P[0](c, c), drift * prior(c, c), 1e-6 * prior(c, c)) << c;
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(id.P[0](c, c), drift * prior(c, c), 1e-6 * prior(c, c)) << c;
   for (int k = 0; k < 20 * per_hour; ++k) id.update(0, still, true, 0.01, 1.0, theta, theta_max);
-  for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(id.P[0](c, c), prior(c, c)) << c;
+  for (int c = 0; c < 4; ++c) EXPECT_DOUBLE_EQ(id.P[0](c, c), prior(c, c)) << c;
   EXPECT_EQ(theta, Vec18<double>::Zero());
 }
 
@@ -151,7 +161,7 @@ TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
 // standard deviations; in float too.
 template <class S>
 void converges_on_noisy_samples() {
-  const Vec3<double> truth(3.7, 4.8, 4.3);
+  const Vec4 truth(3.7, 4.8, 4.3, -0.08);
   const double sd = 0.3;
   const Regression d = samples(truth, sd, 20000, 7);
   FrictionIdentifier<S> id;
@@ -160,7 +170,8 @@ void converges_on_noisy_samples() {
   Vec18<S> theta = Vec18<S>::Zero();
   int updated = 0;
   for (std::size_t k = 0; k < d.y.size(); ++k) {
-    const FrictionSample<S> s{S(d.y[k]), d.phi[k].template cast<S>(), true};
+    const FrictionSample<double> e = sample_of(d, k);
+    const FrictionSample<S> s{S(e.y), e.phi.template cast<S>(), S(e.gravity), true};
     updated += id.update(1, s, true, S(1.0), S(1.0), theta, theta_max) == IdentifyOutcome::kUpdated;
   }
   EXPECT_GT(updated, 19900);  // a 4-sigma gate refuses almost none of gaussian noise
@@ -170,6 +181,7 @@ void converges_on_noisy_samples() {
   EXPECT_LT(std::abs(sum - (truth(1) + truth(2))), 4 * sum_sd);
   EXPECT_LT(std::abs(static_cast<double>(theta(1)) - truth(0)), 4 * std::sqrt(static_cast<double>(id.variance(1, 0))));
   EXPECT_TRUE(friction_identified(sum, sum_sd)) << sum_sd;
+  EXPECT_NEAR(static_cast<double>(id.gravity_error(1)), truth(3), 4 * std::sqrt(static_cast<double>(id.P[1](3, 3))));
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }

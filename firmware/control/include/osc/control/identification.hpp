@@ -37,12 +37,13 @@
 namespace osc {
 
 /// One joint's sample for the identification, taken by the residual monitor: y = H(tau_f), the
-/// regressor columns (vis, cou, sti) through H, and whether the joint has moved long enough for them
+/// regressor columns (vis, cou, sti) and the model's gravity torque through H, and whether the joint has moved long enough for them
 /// to hold no standstill.
 template <class S>
 struct FrictionSample {
   S y;
   Vec3<S> phi;
+  S gravity;  // the model's gravity torque through H (the model error's regressor)
   bool settled;
 };
 
@@ -58,7 +59,16 @@ constexpr bool friction_identified(double value, double sd) {
 
 template <class S>
 struct FrictionIdentifier {
-  Mat3<S> P[kDof];                   // each joint's (vis, cou, sti) covariance [their units squared]
+  using Vec4 = Eigen::Matrix<S, 4, 1>;
+  using Mat4 = Eigen::Matrix<S, 4, 4>;
+  /// Each joint's covariance of (vis, cou, sti, gravity error) [their units squared]. The gravity
+  /// error is the model's: the link inertias are known within robot::kModelErrorBounds' link_inertia
+  /// (10 %), so the residual holds delta g(q), delta the joint's relative error. It is estimated
+  /// beside the friction so that it does not leak into it (on J2, 10 % of its gravity torque is
+  /// several times its friction), and not compensated: the paper's controller compensates friction
+  /// only.
+  Mat4 P[kDof];
+  Vec6<S> gravity_error;             // each joint's delta [1]
   Vec6<S> innovation2;               // each joint's mean squared innovation, recent samples [N^2 m^2]
   std::uint32_t updates[kDof];       // samples taken per joint
   std::uint32_t outliers[kDof];      // samples refused by the innovation gate
@@ -69,6 +79,7 @@ struct FrictionIdentifier {
   void reset() {
     for (int i = 0; i < kDof; ++i) {
       P[i] = prior(i);
+      gravity_error(i) = S(0);
       innovation2(i) = S(-1);  // none yet (update)
       updates[i] = 0;
       outliers[i] = 0;
@@ -94,10 +105,11 @@ struct FrictionIdentifier {
     drift(i);
     if (!s.settled) return IdentifyOutcome::kNotSettled;
     if (!residual_low) return IdentifyOutcome::kResidualHigh;
-    const Vec3<S> th(theta(i), theta(kDof + i), theta(2 * kDof + i));
-    const Vec3<S> Pphi = P[i] * s.phi;
-    const S explained = s.phi.dot(Pphi);
-    const S innovation = s.y - s.phi.dot(th), e2 = innovation * innovation;
+    const Vec4 th(theta(i), theta(kDof + i), theta(2 * kDof + i), gravity_error(i));
+    const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity);
+    const Vec4 Pphi = P[i] * phi;
+    const S explained = phi.dot(Pphi);
+    const S innovation = s.y - phi.dot(th), e2 = innovation * innovation;
     S& mean2 = innovation2(i);
     if (mean2 < S(0)) mean2 = bound_var + explained;  // none yet: start from the bound
     S noise = mean2 - explained;
@@ -111,18 +123,19 @@ struct FrictionIdentifier {
     static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyNoiseSamples);
     mean2 += kAverage * (e2 - mean2);
     const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
-    const Vec3<S> next = th + correct(i, Pphi, var) * innovation;
-    store(i, project(i, next, theta_max), theta);
+    const Vec4 next = project(i, th + correct(i, Pphi, var) * innovation, theta_max);
+    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = next(c);
+    gravity_error(i) = next(3);
     ++updates[i];
     return IdentifyOutcome::kUpdated;
   }
 
   /// The Kalman correction of joint i for a sample of innovation variance var, given P phi: P less
   /// (P phi)(P phi)^T / var, kept symmetric; returns the gain P phi / var.
-  Vec3<S> correct(int i, const Vec3<S>& Pphi, S var) {
-    const Vec3<S> gain = Pphi / var;
-    for (int a = 0; a < 3; ++a)
-      for (int b = a; b < 3; ++b) {
+  Vec4 correct(int i, const Vec4& Pphi, S var) {
+    const Vec4 gain = Pphi / var;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a; b < 4; ++b) {
         const S v = P[i](a, b) - gain(a) * Pphi(b);
         P[i](a, b) = v;
         P[i](b, a) = v;
@@ -132,8 +145,8 @@ struct FrictionIdentifier {
   /// theta within [0, theta_max], projected in the metric of P^-1 (the estimate's own): a coefficient
   /// beyond a bound is set to it and the others move as P correlates them, so that a well
   /// identified sum (Coulomb + Stribeck) keeps its value when one of its terms meets a bound; one
-  /// pass over the three, then a clip for what the pass leaves.
-  Vec3<S> project(int i, Vec3<S> th, const Vec18<S>& theta_max) const {
+  /// pass over the three, then a clip for what the pass leaves. The gravity error is not bounded.
+  Vec4 project(int i, Vec4 th, const Vec18<S>& theta_max) const {
     for (int c = 0; c < 3; ++c) {
       const S hi = theta_max(c * kDof + i), v = th(c);
       const S excess = v < S(0) ? v : (v > hi ? v - hi : S(0));
@@ -152,35 +165,35 @@ struct FrictionIdentifier {
   /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's).
   S breakaway_variance(int i) const { return P[i](1, 1) + P[i](2, 2) + S(2) * P[i](1, 2); }
 
-  /// The prior covariance of joint i: the band's top squared on the diagonal.
-  static Mat3<S> prior(int i) {
-    static constexpr std::array<S, 3 * kDof> kPrior = band_squared(1.0);
-    Mat3<S> p = Mat3<S>::Zero();
-    for (int c = 0; c < 3; ++c) p(c, c) = kPrior[c * kDof + i];
+  /// The prior covariance of joint i: the band's top squared on the diagonal, and the gravity
+  /// error's, link_inertia squared.
+  static Mat4 prior(int i) {
+    static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0);
+    Mat4 p = Mat4::Zero();
+    for (int c = 0; c < 4; ++c) p(c, c) = kPrior[c * kDof + i];
     return p;
   }
 
  private:
-  static void store(int i, const Vec3<S>& th, Vec18<S>& theta) {
-    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = th(c);
-  }
-  /// f times the band's top squared, per coefficient (robot::kModelErrorBounds).
-  static constexpr std::array<S, 3 * kDof> band_squared(double f) {
+  /// f times each coefficient's prior variance: the band's top squared (robot::kModelErrorBounds),
+  /// the gravity error's link_inertia squared.
+  static constexpr std::array<S, 4 * kDof> band_squared(double f) {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
-    std::array<S, 3 * kDof> q{};
+    std::array<S, 4 * kDof> q{};
     for (int i = 0; i < kDof; ++i) {
       q[i] = lit<S>(f * b.friction_hi.vis[i] * b.friction_hi.vis[i]);
       q[kDof + i] = lit<S>(f * b.friction_hi.cou[i] * b.friction_hi.cou[i]);
       q[2 * kDof + i] = lit<S>(f * b.friction_hi.sti[i] * b.friction_hi.sti[i]);
+      q[3 * kDof + i] = lit<S>(f * b.link_inertia * b.link_inertia);
     }
     return q;
   }
-  /// The random walk: (kIdentifyDrift times the band's top)^2 per hour, up to the prior.
+  /// The random walk: (kIdentifyDrift times each prior standard deviation)^2 per hour, up to the prior.
   void drift(int i) {
-    static constexpr std::array<S, 3 * kDof> kDrift =
+    static constexpr std::array<S, 4 * kDof> kDrift =
         band_squared(params::kIdentifyDrift * params::kIdentifyDrift / kPerHour);
-    static constexpr std::array<S, 3 * kDof> kPrior = band_squared(1.0);
-    for (int c = 0; c < 3; ++c) {
+    static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0);
+    for (int c = 0; c < 4; ++c) {
       const S v = P[i](c, c) + kDrift[c * kDof + i];
       P[i](c, c) = v < kPrior[c * kDof + i] ? v : kPrior[c * kDof + i];
     }

@@ -112,12 +112,13 @@ constexpr double kResidualMargin = 2;
 ///   samples are correlated over 1/kResidualGain = 20-50 ms: a sample every 6 ms loses little);
 /// - a joint's sample counts once it has moved, encoder counting, for kIdentifySettle of the
 ///   residual filter's time constants (the filter then holds no standstill, where friction is not
-///   the model's W theta);
+///   the model's W theta), and only at speeds of kIdentifyMinSpeed times its velocity noise or more;
 /// - and while its residual is at most kIdentifyMaxRatio of its threshold (a contact's torque is no
 ///   friction), and its innovation within kIdentifyGate standard deviations;
 /// - the coefficients drift: a random walk of kIdentifyDrift times the band's top per hour (the
 ///   band's own +-30 % with temperature, robot::kModelErrorBounds).
 constexpr int kIdentifyEvery = 6;
+constexpr double kIdentifyMinSpeed = 0;
 constexpr double kIdentifySettle = 3;
 constexpr double kIdentifyMaxRatio = 0.5;
 constexpr double kIdentifyGate = 4;

@@ -438,12 +438,16 @@ struct ResidualMonitor {
   }
   /// Joint i's friction sample: r is this tick's, the filtered regressors still the last tick's, as
   /// the friction in r is the last period's (n_{k-1}). Settled: moving, its encoder counting, since
-  /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that far).
+  /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
+  /// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
+  /// noise is a share of the viscous column, and its errors in the variables a bias).
   void take_sample(int i, const FrictionError& e) {
     static constexpr std::array<S, kDof> kSettled = settled_stillness();
     sample.y = reg[kEstimate](i) - r(i);
     sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
-    sample.settled = e.moving && stillness(i) <= kSettled[i];
+    sample.gravity = reg[kGravity](i);
+    static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
+    sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * velocity_noise(i);
   }
   /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
   static constexpr std::array<S, kDof> settled_stillness() {
