@@ -48,8 +48,8 @@ class LocalController {
     if (r.has_identification) {
       const osc::FrictionIdentifier<S>& id = task_->identifier;
       for (int i = 0; i < 6; ++i) {
-        for (int c = 0; c < 3; ++c) r.theta_sd[6 * c + i] = std::sqrt(static_cast<double>(id.variance(i, c)));
-        r.breakaway_sd[i] = std::sqrt(std::max(0.0, static_cast<double>(id.breakaway_variance(i))));
+        for (int c = 0; c < 3; ++c) r.theta_sd[6 * c + i] = std::sqrt(std::max(0.0, id.variance(i, c)));
+        r.breakaway_sd[i] = std::sqrt(std::max(0.0, id.breakaway_variance(i)));
       }
     }
     const osc::ResidualMonitor<S>& m = task_->residual;

@@ -101,10 +101,13 @@ TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
   // A per-coefficient clip would have raised the sum by the whole excess.
   EXPECT_GT(std::abs((0.0 + 4.0) - (th(1) + th(2))), 0.9);
   // Above a bound: the same rule, from the other side.
-  const Vec4 high(2.0, theta_max(kDof + 2) + 1.0, 0.5, 0.0);
+  // Above a bound (in the joint's units, FrictionIdentifier::scale_of): the same rule, from the
+  // other side.
+  const double sc = FrictionIdentifier<double>::scale_of(2);
+  const Vec4 high(2.0, theta_max(kDof + 2) * sc + 1.0, 0.5, 0.0);
   const Vec4 q = id.project(2, high, theta_max);
-  EXPECT_DOUBLE_EQ(q(1), theta_max(kDof + 2));
-  EXPECT_NEAR(q(2), std::min(theta_max(2 * kDof + 2), 0.5 + 0.99), 1e-12);
+  EXPECT_DOUBLE_EQ(q(1), theta_max(kDof + 2) * sc);
+  EXPECT_NEAR(q(2), 0.5 + 0.99, 1e-12);
 }
 
 // Gates: a sample that has not settled, or whose residual is high, changes nothing but P's random
@@ -175,13 +178,16 @@ void converges_on_noisy_samples() {
     updated += id.update(1, s, true, S(1.0), S(1.0), theta, theta_max) == IdentifyOutcome::kUpdated;
   }
   EXPECT_GT(updated, 19900);  // a 4-sigma gate refuses almost none of gaussian noise
-  EXPECT_NEAR(static_cast<double>(id.innovation2(1)), sd * sd, 0.3 * sd * sd);
+  const double sc = FrictionIdentifier<S>::scale_of(1);  // the joint's unit: 1 / sc N m
+  EXPECT_NEAR(static_cast<double>(id.innovation2(1)) / (sc * sc), sd * sd, 0.3 * sd * sd);
   const double sum = static_cast<double>(theta(kDof + 1) + theta(2 * kDof + 1));
-  const double sum_sd = std::sqrt(static_cast<double>(id.breakaway_variance(1)));
+  const double sum_sd = std::sqrt(id.breakaway_variance(1));
   EXPECT_LT(std::abs(sum - (truth(1) + truth(2))), 4 * sum_sd);
-  EXPECT_LT(std::abs(static_cast<double>(theta(1)) - truth(0)), 4 * std::sqrt(static_cast<double>(id.variance(1, 0))));
+  EXPECT_LT(std::abs(static_cast<double>(theta(1)) - truth(0)), 4 * std::sqrt(id.variance(1, 0)));
   EXPECT_TRUE(friction_identified(sum, sum_sd)) << sum_sd;
-  EXPECT_NEAR(static_cast<double>(id.gravity_error(1)), truth(3), 4 * std::sqrt(static_cast<double>(id.P[1](3, 3))));
+  const double g_sd = std::sqrt(static_cast<double>(id.P[1](3, 3))) /
+                      (FrictionIdentifier<S>::scale_of(1) * robot::kDrives.torque_limit[1]);
+  EXPECT_NEAR(id.gravity_error(1), truth(3), 4 * g_sd);
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }

@@ -61,25 +61,28 @@ template <class S>
 struct FrictionIdentifier {
   using Vec4 = Eigen::Matrix<S, 4, 1>;
   using Mat4 = Eigen::Matrix<S, 4, 4>;
-  /// Each joint's covariance of (vis, cou, sti, gravity error) [their units squared]. The gravity
-  /// error is the model's: the link inertias are known within robot::kModelErrorBounds' link_inertia
-  /// (10 %), so the residual holds delta g(q), delta the joint's relative error. It is estimated
-  /// beside the friction so that it does not leak into it (on J2, 10 % of its gravity torque is
-  /// several times its friction), and not compensated: the paper's controller compensates friction
-  /// only.
-  Mat4 P[kDof];
-  Vec6<S> gravity_error;             // each joint's delta [1]
-  Vec6<S> innovation2;               // each joint's mean squared innovation, recent samples [N^2 m^2]
-  std::uint32_t updates[kDof];       // samples taken per joint
-  std::uint32_t outliers[kDof];      // samples refused by the innovation gate
-  std::uint8_t turn;                 // the joint of the next update
+  /// Each joint's regression runs in its own torque unit, 1 / kScale[i] N m, a power of two chosen
+  /// so that the prior's largest standard deviation is at most 64 units (its variance fits Q12.19's
+  /// range, and a wrist's converged one keeps thousands of its LSBs): exact in every scalar.
+  /// Its coefficients, in those units: (vis, cou, sti) scaled, and the model's gravity error as a
+  /// torque at the joint's full scale, delta T_i, with the regressor g / T_i.
+  /// The gravity error is the model's: the link inertias are known within robot::kModelErrorBounds'
+  /// link_inertia (10 %), so the residual holds delta g(q). It is estimated beside the friction so
+  /// that it does not leak into it (on J2, 10 % of its gravity torque is several times its
+  /// friction), and not compensated: the paper's controller compensates friction only.
+  Mat4 P[kDof];                   // each joint's covariance [its units squared]
+  Vec6<S> gravity;                // each joint's gravity error delta T_i [its units]
+  Vec6<S> innovation2;            // each joint's mean squared innovation, recent samples [its units squared]
+  std::uint32_t updates[kDof];    // samples taken per joint
+  std::uint32_t outliers[kDof];   // samples refused by the innovation gate
+  std::uint8_t turn;              // the joint of the next update
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
   /// The prior: theta^ anywhere from 0 to the band's top (robot::kModelErrorBounds), no counters.
   void reset() {
     for (int i = 0; i < kDof; ++i) {
       P[i] = prior(i);
-      gravity_error(i) = S(0);
+      gravity(i) = S(0);
       innovation2(i) = S(-1);  // none yet (update)
       updates[i] = 0;
       outliers[i] = 0;
@@ -105,18 +108,24 @@ struct FrictionIdentifier {
     drift(i);
     if (!s.settled) return IdentifyOutcome::kNotSettled;
     if (!residual_low) return IdentifyOutcome::kResidualHigh;
-    const Vec4 th(theta(i), theta(kDof + i), theta(2 * kDof + i), gravity_error(i));
-    const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity);
+    static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
+    static constexpr std::array<S, kDof> kUnscale = per_joint([](int j) { return 1 / scale_of(j); });
+    static constexpr std::array<S, kDof> kInverseTorque =
+        per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
+    const S sc = kScale[i];
+    const Vec4 th(theta(i) * sc, theta(kDof + i) * sc, theta(2 * kDof + i) * sc, gravity(i));
+    const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity * kInverseTorque[i]);
     const Vec4 Pphi = P[i] * phi;
     const S explained = phi.dot(Pphi);
-    const S innovation = s.y - phi.dot(th), e2 = innovation * innovation;
+    const S innovation = s.y * sc - phi.dot(th), e2 = innovation * innovation;
+    const S bound = bound_var * (sc * sc);
     S& mean2 = innovation2(i);
-    if (mean2 < S(0)) mean2 = bound_var + explained;  // none yet: start from the bound
+    if (mean2 < S(0)) mean2 = bound + explained;  // none yet: start from the bound
     S noise = mean2 - explained;
-    const S floor = bound_var * lit<S>(1.0 / 256);
-    noise = noise < floor ? floor : (noise > bound_var ? bound_var : noise);
-    static constexpr S kGate = lit<S>(params::kIdentifyGate);
-    if (e2 > (kGate * kGate) * (explained + noise)) {
+    const S floor = bound * lit<S>(1.0 / 256);
+    noise = noise < floor ? floor : (noise > bound ? bound : noise);
+    static constexpr S kGateSquaredInverse = lit<S>(1.0 / (params::kIdentifyGate * params::kIdentifyGate));
+    if (e2 * kGateSquaredInverse > explained + noise) {
       ++outliers[i];
       return IdentifyOutcome::kOutlier;
     }
@@ -124,8 +133,8 @@ struct FrictionIdentifier {
     mean2 += kAverage * (e2 - mean2);
     const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
     const Vec4 next = project(i, th + correct(i, Pphi, var) * innovation, theta_max);
-    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = next(c);
-    gravity_error(i) = next(3);
+    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = next(c) * kUnscale[i];
+    gravity(i) = next(3);
     ++updates[i];
     return IdentifyOutcome::kUpdated;
   }
@@ -142,49 +151,78 @@ struct FrictionIdentifier {
       }
     return gain;
   }
-  /// theta within [0, theta_max], projected in the metric of P^-1 (the estimate's own): a coefficient
-  /// beyond a bound is set to it and the others move as P correlates them, so that a well
-  /// identified sum (Coulomb + Stribeck) keeps its value when one of its terms meets a bound; one
-  /// pass over the three, then a clip for what the pass leaves. The gravity error is not bounded.
+  /// th (joint i's units) within [0, theta_max], projected in the metric of P^-1 (the estimate's
+  /// own): a coefficient beyond a bound is set to it and the others move as P correlates them, so
+  /// that a well identified sum (Coulomb + Stribeck) keeps its value when one of its terms meets a
+  /// bound; one pass over the three, then a clip for what the pass leaves. The gravity error is not
+  /// bounded.
   Vec4 project(int i, Vec4 th, const Vec18<S>& theta_max) const {
+    static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
+    const S sc = kScale[i];
     for (int c = 0; c < 3; ++c) {
-      const S hi = theta_max(c * kDof + i), v = th(c);
+      const S hi = theta_max(c * kDof + i) * sc, v = th(c);
       const S excess = v < S(0) ? v : (v > hi ? v - hi : S(0));
       if (excess != S(0) && P[i](c, c) > S(0)) th -= P[i].col(c) * (excess / P[i](c, c));
     }
     for (int c = 0; c < 3; ++c) {
-      const S hi = theta_max(c * kDof + i);
+      const S hi = theta_max(c * kDof + i) * sc;
       if (th(c) < S(0)) th(c) = S(0);
       if (th(c) > hi) th(c) = hi;
     }
     return th;
   }
 
-  /// Joint i's standard deviation of coefficient c (0 vis, 1 cou, 2 sti).
-  S variance(int i, int c) const { return P[i](c, c); }
-  /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's).
-  S breakaway_variance(int i) const { return P[i](1, 1) + P[i](2, 2) + S(2) * P[i](1, 2); }
+  /// Joint i's variance of coefficient c (0 vis, 1 cou, 2 sti) in its own units, squared [host, double].
+  double variance(int i, int c) const { return static_cast<double>(P[i](c, c)) / square(scale_of(i)); }
+  /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
+  double breakaway_variance(int i) const {
+    const double v = static_cast<double>(P[i](1, 1)) + static_cast<double>(P[i](2, 2)) +
+                     2 * static_cast<double>(P[i](1, 2));
+    return v / square(scale_of(i));
+  }
+  /// Joint i's relative gravity error delta [1].
+  double gravity_error(int i) const {
+    return static_cast<double>(gravity(i)) / (scale_of(i) * robot::kDrives.torque_limit[i]);
+  }
 
-  /// The prior covariance of joint i: the band's top squared on the diagonal, and the gravity
-  /// error's, link_inertia squared.
+  /// The prior covariance of joint i in its units: the band's top squared on the diagonal, and the
+  /// gravity error's (link_inertia T_i)^2.
   static Mat4 prior(int i) {
     static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0);
     Mat4 p = Mat4::Zero();
     for (int c = 0; c < 4; ++c) p(c, c) = kPrior[c * kDof + i];
     return p;
   }
+  /// Joint i's unit: the power of two that brings its largest prior standard deviation within
+  /// [32, 64) units (robot::kModelErrorBounds: the band's tops, link_inertia times full scale).
+  static constexpr double scale_of(int i) {
+    const ModelErrorBounds& b = robot::kModelErrorBounds;
+    double top = b.link_inertia * robot::kDrives.torque_limit[i];
+    for (double v : {b.friction_hi.vis[i], b.friction_hi.cou[i], b.friction_hi.sti[i]}) top = v > top ? v : top;
+    double s = 1.0 / 64;
+    while (s * 2 * top < 64) s *= 2;
+    return s;
+  }
 
  private:
-  /// f times each coefficient's prior variance: the band's top squared (robot::kModelErrorBounds),
-  /// the gravity error's link_inertia squared.
+  static constexpr double square(double v) { return v * v; }
+  template <class F>
+  static constexpr std::array<S, kDof> per_joint(F f) {
+    std::array<S, kDof> a{};
+    for (int j = 0; j < kDof; ++j) a[j] = lit<S>(f(j));
+    return a;
+  }
+  /// f times each coefficient's prior variance in joint i's units: the band's top squared
+  /// (robot::kModelErrorBounds), the gravity error's (link_inertia T_i)^2.
   static constexpr std::array<S, 4 * kDof> band_squared(double f) {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     std::array<S, 4 * kDof> q{};
     for (int i = 0; i < kDof; ++i) {
-      q[i] = lit<S>(f * b.friction_hi.vis[i] * b.friction_hi.vis[i]);
-      q[kDof + i] = lit<S>(f * b.friction_hi.cou[i] * b.friction_hi.cou[i]);
-      q[2 * kDof + i] = lit<S>(f * b.friction_hi.sti[i] * b.friction_hi.sti[i]);
-      q[3 * kDof + i] = lit<S>(f * b.link_inertia * b.link_inertia);
+      const double s2 = f * square(scale_of(i));
+      q[i] = lit<S>(s2 * square(b.friction_hi.vis[i]));
+      q[kDof + i] = lit<S>(s2 * square(b.friction_hi.cou[i]));
+      q[2 * kDof + i] = lit<S>(s2 * square(b.friction_hi.sti[i]));
+      q[3 * kDof + i] = lit<S>(s2 * square(b.link_inertia * robot::kDrives.torque_limit[i]));
     }
     return q;
   }
