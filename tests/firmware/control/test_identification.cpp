@@ -129,7 +129,9 @@ TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
   EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kOutlier);
   EXPECT_EQ(id.outliers[1], 1u);
   EXPECT_EQ(theta, before);
-  // Within the gate it learns.
+  // Within the gate it learns (its estimate z in the joint's units: theta^ = 1 N m s/rad, 1 N m, 1 N m).
+  const double sc = FrictionIdentifier<double>::scale_of(1);
+  id.z[1] << sc, sc, sc, 0;
   s.y = theta(1) * 0.2 + theta(kDof + 1) * 1.0 + theta(2 * kDof + 1) * 0.98 + 0.05;
   EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kUpdated);
   EXPECT_NE(theta, before);

@@ -71,7 +71,7 @@ struct FrictionIdentifier {
   /// that it does not leak into it (on J2, 10 % of its gravity torque is several times its
   /// friction), and not compensated: the paper's controller compensates friction only.
   Mat4 P[kDof];                   // each joint's covariance [its units squared]
-  Vec6<S> gravity;                // each joint's gravity error delta T_i [its units]
+  Vec4 z[kDof];                   // each joint's estimate, unbounded [its units] (theta^ is it projected)
   Vec6<S> innovation2;            // each joint's mean squared innovation, recent samples [its units squared]
   std::uint32_t updates[kDof];    // samples taken per joint
   std::uint32_t outliers[kDof];   // samples refused by the innovation gate
@@ -82,7 +82,7 @@ struct FrictionIdentifier {
   void reset() {
     for (int i = 0; i < kDof; ++i) {
       P[i] = prior(i);
-      gravity(i) = S(0);
+      z[i].setZero();
       innovation2(i) = S(-1);  // none yet (update)
       updates[i] = 0;
       outliers[i] = 0;
@@ -96,9 +96,11 @@ struct FrictionIdentifier {
     return i;
   }
 
-  /// Joint i's Kalman update from sample s: theta^'s coefficients (i, 6 + i, 12 + i) move by the
-  /// gain times the innovation, then are kept within [0, theta_max] as the robust law's are. P grows
-  /// by the drift whether or not the sample counts, up to the prior.
+  /// Joint i's Kalman update from sample s: its estimate z moves by the gain times the innovation,
+  /// and theta^'s coefficients (i, 6 + i, 12 + i) are z projected within [0, theta_max] (project).
+  /// z itself is not bounded: a bound fed back into a linear estimator ratchets (on a frictionless
+  /// plant, estimates near 0 walk to their upper bounds over an hour). P grows by the drift whether
+  /// or not the sample counts, up to the prior.
   /// The sample's noise variance is measured: the recent mean squared innovation less what P
   /// explains of it, within [bound_var / 256, bound_var], bound_var the variance the residual
   /// monitor's quantisation bound implies [N^2 m^2]. The update counts it `correlation` times: the
@@ -113,7 +115,7 @@ struct FrictionIdentifier {
     static constexpr std::array<S, kDof> kInverseTorque =
         per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
     const S sc = kScale[i];
-    const Vec4 th(theta(i) * sc, theta(kDof + i) * sc, theta(2 * kDof + i) * sc, gravity(i));
+    Vec4& th = z[i];
     const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity * kInverseTorque[i]);
     const Vec4 Pphi = P[i] * phi;
     const S explained = phi.dot(Pphi);
@@ -132,9 +134,9 @@ struct FrictionIdentifier {
     static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyNoiseSamples);
     mean2 += kAverage * (e2 - mean2);
     const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
-    const Vec4 next = project(i, th + correct(i, Pphi, var) * innovation, theta_max);
-    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = next(c) * kUnscale[i];
-    gravity(i) = next(3);
+    th += correct(i, Pphi, var) * innovation;
+    const Vec4 bounded = project(i, th, theta_max);
+    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * kUnscale[i];
     ++updates[i];
     return IdentifyOutcome::kUpdated;
   }
@@ -182,7 +184,7 @@ struct FrictionIdentifier {
   }
   /// Joint i's relative gravity error delta [1].
   double gravity_error(int i) const {
-    return static_cast<double>(gravity(i)) / (scale_of(i) * robot::kDrives.torque_limit[i]);
+    return static_cast<double>(z[i](3)) / (scale_of(i) * robot::kDrives.torque_limit[i]);
   }
 
   /// The prior covariance of joint i in its units: the band's top squared on the diagonal, and the

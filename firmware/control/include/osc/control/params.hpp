@@ -118,7 +118,7 @@ constexpr double kResidualMargin = 2;
 /// - the coefficients drift: a random walk of kIdentifyDrift times the band's top per hour (the
 ///   band's own +-30 % with temperature, robot::kModelErrorBounds).
 constexpr int kIdentifyEvery = 6;
-constexpr double kIdentifyMinSpeed = 0;
+constexpr double kIdentifyMinSpeed = 4;
 constexpr double kIdentifySettle = 3;
 constexpr double kIdentifyMaxRatio = 0.5;
 constexpr double kIdentifyGate = 4;
