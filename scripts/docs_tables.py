@@ -544,6 +544,79 @@ def adaptation_hour_paper_law():
     return adaptation_rows([("paper's law (67), default plant", HOUR + ("--adaptation", "paper"))])
 
 
+MOMENTUM = ("--adaptation", "momentum")
+
+
+@table("adaptation_hour_momentum", "docs/adaptation.md", "long")
+def adaptation_hour_momentum():
+    runs = [(name, args + MOMENTUM) for name, args in HOUR_RUNS]
+    runs.append(("fixed, default plant", HOUR + ("--scalar", "fixed") + MOMENTUM))
+    return adaptation_rows(runs)
+
+
+LAWS = ("paper", "robust", "momentum")
+LAW_RUNS = [("--mode", "adaptive", "--duration", "120", "--set", "run.window=5", "--adaptation", law) for law in LAWS]
+LAW_RUNS_MORE = [("--mode", "adaptive", "--duration", "120", "--set", "run.window=5", "--adaptation", "momentum",
+                  "--scalar", sc) for sc in ("float", "fixed")]
+LAW_RUNS_NONE = [("--mode", "adaptive", "--duration", "120", "--friction", "none", "--final-window", "60",
+                  "--adaptation", law) for law in LAWS]
+
+
+def worst(windows):
+    """The worst of each of the six max |e| over a list of windows."""
+    return [max(w[i] for w in windows) for i in range(6)]
+
+
+@table("adaptation_laws", "docs/adaptation.md", "long")
+def adaptation_laws():
+    """The laws on the same 120 s runs: tracking from 5 s and over the last 20 s, J1-J3's estimates."""
+    prefetch(LAW_RUNS + LAW_RUNS_MORE + LAW_RUNS_NONE)
+    lines = ["| law (scalar) | max \|e\| from 5 s, x/y/z mm | last 20 s, x/y/z mm | τ_vis J1/J2/J3 at 120 s "
+             "(plant 5.8/3.7/6.0) | τ_cou + τ_sti J1/J2/J3 (plant 9.0/9.1/3.6) | friction rms error N·m, last 20 s |"
+             " frictionless plant: predicted friction rms N·m, last 60 s |",
+             "|---|---|---|---|---|---|---|"]
+    for args in LAW_RUNS + LAW_RUNS_MORE:
+        r = run_of(experiment(*args), "adaptive")
+        law = args[args.index("--adaptation") + 1]
+        scalar = args[args.index("--scalar") + 1] if "--scalar" in args else "double"
+        after = worst(r["window_max_error"][1:])[:3]
+        th = r["theta_hat"]
+        none = ""
+        if scalar == "double":
+            none = f"{run_of(experiment(*LAW_RUNS_NONE[LAWS.index(law)]), 'adaptive')['friction_rms_error_Nm']:.3f}"
+        lines.append(f"| {law} ({scalar}) | {'/'.join(f'{v:.3f}' for v in after)} | "
+                     f"{'/'.join(f'{v:.3f}' for v in r['final_max_error_mm'])} | "
+                     f"{'/'.join(f'{th[j]:.2f}' for j in range(3))} | "
+                     f"{'/'.join(f'{th[6 + j] + th[12 + j]:.2f}' for j in range(3))} | "
+                     f"{r['friction_rms_error_Nm']:.3f} | {none} |")
+    lines.append("| issue 26's target | 0.190/0.220/0.140 | 0.080/0.080/0.080 | within 10 % | within 10 % | | ≤ 0.3 |")
+    return "\n".join(lines)
+
+
+@table("identification_report", "docs/adaptation.md", "long")
+def identification_report():
+    """The momentum law's excitation monitor after the 120 s experiment: each coefficient's estimate,
+    standard deviation and verdict."""
+    r = run_of(experiment(*LAW_RUNS[2]), "adaptive")
+    ident = r["identification"]
+    th, true = r["theta_hat"], r["theta_true"]
+    lines = ["| coefficient | " + " | ".join(f"J{j + 1}" for j in range(6)) + " |", "|---|" + "---|" * 6]
+    for k, name in enumerate(("τ_vis [N·m·s/rad]", "τ_cou [N·m]", "τ_sti [N·m]")):
+        cells = []
+        for j in range(6):
+            c = 6 * k + j
+            verdict = "**identified**" if ident["theta_identified"][c] else "not excited"
+            cells.append(f"{th[c]:.2f} ± {ident['theta_sd'][c]:.3f} ({true[c]:.2f}) {verdict}")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    cells = []
+    for j in range(6):
+        verdict = "**identified**" if ident["breakaway_identified"][j] else "not excited"
+        cells.append(f"{th[6 + j] + th[12 + j]:.2f} ± {ident['breakaway_sd'][j]:.3f} "
+                     f"({true[6 + j] + true[12 + j]:.2f}) {verdict}")
+    lines.append("| τ_cou + τ_sti [N·m] | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 @table("monitors_hour", "docs/safety.md", "long")
 def monitors_hour():
     runs = [("--duration", "3600", "--friction", fr) for fr in ("paper", "corke")]

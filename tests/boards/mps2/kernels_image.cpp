@@ -121,6 +121,28 @@ void joint_space_kernels(const Vec6<F>& qn, const Vec6<F>& qd) {
   check("c = B qd", d((B * qd - c).norm()), 0.0, 1e-3);
 }
 
+FrictionIdentifier<F> g_identifier;
+
+/// One joint's update of the momentum law (osc/control/identification.hpp), a sample that counts:
+/// the worst a tick adds to the monitors stage with that law. From the prior, a sample of J2's
+/// friction at the regressor W moves theta^'s J2 coefficients toward it and nothing else.
+void identification_kernel(const Regressor<F>& W, const Vec6<F>& fr) {
+  g_identifier.reset();
+  Vec18<F> theta = Vec18<F>::Zero();
+  const Vec18<F> theta_max = Gains<F>::paper().theta_max;
+  const FrictionSample<F> s{fr(1), Vec3<F>(W(1, 1), W(1, kDof + 1), W(1, 2 * kDof + 1)), F(40), true};
+  IdentifyOutcome o;
+  {
+    Timer t("FrictionIdentifier::update (one joint, momentum law)");
+    o = g_identifier.update(1, s, true, F(0.25), F(6), theta, theta_max);
+    keep(theta);
+  }
+  check("identifier took the sample", o == IdentifyOutcome::kUpdated ? 1.0 : 0.0, 1.0, 0.0);
+  check("identifier moved J2 only", d(theta(0) + theta(2) + theta(kDof) + theta(2 * kDof + 5)), 0.0, 0.0);
+  check("identifier moved J2's sum toward the sample", d(theta(kDof + 1) + theta(2 * kDof + 1)) > 0 ? 1.0 : 0.0, 1.0,
+        0.0);
+}
+
 /// Friction (2) and its regressor (19), consistent with each other; returns the friction torque.
 Vec6<F> friction_kernels(const Vec6<F>& qd) {
   Vec6<F> fr;
@@ -137,6 +159,7 @@ Vec6<F> friction_kernels(const Vec6<F>& qd) {
     keep(W);
   }
   check("W theta = tau_f", d((W * fp.theta() - fr).norm()), 0.0, 1e-4);
+  identification_kernel(W, fr);
   return fr;
 }
 
