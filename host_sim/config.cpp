@@ -147,7 +147,8 @@ void add_run_entries(std::vector<Entry>& t) {
       });
   name(
       t, "run.adaptation",
-      "friction adaptation law: paper is (67) exactly, robust adds projection and leakage (docs/adaptation.md)",
+      "friction adaptation law: paper is (67) exactly, robust adds projection and leakage, momentum identifies the "
+      "friction from the residual monitor's momentum residual (docs/adaptation.md)",
       std::vector<std::string>(osc::kAdaptationLawNames, osc::kAdaptationLawNames + osc::kAdaptationLawCount), false,
       [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
       [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
