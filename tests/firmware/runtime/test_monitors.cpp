@@ -134,6 +134,11 @@ TYPED_TEST(Monitors, ThetaBand) {
     EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), 0u) << i;
     th(i) = lit<S>(-band * params::kThetaMax[i] * 1.01);
     EXPECT_EQ(ThetaBandMonitor<S>::check(th, mx), kFaultThetaBounds) << i;
+    // The control task's check a part at a time: the coefficient's own part finds it, no other.
+    for (int p = 0; p < ThetaBandMonitor<S>::kParts; ++p)
+      EXPECT_EQ(ThetaBandMonitor<S>::check_part(th, mx, p),
+                p == i / ThetaBandMonitor<S>::kPart ? static_cast<std::uint32_t>(kFaultThetaBounds) : 0u)
+          << i << " part " << p;
   }
   if constexpr (std::numeric_limits<S>::has_quiet_NaN) {
     th = mx;

@@ -220,7 +220,8 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   if (identify) identify_friction(task);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
-    faults |= ThetaBandMonitor<S>::check(task.state.adapt.theta_hat, task.gains.theta_max);
+    faults |= ThetaBandMonitor<S>::check_part(task.state.adapt.theta_hat, task.gains.theta_max,
+                                              static_cast<int>(task.tick % ThetaBandMonitor<S>::kParts));
   return faults;
 }
 
