@@ -386,7 +386,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   }
   if (accepted && cmd.verb == MotionVerb::kClear) {
     task.sup = {SupervisorState::kInit, 0};
-    task.stuck.reset();
+    task.stuck.reset(true);  // from this tick's torques: a clear while holding is no torque change
     task.residual.reset();
     task.saturation.reset();
   }
