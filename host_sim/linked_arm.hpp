@@ -28,8 +28,8 @@ struct TickView {
   std::uint32_t faults = 0;                              ///< the fault bits the tick detected
   /// The desired state of the last control step, in the controller's coordinates.
   Vec6 x_d = Vec6::Zero(), xd_d = Vec6::Zero(), xdd_d = Vec6::Zero();
-  Vec6 pose = Vec6::Zero();  ///< the arm's true pose after the tick's sample, in the same coordinates
-  bool has_theta = false;    ///< theta_hat is set (in process only)
+  Vec6 pose = Vec6::Zero();   ///< the arm's true pose after the tick's sample, in the same coordinates
+  bool has_theta = false;     ///< theta_hat is set (in process only)
   double theta_hat[18] = {};  ///< the friction estimates after the tick
 };
 

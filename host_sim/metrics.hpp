@@ -42,8 +42,8 @@ struct TickReport {
   double tau_f_hat[6] = {};
   double theta_hat[18] = {};
   bool has_identification = false;  // the `momentum` law's covariance is available (in-process only)
-  double theta_sd[18] = {};          // its standard deviation per coefficient
-  double breakaway_sd[6] = {};       // ... of each joint's Coulomb + Stribeck sum
+  double theta_sd[18] = {};         // its standard deviation per coefficient
+  double breakaway_sd[6] = {};      // ... of each joint's Coulomb + Stribeck sum
 };
 
 /// One control sample as the metrics see it: the true plant, the controller's report, the torques.

@@ -119,7 +119,8 @@ void print_friction_table(const sim::ExperimentResult& ad) {
     std::printf("%-20s", "  cou + sti");
     for (int j = 0; j < 6; ++j) {
       const double sum = ad.theta_hat[6 + j] + ad.theta_hat[12 + j];
-      std::printf(" %5.2f+-%5.3f%c", sum, ad.breakaway_sd[j], osc::friction_identified(sum, ad.breakaway_sd[j]) ? '*' : ' ');
+      std::printf(" %5.2f+-%5.3f%c", sum, ad.breakaway_sd[j],
+                  osc::friction_identified(sum, ad.breakaway_sd[j]) ? '*' : ' ');
     }
     std::printf("\n");
   }

@@ -571,7 +571,7 @@ def worst(windows):
 def adaptation_laws():
     """The laws on the same 120 s runs: tracking from 5 s and over the last 20 s, J1-J3's estimates."""
     prefetch(LAW_RUNS + LAW_RUNS_MORE + LAW_RUNS_NONE)
-    lines = ["| law (scalar) | max \|e\| from 5 s, x/y/z mm | last 20 s, x/y/z mm | τ_vis J1/J2/J3 at 120 s "
+    lines = ["| law (scalar) | max \\|e\\| from 5 s, x/y/z mm | last 20 s, x/y/z mm | τ_vis J1/J2/J3 at 120 s "
              "(plant 5.8/3.7/6.0) | τ_cou + τ_sti J1/J2/J3 (plant 9.0/9.1/3.6) | friction rms error N·m, last 20 s |"
              " frictionless plant: predicted friction rms N·m, last 60 s |",
              "|---|---|---|---|---|---|---|"]

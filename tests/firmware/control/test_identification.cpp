@@ -86,7 +86,7 @@ TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
   FrictionIdentifier<double> id;
   id.reset();
   Mat4& P = id.P[2];
-  P << 0.5, 0.0, 0.0, 0.0,  //
+  P << 0.5, 0.0, 0.0, 0.0,   //
       0.0, 4.0, -3.96, 0.0,  //
       0.0, -3.96, 4.0, 0.0,  //
       0.0, 0.0, 0.0, 0.01;
@@ -179,7 +179,7 @@ void converges_on_noisy_samples() {
     const FrictionSample<S> s{S(e.y), e.phi.template cast<S>(), S(e.gravity), true};
     updated += id.update(1, s, true, S(1.0), S(1.0), theta, theta_max) == IdentifyOutcome::kUpdated;
   }
-  EXPECT_GT(updated, 19900);  // a 4-sigma gate refuses almost none of gaussian noise
+  EXPECT_GT(updated, 19900);                             // a 4-sigma gate refuses almost none of gaussian noise
   const double sc = FrictionIdentifier<S>::scale_of(1);  // the joint's unit: 1 / sc N m
   EXPECT_NEAR(static_cast<double>(id.innovation2(1)) / (sc * sc), sd * sd, 0.3 * sd * sd);
   const double sum = static_cast<double>(theta(kDof + 1) + theta(2 * kDof + 1));

@@ -18,8 +18,8 @@ enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
 
 /// The law that updates the friction estimates (osc/control/adaptation.hpp).
 enum class AdaptationLaw : std::uint8_t {
-  kPaper,   ///< the paper's sampled law (67), exactly
-  kRobust,  ///< (67)'s error with the regressor one sample older, projection, leakage (the default)
+  kPaper,     ///< the paper's sampled law (67), exactly
+  kRobust,    ///< (67)'s error with the regressor one sample older, projection, leakage (the default)
   kMomentum,  ///< identified from the residual monitor's momentum residual, a Kalman filter per joint
               ///< (osc/control/identification.hpp): the control step holds theta^, the task updates it
 };

@@ -37,8 +37,8 @@
 namespace osc {
 
 /// One joint's sample for the identification, taken by the residual monitor: y = H(tau_f), the
-/// regressor columns (vis, cou, sti) and the model's gravity torque through H, and whether the joint has moved long enough for them
-/// to hold no standstill.
+/// regressor columns (vis, cou, sti) and the model's gravity torque through H, and whether the joint has moved long
+/// enough for them to hold no standstill.
 template <class S>
 struct FrictionSample {
   S y;
@@ -70,12 +70,12 @@ struct FrictionIdentifier {
   /// link_inertia (10 %), so the residual holds delta g(q). It is estimated beside the friction so
   /// that it does not leak into it (on J2, 10 % of its gravity torque is several times its
   /// friction), and not compensated: the paper's controller compensates friction only.
-  Mat4 P[kDof];                   // each joint's covariance [its units squared]
-  Vec4 z[kDof];                   // each joint's estimate, unbounded [its units] (theta^ is it projected)
-  Vec6<S> innovation2;            // each joint's mean squared innovation, recent samples [its units squared]
-  std::uint32_t updates[kDof];    // samples taken per joint
-  std::uint32_t outliers[kDof];   // samples refused by the innovation gate
-  std::uint8_t turn;              // the joint of the next update
+  Mat4 P[kDof];                  // each joint's covariance [its units squared]
+  Vec4 z[kDof];                  // each joint's estimate, unbounded [its units] (theta^ is it projected)
+  Vec6<S> innovation2;           // each joint's mean squared innovation, recent samples [its units squared]
+  std::uint32_t updates[kDof];   // samples taken per joint
+  std::uint32_t outliers[kDof];  // samples refused by the innovation gate
+  std::uint8_t turn;             // the joint of the next update
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
   /// The prior: theta^ anywhere from 0 to the band's top (robot::kModelErrorBounds), no counters.
@@ -178,8 +178,8 @@ struct FrictionIdentifier {
   double variance(int i, int c) const { return static_cast<double>(P[i](c, c)) / square(scale_of(i)); }
   /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
   double breakaway_variance(int i) const {
-    const double v = static_cast<double>(P[i](1, 1)) + static_cast<double>(P[i](2, 2)) +
-                     2 * static_cast<double>(P[i](1, 2));
+    const double v =
+        static_cast<double>(P[i](1, 1)) + static_cast<double>(P[i](2, 2)) + 2 * static_cast<double>(P[i](1, 2));
     return v / square(scale_of(i));
   }
   /// Joint i's relative gravity error delta [1].

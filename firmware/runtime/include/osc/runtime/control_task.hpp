@@ -64,7 +64,7 @@ struct ControlTask {
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
   ResidualMonitor<S> residual;
-  FrictionIdentifier<S> identifier;  // the `momentum` law's (osc/control/identification.hpp)
+  FrictionIdentifier<S> identifier;      // the `momentum` law's (osc/control/identification.hpp)
   CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;

@@ -447,13 +447,14 @@ struct ResidualMonitor {
     sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
     sample.gravity = reg[kGravity](i);
     static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
-    sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * velocity_noise(i);
+    sample.settled =
+        e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * velocity_noise(i);
   }
   /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
   static constexpr std::array<S, kDof> settled_stillness() {
     std::array<S, kDof> s{};
     for (int i = 0; i < kDof; ++i) {
-      const int ticks = static_cast<int>(params::kIdentifySettle * params::kControlHz / params::kResidualGain[i] + 0.5);
+      const double ticks = params::kIdentifySettle * params::kControlHz / params::kResidualGain[i];
       double v = 1;
       for (int t = 0; t < ticks; ++t) v *= 1 - params::kResidualSlowGain * params::kDt;
       s[i] = lit<S>(v);
