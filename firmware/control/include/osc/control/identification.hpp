@@ -110,11 +110,10 @@ struct FrictionIdentifier {
     drift(i);
     if (!s.settled) return IdentifyOutcome::kNotSettled;
     if (!residual_low) return IdentifyOutcome::kResidualHigh;
-    static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
     static constexpr std::array<S, kDof> kUnscale = per_joint([](int j) { return 1 / scale_of(j); });
     static constexpr std::array<S, kDof> kInverseTorque =
         per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
-    const S sc = kScale[i];
+    const S sc = scale(i);
     Vec4& th = z[i];
     const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity * kInverseTorque[i]);
     const Vec4 Pphi = P[i] * phi;
@@ -159,8 +158,7 @@ struct FrictionIdentifier {
   /// bound; one pass over the three, then a clip for what the pass leaves. The gravity error is not
   /// bounded.
   Vec4 project(int i, Vec4 th, const Vec18<S>& theta_max) const {
-    static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
-    const S sc = kScale[i];
+    const S sc = scale(i);
     for (int c = 0; c < 3; ++c) {
       const S hi = theta_max(c * kDof + i) * sc, v = th(c);
       const S excess = v < S(0) ? v : (v > hi ? v - hi : S(0));
@@ -174,7 +172,8 @@ struct FrictionIdentifier {
     return th;
   }
 
-  /// Joint i's variance of coefficient c (0 vis, 1 cou, 2 sti) in its own units, squared [host, double].
+  /// Joint i's variance of coefficient c (0 vis, 1 cou, 2 sti), in the coefficient's own units
+  /// squared (N m s/rad, N m) [host, double].
   double variance(int i, int c) const { return static_cast<double>(P[i](c, c)) / square(scale_of(i)); }
   /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
   double breakaway_variance(int i) const {
@@ -208,6 +207,11 @@ struct FrictionIdentifier {
 
  private:
   static constexpr double square(double v) { return v * v; }
+  /// scale_of(i) in the scalar S.
+  static S scale(int i) {
+    static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
+    return kScale[i];
+  }
   template <class F>
   static constexpr std::array<S, kDof> per_joint(F f) {
     std::array<S, kDof> a{};

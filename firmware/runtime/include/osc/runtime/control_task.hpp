@@ -181,8 +181,8 @@ void identify_friction(ControlTask<S>& task) {
   ResidualMonitor<S>& m = task.residual;
   const int i = m.sample_joint;
   const S half = lit<S>(0.5) * m.noise_bound(i);
-  task.identifier.update(i, m.sample, m.ratio_of(i) <= kMaxRatio, half * half, kCorrelation[i],
-                         task.state.adapt.theta_hat, task.gains.theta_max);
+  task.identifier.update(i, m.sample, m.within(i, kMaxRatio), half * half, kCorrelation[i], task.state.adapt.theta_hat,
+                         task.gains.theta_max);
 }
 
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the

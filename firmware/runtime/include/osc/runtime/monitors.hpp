@@ -422,6 +422,11 @@ struct ResidualMonitor {
     return armed ? kind : 0u;
   }
 
+  /// Joint i's residual within `fraction` of its threshold on both channels (ratio_of(i) <= fraction,
+  /// without its divisions).
+  bool within(int i, S fraction) const {
+    return math::abs(r(i)) <= fraction * threshold(i) && math::abs(d(i)) <= fraction * change_threshold(i);
+  }
   /// Joint i's residual against its threshold: the larger of the two channels' ratios.
   S ratio_of(int i) const {
     const S a = math::abs(r(i)) / threshold(i), c = math::abs(d(i)) / change_threshold(i);
@@ -606,7 +611,7 @@ struct TrackingMonitor {
 
 /// theta_bounds: a friction estimate outside [-band theta_max, (1 + band) theta_max], band
 /// params::kThetaFaultBand (a NaN is outside too). The control task checks a sixth of them a tick
-/// (check_part: kThetaBandPart coefficients, each every 6 ms): the estimates move by a small share
+/// (check_part: kPart coefficients, each every 6 ms): the estimates move by a small share
 /// of their bound a second, a drift through the band takes minutes (docs/adaptation.md), and a NaN
 /// is the step's own non_finite fault at once (the whole check took 240 instructions a tick on the M4F).
 template <class S>
