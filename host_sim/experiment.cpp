@@ -50,6 +50,7 @@ class LocalController {
       for (int i = 0; i < 6; ++i) {
         for (int c = 0; c < 3; ++c) r.theta_sd[6 * c + i] = std::sqrt(std::max(0.0, id.variance(i, c)));
         r.breakaway_sd[i] = std::sqrt(std::max(0.0, id.breakaway_variance(i)));
+        r.split_excitation[i] = id.decay_excitation(i);
       }
     }
     const osc::ResidualMonitor<S>& m = task_->residual;

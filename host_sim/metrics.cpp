@@ -200,6 +200,7 @@ void FrictionEstimates::observe(const Sample& s) {
     has_identification = s.rep.has_identification;
     std::copy(s.rep.theta_sd, s.rep.theta_sd + 18, theta_sd);
     std::copy(s.rep.breakaway_sd, s.rep.breakaway_sd + 6, breakaway_sd);
+    std::copy(s.rep.split_excitation, s.rep.split_excitation + 6, split_excitation);
   }
   frozen_ = !s.counting;
   if (!s.counting) return;
@@ -220,6 +221,10 @@ void FrictionEstimates::to_json(Json& j) const {
   Json id;
   id["theta_sd"] = json_array(theta_sd, 18);
   id["breakaway_sd"] = json_array(breakaway_sd, 6);
+  // The Coulomb / Stribeck split's excitation and whether it is learned (its gate).
+  id["split_excitation"] = json_array(split_excitation, 6);
+  for (int i = 0; i < 6; ++i)
+    id["split_learned"].push_back(split_excitation[i] >= osc::params::kIdentifySplitExcitation);
   for (int i = 0; i < 18; ++i) id["theta_identified"].push_back(osc::friction_identified(theta_hat[i], theta_sd[i]));
   for (int i = 0; i < 6; ++i)
     id["breakaway_identified"].push_back(

@@ -44,6 +44,7 @@ struct TickReport {
   bool has_identification = false;  // the `momentum` law's covariance is available (in-process only)
   double theta_sd[18] = {};         // its standard deviation per coefficient
   double breakaway_sd[6] = {};      // ... of each joint's Coulomb + Stribeck sum
+  double split_excitation[6] = {};  // the Stribeck decay's excitation, RMS (FrictionIdentifier::excite)
 };
 
 /// One control sample as the metrics see it: the true plant, the controller's report, the torques.
@@ -132,6 +133,7 @@ struct FrictionEstimates {
   bool has_identification = false;  // the `momentum` law's report below is set
   double theta_sd[18] = {};         // each coefficient's standard deviation at the end
   double breakaway_sd[6] = {};      // ... each joint's Coulomb + Stribeck sum's
+  double split_excitation[6] = {};  // ... and the Stribeck decay's excitation (RMS, 1)
   void begin(const ExperimentConfig& cfg);
   void observe(const Sample& s);
   void to_json(Json& j) const;

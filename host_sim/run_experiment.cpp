@@ -123,6 +123,13 @@ void print_friction_table(const sim::ExperimentResult& ad) {
                   osc::friction_identified(sum, ad.breakaway_sd[j]) ? '*' : ' ');
     }
     std::printf("\n");
+    // The excitation monitor's gate on the Coulomb / Stribeck split (FrictionIdentifier::excite).
+    std::printf("%-20s", "  split excitation");
+    for (int j = 0; j < 6; ++j)
+      std::printf(" %6.3f %-7s", ad.split_excitation[j],
+                  ad.split_excitation[j] >= osc::params::kIdentifySplitExcitation ? "learned" : "held");
+    std::printf("\n  (the Stribeck decay's RMS excitation; the split is learned at %.2f and above)\n",
+                osc::params::kIdentifySplitExcitation);
   }
   if (!ad.status)
     std::printf("estimated vs true joint friction over the last %gs: rms error %.3f N m (rms friction %.3f N m)\n",

@@ -21,17 +21,18 @@ struct Regression {
   std::vector<double> y;
 };
 
-/// A joint's samples: the regressor columns of a sinusoidal velocity through a first-order filter
+/// A joint's samples: the regressor columns of a sinusoidal velocity (amplitude `speed` rad/s, and a
+/// small faster one) through a first-order filter
 /// (as the residual monitor's), a gravity torque that changes with the pose, y = phi^T theta + noise
 /// (theta's fourth coefficient: the model's relative gravity error).
-Regression samples(const Vec4& theta, double noise, int n, unsigned seed) {
+Regression samples(const Vec4& theta, double noise, int n, unsigned seed, double speed = 0.4) {
   std::mt19937 rng(seed);
   std::normal_distribution<double> gauss(0.0, noise);
   Regression r;
   Vec4 f = Vec4::Zero();
   for (int k = 0; k < n; ++k) {
-    const double t = 0.006 * k, v = 0.4 * std::sin(1.3 * t) + 0.05 * std::sin(5.1 * t);
-    const double sign = v > 0 ? 1 : -1, q = 0.4 * (1 - std::cos(1.3 * t)) / 1.3;
+    const double t = 0.006 * k, v = speed * std::sin(1.3 * t) + 0.05 * std::sin(5.1 * t);
+    const double sign = v > 0 ? 1 : -1, q = speed * (1 - std::cos(1.3 * t)) / 1.3;
     const Vec4 w(v, sign, sign * std::exp(-v * v), 40.0 * std::cos(q));
     f += 0.3 * (w - f);  // 50 /s over 6 ms
     r.phi.push_back(f);
@@ -57,7 +58,7 @@ TEST(FrictionIdentifier, CorrectionEqualsBatchLeastSquares) {
   const int joint = 0;
   const Mat4 P0 = id.P[joint];
   Vec4 th = Vec4::Zero();
-  Mat4 info = P0.inverse();  // diagonal
+  Mat4 info = P0.inverse();  // the prior information (a test may invert a 4x4)
   Vec4 rhs = Vec4::Zero();
   for (std::size_t k = 0; k < d.y.size(); ++k) {
     const Vec4 Pphi = id.P[joint] * d.phi[k];
@@ -78,36 +79,38 @@ TEST(FrictionIdentifier, CorrectionEqualsBatchLeastSquares) {
   for (int c = 0; c < 4; ++c) EXPECT_LT(std::abs(th(c) - truth(c)), 4 * std::sqrt(cov(c, c))) << c;
 }
 
-// The projection in the metric of P^-1: a coefficient below 0 is set to 0 and the others move by
-// P's column over its diagonal times the excess. With Coulomb and Stribeck strongly anti-correlated
-// (their sum well known), a Coulomb of -1 becomes 0 and the Stribeck term gives up what keeps the
-// sum: the closed form, and the sum kept to the correlation's shortfall.
+// The projection in the metric of P^-1, in the filter's coordinates (vis, cou + sti, sti, delta):
+// coefficient c = a^T x beyond a bound moves x by P a excess / a^T P a. With the sum well known and
+// the Stribeck level not, a Coulomb level of -1 becomes 0 and the Stribeck level gives up what keeps
+// the sum: the closed form, and the sum kept to within 1 %.
 TEST(FrictionIdentifier, ProjectionKeepsTheWellKnownSum) {
   FrictionIdentifier<double> id;
   id.reset();
   Mat4& P = id.P[2];
-  P << 0.5, 0.0, 0.0, 0.0,   //
-      0.0, 4.0, -3.96, 0.0,  //
-      0.0, -3.96, 4.0, 0.0,  //
+  P << 0.5, 0.0, 0.0, 0.0,  //
+      0.0, 0.04, 0.0, 0.0,  //
+      0.0, 0.0, 4.0, 0.0,   //
       0.0, 0.0, 0.0, 0.01;
   const Vec18<double> theta_max = Gains<double>::paper().theta_max;
-  const Vec4 th(2.0, -1.0, 4.0, -0.3);
-  const Vec4 p = id.project(2, th, theta_max);
+  const Vec4 x(2.0, 3.0, 4.0, -0.3);  // vis 2, cou -1, sti 4
+  const Vec4 p = id.project(2, x, theta_max);
   EXPECT_DOUBLE_EQ(p(3), -0.3);  // the gravity error is not bounded
   EXPECT_DOUBLE_EQ(p(0), 2.0);
-  EXPECT_DOUBLE_EQ(p(1), 0.0);
-  EXPECT_NEAR(p(2), 4.0 - (-3.96 / 4.0) * (-1.0), 1e-12);  // 3.01
-  EXPECT_NEAR(p(1) + p(2), th(1) + th(2), 0.02);           // the sum 3.0 kept within 1 %
+  EXPECT_NEAR(p(1), 0.0, 1e-12);
+  // a = (0, 1, -1, 0): P a = (0, 0.04, -4, 0), a^T P a = 4.04, excess -1.
+  EXPECT_NEAR(p(2), 4.0 - 4.0 / 4.04, 1e-12);
+  EXPECT_NEAR(p(1) + p(2), 3.0 + 0.04 / 4.04, 1e-12);
+  EXPECT_NEAR(p(1) + p(2), 3.0, 0.03);  // the sum kept within 1 %
   // A per-coefficient clip would have raised the sum by the whole excess.
-  EXPECT_GT(std::abs((0.0 + 4.0) - (th(1) + th(2))), 0.9);
-  // Above a bound: the same rule, from the other side.
+  EXPECT_GT(std::abs((0.0 + 4.0) - 3.0), 0.9);
   // Above a bound (in the joint's units, FrictionIdentifier::scale_of): the same rule, from the
   // other side.
   const double sc = FrictionIdentifier<double>::scale_of(2);
-  const Vec4 high(2.0, theta_max(kDof + 2) * sc + 1.0, 0.5, 0.0);
+  const double hi = theta_max(kDof + 2) * sc;
+  const Vec4 high(2.0, hi + 1.5, 0.5, 0.0);  // cou hi + 1
   const Vec4 q = id.project(2, high, theta_max);
-  EXPECT_DOUBLE_EQ(q(1), theta_max(kDof + 2) * sc);
-  EXPECT_NEAR(q(2), 0.5 + 0.99, 1e-12);
+  EXPECT_NEAR(q(1), hi, 1e-12);
+  EXPECT_NEAR(q(2), 0.5 + 4.0 / 4.04, 1e-12);
 }
 
 // Gates: a sample that has not settled, or whose residual is high, changes nothing but P's random
@@ -131,7 +134,7 @@ TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
   EXPECT_EQ(theta, before);
   // Within the gate it learns (its estimate z in the joint's units: theta^ = 1 N m s/rad, 1 N m, 1 N m).
   const double sc = FrictionIdentifier<double>::scale_of(1);
-  id.z[1] << sc, sc, sc, 0;
+  id.z[1] << sc, 2 * sc, sc, 0;  // the filter's coordinates: (vis, cou + sti, sti, delta)
   s.y = theta(1) * 0.2 + theta(kDof + 1) * 1.0 + theta(2 * kDof + 1) * 0.98 + 0.05;
   EXPECT_EQ(id.update(1, s, true, 0.01, 1.0, theta, theta_max), IdentifyOutcome::kUpdated);
   EXPECT_NE(theta, before);
@@ -142,7 +145,7 @@ TEST(FrictionIdentifier, GatesLeaveTheEstimateAlone) {
   }
 }
 
-// The random walk: P's diagonal grows by (kIdentifyDrift times the band's top)^2 per hour of
+// The random walk: P's diagonal grows by kIdentifyDrift^2 times the prior's diagonal per hour of
 // updates, and never beyond the prior.
 TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
   FrictionIdentifier<double> id;
@@ -163,12 +166,13 @@ TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
 
 // The noise measure: from samples of known noise, the identifier's variance settles near it (the
 // mean squared innovation less what P explains), and the estimate converges within its own
-// standard deviations; in float too.
+// standard deviations; in float too. The motion reaches 1.5 rad/s, where the Stribeck decay shows:
+// the excitation monitor opens the split, and the Coulomb and Stribeck levels are learned apart.
 template <class S>
 void converges_on_noisy_samples() {
   const Vec4 truth(3.7, 4.8, 4.3, -0.08);
   const double sd = 0.3;
-  const Regression d = samples(truth, sd, 20000, 7);
+  const Regression d = samples(truth, sd, 20000, 7, 1.5);
   FrictionIdentifier<S> id;
   id.reset();
   const Vec18<S> theta_max = Gains<double>::paper().theta_max.template cast<S>();
@@ -190,6 +194,66 @@ void converges_on_noisy_samples() {
   const double g_sd = std::sqrt(static_cast<double>(id.P[1](3, 3))) /
                       (FrictionIdentifier<S>::scale_of(1) * robot::kDrives.torque_limit[1]);
   EXPECT_NEAR(id.gravity_error(1), truth(3), 4 * g_sd);
+  // The split was excited, and learned: each level within four of its standard deviations.
+  EXPECT_GE(id.decay_excitation(1), params::kIdentifySplitExcitation);
+  EXPECT_LT(std::abs(static_cast<double>(theta(kDof + 1)) - truth(1)), 4 * std::sqrt(id.variance(1, 1)));
+  EXPECT_LT(std::abs(static_cast<double>(theta(2 * kDof + 1)) - truth(2)), 4 * std::sqrt(id.variance(1, 2)));
+  EXPECT_LT(std::sqrt(id.variance(1, 2)), 0.5 * std::sqrt(FrictionIdentifier<double>::prior(1)(2, 2)) /
+                                              FrictionIdentifier<double>::scale_of(1));
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }
+
+// The excitation monitor's gate: at the speeds of the paper's motion (0.15 rad/s) the Stribeck
+// decay hardly shows and the Coulomb and Stribeck columns are collinear. The split is held: the
+// Stribeck estimate and its variance do not move at all, while the sum is learned to its truth.
+TEST(FrictionIdentifier, CollinearMotionLearnsTheSumAndHoldsTheSplit) {
+  const Vec4 truth(3.7, 4.8, 4.3, -0.08);
+  const Regression d = samples(truth, 0.3, 20000, 11, 0.15);
+  FrictionIdentifier<double> id;
+  id.reset();
+  const double sc = FrictionIdentifier<double>::scale_of(1);
+  id.z[1](2) = 1.5 * sc;  // a split learned before (1.5 N m of Stribeck level)
+  const double sti_var = id.P[1](2, 2);
+  const Vec18<double> theta_max = Gains<double>::paper().theta_max;
+  Vec18<double> theta = Vec18<double>::Zero();
+  for (std::size_t k = 0; k < d.y.size(); ++k) id.update(1, sample_of(d, k), true, 1.0, 1.0, theta, theta_max);
+  EXPECT_GT(id.updates[1], 19900u);
+  EXPECT_LT(id.decay_excitation(1), 0.2 * params::kIdentifySplitExcitation);
+  EXPECT_EQ(id.z[1](2), 1.5 * sc);      // held, bit for bit
+  EXPECT_EQ(id.P[1](2, 2), sti_var);    // and its variance with it (the prior: the random walk's cap)
+  const double sum = theta(kDof + 1) + theta(2 * kDof + 1);
+  EXPECT_NEAR(sum, truth(1) + truth(2), 4 * std::sqrt(id.breakaway_variance(1)));
+  EXPECT_TRUE(friction_identified(sum, std::sqrt(id.breakaway_variance(1))));
+}
+
+// The consider (Schmidt) update against its definition: in the filter's coordinates (vis,
+// cou + sti, sti, delta) the Stribeck level's gain is 0, the others' the Kalman gain, and the
+// covariance is Joseph's form for that gain, (I - K h^T) P (I - K h^T)^T + K R K^T, computed here
+// independently; the sum is learned as a Kalman filter would, the Stribeck level not at all.
+TEST(FrictionIdentifier, ConsiderUpdateIsSchmidtsFilter) {
+  FrictionIdentifier<double> id;
+  id.reset();
+  Mat4 P;
+  P << 2.0, 0.3, -0.2, 0.05,  //
+      0.3, 0.9, 0.5, 0.1,     //
+      -0.2, 0.5, 4.6, -0.05,  //
+      0.05, 0.1, -0.05, 0.8;
+  id.P[0] = P;
+  const Vec4 h(0.12, 0.97, -0.02, 0.4);
+  const double R = 0.07;
+  const Vec4 Ph = P * h;
+  const double var = h.dot(Ph) + R;
+  const Vec4 gain = id.correct(0, Ph, var, false);
+  Vec4 K = Ph / var;
+  K(2) = 0.0;
+  const Mat4 A = Mat4::Identity() - K * h.transpose();
+  const Mat4 P_next = A * P * A.transpose() + K * R * K.transpose();
+  for (int a = 0; a < 4; ++a) {
+    EXPECT_NEAR(gain(a), K(a), 1e-12) << a;
+    for (int b = 0; b < 4; ++b) EXPECT_NEAR(id.P[0](a, b), P_next(a, b), 1e-12) << a << b;
+  }
+  EXPECT_EQ(id.P[0](2, 2), 4.6);
+  // The sum's variance falls as the Kalman filter's own would.
+  EXPECT_NEAR(id.P[0](1, 1), P(1, 1) - Ph(1) * Ph(1) / var, 1e-12);
+}

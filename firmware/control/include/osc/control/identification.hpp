@@ -25,9 +25,24 @@
 // threshold, its innovation within params::kIdentifyGate standard deviations.
 // The joints take turns, one update every params::kIdentifyEvery ticks each: a few hundred
 // instructions per tick. The update is + * and one division per joint.
+//
+// Learning is gated by direction where the motion does not excite. At the speeds most motions
+// reach (0.1-0.2 rad/s on the paper's trajectory), the Coulomb and Stribeck columns are collinear:
+// exp(-tau_dec qd^2) is within a few percent of 1. There the data tell their sum, not their split,
+// and a small misfit elsewhere (an observer lag, an inertia error) moves the split without bound
+// through P's correlations (issue 26: an hour of one repeated move took J2's Coulomb level from 7.2
+// to 0 and its Stribeck level from 1.9 to 9.1). So the identifier keeps, per joint, the windowed
+// moments of the columns (viscous, Coulomb, Stribeck decay = Stribeck - Coulomb), and the decay's
+// excitation: its mean square not explained by the other two (a Schur complement). Below
+// params::kIdentifySplitExcitation the split is a consider state: the Stribeck level is held, the
+// sum gets its optimal gain (Schmidt's filter), and P keeps the split's variance. For that, and for
+// P's conditioning in float and fixed point, the filter's coordinates are (vis, cou + sti, sti,
+// delta): the well known sum is a coordinate of its own, not the difference of two large, nearly
+// opposite variances.
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "osc/control/params.hpp"
@@ -70,11 +85,16 @@ struct FrictionIdentifier {
   /// link_inertia (10 %), so the residual holds delta g(q). It is estimated beside the friction so
   /// that it does not leak into it (on J2, 10 % of its gravity torque is several times its
   /// friction), and not compensated: the paper's controller compensates friction only.
+  using Mat3 = Eigen::Matrix<S, 3, 3>;
   Mat4 P[kDof];                  // each joint's covariance [its units squared]
-  Vec4 z[kDof];                  // each joint's estimate, unbounded [its units] (theta^ is it projected)
+  Vec4 z[kDof];                  // each joint's estimate (vis, cou + sti, sti, delta), unbounded [its units]
   Vec6<S> innovation2;           // each joint's mean squared innovation, recent samples [its units squared]
   std::uint32_t updates[kDof];   // samples taken per joint
   std::uint32_t outliers[kDof];  // samples refused by the innovation gate
+  Mat3 moments[kDof];            // the motion's windowed moments of (vis, cou, decay) columns (excite)
+  Mat3 block[kDof];              // the current block's sums of them
+  Vec6<S> split_excitation;      // the decay column's mean square unexplained by the others, times kDecayScale^2
+  std::uint8_t block_count[kDof];
   std::uint8_t turn;             // the joint of the next update
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
@@ -86,7 +106,11 @@ struct FrictionIdentifier {
       innovation2(i) = S(-1);  // none yet (update)
       updates[i] = 0;
       outliers[i] = 0;
+      moments[i].setZero();
+      block[i].setZero();
+      block_count[i] = 0;
     }
+    split_excitation.setZero();
     turn = 0;
   }
   /// The joint whose update is due this tick; advances the turn.
@@ -115,7 +139,9 @@ struct FrictionIdentifier {
         per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
     const S sc = scale(i);
     Vec4& th = z[i];
-    const Vec4 phi(s.phi(0), s.phi(1), s.phi(2), s.gravity * kInverseTorque[i]);
+    // The regressor in the filter's coordinates: phi^T (vis, cou, sti) = (phi_vis, phi_cou, phi_sti -
+    // phi_cou)^T (vis, cou + sti, sti).
+    const Vec4 phi(s.phi(0), s.phi(1), s.phi(2) - s.phi(1), s.gravity * kInverseTorque[i]);
     const Vec4 Pphi = P[i] * phi;
     const S explained = phi.dot(Pphi);
     const S innovation = s.y * sc - phi.dot(th), e2 = innovation * innovation;
@@ -133,7 +159,7 @@ struct FrictionIdentifier {
     static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyNoiseSamples);
     mean2 += kAverage * (e2 - mean2);
     const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
-    th += correct(i, Pphi, var) * innovation;
+    th += correct(i, Pphi, var, excite(i, phi)) * innovation;
     const Vec4 bounded = project(i, th, theta_max);
     for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * kUnscale[i];
     ++updates[i];
@@ -142,28 +168,87 @@ struct FrictionIdentifier {
 
   /// The Kalman correction of joint i for a sample of innovation variance var, given P phi: P less
   /// (P phi)(P phi)^T / var, kept symmetric; returns the gain P phi / var.
-  Vec4 correct(int i, const Vec4& Pphi, S var) {
-    const Vec4 gain = Pphi / var;
+  /// Without split (the Coulomb / Stribeck split not excited: excite), the Stribeck level
+  /// (coordinate 2) is a consider state (Schmidt): its gain is 0, the others' the Kalman gain, and P
+  /// is Joseph's form for that gain, which is the same update with the Stribeck level's variance
+  /// left as it was.
+  Vec4 correct(int i, const Vec4& Pphi, S var, bool split = true) {
+    Vec4 gain = Pphi / var;
+    Mat4& p = P[i];
     for (int a = 0; a < 4; ++a)
       for (int b = a; b < 4; ++b) {
-        const S v = P[i](a, b) - gain(a) * Pphi(b);
-        P[i](a, b) = v;
-        P[i](b, a) = v;
+        if (a == 2 && b == 2 && !split) continue;
+        const S v = p(a, b) - gain(a) * Pphi(b);
+        p(a, b) = v;
+        p(b, a) = v;
       }
+    if (!split) gain(2) = S(0);
     return gain;
   }
+  /// The excitation monitor's gate: joint i's counted sample phi goes into the windowed moments of
+  /// its (vis, cou, decay) columns, decay = sti - cou; at each block's end the moments take the
+  /// block's mean (an average over params::kIdentifyExciteBlocks blocks) and split_excitation(i)
+  /// becomes the decay's mean square not explained by the other two columns. Returns whether the
+  /// Coulomb / Stribeck split is excited enough to be learned.
+  bool excite(int i, const Vec4& phi) {
+    static constexpr S kGate = lit<S>(kDecayScale * kDecayScale * params::kIdentifySplitExcitation *
+                                      params::kIdentifySplitExcitation);
+    const Vec3<S> w(phi(0), phi(1), phi(2) * lit<S>(kDecayScale));
+    Mat3& b = block[i];
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) b(r, c) += w(r) * w(c);
+    if (++block_count[i] >= params::kIdentifyExciteBlock) {
+      static constexpr S kMean = lit<S>(1.0 / params::kIdentifyExciteBlock);
+      static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyExciteBlocks);
+      Mat3& m = moments[i];
+      for (int r = 0; r < 3; ++r)
+        for (int c = r; c < 3; ++c) {
+          m(r, c) += kAverage * (b(r, c) * kMean - m(r, c));
+          b(r, c) = S(0);
+        }
+      block_count[i] = 0;
+      split_excitation(i) = decay_unexplained(m);
+    }
+    return split_excitation(i) >= kGate;
+  }
+  /// The Schur complement of the decay column in the moments m (upper triangle): its mean square
+  /// less what the Coulomb and viscous columns explain of it, eliminated in that order (an LDL^T
+  /// step each, ratios before products, for fixed point's sake); 0 where those two are themselves
+  /// collinear (a motion at one speed), which tells neither the split nor the viscous term.
+  static S decay_unexplained(const Mat3& m) {
+    static constexpr S kCollinear = lit<S>(1.0 / 1024);
+    const S ss = m(1, 1);
+    if (!(ss > S(0))) return S(0);
+    const S l_v = m(0, 1) / ss, l_d = m(1, 2) / ss;
+    const S vv = m(0, 0) - l_v * m(0, 1);  // the viscous column given the Coulomb column
+    if (!(vv > kCollinear * m(0, 0))) return S(0);
+    const S vd = m(0, 2) - l_d * m(0, 1);  // their cross moment given it
+    const S u = m(2, 2) - l_d * m(1, 2) - (vd / vv) * vd;
+    return u > S(0) ? u : S(0);
+  }
+  /// The decay column's factor in the moments (it is at most a few hundredths at the usual speeds:
+  /// scaled up, it keeps fixed point's resolution; the blocks' sums stay within Q12.19 up to 8 rad/s).
+  static constexpr double kDecayScale = 4;
   /// th (joint i's units) within [0, theta_max], projected in the metric of P^-1 (the estimate's
   /// own): a coefficient beyond a bound is set to it and the others move as P correlates them, so
   /// that a well identified sum (Coulomb + Stribeck) keeps its value when one of its terms meets a
   /// bound; one pass over the three, then a clip for what the pass leaves. The gravity error is not
   /// bounded.
-  Vec4 project(int i, Vec4 th, const Vec18<S>& theta_max) const {
+  /// x is in the filter's coordinates (vis, cou + sti, sti, delta); the result is the coefficients
+  /// (vis, cou, sti, delta). Coefficient c is a^T x, a = e_0, e_1 - e_2, e_2; its excess moves x by
+  /// P a excess / a^T P a.
+  Vec4 project(int i, Vec4 x, const Vec18<S>& theta_max) const {
     const S sc = scale(i);
+    const Mat4& p = P[i];
     for (int c = 0; c < 3; ++c) {
-      const S hi = theta_max(c * kDof + i) * sc, v = th(c);
+      const S hi = theta_max(c * kDof + i) * sc, v = c == 1 ? x(1) - x(2) : x(c);
       const S excess = v < S(0) ? v : (v > hi ? v - hi : S(0));
-      if (excess != S(0) && P[i](c, c) > S(0)) th -= P[i].col(c) * (excess / P[i](c, c));
+      if (excess == S(0)) continue;
+      const Vec4 pa = c == 1 ? Vec4(p.col(1) - p.col(2)) : Vec4(p.col(c));
+      const S apa = c == 1 ? pa(1) - pa(2) : pa(c);
+      if (apa > S(0)) x -= pa * (excess / apa);
     }
+    Vec4 th(x(0), x(1) - x(2), x(2), x(3));
     for (int c = 0; c < 3; ++c) {
       const S hi = theta_max(c * kDof + i) * sc;
       if (th(c) < S(0)) th(c) = S(0);
@@ -174,24 +259,37 @@ struct FrictionIdentifier {
 
   /// Joint i's variance of coefficient c (0 vis, 1 cou, 2 sti), in the coefficient's own units
   /// squared (N m s/rad, N m) [host, double].
-  double variance(int i, int c) const { return static_cast<double>(P[i](c, c)) / square(scale_of(i)); }
-  /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
-  double breakaway_variance(int i) const {
-    const double v =
-        static_cast<double>(P[i](1, 1)) + static_cast<double>(P[i](2, 2)) + 2 * static_cast<double>(P[i](1, 2));
+  double variance(int i, int c) const {
+    const Mat4& p = P[i];
+    const double v = c == 1 ? static_cast<double>(p(1, 1)) + static_cast<double>(p(2, 2)) - 2 * static_cast<double>(p(1, 2))
+                            : static_cast<double>(p(c, c));
     return v / square(scale_of(i));
+  }
+  /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
+  double breakaway_variance(int i) const { return static_cast<double>(P[i](1, 1)) / square(scale_of(i)); }
+  /// Joint i's Stribeck decay excitation: the decay column's RMS that the viscous and Coulomb
+  /// columns do not explain, over the recent motion (excite) [1, a fraction of the Stribeck level];
+  /// the split is learned at params::kIdentifySplitExcitation and above [host, double].
+  double decay_excitation(int i) const {
+    const double u = static_cast<double>(split_excitation(i));
+    return u > 0 ? std::sqrt(u) / kDecayScale : 0.0;
   }
   /// Joint i's relative gravity error delta [1].
   double gravity_error(int i) const {
     return static_cast<double>(z[i](3)) / (scale_of(i) * robot::kDrives.torque_limit[i]);
   }
 
-  /// The prior covariance of joint i in its units: the band's top squared on the diagonal, and the
-  /// gravity error's (link_inertia T_i)^2.
+  /// The prior covariance of joint i in its units and the filter's coordinates: the coefficients
+  /// independent, each the band's top as its standard deviation, the gravity error's link_inertia T_i;
+  /// so the sum's variance is the Coulomb's plus the Stribeck's, and it covaries with the Stribeck
+  /// level by the latter's.
   static Mat4 prior(int i) {
     static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0);
     Mat4 p = Mat4::Zero();
     for (int c = 0; c < 4; ++c) p(c, c) = kPrior[c * kDof + i];
+    p(1, 1) += p(2, 2);
+    p(1, 2) = p(2, 2);
+    p(2, 1) = p(2, 2);
     return p;
   }
   /// Joint i's unit: the power of two that brings its largest prior standard deviation within
@@ -219,29 +317,34 @@ struct FrictionIdentifier {
     return a;
   }
   /// f times each coefficient's prior variance in joint i's units: the band's top squared
-  /// (robot::kModelErrorBounds), the gravity error's (link_inertia T_i)^2.
-  static constexpr std::array<S, 4 * kDof> band_squared(double f) {
+  /// (robot::kModelErrorBounds), the gravity error's (link_inertia T_i)^2; with `sum`, the second is
+  /// the filter's coordinate's, cou + sti: the Coulomb's plus the Stribeck's.
+  static constexpr std::array<S, 4 * kDof> band_squared(double f, bool sum = false) {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     std::array<S, 4 * kDof> q{};
     for (int i = 0; i < kDof; ++i) {
       const double s2 = f * square(scale_of(i));
       q[i] = lit<S>(s2 * square(b.friction_hi.vis[i]));
-      q[kDof + i] = lit<S>(s2 * square(b.friction_hi.cou[i]));
+      q[kDof + i] = lit<S>(s2 * (square(b.friction_hi.cou[i]) + (sum ? square(b.friction_hi.sti[i]) : 0.0)));
       q[2 * kDof + i] = lit<S>(s2 * square(b.friction_hi.sti[i]));
       q[3 * kDof + i] = lit<S>(s2 * square(b.link_inertia * robot::kDrives.torque_limit[i]));
     }
     return q;
   }
-  /// The random walk: (kIdentifyDrift times each prior standard deviation)^2 per hour, up to the prior.
+  /// The random walk: (kIdentifyDrift times each prior standard deviation)^2 per hour, up to the
+  /// prior, in the filter's coordinates (the sum and the Stribeck level drift independently: a
+  /// diagonal, so P stays positive definite). A variance above its prior (a held Stribeck level
+  /// keeps its own) is left as it is, never lowered.
   void drift(int i) {
     static constexpr std::array<S, 4 * kDof> kDrift =
-        band_squared(params::kIdentifyDrift * params::kIdentifyDrift / kPerHour);
-    static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0);
+        band_squared(params::kIdentifyDrift * params::kIdentifyDrift / kPerHour, true);
+    static constexpr std::array<S, 4 * kDof> kPrior = band_squared(1.0, true);
     for (int c = 0; c < 4; ++c) {
-      const S v = P[i](c, c) + kDrift[c * kDof + i];
-      P[i](c, c) = v < kPrior[c * kDof + i] ? v : kPrior[c * kDof + i];
+      const S p = P[i](c, c), v = p + kDrift[c * kDof + i], top = kPrior[c * kDof + i];
+      P[i](c, c) = v < top ? v : (p < top ? top : p);
     }
   }
+
 };
 
 }  // namespace osc

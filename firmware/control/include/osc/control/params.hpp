@@ -128,6 +128,18 @@ constexpr double kIdentifyDrift = 0.3;
 constexpr int kIdentifyNoiseSamples = 256;
 /// A coefficient is reported identified when its standard deviation is at most this fraction of it.
 constexpr double kIdentifiedFraction = 0.025;
+/// The excitation monitor's gate on the Coulomb / Stribeck split: the split is learned only while the
+/// recent motion makes the Stribeck decay column, sgn(qd) (exp(-tau_dec qd^2) - 1), vary independently
+/// of the viscous and Coulomb columns by at least this much (RMS, a fraction of the Stribeck level).
+/// A sinusoid of 0.15 rad/s gives 0.003, of 0.4 rad/s 0.012, of 0.8-1.5 rad/s 0.025-0.03 (tau_dec = 1):
+/// the decay is nearly a line in the speed, so the split shows only in what a line leaves. Below the
+/// gate the two levels are collinear: their sum is learned and their split held (a Schmidt, or
+/// consider, update), as a misfit of a few hundredths of a N m would move it by newtons.
+/// The motion's moments are averaged over blocks of kIdentifyExciteBlock counted samples per joint,
+/// and the blocks over kIdentifyExciteBlocks of them (4 096 samples, about 25 s of motion).
+constexpr double kIdentifySplitExcitation = 0.02;
+constexpr int kIdentifyExciteBlock = 64;
+constexpr int kIdentifyExciteBlocks = 64;
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
 /// heavier (corke) friction preset (7.0 mm, 0.43 deg).
