@@ -614,6 +614,10 @@ def identification_report():
         cells.append(f"{th[6 + j] + th[12 + j]:.2f} ± {ident['breakaway_sd'][j]:.3f} "
                      f"({true[6 + j] + true[12 + j]:.2f}) {verdict}")
     lines.append("| τ_cou + τ_sti [N·m] | " + " | ".join(cells) + " |")
+    gate = parse_params("kIdentifySplitExcitation", 1)[0]
+    cells = [f"{e:.4f} {'**learned**' if learned else 'held'}"
+             for e, learned in zip(ident["split_excitation"], ident["split_learned"])]
+    lines.append(f"| Stribeck decay excitation (gate {gate:g}): the split | " + " | ".join(cells) + " |")
     return "\n".join(lines)
 
 

@@ -139,3 +139,48 @@ TEST(FrictionIdentification, HoldingStillLearnsNothingAndAClearChangesNothing) {
     EXPECT_EQ(sim.task().machine.state, osc::MotionState::kHolding);
   }
 }
+
+// One short move repeated (3 cm along x and back, as scripts/repeat_move.py's hour, here for a
+// minute): the move does not excite the Coulomb / Stribeck split (its decay excitation stays below
+// the gate), so every joint's Stribeck level is held bit for bit while its samples still count, and
+// the sums the paper's motion identified hold within 1 %.
+TEST(FrictionIdentification, RepeatedShortMoveHoldsTheUnexcitedSplit) {
+  MotionSim<double> sim(osc::joint_vector<double>(osc::robot::kQStart));
+  sim.task().gains.adaptation = osc::AdaptationLaw::kMomentum;
+  std::uint32_t faults = 0;
+  auto run = [&](int ticks) {
+    for (int k = 0; k < ticks; ++k) faults |= sim.tick();
+  };
+  sim.command(osc::MotionVerb::kEnable, 1);
+  run(500);
+  sim.command(osc::MotionVerb::kPaper, 2);
+  run(30000);
+  sim.command(osc::MotionVerb::kStop, 3);
+  run(4000);
+  ASSERT_EQ(sim.task().machine.state, osc::MotionState::kHolding);
+  const osc::FrictionIdentifier<double> before = sim.task().identifier;
+  std::uint32_t id = 4;
+  double dx = 0.03;
+  for (int k = 0; k < 60000; ++k) {
+    if (sim.idle() && sim.task().machine.state == osc::MotionState::kHolding) {
+      osc::MoveRequest<double> r;
+      r.position = osc::Vec3<double>(dx, 0, 0);
+      r.relative = true;
+      sim.move_to(r, id++);
+      dx = -dx;
+    }
+    faults |= sim.tick();
+  }
+  EXPECT_EQ(faults, 0u);
+  EXPECT_GT(id, 40u);  // the moves were made
+  const osc::FrictionIdentifier<double>& after = sim.task().identifier;
+  for (int j = 1; j < 3; ++j)  // J2 and J3 carry the move (J1 hardly turns)
+    EXPECT_GT(after.updates[j], before.updates[j] + 100) << "J" << j + 1 << ": the move's samples count";
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_LT(after.decay_excitation(j), osc::params::kIdentifySplitExcitation) << "J" << j + 1;
+    EXPECT_EQ(after.z[j](2), before.z[j](2)) << "J" << j + 1 << ": the Stribeck level held";
+    EXPECT_EQ(after.P[j](2, 2), before.P[j](2, 2)) << "J" << j + 1;
+    const double sum_before = before.z[j](1), sum_after = after.z[j](1);  // the filter's coordinate cou + sti
+    EXPECT_NEAR(sum_after, sum_before, 0.01 * sum_before) << "J" << j + 1;
+  }
+}
