@@ -198,8 +198,8 @@ void converges_on_noisy_samples() {
   EXPECT_GE(id.decay_excitation(1), params::kIdentifySplitExcitation);
   EXPECT_LT(std::abs(static_cast<double>(theta(kDof + 1)) - truth(1)), 4 * std::sqrt(id.variance(1, 1)));
   EXPECT_LT(std::abs(static_cast<double>(theta(2 * kDof + 1)) - truth(2)), 4 * std::sqrt(id.variance(1, 2)));
-  EXPECT_LT(std::sqrt(id.variance(1, 2)), 0.5 * std::sqrt(FrictionIdentifier<double>::prior(1)(2, 2)) /
-                                              FrictionIdentifier<double>::scale_of(1));
+  EXPECT_LT(std::sqrt(id.variance(1, 2)),
+            0.5 * std::sqrt(FrictionIdentifier<double>::prior(1)(2, 2)) / FrictionIdentifier<double>::scale_of(1));
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }
@@ -220,8 +220,8 @@ TEST(FrictionIdentifier, CollinearMotionLearnsTheSumAndHoldsTheSplit) {
   for (std::size_t k = 0; k < d.y.size(); ++k) id.update(1, sample_of(d, k), true, 1.0, 1.0, theta, theta_max);
   EXPECT_GT(id.updates[1], 19900u);
   EXPECT_LT(id.decay_excitation(1), 0.2 * params::kIdentifySplitExcitation);
-  EXPECT_EQ(id.z[1](2), 1.5 * sc);      // held, bit for bit
-  EXPECT_EQ(id.P[1](2, 2), sti_var);    // and its variance with it (the prior: the random walk's cap)
+  EXPECT_EQ(id.z[1](2), 1.5 * sc);    // held, bit for bit
+  EXPECT_EQ(id.P[1](2, 2), sti_var);  // and its variance with it (the prior: the random walk's cap)
   const double sum = theta(kDof + 1) + theta(2 * kDof + 1);
   EXPECT_NEAR(sum, truth(1) + truth(2), 4 * std::sqrt(id.breakaway_variance(1)));
   EXPECT_TRUE(friction_identified(sum, std::sqrt(id.breakaway_variance(1))));

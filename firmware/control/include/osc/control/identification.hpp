@@ -95,7 +95,7 @@ struct FrictionIdentifier {
   Mat3 block[kDof];              // the current block's sums of them
   Vec6<S> split_excitation;      // the decay column's mean square unexplained by the others, times kDecayScale^2
   std::uint8_t block_count[kDof];
-  std::uint8_t turn;             // the joint of the next update
+  std::uint8_t turn;  // the joint of the next update
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
   /// The prior: theta^ anywhere from 0 to the band's top (robot::kModelErrorBounds), no counters.
@@ -191,8 +191,8 @@ struct FrictionIdentifier {
   /// becomes the decay's mean square not explained by the other two columns. Returns whether the
   /// Coulomb / Stribeck split is excited enough to be learned.
   bool excite(int i, const Vec4& phi) {
-    static constexpr S kGate = lit<S>(kDecayScale * kDecayScale * params::kIdentifySplitExcitation *
-                                      params::kIdentifySplitExcitation);
+    static constexpr S kGate =
+        lit<S>(kDecayScale * kDecayScale * params::kIdentifySplitExcitation * params::kIdentifySplitExcitation);
     const Vec3<S> w(phi(0), phi(1), phi(2) * lit<S>(kDecayScale));
     Mat3& b = block[i];
     for (int r = 0; r < 3; ++r)
@@ -261,8 +261,9 @@ struct FrictionIdentifier {
   /// squared (N m s/rad, N m) [host, double].
   double variance(int i, int c) const {
     const Mat4& p = P[i];
-    const double v = c == 1 ? static_cast<double>(p(1, 1)) + static_cast<double>(p(2, 2)) - 2 * static_cast<double>(p(1, 2))
-                            : static_cast<double>(p(c, c));
+    const double v =
+        c == 1 ? static_cast<double>(p(1, 1)) + static_cast<double>(p(2, 2)) - 2 * static_cast<double>(p(1, 2))
+               : static_cast<double>(p(c, c));
     return v / square(scale_of(i));
   }
   /// Joint i's variance of the Coulomb and Stribeck levels' sum (the breakaway torque's) [N^2 m^2].
@@ -344,7 +345,6 @@ struct FrictionIdentifier {
       P[i](c, c) = v < top ? v : (p < top ? top : p);
     }
   }
-
 };
 
 }  // namespace osc
