@@ -63,7 +63,10 @@ struct FrictionSample {
 };
 
 /// What one joint's identification step did (for its counters and the tests).
-enum class IdentifyOutcome : std::uint8_t { kUpdated, kNotSettled, kResidualHigh, kOutlier };
+/// kFolded: the sample's turn went to the excitation monitor's block of moments (fold), one in
+/// params::kIdentifyExciteBlock + 1 counted turns, so that no tick does both (the budget is the worst
+/// tick's).
+enum class IdentifyOutcome : std::uint8_t { kUpdated, kNotSettled, kResidualHigh, kOutlier, kFolded };
 
 /// The excitation monitor's verdict on one coefficient (or a sum of them) and its standard
 /// deviation sd: identified when sd is at most params::kIdentifiedFraction of its value, so that a
@@ -134,6 +137,10 @@ struct FrictionIdentifier {
     drift(i);
     if (!s.settled) return IdentifyOutcome::kNotSettled;
     if (!residual_low) return IdentifyOutcome::kResidualHigh;
+    if (block_count[i] >= params::kIdentifyExciteBlock) {
+      fold(i);
+      return IdentifyOutcome::kFolded;
+    }
     static constexpr std::array<S, kDof> kUnscale = per_joint([](int j) { return 1 / scale_of(j); });
     static constexpr std::array<S, kDof> kInverseTorque =
         per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
@@ -185,11 +192,9 @@ struct FrictionIdentifier {
     if (!split) gain(2) = S(0);
     return gain;
   }
-  /// The excitation monitor's gate: joint i's counted sample phi goes into the windowed moments of
-  /// its (vis, cou, decay) columns, decay = sti - cou; at each block's end the moments take the
-  /// block's mean (an average over params::kIdentifyExciteBlocks blocks) and split_excitation(i)
-  /// becomes the decay's mean square not explained by the other two columns. Returns whether the
-  /// Coulomb / Stribeck split is excited enough to be learned.
+  /// The excitation monitor's gate: joint i's counted sample phi (the filter's coordinates) goes
+  /// into the block of moments of its (vis, cou, decay) columns, decay = sti - cou (fold takes the
+  /// full block). Returns whether the Coulomb / Stribeck split is excited enough to be learned.
   bool excite(int i, const Vec4& phi) {
     static constexpr S kGate =
         lit<S>(kDecayScale * kDecayScale * params::kIdentifySplitExcitation * params::kIdentifySplitExcitation);
@@ -197,19 +202,24 @@ struct FrictionIdentifier {
     Mat3& b = block[i];
     for (int r = 0; r < 3; ++r)
       for (int c = r; c < 3; ++c) b(r, c) += w(r) * w(c);
-    if (++block_count[i] >= params::kIdentifyExciteBlock) {
-      static constexpr S kMean = lit<S>(1.0 / params::kIdentifyExciteBlock);
-      static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyExciteBlocks);
-      Mat3& m = moments[i];
-      for (int r = 0; r < 3; ++r)
-        for (int c = r; c < 3; ++c) {
-          m(r, c) += kAverage * (b(r, c) * kMean - m(r, c));
-          b(r, c) = S(0);
-        }
-      block_count[i] = 0;
-      split_excitation(i) = decay_unexplained(m);
-    }
+    ++block_count[i];
     return split_excitation(i) >= kGate;
+  }
+  /// A full block of joint i: the moments take its mean (an average over
+  /// params::kIdentifyExciteBlocks blocks), and split_excitation(i) becomes the decay's mean square
+  /// not explained by the other two columns.
+  void fold(int i) {
+    static constexpr S kMean = lit<S>(1.0 / params::kIdentifyExciteBlock);
+    static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyExciteBlocks);
+    Mat3& b = block[i];
+    Mat3& m = moments[i];
+    for (int r = 0; r < 3; ++r)
+      for (int c = r; c < 3; ++c) {
+        m(r, c) += kAverage * (b(r, c) * kMean - m(r, c));
+        b(r, c) = S(0);
+      }
+    block_count[i] = 0;
+    split_excitation(i) = decay_unexplained(m);
   }
   /// The Schur complement of the decay column in the moments m (upper triangle): its mean square
   /// less what the Coulomb and viscous columns explain of it, eliminated in that order (an LDL^T
