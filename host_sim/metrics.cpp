@@ -223,8 +223,7 @@ void FrictionEstimates::to_json(Json& j) const {
   id["breakaway_sd"] = json_array(breakaway_sd, 6);
   // The Coulomb / Stribeck split's excitation and whether it is learned (its gate).
   id["split_excitation"] = json_array(split_excitation, 6);
-  for (int i = 0; i < 6; ++i)
-    id["split_learned"].push_back(split_excitation[i] >= osc::params::kIdentifySplitExcitation);
+  for (int i = 0; i < 6; ++i) id["split_learned"].push_back(osc::split_excited(split_excitation[i]));
   for (int i = 0; i < 18; ++i) id["theta_identified"].push_back(osc::friction_identified(theta_hat[i], theta_sd[i]));
   for (int i = 0; i < 6; ++i)
     id["breakaway_identified"].push_back(

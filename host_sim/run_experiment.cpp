@@ -127,7 +127,7 @@ void print_friction_table(const sim::ExperimentResult& ad) {
     std::printf("%-20s", "  split excitation");
     for (int j = 0; j < 6; ++j)
       std::printf(" %6.3f %-7s", ad.split_excitation[j],
-                  ad.split_excitation[j] >= osc::params::kIdentifySplitExcitation ? "learned" : "held");
+                  osc::split_excited(ad.split_excitation[j]) ? "learned" : "held");
     std::printf("\n  (the Stribeck decay's RMS excitation; the split is learned at %.2f and above)\n",
                 osc::params::kIdentifySplitExcitation);
   }

@@ -105,6 +105,24 @@ TEST(FrictionIdentification, CorkeFrictionIsIdentifiedToo) {
   for (int a = 0; a < 3; ++a) EXPECT_LE(after[a], kPaperTable1[a] / 2) << "axis " << a;
 }
 
+/// Enables the simulated arm, runs the paper's motion for `paper_ticks`, stops it and lets it settle
+/// into holding (4 s); returns the fault bits seen.
+namespace {
+std::uint32_t learn_then_hold(MotionSim<double>& sim, int paper_ticks) {
+  std::uint32_t faults = 0;
+  auto run = [&](int ticks) {
+    for (int k = 0; k < ticks; ++k) faults |= sim.tick();
+  };
+  sim.command(osc::MotionVerb::kEnable, 1);
+  run(500);
+  sim.command(osc::MotionVerb::kPaper, 2);
+  run(paper_ticks);
+  sim.command(osc::MotionVerb::kStop, 3);
+  run(4000);
+  return faults;
+}
+}  // namespace
+
 // Holding still, the momentum law learns nothing: theta^ is bit for bit the one the stop ended with
 // (no sample counts while a joint does not move; the robust law's leakage would pull it toward 0).
 // And a clear outside a fault, accepted, changes nothing: the monitors it restarts start from the
@@ -116,16 +134,10 @@ TEST(FrictionIdentification, HoldingStillLearnsNothingAndAClearChangesNothing) {
     MotionSim<double> sim(osc::joint_vector<double>(osc::robot::kQStart));
     sim.task().gains.adaptation = osc::AdaptationLaw::kMomentum;
     sim.task().residual.armed = armed;
-    std::uint32_t faults = 0;
+    std::uint32_t faults = learn_then_hold(sim, 20000);
     auto run = [&](int ticks) {
       for (int k = 0; k < ticks; ++k) faults |= sim.tick();
     };
-    sim.command(osc::MotionVerb::kEnable, 1);
-    run(500);
-    sim.command(osc::MotionVerb::kPaper, 2);
-    run(20000);
-    sim.command(osc::MotionVerb::kStop, 3);
-    run(4000);
     ASSERT_EQ(sim.task().machine.state, osc::MotionState::kHolding);
     const osc::Vec18<double> held = sim.task().state.adapt.theta_hat;
     EXPECT_GT(held(osc::kDof + 1), 1.0);  // J2's Coulomb level: learnt during the motion
@@ -147,16 +159,7 @@ TEST(FrictionIdentification, HoldingStillLearnsNothingAndAClearChangesNothing) {
 TEST(FrictionIdentification, RepeatedShortMoveHoldsTheUnexcitedSplit) {
   MotionSim<double> sim(osc::joint_vector<double>(osc::robot::kQStart));
   sim.task().gains.adaptation = osc::AdaptationLaw::kMomentum;
-  std::uint32_t faults = 0;
-  auto run = [&](int ticks) {
-    for (int k = 0; k < ticks; ++k) faults |= sim.tick();
-  };
-  sim.command(osc::MotionVerb::kEnable, 1);
-  run(500);
-  sim.command(osc::MotionVerb::kPaper, 2);
-  run(30000);
-  sim.command(osc::MotionVerb::kStop, 3);
-  run(4000);
+  std::uint32_t faults = learn_then_hold(sim, 30000);
   ASSERT_EQ(sim.task().machine.state, osc::MotionState::kHolding);
   const osc::FrictionIdentifier<double> before = sim.task().identifier;
   std::uint32_t id = 4;

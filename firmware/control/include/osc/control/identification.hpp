@@ -75,6 +75,11 @@ constexpr bool friction_identified(double value, double sd) {
   return sd <= params::kIdentifiedFraction * (value < 0 ? -value : value);
 }
 
+/// The excitation monitor's verdict on a joint's Coulomb / Stribeck split, from its decay excitation
+/// (FrictionIdentifier::decay_excitation): learned at params::kIdentifySplitExcitation and above,
+/// otherwise held.
+constexpr bool split_excited(double decay_excitation) { return decay_excitation >= params::kIdentifySplitExcitation; }
+
 template <class S>
 struct FrictionIdentifier {
   using Vec4 = Eigen::Matrix<S, 4, 1>;
