@@ -898,7 +898,7 @@ ESTIMATE_RANGES = [("amp_lag", 0.2e-3, 0.5e-3, ()), ("ripple", 0.01, 0.05, ("--p
                    ("backlash", 0.1e-3, 1e-3, ()), ("elastic_hz", 15, 25, ())]
 
 
-RESONANCE_HZ = [25, 20, 15, 12, 10, 8, 6, 5, 4, 3]
+RESONANCE_HZ = [25, 20, 15, 12, 10, 8, 6, 5, 4, 3, 2, 1.5, 1]
 RESONANCE = ("--duration", "60", "--mode", "adaptive", "--plant", "realistic")
 
 

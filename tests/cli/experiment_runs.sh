@@ -44,16 +44,16 @@ and j['differs_from_paper']==['run.duration','trajectory.amplitude'] and not j['
   has_line "$d/plot.log" 'titles: .*trajectory.amplitude=0.1'
   test -f "$d/observer_errors.png" || fail "no observer_errors.png"
   ;;
-fault_is_named_and_plotted)  # 0.2 m at 2 Hz is more than the robot can follow: the stuck-encoder monitor trips
+fault_is_named_and_plotted)  # 0.2 m at 2 Hz is more than the robot can follow: the DAC range saturates (the saturation monitor trips)
   "$exe" --duration 2 --mode adaptive --no-progress --set trajectory.amplitude=0.2 --set trajectory.period=0.5 \
     --set trajectory.envelope=10 --csv-dir "$d" --json "$d/summary.json" >"$d/run.log"
   status=$?
   test $status -eq 1 || fail "exit $status, not 1"
-  has_line "$d/run.log" 'FAULT encoder_stuck at tick 359, t = 0.359 s'
+  has_line "$d/run.log" 'FAULT saturation at tick 483, t = 0.483 s'
   has_line "$d/run.log" 'q .deg.:'
   has_line "$d/run.log" '(faulted)'
   plot
-  has_line "$d/plot.log" 'fault encoder_stuck at t = 0.359 s (tick 359): marked'
+  has_line "$d/plot.log" 'fault saturation at t = 0.483 s (tick 483): marked'
   test -f "$d/fig1_tracking_errors.png" || fail "no fig1_tracking_errors.png"
   ;;
 *)

@@ -154,6 +154,7 @@ struct StuckRig {
   StuckEncoderMonitor<S> m;
   Vec6<math::io_scalar_t<S>> cpr;
   StepOutput<S> out{};
+  std::int32_t counts[kDof] = {};
   std::uint64_t tick = 0;
   StuckRig() {
     m.reset();
@@ -161,11 +162,11 @@ struct StuckRig {
     out.tau.setZero();
     out.qd_ref.setZero();
   }
-  /// One tick; `moved`: every encoder counted.
-  std::uint32_t step(bool moved_all) {
+  /// One tick; `moved_all`: every encoder counted, by `way` counts.
+  std::uint32_t step(bool moved_all, std::int32_t way = 1) {
     bool moved[kDof];
-    for (bool& b : moved) b = moved_all;
-    return m.check(out.tau, out.qd_ref, moved, tick++, lit<S>(params::kDt), cpr);
+    for (int i = 0; i < kDof; ++i) moved[i] = moved_all, counts[i] += moved_all ? way : 0;
+    return m.check(out.tau, out.qd_ref, counts, moved, tick++, lit<S>(params::kDt), cpr);
   }
 };
 
@@ -180,7 +181,14 @@ TYPED_TEST(Monitors, StuckEncoderTorqueChangeWhileStill) {
     // wait kStuckIntervals of its 1000-tick interval).
     r.out.tau(j) = lit<S>(5 - 0.95 * params::kStuckTorque[j]);
     for (int k = 0; k < 100; ++k) ASSERT_EQ(r.step(false), 0u) << j << " " << k;
+    // Beyond it: a fault once it has held for kStuckQualifyTicks ticks in a row. A tick back
+    // within it starts the count again.
     r.out.tau(j) = lit<S>(5 + 1.05 * params::kStuckTorque[j]);
+    for (int k = 1; k < params::kStuckQualifyTicks; ++k) ASSERT_EQ(r.step(false), 0u) << j << " " << k;
+    r.out.tau(j) = lit<S>(5);
+    ASSERT_EQ(r.step(false), 0u) << j;
+    r.out.tau(j) = lit<S>(5 + 1.05 * params::kStuckTorque[j]);
+    for (int k = 1; k < params::kStuckQualifyTicks; ++k) ASSERT_EQ(r.step(false), 0u) << j << " " << k;
     EXPECT_EQ(r.step(false), kFaultEncoderStuck) << j;
     EXPECT_GE(static_cast<double>(r.m.dtau_peak(j)), 1.04 * params::kStuckTorque[j]);
   }
@@ -201,7 +209,8 @@ TYPED_TEST(Monitors, StuckEncoderSilentWhileTheReferenceMoves) {
   for (int k = 1; k <= 2 * expect && fault_tick < 0; ++k)
     if (r.step(false) & kFaultEncoderStuck) fault_tick = k;
   EXPECT_NEAR(fault_tick, expect + 1, 2);
-  // A joint that was counting fast also faults on the smaller silent torque change.
+  // A joint that was counting fast also faults on the smaller silent torque change: at once when
+  // the silence is long enough, the change having lasted since (qualified); ...
   StuckRig<S> t;
   for (int k = 0; k < 5; ++k) ASSERT_EQ(t.step(true), 0u);
   t.out.tau(j) = lit<S>(1.05 * params::kStuckTorqueSilent[j]);
@@ -209,6 +218,39 @@ TYPED_TEST(Monitors, StuckEncoderSilentWhileTheReferenceMoves) {
   for (int k = 1; k <= 3 * params::kStuckIntervals && first < 0; ++k)
     if (t.step(false) & kFaultEncoderStuck) first = k;
   EXPECT_EQ(first, params::kStuckIntervals + 1);
+  // ... or once it has lasted kStuckQualifyTicks ticks, a change that came after the silence did.
+  StuckRig<S> u;
+  for (int k = 0; k < 5; ++k) ASSERT_EQ(u.step(true), 0u);
+  first = -1;
+  for (int k = 1; k <= 3 * params::kStuckIntervals && first < 0; ++k) {
+    u.out.tau(j) = lit<S>(k > params::kStuckIntervals ? 1.05 * params::kStuckTorqueSilent[j] : 0.0);
+    if (u.step(false) & kFaultEncoderStuck) first = k;
+  }
+  EXPECT_EQ(first, params::kStuckIntervals + params::kStuckQualifyTicks);
+}
+
+TYPED_TEST(Monitors, StuckEncoderDitherIsNoMovingJoint) {
+  using S = TypeParam;
+  // An encoder dithering by a count every tick, both ways, as an edge under the sensor does at rest:
+  // its interval is 1 tick, but it was not counting one way. Then silent, with a torque change above
+  // the moving joint's silent threshold and below the still joint's: no fault (the compensation's
+  // sign flips at rest by twice the Coulomb + Stribeck level, 18 N m on J2).
+  for (int j = 0; j < kDof; ++j) {
+    StuckRig<S> r;
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(r.step(true, k % 2 ? -1 : 1), 0u);
+    const double between = (params::kStuckTorqueSilent[j] + params::kStuckTorque[j]) / 2;
+    r.out.tau(j) = lit<S>(between);
+    for (int k = 0; k < 4 * params::kStuckIntervals; ++k) ASSERT_EQ(r.step(false), 0u) << j << " " << k;
+    EXPECT_EQ(static_cast<double>(r.m.dtau_gated_peak(j)), 0.0) << j;
+    // The same torque after counting one way: the silent criterion trips.
+    StuckRig<S> t;
+    for (int k = 0; k < 6; ++k) ASSERT_EQ(t.step(true, -1), 0u);
+    t.out.tau(j) = lit<S>(between);
+    int first = -1;
+    for (int k = 1; k <= 4 * params::kStuckIntervals && first < 0; ++k)
+      if (t.step(false) & kFaultEncoderStuck) first = k;
+    EXPECT_EQ(first, params::kStuckIntervals + 1) << j;
+  }
 }
 
 /// Cycles advance by a different amount at each call, so each stage has its own length.

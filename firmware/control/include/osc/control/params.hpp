@@ -84,6 +84,10 @@ constexpr int kStuckFastInterval = 5;
 /// ... and the encoder has been silent for more than this many of its recent intervals between
 /// counts.
 constexpr int kStuckIntervals = 10;
+/// A torque criterion counts once it has held for this many ticks in a row: a torque beyond it for
+/// a tick or two (the compensation's sign flipping with the velocity estimate at a reversal) moves
+/// a joint by a fraction of a count before the amplifier's lag and the inertia let it count.
+constexpr int kStuckQualifyTicks = 3;
 /// The residual monitor (osc/runtime/monitors.hpp; docs/safety.md, "The residual monitor"):
 /// - the bandwidth of its first-order filter per joint [1/s]: 50 on J1-J3 (a torque step of three
 ///   times a threshold crosses it within 8 ms); 20 on the wrist, whose velocity estimate comes from

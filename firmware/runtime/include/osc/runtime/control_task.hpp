@@ -203,7 +203,8 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
   else
-    faults = task.stuck.check(tau, rate, moved, task.tick, task.gains.dt, task.io.counts_per_rad, task.residual.armed);
+    faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad,
+                              task.residual.armed);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();

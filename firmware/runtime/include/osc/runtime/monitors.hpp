@@ -95,8 +95,58 @@ struct EncoderJumpMonitor {
   }
 };
 
-/// Longest interval between encoder changes the stuck-encoder monitor keeps [ticks].
+/// Longest interval between encoder changes the monitors keep [ticks].
 constexpr std::uint32_t kStuckIntervalCap = 1u << 20;
+
+/// Each encoder channel's recent activity, from EncoderJumpMonitor's moved: when it last changed,
+/// the interval between its last two changes, and their directions. A joint counts one way only if
+/// its last two changes had the same sign: an encoder dithering by a count at rest (an edge under
+/// the sensor, a joint held against static friction) changes every tick or two, both ways, and is
+/// not a moving joint.
+struct EncoderActivity {
+  std::uint64_t last_move_tick[kDof];  // tick of each encoder's last change
+  std::uint32_t move_interval[kDof];   // ticks between its last two changes (its recent count rate)
+  std::int32_t last_counts[kDof];      // its reading at its last change
+  std::int8_t direction[kDof];         // the sign of its last change
+  bool steady[kDof];                   // its last two changes had the same sign
+
+  void reset() {
+    for (int i = 0; i < kDof; ++i)
+      last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, last_counts[i] = 0, direction[i] = 0,
+      steady[i] = false;
+  }
+  /// Channel i changed (or is taken as changed) at `tick`.
+  void mark(int i, std::uint64_t tick) {
+    const std::uint64_t gap = tick - last_move_tick[i];
+    move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
+    last_move_tick[i] = tick;
+  }
+  void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
+    for (int i = 0; i < kDof; ++i) {
+      if (!moved[i]) continue;
+      const std::int8_t way = counts[i] > last_counts[i] ? 1 : -1;
+      steady[i] = way == direction[i];
+      direction[i] = way;
+      last_counts[i] = counts[i];
+      mark(i, tick);
+    }
+  }
+  /// Every channel taken as just changed at `tick`, from `counts`; none counts one way yet.
+  void restart(const std::int32_t counts[kDof], std::uint64_t tick) {
+    for (int i = 0; i < kDof; ++i) last_counts[i] = counts[i], steady[i] = false, mark(i, tick);
+  }
+  /// Channel c has been silent for more than params::kStuckIntervals of its recent intervals.
+  bool silent(int c, std::uint64_t tick) const {
+    const std::uint64_t quiet = tick - last_move_tick[c];
+    return move_interval[c] < kStuckIntervalCap &&
+           quiet > static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[c];
+  }
+  /// Channel c was counting one way, fast: its last two changes of one sign, at most
+  /// params::kStuckFastInterval ticks apart.
+  bool was_fast(int c) const {
+    return steady[c] && move_interval[c] <= static_cast<std::uint32_t>(params::kStuckFastInterval);
+  }
+};
 /// The stuck-encoder monitor's accumulated reference motion is held at this bound [counts]: ten
 /// times its threshold, so no decision changes, and within the range of every scalar.
 constexpr double kStuckMotionBound = 10 * params::kStuckMotionCounts;
@@ -111,15 +161,20 @@ constexpr double kStuckMotionBound = 10 * params::kStuckMotionCounts;
 /// The peaks are the monitor's headroom, reported by the runner (docs/safety.md).
 template <class S>
 struct StuckEncoderMonitor {
-  Vec6<S> motion;                      // reference motion since each encoder's last change [counts]
-  std::uint64_t last_move_tick[kDof];  // tick of each encoder's last change
-  std::uint32_t move_interval[kDof];   // ticks between its last two changes (its recent count rate)
-  Vec6<S> tau_at_move;                 // the torque commanded at each encoder's last change
-  Vec6<S> dtau_peak;                   // the largest torque change seen while an encoder stood still
-  Vec6<S> dtau_gated_peak;             // ... while it was silent for kStuckIntervals of its intervals
-  Vec6<S> peak;                        // the largest motion seen
-  bool restart = false;                // the next check takes every encoder as just changed
+  Vec6<S> motion;                  // reference motion since each encoder's last change [counts]
+  EncoderActivity activity;        // each encoder's changes (restarted with the monitor)
+  Vec6<S> tau_at_move;             // the torque commanded at each encoder's last change
+  Vec6<S> dtau_peak;               // the largest torque change seen while an encoder stood still
+  Vec6<S> dtau_gated_peak;         // ... while it was silent for kStuckIntervals of its intervals
+  Vec6<S> peak;                    // the largest motion seen
+  std::uint8_t over[kDof];         // consecutive ticks the torque change has been beyond kStuckTorque
+  std::uint8_t over_silent[kDof];  // ... beyond kStuckTorqueSilent
+  bool restart = false;            // the next check takes every encoder as just changed
 
+  /// A run of ticks that a criterion has held, one tick on.
+  static std::uint8_t qualify(std::uint8_t run, bool holds) {
+    return holds ? static_cast<std::uint8_t>(run < 255 ? run + 1 : 255) : std::uint8_t{0};
+  }
   /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
   /// the torque jumps from zero to what holds the arm, and no encoder needs to count for that).
   void reset(bool restart_next = false) {
@@ -129,19 +184,17 @@ struct StuckEncoderMonitor {
     tau_at_move.setZero();
     dtau_peak.setZero();
     dtau_gated_peak.setZero();
-    for (int i = 0; i < kDof; ++i) {
-      last_move_tick[i] = 0;
-      move_interval[i] = kStuckIntervalCap;
-    }
+    activity.reset();
+    for (int i = 0; i < kDof; ++i) over[i] = 0, over_silent[i] = 0;
   }
   /// After the step of tick `tick` that commanded the motor torques `tau` and reference motor rates
   /// `qd_ref` (both per encoder channel: the joints' own where each encoder reads its joint);
-  /// `moved` from EncoderJumpMonitor. backstop: behind the armed residual monitor, the torque
-  /// criterion alone (kStuckTorque, beyond the torque that breaks any joint away from its static
-  /// friction); the criteria tuned on the paper's trajectory are off (the reference motion while
-  /// silent trips on slow moves of a joint that static friction holds, Corke's J1; the silent-torque
-  /// one on the realistic plant).
-  std::uint32_t check(const Vec6<S>& tau, const Vec6<S>& qd_ref, const bool moved[kDof], std::uint64_t tick, S dt,
+  /// `counts` and `moved` from EncoderJumpMonitor. backstop: behind the armed residual monitor, the
+  /// torque criterion alone (kStuckTorque, beyond the torque that breaks any joint away from its
+  /// static friction); the criteria tuned on the paper's trajectory are off (the reference motion
+  /// while silent trips on slow moves of a joint that static friction holds, Corke's J1).
+  std::uint32_t check(const Vec6<S>& tau, const Vec6<S>& qd_ref, const std::int32_t counts[kDof],
+                      const bool moved[kDof], std::uint64_t tick, S dt,
                       const Vec6<math::io_scalar_t<S>>& counts_per_rad, bool backstop = false) {
     static constexpr std::array<S, kDof> kTorque = lit_array<S>(params::kStuckTorque);
     static constexpr std::array<S, kDof> kTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
@@ -149,31 +202,36 @@ struct StuckEncoderMonitor {
     std::uint32_t faults = 0;
     const bool fresh = restart;
     restart = false;
+    if (fresh)
+      activity.restart(counts, tick);
+    else
+      activity.track(counts, moved, tick);
     for (int i = 0; i < kDof; ++i) {
       S& m = motion(i);
       if (moved[i] || fresh) {
-        const std::uint64_t gap = tick - last_move_tick[i];
-        move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
-        last_move_tick[i] = tick;
         m = S(0);
         tau_at_move(i) = tau(i);
+        over[i] = 0, over_silent[i] = 0;
         continue;
       }
       const S dtau = math::abs(tau(i) - tau_at_move(i));
       if (dtau > dtau_peak(i)) dtau_peak(i) = dtau;
-      if (dtau > kTorque[i]) faults |= kFaultEncoderStuck;
+      // A torque criterion counts once the change has lasted params::kStuckQualifyTicks ticks.
+      over[i] = qualify(over[i], dtau > kTorque[i]);
+      over_silent[i] = qualify(over_silent[i], dtau > kTorqueSilent[i]);
+      if (over[i] >= params::kStuckQualifyTicks) faults |= kFaultEncoderStuck;
       m += math::abs(qd_ref(i)) * dt * counts_per_rad(i);
       if (m > kMotionBound) m = kMotionBound;
       // Silent for many times its recent interval: a joint that was slowing down, as at a reversal
       // held by static friction, had long intervals already.
-      const std::uint64_t silent = tick - last_move_tick[i];
-      if (silent <= static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[i]) continue;
+      if (!activity.silent(i, tick)) continue;
       if (m > peak(i)) peak(i) = m;
       if (backstop) continue;
       if (m > kMotionCounts) faults |= kFaultEncoderStuck;
-      if (move_interval[i] > static_cast<std::uint32_t>(params::kStuckFastInterval)) continue;
+      // A joint that was counting one way fast should have counted on.
+      if (!activity.was_fast(i)) continue;
       if (dtau > dtau_gated_peak(i)) dtau_gated_peak(i) = dtau;
-      if (dtau > kTorqueSilent[i]) faults |= kFaultEncoderStuck;
+      if (over_silent[i] >= params::kStuckQualifyTicks) faults |= kFaultEncoderStuck;
     }
     return faults;
   }
@@ -282,11 +340,7 @@ struct ResidualMonitor {
   Vec6<S> cross_friction;                // set-up: the other motors' static friction a coupling adds [N m]
   S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
   Vec6<S> peak_ratio;                    // the largest |r| / threshold seen per joint
-  std::uint64_t last_move_tick[kDof];    // tick of each encoder's last change
-  std::uint32_t move_interval[kDof];     // ticks between its last two changes
-  std::int32_t last_counts[kDof];        // each encoder's reading at its last change
-  std::int8_t direction[kDof];           // the sign of its last change
-  bool steady[kDof];                     // its last two changes had the same sign
+  EncoderActivity activity;              // each encoder's changes
   std::uint8_t over[kDof];               // consecutive ticks beyond the threshold
   std::uint64_t over_since[kDof];        // the tick the current run of them began
   std::uint32_t detected;                // the first detection's fault (kept while not armed too)
@@ -333,10 +387,8 @@ struct ResidualMonitor {
     change_threshold.setZero();
     tau_prev.setZero();
     peak_ratio.setZero();
-    for (int i = 0; i < kDof; ++i) {
-      last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, over[i] = 0, over_since[i] = 0;
-      last_counts[i] = 0, direction[i] = 0, steady[i] = false;
-    }
+    for (int i = 0; i < kDof; ++i) over[i] = 0, over_since[i] = 0;
+    activity.reset();
     joint = -1;
     detected = 0;
     detected_tick = 0;
@@ -347,36 +399,18 @@ struct ResidualMonitor {
   /// The joint torque that reached the arm over the period that follows this tick.
   void applied(const Vec6<S>& tau) { tau_prev = tau; }
 
-  /// The encoders' activity (EncoderJumpMonitor's moved), per channel.
-  void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
-    for (int i = 0; i < kDof; ++i) {
-      if (!moved[i]) continue;
-      const std::int8_t way = counts[i] > last_counts[i] ? 1 : -1;
-      steady[i] = way == direction[i];
-      direction[i] = way;
-      last_counts[i] = counts[i];
-      const std::uint64_t gap = tick - last_move_tick[i];
-      move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
-      last_move_tick[i] = tick;
-    }
-  }
   /// Channel c's encoder counts one way at its recent pace: its last two changes in the direction
   /// `sign`, the last within twice the interval between them.
   bool counting(int c, S sign, std::uint64_t tick) const {
-    return steady[c] && (direction[c] > 0) == (sign > S(0)) && move_interval[c] < kStuckIntervalCap &&
-           tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
-  }
-  /// Channel c's encoder fell silent at once: more than kStuckIntervals of its recent intervals.
-  bool silent(int c, std::uint64_t tick) const {
-    const std::uint64_t quiet = tick - last_move_tick[c];
-    return move_interval[c] < kStuckIntervalCap &&
-           quiet > static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[c];
+    const EncoderActivity& a = activity;
+    return a.steady[c] && (a.direction[c] > 0) == (sign > S(0)) && a.move_interval[c] < kStuckIntervalCap &&
+           tick - a.last_move_tick[c] <= 2 * static_cast<std::uint64_t>(a.move_interval[c]) + 1;
   }
 
   /// The residual of this step and its faults (see the type's comment).
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
                       const bool moved[kDof], std::uint64_t tick, S dt) {
-    track(counts, moved, tick);
+    activity.track(counts, moved, tick);
     sample.settled = false;
     FrictionError fe[kDof];
     for (int i = 0; i < kDof; ++i) fe[i] = friction_error(in, i, tick);
@@ -578,7 +612,8 @@ struct ResidualMonitor {
   /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
   bool silent_first(int c, int i, std::uint64_t tick) const {
     constexpr std::uint64_t kWindow = params::kControlHz / 4;  // a residual rises within 250 ms of it
-    return silent(c, tick) && last_move_tick[c] <= over_since[i] && over_since[i] - last_move_tick[c] <= kWindow;
+    const std::uint64_t last = activity.last_move_tick[c];
+    return activity.silent(c, tick) && last <= over_since[i] && over_since[i] - last <= kWindow;
   }
   /// The kind of a qualified residual on joint i (the worst).
   std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
