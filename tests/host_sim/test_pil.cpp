@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <thread>
+
+#include <unistd.h>
 
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -201,7 +204,14 @@ TEST(PilClientErrors, CorruptedOrShortFramesAreReported) {
 // ---------------------------------------------------------------- the host applies only valid, in-range codes
 /// A scripted peer: writes the given actuator frames (after its hello) and then stays silent.
 struct ScriptedPeer {
-  std::string path = ::testing::TempDir() + "pil_scripted_peer.bin";
+  /// A file of its own: ctest runs the tests as processes in parallel, and a path they shared let one
+  /// test's peer play another's script.
+  std::string path = ::testing::TempDir() + "pil_scripted_peer_" + std::to_string(::getpid()) + "_" +
+                     std::to_string(next_id()) + ".bin";
+  static int next_id() {
+    static int id = 0;
+    return id++;
+  }
   std::vector<std::uint8_t> bytes;
   void add(const pil::ActuatorFrame& a) {
     std::uint8_t buf[pil::kMaxFrame];
@@ -220,6 +230,9 @@ struct ScriptedPeer {
     return a;
   }
   ScriptedPeer() { add(answer(pil::kHelloSeq, 0)); }
+  ScriptedPeer(const ScriptedPeer&) = delete;
+  ScriptedPeer& operator=(const ScriptedPeer&) = delete;
+  ~ScriptedPeer() { std::remove(path.c_str()); }
 };
 
 TEST(PilClientAmplifiers, OnlyAValidInRangeAnswerToTheTickIsApplied) {
