@@ -98,6 +98,12 @@ struct EncoderJumpMonitor {
 /// Longest interval between encoder changes the monitors keep [ticks].
 constexpr std::uint32_t kStuckIntervalCap = 1u << 20;
 
+/// A run of consecutive ticks that a criterion has held, one tick on (saturating): the monitors'
+/// time qualification.
+constexpr std::uint8_t qualify(std::uint8_t run, bool holds) {
+  return holds ? static_cast<std::uint8_t>(run < 255 ? run + 1 : 255) : std::uint8_t{0};
+}
+
 /// Each encoder channel's recent activity, from EncoderJumpMonitor's moved: when it last changed,
 /// the interval between its last two changes, and their directions. A joint counts one way only if
 /// its last two changes had the same sign: an encoder dithering by a count at rest (an edge under
@@ -141,6 +147,12 @@ struct EncoderActivity {
     return move_interval[c] < kStuckIntervalCap &&
            quiet > static_cast<std::uint64_t>(params::kStuckIntervals) * move_interval[c];
   }
+  /// Channel c counts the way `up` says at its recent pace: its last two changes that way, the last
+  /// within twice the interval between them.
+  bool counting(int c, bool up, std::uint64_t tick) const {
+    return steady[c] && (direction[c] > 0) == up && move_interval[c] < kStuckIntervalCap &&
+           tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
+  }
   /// Channel c was counting one way, fast: its last two changes of one sign, at most
   /// params::kStuckFastInterval ticks apart.
   bool was_fast(int c) const {
@@ -171,10 +183,6 @@ struct StuckEncoderMonitor {
   std::uint8_t over_silent[kDof];  // ... beyond kStuckTorqueSilent
   bool restart = false;            // the next check takes every encoder as just changed
 
-  /// A run of ticks that a criterion has held, one tick on.
-  static std::uint8_t qualify(std::uint8_t run, bool holds) {
-    return holds ? static_cast<std::uint8_t>(run < 255 ? run + 1 : 255) : std::uint8_t{0};
-  }
   /// Clears the monitor. restart: the next check starts afresh from that tick's torques (an enable:
   /// the torque jumps from zero to what holds the arm, and no encoder needs to count for that).
   void reset(bool restart_next = false) {
@@ -399,14 +407,6 @@ struct ResidualMonitor {
   /// The joint torque that reached the arm over the period that follows this tick.
   void applied(const Vec6<S>& tau) { tau_prev = tau; }
 
-  /// Channel c's encoder counts one way at its recent pace: its last two changes in the direction
-  /// `sign`, the last within twice the interval between them.
-  bool counting(int c, S sign, std::uint64_t tick) const {
-    const EncoderActivity& a = activity;
-    return a.steady[c] && (a.direction[c] > 0) == (sign > S(0)) && a.move_interval[c] < kStuckIntervalCap &&
-           tick - a.last_move_tick[c] <= 2 * static_cast<std::uint64_t>(a.move_interval[c]) + 1;
-  }
-
   /// The residual of this step and its faults (see the type's comment).
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
                       const bool moved[kDof], std::uint64_t tick, S dt) {
@@ -446,7 +446,7 @@ struct ResidualMonitor {
       const S ratio = ratio_of(i);
       if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
       if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
-      over[i] = ratio > S(1) ? static_cast<std::uint8_t>(over[i] < 255 ? over[i] + 1 : 255) : std::uint8_t{0};
+      over[i] = qualify(over[i], ratio > S(1));
       if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
     }
     if (worst < 0) return 0;
@@ -521,7 +521,7 @@ struct ResidualMonitor {
     e.ds = larger(c.sti_hi[i] - e.th_s, e.th_s - c.sti_lo[i]);
     // Static friction anywhere within the band, against whatever the estimate says.
     e.still = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
-    e.moving = v > moving && counting(i, in.qd(i), tick);
+    e.moving = v > moving && activity.counting(i, in.qd(i) > S(0), tick);
     return e;
   }
   /// Per joint, the bound on the unexplained torque that changes with the state (then filtered as
