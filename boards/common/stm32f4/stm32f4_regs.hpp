@@ -79,11 +79,30 @@ static_assert(offsetof(RccRegs, AHB1ENR) == 0x30 && offsetof(RccRegs, APB1ENR) =
 
 // ---------------------------------------------------------------- FLASH interface (RM0090 3.9)
 struct FlashRegs {
-  Reg ACR;  // 0x00 access control: LATENCY [2:0] wait states, PRFTEN bit 8, ICEN bit 9, DCEN bit 10
-  Reg KEYR, OPTKEYR, SR, CR, OPTCR;
-  static constexpr std::uint32_t kLatencyMask = 7u, kPrften = 1u << 8, kIcen = 1u << 9, kDcen = 1u << 10;
+  Reg ACR;      // 0x00 access control: LATENCY [2:0] wait states, PRFTEN 8, ICEN 9, DCEN 10, ICRST 11, DCRST 12
+  Reg KEYR;     // 0x04 key: kKey1 then kKey2 clears CR's LOCK (a wrong sequence locks CR until reset)
+  Reg OPTKEYR;  // 0x08 option key (not used)
+  Reg SR;       // 0x0C status: EOP 0, OPERR 1, WRPERR 4, PGAERR 5, PGPERR 6, PGSERR 7 (each cleared by
+                //      writing 1), BSY 16
+  Reg CR;       // 0x10 control: PG 0, SER 1, MER 2, SNB [6:3] (sectors 0-11), PSIZE [9:8], STRT 16,
+                //      EOPIE 24, ERRIE 25, LOCK 31
+  Reg OPTCR;    // 0x14 option control (not used)
+  static constexpr std::uint32_t kLatencyMask = 7u, kPrften = 1u << 8, kIcen = 1u << 9, kDcen = 1u << 10,
+                                 kIcrst = 1u << 11, kDcrst = 1u << 12;
+  static constexpr std::uint32_t kKey1 = 0x45670123u, kKey2 = 0xCDEF89ABu;
+  static constexpr std::uint32_t kEop = 1u << 0, kOperr = 1u << 1, kWrperr = 1u << 4, kPgaerr = 1u << 5,
+                                 kPgperr = 1u << 6, kPgserr = 1u << 7, kBsy = 1u << 16;
+  static constexpr std::uint32_t kErrors = kOperr | kWrperr | kPgaerr | kPgperr | kPgserr;
+  static constexpr std::uint32_t kPg = 1u << 0, kSer = 1u << 1, kSnbMask = 0xFu << 3, kPsizeMask = 3u << 8,
+                                 kStrt = 1u << 16, kLock = 1u << 31;
+  // PSIZE: 0 x8, 1 x16, 2 x32 (the size for 2.7-3.6 V, RM0090 3.6.2), 3 x64 (external VPP)
+  static constexpr std::uint32_t kPsizeX32 = 2u << 8;
+  static constexpr std::uint32_t snb(std::uint32_t sector) { return sector << 3; }
 };
-static_assert(offsetof(FlashRegs, OPTCR) == 0x14, "FLASH register map (RM0090 3.9.7)");
+static_assert(offsetof(FlashRegs, KEYR) == 0x04 && offsetof(FlashRegs, OPTKEYR) == 0x08 &&
+                  offsetof(FlashRegs, SR) == 0x0C && offsetof(FlashRegs, CR) == 0x10 &&
+                  offsetof(FlashRegs, OPTCR) == 0x14,
+              "FLASH register map (RM0090 3.9.7)");
 
 // ---------------------------------------------------------------- GPIO (RM0090 8.4)
 struct GpioRegs {

@@ -8,6 +8,7 @@
 // control task runs for real (ControlTask<double>) over the board's HAL binding.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "ad5754r.hpp"
@@ -16,10 +17,12 @@
 #include "control_timer.hpp"
 #include "dac_bus.hpp"
 #include "encoders.hpp"
+#include "flash.hpp"
 #include "osc/link/command_port.hpp"
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
 #include "pins.hpp"
+#include "record_store.hpp"
 #include "safety.hpp"
 #include "spi_bus.hpp"
 #include "usart.hpp"
@@ -314,6 +317,228 @@ TEST(Stm32SpiBus, ATransmitterThatNeverEmptiesFailsTheFrameBoundedly) {
   f.spi2.SR = SpiRegs::kTxe | SpiRegs::kRxne | SpiRegs::kBsy;  // busy forever
   EXPECT_FALSE(bus.write(0, {{0x00, 0x12, 0x34}}));
   EXPECT_EQ(bus.errors(), 2u);
+}
+
+// ------------------------------------------------------------------------------------------ flash
+
+/// A FLASH block with FlashRegs' member names (FlashController's Regs) that records every write and
+/// answers as the controller would: KEY1 then KEY2 in KEYR clears LOCK (any other sequence leaves
+/// it set, unless keys_unlock is false: then nothing does); CR ignores writes while locked, except
+/// none are made then; a 1 written to an SR flag clears it; an operation (STRT, or PG set) raises
+/// `raise` in SR (an error flag; BSY: it never ends), and an erase sets its sector of `memory` (the
+/// chip's sectors 10 and 11, FlashSectors' layout) to ones.
+struct RecordingFlash {
+  enum Id : std::uint8_t { kAcr, kKeyr, kOptkeyr, kSr, kCr, kOptcr };
+  struct Write {
+    Id reg;
+    std::uint32_t value;
+    bool operator==(const Write&) const = default;
+  };
+  struct Register {
+    RecordingFlash* owner;
+    Id id;
+    std::uint32_t value = 0;
+    Register& operator=(std::uint32_t v) {
+      owner->write(*this, v);
+      return *this;
+    }
+    operator std::uint32_t() const { return value; }
+  };
+  Register ACR{this, kAcr}, KEYR{this, kKeyr}, OPTKEYR{this, kOptkeyr}, SR{this, kSr}, CR{this, kCr},
+      OPTCR{this, kOptcr};
+  std::vector<Write> writes;
+  std::uint32_t raise = 0;
+  bool keys_unlock = true;
+  std::uint32_t* memory = nullptr;
+
+  RecordingFlash() { CR.value = FlashRegs::kLock; }  // locked from reset
+  RecordingFlash(const RecordingFlash&) = delete;
+  RecordingFlash& operator=(const RecordingFlash&) = delete;
+
+  std::vector<std::uint32_t> writes_to(Id id) const {
+    std::vector<std::uint32_t> v;
+    for (const Write& w : writes)
+      if (w.reg == id) v.push_back(w.value);
+    return v;
+  }
+
+ private:
+  bool key1_ = false;
+  void write(Register& r, std::uint32_t v) {
+    writes.push_back({r.id, v});
+    if (r.id == kKeyr) {
+      if (keys_unlock && key1_ && v == FlashRegs::kKey2) CR.value &= ~FlashRegs::kLock;
+      key1_ = v == FlashRegs::kKey1;
+    } else if (r.id == kSr) {
+      SR.value &= ~(v & (FlashRegs::kErrors | FlashRegs::kEop));
+    } else if (r.id == kCr) {
+      if (CR.value & FlashRegs::kLock) return;
+      const bool starts = (v & FlashRegs::kStrt) || ((v & FlashRegs::kPg) && !(CR.value & FlashRegs::kPg));
+      CR.value = v & ~FlashRegs::kStrt;  // STRT reads 0 once the operation is over
+      if (starts) SR.value |= raise;
+      if ((v & FlashRegs::kStrt) && memory != nullptr) {
+        const std::uint32_t sector = ((v & FlashRegs::kSnbMask) >> 3) - 10;
+        std::fill_n(memory + sector * (128 * 1024 / 4), 128 * 1024 / 4, 0xFFFFFFFFu);
+      }
+    } else {
+      r.value = v;
+    }
+  }
+};
+using Rec = RecordingFlash;
+constexpr std::uint32_t kCachesOn = 5u | FlashRegs::kPrften | FlashRegs::kIcen | FlashRegs::kDcen;
+constexpr FlashPolls kFewPolls{1000, 100};
+
+/// The writes that reset the caches after an operation (ACR at kCachesOn before).
+std::vector<Rec::Write> cache_reset() {
+  const std::uint32_t off = 5u | FlashRegs::kPrften;
+  return {{Rec::kAcr, off},
+          {Rec::kAcr, off | FlashRegs::kIcrst | FlashRegs::kDcrst},
+          {Rec::kAcr, off},
+          {Rec::kAcr, kCachesOn}};
+}
+
+TEST(Stm32Flash, ASectorEraseUnlocksSetsSerSnbAndStrtAtX32AndLocks) {
+  for (std::uint32_t sector : {10u, 11u}) {
+    SCOPED_TRACE(sector);
+    Rec f;
+    f.ACR.value = kCachesOn;
+    FlashController<Rec> flash(f);
+    ASSERT_EQ(flash.erase_sector(sector), FlashStatus::kOk);
+    const std::uint32_t erase = FlashRegs::kPsizeX32 | FlashRegs::kSer | (sector << 3);
+    std::vector<Rec::Write> want = {{Rec::kKeyr, 0x45670123u},  // KEY1
+                                    {Rec::kKeyr, 0xCDEF89ABu},  // KEY2
+                                    {Rec::kCr, erase},
+                                    {Rec::kCr, erase | FlashRegs::kStrt},
+                                    {Rec::kCr, FlashRegs::kLock}};
+    for (const Rec::Write& w : cache_reset()) want.push_back(w);
+    EXPECT_EQ(f.writes, want);
+    EXPECT_EQ(erase, (2u << 8) | (1u << 1) | (sector << 3)) << "PSIZE [9:8] = 2 (x32), SER bit 1, SNB [6:3]";
+    EXPECT_EQ(FlashRegs::kStrt | FlashRegs::kLock, (1u << 16) | (1u << 31)) << "STRT bit 16, LOCK bit 31";
+    EXPECT_EQ(f.CR.value, FlashRegs::kLock) << "locked at the end";
+    EXPECT_EQ(f.ACR.value, kCachesOn) << "the caches back on";
+  }
+}
+
+TEST(Stm32Flash, AWordIsProgrammedWithPgAtX32AndLocked) {
+  Rec f;
+  f.ACR.value = kCachesOn;
+  FlashController<Rec> flash(f);
+  volatile std::uint32_t word = 0xFFFFFFFFu;
+  ASSERT_EQ(flash.program_word(&word, 0x12345678u), FlashStatus::kOk);
+  EXPECT_EQ(word, 0x12345678u);
+  EXPECT_EQ(f.writes_to(Rec::kKeyr), (std::vector<std::uint32_t>{FlashRegs::kKey1, FlashRegs::kKey2}));
+  EXPECT_EQ(f.writes_to(Rec::kCr),
+            (std::vector<std::uint32_t>{FlashRegs::kPsizeX32 | FlashRegs::kPg, FlashRegs::kLock}));
+  // Already unlocked: no key (a wrong key sequence locks CR until reset: none that is not needed).
+  Rec g;
+  g.CR.value = 0;
+  FlashController<Rec>(g).program_word(&word, 0u);
+  EXPECT_TRUE(g.writes_to(Rec::kKeyr).empty());
+  EXPECT_EQ(g.CR.value, FlashRegs::kLock);
+}
+
+TEST(Stm32Flash, AnErrorFlagFailsTheOperationWithItsNameAndIsCleared) {
+  const std::pair<std::uint32_t, const char*> flags[] = {{FlashRegs::kWrperr, "write_protected"},
+                                                         {FlashRegs::kPgaerr, "alignment_error"},
+                                                         {FlashRegs::kPgperr, "parallelism_error"},
+                                                         {FlashRegs::kPgserr, "sequence_error"},
+                                                         {FlashRegs::kOperr, "operation_error"}};
+  for (const auto& [flag, name] : flags) {
+    SCOPED_TRACE(name);
+    for (bool erase : {true, false}) {
+      Rec f;
+      f.raise = flag;
+      FlashController<Rec> flash(f);
+      volatile std::uint32_t word = 0xFFFFFFFFu;
+      const FlashStatus s = erase ? flash.erase_sector(11) : flash.program_word(&word, 0u);
+      EXPECT_STREQ(flash_status_name(s), name);
+      EXPECT_EQ(f.SR.value, 0u) << "cleared (written 1)";
+      EXPECT_EQ(f.writes_to(Rec::kSr), (std::vector<std::uint32_t>{flag}));
+      EXPECT_EQ(f.CR.value, FlashRegs::kLock);
+    }
+  }
+  // A stale flag from before is cleared before the operation and does not fail it.
+  Rec f;
+  f.SR.value = FlashRegs::kPgserr;
+  EXPECT_EQ(FlashController<Rec>(f).erase_sector(10), FlashStatus::kOk);
+}
+
+TEST(Stm32Flash, AStuckBsyFailsBoundedly) {
+  Rec before;  // busy before the operation: nothing is written
+  before.SR.value = FlashRegs::kBsy;
+  EXPECT_EQ(FlashController<Rec>(before, kFewPolls).erase_sector(10), FlashStatus::kBusyTimeout);
+  EXPECT_TRUE(before.writes.empty());
+  Rec during;  // BSY never clears after STRT: bounded, then locked all the same
+  during.raise = FlashRegs::kBsy;
+  const FlashStatus s = FlashController<Rec>(during, kFewPolls).erase_sector(10);
+  EXPECT_EQ(s, FlashStatus::kBusyTimeout);
+  EXPECT_STREQ(flash_status_name(s), "busy_timeout");
+  EXPECT_EQ(during.CR.value & FlashRegs::kLock, FlashRegs::kLock);
+  EXPECT_EQ(during.CR.value & (FlashRegs::kSer | FlashRegs::kSnbMask), 0u);
+}
+
+TEST(Stm32Flash, AControllerThatStaysLockedOrABadSectorDoesNothing) {
+  Rec f;
+  f.keys_unlock = false;
+  FlashController<Rec> flash(f);
+  EXPECT_EQ(flash.erase_sector(10), FlashStatus::kLocked);
+  EXPECT_EQ(f.writes_to(Rec::kCr).size(), 0u) << "no operation started";
+  Rec g;
+  EXPECT_EQ(FlashController<Rec>(g).erase_sector(12), FlashStatus::kBadAddress);
+  EXPECT_TRUE(g.writes.empty());
+  for (FlashStatus s = FlashStatus::kOk; s != FlashStatus::kCount;
+       s = static_cast<FlashStatus>(static_cast<int>(s) + 1))
+    EXPECT_NE(flash_status_name(s), nullptr);
+}
+
+TEST(Stm32Flash, TheParameterSectorsCarryTheRecordStore) {
+  std::vector<std::uint32_t> memory(2 * FlashSectors<>::kSectorWords, 0u);  // not erased yet
+  Rec f;
+  f.memory = memory.data();
+  FlashSectors<Rec> sectors(f, memory.data());
+  persist::RecordStore<FlashSectors<Rec>> store(sectors);
+  const std::uint8_t a[5] = {1, 2, 3, 4, 5}, b[3] = {9, 8, 7};
+  ASSERT_TRUE(store.save(a, sizeof a, 1).saved());
+  EXPECT_EQ(memory[0], persist::kMagic) << "sector 10 first";
+  EXPECT_EQ(f.writes_to(Rec::kCr)[0], FlashRegs::kPsizeX32 | FlashRegs::kSer | (10u << 3));
+  f.writes.clear();
+  ASSERT_TRUE(store.save(b, sizeof b, 1).saved());
+  EXPECT_EQ(f.writes_to(Rec::kCr)[0], FlashRegs::kPsizeX32 | FlashRegs::kSer | (11u << 3));
+  EXPECT_EQ(memory[FlashSectors<>::kSectorWords], persist::kMagic) << "sector 11 at 0x080E0000";
+  std::uint8_t got[8] = {};
+  const persist::LoadResult r = store.load(got, sizeof got, 1);
+  ASSERT_TRUE(r.loaded());
+  EXPECT_EQ(r.sequence, persist::kFirstSequence + 1);
+  EXPECT_EQ(got[0], 9);
+  EXPECT_EQ(f.CR.value, FlashRegs::kLock);
+  // A failing sector: the store's status, and the driver's name for it (what a boot would print).
+  f.raise = FlashRegs::kWrperr;
+  EXPECT_EQ(store.save(a, sizeof a, 1).status, persist::SaveStatus::kEraseFailed);
+  EXPECT_STREQ(flash_status_name(sectors.last_status()), "write_protected");
+  EXPECT_FALSE(sectors.program(2, 0, 0u));
+  EXPECT_FALSE(sectors.program(0, FlashSectors<>::kSectorWords, 0u));
+  EXPECT_EQ(sectors.last_status(), FlashStatus::kBadAddress);
+  EXPECT_EQ(sectors.read(1, FlashSectors<>::kSectorWords), persist::kErased);
+  EXPECT_EQ(FlashSectors<>::hardware_memory(), reinterpret_cast<volatile std::uint32_t*>(0x080C0000u));
+}
+
+TEST(Stm32Flash, TheChipsFlashBlockDrivesTheSectors) {
+  FakeChip fc;  // the chip's FLASH block in RAM, as the other drivers' blocks: unlocked, never busy
+  std::vector<std::uint32_t> memory(2 * FlashSectors<>::kSectorWords, 0xFFFFFFFFu);
+  FlashSectors sectors(*fc.chip().flash, memory.data());
+  EXPECT_TRUE(sectors.program(1, 7, 0xA5A5A5A5u));
+  EXPECT_EQ(memory[FlashSectors<>::kSectorWords + 7], 0xA5A5A5A5u);
+  EXPECT_EQ(fc.flash.CR, FlashRegs::kLock) << "locked after the word";
+  EXPECT_EQ(fc.flash.KEYR, 0u) << "it was unlocked: no key written";
+  // RAM ignores the keys, as a controller locked until reset does: the next operation fails locked.
+  EXPECT_FALSE(sectors.erase(0));
+  EXPECT_STREQ(flash_status_name(sectors.last_status()), "locked");
+  EXPECT_EQ(fc.flash.KEYR, FlashRegs::kKey2);
+  fc.flash.CR = 0;
+  fc.flash.SR = FlashRegs::kPgperr;  // RAM keeps the flag (writing 1 does not clear it): reported
+  EXPECT_FALSE(sectors.erase(0));
+  EXPECT_STREQ(flash_status_name(sectors.last_status()), "parallelism_error");
 }
 
 // ------------------------------------------------------------- the board's HAL and the control task
