@@ -47,7 +47,8 @@ struct Entry {
   std::function<std::string(Settings&, const json&)> put = nullptr;
   std::function<bool(const Settings&)> shown = nullptr;  // printed only when true (null: always)
   std::function<void(const Settings&, double& lo, double& hi, int element)> element_range =
-      nullptr;  // per-element bounds
+      nullptr;    // per-element bounds
+  int count = 6;  // kList: its elements
 };
 
 json vec_json(const double* v, int n, double scale = 1) {
@@ -129,6 +130,36 @@ std::vector<std::string> names_of() {
   return {std::begin(osc::MotionNames<E>::kNames), std::end(osc::MotionNames<E>::kNames)};
 }
 
+/// The runtime parameters (osc/runtime/parameters.hpp) that the entries above do not key by name:
+/// run.<name>, a number or a list of the parameter's elements, each in its element's range, from the
+/// one table (the run's task takes them at its start: sim::configure_monitors).
+void add_runtime_param_entries(std::vector<Entry>& t) {
+  for (int i = 0; i < osc::kParamCount; ++i) {
+    const osc::ParamInfo& p = osc::kParams[i];
+    if (p.gain >= 0 || runtime_param_key(p.runtime) != nullptr) continue;
+    const std::string key = std::string("run.") + p.name;
+    const std::string doc = std::string(p.doc) + (*p.unit ? std::string(" [") + p.unit + "]" : "");
+    const int slot = osc::param_slot(i), n = p.count;
+    Entry e{key, doc, n == 1 ? Kind::kNumber : Kind::kList, p.lo_of(0), p.hi_of(0), {}, false};
+    e.count = n;
+    e.get = [slot, n](const Settings& s) {
+      if (n == 1) return json(s.base.params[slot]);
+      json a = json::array();
+      for (int k = 0; k < n; ++k) a.push_back(s.base.params[slot + k]);
+      return a;
+    };
+    e.put = [slot, n](Settings& s, const json& v) {
+      for (int k = 0; k < n; ++k) s.base.params[slot + k] = n == 1 ? v.get<double>() : v[k].get<double>();
+      return std::string();
+    };
+    e.element_range = [i](const Settings&, double& lo, double& hi, int k) {
+      lo = osc::kParams[i].lo_of(k);
+      hi = osc::kParams[i].hi_of(k);
+    };
+    t.push_back(e);
+  }
+}
+
 void add_run_entries(std::vector<Entry>& t) {
   number(t, "run.duration", "simulated seconds per run [s]", 1, 86400, true,
          [](Settings& s) -> double& { return s.base.duration; });
@@ -189,6 +220,7 @@ void add_run_entries(std::vector<Entry>& t) {
          true, [](Settings& s) -> double& { return s.base.final_window; });
   number(t, "run.window", "length of the windows of the per-window worst errors [s]", 1, 3600, false,
          [](Settings& s) -> double& { return s.base.window; });
+  add_runtime_param_entries(t);
 }
 
 /// The entry controller.<key> of one gain of OSC_GAINS_FIELDS, as its parameter column says (form F:
@@ -535,10 +567,12 @@ bool set_entry(const Entry& e, const YAML::Node& n, Settings& s, std::string& er
       break;
     }
     case Kind::kList: {
-      if (!n.IsSequence() || n.size() != 6)
-        return err = key + ": expected a list of 6 numbers like [1, 2, 3, 4, 5, 6], got " + node_text(n), false;
+      if (!n.IsSequence() || n.size() != static_cast<std::size_t>(e.count))
+        return err = key + ": expected a list of " + std::to_string(e.count) + " numbers like " +
+                     (e.count == 6 ? "[1, 2, 3, 4, 5, 6]" : "[1, 2, 3]") + ", got " + node_text(n),
+               false;
       v = json::array();
-      for (int i = 0; i < 6; ++i) {
+      for (int i = 0; i < e.count; ++i) {
         double x, lo = e.lo, hi = e.hi;
         if (e.element_range) e.element_range(s, lo, hi, i);
         const std::string where = key + "[" + std::to_string(i + 1) + "]";

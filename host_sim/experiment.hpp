@@ -14,6 +14,7 @@
 #include "osc/control/gains.hpp"
 #include "osc/link/frames.hpp"
 #include "osc/runtime/motion_states.hpp"
+#include "osc/runtime/parameters.hpp"
 #include "plant.hpp"
 #include "plant_hal.hpp"
 
@@ -24,6 +25,14 @@ namespace sim {
 enum class Scalar { kDouble, kFloat, kFixed };
 /// Names of the scalars, in enum order (configuration, command lines).
 constexpr const char* kScalarNames[] = {"double", "float", "fixed"};
+
+/// The runtime parameters' defaults (osc::param_default), by the table's slots.
+inline std::array<double, osc::kParamSlots> default_params() {
+  std::array<double, osc::kParamSlots> a{};
+  for (int i = 0; i < osc::kParamCount; ++i)
+    for (int e = 0; e < osc::kParams[i].count; ++e) a[osc::param_slot(i) + e] = osc::param_default(i, e);
+  return a;
+}
 
 struct ExperimentConfig {
   double duration = 120.0;  ///< [s]
@@ -65,6 +74,9 @@ struct ExperimentConfig {
   /// alone); with residual_monitor only (osc::ControlTask::set_collision).
   osc::CollisionReaction collision_reaction = osc::CollisionReaction::kCategory0;
   double collision_threshold[6] = {0, 0, 0, 0, 0, 0};
+  /// The runtime parameters (osc/runtime/parameters.hpp) of the in-process controller that have no
+  /// field of their own here (runtime_param_key: null): their values, by the table's slots.
+  std::array<double, osc::kParamSlots> params = default_params();
   double log_period = 0.01;    ///< time-series decimation [s]
   double final_window = 20.0;  ///< "last 20 s" statistics [s]
   double window = 60.0;        ///< length of the per-window maxima [s]
@@ -87,13 +99,39 @@ struct ExperimentConfig {
   double pil_timeout = 10.0;  ///< wall-clock wait per actuator frame [s]
 };
 
+/// The configuration key of a runtime parameter that the host keys by a name of its own (a law's or a
+/// reaction's name rather than its code), or null: the key is then run.<the parameter's name>, made
+/// from the table (host_sim/config.cpp). test_gain_keys checks both kinds against the table.
+constexpr const char* runtime_param_key(osc::RuntimeParam p) {
+  switch (p) {
+    case osc::RuntimeParam::kParamAdaptation:
+      return "run.adaptation";
+    case osc::RuntimeParam::kParamCollisionReaction:
+      return "run.collision_reaction";
+    case osc::RuntimeParam::kParamCollisionThreshold:
+      return "run.collision_threshold";
+    default:
+      return nullptr;
+  }
+}
+
 /// The residual monitor's settings of a run on the task of a host-built controller
-/// (osc::ControlTask): armed or a trial, the collision's reaction and thresholds.
+/// (osc::ControlTask): armed or a trial, the collision's reaction and thresholds; and the runtime
+/// parameters of cfg.params, each set as a board's param set would (osc::param_set).
 template <class Task>
 void configure_monitors(Task& task, const ExperimentConfig& cfg) {
   task.residual.armed = cfg.residual_monitor;
   if (!task.set_collision(cfg.collision_reaction, cfg.collision_threshold))
     throw std::invalid_argument("run.collision_threshold: outside [0, the joint's full-scale torque]");
+  for (int i = 0; i < osc::kParamCount; ++i) {
+    const osc::ParamInfo& p = osc::kParams[i];
+    if (p.gain >= 0 || runtime_param_key(p.runtime) != nullptr) continue;
+    for (int e = 0; e < p.count; ++e) {
+      const osc::ParamStatus st = osc::param_set(task, i, e, cfg.params[osc::param_slot(i) + e]);
+      if (st != osc::ParamStatus::kOk)
+        throw std::invalid_argument(std::string("run.") + p.name + ": " + osc::param_status_name(st));
+    }
+  }
 }
 
 /// A run: its name and set-up, then its metrics (metrics.hpp), in the order of its JSON and console

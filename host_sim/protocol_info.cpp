@@ -19,6 +19,7 @@
 #include "osc/link/command_port.hpp"
 #include "osc/link/commands.hpp"
 #include "osc/link/frames.hpp"
+#include "osc/link/param_frames.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/supervisor.hpp"
@@ -124,6 +125,55 @@ json motion_names() {
   return out;
 }
 
+/// The names, codes and meanings of a list given as two arrays.
+json coded(const char* const* names, const char* const* docs, int n) {
+  json out = json::array();
+  for (int i = 0; i < n; ++i) out.push_back({{"code", i}, {"name", names[i]}, {"doc", docs[i]}});
+  return out;
+}
+
+/// The parameter table (osc/runtime/parameters.hpp): each parameter with its index, elements, unit,
+/// range and default per element, access, persistence and meaning; the operations, statuses, flags.
+json parameters(bool with_docs) {
+  json j;
+  j["layout"] = osc::kParamLayout;
+  j["table"] = json::array();
+  for (int i = 0; i < osc::kParamCount; ++i) {
+    const osc::ParamInfo& p = osc::kParams[i];
+    json lo = json::array(), hi = json::array(), def = json::array();
+    for (int e = 0; e < p.count; ++e)
+      lo.push_back(p.lo_of(e)), hi.push_back(p.hi_of(e)), def.push_back(osc::param_default(i, e));
+    json row = {{"index", i},
+                {"name", p.name},
+                {"count", p.count},
+                {"unit", p.unit},
+                {"lo", lo},
+                {"hi", hi},
+                {"default", def},
+                {"access", osc::kParamAccessNames[static_cast<int>(p.access)]},
+                {"persists", p.persists}};
+    if (with_docs) row["doc"] = p.doc;
+    j["table"].push_back(row);
+  }
+  if (with_docs) {
+    j["ops"] = coded(pil::kParamOpNames, pil::kParamOpDocs, pil::kParamOpCount);
+    j["statuses"] = coded(osc::kParamStatusNames, osc::kParamStatusDocs, osc::kParamStatusCount);
+    j["access"] = coded(osc::kParamAccessNames, osc::kParamAccessDocs, 2);
+    j["flags"] = json::array();
+    for (int i = 0; i < pil::kParamFlagCount; ++i)
+      j["flags"].push_back(
+          {{"bit", i}, {"mask", 1 << i}, {"name", pil::kParamFlagNames[i]}, {"doc", pil::kParamFlagDocs[i]}});
+  } else {
+    j["ops"] = json::array();
+    for (const char* n : pil::kParamOpNames) j["ops"].push_back(n);
+    j["statuses"] = json::array();
+    for (const char* n : osc::kParamStatusNames) j["statuses"].push_back(n);
+    j["flags"] = json::array();
+    for (const char* n : pil::kParamFlagNames) j["flags"].push_back(n);
+  }
+  return j;
+}
+
 /// The command protocol: flags, bounds, the move limits, the names of the codes, examples.
 json command_protocol() {
   json j;
@@ -153,6 +203,7 @@ json command_protocol() {
   j["stop_categories"] = motion_names<osc::StopCategory>();
   j["completions"] = motion_names<osc::MotionCompletion>();
   j["examples"] = command_examples();
+  j["parameters"] = parameters(true);
   return j;
 }
 
@@ -201,6 +252,7 @@ json client_protocol() {
   j["completions"] = names<osc::MotionCompletion>();
   j["faults"] = json::array();
   for (int i = 0; i < osc::kFaultCount; ++i) j["faults"].push_back(osc::kFaultNames[i]);
+  j["parameters"] = parameters(false);
   return j;
 }
 

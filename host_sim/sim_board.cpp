@@ -209,8 +209,8 @@ class InProcessBoard {
 };
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
-/// client's command and setpoint frames onto the link before the next tick's sensor frame, the
-/// image's answer and state frames of each tick back. No other frame goes on the link.
+/// client's command, setpoint and param frames onto the link before the next tick's sensor frame, the
+/// image's answer, state and param_answer frames of each tick back. No other frame goes on the link.
 class QemuBoard {
  public:
   QemuBoard(const sim::ExperimentConfig& cfg, const std::string& elf)
@@ -233,6 +233,11 @@ class QemuBoard {
       if (err_.empty()) arm_.setpoint(sv, err_);
       return true;
     }
+    pil::ParamFrame pf;
+    if (p.decode(pf)) {
+      if (err_.empty()) arm_.param(pf, err_);
+      return true;
+    }
     return false;  // a keep-alive (a state frame) or a frame no controller takes: dropped
   }
   template <class Write>
@@ -242,6 +247,7 @@ class QemuBoard {
     std::uint8_t buf[pil::kMaxFrame];
     for (const pil::AnswerFrame& f : arm_.replies().answers) write(buf, pil::encode(f, buf));
     for (const pil::StateFrame& f : arm_.replies().states) write(buf, pil::encode(f, buf));
+    for (const pil::ParamAnswerFrame& f : arm_.replies().params) write(buf, pil::encode(f, buf));
     return true;
   }
   /// The link's health on stderr; whether it was clean.

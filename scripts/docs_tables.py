@@ -360,7 +360,8 @@ def stm32f4_images():
     for image, note in (("stm32f4_firmware", ""), ("stm32f4_qemu", "")):
         flash, ram = image_size(image, "stm32f4")
         stack = f"{thousands(int(m.group(1)))} B (300 ticks in QEMU)" if m and image == "stm32f4_qemu" else ""
-        lines.append(f"| `{image}` | {thousands(flash)} B ({100 * flash / 1048576:.0f} % of 1 MiB) | "
+        # The image's region: sectors 0-9 (768 KiB); 10 and 11 keep the parameters (linker/stm32f407.ld).
+        lines.append(f"| `{image}` | {thousands(flash)} B ({100 * flash / 786432:.0f} % of its 768 KiB) | "
                      f"{thousands(ram)} B ({100 * ram / 131072:.0f} % of 128 KiB) | {stack} |")
     return "\n".join(lines)
 
@@ -1204,6 +1205,46 @@ def t_protocol_command_checks():
             ("move_to", f"a rotation of at most {math.degrees(c['max_move_rotation']):g}° from where the move starts, "
              "and a plan within the limits", "`over_limit`")]
     return markdown_table(["what", "must be", "else refused"], rows)
+
+
+@table("protocol_param", "docs/protocol.md", "protocol")
+def t_protocol_param():
+    return field_rows(protocol()["param_fields"])
+
+
+@table("protocol_param_answer", "docs/protocol.md", "protocol")
+def t_protocol_param_answer():
+    return field_rows(protocol()["param_answer_fields"])
+
+
+@table("protocol_param_ops", "docs/protocol.md", "protocol")
+def t_protocol_param_ops():
+    return name_rows(protocol()["command"]["parameters"]["ops"])
+
+
+@table("protocol_param_statuses", "docs/protocol.md", "protocol")
+def t_protocol_param_statuses():
+    return name_rows(protocol()["command"]["parameters"]["statuses"])
+
+
+@table("protocol_param_flags", "docs/protocol.md", "protocol")
+def t_protocol_param_flags():
+    flags = protocol()["command"]["parameters"]["flags"]
+    return markdown_table(["bit", "mask", "name", "meaning"],
+                          [(f["bit"], f"`{hexs(f['mask'])}`", f"`{f['name']}`", f["doc"]) for f in flags])
+
+
+@table("protocol_parameters", "docs/protocol.md", "protocol")
+def t_protocol_parameters():
+    """The parameter table, one row per parameter: a list where the elements differ."""
+    def values(v):
+        return f"{v[0]:g}" if all(x == v[0] for x in v) else ", ".join(f"{x:g}" for x in v)
+    t = protocol()["command"]["parameters"]
+    rows = [(p["index"], f"`{p['name']}`", p["count"], p["unit"], f"{values(p['lo'])} to {values(p['hi'])}",
+             values(p["default"]), f"`{p['access']}`", "yes" if p["persists"] else "no", p["doc"])
+            for p in t["table"]]
+    return markdown_table(["index", "name", "elements", "unit", "range", "default", "written", "persists", "meaning"],
+                          rows) + f"\n\nLayout version {t['layout']}."
 
 
 def name_rows(entries):

@@ -31,6 +31,7 @@
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/control_task.hpp"
+#include "param_store.hpp"
 #include "text.hpp"
 
 namespace board {
@@ -51,6 +52,11 @@ struct App {
   osc::CommandLinkWatch watch;
   pil::Parser parser;
   std::uint8_t frame[pil::kMaxFrame];
+  /// The parameters' store: flash sectors 10 and 11 (param_store.hpp). QEMU models no flash
+  /// controller: there the command port keeps them in RAM, and the boot says so.
+  stm32f4::FlashSectors<> sectors{*board.chip.flash};
+  stm32f4::Safety::Stretch stretch{board.safety};
+  FlashParamStore<stm32f4::FlashSectors<>, stm32f4::Safety::Stretch> params{sectors, stretch};
 
   /// The board's boot (Board::init, interrupts off), the control task at the start pose, disabled
   /// (an enable command starts the torque), the boot line on the USART, then the watchdog, and the
@@ -67,8 +73,28 @@ struct App {
     board.describe(banner.str("osc stm32f4: "));
     board.uart.write_blocking(banner.text());
     board.uart.write_blocking("\r\n");
+    cortex_m::text::Line line;
+    board.uart.write_blocking(load_params(line.str("osc stm32f4: params ")).text());
+    board.uart.write_blocking("\r\n");
     board.start_watchdog();
     board.start_control();
+  }
+
+  /// The newest parameter record from flash into the task (before the interrupts start), and the
+  /// port's store: "loaded, sequence N", "defaults (none)", "defaults (layout_mismatch)", or a record
+  /// the task refused ("defaults (bad_record)"); on QEMU "in RAM (QEMU: no flash controller)".
+  [[gnu::cold]] cortex_m::text::Line& load_params(cortex_m::text::Line& l) {
+    if constexpr (kQemu) {
+      return l.str("in RAM (QEMU: no flash controller), defaults");
+    } else {
+      port.set_param_storage(params.storage());
+      osc::ParamRecord r;
+      const persist::LoadResult res = params.load(r);
+      if (!res.loaded()) return l.str("defaults (").str(persist::status_name(res.status)).str(")");
+      const osc::ParamStatus st = osc::param_apply(task, r);
+      if (st != osc::ParamStatus::kOk) return l.str("defaults (").str(osc::param_status_name(st)).str(")");
+      return l.str("loaded, sequence ").u32(res.sequence);
+    }
   }
 
   /// The 1 kHz control interrupt: its acknowledgement, the link watch, the tick (BoardHal::tick:

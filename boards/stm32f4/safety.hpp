@@ -29,6 +29,9 @@ namespace stm32f4 {
 constexpr std::uint32_t kWatchdogPrescaler = 0;  // LSI / 4
 constexpr std::uint32_t kWatchdogReload = 40;    // 40 / (32 kHz / 4) = 5 ms
 constexpr std::uint32_t kLsiHz = 32000, kLsiMinHz = 17000, kLsiMaxHz = 47000;
+constexpr std::uint32_t kWatchdogLongPrescaler = 6, kWatchdogLongReload = 4095;  // LSI / 256, the longest
+static_assert(std::uint64_t{kWatchdogLongReload} * (4u << kWatchdogLongPrescaler) * 1000u / kLsiMaxHz > 2 * 2000,
+              "the stretched watchdog outlasts a sector erase (2 s at most, DS8626) twice at the fastest LSI");
 /// The watchdog's timeout [us] for an LSI frequency.
 constexpr std::uint32_t watchdog_timeout_us(std::uint32_t lsi_hz) {
   return static_cast<std::uint32_t>(std::uint64_t{kWatchdogReload} * (4u << kWatchdogPrescaler) * 1000000u / lsi_hz);
@@ -92,20 +95,35 @@ class Safety {
 
   /// Starts the IWDG (kWatchdogReload). kWatchdogSetup if the prescaler and reload were not taken.
   BootFault watchdog_start() {
-    IwdgRegs& w = *chip_.iwdg;
     chip_.dbgmcu->APB1_FZ = chip_.dbgmcu->APB1_FZ | DbgmcuRegs::kIwdgStop;  // halted by a debugger: paused
-    w.KR = IwdgRegs::kStart;                                                // starts the LSI too
-    w.KR = IwdgRegs::kUnlock;
-    w.PR = kWatchdogPrescaler;
-    w.RLR = kWatchdogReload;
-    const bool taken = poll_until([&] { return (w.SR & (IwdgRegs::kPvu | IwdgRegs::kRvu)) == 0; }, kWatchdogPolls);
-    w.KR = IwdgRegs::kReload;
-    return taken ? BootFault::kNone : BootFault::kWatchdogSetup;
+    chip_.iwdg->KR = IwdgRegs::kStart;                                      // starts the LSI too
+    return watchdog_set(kWatchdogPrescaler, kWatchdogReload) ? BootFault::kNone : BootFault::kWatchdogSetup;
   }
   void watchdog_feed() { chip_.iwdg->KR = IwdgRegs::kReload; }
+  /// The watchdog at its longest (LSI / 256, reload 4095: 22 s at the fastest LSI, 33 s nominal), fed:
+  /// around a flash save, which stalls the core for up to 2 s (board/param_store.hpp).
+  bool watchdog_stretch() { return watchdog_set(kWatchdogLongPrescaler, kWatchdogLongReload); }
+  /// Back to kWatchdogReload, fed.
+  bool watchdog_restore() { return watchdog_set(kWatchdogPrescaler, kWatchdogReload); }
+  /// The stretch and its undoing as a store's watchdog (FlashParamStore).
+  struct Stretch {
+    Safety& s;
+    void stretch() { s.watchdog_stretch(); }
+    void restore() { s.watchdog_restore(); }
+  };
 
  private:
   static constexpr std::uint32_t kLine = 1u << pins::kEstopExtiLine;
+  /// Prescaler and reload, waited for (RM0090 21.3.2: PVU, RVU), then fed; false if not taken.
+  bool watchdog_set(std::uint32_t prescaler, std::uint32_t reload) {
+    IwdgRegs& w = *chip_.iwdg;
+    w.KR = IwdgRegs::kUnlock;
+    w.PR = prescaler;
+    w.RLR = reload;
+    const bool taken = poll_until([&] { return (w.SR & (IwdgRegs::kPvu | IwdgRegs::kRvu)) == 0; }, kWatchdogPolls);
+    w.KR = IwdgRegs::kReload;
+    return taken;
+  }
   void write(const PinConfig& p, bool high) { pin_write(chip_.port(p.pin.port), p.pin.n, high); }
 
   Chip chip_{};

@@ -74,6 +74,12 @@ class Protocol:
         self.faults = p["faults"]
         self.names = {k: p[k] for k in ("verbs", "motion_states", "reasons", "outcomes", "stop_categories",
                                         "completions")}
+        # The parameter table of the firmware's build (osc/runtime/parameters.hpp), its operations,
+        # statuses and answer flags.
+        self.params = p["parameters"]
+        self.param_index = {q["name"]: q["index"] for q in self.params["table"]}
+        self.names.update({"param_ops": self.params["ops"], "param_statuses": self.params["statuses"]})
+        self.param_flag = {n: 1 << i for i, n in enumerate(self.params["flags"])}
 
     def code_of(self, kind, name):
         return self.names[kind].index(name)
@@ -273,6 +279,7 @@ class Client:
         self.parser = Parser(self.p)
         self.next_id = random.randint(1, 2**30)  # unique across clients: no earlier client's answers
         self.answers, self.latest_state, self.states_seen = [], None, 0
+        self.param_answer = None
         self.on_answer = self.on_state = None
 
     def close(self):
@@ -347,6 +354,25 @@ class Client:
         return o
 
     # ------------------------------------------------------------------ answers and state
+    def param(self, op, index=0, element=0, value=0.0, timeout=5.0):
+        """A parameter request (get, set, save, load, reset, check): its param_answer frame (a dict). A
+        timeout, or an answer from a firmware with another parameter table, raises ClientError."""
+        cid = self.next_id
+        self.next_id = self.next_id % 0xFFFFFFFF + 1
+        self._write(self.p.encode("param", {"id": cid, "op": self.p.code_of("param_ops", op), "index": index,
+                                            "element": element, "value": value}))
+        self.param_answer = None
+        if not self._read_until(time.monotonic() + timeout,
+                                lambda: self.param_answer is not None and self.param_answer["id"] == cid):
+            raise ClientError(f"param {op}: no answer within {timeout:g} s")
+        a = self.param_answer
+        table = self.p.params
+        if a["layout"] != table["layout"] or a["count"] != len(table["table"]):
+            raise ClientError(f"param: the controller's parameter table (layout {a['layout']}, {a['count']} "
+                              f"parameters) is not this client's (layout {table['layout']}, {len(table['table'])}): "
+                              "use the client of its build")
+        return a
+
     def state(self, timeout=5.0):
         """The latest state frame (a dict), received after this call; None on a timeout."""
         seen = self.states_seen
@@ -411,7 +437,9 @@ class Client:
         return True
 
     def _dispatch(self, frame, payload):
-        if frame == "answer":
+        if frame == "param_answer":
+            self.param_answer = self.p.decode("param_answer", payload)
+        elif frame == "answer":
             a = self.p.decode("answer", payload)
             self.answers = (self.answers + [a])[-self.HISTORY:]
             if self.on_answer:
@@ -556,6 +584,90 @@ def cmd_watch(c, a):
     return 0
 
 
+def param_line(c, q, a):
+    """One element's line, as oscctl prints it: "ks[2] = 97 (0.001 to 100000; torque_off)"."""
+    idx = f"[{a['element']}]" if q["count"] > 1 else ""
+    unit = f" {q['unit']}" if q["unit"] else ""
+    off = "; torque_off" if a["flags"] & c.p.param_flag["torque_off"] else ""
+    return f"{q['name']}{idx} = {a['value']:.7g}{unit} ({a['lo']:.7g} to {a['hi']:.7g}{off})"
+
+
+def param_refused(c, a):
+    """0 when ok, else 1 with the reason printed."""
+    if a["status"] == 0:
+        return 0
+    print(f"refused: {c.p.name_of('param_statuses', a['status'])}")
+    return 1
+
+
+def margins_text(c, a):
+    warn = ": warning, the paper's sufficient condition cannot hold" \
+        if a["flags"] & c.p.param_flag["warn_37"] else ""
+    return (f"observer margin {a['margins'][0]:.3g} (stable above 1: (4 - 2 k dt) / (b dt^2), b <= "
+            f"{a['margins'][1]:.4g} 1/s^2 at the last pose)\n"
+            f"condition (37) {a['margins'][2]:.3g} (k_s k_nd / 2: above 1 it can hold){warn}")
+
+
+def check_param(ap, p, a):
+    """The param command line's own checks, as oscctl's: a known name, as many values as elements."""
+    if a.op not in ("get", "set"):
+        if a.name is not None or a.values:
+            ap.error(f"param {a.op} takes no name")
+        return
+    if a.name not in p.param_index:
+        ap.error(f"param {a.name}: no such parameter ({', '.join(q['name'] for q in p.params['table'])})")
+    n = p.params["table"][p.param_index[a.name]]["count"]
+    if a.element is not None and not 0 <= a.element < n:
+        ap.error(f"param {a.name} --element {a.element}: it has {n} element" + ("s" if n > 1 else ""))
+    if a.op == "get":
+        if a.values:
+            ap.error("param get takes no value")
+        return
+    want = 1 if a.element is not None else n
+    if len(a.values) != want:
+        ap.error(f"param set {a.name}: {want} value" + ("s" if want > 1 else "") + (
+            " (one element)" if a.element is not None else " (one per element; --element E sets one)") +
+            f", got {len(a.values)}")
+
+
+def cmd_param(c, a):
+    t = c.p.params["table"]
+    if a.op == "list":
+        for q in t:
+            for e in range(q["count"]):
+                r = c.param("get", q["index"], e, timeout=a.timeout)
+                if param_refused(c, r):
+                    return 1
+                print(param_line(c, q, r))
+        return 0
+    if a.op in ("get", "set"):
+        q = t[c.p.param_index[a.name]]
+        if a.op == "get":
+            for e in range(q["count"]):
+                if a.element is None or e == a.element:
+                    r = c.param("get", q["index"], e, timeout=a.timeout)
+                    if param_refused(c, r):
+                        return 1
+                    print(param_line(c, q, r))
+            return 0
+        for k, v in enumerate(a.values):
+            e = a.element if a.element is not None else k
+            r = c.param("set", q["index"], e, v, timeout=a.timeout)
+            if param_refused(c, r):
+                if r["margins"][1] > 0:
+                    print(margins_text(c, r))
+                return 1
+            print(param_line(c, q, r))
+            if r["flags"] & c.p.param_flag["warn_37"]:
+                print(margins_text(c, r))
+        return 0
+    r = c.param(a.op, timeout=a.timeout)
+    if param_refused(c, r):
+        return 1
+    print(margins_text(c, r) if a.op == "check" else f"{a.op}: ok")
+    return 0
+
+
 def positive(text):
     v = float(text)
     if not v > 0:
@@ -604,12 +716,27 @@ def parser():
     limits(s)
     w = sub.add_parser("watch", help="print state changes and every answer")
     w.add_argument("--seconds", type=positive, help="for this long (default: until interrupted)")
+    pm = sub.add_parser("param", help="the controller's parameters: list, get, set, save, load, reset, check")
+    pm.add_argument("op", choices=["list", "get", "set", "save", "load", "reset", "check"])
+    pm.add_argument("name", nargs="?", help="the parameter (get, set)")
+    pm.add_argument("values", type=float, nargs="*", help="set: one value per element, or one with --element")
+    pm.add_argument("--element", type=int, help="get, set: only this element of a vector parameter")
     return ap
 
 
 def main(argv):
     ap = parser()
-    a = ap.parse_args(argv)  # a bad command line: argparse's message, exit status 2
+    # A bad command line: argparse's message, exit status 2. param's values may follow its options
+    # (set k --element 0 2500): numbers left over after a param are its values.
+    a, extra = ap.parse_known_args(argv)
+    if extra and a.verb == "param":
+        try:
+            a.values += [float(x) for x in extra]
+            extra = []
+        except ValueError:
+            pass
+    if extra:
+        ap.error("unrecognized arguments: " + " ".join(extra))
     if a.verb == "move" and not all(math.isfinite(x) for x in a.xyz + (a.rpy or [])):
         ap.error("move: X Y Z and --rpy must be finite numbers")
     if not 50 <= a.baud <= 4000000:
@@ -617,8 +744,10 @@ def main(argv):
     try:
         if a.verb == "stream":
             read_stream_csv(a.file)  # a bad file before the port is touched
+        if a.verb == "param":
+            check_param(ap, Protocol(), a)
         c = Client(a.port, a.baud, keepalive=a.keepalive)
-        verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch}
+        verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param}
         return verbs.get(a.verb, cmd_simple)(c, a)
     except ClientError as e:
         print(f"osc_client: {e}", file=sys.stderr)

@@ -249,7 +249,10 @@ std::uint32_t Client::command(MotionVerb verb, const MoveRequest<double>& req) {
 void Client::dispatch() {
   pil::AnswerFrame a;
   pil::StateFrame s;
-  if (parser_.decode(a)) {
+  pil::ParamAnswerFrame p;
+  if (parser_.decode(p)) {
+    param_answer_ = p;
+  } else if (parser_.decode(a)) {
     answers_.push_back(a);
     if (answers_.size() > kHistory) answers_.pop_front();
     if (on_answer) on_answer(a);
@@ -280,6 +283,32 @@ bool Client::read_until(double deadline, const std::function<bool()>& done) {
 bool Client::pump(double timeout_s) {
   read_until(now_s() + timeout_s, [] { return false; });
   return error_.empty();
+}
+
+std::optional<pil::ParamAnswerFrame> Client::param(std::uint8_t op, int index, int element, double value,
+                                                   double timeout_s) {
+  if (index < 0 || index > 255 || element < 0 || element > 255)
+    return error_ = "param: index and element are 0 to 255", std::nullopt;
+  pil::ParamFrame f;
+  f.id = next_id_++;
+  if (next_id_ == 0) next_id_ = 1;
+  f.op = op;
+  f.index = static_cast<std::uint8_t>(index);
+  f.element = static_cast<std::uint8_t>(element);
+  f.value = static_cast<float>(value);
+  std::uint8_t buf[pil::kMaxFrame];
+  if (!send(buf, pil::encode(f, buf))) return std::nullopt;
+  if (!read_until(now_s() + timeout_s, [&] { return param_answer_ && param_answer_->id == f.id; })) {
+    if (error_.empty()) error_ = "param: no answer within " + std::to_string(timeout_s) + " s";
+    return std::nullopt;
+  }
+  if (param_answer_->layout != kParamLayout || param_answer_->count != kParamCount)
+    return error_ = "param: the controller's parameter table (layout " + std::to_string(param_answer_->layout) + ", " +
+                    std::to_string(param_answer_->count) + " parameters) is not this client's (layout " +
+                    std::to_string(kParamLayout) + ", " + std::to_string(kParamCount) +
+                    "): use the client of its build",
+           std::nullopt;
+  return param_answer_;
 }
 
 std::optional<pil::StateFrame> Client::state(double timeout_s) {

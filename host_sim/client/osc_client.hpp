@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "osc/link/commands.hpp"
+#include "osc/link/param_frames.hpp"
 #include "stream_path.hpp"  // StreamPoint, resample_path
 
 namespace osc::client {
@@ -127,6 +128,12 @@ class Client {
   /// with the reason; or kTimeout, kError.
   Outcome wait_done(std::uint32_t id, double timeout_s);
 
+  /// A parameter request (osc/link/param_frames.hpp): the param frame sent, its param_answer awaited
+  /// up to timeout_s; nullopt on a timeout or an error (error()). The answer's layout is checked
+  /// against this client's table (osc::kParamLayout): another firmware's table is an error.
+  std::optional<pil::ParamAnswerFrame> param(std::uint8_t op, int index = 0, int element = 0, double value = 0,
+                                             double timeout_s = 5);
+
   /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.
   bool pump(double timeout_s);
   std::function<void(const pil::AnswerFrame&)> on_answer;
@@ -156,6 +163,7 @@ class Client {
   std::uint32_t next_id_;
   std::deque<pil::AnswerFrame> answers_;  // the last kHistory answers
   std::optional<pil::StateFrame> state_;
+  std::optional<pil::ParamAnswerFrame> param_answer_;  // the last param_answer frame
   std::uint64_t states_seen_ = 0;
   std::string error_;
   double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)

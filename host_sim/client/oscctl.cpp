@@ -5,6 +5,7 @@
 //   oscctl --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
 //   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative] [--v V --a A --j J]
 //   oscctl --port /dev/pts/7 watch [--seconds S]
+//   oscctl --port /dev/pts/7 param list | get NAME | set NAME VALUE... [--element E] | save | load | reset | check
 //
 // Each command prints its outcome, one line each: "accepted" or "refused: REASON"; then, for a move,
 // a stream, a stop or a disable it waits for, "done" or "aborted: REASON" (a stop prints the motion it
@@ -43,6 +44,9 @@ struct Args {
   double v = 0, a = 0, j = 0, rate = 0, seconds = 0;
   std::vector<std::array<double, 7>> rows;  // stream: the path
   bool has_rpy = false;
+  std::string param_op, param_name;  // param: the operation, the parameter's name
+  std::vector<double> param_values;
+  int element = -1;
 };
 
 constexpr double kDeg = osc::kPi / 180.0;
@@ -163,6 +167,113 @@ int watch(Client& c, const Args& a) {
   return 0;
 }
 
+/// One parameter element's line: "ks[2] = 97 (0.001 to 100000; torque_off)".
+void print_param(int i, const pil::ParamAnswerFrame& r) {
+  const osc::ParamInfo& p = osc::kParams[i];
+  std::string idx = p.count > 1 ? "[" + std::to_string(r.element) + "]" : "";
+  std::printf("%s%s = %.7g%s%s (%.7g to %.7g%s)\n", p.name, idx.c_str(), static_cast<double>(r.value),
+              *p.unit ? " " : "", p.unit, static_cast<double>(r.lo), static_cast<double>(r.hi),
+              (r.flags & pil::kParamFlagTorqueOff) ? "; torque_off" : "");
+}
+
+/// A param answer's status: 0 ok, 1 refused (the reason printed), 2 no answer.
+int param_status(const Client& c, const std::optional<pil::ParamAnswerFrame>& r, const char* what) {
+  if (!r) {
+    std::fprintf(stderr, "oscctl: param %s: %s\n", what, c.error().c_str());
+    return 2;
+  }
+  if (r->status == static_cast<std::uint8_t>(osc::ParamStatus::kOk)) return 0;
+  const int s = r->status < osc::kParamStatusCount ? r->status : static_cast<int>(osc::ParamStatus::kBadOp);
+  std::printf("refused: %s (%s)\n", osc::kParamStatusNames[s], osc::kParamStatusDocs[s]);
+  return 1;
+}
+
+void print_margins(const pil::ParamAnswerFrame& r) {
+  std::printf("observer margin %.3g (stable above 1: (4 - 2 k dt) / (b dt^2), b <= %.4g 1/s^2 at the last pose)\n",
+              static_cast<double>(r.margins[0]), static_cast<double>(r.margins[1]));
+  std::printf("condition (37) %.3g (k_s k_nd / 2: above 1 it can hold)%s\n", static_cast<double>(r.margins[2]),
+              (r.flags & pil::kParamFlagWarn37) ? ": warning, the paper's sufficient condition cannot hold" : "");
+}
+
+int param(Client& c, const Args& a) {
+  const auto op_of = [](const std::string& name) {
+    for (int k = 0; k < pil::kParamOpCount; ++k)
+      if (name == pil::kParamOpNames[k]) return static_cast<std::uint8_t>(k);
+    return static_cast<std::uint8_t>(pil::kParamOpCount);
+  };
+  if (a.param_op == "list") {
+    for (int i = 0; i < osc::kParamCount; ++i)
+      for (int e = 0; e < osc::kParams[i].count; ++e) {
+        const auto r = c.param(pil::kParamOpGet, i, e, 0, a.timeout);
+        if (const int rc = param_status(c, r, "get")) return rc;
+        print_param(i, *r);
+      }
+    return 0;
+  }
+  const int i = osc::param_index(a.param_name.c_str());
+  if (a.param_op == "get" || a.param_op == "set") {
+    const osc::ParamInfo& p = osc::kParams[i];
+    if (a.param_op == "get") {
+      for (int e = 0; e < p.count; ++e) {
+        if (a.element >= 0 && e != a.element) continue;
+        const auto r = c.param(pil::kParamOpGet, i, e, 0, a.timeout);
+        if (const int rc = param_status(c, r, "get")) return rc;
+        print_param(i, *r);
+      }
+      return 0;
+    }
+    for (std::size_t k = 0; k < a.param_values.size(); ++k) {
+      const int e = a.element >= 0 ? a.element : static_cast<int>(k);
+      const auto r = c.param(pil::kParamOpSet, i, e, a.param_values[k], a.timeout);
+      if (const int rc = param_status(c, r, "set")) {
+        if (r && r->margins[1] > 0) print_margins(*r);
+        return rc;
+      }
+      print_param(i, *r);
+      if (r->flags & pil::kParamFlagWarn37) print_margins(*r);
+    }
+    return 0;
+  }
+  const auto r = c.param(op_of(a.param_op), 0, 0, 0, a.timeout);
+  if (const int rc = param_status(c, r, a.param_op.c_str())) return rc;
+  if (a.param_op == "check")
+    print_margins(*r);
+  else
+    std::printf("%s: ok\n", a.param_op.c_str());
+  return 0;
+}
+
+/// The param command line's own checks: a known operation and name, as many values as elements.
+bool check_param(const Args& a, std::string& err) {
+  const bool named = a.param_op == "get" || a.param_op == "set";
+  if (!named) {
+    if (!a.param_name.empty() || !a.param_values.empty()) return err = "param " + a.param_op + " takes no name", false;
+    return true;
+  }
+  const int i = osc::param_index(a.param_name.c_str());
+  if (i < 0) {
+    err = "param " + a.param_name + ": no such parameter (";
+    for (int k = 0; k < osc::kParamCount; ++k) err += std::string(k ? ", " : "") + osc::kParams[k].name;
+    return err += ")", false;
+  }
+  const int n = osc::kParams[i].count;
+  if (a.element >= n)
+    return err = "param " + a.param_name + " --element " + std::to_string(a.element) + ": it has " + std::to_string(n) +
+                 " element" + (n > 1 ? "s (0 to " + std::to_string(n - 1) + ")" : " (0)"),
+           false;
+  if (a.param_op == "get") {
+    if (!a.param_values.empty()) return err = "param get takes no value", false;
+    return true;
+  }
+  const std::size_t want = a.element >= 0 ? 1 : static_cast<std::size_t>(n);
+  if (a.param_values.size() != want)
+    return err = "param set " + a.param_name + ": " + std::to_string(want) + " value" + (want > 1 ? "s" : "") +
+                 (a.element >= 0 ? " (one element)" : " (one per element; --element E sets one)") + ", got " +
+                 std::to_string(a.param_values.size()),
+           false;
+  return true;
+}
+
 void add_limits(CLI::App* s, Args& a) {
   s->add_option("--v", a.v, "linear speed limit [m/s], at most the configured maximum")->check(CLI::PositiveNumber);
   s->add_option("--a", a.a, "linear acceleration limit [m/s^2]")->check(CLI::PositiveNumber);
@@ -205,6 +316,18 @@ void build(CLI::App& app, Args& a) {
   st->add_flag("--velocity", a.velocity,
                "send each setpoint with the path's velocity (its slope between rows): no delay of one period");
   add_limits(st, a);
+  CLI::App* pm = app.add_subcommand(
+      "param",
+      "the controller's parameters (docs/protocol.md, \"Parameters\"): list, get, set, save, load, reset, check");
+  std::vector<std::string> ops = {"list"};
+  for (const char* n : pil::kParamOpNames) ops.emplace_back(n);
+  pm->add_option("op", a.param_op, "list, get NAME, set NAME VALUE..., save, load, reset, check")
+      ->required()
+      ->check(CLI::IsMember(ops));
+  pm->add_option("name", a.param_name, "the parameter (get, set)");
+  pm->add_option("values", a.param_values, "set: one value per element, or one with --element");
+  pm->add_option("--element", a.element, "get, set: only this element of a vector parameter")
+      ->check(CLI::Range(0, 255));
   CLI::App* w = app.add_subcommand("watch", "print state changes and every answer");
   w->add_option("--seconds", a.seconds, "for this long (default: until interrupted)")->check(CLI::PositiveNumber);
 }
@@ -214,6 +337,7 @@ int run(Client& c, const Args& a) {
   if (a.verb == "move") return move(c, a);
   if (a.verb == "stream") return stream(c, a);
   if (a.verb == "watch") return watch(c, a);
+  if (a.verb == "param") return param(c, a);
   const osc::MotionVerb verb = a.verb == "enable"    ? osc::MotionVerb::kEnable
                                : a.verb == "disable" ? osc::MotionVerb::kDisable
                                : a.verb == "clear"   ? osc::MotionVerb::kClear
@@ -232,7 +356,8 @@ int main(int argc, char** argv) {
   auto what = [&](const CLI::ParseError& e) {
     const std::vector<std::string> extra = app.remaining();
     return app.get_subcommands().empty() && !extra.empty()
-               ? extra.front() + ": not a command (state, enable, disable, clear, paper, stop, move, stream, watch)"
+               ? extra.front() +
+                     ": not a command (state, enable, disable, clear, paper, stop, move, stream, watch, param)"
                : std::string(e.what());
   };
   if (const int status = sim::parse_command_line(app, argc, argv, "oscctl", "the commands and options", what);
@@ -240,7 +365,7 @@ int main(int argc, char** argv) {
     return status;
   a.verb = app.get_subcommands().front()->get_name();
   std::string err;
-  if (a.verb == "stream" && !check_stream(a, err)) {
+  if ((a.verb == "stream" && !check_stream(a, err)) || (a.verb == "param" && !check_param(a, err))) {
     std::fprintf(stderr, "oscctl: %s\n", err.c_str());
     return 2;
   }

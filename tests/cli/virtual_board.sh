@@ -11,9 +11,15 @@
 #                                      plain and with the path's velocity
 #   qemu_sequence IMAGE [SCALAR]       osc_sim --pty --qemu --elf IMAGE (the PIL firmware in QEMU, the arm
 #                                      here, at speed 1): the sequence above with oscctl, then with the
-#                                      Python client (the watch given 10 s); the link clean at the end,
+#                                      Python client (the watch given 10 s), then oscctl's param
+#                                      sequence (save, reset, load in the image's RAM); the link clean at the end,
 #                                      the clients' keep-alives dropped, not relayed; a --scalar other than
 #                                      SCALAR (the image's; default float) refused first
+#   oscctl_param, python_param         param: list, get, set (a gain; an unstable observer gain
+#                                      refused with its margin; a bad name or count exit 2), check, save,
+#                                      reset, load (the values back); a smaller move_linear maximum
+#                                      taking effect on the next move (over it refused over_limit); a gain
+#                                      refused torque_on while enabled
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
 #   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
@@ -126,6 +132,33 @@ sequence() {
   expect 1 '^refused: not_enabled' -- "$@" move 0 0 0.01 --relative
 }
 
+# The parameters with one client ("$@"): list, get, set, refusals, check, save / reset / load, a
+# smaller move maximum taking effect on the next move, a gain refused while enabled.
+param_sequence() {
+  expect 0 '^knd\[0\] = 120 \(0.001 to 100000; torque_off\)$' '^stream_timeout = 0.02 s \(0.002 to 0.1\)$' \
+    '^collision_threshold\[5\] = 0 N m' -- "$@" param list
+  expect 0 '^ks\[0\] = 80 ' '^ks\[5\] = 25 ' -- "$@" param set ks 80 80 80 25 25 25
+  expect 1 '^refused: unstable_observer' '^observer margin 0' -- "$@" param set k --element 0 2500
+  expect 0 '^k\[0\] = 108 ' -- "$@" param get k --element 0
+  expect 2 'param nosuch: no such parameter \(knd, k, ' -- "$@" param set nosuch 1
+  expect 2 'param set ks: 6 values \(one per element' -- "$@" param set ks 1
+  expect 2 'param k_ad --element 1: it has 1 element' -- "$@" param get k_ad --element 1
+  expect 0 '^observer margin [0-9.]+ ' '^condition \(37\) [0-9.e+]+ ' -- "$@" param check
+  expect 0 '^save: ok$' -- "$@" param save
+  expect 0 '^reset: ok$' -- "$@" param reset
+  expect 0 '^ks\[0\] = 97 ' -- "$@" param get ks --element 0
+  expect 0 '^load: ok$' -- "$@" param load
+  expect 0 '^ks\[0\] = 80 ' -- "$@" param get ks --element 0
+  # A smaller configured maximum: the next move that asks for more is refused over_limit.
+  expect 0 '^move_linear\[0\] = 0.01 m/s' -- "$@" param set move_linear --element 0 0.01
+  expect 0 '^accepted$' -- "$@" enable
+  expect 1 '^refused: over_limit' -- "$@" move 0 0.01 0 --relative --v 0.02
+  expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" move 0 0.005 0 --relative --v 0.01
+  expect 1 '^refused: torque_on' -- "$@" param set ks --element 0 90
+  expect 1 '^refused: torque_on' -- "$@" param save
+  expect 0 '^accepted$' '^done$' -- "$@" disable
+}
+
 # A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
 # setpoints, then again (from where that ended) with the path's velocity (--velocity).
 stream() {
@@ -176,10 +209,21 @@ case "$case_" in
     watch_s=10  # the watched move takes 3.3 s simulated; QEMU keeps real time within 0.11 s (docs/motion.md)
     sequence "$ctl" --port "$port" --timeout 120
     sequence "$py" "$client" --port "$port" --timeout 120
+    param_sequence "$ctl" --port "$port" --timeout 120  # the image's parameters, its RAM store
     stop_sim
     # The clients' keep-alives (state frames) reached osc_sim and stayed off the PIL link: it is clean.
     grep -E 'osc_sim: [0-9]+ ticks .* [1-9][0-9]* not commands' "$tmp/sim.err" || fail "no keep-alive counted"
     grep -E "osc_sim: firmware image .*: link clean" "$tmp/sim.err" || fail "the PIL link was not clean"
+    ;;
+  oscctl_param)
+    start_sim --speed 4
+    param_sequence "$ctl" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  python_param)
+    start_sim --speed 4 --scalar float
+    param_sequence "$py" "$client" --port "$port" --timeout 60
+    stop_sim
     ;;
   sim_options)
     expect 2 'osc_sim: --pty is required' -- "$sim"

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "osc/link/frames.hpp"
+#include "osc/link/param_frames.hpp"
 #include "osc/runtime/motion_commands.hpp"
 
 namespace {
@@ -328,6 +329,41 @@ void cli() {
 
 }  // namespace
 
+/// fuzz_param: byte 0 the scalar and the torque; then requests of op, index, element, how, value.
+void param() {
+  const auto request = [](Bytes& b, std::uint8_t op, int index, int element, double value) {
+    b.push_back(op);
+    b.push_back(static_cast<std::uint8_t>(index));
+    b.push_back(static_cast<std::uint8_t>(element));
+    b.push_back(1);  // raw f32 bits
+    float v = static_cast<float>(value);
+    std::uint32_t bits;
+    std::memcpy(&bits, &v, 4);
+    u32(b, bits);
+  };
+  for (int scalar = 0; scalar < 3; ++scalar) {
+    // Every parameter's every element read, then set to its default; a save, a reset, a load.
+    Bytes b{static_cast<std::uint8_t>(scalar)};
+    for (int i = 0; i < osc::kParamCount; ++i)
+      for (int e = 0; e < osc::kParams[i].count; ++e) {
+        request(b, pil::kParamOpGet, i, e, 0);
+        request(b, pil::kParamOpSet, i, e, osc::param_default(i, e));
+      }
+    for (std::uint8_t op : {pil::kParamOpSave, pil::kParamOpReset, pil::kParamOpLoad, pil::kParamOpCheck})
+      request(b, op, 0, 0, 0);
+    put("fuzz_param", "defaults_" + std::to_string(scalar), b);
+    // Gains at the edge of the observer's stability, out of range, NaN; the torque on.
+    Bytes edge{static_cast<std::uint8_t>(scalar | 4)};
+    const int k = osc::param_index("k"), ki = osc::param_index("ki");
+    for (double v : {1990.0, 2000.0, 2100.0, 1e5, std::nan(""), -1.0}) request(edge, pil::kParamOpSet, k, 0, v);
+    for (double v : {4000.0, 5000.0, 3e5, 1e6}) request(edge, pil::kParamOpSet, ki, 3, v);
+    request(edge, pil::kParamOpSet, osc::param_index("collision_threshold"), 5, 21.3);
+    put("fuzz_param", "edges_" + std::to_string(scalar), edge);
+    edge[0] = static_cast<std::uint8_t>(scalar);
+    put("fuzz_param", "edges_off_" + std::to_string(scalar), edge);
+  }
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "usage: fuzz_make_corpus DIR (e.g. tests/fuzz/corpus)\n");
@@ -339,6 +375,7 @@ int main(int argc, char** argv) {
   encoder();
   supervisor();
   command();
+  param();
   pil_client();
   cli();
   return 0;

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "config.hpp"
+#include "experiment.hpp"
 
 namespace {
 
@@ -67,6 +68,59 @@ TEST(GainKeys, ARangeIsEnforcedAtItsBounds) {
     EXPECT_FALSE(sim::set_key(key, value(p.hi * 2 + 1), s, err)) << key;
     EXPECT_NE(err.find("out of range"), std::string::npos) << err;
   }
+}
+
+/// A list of the parameter's elements at their bound (hi: the top; otherwise the bottom), scaled.
+std::string bounds_text(const osc::ParamInfo& p, bool hi, double scale, double shift = 0) {
+  std::string t = p.count > 1 ? "[" : "";
+  for (int e = 0; e < p.count; ++e) t += (e ? ", " : "") + number((hi ? p.hi_of(e) : p.lo_of(e)) * scale + shift);
+  return t + (p.count > 1 ? "]" : "");
+}
+
+// Every runtime parameter of the firmware's table (osc/runtime/parameters.hpp) is a host key: its own
+// (a law's or a reaction's name: as many names as codes; the thresholds: each joint's range), or
+// run.<name> made from the table with each element's range and the table's default.
+TEST(GainKeys, EveryRuntimeParameterIsAHostKeyWithTheTablesRanges) {
+  const std::string yaml = sim::config_yaml(sim::Settings{});
+  int generated = 0;
+  for (int i = 0; i < osc::kParamCount; ++i) {
+    const osc::ParamInfo& p = osc::kParams[i];
+    if (p.gain >= 0) {
+      EXPECT_NE(controller_line(yaml, p.name), "") << p.name;  // the gains' entries (the test above)
+      continue;
+    }
+    const char* own = sim::runtime_param_key(p.runtime);
+    const std::string key = own ? own : std::string("run.") + p.name;
+    EXPECT_NE(yaml.find("\n  " + key.substr(4) + ": "), std::string::npos) << key;
+    sim::Settings s;
+    std::string err;
+    if (p.runtime == osc::RuntimeParam::kParamAdaptation) {
+      EXPECT_EQ(p.hi + 1, osc::kAdaptationLawCount);
+      for (int k = 0; k < osc::kAdaptationLawCount; ++k)
+        EXPECT_TRUE(sim::set_key(key, osc::kAdaptationLawNames[k], s, err)) << err;
+      continue;
+    }
+    if (p.runtime == osc::RuntimeParam::kParamCollisionReaction) {
+      EXPECT_EQ(p.hi + 1, osc::MotionNames<osc::CollisionReaction>::kCount);
+      for (int k = 0; k < osc::MotionNames<osc::CollisionReaction>::kCount; ++k)
+        EXPECT_TRUE(sim::set_key(key, osc::MotionNames<osc::CollisionReaction>::kNames[k], s, err)) << err;
+      continue;
+    }
+    // A number or a list: each element's range is the table's, at both ends.
+    EXPECT_TRUE(sim::set_key(key, bounds_text(p, true, 1), s, err)) << key << ": " << err;
+    EXPECT_TRUE(sim::set_key(key, bounds_text(p, false, 1), s, err)) << key << ": " << err;
+    EXPECT_FALSE(sim::set_key(key, bounds_text(p, true, 1.001, 1e-6), s, err)) << key;
+    EXPECT_NE(err.find("out of range"), std::string::npos) << err;
+    EXPECT_FALSE(sim::set_key(key, bounds_text(p, false, 1, -1e-3), s, err)) << key;
+    if (own) continue;
+    ++generated;
+    // Its default is the table's, as the host's configuration prints it.
+    std::string def = p.count > 1 ? "[" : "";
+    for (int e = 0; e < p.count; ++e) def += (e ? ", " : "") + number(osc::param_default(i, e));
+    def += p.count > 1 ? "]" : "";
+    EXPECT_NE(yaml.find("\n  " + key.substr(4) + ": " + def), std::string::npos) << key << " default " << def;
+  }
+  EXPECT_EQ(generated, 3);  // move_linear, move_angular, stream_timeout
 }
 
 }  // namespace

@@ -12,7 +12,9 @@ would drive the board over a serial adapter:
   3. a move_to far outside the workspace (2 m along x from where the arm holds) is refused
      out_of_workspace (the board's path check, in its main loop);
   4. stop is accepted (holding: nothing to stop) and done;
-  5. disable is accepted, and the state becomes disabled.
+  5. disable is accepted, and the state becomes disabled;
+  6. the parameters: a set of k_s while disabled is accepted and reads back, refused torque_on while
+     enabled; save, reset and load bring it back (in RAM here: QEMU models no flash controller).
 The encoders do not move in QEMU, so no motion is run. No timing is asserted: every wait is generous
 (the machine may be busy). Prints one line per step; exit 0 when all pass, 1 otherwise.
 """
@@ -76,6 +78,22 @@ def run(c):
     if s is not None:
         check("no fault", s["faults"] == 0, c.p.fault_names(s["faults"]))
         check("no setpoint dropped (keep-alive frames are no setpoints)", s["dropped"] == 0, str(s["dropped"]))
+    ks = c.p.param_index["ks"]
+    a = c.param("set", ks, 1, 80.0, timeout=TIMEOUT)
+    check("param set ks[1] = 80 accepted", a["status"] == 0 and a["value"] == 80.0, str(a))
+    names = [c.param(op, timeout=TIMEOUT)["status"] for op in ("save", "reset")]
+    check("save and reset ok", names == [0, 0], str(names))
+    check("reset: ks[1] back to 97", c.param("get", ks, 1, timeout=TIMEOUT)["value"] == 97.0)
+    check("load ok", c.param("load", timeout=TIMEOUT)["status"] == 0)
+    check("load: ks[1] is 80 again", c.param("get", ks, 1, timeout=TIMEOUT)["value"] == 80.0)
+    o = c.wait_answer(c.enable(), TIMEOUT)
+    check("enable accepted", o.status == "accepted", o.text())
+    wait_state(c, "holding")
+    a = c.param("set", ks, 1, 90.0, timeout=TIMEOUT)
+    check("param set while enabled refused torque_on",
+          c.p.name_of("param_statuses", a["status"]) == "torque_on" and a["value"] == 80.0, str(a))
+    o = c.wait_answer(c.disable(), TIMEOUT)
+    check("disable accepted", o.status == "accepted", o.text())
     return ok
 
 

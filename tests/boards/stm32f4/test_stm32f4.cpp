@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
+#include <memory>
 #include <vector>
 
 #include "ad5754r.hpp"
@@ -18,6 +20,7 @@
 #include "dac_bus.hpp"
 #include "encoders.hpp"
 #include "flash.hpp"
+#include "param_store.hpp"
 #include "osc/link/command_port.hpp"
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
@@ -521,6 +524,51 @@ TEST(Stm32Flash, TheParameterSectorsCarryTheRecordStore) {
   EXPECT_EQ(sectors.last_status(), FlashStatus::kBadAddress);
   EXPECT_EQ(sectors.read(1, FlashSectors<>::kSectorWords), persist::kErased);
   EXPECT_EQ(FlashSectors<>::hardware_memory(), reinterpret_cast<volatile std::uint32_t*>(0x080C0000u));
+}
+
+/// The board's parameter store (param_store.hpp) over the sectors: the command port's save and load
+/// of the parameter table, each save inside one watchdog stretch; what the boot loads; a record of
+/// another table (layout) not loaded.
+TEST(Stm32Flash, TheBoardsParameterStoreSavesAndLoadsTheTable) {
+  std::vector<std::uint32_t> memory(2 * FlashSectors<>::kSectorWords, 0u);
+  Rec f;
+  f.memory = memory.data();
+  FlashSectors<Rec> sectors(f, memory.data());
+  struct CountingWatchdog {
+    int stretched = 0, restored = 0;
+    void stretch() { ++stretched; }
+    void restore() { ++restored; }
+  } dog;
+  board::FlashParamStore<FlashSectors<Rec>, CountingWatchdog> store(sectors, dog);
+  osc::ParamRecord r{};
+  EXPECT_EQ(store.load(r).status, persist::LoadStatus::kNone);
+  const osc::ParamStorage s = store.storage();
+  EXPECT_EQ(s.load(s.ctx, r), osc::ParamStatus::kNoRecord);
+  osc::ParamRecord saved = osc::param_defaults();
+  saved.value[osc::param_slot(osc::param_index("ks")) + 1] = 80;
+  ASSERT_TRUE(s.save(s.ctx, saved));
+  EXPECT_EQ(dog.stretched, 1);
+  EXPECT_EQ(dog.restored, 1);
+  ASSERT_EQ(s.load(s.ctx, r), osc::ParamStatus::kOk);
+  EXPECT_EQ(std::memcmp(&r, &saved, sizeof r), 0);
+  // The boot's path: the record applied to a task (disabled) as a whole.
+  auto task = std::make_unique<osc::ControlTask<float>>();
+  task->init(osc::Model<float>::of(osc::robot::kArm), osc::Gains<float>::paper(), osc::FrictionMode::kAdaptive,
+             osc::joint_vector<float>(osc::robot::kQStart), 0, osc::TaskStart::kDisabled);
+  ASSERT_EQ(osc::param_apply(*task, r), osc::ParamStatus::kOk);
+  EXPECT_EQ(task->gains.ks(1), 80.0f);
+  // A record of another table: not this one's.
+  persist::RecordStore<FlashSectors<Rec>> raw(sectors);
+  const std::uint8_t other[8] = {};
+  ASSERT_TRUE(raw.save(other, sizeof other, static_cast<std::uint16_t>(osc::kParamLayout + 1)).saved());
+  EXPECT_EQ(s.load(s.ctx, r), osc::ParamStatus::kOk) << "the older record of this layout is still there";
+  ASSERT_TRUE(raw.save(other, sizeof other, static_cast<std::uint16_t>(osc::kParamLayout + 1)).saved());
+  EXPECT_EQ(s.load(s.ctx, r), osc::ParamStatus::kLayoutMismatch) << "both sectors now hold the other table's";
+  // A failed save is reported, the watchdog set back all the same.
+  f.raise = FlashRegs::kWrperr;
+  EXPECT_FALSE(s.save(s.ctx, saved));
+  EXPECT_EQ(store.last_save().status, persist::SaveStatus::kEraseFailed);
+  EXPECT_EQ(dog.restored, 2);
 }
 
 TEST(Stm32Flash, TheChipsFlashBlockDrivesTheSectors) {

@@ -56,8 +56,10 @@ F decoded(const pil::Parser& p) {
   pil::SetpointFrame sp;
   pil::TraceFrame tr;
   pil::SetpointVelocityFrame sv;
-  const int ok =
-      p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) + p.decode(sv);
+  pil::ParamFrame pf;
+  pil::ParamAnswerFrame pa;
+  const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
+                 p.decode(sv) + p.decode(pf) + p.decode(pa);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));
@@ -86,7 +88,11 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kAnswerPayload, 4 + 1 + 1 + 1 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 4);
   EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4);
   EXPECT_EQ(pil::kTracePayload, 4 + 4 + 1 + 3 * 24 + 36);
-  ASSERT_EQ(pil::kFrameTypes, 8);
+  EXPECT_EQ(pil::kParamFrame, 9);
+  EXPECT_EQ(pil::kParamAnswerFrame, 10);
+  EXPECT_EQ(pil::kParamPayload, 4 + 1 + 1 + 1 + 4);
+  EXPECT_EQ(pil::kParamAnswerPayload, 4 + 1 + 1 + 1 + 1 + 1 + 1 + 4 + 4 + 4 + 4 + 12);
+  ASSERT_EQ(pil::kFrameTypes, 10);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -95,7 +101,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 9, 10, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 11, 12, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 TEST(CommandFrames, SensorAndActuatorFramesUnchangedByteForByte) {
@@ -174,6 +180,12 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
           break;
         case pil::kSetpointVelocityFrame:
           out = bytes_of(decoded<pil::SetpointVelocityFrame>(p));
+          break;
+        case pil::kParamFrame:
+          out = bytes_of(decoded<pil::ParamFrame>(p));
+          break;
+        case pil::kParamAnswerFrame:
+          out = bytes_of(decoded<pil::ParamAnswerFrame>(p));
           break;
       }
       ASSERT_EQ(out, in) << info.name;

@@ -87,9 +87,10 @@ class MotionGenerator {
   }
   /// Starts following a stream from the held pose at rest (its setpoints every `period` ticks; with
   /// `relative`, offsets from the held pose: prepare_setpoint), keeping `lim`.
-  void start_stream(std::uint32_t period, bool relative, const CartesianLimits<S>& lim, std::uint32_t id) {
+  void start_stream(std::uint32_t period, bool relative, const CartesianLimits<S>& lim, std::uint32_t id,
+                    std::uint32_t timeout_min = StreamFollower<S>::kTimeoutMinTicks) {
     stream_.set_limits(lim);
-    stream_.start(hold_d_.x, period);
+    stream_.start(hold_d_.x, period, timeout_min);
     stream_relative_ = relative;
     stream_id_ = id;
     ++epoch_;

@@ -169,12 +169,12 @@ class StreamFollower {
   }
 
   /// Starts at x0 at rest (the held pose), the stream's period `period_ticks` (1 to 100 ticks: 1 kHz
-  /// to 10 Hz).
-  void start(const Vec6<S>& x0, std::uint32_t period_ticks) {
+  /// to 10 Hz); stale after max(2 periods, timeout_min ticks) without a sample.
+  void start(const Vec6<S>& x0, std::uint32_t period_ticks, std::uint32_t timeout_min = kTimeoutMinTicks) {
     period_ = period_ticks > 0 ? period_ticks : 1;
     rate_ = math::ratio<S>(kHz, period_);
     const std::uint32_t twice = 2 * period_;
-    timeout_ = twice > kTimeoutMinTicks ? twice : kTimeoutMinTicks;
+    timeout_ = twice > timeout_min ? twice : timeout_min;
     period_s_ = math::ratio<S>(period_, kHz);
     prev_ = cur_ = sample_ = x0;
     w0_ = v1_ = Vec6<S>::Zero();

@@ -139,6 +139,62 @@ constexpr double kCommandMaxVelocity = 10.0;
   X(float, x, [6], "m, rad", "the measured pose of the last control step, the same way")                      \
   X(std::uint32_t, tick, , "tick", "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")
 
+// X(Name, "name", meaning): what a param frame asks (the parameter table, osc/runtime/parameters.hpp).
+// Each is answered at once by a param_answer frame, in the order they come.
+#define OSC_PARAM_OP_LIST(X)                                                                                       \
+  X(Get, "get",                                                                                                    \
+    "the element's value, with its range and the table's size and layout (a listing gets each "                    \
+    "index in turn)")                                                                                              \
+  X(Set, "set", "value into the element, checked (Parameter statuses); the answer carries the value now")          \
+  X(Save, "save", "every value into the board's store (flash on the STM32F4, RAM on the QEMU boards); torque off") \
+  X(Load, "load", "the store's newest valid record applied, checked as a whole; torque off")                       \
+  X(Reset, "reset", "the table's defaults applied; torque off; the store is unchanged")                            \
+  X(Check, "check", "the gains' margins as they are: margins = observer, its b bound [1/s^2], condition (37)")
+
+#define OSC_X_PREFIX kParamOp
+enum ParamOp : std::uint8_t { OSC_PARAM_OP_LIST(OSC_X_ENUMERATOR) kParamOpCount };
+#undef OSC_X_PREFIX
+constexpr const char* kParamOpNames[kParamOpCount] = {OSC_PARAM_OP_LIST(OSC_X_NAME)};
+constexpr const char* kParamOpDocs[kParamOpCount] = {OSC_PARAM_OP_LIST(OSC_X_DOC)};
+
+// X(Name, "name", meaning): the param_answer frame's flag bits, bit k for the k-th entry.
+#define OSC_PARAM_FLAG_LIST(X)                                                                        \
+  X(Warn37, "warn_37", "the gains as they are now leave the paper's sufficient condition (37) unmet") \
+  X(TorqueOff, "torque_off", "the parameter may be written only while the torque is off")             \
+  X(Persists, "persists", "the parameter is kept by save")
+#define OSC_X_PREFIX kParamFlagBit
+enum ParamFlagBit : std::uint8_t { OSC_PARAM_FLAG_LIST(OSC_X_ENUMERATOR) kParamFlagCount };
+#undef OSC_X_PREFIX
+#define OSC_PARAM_FLAG_MASK(Name, name, doc) \
+  constexpr std::uint8_t kParamFlag##Name = static_cast<std::uint8_t>(1u << kParamFlagBit##Name);
+OSC_PARAM_FLAG_LIST(OSC_PARAM_FLAG_MASK)
+#undef OSC_PARAM_FLAG_MASK
+constexpr const char* kParamFlagNames[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC_X_NAME)};
+constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC_X_DOC)};
+
+#define OSC_PARAM_FIELDS(X)                                                                      \
+  X(std::uint32_t, id, , "", "the client's number for the request, echoed in its answer")        \
+  X(std::uint8_t, op, , "", "what to do (Parameter operations)")                                 \
+  X(std::uint8_t, index, , "", "get, set: the parameter's index in the table (Parameters)")      \
+  X(std::uint8_t, element, , "", "get, set: the element of a vector parameter (0 for a number)") \
+  X(float, value, , "the parameter's", "set: the new value")
+
+#define OSC_PARAM_ANSWER_FIELDS(X)                                                                           \
+  X(std::uint32_t, id, , "", "the request's id")                                                             \
+  X(std::uint8_t, op, , "", "its operation")                                                                 \
+  X(std::uint8_t, index, , "", "its parameter's index (get, set)")                                           \
+  X(std::uint8_t, element, , "", "its element (get, set)")                                                   \
+  X(std::uint8_t, status, , "", "ok, or why it was refused (Parameter statuses)")                            \
+  X(std::uint8_t, flags, , "", "warn_37, torque_off, persists (Parameter flags)")                            \
+  X(std::uint8_t, count, , "", "the number of parameters in the table")                                      \
+  X(std::uint32_t, layout, , "", "the table's layout version (a client with another table must not use it)") \
+  X(float, value, , "the parameter's",                                                                       \
+    "get, set: the element's value now (after a set: the new one, or the old when refused)")                 \
+  X(float, lo, , "the parameter's", "get, set: the element's least value")                                   \
+  X(float, hi, , "the parameter's", "get, set: the element's greatest value")                                \
+  X(float, margins, [3], "1, 1/s^2, 1",                                                                      \
+    "set of a gain, check: the observer's stability margin (above 1: stable), its bound on b, condition (37)'s")
+
 // The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
 // (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as
 // the in-process controller's). A Q12.19 number below 32 in magnitude is exact in f32, and so is

@@ -26,6 +26,7 @@
 #include <cstdint>
 
 #include "osc/link/commands.hpp"
+#include "osc/link/param_frames.hpp"
 
 namespace osc {
 
@@ -78,8 +79,10 @@ class CommandPort {
   }
 
   /// A complete frame from the parser, taken but not prepared: a command waits in the FIFO (or is
-  /// refused at once, queue_full), a setpoint goes to the task (offer_setpoint_frame). True for
-  /// those two types; any other is the caller's (false).
+  /// refused at once, queue_full), a setpoint goes to the task (offer_setpoint_frame), a param frame
+  /// is handled and answered at once (param_answer: a set of a gain evaluates the observer's margin,
+  /// an operational-space update and a 6x6 factorisation, in the caller's context). True for those
+  /// types; any other is the caller's (false).
   template <class Write>
   bool receive(ControlTask<S>& task, const pil::Parser& p, Write&& write) {
     pil::CommandFrame c;
@@ -97,8 +100,18 @@ class CommandPort {
       offer_setpoint_frame(task, sv);
       return true;
     }
+    pil::ParamFrame pf;
+    if (p.decode(pf)) {
+      std::uint8_t buf[pil::kMaxFrame];
+      write(buf,
+            pil::encode(param_answer(task, pf, param_storage_.save ? param_storage_ : ram_params_.storage()), buf));
+      return true;
+    }
     return false;
   }
+
+  /// The board's parameter store (save, load); without one, the port keeps the record in RAM.
+  void set_param_storage(const ParamStorage& s) { param_storage_ = s; }
 
   /// A command frame into the FIFO; refused at once (queue_full) when it is full.
   template <class Write>
@@ -220,6 +233,8 @@ class CommandPort {
     return true;
   }
 
+  ParamStorage param_storage_{};
+  RamParamStore ram_params_;
   pil::CommandFrame fifo_[kCommandFifo] = {};
   int head_ = 0, count_ = 0;
   bool commanded_ = false;

@@ -131,7 +131,11 @@ struct LinkCounters {
   X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                                 \
     "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "        \
     "line without the setpoints' delay)",                                                                             \
-    OSC_SETPOINT_VELOCITY_FIELDS)
+    OSC_SETPOINT_VELOCITY_FIELDS)                                                                                     \
+  X(Param, 9, "param", "host", "a parameter request: get, set, save, load, reset, check (answered at once)",          \
+    OSC_PARAM_FIELDS)                                                                                                 \
+  X(ParamAnswer, 10, "param_answer", "firmware", "the answer to each param frame, sent as it is handled",             \
+    OSC_PARAM_ANSWER_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

@@ -66,6 +66,7 @@ struct ControlTask {
   ResidualMonitor<S> residual;
   FrictionIdentifier<S> identifier;      // the `momentum` law's (osc/control/identification.hpp)
   CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
+  std::uint32_t stream_timeout_ticks;    // a stream is stale after max(2 periods, this) without a setpoint
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
   Supervisor sup;
@@ -105,6 +106,7 @@ struct ControlTask {
     residual.collision_floor.setZero();
     identifier.reset();
     collision_reaction = CollisionReaction::kCategory0;
+    stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
     saturation.reset();
     set_encoders(robot::kEncodersUniform);
@@ -378,7 +380,8 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   }
   if (accepted && cmd.verb == MotionVerb::kPaper)
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
-  if (accepted && cmd.verb == MotionVerb::kStream) task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id);
+  if (accepted && cmd.verb == MotionVerb::kStream)
+    task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {

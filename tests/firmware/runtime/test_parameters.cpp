@@ -1,0 +1,359 @@
+// The runtime parameter table (osc/runtime/parameters.hpp) and its link (osc/link/param_frames.hpp,
+// through the command port): one declaration, checked sets, the observer's stability margin against
+// the spectral radius of the discrete observer's error map, records, and save / reset / load.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "osc/link/command_port.hpp"
+#include "osc/math/fixed.hpp"
+#include "osc/robot.hpp"
+#include "osc/runtime/parameters.hpp"
+
+namespace {
+
+using namespace osc;
+
+template <class S>
+std::unique_ptr<ControlTask<S>> disabled_task() {
+  auto t = std::make_unique<ControlTask<S>>();
+  t->init(Model<S>::of(robot::kArm), Gains<S>::paper(), FrictionMode::kAdaptive, joint_vector<S>(robot::kQStart), 0,
+          TaskStart::kDisabled);
+  return t;
+}
+
+/// The spectral radius of the observer's linearised error map at a pose, from observer.hpp's
+/// discretisation with the arm still (x fixed, F and the bias forces cancelling to first order):
+///   e' = e - dt (y' ... ) : [e; y]' = [[I - dt K - dt^2 M, -dt I], [dt M, I]] [e; y],  M = Lambda^-1 K_i,
+/// with e = x - x^ and K = diag(k). An independent statement of the stability the margin bounds.
+double observer_spectral_radius(const Gains<double>& g, const Mat6<double>& lambda_inv) {
+  const double dt = g.dt;
+  const Mat6<double> M = lambda_inv * g.ki.asDiagonal();
+  Eigen::Matrix<double, 12, 12> A;
+  A.topLeftCorner<6, 6>() = Mat6<double>::Identity() - dt * Mat6<double>(g.k.asDiagonal()) - dt * dt * M;
+  A.topRightCorner<6, 6>() = -dt * Mat6<double>::Identity();
+  A.bottomLeftCorner<6, 6>() = dt * M;
+  A.bottomRightCorner<6, 6>() = Mat6<double>::Identity();
+  return Eigen::EigenSolver<Eigen::Matrix<double, 12, 12>>(A).eigenvalues().cwiseAbs().maxCoeff();
+}
+
+TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
+  std::set<std::string> names;
+  int gains = 0, slots = 0;
+  for (int i = 0; i < kParamCount; ++i) {
+    const ParamInfo& p = kParams[i];
+    EXPECT_TRUE(names.insert(p.name).second) << p.name << " twice";
+    EXPECT_EQ(param_index(p.name), i);
+    EXPECT_EQ(param_slot(i), slots);
+    slots += p.count;
+    EXPECT_TRUE(p.count == 1 || p.count == 3 || p.count == kDof) << p.name;
+    for (int e = 0; e < p.count; ++e) {
+      EXPECT_LT(p.lo_of(e), p.hi_of(e)) << p.name;
+      EXPECT_EQ(param_value_status(i, e, param_default(i, e)), ParamStatus::kOk) << p.name << "[" << e << "]";
+    }
+    if (p.gain >= 0) {
+      // The gains come first, with their key, range and unit from OSC_GAINS_FIELDS.
+      EXPECT_EQ(i, gains++);
+      const GainParam& g = kGainInfo[p.gain].param;
+      EXPECT_STREQ(p.name, g.key);
+      EXPECT_EQ(p.lo, g.lo);
+      EXPECT_EQ(p.hi, g.hi);
+      EXPECT_STREQ(p.unit, g.unit);
+      EXPECT_EQ(p.access, ParamAccess::kTorqueOff);
+    }
+  }
+  EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
+  EXPECT_EQ(slots, kParamSlots);
+  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1));
+  EXPECT_EQ(param_index("no_such"), -1);
+  EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
+}
+
+/// The table's defaults are what a task starts with: the gains' paper values, the configured
+/// motion limits, the collision reaction and thresholds, the stream timeout.
+template <class S>
+void defaults_are_a_new_tasks() {
+  auto t = disabled_task<S>();
+  const ParamRecord now = param_capture(*t), def = param_defaults();
+  for (int i = 0; i < kParamCount; ++i)
+    for (int e = 0; e < kParams[i].count; ++e) {
+      const int k = param_slot(i) + e;
+      EXPECT_NEAR(now.value[k], def.value[k], 1e-5 * std::fabs(def.value[k]) + 1e-6)
+          << kParams[i].name << "[" << e << "]";
+    }
+  EXPECT_EQ(param_default(param_index("knd"), 3), params::kKnd[3]);
+  EXPECT_EQ(param_default(param_index("move_angular"), 2), params::kMoveAngular[2]);
+  EXPECT_EQ(param_default(param_index("stream_timeout"), 0), kStreamTimeoutMin);
+}
+TEST(Parameters, DefaultsAreANewTasksDouble) { defaults_are_a_new_tasks<double>(); }
+TEST(Parameters, DefaultsAreANewTasksFloat) { defaults_are_a_new_tasks<float>(); }
+TEST(Parameters, DefaultsAreANewTasksFixed) { defaults_are_a_new_tasks<Fixed>(); }
+
+/// Every element set to a value inside its range reads back, in the task's scalar.
+template <class S>
+void every_element_sets_and_reads_back() {
+  auto t = disabled_task<S>();
+  for (int i = 0; i < kParamCount; ++i)
+    for (int e = 0; e < kParams[i].count; ++e) {
+      const ParamInfo& p = kParams[i];
+      const bool code = p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
+                                       p.runtime == RuntimeParam::kParamCollisionReaction);
+      // A value between the default and the top of the range, that keeps the observer stable.
+      const double v =
+          code ? p.hi_of(e) : param_default(i, e) * 0.75 + 0.25 * std::fmin(p.hi_of(e), 4 * param_default(i, e) + 1);
+      if (std::fabs(v) >= param_scalar_max<S>()) {  // beyond a fixed-point scalar: refused, unchanged
+        EXPECT_EQ(param_set(*t, i, e, v), ParamStatus::kOutOfRange) << p.name;
+        EXPECT_NEAR(param_get(*t, i, e), param_default(i, e), 1e-3) << p.name;
+        continue;
+      }
+      ASSERT_EQ(param_set(*t, i, e, v), ParamStatus::kOk) << p.name << "[" << e << "] = " << v;
+      EXPECT_NEAR(param_get(*t, i, e), v, 2e-6 * std::fabs(v) + 1e-5) << p.name;
+    }
+  // A gain of form `every` sets every element of its vector.
+  const int tau = param_index("tau_dec");
+  ASSERT_EQ(param_set(*t, tau, 0, 2.5), ParamStatus::kOk);
+  for (int j = 0; j < kDof; ++j) EXPECT_NEAR(static_cast<double>(t->gains.tau_dec(j)), 2.5, 1e-5);
+  // The runtime ones reach what the task uses.
+  ASSERT_EQ(param_set(*t, param_index("move_linear"), 1, 0.5), ParamStatus::kOk);
+  EXPECT_NEAR(static_cast<double>(t->limits.linear.a), 0.5, 1e-5);
+  ASSERT_EQ(param_set(*t, param_index("collision_threshold"), 4, 12.0), ParamStatus::kOk);
+  EXPECT_NEAR(static_cast<double>(t->residual.collision_floor(4)), 12.0, 1e-4);
+  ASSERT_EQ(param_set(*t, param_index("collision_reaction"), 0, 2.0), ParamStatus::kOk);
+  EXPECT_EQ(t->collision_reaction, CollisionReaction::kYield);
+  ASSERT_EQ(param_set(*t, param_index("stream_timeout"), 0, 0.05), ParamStatus::kOk);
+  EXPECT_EQ(t->stream_timeout_ticks, 50u);
+  ASSERT_EQ(param_set(*t, param_index("adaptation"), 0, 2.0), ParamStatus::kOk);
+  EXPECT_EQ(t->gains.adaptation, AdaptationLaw::kMomentum);
+}
+TEST(Parameters, EveryElementSetsAndReadsBackDouble) { every_element_sets_and_reads_back<double>(); }
+TEST(Parameters, EveryElementSetsAndReadsBackFloat) { every_element_sets_and_reads_back<float>(); }
+TEST(Parameters, EveryElementSetsAndReadsBackFixed) { every_element_sets_and_reads_back<Fixed>(); }
+
+TEST(Parameters, AFixedPointBuildRefusesWhatItsScalarWouldSaturate) {
+  auto t = disabled_task<Fixed>();
+  const int ki = param_index("ki");
+  EXPECT_EQ(param_set(*t, ki, 0, 4096.0), ParamStatus::kOutOfRange);  // Q12.19 holds less than 4096
+  EXPECT_EQ(param_set(*t, ki, 0, 4000.0), ParamStatus::kOk);
+  EXPECT_EQ(param_value_status<double>(ki, 0, 1e5), ParamStatus::kOk);  // double holds it
+}
+
+TEST(Parameters, EachBadSetIsRefusedByNameAndChangesNothing) {
+  auto t = disabled_task<double>();
+  const ParamRecord before = param_capture(*t);
+  const int knd = param_index("knd"), thr = param_index("collision_threshold"), law = param_index("adaptation");
+  EXPECT_EQ(param_set(*t, kParamCount, 0, 1.0), ParamStatus::kUnknownParam);
+  EXPECT_EQ(param_set(*t, -1, 0, 1.0), ParamStatus::kUnknownParam);
+  EXPECT_EQ(param_set(*t, knd, 6, 1.0), ParamStatus::kBadElement);
+  EXPECT_EQ(param_set(*t, param_index("k_ad"), 1, 1.0), ParamStatus::kBadElement);
+  EXPECT_EQ(param_set(*t, knd, 0, std::numeric_limits<double>::quiet_NaN()), ParamStatus::kNotFinite);
+  EXPECT_EQ(param_set(*t, knd, 0, std::numeric_limits<double>::infinity()), ParamStatus::kNotFinite);
+  EXPECT_EQ(param_set(*t, knd, 0, 1e-4), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, knd, 0, 2e5), ParamStatus::kOutOfRange);
+  // Per-element ranges: each joint's threshold up to its own full-scale torque.
+  EXPECT_EQ(param_set(*t, thr, 5, robot::kDrives.torque_limit[5] * 1.001), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, thr, 0, -0.1), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, law, 0, 1.5), ParamStatus::kOutOfRange);  // a code is a whole number
+  EXPECT_EQ(param_set(*t, law, 0, 3.0), ParamStatus::kOutOfRange);
+  // Torque on: a gain is refused, a runtime parameter of access `always` is not.
+  t->machine.state = MotionState::kHolding;
+  EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kTorqueOn);
+  EXPECT_EQ(param_set(*t, law, 0, 0.0), ParamStatus::kTorqueOn);
+  const ParamRecord mid = param_capture(*t);
+  for (int k = 0; k < kParamSlots; ++k) EXPECT_EQ(mid.value[k], before.value[k]) << k;
+  EXPECT_EQ(param_set(*t, thr, 0, 30.0), ParamStatus::kOk);
+  t->machine.state = MotionState::kFault;  // in fault the torque is off
+  EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kOk);
+}
+
+/// The margin against the discrete observer's error map: wherever the margin says stable (above 1),
+/// the map's spectral radius is below 1 (the margin bounds b from above), and gains whose map is
+/// unstable are refused. Swept over k and k_i of one axis group at a time, at the start pose.
+TEST(Parameters, ObserverMarginIsConservativeAgainstTheErrorMapsSpectralRadius) {
+  auto t = disabled_task<double>();
+  const Mat6<double> li = task_lambda_inverse(*t);
+  // The paper's gains: b bounded near observer.hpp's 2.7e4, a wide margin, (37) met.
+  const GainMargins paper = param_margins(*t);
+  EXPECT_GT(paper.b_max, 2.7e4);
+  EXPECT_LT(paper.b_max, 4e4);
+  EXPECT_GT(paper.observer, 50);
+  EXPECT_GT(paper.condition37, 1);
+  EXPECT_LT(observer_spectral_radius(Gains<double>::paper(), li), 1);
+  int stable = 0, refused = 0, unstable_refused = 0;
+  for (const double k : {10.0, 108.0, 500.0, 1000.0, 1500.0, 1900.0, 1990.0, 2100.0})
+    for (const double ki : {1e2, 2e3, 1e4, 1e5, 3e5, 1e6}) {
+      Gains<double> g = Gains<double>::paper();
+      g.k.setConstant(k);
+      g.ki.setConstant(ki);
+      const GainMargins m = gain_margins(g, li);
+      const double rho = observer_spectral_radius(g, li);
+      if (m.observer > 1) {
+        ++stable;
+        EXPECT_LT(rho, 1) << "k " << k << " ki " << ki << ": margin " << m.observer;
+      } else {
+        ++refused;
+      }
+      if (rho > 1) {
+        ++unstable_refused;
+        EXPECT_LE(m.observer, 1) << "k " << k << " ki " << ki;
+      }
+    }
+  EXPECT_GT(stable, 10);
+  EXPECT_GT(unstable_refused, 3);  // the sweep reaches unstable gains, and each is refused
+  // Through param_set: a k beyond 2 / dt, and a k_i that makes b dt^2 exceed the room, are refused.
+  EXPECT_EQ(param_set(*t, param_index("k"), 0, 2100.0), ParamStatus::kUnstableObserver);
+  EXPECT_EQ(param_set(*t, param_index("ki"), 3, 1e6), ParamStatus::kUnstableObserver);
+  EXPECT_EQ(param_set(*t, param_index("ki"), 3, 5000.0), ParamStatus::kOk);
+}
+
+TEST(Parameters, Condition37OnlyWarns) {
+  auto t = disabled_task<double>();
+  GainMargins m;
+  // k_s k_nd / 2 <= 1: (37) cannot hold; set anyway, with the margin telling it.
+  ASSERT_EQ(param_set(*t, param_index("ks"), 2, 0.01, &m), ParamStatus::kOk);
+  EXPECT_LE(m.condition37, 1);
+  EXPECT_GT(m.observer, 1);
+  EXPECT_NEAR(m.condition37, 0.01 * 120 / 2, 1e-12);
+}
+
+TEST(Parameters, RecordsApplyWholeOrNotAtAll) {
+  auto t = disabled_task<float>();
+  ParamRecord r = param_defaults();
+  r.value[param_slot(param_index("ks")) + 1] = 50;
+  r.value[param_slot(param_index("stream_timeout"))] = 0.04f;
+  ASSERT_EQ(param_apply(*t, r), ParamStatus::kOk);
+  EXPECT_FLOAT_EQ(t->gains.ks(1), 50);
+  EXPECT_EQ(t->stream_timeout_ticks, 40u);
+  ParamRecord bad = param_defaults();
+  bad.value[param_slot(param_index("collision_threshold")) + 2] = 1e6;  // beyond J3's full scale
+  EXPECT_EQ(param_apply(*t, bad), ParamStatus::kBadRecord);
+  EXPECT_FLOAT_EQ(t->gains.ks(1), 50);  // unchanged
+  ParamRecord unstable = param_defaults();
+  unstable.value[param_slot(param_index("k"))] = 2500;
+  EXPECT_EQ(param_apply(*t, unstable), ParamStatus::kUnstableObserver);
+  EXPECT_FLOAT_EQ(t->gains.ks(1), 50);
+  t->machine.state = MotionState::kMoving;
+  EXPECT_EQ(param_apply(*t, param_defaults()), ParamStatus::kTorqueOn);
+}
+
+TEST(Parameters, LayoutVersionIsOfTheTable) {
+  EXPECT_NE(kParamLayout, 0);
+  // A fixed value: a change of any name or element count changes it, and this test with it (the
+  // stored records of the old table are then not loaded: layout_mismatch).
+  EXPECT_EQ(kParamLayout, 22691);
+}
+
+// ------------------------------------------------------------------------------- over the link
+
+struct ParamLink : ::testing::Test {
+  std::unique_ptr<ControlTask<double>> task = disabled_task<double>();
+  CommandPort<double> port;
+  std::vector<pil::ParamAnswerFrame> answers;
+
+  pil::ParamAnswerFrame ask(std::uint8_t op, int index = 0, int element = 0, float value = 0) {
+    pil::ParamFrame f;
+    f.id = static_cast<std::uint32_t>(answers.size() + 1);
+    f.op = op;
+    f.index = static_cast<std::uint8_t>(index);
+    f.element = static_cast<std::uint8_t>(element);
+    f.value = value;
+    std::uint8_t buf[pil::kMaxFrame];
+    const int n = pil::encode(f, buf);
+    pil::Parser parser;
+    bool taken = false;
+    for (int k = 0; k < n; ++k)
+      if (parser.feed(buf[k]) == pil::Parser::kFrame)
+        taken = port.receive(*task, parser, [this](const std::uint8_t* b, int len) {
+          pil::Parser p;
+          for (int j = 0; j < len; ++j)
+            if (p.feed(b[j]) == pil::Parser::kFrame) {
+              pil::ParamAnswerFrame a;
+              if (p.decode(a)) answers.push_back(a);
+            }
+        });
+    EXPECT_TRUE(taken);
+    EXPECT_EQ(answers.size(), f.id);
+    return answers.empty() ? pil::ParamAnswerFrame{} : answers.back();
+  }
+};
+
+TEST_F(ParamLink, GetListsEveryParameterWithItsRangeAndTheLayout) {
+  for (int i = 0; i < kParamCount; ++i) {
+    const pil::ParamAnswerFrame a = ask(pil::kParamOpGet, i, kParams[i].count - 1);
+    EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOk)) << kParams[i].name;
+    EXPECT_EQ(a.count, kParamCount);
+    EXPECT_EQ(a.layout, kParamLayout);
+    EXPECT_FLOAT_EQ(a.value, static_cast<float>(param_default(i, kParams[i].count - 1)));
+    EXPECT_FLOAT_EQ(a.hi, static_cast<float>(kParams[i].hi_of(kParams[i].count - 1)));
+    EXPECT_EQ((a.flags & pil::kParamFlagTorqueOff) != 0, kParams[i].access == ParamAccess::kTorqueOff);
+  }
+  EXPECT_EQ(ask(pil::kParamOpGet, kParamCount).status, static_cast<std::uint8_t>(ParamStatus::kUnknownParam));
+  EXPECT_EQ(ask(pil::kParamOpGet, 0, 6).status, static_cast<std::uint8_t>(ParamStatus::kBadElement));
+  EXPECT_EQ(ask(pil::kParamOpCount).status, static_cast<std::uint8_t>(ParamStatus::kBadOp));
+}
+
+TEST_F(ParamLink, SetSaveResetLoadGivesTheValuesBack) {
+  const int ks = param_index("ks"), thr = param_index("collision_threshold");
+  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kNoRecord));
+  pil::ParamAnswerFrame a = ask(pil::kParamOpSet, ks, 0, 80);
+  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_FLOAT_EQ(a.value, 80);
+  EXPECT_GT(a.margins[0], 1);  // judged: the observer's margin
+  EXPECT_EQ(ask(pil::kParamOpSet, thr, 2, 15).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_EQ(ask(pil::kParamOpReset).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, ks, 0).value, params::kKs[0]);
+  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, thr, 2).value, 0);
+  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, ks, 0).value, 80);
+  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, thr, 2).value, 15);
+  EXPECT_DOUBLE_EQ(task->gains.ks(0), 80);
+  // A refused set answers the value as it stays, and the reason.
+  a = ask(pil::kParamOpSet, param_index("k"), 0, 2500);
+  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kUnstableObserver));
+  EXPECT_FLOAT_EQ(a.value, params::kK[0]);
+  EXPECT_LT(a.margins[0], 1);
+  // Torque on: save, load and reset are refused.
+  task->machine.state = MotionState::kHolding;
+  for (std::uint8_t op : {pil::kParamOpSave, pil::kParamOpLoad, pil::kParamOpReset})
+    EXPECT_EQ(ask(op).status, static_cast<std::uint8_t>(ParamStatus::kTorqueOn)) << pil::kParamOpNames[op];
+  const pil::ParamAnswerFrame c = ask(pil::kParamOpCheck);
+  EXPECT_EQ(c.status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_GT(c.margins[0], 50);
+  EXPECT_GT(c.margins[2], 1);
+  EXPECT_EQ(c.flags & pil::kParamFlagWarn37, 0);
+}
+
+TEST_F(ParamLink, ABoardsStoreTakesSaveAndLoad) {
+  struct Counting {
+    ParamRecord r{};
+    int saves = 0, loads = 0;
+  } c;
+  ParamStorage s;
+  s.ctx = &c;
+  s.save = [](void* ctx, const ParamRecord& r) {
+    auto* k = static_cast<Counting*>(ctx);
+    k->r = r;
+    return ++k->saves < 2;  // the second save fails
+  };
+  s.load = [](void* ctx, ParamRecord& r) {
+    auto* k = static_cast<Counting*>(ctx);
+    ++k->loads;
+    r = k->r;
+    return ParamStatus::kLayoutMismatch;
+  };
+  port.set_param_storage(s);
+  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kStoreFailed));
+  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kLayoutMismatch));
+  EXPECT_EQ(c.saves, 2);
+  EXPECT_EQ(c.loads, 1);
+}
+
+}  // namespace
