@@ -37,6 +37,19 @@ concept ControlHal = requires(H& h, std::int32_t* counts, const std::int32_t* co
   { h.fault_output(active) } -> std::same_as<void>;
 };
 
+/// What homing and the position cross-check (issue 27) need beyond ControlHal: each joint's
+/// potentiometer and each encoder's index latch. A HAL without them (a still-robot stub, the PIL
+/// link today) satisfies ControlHal alone, and the task then takes its start pose on trust.
+template <class H>
+concept PositionHal = requires(H& h, std::uint16_t* codes, int channel, std::int32_t& count) {
+  /// The potentiometers' ADC codes, one per joint (0 to 2^pot_bits - 1, osc::robot::kDriveTrain),
+  /// the latest complete conversion; false when there is none yet (or it failed).
+  { h.read_pots(codes) } -> std::same_as<bool>;
+  /// The index pulse latched on an encoder channel since the last call: true once per pulse, with
+  /// the encoder's accumulated count (as read_encoders gives it) at the pulse's edge.
+  { h.take_index(channel, count) } -> std::same_as<bool>;
+};
+
 /// Extends a free-running N-bit hardware counter (e.g. a 16-bit timer in encoder mode) to a
 /// 32-bit position. Correct as long as fewer than 2^(N-1) counts pass between two reads.
 template <int Bits>
