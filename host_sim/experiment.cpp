@@ -62,6 +62,8 @@ class LocalController {
       const bool change = d_abs * th_abs > r_abs * th_d;
       const double th = change ? th_d : th_abs, ri = change ? d_abs : r_abs;
       const double ratio = th > 0 ? ri / th : 0;
+      const double position = static_cast<double>(task_->position.ratio(i));
+      if (position > residual_.position_peak_ratio[i]) residual_.position_peak_ratio[i] = position;
       if (m.primed && th > 0 && ratio > residual_.residual_peak_ratio[i]) {
         residual_.residual_peak_ratio[i] = ratio;
         residual_.residual_peak_s[i] = static_cast<double>(task_->tick - 1) / osc::params::kControlHz;
@@ -81,6 +83,7 @@ class LocalController {
       res.residual_peak_s[i] = residual_.residual_peak_s[i];
       res.residual_peak_Nm[i] = residual_.residual_peak_Nm[i];
       res.residual_threshold_Nm[i] = residual_.residual_threshold_Nm[i];
+      res.position_peak_ratio[i] = residual_.position_peak_ratio[i];
     }
     const osc::ResidualMonitor<S>& m = task_->residual;
     if (m.detected != 0) {

@@ -168,6 +168,7 @@ struct StuckMonitorPeaks {
   double residual_detected_s = -1;        ///< the residual monitor's first detection [s] (-1: none)
   std::uint32_t residual_fault = 0;       ///< ... its fault
   int residual_joint = -1;                ///< ... its joint (0-based)
+  double position_peak_ratio[6] = {};     ///< the position cross-check's largest |d - d_ref| / band per joint
   void to_json(Json& j) const;
 };
 

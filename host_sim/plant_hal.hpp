@@ -281,7 +281,7 @@ class PlantHal {
 
   /// The potentiometers: code = clamp(round(pot_scale(q) + offset + noise), 0, full scale), q the
   /// plant's joint angles, the noise Gaussian of standard deviation pot_noise.
-  void read_pots(std::uint16_t codes[hal::kJoints]) {
+  bool read_pots(std::uint16_t codes[hal::kJoints]) {
     const Vec6& q = plant_.q();
     for (int i = 0; i < hal::kJoints; ++i) {
       double x = pot_scale(i, q(i)) + sensors_.pot_offset[i];
@@ -289,6 +289,7 @@ class PlantHal {
       x = std::round(x);
       codes[i] = static_cast<std::uint16_t>(!(x > 0) ? 0.0 : (x >= kPotFullScale ? kPotFullScale : x));
     }
+    return true;
   }
 
   /// The index pulse latched on a channel since the last call: true once per latch, with the
@@ -330,5 +331,6 @@ class PlantHal {
   std::normal_distribution<double> gauss_{0.0, 1.0};
 };
 static_assert(hal::ControlHal<PlantHal>);
+static_assert(hal::PositionHal<PlantHal>, "the simulated arm has potentiometers and index pulses");
 
 }  // namespace sim

@@ -31,7 +31,9 @@ namespace osc {
     "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")         \
   X(DriveFault, "drive_fault",                                                                                 \
     "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the residual monitor")  \
-  X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")
+  X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")        \
+  X(PositionMismatch, "position_mismatch",                                                                     \
+    "a joint's potentiometer and its encoders disagree beyond their band: a stuck or slipping encoder")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

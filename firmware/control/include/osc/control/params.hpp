@@ -144,6 +144,28 @@ constexpr double kIdentifiedFraction = 0.025;
 constexpr double kIdentifySplitExcitation = 0.02;
 constexpr int kIdentifyExciteBlock = 64;
 constexpr int kIdentifyExciteBlocks = 64;
+/// The position cross-check (osc/runtime/monitors.hpp, PositionCrossCheck; docs/safety.md, "The
+/// position cross-check"): each joint's potentiometer angle minus its encoder angle, low-pass filtered
+/// (time constant kPositionFilter [s], the joints updated in turn, kPositionJointsPerTick a tick), must
+/// stay within kPositionBand [rad] of its value once settled (after kPositionSettle filter time
+/// constants), for kPositionQualify updates in a row, else position_mismatch. The band per joint is
+/// derived, not fitted (tests/firmware/runtime/test_monitors.cpp recomputes it):
+///   6 codes of the potentiometer (its span / 4095: 0.94 to 2.35 mrad): the filtered difference of a
+///     noise of up to 4 codes rms (twice the realistic plant's estimate) and the quantisation, the
+///     settled value's own error included (sigma about 1 code);
+/// + on J1-J3, twice the elastic deflection at full-scale torque, tau_fs / K with K the stiffness of a
+///   locked-motor resonance of 15 Hz (the lower end of the published 15-25 Hz) at the start pose,
+///   K = (2 pi 15)^2 A_ii(q_start): the pot reads the link, the encoder the motor;
+/// + 1 mrad of gear backlash at the joint (the top of the published 0.1-1 mrad).
+constexpr double kPositionFilter = 0.05;
+constexpr int kPositionJointsPerTick = 2;
+constexpr double kPositionSettle = 5;
+constexpr int kPositionQualify = 3;
+constexpr double kPositionBandCodes = 6;
+constexpr double kPositionElasticHz = 15;
+constexpr double kPositionBacklash = 1e-3;
+constexpr double kPositionBand[6] = {0.0157, 0.0180, 0.0299, 0.0087, 0.0067, 0.0152};
+
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the
 /// heavier (corke) friction preset (7.0 mm, 0.43 deg).

@@ -69,6 +69,7 @@ struct ControlTask {
   std::uint32_t stream_timeout_ticks;    // a stream is stale after max(2 periods, this) without a setpoint
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
+  PositionCrossCheck<S> position;  // a HAL with potentiometers (hal::PositionHal)
   Supervisor sup;
   std::uint32_t period_cycles;  // overrun budget per step (0: not checked)
   StepTiming timing;            // the whole tick: I/O, step, supervision
@@ -109,6 +110,7 @@ struct ControlTask {
     stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
     saturation.reset();
+    position.reset();
     set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
@@ -393,6 +395,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.stuck.reset(true);  // from this tick's torques: a clear while holding is no torque change
     task.residual.reset();
     task.saturation.reset();
+    task.position.reset();  // the encoders' count may be off now: learnt again (homing would set it)
   }
   if (!motion_powered(st.machine.state)) task.ramping = false;
 }
@@ -472,6 +475,14 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageMonitors] = hal.cycles();
   // monitors
   if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
+  if constexpr (hal::PositionHal<Hal>) {
+    // The potentiometers against the encoders, whether the torque is on or not (an arm moved by hand).
+    std::uint16_t pots[kDof];
+    if (measured) {
+      const bool valid = hal.read_pots(pots);
+      faults |= task.position.check(pots, valid, q);
+    }
+  }
   const CollisionReaction collision = take_collision(task, faults);
   mark[kStageOutput] = hal.cycles();
   // output

@@ -8,6 +8,7 @@
 //                    TrackingMonitor       the tracking error e (36) within params::kTrackingLimit*
 //                    ThetaBandMonitor      the friction estimates within their band
 //                    SaturationMonitor     a DAC clipped for params::kSaturationTicks ticks in a row
+//                    PositionCrossCheck    each joint's potentiometer against its encoders (a HAL with pots)
 // The thresholds are params:: constants (osc/control/params.hpp), converted to the scalar at compile time.
 #pragma once
 
@@ -670,6 +671,104 @@ struct ThetaBandMonitor {
       if (!(th >= -band * mx && th <= (S(1) + band) * mx)) faults |= kFaultThetaBounds;
     }
     return faults;
+  }
+};
+
+/// position_mismatch: each joint's potentiometer against its encoders (docs/safety.md, "The position
+/// cross-check"), an independent detector of a stuck or slipping encoder. The difference
+/// d = q_pot - q_enc is the potentiometer's offset plus its noise and quantisation, the joint's elastic
+/// deflection and backlash: it does not change with the motion. It is low-pass filtered (time
+/// constant params::kPositionFilter; params::kPositionJointsPerTick joints a tick, in turn), its
+/// settled value kept as the reference (after params::kPositionSettle time constants), and a joint
+/// whose filtered difference is further than params::kPositionBand from it for kPositionQualify of its
+/// updates in a row is a fault. reset() (a cleared fault, a new start pose) learns it again. A HAL
+/// without potentiometers (hal::PositionHal) never runs it.
+template <class S>
+struct PositionCrossCheck {
+  static constexpr int kPerTick = params::kPositionJointsPerTick;
+  static constexpr int kUpdateTicks = (kDof + kPerTick - 1) / kPerTick;  // a joint's update period [ticks]
+  static constexpr double kAlpha = kUpdateTicks * params::kDt / params::kPositionFilter;
+  static constexpr std::uint16_t kSettleUpdates =
+      static_cast<std::uint16_t>(params::kPositionSettle * params::kPositionFilter / (kUpdateTicks * params::kDt));
+  static_assert(kAlpha > 0 && kAlpha < 0.5, "a joint's update period well inside the filter's time constant");
+
+  Vec6<S> filtered;             // the filtered difference q_pot - q_enc per joint [rad]
+  Vec6<S> reference;            // its settled value
+  std::uint16_t updates[kDof];  // updates since the reset (saturating at kSettleUpdates)
+  std::uint8_t over[kDof];      // consecutive updates beyond the band
+  int next;                     // the first joint of the next tick's turn
+
+  void reset() {
+    filtered.setZero();
+    reference.setZero();
+    for (int i = 0; i < kDof; ++i) updates[i] = 0, over[i] = 0;
+    next = 0;
+  }
+
+  /// One tick: the potentiometer codes (valid: a complete conversion) and the encoder angles q.
+  std::uint32_t check(const std::uint16_t codes[kDof], bool valid, const Vec6<S>& q) {
+    static constexpr std::array<S, kDof> kBand = lit_array<S>(params::kPositionBand);
+    static constexpr S kA = lit<S>(kAlpha);
+    const int first = next;
+    next = (next + kPerTick) % kDof;
+    if (!valid) return 0;
+    std::uint32_t faults = 0;
+    for (int k = 0; k < kPerTick; ++k) {
+      const int i = first + k;
+      if (i >= kDof) break;
+      const S d = pot_angle(i, codes[i]) - q(i);
+      if (updates[i] == 0) {
+        filtered(i) = d;
+      } else {
+        filtered(i) += kA * (d - filtered(i));
+      }
+      if (updates[i] < kSettleUpdates) {
+        if (++updates[i] == kSettleUpdates) reference(i) = filtered(i);
+        continue;
+      }
+      const S e = filtered(i) - reference(i);
+      over[i] = qualify(over[i], e > kBand[i] || -e > kBand[i]);
+      if (over[i] >= params::kPositionQualify) faults |= kFaultPositionMismatch;
+    }
+    return faults;
+  }
+  /// Joint i's angle at a potentiometer code: pot_min + code (pot_max - pot_min) / full scale. In fixed
+  /// point from the span's raw value in 64 bits: a Q12.19 scale of about 1.5 mrad a code would be off
+  /// by up to half its resolution, 4 mrad over the 4095 codes.
+  static S pot_angle(int i, std::uint16_t code) {
+    static constexpr std::array<S, kDof> kMin = lit_array<S>(robot::kDriveTrain.pot_min);
+    static constexpr double kFull = static_cast<double>((1 << robot::kDriveTrain.pot_bits) - 1);
+    if constexpr (fixed::is_q_v<S>) {
+      static constexpr std::array<std::int64_t, kDof> kSpanRaw = [] {
+        std::array<std::int64_t, kDof> a{};
+        for (int j = 0; j < kDof; ++j)
+          a[j] = lit<S>(robot::kDriveTrain.pot_max[j] - robot::kDriveTrain.pot_min[j]).raw();
+        return a;
+      }();
+      const std::int64_t full = static_cast<std::int64_t>(kFull);
+      return kMin[i] + S::from_raw(static_cast<typename S::Raw>((kSpanRaw[i] * code + full / 2) / full));
+    } else {
+      static constexpr std::array<S, kDof> kScale = [] {
+        std::array<S, kDof> a{};
+        for (int j = 0; j < kDof; ++j)
+          a[j] = lit<S>((robot::kDriveTrain.pot_max[j] - robot::kDriveTrain.pot_min[j]) / kFull);
+        return a;
+      }();
+      return kMin[i] + static_cast<S>(code) * kScale[i];
+    }
+  }
+
+  /// How far joint i's filtered difference is from its reference, as a fraction of its band (0 until
+  /// settled): the healthy runs' margin.
+  S ratio(int i) const {
+    static constexpr std::array<S, kDof> kInvBand = [] {
+      std::array<S, kDof> a{};
+      for (int j = 0; j < kDof; ++j) a[j] = lit<S>(1.0 / params::kPositionBand[j]);
+      return a;
+    }();
+    if (updates[i] < kSettleUpdates) return S(0);
+    const S e = filtered(i) - reference(i);
+    return (e < S(0) ? -e : e) * kInvBand[i];
   }
 };
 
