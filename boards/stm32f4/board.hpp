@@ -6,11 +6,15 @@
 //
 // Build-time switch OSC_STM32F4_QEMU (the image stm32f4_qemu, for QEMU's netduinoplus2, an
 // STM32F405 with the same core and memory map): QEMU models TIM2..TIM5, the USARTs, SPI, SYSCFG and
-// EXTI, but not TIM6/TIM7, the RCC, GPIO, the IWDG nor encoder mode. With the switch
+// EXTI, but not TIM6/TIM7, the RCC, GPIO, the IWDG, encoder mode nor input capture; its ADCs are a
+// stub (a read of DR after a start gives the last value + 7: no scan, no EOC), DMA2 a placeholder that
+// reads 0, and the ADCs' common registers (ADC1 + 0x300) are not mapped. With the switch
 //   - the control interrupt comes from TIM2 (IRQ 28) instead of TIM6 (IRQ 54), with QEMU's fixed
 //     48 MHz timer clock;
-//   - the encoders are a still robot (every count 0): TIM2 is the tick, and QEMU would run TIM3..5 as
-//     free counters, not in encoder mode;
+//   - the encoders are a still robot (every count 0, and no index pulse ever: take_index is always
+//     false): TIM2 is the tick, and QEMU would run TIM3..5 as free counters, not in encoder mode;
+//   - there are no potentiometers: the ADC and DMA2 are never touched, and read_pots is always
+//     false (no sample);
 //   - the cycle counter's rate is QEMU's fixed 168 MHz CPU clock, whatever the RCC set-up reports.
 // Everything else is the board image's code: the bounded clock set-up (which falls back to HSI
 // there, the RCC reading zero), the DAC frames on SPI2, the safety I/O registers, the watchdog's
@@ -22,6 +26,7 @@
 #include <type_traits>
 
 #include "ad5754r.hpp"
+#include "adc.hpp"
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "control_timer.hpp"
@@ -113,14 +118,30 @@ void with_tick_masked(F&& f) {
   cortex_m::basepri_restore(old);
 }
 
-/// The QEMU image's encoders: a still robot.
+/// The QEMU image's encoders: a still robot, with no index pulse.
 struct StillEncoders {
   void init(const stm32f4::Chip&) {}
   void read(std::int32_t counts[hal::kJoints]) {
     for (int i = 0; i < hal::kJoints; ++i) counts[i] = 0;
   }
+  bool take_index(int, std::int32_t&) { return false; }
 };
 using Encoders = std::conditional_t<kQemu, StillEncoders, stm32f4::EncoderBank<stm32f4::pins::kEncoders>>;
+
+/// The QEMU image's potentiometers: none (QEMU has no DMA2 and no scan): never a sample.
+struct NoPots {
+  void init(const stm32f4::Chip&, std::uint32_t) {}
+  bool update() { return false; }
+  bool read(std::uint16_t*) const { return false; }
+};
+using Pots = std::conditional_t<kQemu, NoPots, stm32f4::AdcScan<stm32f4::pins::kPots>>;
+/// A scan fits a tick, on the PLL and on the HSI fallback alike: each tick takes the one before.
+constexpr std::uint32_t scan_ns_at(std::uint32_t pclk2) {
+  return stm32f4::AdcScan<stm32f4::pins::kPots>::scan_ns(pclk2 / stm32f4::adc_divider(pclk2));
+}
+static_assert(scan_ns_at(stm32f4::kPllClocks.pclk2) < 1000000000u / kControlHz &&
+                  scan_ns_at(stm32f4::kHsiClocks.pclk2) < 1000000000u / kControlHz,
+              "the potentiometers' scan within the tick");
 
 /// Step timing: the DWT cycle counter, or SysTick where the DWT does not count (start() finds out).
 struct CycleCounter {
@@ -144,7 +165,8 @@ inline const char* reset_cause_name(std::uint32_t csr) {
 }
 
 using Dac = ad5754r::DacPair<stm32f4::SpiDacBus>;
-using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter>;
+using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter, Pots>;
+static_assert(hal::ControlHal<Hal> && hal::PositionHal<Hal>);
 /// The USART link: commands in, answer, state and telemetry frames out.
 using Uart = stm32f4::UsartLink<kTxFrames, pil::kMaxFrame, kRxBytes>;
 
@@ -155,15 +177,17 @@ struct Board {
   BootFault boot = BootFault::kNone;  ///< the first boot fault (docs/stm32f4.md, "Boot faults")
   std::uint32_t reset_flags = 0;
   Encoders encoders;
+  Pots pots;
   stm32f4::SpiDacBus dac_bus;
   Dac dac{dac_bus};
   stm32f4::Safety safety;
   Uart uart;
-  Hal hal{encoders, dac, safety, chip.timer(kControlTimer)};
+  Hal hal{encoders, dac, pots, safety, chip.timer(kControlTimer)};
 
   /// Boot, with interrupts still off: clocks (bounded, HSI fallback), the reset cause, the cycle
-  /// counter, the safety outputs first (amplifier disabled), the DACs at 0 V, the encoders, the
-  /// USART link. A boot fault keeps the torque off for good (Hal::permit_torque).
+  /// counter, the safety outputs first (amplifier disabled), the DACs at 0 V, the encoders and their
+  /// index captures, the potentiometers' ADC (the first tick starts its first scan), the USART link.
+  /// A boot fault keeps the torque off for good (Hal::permit_torque).
   void init() {
     clocks = stm32f4::clock_init(*chip.rcc, *chip.flash);
     note(clocks.fault);
@@ -176,6 +200,7 @@ struct Board {
     dac_bus.init(chip, clocks.pclk1);
     if (!dac.init()) note(BootFault::kDacSetup);
     encoders.init(chip);
+    pots.init(chip, clocks.pclk2);
     uart.init(chip, clocks.pclk1, kTelemetryBaud, stm32f4::pins::kUartTx, stm32f4::pins::kUartRx);
   }
   /// The independent watchdog: from here on only healthy ticks keep the MCU out of reset.

@@ -1,6 +1,8 @@
 // The board's binding of the control task (hal::ControlHal): encoders from the timers, torque
 // commands to the DAC pair, the E-stop and the control timer's overrun as I/O faults, and a tick
 // (BoardHal::tick) that drives the safety outputs and feeds the watchdog after the control step.
+// Also hal::PositionHal: the joints' potentiometers (the ADC scan each tick takes and restarts) and
+// the encoders' index latches.
 // Templates over the drivers (the board's, or fakes in tests/boards/stm32f4/test_stm32f4.cpp), each constrained by
 // the concept of what the binding needs from it: no virtual calls.
 #pragma once
@@ -16,10 +18,19 @@
 
 namespace stm32f4 {
 
-/// The encoders: every joint's accumulated count (e.g. EncoderBank, or a still robot's zeros).
+/// The encoders: every joint's accumulated count, and each index pulse latched since it was last
+/// taken, as such a count (e.g. EncoderBank, or a still robot's zeros and no pulse).
 template <class E>
-concept EncoderInput = requires(E& e, std::int32_t* counts) {
+concept EncoderInput = requires(E& e, std::int32_t* counts, int channel, std::int32_t& count) {
   { e.read(counts) } -> std::same_as<void>;
+  { e.take_index(channel, count) } -> std::same_as<bool>;
+};
+/// The potentiometers: a scan taken and the next started once a tick (update: whether the scan was
+/// good), and that tick's codes (read: false without a good scan). E.g. AdcScan, or none (QEMU).
+template <class P>
+concept PotInput = requires(P& p, const P& cp, std::uint16_t* codes) {
+  { p.update() } -> std::same_as<bool>;
+  { cp.read(codes) } -> std::same_as<bool>;
 };
 /// The torque outputs: one tick's codes (false: a bus fault), and every output to 0 V at once
 /// (e.g. ad5754r::DacPair).
@@ -34,11 +45,11 @@ concept CycleClock = requires {
   { C::cycles() } -> std::same_as<std::uint32_t>;
 };
 
-template <EncoderInput Encoders, DacOutput Dac, CycleClock Clock>
+template <EncoderInput Encoders, DacOutput Dac, CycleClock Clock, PotInput Pots>
 class BoardHal {
  public:
-  BoardHal(Encoders& encoders, Dac& dac, Safety& safety, TimRegs& control_timer)
-      : enc_(encoders), dac_(dac), safety_(safety), timer_(control_timer) {}
+  BoardHal(Encoders& encoders, Dac& dac, Pots& pots, Safety& safety, TimRegs& control_timer)
+      : enc_(encoders), dac_(dac), pots_(pots), safety_(safety), timer_(control_timer) {}
 
   /// Whether torque may be commanded at all: false after a boot fault (docs/stm32f4.md, "Boot
   /// faults"): zero codes and the amplifier disabled, whatever the supervisor says.
@@ -68,12 +79,19 @@ class BoardHal {
     if (active) safety_.force_safe();
   }
 
-  /// One control tick: the control task, then the amplifier enable (on only in kRun with torque
-  /// permitted and no E-stop) and the fault LED (a latched fault or a boot fault), then the watchdog,
-  /// fed only when the supervisor is healthy (osc::supervisor_healthy). Returns the faults detected
-  /// in the tick.
+  // hal::PositionHal
+  /// The scan this tick took (the one the previous tick started); false when it failed or none ran.
+  bool read_pots(std::uint16_t codes[hal::kJoints]) { return pots_.read(codes); }
+  /// The index pulse latched on joint `channel`'s encoder, once, as the count read_encoders gives.
+  bool take_index(int channel, std::int32_t& count) { return enc_.take_index(channel, count); }
+
+  /// One control tick: the potentiometers' scan taken and the next one started (no wait), the
+  /// control task, then the amplifier enable (on only in kRun with torque permitted and no E-stop)
+  /// and the fault LED (a latched fault or a boot fault), then the watchdog, fed only when the
+  /// supervisor is healthy (osc::supervisor_healthy). Returns the faults detected in the tick.
   template <class S>
   std::uint32_t tick(osc::ControlTask<S>& task) {
+    pots_.update();
     const std::uint32_t faults = osc::control_tick(task, *this);
     safety_.set_outputs(permitted_ && osc::torque_enabled(task.sup),
                         task.sup.state == osc::SupervisorState::kFault || !permitted_);
@@ -91,6 +109,7 @@ class BoardHal {
  private:
   Encoders& enc_;
   Dac& dac_;
+  Pots& pots_;
   Safety& safety_;
   TimRegs& timer_;
   bool permitted_ = true;

@@ -1,13 +1,14 @@
 // The board's pin map: every pin the firmware uses, its alternate function (datasheet DS8626,
 // table 9 "alternate function mapping") and its role, in one place; the chip's drivers
 // (boards/common/stm32f4) take their pins from here. The encoder table also names each joint's
-// timer, its counter width and its clock-enable bit. docs/stm32f4.md, "Wiring", is this file as a
-// table; the pins are chosen free on the STM32F4DISCOVERY (MB997) where they can be (the exceptions
-// are noted there).
+// timer, its counter width and its clock-enable bit; the potentiometer table each joint's ADC
+// channel (data sheet DS8626, table 7). docs/stm32f4.md, "Wiring", is this file as a table; the pins
+// are chosen free on the STM32F4DISCOVERY (MB997) where they can be (the exceptions are noted there).
 #pragma once
 
 #include <cstdint>
 
+#include "adc.hpp"
 #include "encoders.hpp"
 #include "gpio.hpp"
 #include "hal/hal.hpp"
@@ -27,14 +28,37 @@ constexpr PinConfig enc(Pin p, std::uint8_t af) { return alternate(p, af, Speed:
 /// One timer in encoder mode per joint (stm32f4::EncoderChannel, encoders.hpp). `invert`: set it for
 /// a joint whose encoder counts against the joint's positive direction (first power-up,
 /// docs/stm32f4.md). A 16-bit counter is unwrapped right while fewer than 32768 counts pass between
-/// two ticks, about 240 times the fastest joint's counts per tick.
+/// two ticks, about 240 times the fastest joint's counts per tick. The index pulse (once per motor
+/// revolution) on the same timer's CH3 or CH4, the timer's alternate function on a free pin: TIM5's
+/// CH3 and CH4 exist only on PA2 and PA3 in the 100-pin package (PH12 and PI0 are the 176-pin
+/// part's), so the command link's RX moved from PA3 to PD6 to free PA3.
 inline constexpr EncoderChannel kEncoders[hal::kJoints] = {
-    {Timer::kTim1, 16, &RccRegs::APB2ENR, RccRegs::kTim1En, enc(PE(9), 1), enc(PE(11), 1), false},  // joint 1
-    {Timer::kTim2, 32, &RccRegs::APB1ENR, RccRegs::kTim2En, enc(PA(15), 1), enc(PB(3), 1), false},  // joint 2
-    {Timer::kTim3, 16, &RccRegs::APB1ENR, RccRegs::kTim3En, enc(PB(4), 2), enc(PB(5), 2), false},   // joint 3
-    {Timer::kTim4, 16, &RccRegs::APB1ENR, RccRegs::kTim4En, enc(PB(6), 2), enc(PB(7), 2), false},   // joint 4
-    {Timer::kTim5, 32, &RccRegs::APB1ENR, RccRegs::kTim5En, enc(PA(0), 2), enc(PA(1), 2), false},   // joint 5
-    {Timer::kTim8, 16, &RccRegs::APB2ENR, RccRegs::kTim8En, enc(PC(6), 3), enc(PC(7), 3), false},   // joint 6
+    // timer, width, clock enable, A, B, invert, index, its channel
+    {Timer::kTim1, 16, &RccRegs::APB2ENR, RccRegs::kTim1En, enc(PE(9), 1), enc(PE(11), 1), false, enc(PE(13), 1),
+     3},  // joint 1: TIM1_CH1/2, index TIM1_CH3
+    {Timer::kTim2, 32, &RccRegs::APB1ENR, RccRegs::kTim2En, enc(PA(15), 1), enc(PB(3), 1), false, enc(PB(11), 1),
+     4},  // joint 2: TIM2_CH1/2, index TIM2_CH4
+    {Timer::kTim3, 16, &RccRegs::APB1ENR, RccRegs::kTim3En, enc(PB(4), 2), enc(PB(5), 2), false, enc(PC(8), 2),
+     3},  // joint 3: TIM3_CH1/2, index TIM3_CH3
+    {Timer::kTim4, 16, &RccRegs::APB1ENR, RccRegs::kTim4En, enc(PB(6), 2), enc(PB(7), 2), false, enc(PB(8), 2),
+     3},  // joint 4: TIM4_CH1/2, index TIM4_CH3
+    {Timer::kTim5, 32, &RccRegs::APB1ENR, RccRegs::kTim5En, enc(PA(0), 2), enc(PA(1), 2), false, enc(PA(3), 2),
+     4},  // joint 5: TIM5_CH1/2, index TIM5_CH4
+    {Timer::kTim8, 16, &RccRegs::APB2ENR, RccRegs::kTim8En, enc(PC(6), 3), enc(PC(7), 3), false, enc(PC(9), 3),
+     4},  // joint 6: TIM8_CH1/2, index TIM8_CH4
+};
+
+// ---------------------------------------------------------------- potentiometers: ADC1
+/// Each joint's potentiometer (wiper to the pin, ends to VREF+ and VSSA), in joint order: channels
+/// that are free on the Discovery (PC0 drives its USB power switch, PC3 carries its microphone's
+/// output; PA4-PA7 its audio and accelerometer), scanned by stm32f4::AdcScan (adc.hpp).
+inline constexpr AnalogInput kPots[hal::kJoints] = {
+    {analog(PC(1)), 11},  // joint 1: ADC123_IN11
+    {analog(PC(2)), 12},  // joint 2: ADC123_IN12
+    {analog(PC(4)), 14},  // joint 3: ADC12_IN14
+    {analog(PC(5)), 15},  // joint 4: ADC12_IN15
+    {analog(PB(0)), 8},   // joint 5: ADC12_IN8
+    {analog(PB(1)), 9},   // joint 6: ADC12_IN9
 };
 
 // ---------------------------------------------------------------- DAC: two AD5754R on SPI2
@@ -58,21 +82,32 @@ constexpr PinConfig kFaultLed = output(PD(14), false);
 
 // ---------------------------------------------------------------- telemetry
 constexpr PinConfig kUartTx = alternate(PA(2), 7, Speed::kMedium);          // USART2_TX
-constexpr PinConfig kUartRx = alternate(PA(3), 7, Speed::kLow, Pull::kUp);  // USART2_RX
+constexpr PinConfig kUartRx = alternate(PD(6), 7, Speed::kLow, Pull::kUp);  // USART2_RX (PA3: joint 5's index)
 
 // ---------------------------------------------------------------- every pin, once
 constexpr PinConfig kOthers[] = {kDacSck,    kDacMosi, kDacSync[0], kDacSync[1], kDacLdac, kDacClr,
                                  kAmpEnable, kEstop,   kFaultLed,   kUartTx,     kUartRx};
-constexpr int kPinCount = 2 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
+/// Every pin of the map: each encoder's A, B and index, each potentiometer's, then the others.
+constexpr int kPinCount = 4 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
 constexpr Pin pin_at(int i) {
-  return i < 2 * hal::kJoints ? (i % 2 ? kEncoders[i / 2].b.pin : kEncoders[i / 2].a.pin)
-                              : kOthers[i - 2 * hal::kJoints].pin;
+  if (i < 3 * hal::kJoints) {
+    const EncoderChannel& e = kEncoders[i / 3];
+    return i % 3 == 0 ? e.a.pin : i % 3 == 1 ? e.b.pin : e.index.pin;
+  }
+  if (i < 4 * hal::kJoints) return kPots[i - 3 * hal::kJoints].pin.pin;
+  return kOthers[i - 4 * hal::kJoints].pin;
+}
+/// No pin twice among `pins`.
+constexpr bool distinct(const Pin* pins, int n) {
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j)
+      if (pins[i] == pins[j]) return false;
+  return true;
 }
 constexpr bool pins_distinct() {
-  for (int i = 0; i < kPinCount; ++i)
-    for (int j = i + 1; j < kPinCount; ++j)
-      if (pin_at(i) == pin_at(j)) return false;
-  return true;
+  Pin all[kPinCount] = {};
+  for (int i = 0; i < kPinCount; ++i) all[i] = pin_at(i);
+  return distinct(all, kPinCount);
 }
 static_assert(pins_distinct(), "a pin is used twice in the pin map");
 static_assert(kEstop.pin.n == kEstopExtiLine, "EXTI line n is pin n of some port");

@@ -37,6 +37,8 @@ constexpr PinConfig output(Pin p, bool initial_high, Speed s = Speed::kMedium) {
   return {p, Mode::kOutput, 0, Pull::kNone, s, initial_high};
 }
 constexpr PinConfig input(Pin p, Pull pull) { return {p, Mode::kInput, 0, pull, Speed::kLow, false}; }
+/// An analog input (an ADC channel): no pull resistor, the digital input off (RM0090 8.3.12).
+constexpr PinConfig analog(Pin p) { return {p, Mode::kAnalog, 0, Pull::kNone, Speed::kLow, false}; }
 
 /// Drives pin n high or low (BSRR: one atomic write, safe against an interrupt's write to the port).
 inline void pin_write(GpioRegs& g, std::uint8_t n, bool high) { g.BSRR = high ? 1u << n : 1u << (n + 16u); }

@@ -4,8 +4,10 @@
 // fallbacks, the encoder unwrap across the 16- and 32-bit counter wraps, the AD5754R frames and the
 // one LDAC per burst, the SPI bus and its bounded waits, the zero-on-fault path, the E-stop latch,
 // the amplifier enable, the watchdog fed only by healthy ticks, the control timer, the USART link
-// (receive ring, frame queue) and the command link's silence (a category-2 stop, link_silent). The
-// control task runs for real (ControlTask<double>) over the board's HAL binding.
+// (receive ring, frame queue) and the command link's silence (a category-2 stop, link_silent); the
+// potentiometers' ADC scan over DMA (its set-up, a tick's read, the no-sample cases), the index
+// captures converted to accumulated counts, the pin map. The control task runs for real
+// (ControlTask<double>) over the board's HAL binding.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -14,6 +16,7 @@
 #include <vector>
 
 #include "ad5754r.hpp"
+#include "adc.hpp"
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "control_timer.hpp"
@@ -36,6 +39,8 @@ namespace {
 
 /// The board's encoders: a timer per joint, as its pin map says.
 using Encoders = EncoderBank<pins::kEncoders>;
+/// The board's potentiometers: ADC1's scan of the pin map's inputs.
+using Pots = AdcScan<pins::kPots>;
 
 /// Every register block of the board, in RAM, zeroed.
 struct FakeChip {
@@ -49,6 +54,9 @@ struct FakeChip {
   ExtiRegs exti{};
   SyscfgRegs syscfg{};
   DbgmcuRegs dbgmcu{};
+  AdcRegs adc1{};
+  AdcCommonRegs adc_common{};
+  DmaRegs dma2{};
   Chip chip() {
     Chip c{};
     c.rcc = &rcc;
@@ -61,6 +69,9 @@ struct FakeChip {
     c.exti = &exti;
     c.syscfg = &syscfg;
     c.dbgmcu = &dbgmcu;
+    c.adc1 = &adc1;
+    c.adc_common = &adc_common;
+    c.dma2 = &dma2;
     return c;
   }
   GpioRegs& port(Port p) { return gpio[static_cast<int>(p)]; }
@@ -218,6 +229,375 @@ TEST(Stm32Encoders, EveryJointReadsItsOwnTimer) {
   std::int32_t c[hal::kJoints];
   enc.read(c);
   for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(c[j], 10 * (j + 1));
+}
+
+// ----------------------------------------------------------------------------------- index pulses
+
+/// A timer block with TimRegs' member names (take_capture's Regs) whose SR and CCRx behave as the
+/// hardware's: a 0 written to a flag of SR clears it, a 1 leaves it (rc_w0); reading CCRx clears
+/// CCxIF; edge(x, v) latches the counter value v as an edge on channel x does (CCxOF too when CCxIF
+/// is still set).
+struct CapturingTimer {
+  struct Status {
+    std::uint32_t value = 0;
+    int writes = 0;
+    Status& operator=(std::uint32_t v) {
+      value &= v;
+      ++writes;
+      return *this;
+    }
+    operator std::uint32_t() const { return value; }
+  };
+  struct Capture {
+    CapturingTimer* owner;
+    int x;
+    std::uint32_t value = 0;
+    operator std::uint32_t() const {
+      owner->SR.value &= ~TimRegs::ccif(x);
+      return value;
+    }
+  };
+  Status SR;
+  Capture CCR[4] = {{this, 1}, {this, 2}, {this, 3}, {this, 4}};
+  CapturingTimer() = default;
+  CapturingTimer(const CapturingTimer&) = delete;
+  CapturingTimer& operator=(const CapturingTimer&) = delete;
+  void edge(int x, std::uint32_t v) {
+    if (SR.value & TimRegs::ccif(x)) SR.value |= TimRegs::ccof(x);
+    SR.value |= TimRegs::ccif(x);
+    CCR[x - 1].value = v;
+  }
+};
+
+TEST(Stm32Index, ACaptureIsTakenOnceAndAnOvercaptureGivesTheLatest) {
+  CapturingTimer t;
+  std::uint32_t v = 0;
+  bool over = true;
+  EXPECT_FALSE(take_capture(t, 3, v, over)) << "no edge yet";
+  t.edge(3, 1234);
+  ASSERT_TRUE(take_capture(t, 3, v, over));
+  EXPECT_EQ(v, 1234u);
+  EXPECT_FALSE(over);
+  EXPECT_EQ(t.SR.writes, 0) << "CC3IF cleared by reading CCR3: no write that could clear a newer edge's flag";
+  EXPECT_FALSE(take_capture(t, 3, v, over)) << "once";
+  t.edge(3, 100);
+  t.edge(3, 200);  // a second edge before the first was taken: CC3OF
+  t.edge(4, 77);   // and one on channel 4
+  ASSERT_TRUE(take_capture(t, 3, v, over));
+  EXPECT_EQ(v, 200u) << "the latest";
+  EXPECT_TRUE(over);
+  EXPECT_EQ(t.SR.value & (TimRegs::ccif(3) | TimRegs::ccof(3)), 0u) << "CC3IF and CC3OF cleared";
+  EXPECT_EQ(t.SR.value, TimRegs::ccif(4)) << "channel 4's flag untouched";
+  EXPECT_FALSE(take_capture(t, 3, v, over));
+  ASSERT_TRUE(take_capture(t, 4, v, over));
+  EXPECT_EQ(v, 77u);
+  EXPECT_FALSE(over);
+  EXPECT_EQ(t.SR.value, 0u);
+}
+
+/// An index edge on joint j's timer as the hardware latches it: the counter value in CCRx, CCxIF set.
+void index_edge(FakeChip& f, int j, std::uint32_t counter) {
+  const EncoderChannel& e = pins::kEncoders[j];
+  TimRegs& t = f.timer(e.timer);
+  t.CCR[e.index_channel - 1] = counter;
+  t.SR = t.SR | TimRegs::ccif(e.index_channel);
+}
+/// What the driver's read of CCRx did on the chip, which RAM does not: CCxIF cleared.
+void ccr_read(FakeChip& f, int j) {
+  const EncoderChannel& e = pins::kEncoders[j];
+  TimRegs& t = f.timer(e.timer);
+  t.SR = t.SR & ~TimRegs::ccif(e.index_channel);
+}
+
+TEST(Stm32Index, InitCapturesEachIndexOnItsRisingEdgeOnItsPin) {
+  FakeChip f;
+  Encoders enc;
+  enc.init(f.chip());
+  for (const EncoderChannel& e : pins::kEncoders) {
+    const TimRegs& t = f.timer(e.timer);
+    if (e.index_channel == 3) {
+      EXPECT_EQ(t.CCMR2, 0x01u | (3u << 4)) << "CC3S = TI3, IC3F = 3";
+      EXPECT_EQ(t.CCER & 0xFF00u, 1u << 8) << "CC3E; CC3P = CC3NP = 0: the rising edge";
+    } else {
+      EXPECT_EQ(t.CCMR2, (0x01u | (3u << 4)) << 8) << "CC4S = TI4, IC4F = 3";
+      EXPECT_EQ(t.CCER & 0xFF00u, 1u << 12) << "CC4E; CC4P = CC4NP = 0: the rising edge";
+    }
+    EXPECT_EQ(t.CCER & 0xFFu, 0u) << "A and B as before (no invert)";
+    EXPECT_EQ(t.DIER, 0u) << "no interrupt: the tick takes the captures";
+    const GpioRegs& g = f.port(e.index.pin.port);
+    EXPECT_EQ((g.MODER >> (2 * e.index.pin.n)) & 3u, 2u) << "alternate function";
+    EXPECT_EQ((g.AFR[e.index.pin.n / 8] >> (4 * (e.index.pin.n % 8))) & 0xFu, e.index.af);
+  }
+}
+
+TEST(Stm32Index, AnIndexIsTheAccumulatedCountAtItsEdgeOnceAcrossSixteenBitWraps) {
+  FakeChip f;
+  Encoders enc;
+  enc.init(f.chip());
+  TimRegs& t = f.timer(Timer::kTim1);  // joint 1, 16-bit, index on CH3
+  std::int32_t c[hal::kJoints], n = 0;
+  for (std::uint32_t raw : {30000u, 60000u}) {
+    t.CNT = raw;
+    enc.read(c);
+  }
+  ASSERT_EQ(c[0], 60000);
+  EXPECT_FALSE(enc.take_index(0, n)) << "no edge yet";
+  index_edge(f, 0, 65530);  // the edge at count 65530, then the counter wraps
+  t.CNT = 24464;            // 90000
+  enc.read(c);
+  ccr_read(f, 0);
+  ASSERT_EQ(c[0], 90000);
+  ASSERT_TRUE(enc.take_index(0, n));
+  EXPECT_EQ(n, 65530) << "captured before the wrap, read after it";
+  EXPECT_FALSE(enc.take_index(0, n)) << "once";
+  enc.read(c);
+  EXPECT_FALSE(enc.take_index(0, n)) << "no new edge";
+  // Backwards through the wrap: the edge at 65539 (counter 3), read at 65000 (counter 65000).
+  index_edge(f, 0, 3);
+  t.CNT = 65000;
+  enc.read(c);
+  ccr_read(f, 0);
+  ASSERT_EQ(c[0], 65000);
+  ASSERT_TRUE(enc.take_index(0, n));
+  EXPECT_EQ(n, 65539) << "captured after the wrap, read before it";
+  // Below zero: joint 4 (16-bit) from 0 back to -536, its edge at -6.
+  TimRegs& t4 = f.timer(Timer::kTim4);
+  index_edge(f, 3, 65530);
+  t4.CNT = 65000;
+  enc.read(c);
+  ccr_read(f, 3);
+  ASSERT_EQ(c[3], -536);
+  ASSERT_TRUE(enc.take_index(3, n));
+  EXPECT_EQ(n, -6);
+}
+
+TEST(Stm32Index, EveryChannelLatchesItsOwnIndexAndThirtyTwoBitCountersToo) {
+  FakeChip f;
+  Encoders enc;
+  enc.init(f.chip());
+  f.timer(Timer::kTim2).CNT = 0xFFFFFF00u;  // joint 2 (32-bit, index on CH4) near the 32-bit wrap
+  enc.restart();
+  std::int32_t c[hal::kJoints], n = 0;
+  index_edge(f, 1, 0xFFFFFFF0u);      // +240, before the wrap
+  index_edge(f, 4, 0x00001000u);      // joint 5 (32-bit, CH4): +4096
+  index_edge(f, 5, 0xFFF0u);          // joint 6 (16-bit, CH4): -16
+  f.timer(Timer::kTim2).CNT = 0x100;  // +512, after the wrap
+  enc.read(c);
+  for (int j : {1, 4, 5}) ccr_read(f, j);
+  ASSERT_EQ(c[1], 512);
+  for (int j : {0, 2, 3}) EXPECT_FALSE(enc.take_index(j, n)) << "joint " << j + 1 << ": no edge";
+  ASSERT_TRUE(enc.take_index(1, n));
+  EXPECT_EQ(n, 240);
+  EXPECT_FALSE(enc.take_index(1, n));
+  ASSERT_TRUE(enc.take_index(5, n)) << "joint 2's take left joint 6's";
+  EXPECT_EQ(n, -16);
+  ASSERT_TRUE(enc.take_index(4, n));
+  EXPECT_EQ(n, 4096);
+  EXPECT_FALSE(enc.take_index(-1, n));
+  EXPECT_FALSE(enc.take_index(hal::kJoints, n));
+  // A capture on a channel that is not the joint's index (CH3 of TIM2) is not an index.
+  f.timer(Timer::kTim2).SR = TimRegs::ccif(3);
+  enc.read(c);
+  EXPECT_FALSE(enc.take_index(1, n));
+  // Two edges before the tick (CC4OF): the latest, counted; a restart drops an untaken index.
+  f.timer(Timer::kTim2).SR = 0;
+  index_edge(f, 1, 0x200);
+  f.timer(Timer::kTim2).SR = f.timer(Timer::kTim2).SR | TimRegs::ccof(4);
+  enc.read(c);
+  EXPECT_EQ(f.timer(Timer::kTim2).SR & TimRegs::ccof(4), 0u) << "CC4OF cleared (written 0)";
+  f.timer(Timer::kTim2).SR = 0;  // RAM took the 1s of that write as set flags
+  EXPECT_EQ(enc.overcaptures(1), 1u);
+  ASSERT_TRUE(enc.take_index(1, n));
+  EXPECT_EQ(n, 512 + 256);
+  index_edge(f, 1, 0x300);
+  enc.read(c);
+  ccr_read(f, 1);
+  enc.restart();
+  EXPECT_FALSE(enc.take_index(1, n)) << "relative to the counts before the restart: dropped";
+}
+
+// ------------------------------------------------------------------------------- potentiometers
+
+/// The end of a scan as the DMA and the ADC leave it: the six codes in the buffer, the stream
+/// disabled with its transfers done (TCIF0, and HTIF0 half-way), the ADC's end of sequence.
+void scan_done(FakeChip& f, Pots& pots, const std::uint16_t (&codes)[hal::kJoints]) {
+  for (int i = 0; i < hal::kJoints; ++i) pots.dma_buffer()[i] = codes[i];
+  f.dma2.S[0].CR = f.dma2.S[0].CR & ~DmaStream::kEn;
+  f.dma2.S[0].NDTR = 0;
+  f.dma2.LISR = DmaRegs::kTcif0 | DmaRegs::kHtif0;
+  f.adc1.SR = AdcRegs::kEoc | AdcRegs::kStrt;
+}
+/// A scan was started since `forget` cleared the marks: the stream re-armed for six half-words with
+/// its flags cleared, the ADC's flags cleared, its DMA requests on and the software start set.
+::testing::AssertionResult started(FakeChip& f) {
+  const DmaStream& s = f.dma2.S[0];
+  if (f.dma2.LIFCR != 0x3Du) return ::testing::AssertionFailure() << "LIFCR 0x" << std::hex << f.dma2.LIFCR;
+  if (s.NDTR != 6u) return ::testing::AssertionFailure() << "NDTR " << s.NDTR;
+  if ((s.CR & DmaStream::kEn) == 0) return ::testing::AssertionFailure() << "stream not enabled";
+  if (f.adc1.SR != 0u) return ::testing::AssertionFailure() << "ADC flags not cleared";
+  if (f.adc1.CR2 != ((1u << 30) | (1u << 8) | 1u))
+    return ::testing::AssertionFailure() << "CR2 0x" << std::hex << f.adc1.CR2 << ", not ADON | DMA | SWSTART";
+  return ::testing::AssertionSuccess();
+}
+/// What the start's write of LIFCR did on the chip, which RAM does not: those flags of LISR cleared.
+void lifcr_cleared(FakeChip& f) { f.dma2.LISR = f.dma2.LISR & ~f.dma2.LIFCR; }
+void forget(FakeChip& f) {
+  f.dma2.LIFCR = 0;
+  f.dma2.S[0].NDTR = 0;
+  f.adc1.CR2 = AdcRegs::kAdon;
+}
+
+TEST(Stm32Pots, InitSetsUpOneScanOfTheSixChannelsInJointOrderThroughDma) {
+  FakeChip f;
+  Pots pots;
+  pots.init(f.chip(), 84000000);
+  EXPECT_NE(f.rcc.APB2ENR & (1u << 8), 0u) << "ADC1EN";
+  EXPECT_NE(f.rcc.AHB1ENR & (1u << 22), 0u) << "DMA2EN";
+  EXPECT_EQ(f.adc_common.CCR, 1u << 16) << "ADCPRE /4: 21 MHz from 84 MHz; independent ADCs";
+  EXPECT_EQ(f.adc1.CR1, 1u << 8) << "SCAN; RES 0: 12-bit; no interrupt";
+  EXPECT_EQ(f.adc1.CR2, 1u) << "on and idle (no CONT, no external trigger): the first tick starts it";
+  // 480 cycles (SMP 7) on channels 11, 12, 14, 15 (SMPR1) and 8, 9 (SMPR2), nothing else.
+  EXPECT_EQ(f.adc1.SMPR1, (7u << 3) | (7u << 6) | (7u << 12) | (7u << 15));
+  EXPECT_EQ(f.adc1.SMPR2, (7u << 24) | (7u << 27));
+  // Six conversions (L = 5), SQ1..SQ6 the joints' channels in joint order.
+  EXPECT_EQ(f.adc1.SQR1, 5u << 20);
+  EXPECT_EQ(f.adc1.SQR2, 0u);
+  EXPECT_EQ(f.adc1.SQR3, 11u | (12u << 5) | (14u << 10) | (15u << 15) | (8u << 20) | (9u << 25));
+  for (int j = 0; j < hal::kJoints; ++j) {
+    const std::uint32_t ch = pins::kPots[j].channel;
+    const std::uint32_t smp = ch >= 10 ? (f.adc1.SMPR1 >> (3 * (ch - 10))) & 7u : (f.adc1.SMPR2 >> (3 * ch)) & 7u;
+    EXPECT_EQ(smp, 7u) << "joint " << j + 1;
+    EXPECT_EQ((f.adc1.SQR3 >> (5 * j)) & 0x1Fu, ch) << "joint " << j + 1;
+  }
+  const DmaStream& s = f.dma2.S[0];
+  EXPECT_EQ(s.CR, (2u << 16) | (1u << 13) | (1u << 11) | (1u << 10))
+      << "channel 0, peripheral to memory, half-words, memory increment, normal mode, high priority; off";
+  EXPECT_EQ(s.PAR, static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&f.adc1.DR)));
+  EXPECT_EQ(s.M0AR, static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(pots.dma_buffer())));
+  EXPECT_EQ(s.FCR, 0u) << "direct mode";
+  for (const AnalogInput& in : pins::kPots) {
+    const GpioRegs& g = f.port(in.pin.pin.port);
+    EXPECT_EQ((g.MODER >> (2 * in.pin.pin.n)) & 3u, 3u) << "analog";
+    EXPECT_EQ((g.PUPDR >> (2 * in.pin.pin.n)) & 3u, 0u) << "no pull resistor";
+  }
+  Pots slow;
+  FakeChip g;
+  slow.init(g.chip(), 16000000);
+  EXPECT_EQ(g.adc_common.CCR, 0u) << "HSI fallback: /2, 8 MHz";
+}
+
+TEST(Stm32Pots, EachTickTakesTheScanThePreviousTickStartedAndStartsTheNext) {
+  FakeChip f;
+  Pots pots;
+  pots.init(f.chip(), 84000000);
+  std::uint16_t codes[hal::kJoints] = {};
+  EXPECT_FALSE(pots.update()) << "the first tick: no scan ran yet";
+  EXPECT_FALSE(pots.read(codes));
+  EXPECT_TRUE(started(f));
+  const std::uint16_t first[hal::kJoints] = {100, 4095, 2048, 0, 1, 3000};
+  scan_done(f, pots, first);
+  forget(f);
+  ASSERT_TRUE(pots.update());
+  EXPECT_TRUE(started(f)) << "the next scan, right after the read";
+  ASSERT_TRUE(pots.read(codes));
+  for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(codes[j], first[j]) << "joint " << j + 1;
+  EXPECT_TRUE(pots.read(codes)) << "the same tick's codes, again";
+  const std::uint16_t second[hal::kJoints] = {7, 6, 5, 4, 3, 2};
+  scan_done(f, pots, second);
+  forget(f);
+  ASSERT_TRUE(pots.update());
+  ASSERT_TRUE(pots.read(codes));
+  for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(codes[j], second[j]) << "joint " << j + 1;
+  EXPECT_EQ(pots.scans(), 2u);
+}
+
+TEST(Stm32Pots, AnOverrunAnIncompleteScanOrAStreamErrorIsNoSample) {
+  FakeChip f;
+  Pots pots;
+  pots.init(f.chip(), 84000000);
+  std::uint16_t codes[hal::kJoints] = {};
+  const std::uint16_t c[hal::kJoints] = {1, 2, 3, 4, 5, 6};
+  pots.update();
+  // A result lost (OVR): the buffer may be shifted.
+  scan_done(f, pots, c);
+  f.adc1.SR = f.adc1.SR | AdcRegs::kOvr;
+  forget(f);
+  EXPECT_FALSE(pots.update());
+  EXPECT_FALSE(pots.read(codes));
+  EXPECT_EQ(pots.overruns(), 1u);
+  EXPECT_EQ(f.adc1.CR2, 1u) << "stopped, on again, no scan started this tick";
+  EXPECT_EQ(f.dma2.S[0].CR & DmaStream::kEn, 0u) << "the stream disabled";
+  EXPECT_FALSE(pots.update()) << "the tick after: nothing ran";
+  EXPECT_TRUE(started(f)) << "a fresh scan";
+  scan_done(f, pots, c);
+  EXPECT_TRUE(pots.update()) << "and the one after has a sample again";
+  // Not complete at the tick (only half the transfers done).
+  f.dma2.LISR = DmaRegs::kHtif0;
+  forget(f);
+  EXPECT_FALSE(pots.update());
+  EXPECT_FALSE(pots.read(codes));
+  EXPECT_EQ(pots.incomplete(), 1u);
+  EXPECT_EQ(f.adc1.CR2, 1u) << "stopped: the rest of the late scan never reaches the next one's buffer";
+  EXPECT_FALSE(pots.update());
+  // A transfer error of the stream.
+  scan_done(f, pots, c);
+  f.dma2.LISR = f.dma2.LISR | DmaRegs::kTeif0;
+  EXPECT_FALSE(pots.update());
+  EXPECT_EQ(pots.overruns(), 2u);
+  EXPECT_EQ(pots.scans(), 1u);
+}
+
+TEST(Stm32Pots, TheClockTheChannelsAndTheScanTime) {
+  EXPECT_EQ(adc_divider(84000000), 4u);
+  EXPECT_EQ(adc_divider(16000000), 2u);
+  EXPECT_EQ(adc_divider(168000000), 6u) << "28 MHz: within 36 MHz";
+  EXPECT_EQ(Pots::scan_ns(21000000), 140571u) << "6 x (480 + 12) cycles at 21 MHz";
+  EXPECT_EQ(Pots::scan_ns(8000000), 369000u) << "at the HSI fallback";
+  EXPECT_LT(Pots::scan_ns(8000000), 1000000u) << "within the 1 ms tick";
+  EXPECT_EQ(adc1_channel_of(pins::PA(0)), 0);
+  EXPECT_EQ(adc1_channel_of(pins::PA(7)), 7);
+  EXPECT_EQ(adc1_channel_of(pins::PB(1)), 9);
+  EXPECT_EQ(adc1_channel_of(pins::PC(0)), 10);
+  EXPECT_EQ(adc1_channel_of(pins::PC(5)), 15);
+  for (Pin p : {pins::PA(8), pins::PB(2), pins::PC(6), pins::PD(0), pins::PE(13)}) EXPECT_EQ(adc1_channel_of(p), -1);
+}
+
+// ------------------------------------------------------------------------------------------- pins
+
+TEST(Stm32Pins, TheIndexAndPotentiometerPinsWithTheirFunctions) {
+  using namespace pins;
+  // DS8626 table 9: TIM1_CH3 PE13 AF1, TIM2_CH4 PB11 AF1, TIM3_CH3 PC8 AF2, TIM4_CH3 PB8 AF2,
+  // TIM5_CH4 PA3 AF2, TIM8_CH4 PC9 AF3.
+  const Pin index[hal::kJoints] = {PE(13), PB(11), PC(8), PB(8), PA(3), PC(9)};
+  const std::uint8_t af[hal::kJoints] = {1, 1, 2, 2, 2, 3};
+  const int channel[hal::kJoints] = {3, 4, 3, 3, 4, 4};
+  // DS8626 table 7: ADC123_IN11 PC1, ADC123_IN12 PC2, ADC12_IN14 PC4, ADC12_IN15 PC5, ADC12_IN8 PB0,
+  // ADC12_IN9 PB1.
+  const Pin pot[hal::kJoints] = {PC(1), PC(2), PC(4), PC(5), PB(0), PB(1)};
+  const std::uint8_t adc[hal::kJoints] = {11, 12, 14, 15, 8, 9};
+  for (int j = 0; j < hal::kJoints; ++j) {
+    SCOPED_TRACE(j + 1);
+    EXPECT_TRUE(kEncoders[j].index.pin == index[j]);
+    EXPECT_EQ(kEncoders[j].index.mode, Mode::kAlternate);
+    EXPECT_EQ(kEncoders[j].index.af, af[j]);
+    EXPECT_EQ(kEncoders[j].index_channel, channel[j]);
+    EXPECT_TRUE(kPots[j].pin.pin == pot[j]);
+    EXPECT_EQ(kPots[j].pin.mode, Mode::kAnalog);
+    EXPECT_EQ(kPots[j].pin.pull, Pull::kNone);
+    EXPECT_EQ(kPots[j].channel, adc[j]);
+  }
+  EXPECT_TRUE(kUartRx.pin == PD(6)) << "USART2_RX moved off PA3 (TIM5_CH4)";
+  EXPECT_EQ(kUartRx.af, 7);
+  // Every pin once (the pin map's static_assert), and the check finds a pin used twice.
+  EXPECT_TRUE(pins_distinct());
+  EXPECT_EQ(kPinCount, 4 * hal::kJoints + 11);
+  const Pin twice[] = {PC(1), PE(13), PA(3), PC(1)};
+  EXPECT_FALSE(distinct(twice, 4));
+  EXPECT_TRUE(distinct(twice, 3));
+  Pin all[kPinCount];
+  for (int i = 0; i < kPinCount; ++i) all[i] = pin_at(i);
+  all[3 * hal::kJoints + 4] = PA(3);  // joint 5's potentiometer on joint 5's index pin
+  EXPECT_FALSE(distinct(all, kPinCount));
 }
 
 // -------------------------------------------------------------------------------------------- DAC
@@ -616,12 +996,14 @@ struct BoardRig {
   FakeChip f;
   Encoders enc;
   RecordingDac dac;
+  Pots pots;
   Safety safety;
-  BoardHal<Encoders, RecordingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RecordingDac, FakeCycles, Pots> hal{enc, dac, pots, safety, f.timer(Timer::kTim6)};
   osc::ControlTask<double> task;
   BoardRig() {
     const Chip c = f.chip();
     enc.init(c);
+    pots.init(c, 84000000);
     safety.init(c);
     task.init(osc::Model<double>::of(osc::robot::kArm), osc::Gains<double>::paper(), osc::FrictionMode::kAdaptive,
               osc::joint_vector<double>(osc::robot::kQStart), 168000);
@@ -632,10 +1014,11 @@ struct BoardRig {
     return hal.tick(task);
   }
 };
-static_assert(hal::ControlHal<BoardHal<Encoders, RecordingDac, FakeCycles>>);
+static_assert(hal::ControlHal<BoardHal<Encoders, RecordingDac, FakeCycles, Pots>>);
+static_assert(hal::PositionHal<BoardHal<Encoders, RecordingDac, FakeCycles, Pots>>);
 // What BoardHal needs from its drivers: the board's and the fakes satisfy it...
 static_assert(EncoderInput<Encoders> && DacOutput<ad5754r::DacPair<SpiDacBus>> && DacOutput<RecordingDac> &&
-              CycleClock<FakeCycles>);
+              CycleClock<FakeCycles> && PotInput<Pots>);
 // ...and a driver that lacks a function, returns the wrong type or needs an instance does not: BoardHal
 // refuses it.
 struct DacWithoutClear {
@@ -647,21 +1030,35 @@ struct DacWithVoidWrite {
 };
 struct EncodersWithoutRead {
   void init(const Chip&) {}
+  bool take_index(int, std::int32_t&) { return false; }
+};
+struct EncodersWithoutIndex {
+  void read(std::int32_t*) {}
 };
 struct CyclesOfAnInstance {
   std::uint32_t cycles() { return 0; }
 };
+struct PotsWithoutUpdate {
+  bool read(std::uint16_t*) const { return false; }
+};
+struct PotsWithVoidRead {
+  bool update() { return false; }
+  void read(std::uint16_t*) const {}  // cannot say there is no sample
+};
 static_assert(!DacOutput<DacWithoutClear> && !DacOutput<DacWithVoidWrite>);
-static_assert(!EncoderInput<EncodersWithoutRead>);
+static_assert(!EncoderInput<EncodersWithoutRead> && !EncoderInput<EncodersWithoutIndex>);
 static_assert(!CycleClock<CyclesOfAnInstance>);
-template <class E, class D, class C>
+static_assert(!PotInput<PotsWithoutUpdate> && !PotInput<PotsWithVoidRead>);
+template <class E, class D, class C, class P = Pots>
 concept BoardHalOf = requires {
-  typename BoardHal<E, D, C>;
+  typename BoardHal<E, D, C, P>;
 };
 static_assert(BoardHalOf<Encoders, RecordingDac, FakeCycles>);
 static_assert(!BoardHalOf<Encoders, DacWithVoidWrite, FakeCycles>);
 static_assert(!BoardHalOf<EncodersWithoutRead, RecordingDac, FakeCycles>);
+static_assert(!BoardHalOf<EncodersWithoutIndex, RecordingDac, FakeCycles>);
 static_assert(!BoardHalOf<Encoders, RecordingDac, CyclesOfAnInstance>);
+static_assert(!BoardHalOf<Encoders, RecordingDac, FakeCycles, PotsWithVoidRead>);
 
 TEST(Stm32Board, AmplifierOffUntilTheSupervisorRunsHealthy) {
   BoardRig r;
@@ -738,11 +1135,12 @@ TEST(Stm32Board, AnEstopDuringTheBurstClearsTheOutputs) {
   FakeChip f;
   Encoders enc;
   RacingDac dac;
+  Pots pots;
   Safety safety;
   enc.init(f.chip());
   safety.init(f.chip());
   dac.s = &safety;
-  BoardHal<Encoders, RacingDac, FakeCycles> hal{enc, dac, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RacingDac, FakeCycles, Pots> hal{enc, dac, pots, safety, f.timer(Timer::kTim6)};
   const std::int32_t codes[hal::kJoints] = {1, 2, 3, 4, 5, 6};
   hal.write_dacs(codes);
   EXPECT_EQ(dac.clears, 1) << "CLR pulsed: the codes of that burst never reach the joints";
@@ -804,6 +1202,29 @@ TEST(Stm32Board, ADacBusFaultLatchesOnTheNextTick) {
   // In the catalogue: named in the console, the JSON and the telemetry reader (it once read "none").
   EXPECT_EQ(r.task.sup.latched & ~osc::kAllFaults, 0u);
   EXPECT_STREQ(osc::fault_name(r.task.sup.latched), "dac_bus");
+}
+
+TEST(Stm32Board, TheTickScansThePotsAndTheHalGivesThemAndTheIndex) {
+  BoardRig r;
+  std::uint16_t codes[hal::kJoints] = {};
+  ASSERT_EQ(r.tick(), 0u);
+  EXPECT_FALSE(r.hal.read_pots(codes)) << "the first tick started the first scan";
+  EXPECT_TRUE(started(r.f));
+  const std::uint16_t c[hal::kJoints] = {2048, 100, 4000, 1234, 3333, 17};
+  scan_done(r.f, r.pots, c);
+  index_edge(r.f, 2, 65535);  // joint 3's index one count below the start
+  ASSERT_EQ(r.tick(), 0u);
+  ccr_read(r.f, 2);
+  ASSERT_TRUE(r.hal.read_pots(codes));
+  for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(codes[j], c[j]) << "joint " << j + 1;
+  std::int32_t n = 0;
+  EXPECT_FALSE(r.hal.take_index(0, n));
+  ASSERT_TRUE(r.hal.take_index(2, n));
+  EXPECT_EQ(n, -1);
+  EXPECT_FALSE(r.hal.take_index(2, n));
+  lifcr_cleared(r.f);
+  ASSERT_EQ(r.tick(), 0u);  // the scan the last tick started has not completed
+  EXPECT_FALSE(r.hal.read_pots(codes));
 }
 
 // ---------------------------------------------------------------------- control timer, telemetry
