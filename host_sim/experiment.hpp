@@ -6,6 +6,7 @@
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "osc/control/controller.hpp"
@@ -117,7 +118,7 @@ constexpr const char* runtime_param_key(osc::RuntimeParam p) {
 
 /// The residual monitor's settings of a run on the task of a host-built controller
 /// (osc::ControlTask): armed or a trial, the collision's reaction and thresholds; and the runtime
-/// parameters of cfg.params, each set as a board's param set would (osc::param_set).
+/// parameters of cfg.params, each checked as a board's param set would (osc::param_value_status).
 template <class Task>
 void configure_monitors(Task& task, const ExperimentConfig& cfg) {
   task.residual.armed = cfg.residual_monitor;
@@ -126,10 +127,14 @@ void configure_monitors(Task& task, const ExperimentConfig& cfg) {
   for (int i = 0; i < osc::kParamCount; ++i) {
     const osc::ParamInfo& p = osc::kParams[i];
     if (p.gain >= 0 || runtime_param_key(p.runtime) != nullptr) continue;
+    // Before the first tick, as a board's boot applies its stored record: each value checked, the
+    // access (torque off) not, the task starting in the paper's motion.
     for (int e = 0; e < p.count; ++e) {
-      const osc::ParamStatus st = osc::param_set(task, i, e, cfg.params[osc::param_slot(i) + e]);
+      const double v = cfg.params[osc::param_slot(i) + e];
+      const osc::ParamStatus st = osc::param_value_status<std::decay_t<decltype(task.gains.dt)>>(i, e, v);
       if (st != osc::ParamStatus::kOk)
         throw std::invalid_argument(std::string("run.") + p.name + ": " + osc::param_status_name(st));
+      osc::param_put(task, i, e, v);
     }
   }
 }

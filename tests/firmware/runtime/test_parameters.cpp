@@ -71,7 +71,7 @@ TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
   }
   EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
   EXPECT_EQ(slots, kParamSlots);
-  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1));
+  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1));
   EXPECT_EQ(param_index("no_such"), -1);
   EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
 }
@@ -103,8 +103,9 @@ void every_element_sets_and_reads_back() {
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e) {
       const ParamInfo& p = kParams[i];
-      const bool code = p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
-                                       p.runtime == RuntimeParam::kParamCollisionReaction);
+      const bool code =
+          p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
+                         p.runtime == RuntimeParam::kParamCollisionReaction || p.runtime == RuntimeParam::kParamPots);
       // A value between the default and the top of the range, that keeps the observer stable.
       const double v =
           code ? p.hi_of(e) : param_default(i, e) * 0.75 + 0.25 * std::fmin(p.hi_of(e), 4 * param_default(i, e) + 1);
@@ -242,11 +243,47 @@ TEST(Parameters, RecordsApplyWholeOrNotAtAll) {
   EXPECT_EQ(param_apply(*t, param_defaults()), ParamStatus::kTorqueOn);
 }
 
+/// A HAL with potentiometers that counts its reads: the tick reads them (the position cross-check)
+/// only while the parameter pots is 1.
+struct PotsHal {
+  int pot_reads = 0;
+  bool read_encoders(std::int32_t c[kDof]) {
+    for (int i = 0; i < kDof; ++i) c[i] = 0;
+    return true;
+  }
+  void write_dacs(const std::int32_t*) {}
+  std::uint32_t cycles() { return 0; }
+  std::uint32_t io_faults() { return 0; }
+  void fault_output(bool) {}
+  bool read_pots(std::uint16_t c[kDof]) {
+    ++pot_reads;
+    for (int i = 0; i < kDof; ++i) c[i] = 2000;
+    return true;
+  }
+  bool take_index(int, std::int32_t&) { return false; }
+};
+static_assert(hal::ControlHal<PotsHal> && hal::PositionHal<PotsHal>);
+
+TEST(Parameters, PotsZeroTurnsThePositionCrossCheckOff) {
+  auto t = disabled_task<double>();
+  PotsHal hal;
+  control_tick(*t, hal);
+  EXPECT_EQ(hal.pot_reads, 1);
+  ASSERT_EQ(param_set(*t, param_index("pots"), 0, 0.0), ParamStatus::kOk);
+  EXPECT_FALSE(t->pots);
+  control_tick(*t, hal);
+  EXPECT_EQ(hal.pot_reads, 1);
+  EXPECT_EQ(param_set(*t, param_index("pots"), 0, 0.5), ParamStatus::kOutOfRange);
+  ASSERT_EQ(param_set(*t, param_index("pots"), 0, 1.0), ParamStatus::kOk);
+  control_tick(*t, hal);
+  EXPECT_EQ(hal.pot_reads, 2);
+}
+
 TEST(Parameters, LayoutVersionIsOfTheTable) {
   EXPECT_NE(kParamLayout, 0);
   // A fixed value: a change of any name or element count changes it, and this test with it (the
   // stored records of the old table are then not loaded: layout_mismatch).
-  EXPECT_EQ(kParamLayout, 22691);
+  EXPECT_EQ(kParamLayout, 33816);
 }
 
 // ------------------------------------------------------------------------------- over the link

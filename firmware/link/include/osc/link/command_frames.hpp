@@ -142,9 +142,7 @@ constexpr double kCommandMaxVelocity = 10.0;
 // X(Name, "name", meaning): what a param frame asks (the parameter table, osc/runtime/parameters.hpp).
 // Each is answered at once by a param_answer frame, in the order they come.
 #define OSC_PARAM_OP_LIST(X)                                                                                       \
-  X(Get, "get",                                                                                                    \
-    "the element's value, with its range and the table's size and layout (a listing gets each "                    \
-    "index in turn)")                                                                                              \
+  X(Get, "get", "the element's value, its range, the table's size and layout (a listing gets each index)")         \
   X(Set, "set", "value into the element, checked (Parameter statuses); the answer carries the value now")          \
   X(Save, "save", "every value into the board's store (flash on the STM32F4, RAM on the QEMU boards); torque off") \
   X(Load, "load", "the store's newest valid record applied, checked as a whole; torque off")                       \

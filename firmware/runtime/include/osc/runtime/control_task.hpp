@@ -70,6 +70,7 @@ struct ControlTask {
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
   PositionCrossCheck<S> position;  // a HAL with potentiometers (hal::PositionHal)
+  bool pots;                       // the arm's potentiometers are wired (parameter pots): the cross-check runs
   Supervisor sup;
   std::uint32_t period_cycles;  // overrun budget per step (0: not checked)
   StepTiming timing;            // the whole tick: I/O, step, supervision
@@ -111,6 +112,7 @@ struct ControlTask {
     contact = false;
     saturation.reset();
     position.reset();
+    pots = true;
     set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
@@ -433,6 +435,21 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   return st.torque;
 }
 
+/// The position cross-check of a tick with a measured sample, on a HAL with potentiometers (none
+/// otherwise, or with the parameter pots 0): whether the torque is on or not (an arm moved by hand).
+template <class S, class Hal>
+std::uint32_t position_faults(ControlTask<S>& task, Hal& hal, const Vec6<S>& q) {
+  if constexpr (hal::PositionHal<Hal>) {
+    if (!task.pots) return 0;
+    std::uint16_t pots[kDof];
+    const bool valid = hal.read_pots(pots);
+    return task.position.check(pots, valid, q);
+  } else {
+    (void)task, (void)hal, (void)q;
+    return 0;
+  }
+}
+
 /// One tick, the block diagram in five timed stages (TickStage): read, checks, step, monitors,
 /// output; then the supervisor and the motion state machine. Returns the fault bits detected in
 /// this tick. On any fault, whenever the supervisor is not in kRun or the motion state machine has
@@ -475,14 +492,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageMonitors] = hal.cycles();
   // monitors
   if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
-  if constexpr (hal::PositionHal<Hal>) {
-    // The potentiometers against the encoders, whether the torque is on or not (an arm moved by hand).
-    std::uint16_t pots[kDof];
-    if (measured) {
-      const bool valid = hal.read_pots(pots);
-      faults |= task.position.check(pots, valid, q);
-    }
-  }
+  if (measured) faults |= position_faults(task, hal, q);
   const CollisionReaction collision = take_collision(task, faults);
   mark[kStageOutput] = hal.cycles();
   // output

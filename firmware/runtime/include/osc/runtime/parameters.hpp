@@ -99,7 +99,9 @@ constexpr double kZeros[kDof] = {};
   X(CollisionThreshold, "collision_threshold", kDof, "N m", 0, robot::kDrives.torque_limit, detail::kZeros, Always, \
     true, "each joint's collision threshold; 0: the derived threshold alone")                                       \
   X(StreamTimeout, "stream_timeout", 1, "s", params::kStreamTimeoutLo, kStreamExtrapolation, kStreamTimeoutMin,     \
-    Always, true, "a stream is stale after max(2 periods, this) without a setpoint; from the next stream on")
+    Always, true, "a stream is stale after max(2 periods, this) without a setpoint; from the next stream on")       \
+  X(Pots, "pots", 1, "", 0, 1, 1, TorqueOff, true,                                                                  \
+    "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),
@@ -338,6 +340,8 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return static_cast<double>(task.residual.collision_floor(e));
     case RuntimeParam::kParamStreamTimeout:
       return static_cast<double>(task.stream_timeout_ticks) / params::kControlHz;
+    case RuntimeParam::kParamPots:
+      return task.pots ? 1.0 : 0.0;
     case RuntimeParam::kCount:
       break;
   }
@@ -375,6 +379,10 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamStreamTimeout:
       task.stream_timeout_ticks = static_cast<std::uint32_t>(std::lround(v * params::kControlHz));
       break;
+    case RuntimeParam::kParamPots:
+      if ((v != 0) != task.pots) task.position.reset();  // learnt again from the next sample
+      task.pots = v != 0;
+      break;
     case RuntimeParam::kCount:
       break;
   }
@@ -406,7 +414,8 @@ ParamStatus param_value_status(int i, int e, double v) {
   if (!std::isfinite(v)) return ParamStatus::kNotFinite;
   if (v < p.lo_of(e) || v > p.hi_of(e) || std::fabs(v) >= param_scalar_max<S>()) return ParamStatus::kOutOfRange;
   const bool code =
-      p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation || p.runtime == RuntimeParam::kParamCollisionReaction);
+      p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
+                     p.runtime == RuntimeParam::kParamCollisionReaction || p.runtime == RuntimeParam::kParamPots);
   if (code && v != std::floor(v)) return ParamStatus::kOutOfRange;
   return ParamStatus::kOk;
 }
