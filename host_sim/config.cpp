@@ -136,7 +136,7 @@ std::vector<std::string> names_of() {
 void add_runtime_param_entries(std::vector<Entry>& t) {
   for (int i = 0; i < osc::kParamCount; ++i) {
     const osc::ParamInfo& p = osc::kParams[i];
-    if (p.gain >= 0 || runtime_param_key(p.runtime) != nullptr) continue;
+    if (!runtime_param_generated(p)) continue;
     const std::string key = std::string("run.") + p.name;
     const std::string doc = std::string(p.doc) + (*p.unit ? std::string(" [") + p.unit + "]" : "");
     const int slot = osc::param_slot(i), n = p.count;

@@ -116,6 +116,12 @@ constexpr const char* runtime_param_key(osc::RuntimeParam p) {
   }
 }
 
+/// Whether a parameter's host key is run.<its name>, made from the table (a runtime parameter without a
+/// key of its own).
+constexpr bool runtime_param_generated(const osc::ParamInfo& p) {
+  return p.gain < 0 && runtime_param_key(p.runtime) == nullptr;
+}
+
 /// The residual monitor's settings of a run on the task of a host-built controller
 /// (osc::ControlTask): armed or a trial, the collision's reaction and thresholds; and the runtime
 /// parameters of cfg.params, each checked as a board's param set would (osc::param_value_status).
@@ -126,7 +132,7 @@ void configure_monitors(Task& task, const ExperimentConfig& cfg) {
     throw std::invalid_argument("run.collision_threshold: outside [0, the joint's full-scale torque]");
   for (int i = 0; i < osc::kParamCount; ++i) {
     const osc::ParamInfo& p = osc::kParams[i];
-    if (p.gain >= 0 || runtime_param_key(p.runtime) != nullptr) continue;
+    if (!runtime_param_generated(p)) continue;
     // Before the first tick, as a board's boot applies its stored record: each value checked, the
     // access (torque off) not, the task starting in the paper's motion.
     for (int e = 0; e < p.count; ++e) {

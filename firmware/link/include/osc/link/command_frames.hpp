@@ -33,13 +33,17 @@ namespace pil {
     "rest; otherwise the move is queued")                                                                     \
   X(HasLimits, "has_limits", "limits apply to this move or stream; otherwise the configured maxima (Command checks)")
 
+// The masks of a list of flag bits: `LIST(OSC_X_FLAG_MASK)` with OSC_X_PREFIX the bits' prefix
+// (the enumerators) and OSC_X_MASK the masks'.
+#define OSC_X_FLAG_MASK(Name, name, doc) \
+  constexpr std::uint8_t OSC_X_CAT(OSC_X_MASK, Name) = static_cast<std::uint8_t>(1u << OSC_X_CAT(OSC_X_PREFIX, Name));
+
 #define OSC_X_PREFIX kFlagBit
+#define OSC_X_MASK kFlag
 enum CommandFlagBit : std::uint8_t { OSC_COMMAND_FLAG_LIST(OSC_X_ENUMERATOR) kCommandFlagCount };
+OSC_COMMAND_FLAG_LIST(OSC_X_FLAG_MASK)
+#undef OSC_X_MASK
 #undef OSC_X_PREFIX
-#define OSC_COMMAND_FLAG_MASK(Name, name, doc) \
-  constexpr std::uint8_t kFlag##Name = static_cast<std::uint8_t>(1u << kFlagBit##Name);
-OSC_COMMAND_FLAG_LIST(OSC_COMMAND_FLAG_MASK)
-#undef OSC_COMMAND_FLAG_MASK
 static_assert(kCommandFlagCount <= 8, "the flags fit their byte");
 /// Every defined flag bit.
 constexpr std::uint8_t kCommandFlagsKnown = static_cast<std::uint8_t>((1u << kCommandFlagCount) - 1u);
@@ -54,12 +58,11 @@ constexpr const char* kCommandFlagDocs[kCommandFlagCount] = {OSC_COMMAND_FLAG_LI
   X(HasRpy, "has_rpy", "rpy gives the orientation; otherwise it stays as the stream started")
 
 #define OSC_X_PREFIX kSetpointBit
+#define OSC_X_MASK kSetpoint
 enum SetpointFlagBit : std::uint8_t { OSC_SETPOINT_FLAG_LIST(OSC_X_ENUMERATOR) kSetpointFlagCount };
+OSC_SETPOINT_FLAG_LIST(OSC_X_FLAG_MASK)
+#undef OSC_X_MASK
 #undef OSC_X_PREFIX
-#define OSC_SETPOINT_FLAG_MASK(Name, name, doc) \
-  constexpr std::uint8_t kSetpoint##Name = static_cast<std::uint8_t>(1u << kSetpointBit##Name);
-OSC_SETPOINT_FLAG_LIST(OSC_SETPOINT_FLAG_MASK)
-#undef OSC_SETPOINT_FLAG_MASK
 constexpr std::uint8_t kSetpointFlagsKnown = static_cast<std::uint8_t>((1u << kSetpointFlagCount) - 1u);
 constexpr const char* kSetpointFlagNames[kSetpointFlagCount] = {OSC_SETPOINT_FLAG_LIST(OSC_X_NAME)};
 constexpr const char* kSetpointFlagDocs[kSetpointFlagCount] = {OSC_SETPOINT_FLAG_LIST(OSC_X_DOC)};
@@ -161,12 +164,11 @@ constexpr const char* kParamOpDocs[kParamOpCount] = {OSC_PARAM_OP_LIST(OSC_X_DOC
   X(TorqueOff, "torque_off", "the parameter may be written only while the torque is off")             \
   X(Persists, "persists", "the parameter is kept by save")
 #define OSC_X_PREFIX kParamFlagBit
+#define OSC_X_MASK kParamFlag
 enum ParamFlagBit : std::uint8_t { OSC_PARAM_FLAG_LIST(OSC_X_ENUMERATOR) kParamFlagCount };
+OSC_PARAM_FLAG_LIST(OSC_X_FLAG_MASK)
+#undef OSC_X_MASK
 #undef OSC_X_PREFIX
-#define OSC_PARAM_FLAG_MASK(Name, name, doc) \
-  constexpr std::uint8_t kParamFlag##Name = static_cast<std::uint8_t>(1u << kParamFlagBit##Name);
-OSC_PARAM_FLAG_LIST(OSC_PARAM_FLAG_MASK)
-#undef OSC_PARAM_FLAG_MASK
 constexpr const char* kParamFlagNames[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC_X_NAME)};
 constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC_X_DOC)};
 

@@ -77,14 +77,8 @@ pil::ParamAnswerFrame param_answer(ControlTask<S>& task, const pil::ParamFrame& 
   switch (f.op) {
     case pil::kParamOpGet:
     case pil::kParamOpSet: {
-      if (i >= kParamCount) {
-        s = ParamStatus::kUnknownParam;
-        break;
-      }
-      if (e >= kParams[i].count) {
-        s = ParamStatus::kBadElement;
-        break;
-      }
+      s = param_address_status(i, e);
+      if (s != ParamStatus::kOk) break;
       if (f.op == pil::kParamOpSet) {
         GainMargins m;
         m.observer = -1;  // not judged (a runtime parameter, or refused before the gains were)

@@ -288,14 +288,20 @@ void field_set(F& f, int e, double v, bool every) {
     f = static_cast<F>(v);
   }
 }
-/// Calls fn(field) with the gain of index i of g.
-template <class S, class Fn>
-void visit_gain(Gains<S>& g, int i, Fn&& fn) {
+/// Calls fn(field) with the gain of index i of g (a Gains<S>, const or not).
+template <class G, class Fn>
+void visit_gain(G& g, int i, Fn&& fn) {
   int k = 0;
 #define OSC_PARAM_VISIT(type, name, paper, doc, param) \
   if (k++ == i) return fn(g.name);
   OSC_GAINS_FIELDS(OSC_PARAM_VISIT)
 #undef OSC_PARAM_VISIT
+}
+/// Element e of gain i of g set to v (a gain of form kEvery: every element of its vector).
+template <class S>
+void gain_put(Gains<S>& g, int i, int e, double v) {
+  const bool every = kGainInfo[i].param.form == GainForm::kEvery;
+  visit_gain(g, i, [&](auto& f) { field_set(f, e, v, every); });
 }
 template <class S>
 double limit_get(const JerkLimits<S>& l, int e) {
@@ -324,7 +330,7 @@ double param_get(const ControlTask<S>& task, int i, int e) {
   const ParamInfo& p = kParams[i];
   if (p.gain >= 0) {
     double v = 0;
-    detail::visit_gain(const_cast<Gains<S>&>(task.gains), p.gain, [&](const auto& f) { v = detail::field_get(f, e); });
+    detail::visit_gain(task.gains, p.gain, [&](const auto& f) { v = detail::field_get(f, e); });
     return v;
   }
   switch (p.runtime) {
@@ -352,11 +358,7 @@ double param_get(const ControlTask<S>& task, int i, int e) {
 template <class S>
 void param_put(ControlTask<S>& task, int i, int e, double v) {
   const ParamInfo& p = kParams[i];
-  if (p.gain >= 0) {
-    const bool every = kGainInfo[p.gain].param.form == GainForm::kEvery;
-    detail::visit_gain(task.gains, p.gain, [&](auto& f) { detail::field_set(f, e, v, every); });
-    return;
-  }
+  if (p.gain >= 0) return detail::gain_put(task.gains, p.gain, e, v);
   switch (p.runtime) {
     case RuntimeParam::kParamAdaptation: {
       const auto law = static_cast<AdaptationLaw>(static_cast<int>(v));
@@ -404,13 +406,18 @@ constexpr double param_scalar_max() {
     return std::numeric_limits<double>::max();
 }
 
+/// Whether parameter i has an element e: unknown_param, bad_element, or ok.
+constexpr ParamStatus param_address_status(int i, int e) {
+  if (i < 0 || i >= kParamCount) return ParamStatus::kUnknownParam;
+  return e < 0 || e >= kParams[i].count ? ParamStatus::kBadElement : ParamStatus::kOk;
+}
+
 /// Whether v is a valid value of element e of parameter i (finite, in range and within the scalar
 /// S, a whole number for an enumeration's code).
 template <class S = double>
 ParamStatus param_value_status(int i, int e, double v) {
-  if (i < 0 || i >= kParamCount) return ParamStatus::kUnknownParam;
+  if (const ParamStatus a = param_address_status(i, e); a != ParamStatus::kOk) return a;
   const ParamInfo& p = kParams[i];
-  if (e < 0 || e >= p.count) return ParamStatus::kBadElement;
   if (!std::isfinite(v)) return ParamStatus::kNotFinite;
   if (v < p.lo_of(e) || v > p.hi_of(e) || std::fabs(v) >= param_scalar_max<S>()) return ParamStatus::kOutOfRange;
   const bool code =
@@ -433,10 +440,7 @@ Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
 template <class S>
 GainMargins param_margins(ControlTask<S>& task, int i = -1, int e = 0, double v = 0) {
   Gains<double> g = task.gains.template cast<double>();
-  if (i >= 0 && kParams[i].gain >= 0) {
-    const bool every = kGainInfo[kParams[i].gain].param.form == GainForm::kEvery;
-    detail::visit_gain(g, kParams[i].gain, [&](auto& f) { detail::field_set(f, e, v, every); });
-  }
+  if (i >= 0 && kParams[i].gain >= 0) detail::gain_put(g, kParams[i].gain, e, v);
   return gain_margins(g, task_lambda_inverse(task));
 }
 
@@ -488,13 +492,9 @@ ParamStatus param_apply(ControlTask<S>& task, const ParamRecord& r) {
     for (int e = 0; e < kParams[i].count; ++e)
       if (param_value_status<S>(i, e, r.value[param_slot(i) + e]) != ParamStatus::kOk) return ParamStatus::kBadRecord;
   Gains<double> g = task.gains.template cast<double>();
-  for (int i = 0; i < kParamCount; ++i) {
-    if (kParams[i].gain < 0) continue;
-    const bool every = kGainInfo[kParams[i].gain].param.form == GainForm::kEvery;
-    for (int e = 0; e < kParams[i].count; ++e)
-      detail::visit_gain(g, kParams[i].gain,
-                         [&](auto& f) { detail::field_set(f, e, r.value[param_slot(i) + e], every); });
-  }
+  for (int i = 0; i < kParamCount; ++i)
+    for (int e = 0; e < kParams[i].count && kParams[i].gain >= 0; ++e)
+      detail::gain_put(g, kParams[i].gain, e, r.value[param_slot(i) + e]);
   if (!(gain_margins(g, task_lambda_inverse(task)).observer > 1)) return ParamStatus::kUnstableObserver;
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e) param_put(task, i, e, r.value[param_slot(i) + e]);
