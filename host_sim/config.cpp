@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iterator>
 #include <sstream>
@@ -325,6 +326,57 @@ void add_start_pose_entry(std::vector<Entry>& t) {
   t.push_back(q);
 }
 
+/// The simulated arm's pose at power-on: start (placed at the start pose, declared there), random:SEED,
+/// or six joint angles in degrees within the joint limits (experiment.hpp, ExperimentConfig::power_on_pose).
+void add_power_on_entry(std::vector<Entry>& t) {
+  Entry e{"plant.power_on_pose",
+          "the simulated arm's pose at power-on (motion scripts): start (placed at the start pose and declared "
+          "there), random:SEED (the start pose, each joint moved by up to +-25 deg), or six joint angles [deg]; "
+          "other than start, the firmware is not homed: motion is refused until a home or a declare_pose step",
+          Kind::kName,
+          0,
+          0,
+          {},
+          true};
+  e.get = [](const Settings& s) -> json {
+    if (s.base.power_on_text.empty()) return vec_json(*s.base.power_on_pose, 1 / kDeg);
+    return s.base.power_on_text;
+  };
+  e.put = [](Settings& s, const json& v) {
+    ExperimentConfig& c = s.base;
+    if (v.is_array()) {
+      if (v.size() != 6) return std::string("expected start, random:SEED or six joint angles in degrees");
+      Vec6 q;
+      for (int i = 0; i < 6; ++i) {
+        q(i) = v[i].get<double>() * kDeg;
+        if (q(i) < osc::robot::kArm.q_min[i] || q(i) > osc::robot::kArm.q_max[i])
+          return "joint " + std::to_string(i + 1) + ": " + number_text(v[i].get<double>()) +
+                 " deg is outside its limits " +
+                 range_text(osc::robot::kArm.q_min[i] / kDeg, osc::robot::kArm.q_max[i] / kDeg);
+      }
+      c.power_on_pose = q;
+      c.power_on_text.clear();
+      return std::string();
+    }
+    const std::string text = v.get<std::string>();
+    if (text == "start") {
+      c.power_on_pose.reset();
+      c.power_on_text = text;
+      return std::string();
+    }
+    unsigned long seed = 0;
+    const char* digits = text.c_str() + 7;
+    char* end = nullptr;
+    if (text.rfind("random:", 0) == 0 && *digits >= '0' && *digits <= '9') seed = std::strtoul(digits, &end, 10);
+    if (end == nullptr || *end != '\0' || seed > 0xffffffffUL)
+      return "'" + text + "' is not start, random:SEED (SEED a whole number) or six joint angles in degrees";
+    c.power_on_pose = random_power_on_pose(static_cast<std::uint32_t>(seed), c.q_start);
+    c.power_on_text = text;
+    return std::string();
+  };
+  t.push_back(e);
+}
+
 /// The plant's friction: a preset of the robot by name, or custom coefficients.
 void add_plant_friction_entries(std::vector<Entry>& t) {
   Entry f{"plant.friction.preset",
@@ -519,6 +571,7 @@ const std::vector<Entry>& entries() {
     add_controller_entries(t);
     add_trajectory_entries(t);
     add_start_pose_entry(t);
+    add_power_on_entry(t);
     add_plant_entries(t);
     return t;
   }();
@@ -532,6 +585,7 @@ const Entry* find_entry(const std::string& key) {
 }
 
 std::string allowed_names(const Entry& e) {
+  if (e.names.empty()) return "a name or a list of numbers";
   std::string s;
   for (size_t i = 0; i < e.names.size(); ++i) s += (i ? (i + 1 == e.names.size() ? " or " : ", ") : "") + e.names[i];
   return s;
@@ -585,8 +639,18 @@ bool set_entry(const Entry& e, const YAML::Node& n, Settings& s, std::string& er
       break;
     }
     case Kind::kName: {
+      if (e.names.empty() && n.IsSequence()) {  // a name or a list of numbers, which put() checks
+        v = json::array();
+        for (std::size_t i = 0; i < n.size(); ++i) {
+          double x;
+          if (!read_number(n[i], x) || !std::isfinite(x))
+            return err = key + "[" + std::to_string(i + 1) + "]: expected a number, got " + node_text(n[i]), false;
+          v.push_back(x);
+        }
+        break;
+      }
       const std::string t = n.IsScalar() ? n.Scalar() : "";
-      bool ok = false;
+      bool ok = e.names.empty() && n.IsScalar();
       for (const auto& name : e.names) ok = ok || t == name;
       if (!ok) return err = key + ": expected " + allowed_names(e) + ", got " + node_text(n), false;
       v = t;

@@ -4,6 +4,8 @@
 
 #include <array>
 #include <functional>
+#include <optional>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -86,7 +88,14 @@ struct ExperimentConfig {
   /// image uses its own compiled-in values (only the adaptation law and mode go over the link).
   osc::Gains<double> gains = osc::Gains<double>::paper();
   Vec6 q_start = osc::joint_vector<double>(osc::robot::kQStart);  ///< start pose of the task [rad]
-  double observer_offset[6] = {0, 0, 0, 0, 0, 0};                 ///< x^(0) - x(0), to test observer convergence
+  /// The simulated arm's pose at power-on (motion scripts, in process): none, the arm placed at the
+  /// start pose and declared there (the paper's procedure); else the pose where it powers on, its
+  /// encoders counting from there while the firmware assumes q_start: not homed, it refuses motion
+  /// (not_homed) until a home or a declare_pose (plant.power_on_pose; power_on_text as configured:
+  /// start, random:SEED, or the pose's degrees).
+  std::optional<Vec6> power_on_pose;
+  std::string power_on_text = "start";
+  double observer_offset[6] = {0, 0, 0, 0, 0, 0};  ///< x^(0) - x(0), to test observer convergence
   /// Uptime test (in-process controller only): at jump_at [s] the controller's sample counter
   /// advances by jump_ticks, as if it had been running that much longer (a multiple of the
   /// trajectory's period keeps the reference unchanged).
@@ -99,6 +108,22 @@ struct ExperimentConfig {
   std::vector<std::string> pil_command;
   double pil_timeout = 10.0;  ///< wall-clock wait per actuator frame [s]
 };
+
+/// A random power-on pose (plant.power_on_pose random:SEED): each joint of `around` moved by up to
+/// +-25 degrees, uniformly, within the joint limits less 5 degrees, the wrist's q5 kept 15 degrees
+/// from its singularity at 0.
+inline Vec6 random_power_on_pose(std::uint32_t seed, const Vec6& around) {
+  constexpr double kDeg = osc::kPi / 180;
+  std::mt19937 g(seed);
+  std::uniform_real_distribution<double> u(-25 * kDeg, 25 * kDeg);
+  Vec6 q = around;
+  for (int i = 0; i < 6; ++i) {
+    q(i) += u(g);
+    q(i) = std::min(std::max(q(i), osc::robot::kArm.q_min[i] + 5 * kDeg), osc::robot::kArm.q_max[i] - 5 * kDeg);
+  }
+  if (std::abs(q(4)) < 15 * kDeg) q(4) = q(4) < 0 ? -15 * kDeg : 15 * kDeg;
+  return q;
+}
 
 /// The configuration key of a runtime parameter that the host keys by a name of its own (a law's or a
 /// reaction's name rather than its code), or null: the key is then run.<the parameter's name>, made

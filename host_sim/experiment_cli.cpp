@@ -42,7 +42,11 @@ constexpr Shorthand kShorthands[] = {
 constexpr const char* kHostOnlyKeys[] = {
     "controller.knd",      "controller.k",       "controller.ks",          "controller.ki",        "controller.k_ad",
     "controller.tau_dec",  "controller.leakage", "controller.model_error", "trajectory.amplitude", "trajectory.period",
-    "trajectory.envelope", "start_pose",         "plant.encoder_cpr"};
+    "trajectory.envelope", "start_pose",         "plant.encoder_cpr",      "plant.power_on_pose"};
+
+constexpr const char* kPowerOnNeedsMotion =
+    "plant.power_on_pose applies to a motion script (--motion), whose steps home the arm or declare its pose; the "
+    "paper's experiment starts at the declared start pose";
 
 struct Parsed {
   std::vector<std::pair<const Shorthand*, std::string>> shorthands;
@@ -79,9 +83,10 @@ void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vect
       ->type_name("KEY=VALUE")
       ->allow_extra_args(false);
   app.add_flag("--print-config", o.print_config, "print the effective configuration as YAML and exit");
-  app.add_option("--motion", o.motion,
-                 "play a motion script (timed commands: enable, move_to, paper, stop, disable, clear; "
-                 "docs/motion.md, examples/) on the simulated arm instead of the paper's experiment")
+  app.add_option(
+         "--motion", o.motion,
+         "play a motion script (timed commands: enable, move_to, paper, stop, disable, clear, home, declare_pose; "
+         "docs/motion.md, examples/) on the simulated arm instead of the paper's experiment")
       ->type_name("FILE.yaml");
   values.resize(std::size(kShorthands));
   for (size_t i = 0; i < std::size(kShorthands); ++i)
@@ -192,6 +197,7 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
   if (app.get_option("--json")->count() > 0 && o.json.empty()) return err = "--json needs a file name", false;
   if (app.get_option("--motion")->count() > 0 && o.motion.empty()) return err = "--motion needs a file name", false;
   if (o.csv_dir.empty()) return err = "--csv-dir needs a directory", false;
+  if (o.base.power_on_pose && o.motion.empty()) return err = kPowerOnNeedsMotion, false;
 
   if (o.qemu) {
     // The image's controller is compiled in: only the mode and the adaptation law go over the link.

@@ -56,6 +56,7 @@ bool triple(const YAML::Node& n, const std::string& key, osc::Vec3<double>& out,
 /// The keys of a step that apply to its command.
 bool known_key(const std::string& k, osc::MotionVerb v) {
   if (k == "at" || k == "after" || k == "cmd" || k == "delay") return true;
+  if (v == osc::MotionVerb::kDeclarePose) return k == "pose";
   if (v == osc::MotionVerb::kStream)
     return k == "file" || k == "rate_hz" || k == "relative" || k == "cut_s" || k == "velocity" || k == "v" ||
            k == "a" || k == "j";
@@ -121,6 +122,19 @@ bool parse_stream(const YAML::Node& n, const std::string& where, const std::stri
   return parse_options(n, where, s.move, err);
 }
 
+/// declare_pose's pose: a name of the robot's named poses (osc::robot::kNamedPoses), its code in the
+/// command frame's period field (the protocol's).
+bool parse_pose(const YAML::Node& n, const std::string& where, MotionStepSpec& s, std::string& err) {
+  std::string names;
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
+    names += std::string(i ? " | " : "") + osc::robot::kNamedPoses[i].name;
+  if (!n["pose"]) return err = where + ".pose: declare_pose needs a pose: " + names, false;
+  const std::string name = n["pose"].as<std::string>("");
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
+    if (name == osc::robot::kNamedPoses[i].name) return s.move.period = static_cast<std::uint32_t>(i), true;
+  return err = where + ".pose: '" + name + "' is not a named pose: " + names, false;
+}
+
 bool parse_step(const YAML::Node& n, const std::string& where, const std::string& script_name, MotionStepSpec& s,
                 std::string& err) {
   if (!n.IsMap()) return err = where + ": a step is a map with cmd: and at: or after:", false;
@@ -148,6 +162,7 @@ bool parse_step(const YAML::Node& n, const std::string& where, const std::string
   }
   if (s.verb == osc::MotionVerb::kMoveTo && !parse_move(n, where, s.move, err)) return false;
   if (s.verb == osc::MotionVerb::kStream && !parse_stream(n, where, script_name, s, err)) return false;
+  if (s.verb == osc::MotionVerb::kDeclarePose && !parse_pose(n, where, s, err)) return false;
   YAML::Emitter e;
   e << YAML::Flow << n;
   s.text = e.c_str();
@@ -263,7 +278,8 @@ template <class S>
 class HostArm {
  public:
   HostArm(const MotionScript& script, const ExperimentConfig& cfg)
-      : sim_(script.start_pose.value_or(cfg.q_start), cfg.injection, cfg.plant, cfg.mode, cfg.gains) {
+      : sim_(script.start_pose.value_or(cfg.q_start), cfg.injection, cfg.plant, cfg.mode, cfg.gains,
+             cfg.sensor_config(), cfg.power_on_pose) {
     configure_monitors(sim_.task(), cfg);
     port_.state_period = 0;
   }
@@ -319,7 +335,11 @@ class HostArm {
 class ScriptLinkedArm : public LinkedArm {
  public:
   ScriptLinkedArm(const MotionScript& script, const ExperimentConfig& cfg)
-      : LinkedArm(script.start_pose.value_or(cfg.q_start), cfg) {}
+      : LinkedArm(script.start_pose.value_or(cfg.q_start), cfg), power_on_(cfg.power_on_pose.has_value()) {}
+  bool ok(std::string& err) const {
+    if (power_on_) return err = "plant.power_on_pose applies to the controller in process, not over the link", false;
+    return LinkedArm::ok(err);
+  }
   void finish(MotionRun& run) {
     run.controller = "pil";
     run.pil_command = program();
@@ -327,6 +347,9 @@ class ScriptLinkedArm : public LinkedArm {
     run.peak_contact_force = plant().peak_contact_force();
     stop();
   }
+
+ private:
+  bool power_on_;
 };
 
 /// The player: sends the steps in order as command frames (and a stream's setpoints as setpoint
@@ -358,7 +381,7 @@ class Player {
   }
 
  private:
-  bool at_rest() const { return state_ != osc::MotionState::kMoving && state_ != osc::MotionState::kStopping; }
+  bool at_rest() const { return !osc::motion_running(state_) && state_ != osc::MotionState::kStopping; }
   /// Every command sent has been answered (the controller's mailbox is free: it holds one command).
   bool idle() const { return run_.commands.empty() || run_.commands.back().answered_s >= 0; }
   /// The next step's time has come: its at: (or the moment its after: done held first) plus its delay.

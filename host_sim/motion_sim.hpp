@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 
 #include "osc/runtime/control_task.hpp"
 #include "plant.hpp"
@@ -21,17 +22,28 @@ template <class S>
 class MotionSim {
  public:
   /// The arm at rest at q0, its encoders zeroed there (the task's q_start), the controller disabled.
-  /// inj: a simulated hardware fault or a contact (injection.hpp), none by default.
+  /// inj: a simulated hardware fault or a contact (injection.hpp), none by default. sensors: the
+  /// plant's (the task reads encoders of sensors.encoders). Without power_on the arm was placed at q0,
+  /// a pose the task takes as declared (homed, as the paper's procedure); with power_on, the arm
+  /// powers on there (the encoders count from there) while the task assumes q0: not homed, motion is
+  /// refused until a home or a declare_pose.
   explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
                      osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
-                     const osc::Gains<double>& gains = osc::Gains<double>::paper())
-      : plant_(pc), hal_(plant_, q0, SensorConfig{}, inj), task_(new osc::ControlTask<S>) {
-    plant_.reset(q0);
+                     const osc::Gains<double>& gains = osc::Gains<double>::paper(), const SensorConfig& sensors = {},
+                     const std::optional<Vec6>& power_on = std::nullopt)
+      : plant_(pc), hal_(plant_, power_on.value_or(q0), sensors, inj), task_(new osc::ControlTask<S>) {
+    plant_.reset(power_on.value_or(q0));
     plant_.set_contact(Contact::of(inj));  // a collision or a wall acts in the plant, the rest in the HAL
     plant_.set_brakes(true);
     task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(), PlantHal::kPeriodNs,
                 osc::TaskStart::kDisabled);
+    task_->set_encoders(sensors.encoders);
+    task_->homed = !power_on.has_value();
   }
+  /// A home, planned (the homing move, path-checked) from the measured angles, taken by the next tick.
+  void home(std::uint32_t id) { task_->pending = osc::prepare_checked_home(*task_, id); }
+  /// A declare_pose of the named pose of code `pose` (robot::kNamedPoses), taken by the next tick.
+  void declare_pose(unsigned pose, std::uint32_t id) { task_->pending = osc::prepare_declare_pose<S>(pose, id); }
 
   /// A command without a plan (enable, disable, paper, stop, clear), taken by the next tick.
   void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command<S>(verb, id); }

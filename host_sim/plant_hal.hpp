@@ -35,6 +35,7 @@ struct SensorConfig {
   int dac_bits = 16;
   double pot_noise = 0;        ///< potentiometer noise, standard deviation [ADC codes]
   double pot_offset[6] = {};   ///< potentiometer offset per joint [ADC codes]
+  std::uint8_t index_off = 0;  ///< bit c: channel c's index pulse never fires (a broken index track)
   std::uint32_t seed = 12345;  ///< the noise generators' seed (runs are reproducible)
 };
 
@@ -204,7 +205,7 @@ class PlantHal {
     for (int i = 0; i < hal::kJoints; ++i) {
       const double shift = a > 0 ? jitter(jitter_rng_) : 0.0;
       counts[i] = encoder_count(e(i), e_start_(i), counts_per_rad_[i], shift);
-      index_[i].sample(osc::robot::kArm.links[i].gear_ratio * e(i), counts[i]);
+      if ((sensors_.index_off >> i & 1u) == 0) index_[i].sample(osc::robot::kArm.links[i].gear_ratio * e(i), counts[i]);
       if (!active_ || !inj_.hits(i)) continue;
       switch (inj_.kind) {
         case InjectionKind::kEncoderStuck:

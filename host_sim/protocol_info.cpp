@@ -202,6 +202,13 @@ json command_protocol() {
   j["outcomes"] = motion_names<osc::CommandOutcome>();
   j["stop_categories"] = motion_names<osc::StopCategory>();
   j["completions"] = motion_names<osc::MotionCompletion>();
+  j["poses"] = json::array();
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i) {
+    const osc::NamedPose& p = osc::robot::kNamedPoses[i];
+    json deg = json::array();
+    for (double q : p.q) deg.push_back(std::round(q * 180 / osc::kPi * 1e6) / 1e6);
+    j["poses"].push_back({{"code", i}, {"name", p.name}, {"q_deg", deg}, {"doc", p.doc}});
+  }
   j["examples"] = command_examples();
   j["parameters"] = parameters(true);
   return j;
@@ -250,6 +257,8 @@ json client_protocol() {
   j["outcomes"] = names<osc::CommandOutcome>();
   j["stop_categories"] = names<osc::StopCategory>();
   j["completions"] = names<osc::MotionCompletion>();
+  j["poses"] = json::array();
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i) j["poses"].push_back(osc::robot::kNamedPoses[i].name);
   j["faults"] = json::array();
   for (int i = 0; i < osc::kFaultCount; ++i) j["faults"].push_back(osc::kFaultNames[i]);
   j["parameters"] = parameters(false);

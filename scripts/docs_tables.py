@@ -1281,6 +1281,13 @@ def t_protocol_completions():
     return name_rows(protocol()["command"]["completions"])
 
 
+@table("protocol_poses", "docs/protocol.md", "protocol")
+def t_protocol_poses():
+    rows = [[p["code"], f"`{p['name']}`", ", ".join(f"{q:g}" for q in p["q_deg"]), p["doc"]]
+            for p in protocol()["command"]["poses"]]
+    return markdown_table(["code", "name", "q1 .. q6 [deg]", "meaning"], rows)
+
+
 def markdown_table(header, rows):
     """A table of a header row (its cells) and rows of cells."""
     return "\n".join(["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]

@@ -16,7 +16,8 @@ As a module:
 As a program, the verbs of oscctl, printing the same lines and exiting with the same status (0
 accepted or done, 1 refused, aborted or timed out, 2 a bad command line, port or file):
 
-    python3 clients/python/osc_client.py --port /dev/pts/7 state | enable | disable | clear | paper | stop
+    python3 clients/python/osc_client.py --port /dev/pts/7 state | enable | disable | clear | paper | stop | home
+    python3 clients/python/osc_client.py --port /dev/pts/7 declare_pose start | zero | ready | stretch
     python3 clients/python/osc_client.py --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative]
                                          [--v V --a A --j J] [--replace] [--no-wait]
     python3 clients/python/osc_client.py --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
@@ -72,6 +73,7 @@ class Protocol:
         self.stream_max_period = p["stream_max_period"]
         self.limits = p["limits"]
         self.faults = p["faults"]
+        self.poses = p["poses"]
         self.names = {k: p[k] for k in ("verbs", "motion_states", "reasons", "outcomes", "stop_categories",
                                         "completions")}
         # The parameter table of the firmware's build (osc/runtime/parameters.hpp), its operations,
@@ -314,6 +316,16 @@ class Client:
     def paper(self):
         return self.command("paper")
 
+    def home(self):
+        """Homing: each motor to its index pulse from the pots' coarse angles; wait_done for its end."""
+        return self.command("home")
+
+    def declare_pose(self, pose):
+        """The arm stands at the named pose (osc_protocol.json's poses; torque off): its code in period."""
+        if pose not in self.p.poses:
+            raise ClientError(f"'{pose}' is not a named pose: {', '.join(self.p.poses)}")
+        return self.command("declare_pose", period=self.p.poses.index(pose))
+
     def move_to(self, position, rpy=None, relative=False, replace=False, limits=None):
         return self.command("move_to", position, rpy, relative, replace, limits)
 
@@ -453,7 +465,7 @@ class Client:
     def _evaluate(self, cid, until_done):
         """The command's answer and end as far as the answers so far tell (timeout: not yet)."""
         name = self.p.name_of
-        motion_verbs = {self.p.code_of("verbs", v) for v in ("move_to", "paper", "stream")}
+        motion_verbs = {self.p.code_of("verbs", v) for v in ("move_to", "paper", "stream", "home")}
         accepted = wait_rest = motion = False
         o = Outcome("timeout", cid, protocol=self.p)
         for a in self.answers:
@@ -530,9 +542,13 @@ def cmd_simple(c, a):
         return rc
     if c.p.name_of("reasons", o.answer["abort"]) != "none":
         print(f"aborted {o.answer['aborted_id']}: {c.p.name_of('reasons', o.answer['abort'])}", flush=True)
-    if a.verb not in ("stop", "disable"):
+    if a.verb not in ("stop", "disable", "home"):
         return rc
     return report(c.wait_done(cid, a.timeout))
+
+
+def cmd_declare_pose(c, a):
+    return report(c.wait_answer(c.declare_pose(a.pose), a.timeout))
 
 
 def cmd_move(c, a):
@@ -693,8 +709,10 @@ def parser():
                     help="while waiting, a keep-alive frame after this many seconds without a frame sent (default "
                          "0.1; 0: none): a board with local encoders stops a motion after 0.5 s of link silence")
     sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
-    for v in ("state", "enable", "disable", "clear", "paper", "stop"):
+    for v in ("state", "enable", "disable", "clear", "paper", "stop", "home"):
         sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")
+    dp = sub.add_parser("declare_pose", help="the arm stands at a named pose (torque off; the pots must agree)")
+    dp.add_argument("pose", help="the pose's name (osc_protocol.json's poses: start, zero, ready, stretch)")
 
     def limits(p):
         p.add_argument("--v", type=positive, help="linear speed limit [m/s]")
@@ -747,7 +765,8 @@ def main(argv):
         if a.verb == "param":
             check_param(ap, Protocol(), a)
         c = Client(a.port, a.baud, keepalive=a.keepalive)
-        verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param}
+        verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param,
+                 "declare_pose": cmd_declare_pose}
         return verbs.get(a.verb, cmd_simple)(c, a)
     except ClientError as e:
         print(f"osc_client: {e}", file=sys.stderr)

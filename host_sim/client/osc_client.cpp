@@ -43,9 +43,10 @@ speed_t standard_baud(int baud) {
   return B0;
 }
 
+/// A verb whose command runs a motion that ends done (done_id) or aborted: move_to, paper, stream, home.
 bool motion_verb(std::uint8_t v) {
   return v == static_cast<std::uint8_t>(MotionVerb::kMoveTo) || v == static_cast<std::uint8_t>(MotionVerb::kPaper) ||
-         v == static_cast<std::uint8_t>(MotionVerb::kStream);
+         v == static_cast<std::uint8_t>(MotionVerb::kStream) || v == static_cast<std::uint8_t>(MotionVerb::kHome);
 }
 
 template <class E>

@@ -35,7 +35,7 @@ volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_signal(int) { g_stop = 1; }
 
 struct Args {
-  std::string port, verb, csv;
+  std::string port, verb, csv, pose;
   int baud = 115200;
   double timeout = 120;
   double keepalive = Client::kKeepAliveDefault;
@@ -79,8 +79,18 @@ int simple(Client& c, const Args& a, osc::MotionVerb verb) {
   if (o.answer.abort != 0)
     std::printf("aborted %u: %s\n", o.answer.aborted_id,
                 osc::motion_name(static_cast<osc::MotionReason>(o.answer.abort)));
-  if (verb != osc::MotionVerb::kStop && verb != osc::MotionVerb::kDisable) return rc;
+  if (verb != osc::MotionVerb::kStop && verb != osc::MotionVerb::kDisable && verb != osc::MotionVerb::kHome) return rc;
   return report(c.wait_done(id, a.timeout));
+}
+
+/// declare_pose NAME: the pose's code in the frame's period field (the protocol's).
+int declare_pose(Client& c, const Args& a) {
+  osc::MoveRequest<double> m;
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
+    if (a.pose == osc::robot::kNamedPoses[i].name) m.period = static_cast<std::uint32_t>(i);
+  const std::uint32_t id = c.command(osc::MotionVerb::kDeclarePose, m);
+  if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
+  return report(c.wait_answer(id, a.timeout));
 }
 
 int move(Client& c, const Args& a) {
@@ -300,8 +310,20 @@ void build(CLI::App& app, Args& a) {
   app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
   // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
   for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
-                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop})
+                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop, osc::MotionVerb::kHome})
     app.add_subcommand(osc::motion_name(v), osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(v)]);
+  std::string poses;
+  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
+    poses += std::string(i ? ", " : "") + osc::robot::kNamedPoses[i].name;
+  CLI::App* dp = app.add_subcommand(
+      "declare_pose",
+      std::string(osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(osc::MotionVerb::kDeclarePose)]) +
+          " (torque off)");
+  dp->add_option("pose", a.pose, "the pose's name: " + poses)->required()->check([](const std::string& v) {
+    for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
+      if (v == osc::robot::kNamedPoses[i].name) return std::string();
+    return "'" + v + "' is not a named pose";
+  });
   CLI::App* mv = app.add_subcommand("move", "a jerk-limited move_to of the wrist centre; waits until done");
   mv->add_option("xyz", a.xyz, "X Y Z [m], base frame")->expected(3)->required();
   mv->add_option("--rpy", a.rpy, "roll pitch yaw [deg] of the target orientation")->expected(3);
@@ -338,10 +360,12 @@ int run(Client& c, const Args& a) {
   if (a.verb == "stream") return stream(c, a);
   if (a.verb == "watch") return watch(c, a);
   if (a.verb == "param") return param(c, a);
+  if (a.verb == "declare_pose") return declare_pose(c, a);
   const osc::MotionVerb verb = a.verb == "enable"    ? osc::MotionVerb::kEnable
                                : a.verb == "disable" ? osc::MotionVerb::kDisable
                                : a.verb == "clear"   ? osc::MotionVerb::kClear
                                : a.verb == "paper"   ? osc::MotionVerb::kPaper
+                               : a.verb == "home"    ? osc::MotionVerb::kHome
                                                      : osc::MotionVerb::kStop;
   return simple(c, a, verb);
 }
@@ -357,7 +381,9 @@ int main(int argc, char** argv) {
     const std::vector<std::string> extra = app.remaining();
     return app.get_subcommands().empty() && !extra.empty()
                ? extra.front() +
-                     ": not a command (state, enable, disable, clear, paper, stop, move, stream, watch, param)"
+                     ": not a command (state, enable, disable, clear, paper, stop, home, declare_pose, move, stream, "
+                     "watch, "
+                     "param)"
                : std::string(e.what());
   };
   if (const int status = sim::parse_command_line(app, argc, argv, "oscctl", "the commands and options", what);

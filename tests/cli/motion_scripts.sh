@@ -65,6 +65,35 @@ got = [c["refused"] for c in j["commands"]]
 assert got == ["not_enabled", None, "out_of_workspace", "over_limit", None], got
 PY
   ;;
+homing)  # examples/homing.yaml: powered on away from the start pose, refused not_homed, homed, moved
+  "$exe" --motion "$examples/homing.yaml" --set plant.power_on_pose=random:7 --json "$d/r.json" \
+    >"$d/out.txt" 2>&1 || fail "exit $?: $(cat "$d/out.txt")"
+  "$py" - "$d/r.json" <<'PY' || fail "$(cat "$d/out.txt")"
+import json, sys
+j = json.load(open(sys.argv[1]))
+assert j["result"] == "ok" and j["faults"] == [], (j["result"], j["faults"])
+got = [(c["cmd"], c["refused"], c["done_s"] is not None) for c in j["commands"]]
+assert got == [("enable", None, True), ("move_to", "not_homed", False), ("home", None, True),
+               ("move_to", None, True), ("disable", None, True), ("declare_pose", "pots_disagree", False)], got
+PY
+  ;;
+power_on_pose_named_errors)  # a bad plant.power_on_pose, and one without a motion script, are named errors
+  for v in random:x random: '[1, 2, 3]' '[0, 45, -180, 0, 45, 999]' north; do
+    out=$("$exe" --motion "$examples/homing.yaml" --set "plant.power_on_pose=$v" --json "$d/o.json" 2>&1)
+    test $? -eq 2 || fail "$v: exit not 2: $out"
+    grep -qF "plant.power_on_pose" <<<"$out" || fail "$v: the key is not named: $out"
+  done
+  out=$("$exe" --duration 1 --set plant.power_on_pose=random:3 --json "$d/o.json" 2>&1)
+  test $? -eq 2 || fail "without --motion: exit not 2: $out"
+  grep -qF "applies to a motion script" <<<"$out" || fail "without --motion: $out"
+  test ! -e "$d/o.json" || fail "a JSON was written"
+  ;;
+declare_pose_needs_a_named_pose)
+  bad_script "steps[0].pose: 'home' is not a named pose: start | zero | ready | stretch" <<'YAML'
+steps:
+  - {at: 0, cmd: declare_pose, pose: home}
+YAML
+  ;;
 unknown_command)
   bad_script "steps[1].cmd: 'jump' is not a command: enable | disable | move_to | paper | stop | clear" <<'YAML'
 steps:

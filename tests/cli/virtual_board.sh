@@ -20,6 +20,8 @@
 #                                      reset, load (the values back); a smaller move_linear maximum
 #                                      taking effect on the next move (over it refused over_limit); a gain
 #                                      refused torque_on while enabled
+#   oscctl_homing, python_homing       declare_pose (refused pots_disagree, accepted, refused torque_on;
+#                                      an unknown pose exit 2), home done
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
 #   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
@@ -159,6 +161,20 @@ param_sequence() {
   expect 0 '^accepted$' '^done$' -- "$@" disable
 }
 
+# Declared poses and homing: a pose the pots contradict refused, the start pose (where the arm
+# stands) accepted, an unknown one a bad command line; enabled, a declare refused torque_on; a home
+# done (each motor to its index pulse), the arm holding after it.
+homing_sequence() {
+  expect 1 '^refused: pots_disagree' -- "$@" declare_pose zero
+  expect 0 '^accepted$' -- "$@" declare_pose start
+  expect 2 "'north' is not a named pose" -- "$@" declare_pose north
+  expect 0 '^accepted$' -- "$@" enable
+  expect 1 '^refused: torque_on' -- "$@" declare_pose start
+  expect 0 '^accepted$' '^done$' -- "$@" home
+  expect 0 '^state: holding$' -- "$@" state
+  expect 0 '^accepted$' '^done$' -- "$@" disable
+}
+
 # A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
 # setpoints, then again (from where that ended) with the path's velocity (--velocity).
 stream() {
@@ -223,6 +239,16 @@ case "$case_" in
   python_param)
     start_sim --speed 4 --scalar float
     param_sequence "$py" "$client" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  oscctl_homing)
+    start_sim --speed 4
+    homing_sequence "$ctl" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  python_homing)
+    start_sim --speed 4 --scalar float
+    homing_sequence "$py" "$client" --port "$port" --timeout 60
     stop_sim
     ;;
   sim_options)

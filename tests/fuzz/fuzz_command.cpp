@@ -47,7 +47,7 @@ const osc::CartesianLimits<double> kMax = osc::CartesianLimits<double>::defaults
 
 /// The command checks of docs/protocol.md, written from the document (not from the code).
 bool valid_by_the_document(const pil::CommandFrame& f) {
-  if (f.verb > 7 || (f.flags & 0xF0) != 0) return false;
+  if (f.verb > 9 || (f.flags & 0xF0) != 0) return false;              // verbs 0 to 9: none ... home, declare_pose
   if (f.verb == 7 && (f.period < 1 || f.period > 100)) return false;  // stream: 1 to 100 ms
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(f.position[i]) || std::isinf(f.position[i]) || f.position[i] < -10.0f || f.position[i] > 10.0f)
@@ -131,6 +131,9 @@ struct Checker {
     FUZZ_CHECK(static_cast<int>(c.refusal) < osc::MotionNames<MotionReason>::kCount);
     FUZZ_CHECK(std::strcmp(osc::motion_name(c.refusal), "?") != 0);
     FUZZ_CHECK((c.refusal == MotionReason::kBadCommand) == (why == MotionReason::kBadCommand));
+    // declare_pose: a pose code beyond the document's Poses table (4 poses) is unknown_pose, and only it.
+    const bool unknown_pose = why == MotionReason::kNone && verb == MotionVerb::kDeclarePose && f.period >= 4;
+    FUZZ_CHECK((c.refusal == MotionReason::kUnknownPose) == unknown_pose);
     if (why == MotionReason::kNone && verb == MotionVerb::kMoveTo && c.refusal == MotionReason::kNone)
       check_move(f, req, c);
   }

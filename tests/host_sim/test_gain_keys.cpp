@@ -120,7 +120,7 @@ TEST(GainKeys, EveryRuntimeParameterIsAHostKeyWithTheTablesRanges) {
     def += p.count > 1 ? "]" : "";
     EXPECT_NE(yaml.find("\n  " + key.substr(4) + ": " + def), std::string::npos) << key << " default " << def;
   }
-  EXPECT_EQ(generated, 4);  // move_linear, move_angular, stream_timeout, pots
+  EXPECT_EQ(generated, 5);  // move_linear, move_angular, stream_timeout, pots, home_speed
 }
 
 }  // namespace

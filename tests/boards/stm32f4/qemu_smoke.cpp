@@ -197,11 +197,14 @@ int verdict(const Checks& c) {
 
 int main() {
   g_app.boot();
-  g_app.port.state_period = 0;          // no host here: the USART carries the telemetry alone (osc_telemetry reads it)
-  bool enabled = false, paper = false;  // the compiled-in commands, each placed once
+  g_app.port.state_period = 0;  // no host here: the USART carries the telemetry alone (osc_telemetry reads it)
+  bool declared = false, enabled = false, paper = false;  // the compiled-in commands, each placed once
   for (;;) {
     g_app.serve();  // never asleep (idle() sleeps): the run stays deterministic under -icount
-    if (!enabled) enabled = g_app.command(osc::MotionVerb::kEnable, 1);
+    // Not homed at boot: the still robot stands at the start pose, declared (pose code 0, a
+    // TaskCommand's default; no pots here, so on trust).
+    if (!declared) declared = g_app.command(osc::MotionVerb::kDeclarePose, 3);
+    if (declared && !enabled) enabled = g_app.command(osc::MotionVerb::kEnable, 1);
     if (enabled && !paper && g_app.task.machine.state == osc::MotionState::kHolding)
       paper = g_app.command(osc::MotionVerb::kPaper, 2);
     // The E-stop: QEMU models no GPIO and its EXTI ignores the software trigger (SWIER), so the

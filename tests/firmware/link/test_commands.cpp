@@ -544,7 +544,8 @@ TEST(CommandFrames, ReasonsListKeepsItsCodesAndEndsWithTheCollisionReasons) {
   EXPECT_EQ(static_cast<int>(MotionReason::kLinkSilent), 15);
   EXPECT_EQ(static_cast<int>(MotionReason::kCollision), 16);
   EXPECT_EQ(static_cast<int>(MotionReason::kYielding), 17);
-  EXPECT_EQ(static_cast<int>(MotionReason::kYielding) + 1, MotionNames<MotionReason>::kCount);
+  EXPECT_EQ(static_cast<int>(MotionReason::kNotHomed), 18);  // issue 27's, after them
+  EXPECT_EQ(static_cast<int>(MotionReason::kUnknownPose) + 1, MotionNames<MotionReason>::kCount);
   // The states too: yielding after fault.
   EXPECT_EQ(static_cast<int>(MotionState::kFault), 4);
   EXPECT_EQ(static_cast<int>(MotionState::kYielding), 5);

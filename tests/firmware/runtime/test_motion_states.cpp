@@ -29,9 +29,9 @@ using R = MotionReason;
 constexpr int kStates = MotionNames<S>::kCount;
 constexpr int kCommands = MotionNames<C>::kCount;
 constexpr int kReasons = MotionNames<R>::kCount;
-static_assert(kStates == 6 && kCommands == 6 && kReasons == 18);
+static_assert(kStates == 7 && kCommands == 8 && kReasons == 23);
 static_assert(MotionNames<CommandOutcome>::kCount == 3 && MotionNames<StopCategory>::kCount == 3);
-static_assert(MotionNames<MotionCompletion>::kCount == 3);
+static_assert(MotionNames<MotionCompletion>::kCount == 4);
 static_assert(sizeof(MotionNames<S>::kDocs) == sizeof(MotionNames<S>::kNames));
 static_assert(sizeof(MotionNames<R>::kDocs) == sizeof(MotionNames<R>::kNames));
 
@@ -54,22 +54,35 @@ constexpr Cell go(S to, Pending p = Pending::kKeep) { return {to, R::kNone, R::k
 constexpr Cell refuse(S stay, R why) { return {stay, why, R::kNone, Pending::kKeep, false}; }
 constexpr Cell abort_to_stopping(R why, Pending p) { return {S::kStopping, R::kNone, why, p, false}; }
 
-// Rows: disabled, holding, moving, stopping, (fault: the fault rules decide), yielding; columns:
-// enable, disable, move, stop (clear: accepted, nothing changes, outside fault).
-constexpr Cell kTable[6][4] = {
+// Rows: disabled, holding, moving, stopping, (fault: the fault rules decide), yielding, homing;
+// columns: enable, disable, move, stop, (clear: accepted, nothing changes, outside fault), home,
+// declare_pose. A move the table accepts is refused not_homed while the encoders' offsets are unknown.
+constexpr Cell kClearCell = go(S::kDisabled);  // unused: clear has its own rule
+constexpr Cell kTable[7][7] = {
     {{S::kHolding, R::kNone, R::kNone, Pending::kCancel, true},
      go(S::kDisabled),
      refuse(S::kDisabled, R::kNotEnabled),
-     refuse(S::kDisabled, R::kNotEnabled)},
-    {go(S::kHolding), go(S::kDisabled), go(S::kMoving), go(S::kHolding)},
+     refuse(S::kDisabled, R::kNotEnabled),
+     kClearCell,
+     refuse(S::kDisabled, R::kNotEnabled),
+     go(S::kDisabled)},
+    {go(S::kHolding), go(S::kDisabled), go(S::kMoving), go(S::kHolding), kClearCell, go(S::kHoming),
+     refuse(S::kHolding, R::kTorqueOn)},
     {go(S::kMoving), abort_to_stopping(R::kDisableCommand, Pending::kSet), go(S::kMoving),
-     abort_to_stopping(R::kStopCommand, Pending::kKeep)},
+     abort_to_stopping(R::kStopCommand, Pending::kKeep), kClearCell, refuse(S::kMoving, R::kBusy),
+     refuse(S::kMoving, R::kTorqueOn)},
     {go(S::kStopping, Pending::kCancel), go(S::kStopping, Pending::kSet), refuse(S::kStopping, R::kStopping),
-     go(S::kStopping)},
+     go(S::kStopping), kClearCell, refuse(S::kStopping, R::kStopping), refuse(S::kStopping, R::kTorqueOn)},
     {refuse(S::kFault, R::kFaulted), refuse(S::kFault, R::kFaulted), refuse(S::kFault, R::kFaulted),
-     refuse(S::kFault, R::kFaulted)},
-    {go(S::kHolding), go(S::kDisabled), refuse(S::kYielding, R::kYielding), go(S::kHolding)},
+     refuse(S::kFault, R::kFaulted), kClearCell, refuse(S::kFault, R::kFaulted), refuse(S::kFault, R::kFaulted)},
+    {go(S::kHolding), go(S::kDisabled), refuse(S::kYielding, R::kYielding), go(S::kHolding), kClearCell,
+     refuse(S::kYielding, R::kYielding), refuse(S::kYielding, R::kTorqueOn)},
+    {go(S::kHoming), abort_to_stopping(R::kDisableCommand, Pending::kSet), refuse(S::kHoming, R::kBusy),
+     abort_to_stopping(R::kStopCommand, Pending::kKeep), kClearCell, go(S::kHoming), refuse(S::kHoming, R::kTorqueOn)},
 };
+
+/// A motion runs: a client's or homing's.
+bool running(S s) { return s == S::kMoving || s == S::kHoming; }
 
 int code(S s) { return static_cast<int>(s); }
 int code(C c) { return static_cast<int>(c); }
@@ -80,7 +93,7 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
   const bool unknown_state = code(m.state) >= kStates;
   // Faults: a new one, a latched one, the fault state, an unreadable state.
   if (in.faults || m.latched || m.state == S::kFault || unknown_state) {
-    if (m.state == S::kMoving) w.abort = R::kFaulted;
+    if (running(m.state)) w.abort = R::kFaulted;
     const std::uint32_t now = in.faults | in.causes;
     if (cmd == C::kClear && now == 0) {
       w.machine = MotionMachine{S::kDisabled, 0, false};
@@ -100,13 +113,13 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
   S s = m.state;
   bool pending = s == S::kStopping && m.disable_at_rest;
   if (in.yield && s != S::kDisabled) {
-    if (s == S::kMoving) w.abort = R::kCollision;
+    if (running(s)) w.abort = R::kCollision;
     s = S::kYielding;
     pending = false;
-  } else if (s == S::kMoving && in.motion_finished) {
+  } else if (running(s) && in.motion_finished) {
+    w.completion = s == S::kHoming ? MotionCompletion::kHomed : MotionCompletion::kFinished;
     s = S::kHolding;
-    w.completion = MotionCompletion::kFinished;
-  } else if (s == S::kMoving && in.stop_request != R::kNone) {
+  } else if (running(s) && in.stop_request != R::kNone) {
     s = S::kStopping;
     w.abort = in.stop_request;
   } else if (s == S::kStopping && in.stopped) {
@@ -117,7 +130,8 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
   // The command, from the table.
   if (cmd == C::kClear) w.outcome = CommandOutcome::kAccepted;
   if (cmd != C::kNone && cmd != C::kClear) {
-    const Cell& cell = kTable[code(s)][code(cmd) - 1];
+    Cell cell = kTable[code(s)][code(cmd) - 1];
+    if (cmd == C::kMove && cell.refusal == R::kNone && !in.homed) cell = refuse(s, R::kNotHomed);
     s = cell.to;
     w.outcome = cell.refusal == R::kNone ? CommandOutcome::kAccepted : CommandOutcome::kRefused;
     w.refusal = cell.refusal;
@@ -150,10 +164,13 @@ std::string describe(const MotionMachine& m, const MotionInput& in) {
          " command=" + motion_name(in.command) + "(" + std::to_string(code(in.command)) +
          ") faults=" + std::to_string(in.faults) + " causes=" + std::to_string(in.causes) +
          " stop_request=" + motion_name(in.stop_request) + " finished=" + std::to_string(in.motion_finished) +
-         " stopped=" + std::to_string(in.stopped) + " yield=" + std::to_string(in.yield);
+         " stopped=" + std::to_string(in.stopped) + " yield=" + std::to_string(in.yield) +
+         " homed=" + std::to_string(in.homed);
 }
 
-bool torque_state(S s) { return s == S::kHolding || s == S::kMoving || s == S::kStopping || s == S::kYielding; }
+bool torque_state(S s) {
+  return s == S::kHolding || s == S::kMoving || s == S::kStopping || s == S::kYielding || s == S::kHoming;
+}
 
 /// The safety properties of one tick, whatever the table says.
 void check_properties(const MotionMachine& m, const MotionInput& in, const MotionStep& t) {
@@ -186,8 +203,11 @@ void check_properties(const MotionMachine& m, const MotionInput& in, const Motio
     ASSERT_EQ(t.cause, in.faults | in.causes);  // the refusal names the cause still present
   }
   // No tick reaches moving from disabled, fault or yielding: only an enabled machine moves, and a
-  // yielding one holds first.
-  ASSERT_TRUE(to != S::kMoving || m.state == S::kHolding || m.state == S::kMoving || m.state == S::kStopping);
+  // yielding one holds first; an arm not homed never starts a move; only an accepted home starts homing.
+  ASSERT_TRUE(to != S::kMoving || m.state == S::kHolding || running(m.state) || m.state == S::kStopping);
+  ASSERT_TRUE(to != S::kMoving || m.state == S::kMoving || in.homed);
+  ASSERT_TRUE(to != S::kHoming || m.state == S::kHoming ||
+              (in.command == C::kHome && t.outcome == CommandOutcome::kAccepted));
   // A collision to yield to leaves every powered state yielding, in the same tick, unless a command
   // of that tick holds or disables; a fault still wins.
   if (in.yield && in.faults == 0 && !was_fault && torque_state(m.state) && in.command != C::kEnable &&
@@ -201,15 +221,18 @@ void check_properties(const MotionMachine& m, const MotionInput& in, const Motio
   if (t.outcome == CommandOutcome::kRefused) {
     ASSERT_STRNE(motion_name(t.refusal), "?");
     ASSERT_TRUE(t.refusal == R::kNotEnabled || t.refusal == R::kFaulted || t.refusal == R::kStopping ||
-                t.refusal == R::kYielding);
+                t.refusal == R::kYielding || t.refusal == R::kBusy || t.refusal == R::kNotHomed ||
+                t.refusal == R::kTorqueOn);
+    ASSERT_TRUE(t.refusal != R::kNotHomed || (in.command == C::kMove && !in.homed));
   }
   ASSERT_TRUE(t.cause == 0 || t.refusal == R::kFaulted);  // a cause comes with a refusal `faulted` alone
   // Only a motion in progress is aborted, with a name; the pose is captured on entering holding.
   if (t.abort != R::kNone) {
-    ASSERT_EQ(m.state, S::kMoving);
+    ASSERT_TRUE(running(m.state));
     ASSERT_STRNE(motion_name(t.abort), "none");
   }
-  const bool ended = m.state == S::kMoving && to != S::kMoving && t.completion != MotionCompletion::kFinished;
+  const bool ended = running(m.state) && to != m.state && t.completion != MotionCompletion::kFinished &&
+                     t.completion != MotionCompletion::kHomed;
   ASSERT_TRUE(!ended || t.abort != R::kNone) << "a motion that ends without finishing is aborted, with a reason";
   ASSERT_EQ(t.capture_pose, to == S::kHolding && m.state != S::kHolding);
   if (t.enabling) {
@@ -230,7 +253,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
           for (std::uint32_t f : faults)
             for (std::uint32_t cause : causes)
               for (int req = 0; req < kReasons; ++req)
-                for (int ev = 0; ev < 8; ++ev) {
+                for (int ev = 0; ev < 16; ++ev) {
                   const MotionMachine m{static_cast<S>(st), latched, pending != 0};
                   MotionInput in{};
                   in.command = static_cast<C>(cmd);
@@ -240,6 +263,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   in.motion_finished = (ev & 1) != 0;
                   in.stopped = (ev & 2) != 0;
                   in.yield = (ev & 4) != 0;
+                  in.homed = (ev & 8) == 0;
                   const MotionStep got = motion_next(m, in);
                   ASSERT_EQ(describe(got), describe(oracle(m, in))) << describe(m, in);
                   check_properties(m, in, got);
@@ -249,7 +273,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   faulting += f != 0;
                   ++cases;
                 }
-  EXPECT_EQ(cases, 7L * 2 * 3 * 7 * 3 * 3 * 18 * 8);
+  EXPECT_EQ(cases, 8L * 2 * 3 * 9 * 3 * 3 * 23 * 16);
   EXPECT_GT(refusals, 0);  // the loop reached every kind of row
   EXPECT_GT(aborts, 0);
   EXPECT_GT(faulting, 0);
@@ -259,7 +283,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
 
 /// The states reachable from disabled, over every input (faults: none or one named) but those
 /// with a command left out.
-std::set<int> reachable(C left_out) {
+std::set<int> reachable(std::set<C> left_out) {
   std::vector<MotionMachine> todo{MotionMachine{}};
   std::set<std::vector<std::uint32_t>> seen;
   std::set<int> states;
@@ -272,7 +296,7 @@ std::set<int> reachable(C left_out) {
       for (std::uint32_t f : {0u, static_cast<std::uint32_t>(kFaultEstop)})
         for (int req = 0; req < kReasons; ++req)
           for (int ev = 0; ev < 8; ++ev) {
-            if (static_cast<C>(cmd) == left_out) continue;
+            if (left_out.count(static_cast<C>(cmd)) != 0) continue;
             MotionInput in{static_cast<C>(cmd), f, f, static_cast<R>(req), (ev & 1) != 0, (ev & 2) != 0, (ev & 4) != 0};
             todo.push_back(motion_next(m, in).machine);
             in.causes = 0;
@@ -283,12 +307,14 @@ std::set<int> reachable(C left_out) {
 }
 
 TEST(MotionStates, NoPathReachesMovingWithoutEnable) {
-  EXPECT_EQ(reachable(C::kEnable), (std::set<int>{code(S::kDisabled), code(S::kFault)}));
+  EXPECT_EQ(reachable({C::kEnable}), (std::set<int>{code(S::kDisabled), code(S::kFault)}));
   // The search is a real one: with enable every state is reachable.
-  EXPECT_EQ(reachable(C::kNone).size(), static_cast<std::size_t>(kStates));
-  // And without move no motion starts, so nothing stops.
-  EXPECT_EQ(reachable(C::kMove),
+  EXPECT_EQ(reachable({C::kNone}).size(), static_cast<std::size_t>(kStates));
+  // And without move and home no motion starts, so nothing stops.
+  EXPECT_EQ(reachable({C::kMove, C::kHome}),
             (std::set<int>{code(S::kDisabled), code(S::kHolding), code(S::kFault), code(S::kYielding)}));
+  // Without move, homing still moves (and stops).
+  EXPECT_EQ(reachable({C::kMove}).count(code(S::kMoving)), 0u);
 }
 
 TEST(MotionStates, AFaultIsCategoryZeroWithTorqueOffInTheSameTickFromEveryState) {
@@ -299,7 +325,7 @@ TEST(MotionStates, AFaultIsCategoryZeroWithTorqueOffInTheSameTickFromEveryState)
       EXPECT_EQ(t.stop, StopCategory::kCategory0);
       EXPECT_FALSE(t.torque);
       EXPECT_EQ(t.machine.latched, f);
-      EXPECT_EQ(t.abort, st == code(S::kMoving) ? R::kFaulted : R::kNone);
+      EXPECT_EQ(t.abort, running(static_cast<S>(st)) ? R::kFaulted : R::kNone);
     }
 }
 
@@ -332,7 +358,9 @@ TEST(MotionStates, EveryEntryOfEveryListHasAUniqueNameAndAMeaning) {
 
 TEST(MotionStates, TheIssuesNamesAreTheNamesInTelemetry) {
   const std::vector<std::string> states(std::begin(MotionNames<S>::kNames), std::end(MotionNames<S>::kNames));
-  EXPECT_EQ(states, (std::vector<std::string>{"disabled", "holding", "moving", "stopping", "fault", "yielding"}));
+  EXPECT_EQ(states,
+            (std::vector<std::string>{"disabled", "holding", "moving", "stopping", "fault", "yielding", "homing"}));
+  EXPECT_STREQ(motion_name(R::kNotHomed), "not_homed");  // issue 27's
   EXPECT_STREQ(motion_name(R::kOutOfWorkspace), "out_of_workspace");
   EXPECT_STREQ(motion_name(R::kNearSingular), "near_singular");
   EXPECT_STREQ(motion_name(R::kOverLimit), "over_limit");

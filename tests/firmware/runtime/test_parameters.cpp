@@ -53,7 +53,7 @@ TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
     EXPECT_EQ(param_index(p.name), i);
     EXPECT_EQ(param_slot(i), slots);
     slots += p.count;
-    EXPECT_TRUE(p.count == 1 || p.count == 3 || p.count == kDof) << p.name;
+    EXPECT_TRUE(p.count >= 1 && p.count <= kDof) << p.name;
     for (int e = 0; e < p.count; ++e) {
       EXPECT_LT(p.lo_of(e), p.hi_of(e)) << p.name;
       EXPECT_EQ(param_value_status(i, e, param_default(i, e)), ParamStatus::kOk) << p.name << "[" << e << "]";
@@ -71,7 +71,7 @@ TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
   }
   EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
   EXPECT_EQ(slots, kParamSlots);
-  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1));
+  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2));
   EXPECT_EQ(param_index("no_such"), -1);
   EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
 }
@@ -93,6 +93,23 @@ void defaults_are_a_new_tasks() {
   EXPECT_EQ(param_default(param_index("stream_timeout"), 0), kStreamTimeoutMin);
 }
 TEST(Parameters, DefaultsAreANewTasksDouble) { defaults_are_a_new_tasks<double>(); }
+
+TEST(Parameters, HomeSpeedIsTheHomingMovesSpeedWithinTheMoveLimits) {
+  auto t = disabled_task<double>();
+  const int i = param_index("home_speed");
+  ASSERT_GE(i, 0);
+  EXPECT_EQ(home_limits(*t).linear.v, params::kHomeSpeed[0]);
+  EXPECT_EQ(home_limits(*t).angular.v, params::kHomeSpeed[1]);
+  EXPECT_EQ(home_limits(*t).linear.a, params::kMoveLinear[1]);  // accelerations and jerks: the move's
+  ASSERT_EQ(param_set(*t, i, 0, 0.01), ParamStatus::kOk);
+  ASSERT_EQ(param_set(*t, i, 1, 0.02), ParamStatus::kOk);
+  EXPECT_EQ(home_limits(*t).linear.v, 0.01);
+  EXPECT_EQ(home_limits(*t).angular.v, 0.02);
+  // At most the configured move speed; a slower move limit caps it too.
+  EXPECT_EQ(param_set(*t, i, 0, params::kMoveLinear[0] * 1.5), ParamStatus::kOutOfRange);
+  ASSERT_EQ(param_set(*t, param_index("move_linear"), 0, 0.005), ParamStatus::kOk);
+  EXPECT_EQ(home_limits(*t).linear.v, 0.005);
+}
 TEST(Parameters, DefaultsAreANewTasksFloat) { defaults_are_a_new_tasks<float>(); }
 TEST(Parameters, DefaultsAreANewTasksFixed) { defaults_are_a_new_tasks<Fixed>(); }
 
@@ -283,7 +300,7 @@ TEST(Parameters, LayoutVersionIsOfTheTable) {
   EXPECT_NE(kParamLayout, 0);
   // A fixed value: a change of any name or element count changes it, and this test with it (the
   // stored records of the old table are then not loaded: layout_mismatch).
-  EXPECT_EQ(kParamLayout, 33816);
+  EXPECT_EQ(kParamLayout, 39635);
 }
 
 // ------------------------------------------------------------------------------- over the link

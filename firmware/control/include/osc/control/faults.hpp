@@ -10,30 +10,31 @@
 namespace osc {
 
 // X(Name, "name", description), in bit order.
-#define OSC_FAULT_LIST(X)                                                                                      \
-  X(NonFinite, "non_finite", "a non-finite value anywhere in the step")                                        \
-  X(EncoderJump, "encoder_jump", "an encoder moved further in one tick than the joint can")                    \
-  X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")                   \
-  X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                                 \
-  X(Overrun, "overrun", "the next tick arrived before this one ended")                                         \
-  X(LinkLost, "link_lost", "repeated link errors, the last a silence alone (no frame, no byte)")               \
-  X(LinkCorrupt, "link_corrupt", "repeated link errors, the last a bad, cut short or stray frame")             \
-  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")                \
-  X(EncoderStuck, "encoder_stuck",                                                                             \
-    "an encoder stood still while the reference moved its joint by more than the bound")                       \
-  X(Tracking, "tracking", "the measured tracking error exceeded its bound")                                    \
-  X(ThetaBounds, "theta_bounds",                                                                               \
-    "a friction estimate left its band [-b theta_max, (1 + b) theta_max], b = params::kThetaFaultBand")        \
-  X(Estop, "estop", "the emergency-stop input is active")                                                      \
-  X(Overflow, "overflow",                                                                                      \
-    "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain") \
-  X(DacBus, "dac_bus",                                                                                         \
-    "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")         \
-  X(DriveFault, "drive_fault",                                                                                 \
-    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the residual monitor")  \
-  X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")        \
-  X(PositionMismatch, "position_mismatch",                                                                     \
-    "a joint's potentiometer and its encoders disagree beyond their band: a stuck or slipping encoder")
+#define OSC_FAULT_LIST(X)                                                                                          \
+  X(NonFinite, "non_finite", "a non-finite value anywhere in the step")                                            \
+  X(EncoderJump, "encoder_jump", "an encoder moved further in one tick than the joint can")                        \
+  X(Saturation, "saturation", "a torque stayed clipped at the DAC range for too many ticks")                       \
+  X(Singular, "singular", "Jacobian reciprocal condition below the threshold")                                     \
+  X(Overrun, "overrun", "the next tick arrived before this one ended")                                             \
+  X(LinkLost, "link_lost", "repeated link errors, the last a silence alone (no frame, no byte)")                   \
+  X(LinkCorrupt, "link_corrupt", "repeated link errors, the last a bad, cut short or stray frame")                 \
+  X(EncoderRange, "encoder_range", "an encoder reading outside the joint limits plus a margin")                    \
+  X(EncoderStuck, "encoder_stuck",                                                                                 \
+    "an encoder stood still while the reference moved its joint by more than the bound")                           \
+  X(Tracking, "tracking", "the measured tracking error exceeded its bound")                                        \
+  X(ThetaBounds, "theta_bounds",                                                                                   \
+    "a friction estimate left its band [-b theta_max, (1 + b) theta_max], b = params::kThetaFaultBand")            \
+  X(Estop, "estop", "the emergency-stop input is active")                                                          \
+  X(Overflow, "overflow",                                                                                          \
+    "a fixed-point result saturated: an overflow, a division by a near-zero or a function outside its domain")     \
+  X(DacBus, "dac_bus",                                                                                             \
+    "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")             \
+  X(DriveFault, "drive_fault",                                                                                     \
+    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the residual monitor")      \
+  X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")            \
+  X(PositionMismatch, "position_mismatch",                                                                         \
+    "a pot and its encoders disagree beyond their band: a stuck or slipping encoder; homing: a pot off its index") \
+  X(IndexMissing, "index_missing", "homing: a motor turned a whole revolution and more without an index pulse")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

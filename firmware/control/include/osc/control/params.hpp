@@ -165,6 +165,22 @@ constexpr double kPositionBandCodes = 6;
 constexpr double kPositionElasticHz = 15;
 constexpr double kPositionBacklash = 1e-3;
 constexpr double kPositionBand[6] = {0.0157, 0.0180, 0.0299, 0.0087, 0.0067, 0.0152};
+/// Homing (osc/runtime/control_task.hpp, docs/safety.md "Homing"): the pots' coarse angles pick each
+/// motor's revolution, and the index pulse the exact count in it. Every motor turns, toward the
+/// middle of its joint's travel, by at most (1 + kHomeMargin) revolutions (the index is within one
+/// revolution; the margin covers the tracking lag), along a straight line of the wrist centre and a
+/// rotation at the homing speeds (parameter home_speed: [m/s, rad/s]; the move limits' accelerations
+/// and jerks), and the move brakes once every index is found. A pot whose coarse angle is off the
+/// index position by more than kHomeBand of a revolution is position_mismatch: up to half a
+/// revolution the revolution it picks is right, beyond it the wrong one (J2: 1.67 degrees), so the band
+/// leaves a tenth of a turn of margin to detect a pot drifting toward it (J1 2.3, J2 1.3, J3 2.7, J4-J6
+/// 1.9 to 2.0 degrees; the realistic plant's pot offsets, the +-1.7 degrees a PUMA's pot is good for,
+/// reach 0.32 of a turn on J4).
+constexpr double kHomeSpeed[2] = {0.04, 0.1};
+constexpr double kHomeMargin = 0.05;
+constexpr double kHomeBand = 0.4;
+/// declare_pose: each potentiometer's angle within this of the declared pose [rad], or pots_disagree.
+constexpr double kDeclareBand = 2 * kPi / 180;
 
 /// Tracking-error bounds on the measured error e (36): position [m] and each orientation
 /// coordinate [rad]; about twice the worst fault-free error without friction compensation on the

@@ -95,7 +95,9 @@ constexpr double kCommandMaxVelocity = 10.0;
   X(float, limits, [6], "m/s, m/s^2, m/s^3, rad/s, rad/s^2, rad/s^3",                                         \
     "move_to or stream with has_limits: the linear speed, acceleration and jerk, then the angular speed, "    \
     "acceleration and jerk; each at most the configured maximum (Command checks)")                            \
-  X(std::uint8_t, period, , "ms", "stream: the setpoints' period, 1 to 100 ms (1 kHz to 10 Hz); other verbs ignore it")
+  X(std::uint8_t, period, , "ms",                                                                             \
+    "stream: the setpoints' period, 1 to 100 ms (1 kHz to 10 Hz); declare_pose: the pose's code (Poses); "    \
+    "other verbs ignore it")
 
 #define OSC_SETPOINT_FIELDS(X)                                                                                    \
   X(std::uint32_t, id, , "", "the id of the stream command whose stream this is (others' setpoints are dropped)") \

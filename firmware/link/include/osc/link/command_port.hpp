@@ -55,6 +55,7 @@ class CommandPort {
     pil::CommandFrame frame;
     MotionGenerator<S> gen;
     CartesianLimits<S> limits;
+    CartesianLimits<S> home_limits;  // a home's (home_limits)
     std::uint64_t tick = 0;
     Vec6<S> q_measured, q_queue_end;  // the path check's seeds: a braked move's, a queued one's
   };
@@ -135,6 +136,7 @@ class CommandPort {
         refuse_now(task, f, c.refusal == MotionReason::kNone ? MotionReason::kBadCommand : c.refusal, write);
         continue;
       }
+      if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone) c = prepare_checked_home(task, f.id);
       if (c.verb == MotionVerb::kMoveTo) check_prepared_move(task, c);
       task.pending = c;
     }
@@ -168,7 +170,10 @@ class CommandPort {
         masked([&] { refuse_now(task, in.frame, why, write); });
         continue;
       }
-      if (c.verb == MotionVerb::kMoveTo && c.refusal == MotionReason::kNone) {
+      if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone)
+        c = prepare_home(in.gen, in.home_limits, task.model, task.check_data, task.io, in.q_measured, in.frame.id);
+      const bool has_path = c.verb == MotionVerb::kMoveTo || c.verb == MotionVerb::kHome;
+      if (has_path && c.refusal == MotionReason::kNone) {
         const Vec6<S>& seed = c.brake ? in.q_measured : in.q_queue_end;
         const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, in.gen.reference_orientation(), seed);
         c.refusal = path_refusal(pc.status);
@@ -218,6 +223,7 @@ class CommandPort {
     --count_;
     in.gen = task.gen;
     in.limits = task.limits;
+    in.home_limits = home_limits(task);
     in.tick = task.tick;
     in.q_measured = task.state.adapt.q_prev;
     in.q_queue_end = task.q_queue_end;
@@ -265,7 +271,7 @@ class CommandLinkWatch {
     } else if (silent_ < kTimeoutTicks) {
       ++silent_;
     }
-    if (!commanded || silent_ < kTimeoutTicks || task.machine.state != MotionState::kMoving) return false;
+    if (!commanded || silent_ < kTimeoutTicks || !motion_running(task.machine.state)) return false;
     request_stop(task, MotionReason::kLinkSilent);
     ++stops_;
     return true;

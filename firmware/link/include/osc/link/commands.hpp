@@ -114,6 +114,7 @@ TaskCommand<S> prepare_frame_command(const MotionGenerator<S>& gen, const Cartes
   }
   if (verb == MotionVerb::kMoveTo) return prepare_move(gen, max, next_tick, rate_hz, req, f.id);
   if (verb == MotionVerb::kStream) return prepare_stream(max, req, f.id);
+  if (verb == MotionVerb::kDeclarePose) return prepare_declare_pose<S>(f.period, f.id);
   return prepare_command<S>(verb, f.id);
 }
 

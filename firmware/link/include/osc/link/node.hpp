@@ -200,6 +200,9 @@ class PilNode {
                 TaskStart::kDisabled);
       task.sup = sup;
       task.tick = tick;
+      // The host's simulated arm stands at the start pose, which the host declares (as the in-process
+      // simulator's arm does: sim::MotionSim): homed.
+      task.homed = true;
       if (sup.state == SupervisorState::kFault) task.machine = {MotionState::kFault, sup.latched, false};
     }
     if (config & pil::kConfigStateFrames) port.state_period = kStatePeriod;

@@ -100,6 +100,13 @@ struct DriveTrain {
   double index_angle[kDof];  ///< the motor shaft's angle at its index pulse [rad, 0..2 pi), from its angle at q = 0
 };
 
+/// A pose an operator can declare the arm to stand at (declare_pose): its name, its joint angles.
+struct NamedPose {
+  const char* name;
+  double q[kDof];  ///< [rad]
+  const char* doc;
+};
+
 /// Joint friction of model (2), link side: viscous, Coulomb and Stribeck coefficients.
 struct FrictionCoefficients {
   const char* name;

@@ -6,7 +6,9 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 #include "hal/hal.hpp"
 #include "osc/control/controller.hpp"
@@ -25,7 +27,8 @@ static_assert(has_spherical_wrist(robot::kArm),
 
 /// How a task starts: running the paper's experiment from the first sample (moving along (68)
 /// about the start pose, the observer started at q_start; the firmware's default, and bit for bit
-/// the paper's run), or disabled, waiting for an enable.
+/// the paper's run: its procedure places the arm at q_start, a declared pose), or disabled, waiting
+/// for an enable, not homed: motion is refused (not_homed) until a home or a declare_pose.
 enum class TaskStart : std::uint8_t { kPaper, kDisabled };
 
 /// Collision thresholds a user may set [N m]: each finite, from 0 (the derived threshold alone) to
@@ -35,6 +38,100 @@ constexpr bool collision_thresholds_valid(const double threshold_nm[kDof]) {
     if (!(threshold_nm[i] >= 0 && threshold_nm[i] <= robot::kDrives.torque_limit[i])) return false;
   return true;
 }
+
+namespace detail {
+/// Each motor's revolution referred to its joint, 2 pi / |G| [rad], and its index pulse's phase in
+/// it: the shaft angle G e passes the index at index_angle + 2 pi k, so motor c's index positions are
+/// e = (phase_c + k) rev_c, k integer, phase_c = sign(G_c) index_angle_c / 2 pi.
+struct IndexTable {
+  double rev[kDof], phase[kDof];
+};
+constexpr IndexTable index_table() {
+  IndexTable t{};
+  for (int c = 0; c < kDof; ++c) {
+    const double G = robot::kArm.links[c].gear_ratio;
+    t.rev[c] = 2 * kPi / abs_of(G);
+    t.phase[c] = (G < 0 ? -1 : 1) * robot::kDriveTrain.index_angle[c] / (2 * kPi);
+  }
+  return t;
+}
+inline constexpr IndexTable kIndexTable = index_table();
+static_assert(params::kHomeBand > 0 && params::kHomeBand < 0.5,
+              "a pot within the band of the index position picks the right revolution (band < half a turn)");
+
+/// Homing's arithmetic is in integer ticks of 1/65536 count (int64), on every scalar: an absolute
+/// count reaches 10^5 (a joint's travel), which needs more than Q12.19 and float's 24 bits give to a
+/// hundredth of a count, and the control path of the M4F calls no double routine, the M3's neither
+/// double nor float (control_path_calls).
+constexpr int kTickBits = 16;
+/// x [rad] times counts per radian, in ticks.
+template <class S>
+std::int64_t to_ticks(S x, math::io_scalar_t<S> cpr) {
+  if constexpr (fixed::is_q_v<S>) {
+    constexpr int kShift = S::kFractionBits + math::io_scalar_t<S>::kFractionBits - kTickBits;
+    return (static_cast<std::int64_t>(x.raw()) * cpr.raw()) >> kShift;
+  } else {
+    const S v = x * static_cast<S>(cpr);
+    const auto whole = static_cast<std::int32_t>(v);  // |v| < 2^31 counts; float to int32: one instruction
+    const auto frac = static_cast<std::int32_t>((v - static_cast<S>(whole)) * S(1 << kTickBits));
+    return static_cast<std::int64_t>(whole) * (1 << kTickBits) + frac;
+  }
+}
+/// Ticks over counts per radian [rad].
+template <class S>
+S from_ticks(std::int64_t t, math::io_scalar_t<S> cpr) {
+  if constexpr (fixed::is_q_v<S>) {
+    constexpr int kShift = S::kFractionBits + math::io_scalar_t<S>::kFractionBits - kTickBits;
+    return S::from_raw(static_cast<typename S::Raw>(t * (std::int64_t{1} << kShift) / cpr.raw()));
+  } else {
+    const auto whole = static_cast<std::int32_t>(t >> kTickBits);
+    const auto frac = static_cast<std::int32_t>(t & ((1 << kTickBits) - 1));
+    return (static_cast<S>(whole) + static_cast<S>(frac) * S(1.0 / (1 << kTickBits))) / static_cast<S>(cpr);
+  }
+}
+/// a / b rounded toward minus infinity (b > 0).
+constexpr std::int64_t floor_div(std::int64_t a, std::int64_t b) {
+  const std::int64_t q = a / b;
+  return (a % b != 0 && a < 0) ? q - 1 : q;
+}
+/// The named poses in the scalar S, built at compile time (no conversion from double in the tick).
+template <class S>
+inline constexpr auto kPoseTable = [] {
+  std::array<std::array<S, kDof>, robot::kNamedPoseCount> t{};
+  for (int p = 0; p < robot::kNamedPoseCount; ++p)
+    for (int i = 0; i < kDof; ++i) t[p][i] = lit<S>(robot::kNamedPoses[p].q[i]);
+  return t;
+}();
+}  // namespace detail
+
+/// Each motor's index positions in ticks of its encoder (homing's, set with the encoders): at
+/// phase + k rev from the motor's angle 0, and the band of a pot's coarse angle around one.
+struct IndexTicks {
+  std::int64_t rev[kDof], phase[kDof], band[kDof];
+  [[gnu::cold]] static IndexTicks of(const EncoderMap& map) {  // set-up, in double
+    IndexTicks t{};
+    for (int c = 0; c < kDof; ++c) {
+      const double n = map.counts_per_rad[c] * detail::kIndexTable.rev[c] * (1 << detail::kTickBits);
+      t.rev[c] = std::llround(n);
+      const double ph = detail::kIndexTable.phase[c] * n;
+      t.phase[c] = std::llround(ph);
+      t.band[c] = std::llround(params::kHomeBand * n);
+    }
+    return t;
+  }
+};
+
+/// A homing in progress (the state homing; docs/safety.md "Homing").
+template <class S>
+struct Homing {
+  std::uint32_t id = 0;                         ///< the home command's (the done_id of its completion)
+  bool started = false;                         ///< its first tick took the start counts
+  std::uint8_t found = 0;                       ///< bit c: channel c's index pulse found
+  std::int32_t start_counts[kDof]{};            ///< the counts at its first tick
+  FrictionMode mode = FrictionMode::kAdaptive;  ///< the task's friction mode, restored when homing ends
+  Vec6<S> pot_offset = Vec6<S>::Zero();         ///< per motor: the pots' angle minus the encoders', at rest before it
+  Vec6<S> correction = Vec6<S>::Zero();         ///< per motor: the exact angle minus the encoders' belief [rad]
+};
 
 template <class S>
 struct ControlTask {
@@ -76,6 +173,11 @@ struct ControlTask {
   StepTiming timing;            // the whole tick: I/O, step, supervision
   StepTiming step_timing;       // the control step alone: observer + controller + adaptation
   TickTiming stages;            // each stage of the tick (TickStage)
+  // Last: the tick's hot members keep their offsets (the M4F's loads reach 4 kB from the task's base).
+  bool homed;                   // the encoders' offsets are known (homing, declare_pose, a paper start)
+  Homing<S> homing;             // the homing in progress (state homing)
+  IndexTicks index_ticks;       // the index positions of the encoders (set_encoders)
+  std::array<S, 2> home_speed;  // the homing move's speeds [m/s, rad/s] (parameter home_speed)
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -113,6 +215,9 @@ struct ControlTask {
     saturation.reset();
     position.reset();
     pots = true;
+    homed = start == TaskStart::kPaper;  // the paper's procedure: the arm placed at q_start
+    homing = {};
+    home_speed = lit_array<S>(params::kHomeSpeed);
     set_encoders(robot::kEncodersUniform);
     sup = {SupervisorState::kInit, 0};
     period_cycles = period;
@@ -124,6 +229,7 @@ struct ControlTask {
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
   [[gnu::cold]] void set_encoders(const EncoderMap& map) {  // set-up, in double: compiled for size
     io = IoMap<S>::of(map);
+    index_ticks = IndexTicks::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
     double C[kDof][kDof], inverse[kDof][kDof];
@@ -202,15 +308,17 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
   const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
   // The stuck-encoder monitor; a backstop with its torque criterion alone where the residual
-  // monitor is armed (docs/safety.md). Yielding, the reference follows the arm and the torque follows gravity; against
-  // a contact the torque holds a joint that cannot move: neither says where the arm must go, so the stuck-encoder
-  // monitor waits, from a collision reacted to until the next motion (the residual monitor runs on).
+  // monitor is armed, and while homing, whose slow moves static friction holds and whose end names a
+  // motor that did not turn (homing_faults) (docs/safety.md). Yielding, the reference follows the arm and the torque
+  // follows gravity; against a contact the torque holds a joint that cannot move: neither says where the arm must go,
+  // so the stuck-encoder monitor waits, from a collision reacted to until the next motion (the residual monitor runs
+  // on).
   std::uint32_t faults = 0;
   if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
   else
     faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad,
-                              task.residual.armed);
+                              task.residual.armed || task.machine.state == MotionState::kHoming);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
@@ -248,8 +356,7 @@ Vec6<S> applied_torque(const ControlTask<S>& task) {
 
 /// The states in which the control step runs and torque reaches the DACs.
 constexpr bool motion_powered(MotionState s) {
-  return s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping ||
-         s == MotionState::kYielding;
+  return s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
 }
 
 /// The reference of a yielding arm (a collision's reaction yield): the arm's own pose and observed
@@ -274,7 +381,7 @@ MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q)
   static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
   static constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
   static constexpr S kMinRcond = lit<S>(params::kLimitMinRcond);
-  if (task.machine.state != MotionState::kMoving) return MotionReason::kNone;
+  if (!motion_running(task.machine.state)) return MotionReason::kNone;
   for (int i = 0; i < kDof; ++i)
     if (q(i) < kQMin[i] || q(i) > kQMax[i]) return MotionReason::kLimitReached;
   if (task.last.rcond < kMinRcond) return MotionReason::kLimitReached;
@@ -305,6 +412,234 @@ MotionReason tick_stop_request(ControlTask<S>& task, bool stepped, const Vec6<S>
   return r;
 }
 
+/// The faults after which the encoders' offsets are no longer trusted: the arm must be homed again.
+constexpr std::uint32_t kFaultsUnhoming =
+    kFaultEncoderJump | kFaultEncoderRange | kFaultEncoderStuck | kFaultPositionMismatch | kFaultIndexMissing;
+
+/// The joint angles of motor angles e (referred to their joints): C e.
+template <class S>
+Vec6<S> joint_from_motor(const IoMap<S>& io, const Vec6<S>& e) {
+  Vec6<S> q = e;
+  for (int k = 0; k < io.terms; ++k) q(io.row[k]) += io.c[k] * e(io.col[k]);
+  return q;
+}
+
+/// The encoders' zero moves: the joint angles at count 0 by dq (motor angles by de = C^-1 dq), and
+/// the plausible counts (EncoderRangeMonitor) with them, to the count.
+template <class S>
+void shift_encoder_zero(ControlTask<S>& task, const Vec6<S>& dq, const Vec6<S>& de) {
+  task.q_start += dq;
+  for (int c = 0; c < kDof; ++c) {
+    const std::int64_t t = detail::to_ticks<S>(de(c), task.io.counts_per_rad(c));
+    const std::int64_t shift = (t + (1 << (detail::kTickBits - 1))) >> detail::kTickBits;  // to the nearest count
+    task.range.min_counts[c] -= shift;
+    task.range.max_counts[c] -= shift;
+  }
+}
+
+/// The limits of the homing move: the move limits, their speeds at most home_speed.
+template <class S>
+CartesianLimits<S> home_limits(const ControlTask<S>& task) {
+  CartesianLimits<S> l = task.limits;
+  if (task.home_speed[0] < l.linear.v) l.linear.v = task.home_speed[0];
+  if (task.home_speed[1] < l.angular.v) l.angular.v = task.home_speed[1];
+  return l;
+}
+
+/// Whether a home may start: potentiometers wired (parameter pots) and their cross-check's filter
+/// settled on every joint (its difference is the coarse angle's offset). While it settles a home
+/// waits (pots_settling); a HAL that has read no pot refuses it (no_pots).
+template <class S>
+bool homing_possible(const ControlTask<S>& task) {
+  if (!task.pots) return false;
+  for (int i = 0; i < kDof; ++i)
+    if (task.position.updates[i] < PositionCrossCheck<S>::kSettleUpdates) return false;
+  return true;
+}
+
+/// Whether the pots' filter is settling: a pot read, some joint not yet settled (a home and a
+/// declare_pose wait for it: at most params::kPositionSettle filter time constants, 250 ms). A HAL
+/// that reads no pot is never settling.
+template <class S>
+bool pots_settling(const ControlTask<S>& task) {
+  bool read = false, settled = true;
+  for (int i = 0; i < kDof; ++i) {
+    read = read || task.position.updates[i] != 0;
+    settled = settled && task.position.updates[i] >= PositionCrossCheck<S>::kSettleUpdates;
+  }
+  return read && !settled;
+}
+
+/// Plans the homing move, outside the tick (like a move_to: path-checked by check_prepared_move):
+/// from the held pose, every motor (1 + kHomeMargin) revolutions toward the middle of its joint's
+/// travel, at the homing limits `lim`. q: the measured angles; data: the planning workspace.
+/// Refused busy unless the generator holds, over_limit when the plan fails.
+template <class S>
+TaskCommand<S> prepare_home(const MotionGenerator<S>& gen, const CartesianLimits<S>& lim, const Model<S>& model,
+                            Data<S>& data, const IoMap<S>& io, const Vec6<S>& q, std::uint32_t id) {
+  static constexpr std::array<S, kDof> kTurn = [] {
+    std::array<S, kDof> t{};
+    for (int c = 0; c < kDof; ++c) t[c] = lit<S>(detail::kIndexTable.rev[c] * (1 + params::kHomeMargin));
+    return t;
+  }();
+  static constexpr std::array<S, kDof> kMid = [] {
+    std::array<S, kDof> m{};
+    for (int c = 0; c < kDof; ++c) m[c] = lit<S>((robot::kArm.q_min[c] + robot::kArm.q_max[c]) / 2);
+    return m;
+  }();
+  TaskCommand<S> c = prepare_command<S>(MotionVerb::kHome, id);
+  c.epoch = gen.epoch();
+  if (gen.source() != MotionSource::kHold) {
+    c.refusal = MotionReason::kBusy;
+    return c;
+  }
+  Vec6<S> de;
+  for (int k = 0; k < kDof; ++k) de(k) = q(k) < kMid[k] ? kTurn[k] : S(-kTurn[k]);
+  const Vec6<S> q_end = q + joint_from_motor(io, de);
+  const std::uint32_t saved = math::take_arithmetic_flags<S>();
+  forward_kinematics(model, data, q_end);
+  const Pose<S> to{data.o[kDof], data.R[kDof]};
+  const ProfileStatus st = c.move.plan(gen.queue_end(), to, lim, gen.reference_orientation());
+  if (math::take_arithmetic_fault<S>() || st != ProfileStatus::kOk) c.refusal = MotionReason::kOverLimit;
+  math::restore_arithmetic_flags<S>(saved);
+  return c;
+}
+
+/// A home accepted: the move starts in the next tick; the pots' offset from the encoders (the
+/// cross-check's filtered difference, at rest) is taken per motor.
+template <class S>
+[[gnu::noinline]] void start_homing(ControlTask<S>& task, std::uint32_t id) {
+  task.homing = {};
+  task.homing.id = id;
+  task.homing.pot_offset = motor_rates(task.io, task.position.filtered);
+  // No friction compensation nor learning while homing (restored by end_homing): its slow move is
+  // no excitation to learn from (the robust law tripled J5's estimates in 2.5 s), and the estimate's
+  // sign flipping with the velocity at a slow reversal stepped the torque by twice it.
+  task.homing.mode = task.mode;
+  task.mode = FrictionMode::kNone;
+}
+
+/// Homing ended (done, stopped, aborted or faulted): the friction mode back.
+template <class S>
+void end_homing(ControlTask<S>& task) {
+  task.mode = task.homing.mode;
+}
+
+/// Motor c's index pulse at count n: its coarse angle (the encoders' belief plus the pots' offset)
+/// picks the revolution, the index phase gives the exact angle, and their difference is the
+/// correction. A coarse angle further than kHomeBand of a turn from the index position: position_mismatch.
+template <class S>
+[[gnu::noinline]] std::uint32_t homing_latch(ControlTask<S>& task, int c, std::int32_t n) {
+  const IndexTicks& x = task.index_ticks;
+  const math::io_scalar_t<S> cpr = task.io.counts_per_rad(c);
+  const Vec6<S> e0 = motor_rates(task.io, task.q_start);  // the motors' angles at count 0, believed
+  // The motor's angle at the latch from its 0, in ticks: as the encoders believe it, as the pots do.
+  const std::int64_t believed =
+      detail::to_ticks<S>(e0(c), cpr) + static_cast<std::int64_t>(n) * (1 << detail::kTickBits);
+  const std::int64_t coarse = believed + detail::to_ticks<S>(task.homing.pot_offset(c), cpr);
+  const std::int64_t k = detail::floor_div(coarse - x.phase[c] + x.rev[c] / 2, x.rev[c]);  // the nearest index
+  const std::int64_t exact = x.phase[c] + k * x.rev[c];
+  const std::int64_t off = coarse - exact;  // the coarse angle minus the index position
+  task.homing.correction(c) = detail::from_ticks<S>(exact - believed, cpr);
+  task.homing.found = static_cast<std::uint8_t>(task.homing.found | (1u << c));
+  return off > x.band[c] || -off > x.band[c] ? static_cast<std::uint32_t>(kFaultPositionMismatch) : 0u;
+}
+
+/// A tick of the homing, with the step's generator events: each motor's index pulse latched in the
+/// last sample interval (a latch further from the count than a tick's plausible step is an old one,
+/// or its encoder stopped counting: not taken), the move braked once all are found, and at the move's
+/// end a motor without its index pulse named: encoder_stuck when it turned less than half a
+/// revolution, index_missing otherwise.
+template <class S, class Hal>
+[[gnu::noinline]] std::uint32_t homing_faults(
+    ControlTask<S>& task, Hal& hal, const std::int32_t counts[kDof],
+    const MotionEvents& ev) {  // out of line: the running tick's code stays as it was
+  constexpr std::uint8_t kAll = (1u << kDof) - 1u;
+  Homing<S>& h = task.homing;
+  if (!h.started) {
+    for (int c = 0; c < kDof; ++c) h.start_counts[c] = counts[c];
+    h.started = true;
+  }
+  std::uint32_t faults = 0;
+  for (int c = 0; c < kDof; ++c) {
+    std::int32_t n;
+    if (!hal.take_index(c, n) || (h.found >> c & 1u) != 0) continue;
+    const std::int64_t d = static_cast<std::int64_t>(n) - counts[c];
+    if (d > task.jump.max_step[c] || -d > task.jump.max_step[c]) continue;
+    faults |= homing_latch(task, c, n);
+  }
+  if (h.found == kAll && !task.gen.braking()) task.gen.brake(task.tick + 1, params::kControlHz, home_limits(task));
+  if (!ev.finished || h.found == kAll) return faults;
+  for (int c = 0; c < kDof; ++c) {
+    if ((h.found >> c & 1u) != 0) continue;
+    const std::int64_t d = static_cast<std::int64_t>(counts[c]) - h.start_counts[c];
+    const std::int64_t turned2 = (d < 0 ? -d : d) * (2 << detail::kTickBits);  // twice the turn, in ticks
+    faults |= turned2 < task.index_ticks.rev[c] ? kFaultEncoderStuck : kFaultIndexMissing;
+  }
+  return faults;
+}
+
+/// Homing complete (every index found, at rest): the encoders' zero corrected, the observer
+/// restarted and the pose held where the arm now is known to be, the torque beyond gravity ramped
+/// in again, the cross-check learnt anew; the home command done.
+template <class S>
+[[gnu::noinline]] void finish_homing(ControlTask<S>& task, const Vec6<S>& q) {
+  const Vec6<S> dq = joint_from_motor(task.io, task.homing.correction);
+  shift_encoder_zero(task, dq, task.homing.correction);
+  const Vec6<S> q_now = q + dq;
+  controller_restart(task.model, task.state, q_now);
+  task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
+  task.q_queue_end = q_now;
+  task.stuck.reset(true);
+  task.residual.reset();
+  task.position.reset();
+  task.ramping = true;
+  task.ramp_start = task.tick + 1;
+  task.homed = true;
+  task.report.done_id = task.homing.id;
+}
+
+/// An enable of an arm not homed: where the pots have settled, the encoders' zero moves to the pots'
+/// coarse angles (the cross-check's filtered difference, which moves with it), so that the model,
+/// the limits and the hold are computed within the pots' accuracy of the true pose rather than at an
+/// assumed one. Returns the angles now measured.
+template <class S>
+[[gnu::noinline]] Vec6<S> coarse_from_pots(ControlTask<S>& task, const Vec6<S>& q) {
+  if (!homing_possible(task)) return q;
+  const Vec6<S> dq = task.position.filtered;
+  shift_encoder_zero(task, dq, motor_rates(task.io, dq));
+  task.position.filtered -= dq;
+  task.position.reference -= dq;
+  return q + dq;
+}
+
+/// declare_pose accepted (disabled, measured, the pots agreeing): the encoders' zero set so that
+/// the angles now read are the pose's.
+template <class S>
+[[gnu::noinline]] void declare_pose(ControlTask<S>& task, const Vec6<S>& q, int pose) {
+  Vec6<S> dq;
+  for (int i = 0; i < kDof; ++i) dq(i) = detail::kPoseTable<S>[pose][i] - q(i);
+  shift_encoder_zero(task, dq, motor_rates(task.io, dq));
+  task.position.filtered -= dq;  // the pots' difference from the encoders' angles moves with them
+  task.position.reference -= dq;
+  task.homed = true;
+}
+
+/// Whether the pots contradict a declared pose: a joint whose pot angle (the encoders' plus the
+/// cross-check's filtered difference) is further than kDeclareBand from it. Joints whose pots have
+/// not been read yet, and an arm without pots, contradict nothing.
+template <class S>
+[[gnu::noinline]] bool pots_disagree(const ControlTask<S>& task, const Vec6<S>& q, int pose) {
+  static constexpr S kBand = lit<S>(params::kDeclareBand);
+  if (!task.pots) return false;
+  for (int i = 0; i < kDof; ++i) {
+    if (task.position.updates[i] == 0) continue;
+    const S d = q(i) + task.position.filtered(i) - detail::kPoseTable<S>[pose][i];
+    if (d > kBand || -d > kBand) return true;
+  }
+  return false;
+}
+
 /// Enable's torque ramp: the torque beyond the gravity the model predicts at q is ramped in over
 /// params::kEnableRamp, tau = g + r (tau - g), r from 0 to 1.
 template <class S>
@@ -325,18 +660,29 @@ void ramp_torque(ControlTask<S>& task) {
 /// refusal goes into the report) or it is no longer valid (its plan's epoch passed: superseded; a
 /// paper command when the generator does not hold: busy).
 template <class S>
-MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured) {
+MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const Vec6<S>& q) {
   const TaskCommand<S>& cmd = task.pending;
   MotionReport& rep = task.report;
   if (cmd.verb == MotionVerb::kNone) return MotionCommand::kNone;
   if (cmd.verb == MotionVerb::kEnable && task.machine.state == MotionState::kDisabled &&
       (task.sup.state != SupervisorState::kRun || !measured))
     return MotionCommand::kNone;
+  if (cmd.verb == MotionVerb::kDeclarePose && !measured) return MotionCommand::kNone;  // it needs the angles now
+  // A home, a declare_pose and the enable of an arm not homed (it takes the pots' coarse angles) wait
+  // for the pots.
+  const bool coarse = cmd.verb == MotionVerb::kHome || cmd.verb == MotionVerb::kDeclarePose ||
+                      (cmd.verb == MotionVerb::kEnable && !task.homed);
+  if (coarse && task.pots && pots_settling(task)) return MotionCommand::kNone;
   rep.id = cmd.id;
   rep.verb = cmd.verb;
   MotionReason pre = cmd.refusal;
-  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kMoveTo && cmd.epoch != task.gen.epoch())
-    pre = MotionReason::kSuperseded;
+  const bool planned = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome;
+  if (pre == MotionReason::kNone && planned && cmd.epoch != task.gen.epoch()) pre = MotionReason::kSuperseded;
+  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kHome && !homing_possible(task))
+    pre = MotionReason::kNoPots;
+  if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kDeclarePose &&
+      task.machine.state == MotionState::kDisabled && pots_disagree(task, q, cmd.pose))
+    pre = MotionReason::kPotsDisagree;
   if (pre == MotionReason::kNone && (cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream) &&
       task.gen.source() != MotionSource::kHold)
     pre = MotionReason::kBusy;
@@ -364,8 +710,9 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
                    cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kClear))
     task.contact = false;
   if (st.enabling) {
-    controller_restart(task.model, task.state, q);
-    hold_measured_pose(task, q);
+    const Vec6<S> q_now = task.homed ? q : coarse_from_pots(task, q);
+    controller_restart(task.model, task.state, q_now);
+    hold_measured_pose(task, q_now);
     task.stuck.reset(true);
     task.residual.reset();
     task.contact = false;
@@ -382,6 +729,15 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_moves(next);
     task.q_queue_end = cmd.q_end;
   }
+  if (accepted && cmd.verb == MotionVerb::kHome) {
+    task.gen.push(cmd.move, cmd.id);
+    task.gen.start_moves(next);
+    task.q_queue_end = cmd.q_end;
+    start_homing(task, cmd.id);
+  }
+  if (accepted && cmd.verb == MotionVerb::kDeclarePose) declare_pose(task, q, cmd.pose);
+  if (before == MotionState::kHoming && st.machine.state != MotionState::kHoming) end_homing(task);
+  if (st.completion == MotionCompletion::kHomed) finish_homing(task, q);
   if (accepted && cmd.verb == MotionVerb::kPaper)
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream)
@@ -397,7 +753,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.stuck.reset(true);  // from this tick's torques: a clear while holding is no torque change
     task.residual.reset();
     task.saturation.reset();
-    task.position.reset();  // the encoders' count may be off now: learnt again (homing would set it)
+    task.position.reset();  // learnt again from the next samples (an encoder fault also unhomed the arm)
   }
   if (!motion_powered(st.machine.state)) task.ramping = false;
 }
@@ -410,7 +766,8 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
                    MotionReason stop_request, bool yield) {
   task.report = {};
   MotionInput in;
-  in.command = motion_command_of_tick(task, measured);
+  in.command = motion_command_of_tick(task, measured, q);
+  in.homed = task.homed;
   in.faults = faults;
   in.stop_request = stop_request;
   in.yield = yield;
@@ -420,6 +777,7 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   const std::uint32_t running = task.gen.running_id();
   const MotionStep st = motion_next(task.machine, in);
   task.machine = st.machine;
+  if ((faults & kFaultsUnhoming) != 0) task.homed = false;
   MotionReport& rep = task.report;
   if (in.command != MotionCommand::kNone) {
     rep.outcome = st.outcome;
@@ -436,11 +794,12 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
 }
 
 /// The position cross-check of a tick with a measured sample, on a HAL with potentiometers (none
-/// otherwise, or with the parameter pots 0): whether the torque is on or not (an arm moved by hand).
+/// otherwise, with the parameter pots 0, or while homing: homing_faults reads the index pulses then),
+/// whether the torque is on or not (an arm moved by hand).
 template <class S, class Hal>
 std::uint32_t position_faults(ControlTask<S>& task, Hal& hal, const Vec6<S>& q) {
   if constexpr (hal::PositionHal<Hal>) {
-    if (!task.pots) return 0;
+    if (!task.pots || task.machine.state == MotionState::kHoming) return 0;
     std::uint16_t pots[kDof];
     const bool valid = hal.read_pots(pots);
     return task.position.check(pots, valid, q);
@@ -448,6 +807,18 @@ std::uint32_t position_faults(ControlTask<S>& task, Hal& hal, const Vec6<S>& q) 
     (void)task, (void)hal, (void)q;
     return 0;
   }
+}
+
+/// Homing's checks of a tick with a measured sample (homing_faults), while homing on a HAL with
+/// potentiometers and index pulses (homing cannot start without: no_pots).
+template <class S, class Hal>
+std::uint32_t index_faults(ControlTask<S>& task, Hal& hal, const std::int32_t counts[kDof], const MotionEvents& ev) {
+  if constexpr (hal::PositionHal<Hal>) {
+    if (task.machine.state == MotionState::kHoming) return homing_faults(task, hal, counts, ev);
+  } else {
+    (void)task, (void)hal, (void)counts, (void)ev;
+  }
+  return 0;
 }
 
 /// One tick, the block diagram in five timed stages (TickStage): read, checks, step, monitors,
@@ -514,6 +885,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   const std::uint32_t elapsed = hal.cycles() - mark[kStageRead];
   if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
 
+  if (measured) faults |= index_faults(task, hal, counts, ev);
   task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
   const MotionReason stop_request = tick_stop_request(task, stepped, q, collision);
   const bool torque =
@@ -558,10 +930,10 @@ constexpr MotionReason path_refusal(PathStatus s) {
   return MotionReason::kOutOfWorkspace;
 }
 
-/// The path check of a move_to prepare_move planned (nothing if it refused it already).
+/// The path check of a move_to prepare_move planned, or of a home's move (nothing if it refused it already).
 template <class S>
 void check_prepared_move(ControlTask<S>& task, TaskCommand<S>& c) {
-  if (c.verb != MotionVerb::kMoveTo || c.refusal != MotionReason::kNone) return;
+  if ((c.verb != MotionVerb::kMoveTo && c.verb != MotionVerb::kHome) || c.refusal != MotionReason::kNone) return;
   const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
   const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
   c.refusal = path_refusal(pc.status);
@@ -575,6 +947,16 @@ void check_prepared_move(ControlTask<S>& task, TaskCommand<S>& c) {
 template <class S>
 TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& req, std::uint32_t id) {
   TaskCommand<S> c = prepare_move(task.gen, task.limits, task.tick, params::kControlHz, req, id);
+  check_prepared_move(task, c);
+  return c;
+}
+
+/// Prepares a home in full, outside the tick (like prepare_checked_move): the homing move from the
+/// last measured angles, path-checked.
+template <class S>
+TaskCommand<S> prepare_checked_home(ControlTask<S>& task, std::uint32_t id) {
+  TaskCommand<S> c =
+      prepare_home(task.gen, home_limits(task), task.model, task.check_data, task.io, task.state.adapt.q_prev, id);
   check_prepared_move(task, c);
   return c;
 }

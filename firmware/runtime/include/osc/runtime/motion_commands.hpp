@@ -15,20 +15,23 @@
 #include <cstdint>
 
 #include "osc/control/motion.hpp"
+#include "osc/robot.hpp"
 #include "osc/runtime/motion_states.hpp"
 
 namespace osc {
 
 // X(Name, "name", meaning): the verbs of the command frame, in code order.
-#define OSC_MOTION_VERB_LIST(X)                                                                     \
-  X(None, "none", "no command")                                                                     \
-  X(Enable, "enable", "torque on, holding the measured pose; the observer starts there")            \
-  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")               \
-  X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion") \
-  X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                \
-  X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")        \
-  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")                     \
-  X(Stream, "stream", "follow the setpoint frames that follow, jerk-limited; stale: category-2 stop")
+#define OSC_MOTION_VERB_LIST(X)                                                                               \
+  X(None, "none", "no command")                                                                               \
+  X(Enable, "enable", "torque on, holding the measured pose; the observer starts there")                      \
+  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")                         \
+  X(MoveTo, "move_to", "a jerk-limited move to a pose: queued, or re-targeting the running motion")           \
+  X(Paper, "paper", "the paper's motion (68) about the held position, until a stop")                          \
+  X(Stop, "stop", "category-2 stop: decelerate along the path within the limits, then hold")                  \
+  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")                               \
+  X(Stream, "stream", "follow the setpoint frames that follow, jerk-limited; stale: category-2 stop")         \
+  X(Home, "home", "homing: each motor up to one revolution to its index pulse, from the pots' coarse angles") \
+  X(DeclarePose, "declare_pose", "the arm stands at the named pose `pose` (torque off; the pots must agree)")
 
 #define OSC_X_PREFIX k
 OSC_MOTION_ENUM(MotionVerb, OSC_MOTION_VERB_LIST);
@@ -49,6 +52,10 @@ constexpr MotionCommand verb_command(MotionVerb v) {
       return MotionCommand::kStop;
     case MotionVerb::kClear:
       return MotionCommand::kClear;
+    case MotionVerb::kHome:
+      return MotionCommand::kHome;
+    case MotionVerb::kDeclarePose:
+      return MotionCommand::kDeclarePose;
     case MotionVerb::kNone:
       break;
   }
@@ -78,6 +85,7 @@ struct TaskCommand {
   std::uint32_t id = 0;                        ///< the client's, echoed in the reports
   MotionReason refusal = MotionReason::kNone;  ///< decided while preparing
   bool brake = false;                          ///< move_to: brake the running motion first
+  std::uint8_t pose = 0;                       ///< declare_pose: the pose's code (robot::kNamedPoses)
   std::uint32_t epoch = 0;                     ///< the generator's, when the move was planned
   CartesianMove<S> move{};                     ///< move_to: the planned move
   Vec6<S> q_end = Vec6<S>::Zero();             ///< move_to: the joint angles at its end (path check)
@@ -206,6 +214,19 @@ TaskCommand<S> prepare_command(MotionVerb verb, std::uint32_t id) {
   TaskCommand<S> c;
   c.verb = verb;
   c.id = id;
+  return c;
+}
+
+/// Prepares a declare_pose of the pose of code `pose` (robot::kNamedPoses): unknown_pose for a code
+/// outside the list. The pots check and the state are the tick's.
+template <class S>
+TaskCommand<S> prepare_declare_pose(unsigned pose, std::uint32_t id) {
+  TaskCommand<S> c = prepare_command<S>(MotionVerb::kDeclarePose, id);
+  if (pose >= static_cast<unsigned>(robot::kNamedPoseCount)) {
+    c.refusal = MotionReason::kUnknownPose;
+    return c;
+  }
+  c.pose = static_cast<std::uint8_t>(pose);
   return c;
 }
 

@@ -26,21 +26,24 @@
 namespace osc {
 
 // X(Name, "name", meaning), in code order (each list below is declared once, by OSC_MOTION_ENUM).
-#define OSC_MOTION_STATE_LIST(X)                                                               \
-  X(Disabled, "disabled", "no torque, no fault: an enable holds the measured pose")            \
-  X(Holding, "holding", "torque on, holding the pose captured on entry, the observer running") \
-  X(Moving, "moving", "following the motion generator (move_to, stream, paper, queued moves)") \
-  X(Stopping, "stopping", "category-2 stop: decelerating along the path to rest, torque on")   \
-  X(Fault, "fault", "category-0 stop: zero torque, amplifiers off; sticky until a clear")      \
-  X(Yielding, "yielding", "a collision's reaction yield: gravity, Coriolis and friction compensated, no stiffness")
+#define OSC_MOTION_STATE_LIST(X)                                                                                    \
+  X(Disabled, "disabled", "no torque, no fault: an enable holds the measured pose")                                 \
+  X(Holding, "holding", "torque on, holding the pose captured on entry, the observer running")                      \
+  X(Moving, "moving", "following the motion generator (move_to, stream, paper, queued moves)")                      \
+  X(Stopping, "stopping", "category-2 stop: decelerating along the path to rest, torque on")                        \
+  X(Fault, "fault", "category-0 stop: zero torque, amplifiers off; sticky until a clear")                           \
+  X(Yielding, "yielding", "a collision's reaction yield: gravity, Coriolis and friction compensated, no stiffness") \
+  X(Homing, "homing", "torque on, each motor turning up to one revolution to its index pulse (a home command)")
 
-#define OSC_MOTION_COMMAND_LIST(X)                                                      \
-  X(None, "none", "no command this tick (a code outside this list counts as none)")     \
-  X(Enable, "enable", "torque on, holding the measured pose (observer started there)")  \
-  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")   \
-  X(Move, "move", "any motion: move_to, stream, the paper's trajectory, a queued move") \
-  X(Stop, "stop", "category-2 stop of the motion, then hold")                           \
-  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")
+#define OSC_MOTION_COMMAND_LIST(X)                                                           \
+  X(None, "none", "no command this tick (a code outside this list counts as none)")          \
+  X(Enable, "enable", "torque on, holding the measured pose (observer started there)")       \
+  X(Disable, "disable", "torque off; from a motion, after a category-2 stop to rest")        \
+  X(Move, "move", "any motion: move_to, stream, the paper's trajectory, a queued move")      \
+  X(Stop, "stop", "category-2 stop of the motion, then hold")                                \
+  X(Clear, "clear", "leave fault for disabled, once no fault cause is present")              \
+  X(Home, "home", "find each encoder's index pulse from the pots' coarse angles, then hold") \
+  X(DeclarePose, "declare_pose", "the operator asserts the arm stands at a named pose (torque off)")
 
 /// Why a command was refused or a running motion aborted. The geometric ones are decided by the
 /// motion generator, which refuses with them after this machine accepted; motion_next() decides the
@@ -64,7 +67,13 @@ namespace osc {
     "a bad command frame: a verb or flag outside its list, a non-finite number, a bound exceeded, a limit <= 0")    \
   X(LinkSilent, "link_silent", "the board's command link went silent while a motion ran: category-2 stop")          \
   X(Collision, "collision", "the runtime stopped the motion: a collision, its reaction category_2 or yield")        \
-  X(Yielding, "yielding", "a move while yielding to a collision: a stop or an enable holds the pose first")
+  X(Yielding, "yielding", "a move while yielding to a collision: a stop or an enable holds the pose first")         \
+  X(NotHomed, "not_homed", "a motion before the encoders' offsets are known: home, or declare_pose, first")         \
+  X(NoPots, "no_pots", "a home on an arm without potentiometers (parameter pots 0, or none read): declare_pose")    \
+  X(PotsDisagree, "pots_disagree",                                                                                  \
+    "a declare_pose whose pose a potentiometer contradicts by more than params::kDeclareBand (2 degrees)")          \
+  X(TorqueOn, "torque_on", "a declare_pose while the torque is on: disable first")                                  \
+  X(UnknownPose, "unknown_pose", "a declare_pose of a pose code outside the robot's list of named poses")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -79,7 +88,8 @@ namespace osc {
 #define OSC_MOTION_COMPLETION_LIST(X)                                                              \
   X(None, "none", "nothing completed this tick")                                                   \
   X(Finished, "finished", "the motion finished: the generator's queue ran empty at rest; holding") \
-  X(Stopped, "stopped", "a category-2 stop reached rest; holding, or disabled after a disable")
+  X(Stopped, "stopped", "a category-2 stop reached rest; holding, or disabled after a disable")    \
+  X(Homed, "homed", "homing found every index pulse: the encoders' offsets are set; holding")
 
 /// What a detected collision does (the residual monitor's collision, osc/runtime/monitors.hpp); an
 /// encoder or a drive fault is always category 0.
@@ -112,12 +122,12 @@ OSC_MOTION_ENUM(CollisionReaction, OSC_COLLISION_REACTION_LIST);
 #undef OSC_X_PREFIX  // OSC_MOTION_ENUM stays defined: motion_commands.hpp declares its verbs with it
 
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
-static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kYielding) + 1);
-static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kClear) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kYielding) + 1);
+static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kHoming) + 1);
+static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kDeclarePose) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kUnknownPose) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
-static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kStopped) + 1);
+static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kHomed) + 1);
 static_assert(MotionNames<CollisionReaction>::kCount == static_cast<int>(CollisionReaction::kYield) + 1);
 
 /// The name of a code of one of these enumerations ("?" for a code outside its list).
@@ -143,6 +153,7 @@ struct MotionInput {
   bool motion_finished = false;  ///< the generator's queue ran empty at rest
   bool stopped = false;          ///< the category-2 deceleration reached rest
   bool yield = false;            ///< a collision whose reaction is yield (CollisionReaction::kYield)
+  bool homed = true;             ///< the encoders' offsets are known (homing, declare_pose): motion allowed
 };
 
 /// The next machine and what the tick does.
@@ -160,6 +171,9 @@ struct MotionStep {
   bool enabling = false;                    ///< enabled: start the observer at the measured pose, ramp torque in
 };
 
+/// A motion runs: a client's (moving) or homing's. Both end in holding, or stop like a motion.
+constexpr bool motion_running(MotionState s) { return s == MotionState::kMoving || s == MotionState::kHoming; }
+
 namespace detail {
 
 constexpr bool motion_state_known(MotionState s) { return static_cast<int>(s) < MotionNames<MotionState>::kCount; }
@@ -167,7 +181,7 @@ constexpr bool motion_state_known(MotionState s) { return static_cast<int>(s) < 
 /// A machine in fault (or faulting now, or unreadable): only a clear with no cause present leaves it.
 constexpr MotionStep motion_fault_tick(const MotionMachine& m, const MotionInput& in, MotionCommand c) {
   MotionStep r{};
-  if (m.state == MotionState::kMoving) r.abort = MotionReason::kFaulted;
+  if (motion_running(m.state)) r.abort = MotionReason::kFaulted;
   const std::uint32_t present = in.faults | in.causes;
   if (c == MotionCommand::kClear && present == 0) {
     r.machine = {MotionState::kDisabled, 0, false};
@@ -191,11 +205,11 @@ constexpr MotionStep motion_events(const MotionMachine& m, const MotionInput& in
   if (in.yield && m.state != MotionState::kDisabled) {
     // A collision to yield to: whatever the arm did (a motion, its stop), it now gives way.
     r.machine = {MotionState::kYielding, 0, false};
-    if (m.state == MotionState::kMoving) r.abort = MotionReason::kCollision;
-  } else if (m.state == MotionState::kMoving && in.motion_finished) {
+    if (motion_running(m.state)) r.abort = MotionReason::kCollision;
+  } else if (motion_running(m.state) && in.motion_finished) {
     r.machine.state = MotionState::kHolding;
-    r.completion = MotionCompletion::kFinished;
-  } else if (m.state == MotionState::kMoving && in.stop_request != MotionReason::kNone) {
+    r.completion = m.state == MotionState::kHoming ? MotionCompletion::kHomed : MotionCompletion::kFinished;
+  } else if (motion_running(m.state) && in.stop_request != MotionReason::kNone) {
     r.machine.state = MotionState::kStopping;
     r.abort = in.stop_request;
   } else if (m.state == MotionState::kStopping && in.stopped) {
@@ -216,11 +230,19 @@ constexpr void motion_stop(MotionStep& r, MotionReason why) {
   if (r.abort == MotionReason::kNone) r.abort = why;
 }
 
+/// A move's or a home's refusal in a state with the torque on (none: it may start).
+constexpr MotionReason motion_start_refusal(MotionState s) {
+  if (s == MotionState::kStopping) return MotionReason::kStopping;
+  if (s == MotionState::kYielding) return MotionReason::kYielding;
+  return MotionReason::kNone;
+}
+
 /// The command, on the state the events left (the table of motion_next()).
-constexpr void motion_command(MotionStep& r, MotionCommand c) {
+constexpr void motion_command(MotionStep& r, MotionCommand c, bool homed) {
   MotionMachine& m = r.machine;
   r.outcome = c == MotionCommand::kNone ? CommandOutcome::kNone : CommandOutcome::kAccepted;
   const bool disabled = m.state == MotionState::kDisabled;
+  const MotionReason blocked = disabled ? MotionReason::kNotEnabled : motion_start_refusal(m.state);
   switch (c) {
     case MotionCommand::kEnable:
       r.enabling = disabled;
@@ -229,19 +251,27 @@ constexpr void motion_command(MotionStep& r, MotionCommand c) {
       return;
     case MotionCommand::kDisable:
       if (m.state == MotionState::kHolding || m.state == MotionState::kYielding) m.state = MotionState::kDisabled;
-      if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kDisableCommand);
+      if (motion_running(m.state)) motion_stop(r, MotionReason::kDisableCommand);
       m.disable_at_rest = m.state == MotionState::kStopping;
       return;
     case MotionCommand::kMove:
-      if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
-      if (m.state == MotionState::kStopping) return motion_refuse(r, MotionReason::kStopping);
-      if (m.state == MotionState::kYielding) return motion_refuse(r, MotionReason::kYielding);
+      if (blocked != MotionReason::kNone) return motion_refuse(r, blocked);
+      if (m.state == MotionState::kHoming) return motion_refuse(r, MotionReason::kBusy);
+      if (!homed) return motion_refuse(r, MotionReason::kNotHomed);
       m.state = MotionState::kMoving;
       return;
     case MotionCommand::kStop:
       if (disabled) return motion_refuse(r, MotionReason::kNotEnabled);
-      if (m.state == MotionState::kMoving) motion_stop(r, MotionReason::kStopCommand);
+      if (motion_running(m.state)) motion_stop(r, MotionReason::kStopCommand);
       if (m.state == MotionState::kYielding) m.state = MotionState::kHolding;
+      return;
+    case MotionCommand::kHome:
+      if (blocked != MotionReason::kNone) return motion_refuse(r, blocked);
+      if (m.state == MotionState::kMoving) return motion_refuse(r, MotionReason::kBusy);
+      m.state = MotionState::kHoming;
+      return;
+    case MotionCommand::kDeclarePose:
+      if (!disabled) return motion_refuse(r, MotionReason::kTorqueOn);
       return;
     case MotionCommand::kNone:
     case MotionCommand::kClear:
@@ -261,21 +291,32 @@ constexpr void motion_command(MotionStep& r, MotionCommand c) {
 ///   fault, clear, a cause present        -> fault, refused: faulted (cause: faults | causes)
 ///   events (states not named ignore them):
 ///   moving, motion finished              -> holding, completion finished, pose captured
-///   moving, stop requested (reason r)    -> stopping, category 2, motion aborted: r
+///   homing, motion finished              -> holding, completion homed, pose captured
+///   moving, homing, stop requested (r)   -> stopping, category 2, motion aborted: r
 ///   stopping, stopped                    -> holding (pose captured), or disabled if a disable is
 ///                                           pending; completion stopped
-///   holding, moving, stopping, yielding, yield (a collision, reaction yield; before the events above)
-///                                        -> yielding, a pending disable dropped; moving: aborted collision
+///   holding, moving, homing, stopping, yielding, yield (a collision, reaction yield; before the events above)
+///                                        -> yielding, a pending disable dropped; moving, homing: aborted collision
 ///   commands (= : stays, accepted; a command code outside the list is none):
 ///              enable            disable                  move                 stop
 ///   disabled   holding, enabling =                        refused not_enabled  refused not_enabled
-///   holding    =                 disabled                 moving               =
+///   holding    =                 disabled                 moving [3]           =
 ///   moving     =                 stopping, pending [1]    = (re-target/queue)  stopping [2]
+///   homing     =                 stopping, pending [1]    refused busy         stopping [2]
 ///   stopping   =, not pending    =, pending               refused stopping     =
 ///   yielding   holding           disabled                 refused yielding     holding
+///              home                  declare_pose
+///   disabled   refused not_enabled   = [4]
+///   holding    homing                refused torque_on
+///   moving     refused busy          refused torque_on
+///   homing     =                     refused torque_on
+///   stopping   refused stopping      refused torque_on
+///   yielding   refused yielding      refused torque_on
 ///   clear: = in every state but fault.
 ///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
-/// Torque is on in holding, moving, stopping, yielding; the stop in effect is category 0 in fault, 2 in
+///   [3] refused not_homed until the encoders' offsets are known (MotionInput::homed).
+///   [4] the runtime sets the offsets from the named pose (declare_pose, after its pots check).
+/// Torque is on in holding, moving, homing, stopping, yielding; the stop in effect is category 0 in fault, 2 in
 /// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable,
 /// finished, stopped). Decisions: a command whose end state already holds is accepted and does nothing (enable when
 /// enabled, disable when disabled, stop when holding or stopping, clear outside fault): repeating
@@ -295,11 +336,11 @@ constexpr MotionStep motion_next(const MotionMachine& m, const MotionInput& in) 
   if (in.faults != 0 || m.latched != 0 || m.state == MotionState::kFault || !detail::motion_state_known(m.state))
     return detail::motion_fault_tick(m, in, c);
   MotionStep r = detail::motion_events(m, in);
-  detail::motion_command(r, c);
+  detail::motion_command(r, c, in.homed);
   const MotionState s = r.machine.state;
   r.stop = s == MotionState::kStopping ? StopCategory::kCategory2 : StopCategory::kNone;
-  r.torque = s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kStopping ||
-             s == MotionState::kYielding;
+  r.torque =
+      s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
   r.capture_pose = s == MotionState::kHolding && m.state != MotionState::kHolding;
   return r;
 }

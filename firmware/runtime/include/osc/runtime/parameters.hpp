@@ -82,26 +82,32 @@ constexpr double kMoveAngularCap[3] = {params::kMoveAngular[0] * params::kMoveLi
                                        params::kMoveAngular[1] * params::kMoveLimitCap,
                                        params::kMoveAngular[2] * params::kMoveLimitCap};
 constexpr double kZeros[kDof] = {};
+/// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
+/// configured move maxima.
+constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
+constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular[0]};
 }  // namespace detail
 
 // X(Name, "name", elements, unit, lo, hi (of each element: a number or a list), default (a number or
 // a list), access, persists, meaning): the runtime parameters besides the gains. A name is a key of
 // the host's run.* configuration where the host sets it too.
-#define OSC_RUNTIME_PARAM_LIST(X)                                                                                   \
-  X(Adaptation, "adaptation", 1, "", 0, kAdaptationLawCount - 1, static_cast<double>(AdaptationLaw::kRobust),       \
-    TorqueOff, true, "the friction adaptation law: 0 paper (67), 1 robust, 2 momentum")                             \
-  X(MoveLinear, "move_linear", 3, "m/s, m/s^2, m/s^3", 1e-6, detail::kMoveLinearCap, params::kMoveLinear, Always,   \
-    true, "a move's and a stream's maxima of the wrist centre's speed, acceleration, jerk")                         \
-  X(MoveAngular, "move_angular", 3, "rad/s, rad/s^2, rad/s^3", 1e-6, detail::kMoveAngularCap, params::kMoveAngular, \
-    Always, true, "the same of the rotation")                                                                       \
-  X(CollisionReaction, "collision_reaction", 1, "", 0, MotionNames<CollisionReaction>::kCount - 1, 0, Always, true, \
-    "what a collision does: 0 category_0, 1 category_2, 2 yield")                                                   \
-  X(CollisionThreshold, "collision_threshold", kDof, "N m", 0, robot::kDrives.torque_limit, detail::kZeros, Always, \
-    true, "each joint's collision threshold; 0: the derived threshold alone")                                       \
-  X(StreamTimeout, "stream_timeout", 1, "s", params::kStreamTimeoutLo, kStreamExtrapolation, kStreamTimeoutMin,     \
-    Always, true, "a stream is stale after max(2 periods, this) without a setpoint; from the next stream on")       \
-  X(Pots, "pots", 1, "", 0, 1, 1, TorqueOff, true,                                                                  \
-    "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them")
+#define OSC_RUNTIME_PARAM_LIST(X)                                                                                     \
+  X(Adaptation, "adaptation", 1, "", 0, kAdaptationLawCount - 1, static_cast<double>(AdaptationLaw::kRobust),         \
+    TorqueOff, true, "the friction adaptation law: 0 paper (67), 1 robust, 2 momentum")                               \
+  X(MoveLinear, "move_linear", 3, "m/s, m/s^2, m/s^3", 1e-6, detail::kMoveLinearCap, params::kMoveLinear, Always,     \
+    true, "a move's and a stream's maxima of the wrist centre's speed, acceleration, jerk")                           \
+  X(MoveAngular, "move_angular", 3, "rad/s, rad/s^2, rad/s^3", 1e-6, detail::kMoveAngularCap, params::kMoveAngular,   \
+    Always, true, "the same of the rotation")                                                                         \
+  X(CollisionReaction, "collision_reaction", 1, "", 0, MotionNames<CollisionReaction>::kCount - 1, 0, Always, true,   \
+    "what a collision does: 0 category_0, 1 category_2, 2 yield")                                                     \
+  X(CollisionThreshold, "collision_threshold", kDof, "N m", 0, robot::kDrives.torque_limit, detail::kZeros, Always,   \
+    true, "each joint's collision threshold; 0: the derived threshold alone")                                         \
+  X(StreamTimeout, "stream_timeout", 1, "s", params::kStreamTimeoutLo, kStreamExtrapolation, kStreamTimeoutMin,       \
+    Always, true, "a stream is stale after max(2 periods, this) without a setpoint; from the next stream on")         \
+  X(Pots, "pots", 1, "", 0, 1, 1, TorqueOff, true,                                                                    \
+    "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them")                  \
+  X(HomeSpeed, "home_speed", 2, "m/s, rad/s", detail::kHomeSpeedLo, detail::kHomeSpeedHi, params::kHomeSpeed, Always, \
+    true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),
@@ -114,7 +120,7 @@ struct ParamInfo {
   const char* name;
   const char* unit;
   const char* doc;
-  std::uint8_t count;  ///< elements: 1, 3 or 6
+  std::uint8_t count;  ///< elements: 1 to 6
   double lo, hi;       ///< the range of every element, unless lo_each / hi_each give one per element
   const double* lo_each;
   const double* hi_each;
@@ -348,6 +354,8 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return static_cast<double>(task.stream_timeout_ticks) / params::kControlHz;
     case RuntimeParam::kParamPots:
       return task.pots ? 1.0 : 0.0;
+    case RuntimeParam::kParamHomeSpeed:
+      return static_cast<double>(task.home_speed[e]);
     case RuntimeParam::kCount:
       break;
   }
@@ -384,6 +392,9 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamPots:
       if ((v != 0) != task.pots) task.position.reset();  // learnt again from the next sample
       task.pots = v != 0;
+      break;
+    case RuntimeParam::kParamHomeSpeed:
+      task.home_speed[e] = static_cast<S>(v);
       break;
     case RuntimeParam::kCount:
       break;

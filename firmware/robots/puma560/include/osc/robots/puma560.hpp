@@ -44,6 +44,24 @@ constexpr double kQs[kDof] = {0, 0, -kPi / 2, 0, 0, 0};
 constexpr double kQn[kDof] = {0, kPi / 4, kPi, 0, kPi / 4, 0};
 /// Start pose of the task: the toolbox's qn, with q3 written as -pi so it lies inside the limits.
 constexpr double kQStart[kDof] = {0, kPi / 4, -kPi, 0, kPi / 4, 0};
+/// The poses an operator may declare (declare_pose), in code order. Each within the joint limits.
+constexpr NamedPose kNamedPoses[] = {
+    {"start", {0, kPi / 4, -kPi, 0, kPi / 4, 0}, "the task's start pose (kQStart): the paper's experiment starts here"},
+    {"zero", {0, 0, 0, 0, 0, 0}, "every joint at zero (the toolbox's qz): the arm stretched out horizontally"},
+    {"ready", {0, kPi / 2, -kPi / 2, 0, 0, 0}, "the toolbox's qr: the arm straight up"},
+    {"stretch", {0, 0, -kPi / 2, 0, 0, 0}, "the toolbox's qs: the upper arm horizontal, the forearm up"},
+};
+constexpr int kNamedPoseCount = sizeof(kNamedPoses) / sizeof(*kNamedPoses);
+constexpr bool named_poses_valid() {
+  for (const NamedPose& p : kNamedPoses)
+    for (int i = 0; i < kDof; ++i)
+      if (p.q[i] < kArm.q_min[i] || p.q[i] > kArm.q_max[i]) return false;
+  for (int i = 0; i < kDof; ++i)
+    if (kNamedPoses[0].q[i] != kQStart[i]) return false;
+  return kNamedPoseCount <= 255;
+}
+static_assert(named_poses_valid(),
+              "each named pose within the joint limits, the first the start pose, codes in a byte");
 
 /// Drive electronics. The references give no encoder or amplifier data (puma560.md section 7);
 /// these are stated assumptions, used alike by the firmware scaling and the simulated plant.
