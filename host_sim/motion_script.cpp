@@ -130,8 +130,8 @@ bool parse_pose(const YAML::Node& n, const std::string& where, MotionStepSpec& s
     names += std::string(i ? " | " : "") + osc::robot::kNamedPoses[i].name;
   if (!n["pose"]) return err = where + ".pose: declare_pose needs a pose: " + names, false;
   const std::string name = n["pose"].as<std::string>("");
-  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
-    if (name == osc::robot::kNamedPoses[i].name) return s.move.period = static_cast<std::uint32_t>(i), true;
+  const int code = osc::robot::named_pose_code(name);
+  if (code >= 0) return s.move.period = static_cast<std::uint32_t>(code), true;
   return err = where + ".pose: '" + name + "' is not a named pose: " + names, false;
 }
 

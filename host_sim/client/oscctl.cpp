@@ -86,8 +86,7 @@ int simple(Client& c, const Args& a, osc::MotionVerb verb) {
 /// declare_pose NAME: the pose's code in the frame's period field (the protocol's).
 int declare_pose(Client& c, const Args& a) {
   osc::MoveRequest<double> m;
-  for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
-    if (a.pose == osc::robot::kNamedPoses[i].name) m.period = static_cast<std::uint32_t>(i);
+  m.period = static_cast<std::uint32_t>(osc::robot::named_pose_code(a.pose));  // checked by the parser
   const std::uint32_t id = c.command(osc::MotionVerb::kDeclarePose, m);
   if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
   return report(c.wait_answer(id, a.timeout));
@@ -320,9 +319,7 @@ void build(CLI::App& app, Args& a) {
       std::string(osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(osc::MotionVerb::kDeclarePose)]) +
           " (torque off)");
   dp->add_option("pose", a.pose, "the pose's name: " + poses)->required()->check([](const std::string& v) {
-    for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
-      if (v == osc::robot::kNamedPoses[i].name) return std::string();
-    return "'" + v + "' is not a named pose";
+    return osc::robot::named_pose_code(v) >= 0 ? std::string() : "'" + v + "' is not a named pose";
   });
   CLI::App* mv = app.add_subcommand("move", "a jerk-limited move_to of the wrist centre; waits until done");
   mv->add_option("xyz", a.xyz, "X Y Z [m], base frame")->expected(3)->required();

@@ -80,13 +80,24 @@ std::uint32_t run_until_answer(Sim& s, std::uint32_t id, MotionReport& rep, int 
 
 /// Where the firmware puts each motor's count 0 (the motor angles, referred to their joints, of its
 /// q_start) minus where the plant's encoders count from, in counts of each channel.
-sim::Vec6 count_error(Sim& s) {
-  const ControlTask<double>& t = s.task();
-  const Vec6<double> e0 = motor_rates(t.io, t.q_start);
+template <class S>
+sim::Vec6 count_error(sim::MotionSim<S>& s) {
+  const ControlTask<S>& t = s.task();
+  const Vec6<S> e0 = motor_rates(t.io, t.q_start);
   const sim::Vec6& truth = s.hal().motor_start();
   sim::Vec6 err;
-  for (int c = 0; c < kDof; ++c) err(c) = (e0(c) - truth(c)) * t.counts_per_rad(c);
+  for (int c = 0; c < kDof; ++c) err(c) = (static_cast<double>(e0(c)) - truth(c)) * t.counts_per_rad(c);
   return err;
+}
+
+/// Ticks until homing completes (true) or a fault (added to `faults`), at most 8 s.
+template <class S>
+bool run_until_homed(sim::MotionSim<S>& s, std::uint32_t& faults) {
+  for (int k = 0; k < 8000 && faults == 0; ++k) {
+    faults |= s.tick();
+    if (s.task().report.completion == MotionCompletion::kHomed) return true;
+  }
+  return false;
 }
 
 struct HomingResult {
@@ -322,9 +333,6 @@ TEST(Homing, WithoutPotsHomeIsRefusedAndDeclarePoseIsTakenOnTrust) {
   EXPECT_TRUE(s->task().homed);
 }
 
-}  // namespace
-
-namespace {
 TEST(Homing, RightAfterTheEnableOnTheIdealPlant) {
   // A client sends home as soon as the enable is answered (the torque still ramping in).
   const sim::Vec6 q0 = joint_vector<double>(robot::kQStart);
@@ -336,16 +344,11 @@ TEST(Homing, RightAfterTheEnableOnTheIdealPlant) {
   s->home(2);
   std::uint32_t faults = run_until_answer(*s, 2, rep);
   EXPECT_EQ(rep.outcome, CommandOutcome::kAccepted);
-  for (int k = 0; k < 8000 && faults == 0; ++k) {
-    faults |= s->tick();
-    if (s->task().report.completion == MotionCompletion::kHomed) break;
-  }
+  run_until_homed(*s, faults);
   EXPECT_EQ(faults, 0u) << fault_name(faults);
   EXPECT_TRUE(s->task().homed);
 }
-}  // namespace
 
-namespace {
 TEST(Homing, TheVirtualBoardsSequence) {
   const sim::Vec6 q0 = joint_vector<double>(robot::kQStart);
   auto s = std::make_unique<Sim>(q0);
@@ -361,16 +364,11 @@ TEST(Homing, TheVirtualBoardsSequence) {
   s->home(4);
   std::uint32_t faults = run_until_answer(*s, 4, rep);
   EXPECT_EQ(rep.outcome, CommandOutcome::kAccepted) << motion_name(rep.refusal);
-  for (int k = 0; k < 8000 && faults == 0; ++k) {
-    faults |= s->tick();
-    if (s->task().report.completion == MotionCompletion::kHomed) break;
-  }
+  run_until_homed(*s, faults);
   EXPECT_EQ(faults, 0u) << fault_name(faults);
   EXPECT_TRUE(s->task().homed);
 }
-}  // namespace
 
-namespace {
 /// Homing in the scalar S (the firmware's float on the M4F, Q12.19 on the M3): its integer ticks
 /// arithmetic (detail::to_ticks) gives the same exact counts.
 template <class S>
@@ -385,18 +383,10 @@ void homes_in_scalar() {
     std::uint32_t faults = 0;
     for (int k = 0; k < 100; ++k) faults |= s.tick();
     s.home(2);
-    bool homed = false;
-    for (int k = 0; k < 8000 && faults == 0 && !homed; ++k) {
-      faults |= s.tick();
-      homed = s.task().report.completion == MotionCompletion::kHomed;
-    }
+    const bool homed = run_until_homed(s, faults);
     ASSERT_EQ(faults, 0u) << fault_name(faults);
     ASSERT_TRUE(homed);
-    const ControlTask<S>& t = s.task();
-    const Vec6<S> e0 = motor_rates(t.io, t.q_start);
-    for (int c = 0; c < kDof; ++c)
-      EXPECT_LE(std::fabs((static_cast<double>(e0(c)) - s.hal().motor_start()(c)) * t.counts_per_rad(c)), 1.5)
-          << "seed " << seed << " motor " << c + 1;
+    EXPECT_LE(count_error(s).cwiseAbs().maxCoeff(), 1.5) << "seed " << seed;
   }
 }
 TEST(Homing, InFloat) { homes_in_scalar<float>(); }

@@ -8,7 +8,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <type_traits>
 
 #include "hal/hal.hpp"
 #include "osc/control/controller.hpp"
@@ -437,6 +436,15 @@ void shift_encoder_zero(ControlTask<S>& task, const Vec6<S>& dq, const Vec6<S>& 
   }
 }
 
+/// The encoders' zero moved by dq at rest, with the position cross-check's pot-minus-encoder
+/// difference moving with it (its learnt reference stays valid).
+template <class S>
+void move_encoder_zero(ControlTask<S>& task, const Vec6<S>& dq) {
+  shift_encoder_zero(task, dq, motor_rates(task.io, dq));
+  task.position.filtered -= dq;
+  task.position.reference -= dq;
+}
+
 /// The limits of the homing move: the move limits, their speeds at most home_speed.
 template <class S>
 CartesianLimits<S> home_limits(const ControlTask<S>& task) {
@@ -607,9 +615,7 @@ template <class S>
 [[gnu::noinline]] Vec6<S> coarse_from_pots(ControlTask<S>& task, const Vec6<S>& q) {
   if (!homing_possible(task)) return q;
   const Vec6<S> dq = task.position.filtered;
-  shift_encoder_zero(task, dq, motor_rates(task.io, dq));
-  task.position.filtered -= dq;
-  task.position.reference -= dq;
+  move_encoder_zero(task, dq);
   return q + dq;
 }
 
@@ -619,9 +625,7 @@ template <class S>
 [[gnu::noinline]] void declare_pose(ControlTask<S>& task, const Vec6<S>& q, int pose) {
   Vec6<S> dq;
   for (int i = 0; i < kDof; ++i) dq(i) = detail::kPoseTable<S>[pose][i] - q(i);
-  shift_encoder_zero(task, dq, motor_rates(task.io, dq));
-  task.position.filtered -= dq;  // the pots' difference from the encoders' angles moves with them
-  task.position.reference -= dq;
+  move_encoder_zero(task, dq);
   task.homed = true;
 }
 

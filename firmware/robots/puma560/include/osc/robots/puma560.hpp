@@ -4,6 +4,8 @@
 // Table II; drive electronics as stated assumptions.
 #pragma once
 
+#include <string_view>
+
 #include "osc/robots/arm.hpp"
 
 namespace osc::puma560 {
@@ -52,6 +54,12 @@ constexpr NamedPose kNamedPoses[] = {
     {"stretch", {0, 0, -kPi / 2, 0, 0, 0}, "the toolbox's qs: the upper arm horizontal, the forearm up"},
 };
 constexpr int kNamedPoseCount = sizeof(kNamedPoses) / sizeof(*kNamedPoses);
+/// The code of the named pose `name` (its index in kNamedPoses), or -1.
+constexpr int named_pose_code(std::string_view name) {
+  for (int i = 0; i < kNamedPoseCount; ++i)
+    if (name == kNamedPoses[i].name) return i;
+  return -1;
+}
 constexpr bool named_poses_valid() {
   for (const NamedPose& p : kNamedPoses)
     for (int i = 0; i < kDof; ++i)
