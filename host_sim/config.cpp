@@ -187,7 +187,8 @@ void add_run_entries(std::vector<Entry>& t) {
   name(
       t, "run.residual_monitor",
       "trial: the residual monitor is computed and reported, the stuck-encoder monitor raises encoder_stuck; on: the "
-      "residual monitor raises encoder_stuck, drive_fault and collision in its place (docs/safety.md)",
+      "residual monitor raises encoder_stuck, drive_fault and collision in its place (docs/safety.md); the "
+      "firmware's parameter residual_monitor (0 trial, 1 on)",
       {"trial", "on"}, false, [](const Settings& s) { return std::string(s.base.residual_monitor ? "on" : "trial"); },
       [](Settings& s, const std::string& m) { s.base.residual_monitor = m == "on"; });
   name(

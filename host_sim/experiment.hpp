@@ -70,8 +70,9 @@ struct ExperimentConfig {
     return s;
   }
   double model_error = 0.0;  ///< controller's link mass/inertia relative error
-  /// The residual monitor raises the faults in place of the stuck-encoder monitor (in-process
-  /// controller only; otherwise it runs as a trial: computed and reported, docs/safety.md).
+  /// The residual monitor raises the faults in place of the stuck-encoder monitor (the runtime
+  /// parameter residual_monitor; in-process controller only: an image runs it as a trial unless its
+  /// parameter is set, docs/safety.md).
   bool residual_monitor = false;
   /// What a collision does, and each joint's collision threshold [N m] (0: the derived threshold
   /// alone); with residual_monitor only (osc::ControlTask::set_collision).
@@ -136,6 +137,8 @@ constexpr const char* runtime_param_key(osc::RuntimeParam p) {
       return "run.collision_reaction";
     case osc::RuntimeParam::kParamCollisionThreshold:
       return "run.collision_threshold";
+    case osc::RuntimeParam::kParamResidualMonitor:
+      return "run.residual_monitor";
     default:
       return nullptr;
   }

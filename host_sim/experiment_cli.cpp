@@ -218,7 +218,8 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
     if (o.base.residual_monitor)
       return err =
                  "run.residual_monitor=on applies to the host-built controller only, not with --qemu (the "
-                 "firmware image runs the residual monitor as a trial)",
+                 "runner does not set the image's parameters: it runs the residual monitor as a trial; a board "
+                 "arms it with its parameter residual_monitor, e.g. oscctl param set residual_monitor 1)",
              false;
     if (!qemu_takes(o.base.injection, "--inject", err)) return false;
   }

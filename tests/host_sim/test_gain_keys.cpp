@@ -100,6 +100,15 @@ TEST(GainKeys, EveryRuntimeParameterIsAHostKeyWithTheTablesRanges) {
         EXPECT_TRUE(sim::set_key(key, osc::kAdaptationLawNames[k], s, err)) << err;
       continue;
     }
+    if (p.runtime == osc::RuntimeParam::kParamResidualMonitor) {  // trial (0) or on (1)
+      EXPECT_EQ(p.hi, 1);
+      EXPECT_TRUE(sim::set_key(key, "on", s, err)) << err;
+      EXPECT_TRUE(s.base.residual_monitor);
+      EXPECT_TRUE(sim::set_key(key, "trial", s, err)) << err;
+      EXPECT_FALSE(s.base.residual_monitor);
+      EXPECT_FALSE(sim::set_key(key, "1", s, err));
+      continue;
+    }
     if (p.runtime == osc::RuntimeParam::kParamCollisionReaction) {
       EXPECT_EQ(p.hi + 1, osc::MotionNames<osc::CollisionReaction>::kCount);
       for (int k = 0; k < osc::MotionNames<osc::CollisionReaction>::kCount; ++k)

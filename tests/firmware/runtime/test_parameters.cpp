@@ -71,7 +71,7 @@ TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
   }
   EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
   EXPECT_EQ(slots, kParamSlots);
-  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2));
+  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2 + 1));
   EXPECT_EQ(param_index("no_such"), -1);
   EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
 }
@@ -120,9 +120,7 @@ void every_element_sets_and_reads_back() {
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e) {
       const ParamInfo& p = kParams[i];
-      const bool code =
-          p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
-                         p.runtime == RuntimeParam::kParamCollisionReaction || p.runtime == RuntimeParam::kParamPots);
+      const bool code = param_is_code(p);
       // A value between the default and the top of the range, that keeps the observer stable.
       const double v =
           code ? p.hi_of(e) : param_default(i, e) * 0.75 + 0.25 * std::fmin(p.hi_of(e), 4 * param_default(i, e) + 1);
@@ -149,6 +147,15 @@ void every_element_sets_and_reads_back() {
   EXPECT_EQ(t->stream_timeout_ticks, 50u);
   ASSERT_EQ(param_set(*t, param_index("adaptation"), 0, 2.0), ParamStatus::kOk);
   EXPECT_EQ(t->gains.adaptation, AdaptationLaw::kMomentum);
+  const int armed = param_index("residual_monitor");
+  ASSERT_EQ(param_set(*t, armed, 0, 0.0), ParamStatus::kOk);
+  EXPECT_FALSE(t->residual.armed);
+  ASSERT_EQ(param_set(*t, armed, 0, 1.0), ParamStatus::kOk);
+  EXPECT_TRUE(t->residual.armed);
+  EXPECT_EQ(param_set(*t, armed, 0, 0.5), ParamStatus::kOutOfRange);  // a switch: 0 or 1
+  EXPECT_TRUE(t->residual.armed);
+  ASSERT_EQ(param_set(*t, armed, 0, 0.0), ParamStatus::kOk);
+  EXPECT_FALSE(t->residual.armed);
 }
 TEST(Parameters, EveryElementSetsAndReadsBackDouble) { every_element_sets_and_reads_back<double>(); }
 TEST(Parameters, EveryElementSetsAndReadsBackFloat) { every_element_sets_and_reads_back<float>(); }
@@ -183,6 +190,9 @@ TEST(Parameters, EachBadSetIsRefusedByNameAndChangesNothing) {
   t->machine.state = MotionState::kHolding;
   EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kTorqueOn);
   EXPECT_EQ(param_set(*t, law, 0, 0.0), ParamStatus::kTorqueOn);
+  // The monitors are not swapped under a running arm.
+  EXPECT_EQ(param_set(*t, param_index("residual_monitor"), 0, 1.0), ParamStatus::kTorqueOn);
+  EXPECT_FALSE(t->residual.armed);
   const ParamRecord mid = param_capture(*t);
   for (int k = 0; k < kParamSlots; ++k) EXPECT_EQ(mid.value[k], before.value[k]) << k;
   EXPECT_EQ(param_set(*t, thr, 0, 30.0), ParamStatus::kOk);
@@ -300,7 +310,7 @@ TEST(Parameters, LayoutVersionIsOfTheTable) {
   EXPECT_NE(kParamLayout, 0);
   // A fixed value: a change of any name or element count changes it, and this test with it (the
   // stored records of the old table are then not loaded: layout_mismatch).
-  EXPECT_EQ(kParamLayout, 39635);
+  EXPECT_EQ(kParamLayout, 2123);
 }
 
 // ------------------------------------------------------------------------------- over the link

@@ -107,7 +107,10 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
   X(Pots, "pots", 1, "", 0, 1, 1, TorqueOff, true,                                                                    \
     "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them")                  \
   X(HomeSpeed, "home_speed", 2, "m/s, rad/s", detail::kHomeSpeedLo, detail::kHomeSpeedHi, params::kHomeSpeed, Always, \
-    true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")
+    true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")          \
+  X(ResidualMonitor, "residual_monitor", 1, "", 0, 1, 0, TorqueOff, true,                                             \
+    "0: the residual monitor a trial (recorded; the stuck-encoder monitor raises encoder_stuck); 1: "                 \
+    "armed: it raises encoder_stuck, drive_fault, collision (the stuck-encoder monitor its backstop)")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),
@@ -356,6 +359,8 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return task.pots ? 1.0 : 0.0;
     case RuntimeParam::kParamHomeSpeed:
       return static_cast<double>(task.home_speed[e]);
+    case RuntimeParam::kParamResidualMonitor:
+      return task.residual.armed ? 1.0 : 0.0;
     case RuntimeParam::kCount:
       break;
   }
@@ -396,6 +401,9 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamHomeSpeed:
       task.home_speed[e] = static_cast<S>(v);
       break;
+    case RuntimeParam::kParamResidualMonitor:
+      task.residual.armed = v != 0;
+      break;
     case RuntimeParam::kCount:
       break;
   }
@@ -423,6 +431,13 @@ constexpr ParamStatus param_address_status(int i, int e) {
   return e < 0 || e >= kParams[i].count ? ParamStatus::kBadElement : ParamStatus::kOk;
 }
 
+/// Whether parameter p's values are the codes of an enumeration or a switch (whole numbers).
+constexpr bool param_is_code(const ParamInfo& p) {
+  return p.gain < 0 &&
+         (p.runtime == RuntimeParam::kParamAdaptation || p.runtime == RuntimeParam::kParamCollisionReaction ||
+          p.runtime == RuntimeParam::kParamPots || p.runtime == RuntimeParam::kParamResidualMonitor);
+}
+
 /// Whether v is a valid value of element e of parameter i (finite, in range and within the scalar
 /// S, a whole number for an enumeration's code).
 template <class S = double>
@@ -431,10 +446,7 @@ ParamStatus param_value_status(int i, int e, double v) {
   const ParamInfo& p = kParams[i];
   if (!std::isfinite(v)) return ParamStatus::kNotFinite;
   if (v < p.lo_of(e) || v > p.hi_of(e) || std::fabs(v) >= param_scalar_max<S>()) return ParamStatus::kOutOfRange;
-  const bool code =
-      p.gain < 0 && (p.runtime == RuntimeParam::kParamAdaptation ||
-                     p.runtime == RuntimeParam::kParamCollisionReaction || p.runtime == RuntimeParam::kParamPots);
-  if (code && v != std::floor(v)) return ParamStatus::kOutOfRange;
+  if (param_is_code(p) && v != std::floor(v)) return ParamStatus::kOutOfRange;
   return ParamStatus::kOk;
 }
 
