@@ -77,6 +77,24 @@ assert got == [("enable", None, True), ("move_to", "not_homed", False), ("home",
                ("move_to", None, True), ("disable", None, True), ("declare_pose", "pots_disagree", False)], got
 PY
   ;;
+real_arm)  # docs/experiment.md: from power-on pose 5 the paper's gains vibrate the realistic wrist
+  # until a monitor stops it; examples/real_arm.yaml's (the observer's rotational k doubled) run clean
+  run() {
+    "$exe" --plant realistic --motion "$examples/home_then_paper.yaml" --set plant.power_on_pose=random:5 \
+      --set run.residual_monitor=on --json "$d/$1.json" "${@:2}" >"$d/$1.txt" 2>&1
+  }
+  run paper
+  rc=$?
+  test $rc -eq 1 || fail "exit $rc, not 1 (a fault): $(cat "$d/paper.txt")"
+  run real --config "$examples/real_arm.yaml" || fail "exit $?: $(cat "$d/real.txt")"
+  "$py" - "$d/paper.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/real.txt")"
+import json, sys
+paper, real = (json.load(open(f)) for f in sys.argv[1:])
+assert paper["faults"] in (["collision"], ["drive_fault"]), paper["faults"]
+assert real["faults"] == [], real["faults"]
+assert [(c["cmd"], c["refused"]) for c in real["commands"]][:3] == [("enable", None), ("home", None), ("paper", None)]
+PY
+  ;;
 power_on_pose_named_errors)  # a bad plant.power_on_pose, and one without a motion script, are named errors
   for v in random:x random: '[1, 2, 3]' '[0, 45, -180, 0, 45, 999]' north; do
     out=$("$exe" --motion "$examples/homing.yaml" --set "plant.power_on_pose=$v" --json "$d/o.json" 2>&1)
