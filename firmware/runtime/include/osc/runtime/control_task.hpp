@@ -723,8 +723,8 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.ramping = true;
     task.ramp_start = next;
   }
-  if (accepted && cmd.verb == MotionVerb::kMoveTo) {
-    if (cmd.brake) {
+  if (accepted && (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome)) {  // a planned move
+    if (cmd.brake) {  // a re-target (a home starts from holding only)
       task.report.aborted_id = task.gen.running_id();
       if (task.gen.source() != MotionSource::kHold) task.report.abort = MotionReason::kSuperseded;
       task.gen.brake(next, params::kControlHz, task.limits);
@@ -733,12 +733,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_moves(next);
     task.q_queue_end = cmd.q_end;
   }
-  if (accepted && cmd.verb == MotionVerb::kHome) {
-    task.gen.push(cmd.move, cmd.id);
-    task.gen.start_moves(next);
-    task.q_queue_end = cmd.q_end;
-    start_homing(task, cmd.id);
-  }
+  if (accepted && cmd.verb == MotionVerb::kHome) start_homing(task, cmd.id);
   if (accepted && cmd.verb == MotionVerb::kDeclarePose) declare_pose(task, q, cmd.pose);
   if (before == MotionState::kHoming && st.machine.state != MotionState::kHoming) end_homing(task);
   if (st.completion == MotionCompletion::kHomed) finish_homing(task, q);
