@@ -341,7 +341,7 @@ struct ResidualRig {
     const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
     Vec6<S> decay = Vec6<S>::Ones();
     const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr};
-    const std::uint32_t f = m.check(in, io, counts, moved, tick, lit<S>(dt));
+    const std::uint32_t f = m.check(in, io, counts, moved, tick);
     m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
     if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);
     ++tick;

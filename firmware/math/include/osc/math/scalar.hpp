@@ -165,6 +165,16 @@ inline double abs(double v) { return std::fabs(v); }
 inline double atan2(double y, double x) { return std::atan2(y, x); }
 inline double asin(double v) { return std::asin(v); }
 inline bool isfinite(double v) { return std::isfinite(v); }
+/// a b + c rounded once (IEEE 754's fusedMultiplyAdd): one instruction on the M4F's FPU (vfma.f32)
+/// and the C library's fma on the host, the same bits on both. The build's -ffp-contract=off keeps
+/// the compiler from fusing a b + c where the source does not ask for it; this asks. In fixed point,
+/// a b + c.
+inline float mul_add(float a, float b, float c) { return std::fma(a, b, c); }
+inline double mul_add(double a, double b, double c) { return std::fma(a, b, c); }
+template <class S>
+inline S mul_add(S a, S b, S c) {
+  return a * b + c;
+}
 /// sin v and cos v together (one argument reduction in fixed point).
 inline void sincos(float v, float& s, float& c) { detail::sincos_float(v, s, c); }
 inline void sincos(double v, double& s, double& c) { s = std::sin(v), c = std::cos(v); }

@@ -247,46 +247,78 @@ struct StuckEncoderMonitor {
 };
 
 /// The residual monitor's constants of the arm, in the scalar S (robot::kModelErrorBounds, the
-/// drive train's motor-inertia sets, the DACs' full scale): built at compile time.
+/// drive train's motor-inertia sets, the DACs' full scale, the filters' gains at the control rate
+/// params::kDt): built at compile time, so that a tick multiplies no two constants.
 template <class S>
 struct ResidualConstants {
-  S vis_lo[kDof], vis_hi[kDof], cou_lo[kDof], cou_hi[kDof], sti_lo[kDof], sti_hi[kDof];
+  // The friction band per coefficient as its middle and half-width: theta^'s farthest distance from
+  // the band is |theta^ - mid| + half.
+  S vis_mid[kDof], vis_half[kDof], cou_mid[kDof], cou_half[kDof], sti_mid[kDof], sti_half[kDof];
+  S vis_hi[kDof];          // the viscous band's upper end [N m s/rad]
+  S static_band[kDof];     // the Coulomb and Stribeck bands' upper ends together [N m]
   S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
   S offset[kDof];          // an amplifier's offset bound [N m]
   S full_scale[kDof];      // a channel's full-scale torque [N m]
+  S gain[kDof];            // the residual's filter gain K [1/s]
+  S gain_dt[kDof];         // K dt
+  S keep[kDof];            // 1 - K dt: what the filter keeps of its last value
+  S quantum_gain[kDof];    // 2 K: the velocity noise's bound through A and the filter, per rad/s [1/s]
+  S lag_gain[kDof];        // T K: the current loop's lag T times K
+  S peak_margin[kDof];     // params::kResidualMargin times the joint's peak factor
   S link_inertia, gain_ripple, amp_gain, ripple;
-  S amp_lag;  // the current loop's time constant [s]
+  S slow_dt;  // params::kResidualSlowGain dt
+  S margin;   // params::kResidualMargin
   constexpr ResidualConstants()
-      : vis_lo{},
+      : vis_mid{},
+        vis_half{},
+        cou_mid{},
+        cou_half{},
+        sti_mid{},
+        sti_half{},
         vis_hi{},
-        cou_lo{},
-        cou_hi{},
-        sti_lo{},
-        sti_hi{},
+        static_band{},
         armature_delta{},
         offset{},
         full_scale{},
+        gain{},
+        gain_dt{},
+        keep{},
+        quantum_gain{},
+        lag_gain{},
+        peak_margin{},
         link_inertia{},
         gain_ripple{},
         amp_gain{},
         ripple{},
-        amp_lag{} {
+        slow_dt{},
+        margin{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
+    const FrictionCoefficients &lo = b.friction_lo, &hi = b.friction_hi;
     for (int i = 0; i < kDof; ++i) {
-      vis_lo[i] = lit<S>(b.friction_lo.vis[i]), vis_hi[i] = lit<S>(b.friction_hi.vis[i]);
-      cou_lo[i] = lit<S>(b.friction_lo.cou[i]), cou_hi[i] = lit<S>(b.friction_hi.cou[i]);
-      sti_lo[i] = lit<S>(b.friction_lo.sti[i]), sti_hi[i] = lit<S>(b.friction_hi.sti[i]);
+      vis_mid[i] = lit<S>(0.5 * (lo.vis[i] + hi.vis[i])), vis_half[i] = lit<S>(0.5 * (hi.vis[i] - lo.vis[i]));
+      cou_mid[i] = lit<S>(0.5 * (lo.cou[i] + hi.cou[i])), cou_half[i] = lit<S>(0.5 * (hi.cou[i] - lo.cou[i]));
+      sti_mid[i] = lit<S>(0.5 * (lo.sti[i] + hi.sti[i])), sti_half[i] = lit<S>(0.5 * (hi.sti[i] - lo.sti[i]));
+      vis_hi[i] = lit<S>(hi.vis[i]);
+      static_band[i] = lit<S>(hi.cou[i] + hi.sti[i]);
       const double G = abs_of(robot::kArm.links[i].gear_ratio);
       armature_delta[i] =
           lit<S>(abs_of(robot::kDriveTrain.motor_inertia_alt.jm[i] - robot::kArm.links[i].motor_inertia) * G * G);
       offset[i] = lit<S>(b.amp_offset * robot::kDrives.torque_limit[i]);
       full_scale[i] = lit<S>(robot::kDrives.torque_limit[i]);
+      const double K = params::kResidualGain[i];
+      gain[i] = lit<S>(K);
+      gain_dt[i] = lit<S>(K * params::kDt);
+      keep[i] = lit<S>(1 - K * params::kDt);
+      quantum_gain[i] = lit<S>(2 * K);
+      lag_gain[i] = lit<S>(b.amp_lag * K);
+      peak_margin[i] = lit<S>(params::kResidualMargin * params::kResidualPeakFactor[i]);
     }
     link_inertia = lit<S>(b.link_inertia);
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
     amp_gain = lit<S>(b.amp_gain);
     ripple = lit<S>(b.ripple);
-    amp_lag = lit<S>(b.amp_lag);
+    slow_dt = lit<S>(params::kResidualSlowGain * params::kDt);
+    margin = lit<S>(params::kResidualMargin);
   }
 };
 template <class S>
@@ -408,47 +440,54 @@ struct ResidualMonitor {
   /// The joint torque that reached the arm over the period that follows this tick.
   void applied(const Vec6<S>& tau) { tau_prev = tau; }
 
-  /// The residual of this step and its faults (see the type's comment).
+  /// The residual of this step and its faults (see the type's comment), a step every params::kDt.
+  /// The joints' accelerations and A's rows against them first (each joint's thresholds read every
+  /// joint's), then one pass per joint: its friction, bound, filters, change channel and thresholds.
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
-                      const bool moved[kDof], std::uint64_t tick, S dt) {
+                      const bool moved[kDof], std::uint64_t tick) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
     activity.track(counts, moved, tick);
     sample.settled = false;
-    FrictionError fe[kDof];
-    for (int i = 0; i < kDof; ++i) fe[i] = friction_error(in, i, tick);
-    if (!primed) {
+    const bool prime = !primed;  // the first step after a reset: no previous step to difference
+    if (prime) {
       qd_prev = in.qd;
       bias_prev = in.bias;
       r.setZero();
       acc.setZero();
       prime_change();
-      bound = pointwise_bound(in, fe);
-      update_thresholds(in.A, fe);
-      for (int i = 0; i < kDof; ++i) over[i] = 0;
-      primed = true;
-      return 0;
     }
-    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
-    const Vec6<S> dqd = in.qd - qd_prev;
-    const Vec6<S> u = in.A * dqd + dt * (bias_prev - tau_prev), b = pointwise_bound(in, fe);
-    for (int i = 0; i < kDof; ++i) {
-      const S K = kGain[i], Kdt = K * dt;
-      r(i) += K * u(i) - Kdt * r(i);
-      acc(i) += K * dqd(i) - Kdt * acc(i);
-      bound(i) += Kdt * (b(i) - bound(i));
-    }
-    if (sample_joint >= 0) take_sample(sample_joint, fe[sample_joint]);
-    update_change(in, fe, dt);
-    update_thresholds(in.A, fe);
-    qd_prev = in.qd;
-    bias_prev = in.bias;
+    const Motion m = motion(in);
     int worst = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) {
+      const FrictionError e = friction_error(in, i, tick, m.moving_speed[i]);
+      const S b = pointwise_bound(in, e, i);
+      Changes ch{};
+      if (prime) {
+        bound(i) = b;
+      } else {
+        static constexpr S kDt = lit<S>(params::kDt);
+        r(i) = math::mul_add(c.gain[i], math::mul_add(kDt, bias_prev(i) - tau_prev(i), m.u[i]), c.keep[i] * r(i));
+        low_pass(bound(i), b, c.gain_dt[i]);
+        if (i == sample_joint) take_sample(i, e);
+        ch = update_change(in, e, i);
+      }
+      update_thresholds(e, ch, m, i);
+      qd_prev(i) = in.qd(i);
+      bias_prev(i) = in.bias(i);
+      if (prime) {
+        over[i] = 0;
+        continue;
+      }
       const S ratio = ratio_of(i);
       if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
       if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
       over[i] = qualify(over[i], ratio > S(1));
       if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
+    }
+    if (prime) {
+      primed = true;
+      return 0;
     }
     if (worst < 0) return 0;
     const std::uint32_t kind = classify(worst, io, tick);
@@ -469,6 +508,44 @@ struct ResidualMonitor {
   }
 
  private:
+  /// This step's joint motion and A's rows against it: per joint, the speed beyond which it may
+  /// count as moving (its noise, and its lag at the acceleration filtered before this step), the
+  /// filtered acceleration's size and change, the residual's inertial input (A times q^dot's
+  /// change), and |A| times the accelerations, their changes and the velocity noise.
+  struct Motion {
+    S moving_speed[kDof], a[kDof], da[kDof];
+    S u[kDof], inertia[kDof], inertia_change[kDof], noise[kDof];
+  };
+  Motion motion(const ResidualInput<S>& in) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    Motion m;
+    S dqd[kDof];
+    for (int j = 0; j < kDof; ++j) {
+      m.moving_speed[j] = math::mul_add(lag, math::abs(acc(j)), velocity_noise(j));
+      dqd[j] = in.qd(j) - qd_prev(j);
+      acc(j) = math::mul_add(c.gain[j], dqd[j], c.keep[j] * acc(j));
+      low_pass(acc_slow(j), acc(j), c.slow_dt);
+      m.a[j] = math::abs(acc(j));
+      m.da[j] = math::abs(acc(j) - acc_slow(j));
+      m.u[j] = m.inertia[j] = m.inertia_change[j] = m.noise[j] = S(0);
+    }
+    // Column by column: each of A's coefficients is read once.
+    for (int j = 0; j < kDof; ++j)
+      for (int i = 0; i < kDof; ++i) {
+        const S aij = in.A(i, j), mag = math::abs(aij);
+        m.u[i] = math::mul_add(aij, dqd[j], m.u[i]);
+        m.inertia[i] = math::mul_add(mag, m.a[j], m.inertia[i]);
+        m.inertia_change[i] = math::mul_add(mag, m.da[j], m.inertia_change[i]);
+        m.noise[i] = math::mul_add(mag, velocity_noise(j), m.noise[i]);
+      }
+    return m;
+  }
+  /// y filtered toward x at the gain g (K dt): y + g (x - y), one rounding.
+  static void low_pass(S& y, S x, S g) { y = math::mul_add(g, x - y, y); }
+  /// A joint's regressor changes (their filtered values less their slow parts), signed.
+  struct Changes {
+    S vis, cou, sti, estimate, gravity, coriolis, torque;
+  };
   void prime_change() {
     d.setZero();
     r_slow.setZero();
@@ -506,108 +583,92 @@ struct ResidualMonitor {
       if (over[j] >= params::kResidualQualifyTicks && math::abs(r(j)) > collision_floor(j)) return true;
     return false;
   }
-  /// Joint i's friction against the band (FrictionError).
-  FrictionError friction_error(const ResidualInput<S>& in, int i, std::uint64_t tick) const {
+  /// Joint i's friction against the band (FrictionError); `moving` is the speed beyond which the
+  /// joint may count as moving (Motion::moving_speed).
+  FrictionError friction_error(const ResidualInput<S>& in, int i, std::uint64_t tick, S moving) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
-    const S v = math::abs(in.qd(i));
-    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
-    const S moving = velocity_noise(i) + lag * math::abs(acc(i));
-    const auto larger = [](S x, S y) { return x > y ? x : y; };
+    using math::abs;
     FrictionError e;
-    e.th_v = in.theta ? (*in.theta)(i) : S(0);
-    e.th_c = in.theta ? (*in.theta)(kDof + i) : S(0);
-    e.th_s = in.theta ? (*in.theta)(2 * kDof + i) : S(0);
-    e.dv = larger(c.vis_hi[i] - e.th_v, e.th_v - c.vis_lo[i]);
-    e.dc = larger(c.cou_hi[i] - e.th_c, e.th_c - c.cou_lo[i]);
-    e.ds = larger(c.sti_hi[i] - e.th_s, e.th_s - c.sti_lo[i]);
+    if (in.theta) {
+      const Vec18<S>& th = *in.theta;
+      e.th_v = th(i), e.th_c = th(kDof + i), e.th_s = th(2 * kDof + i);
+    } else {
+      e.th_v = e.th_c = e.th_s = S(0);
+    }
+    e.dv = abs(e.th_v - c.vis_mid[i]) + c.vis_half[i];
+    e.dc = abs(e.th_c - c.cou_mid[i]) + c.cou_half[i];
+    e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
     // Static friction anywhere within the band, against whatever the estimate says.
-    e.still = c.cou_hi[i] + c.sti_hi[i] + c.vis_hi[i] * moving + math::abs(in.tau_f(i));
-    e.moving = v > moving && activity.counting(i, in.qd(i) > S(0), tick);
+    e.still = math::mul_add(c.vis_hi[i], moving, c.static_band[i]) + abs(in.tau_f(i));
+    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
+    e.moving = abs(in.qd(i)) > moving && activity.counting(i, in.qd(i) > S(0), tick);
     return e;
   }
-  /// Per joint, the bound on the unexplained torque that changes with the state (then filtered as
-  /// r): friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
-  Vec6<S> pointwise_bound(const ResidualInput<S>& in, const FrictionError (&fe)[kDof]) const {
+  /// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
+  /// friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
+  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
-    Vec6<S> b;
-    for (int i = 0; i < kDof; ++i) {
-      const FrictionError& e = fe[i];
-      // Moving: the band's distance from the estimate, coefficient by coefficient.
-      const S friction =
-          e.moving ? math::abs(in.qd(i)) * e.dv + e.dc + in.decay(i) * e.ds + c.vis_hi[i] * velocity_noise(i) : e.still;
-      const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
-      b(i) = friction + cross_friction(i) + c.gain_ripple * math::abs(tau_prev(i)) + c.offset[i] +
-             c.link_inertia * (math::abs(in.g(i)) + math::abs(coriolis));
-    }
-    return b;
+    using math::mul_add;
+    // Moving: the band's distance from the estimate, coefficient by coefficient.
+    const S friction = e.moving ? mul_add(math::abs(in.qd(i)), e.dv,
+                                          mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
+                                : e.still;
+    const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
+    return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(coriolis),
+                   mul_add(c.gain_ripple, math::abs(tau_prev(i)), friction + cross_friction(i) + c.offset[i]));
   }
-  /// The change channel: each regressor of the model's error filtered as r, then slowly. A model
-  /// error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
+  /// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
+  /// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
   /// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
   /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
   /// anything within its static band, from one end to the other (twice the band), and keeps it in
   /// the change threshold until the slow filter forgets it.
-  void update_change(const ResidualInput<S>& in, const FrictionError (&fe)[kDof], S dt) {
-    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
-    static constexpr S kSlow = lit<S>(params::kResidualSlowGain);
-    const S Ks = kSlow * dt;
-    for (int i = 0; i < kDof; ++i) {
-      const S Kdt = kGain[i] * dt;
-      const S sign = in.qd(i) > S(0) ? S(1) : (in.qd(i) < S(0) ? S(-1) : S(0));
-      const S phi[kRegressors] = {in.qd(i),
-                                  sign,
-                                  sign * in.decay(i),
-                                  in.tau_f(i),
-                                  in.g(i),
-                                  in.bias(i) - in.g(i) - in.tau_f(i),
-                                  tau_prev(i),
-                                  math::abs(tau_prev(i))};
-      for (int k = 0; k < kRegressors; ++k) {
-        reg[k](i) += Kdt * (phi[k] - reg[k](i));
-        if (k != kTorqueSize) reg_slow[k](i) += Ks * (reg[k](i) - reg_slow[k](i));  // |tau|: its size alone
-      }
-      acc_slow(i) += Ks * (acc(i) - acc_slow(i));
-      r_slow(i) += Ks * (r(i) - r_slow(i));
-      d(i) = r(i) - r_slow(i);
-      stillness(i) = fe[i].moving ? stillness(i) - Ks * stillness(i) : S(1);
-    }
-  }
-  /// The regressor k's change in joint i (its filtered value less its slow part).
-  S signed_change(int k, int i) const { return reg[k](i) - reg_slow[k](i); }
-  S change(int k, int i) const { return math::abs(signed_change(k, i)); }
-  /// The thresholds: the filtered bound, the inertias' error on the filtered accelerations, and the
-  /// velocity estimate's noise through A and the filter.
-  void update_thresholds(const Mat6<S>& A, const FrictionError (&fe)[kDof]) {
+  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, int i) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
-    static constexpr std::array<S, kDof> kGain = lit_array<S>(params::kResidualGain);
-    static constexpr std::array<S, kDof> kPeak = lit_array<S>(params::kResidualPeakFactor);
-    static constexpr S kMargin = lit<S>(params::kResidualMargin);
-    const Vec6<S> a = acc.cwiseAbs(), da = (acc - acc_slow).cwiseAbs();
-    for (int i = 0; i < kDof; ++i) {
-      // |A| times the accelerations, their changes and the velocity noise, in one pass over A's row.
-      S inertia = S(0), inertia_change = S(0), noise = S(0);
-      for (int j = 0; j < kDof; ++j) {
-        const S aij = math::abs(A(i, j));
-        inertia += aij * a(j), inertia_change += aij * da(j), noise += aij * velocity_noise(j);
-      }
-      const S quantum = S(2) * kGain[i] * noise;
-      noise_bound(i) = quantum;
-      // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
-      const S loop = c.amp_lag * kGain[i] * math::abs(tau_prev(i) - reg[kTorque](i));
-      threshold(i) =
-          kMargin * (kPeak[i] * (bound(i) + c.link_inertia * inertia + c.armature_delta[i] * a(i) + loop) + quantum);
-      const FrictionError& e = fe[i];
-      // The friction error (theta - theta^)^T w: the band's distances times the regressors'
-      // changes at the estimate of now, plus what the estimate's own change added.
-      const S learnt = signed_change(kEstimate, i) - e.th_v * signed_change(kVis, i) - e.th_c * signed_change(kCou, i) -
-                       e.th_s * signed_change(kSti, i);
-      const S friction = e.dv * change(kVis, i) + e.dc * change(kCou, i) + e.ds * change(kSti, i) + math::abs(learnt) +
-                         c.vis_hi[i] * velocity_noise(i) + S(2) * stillness(i) * e.still + S(2) * cross_friction(i);
-      const S model =
-          c.link_inertia * (inertia_change + change(kGravity, i) + change(kCoriolis, i)) + c.armature_delta[i] * da(i);
-      const S amplifier = c.amp_gain * change(kTorque, i) + c.ripple * reg[kTorqueSize](i) + loop;
-      change_threshold(i) = kMargin * (kPeak[i] * (friction + model + amplifier) + quantum);
-    }
+    const S Ks = c.slow_dt, Kdt = c.gain_dt[i];
+    const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
+    // Filtered as r, then slowly: the regressor's change.
+    const auto band = [&](int k, S phi) {
+      low_pass(reg[k](i), phi, Kdt);
+      low_pass(reg_slow[k](i), reg[k](i), Ks);
+      return reg[k](i) - reg_slow[k](i);
+    };
+    Changes ch;
+    ch.vis = band(kVis, qd);
+    ch.cou = band(kCou, sign);
+    ch.sti = band(kSti, sign * in.decay(i));
+    ch.estimate = band(kEstimate, in.tau_f(i));
+    ch.gravity = band(kGravity, in.g(i));
+    ch.coriolis = band(kCoriolis, in.bias(i) - in.g(i) - in.tau_f(i));
+    ch.torque = band(kTorque, tau_prev(i));
+    low_pass(reg[kTorqueSize](i), math::abs(tau_prev(i)), Kdt);  // |tau|: its size alone
+    low_pass(r_slow(i), r(i), Ks);
+    d(i) = r(i) - r_slow(i);
+    stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
+    return ch;
+  }
+  /// Joint i's thresholds: the filtered bound, the inertias' error on the filtered accelerations, and
+  /// the velocity estimate's noise through A and the filter. `ch`: the regressors' changes (zero
+  /// when priming).
+  void update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    using math::abs;
+    using math::mul_add;
+    const S quantum = c.quantum_gain[i] * m.noise[i], margin_quantum = c.margin * quantum;
+    noise_bound(i) = quantum;
+    // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
+    const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
+    const S pointwise = mul_add(c.link_inertia, m.inertia[i], mul_add(c.armature_delta[i], m.a[i], bound(i) + loop));
+    threshold(i) = mul_add(c.peak_margin[i], pointwise, margin_quantum);
+    // The friction error (theta - theta^)^T w: the band's distances times the regressors'
+    // changes at the estimate of now, plus what the estimate's own change added.
+    const S learnt = ch.estimate - mul_add(e.th_v, ch.vis, mul_add(e.th_c, ch.cou, e.th_s * ch.sti));
+    const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
+                       mul_add(c.vis_hi[i], velocity_noise(i), S(2) * mul_add(stillness(i), e.still, cross_friction(i)));
+    const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
+                            c.armature_delta[i] * m.da[i]);
+    const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
+    change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
   }
   /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
   /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
@@ -786,3 +847,4 @@ struct SaturationMonitor {
 };
 
 }  // namespace osc
+
