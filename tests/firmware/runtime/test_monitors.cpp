@@ -458,6 +458,38 @@ TYPED_TEST(Monitors, TheChangeChannelIgnoresASlowDriftAndCatchesAStep) {
   }
 }
 
+// A joint that counts slowly one way may be creeping in stick-slip, its friction anywhere within
+// the static band however steady its velocity estimate: it keeps that band in both channels
+// (params::kResidualSlideInterval). The same friction flipping on a joint that counts every tick,
+// sliding, is a fault: its change threshold has left the static band out.
+TYPED_TEST(Monitors, ACreepingJointKeepsItsStaticBand) {
+  using S = TypeParam;
+  constexpr int kJ = 3;  // J4
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  const double band = b.friction_hi.cou[kJ] + b.friction_hi.sti[kJ];
+  // After 1 s of steady motion, an unexplained torque of +-half the band, flipping every 80 ms.
+  const auto run = [&](int interval) {
+    ResidualRig<S> rig;
+    rig.m.armed = true;
+    rig.qd(kJ) = 1 / (counts_per_rad(kJ) * interval * params::kDt);  // a count every `interval` ticks
+    std::uint32_t kind = 0;
+    for (int n = 0; n < 3000 && kind == 0; ++n) {
+      bool counting[kDof] = {};
+      counting[kJ] = n % interval == 0;
+      Vec6<double> ext = Vec6<double>::Zero();
+      if (n >= 1000) ext(kJ) = ((n / 80) % 2 ? 0.5 : -0.5) * band;
+      kind = rig.step(ext, counting, false);
+    }
+    return std::make_pair(kind, static_cast<double>(rig.m.peak_ratio(kJ)));
+  };
+  // J4's creep in the sweep: a count every 10 ticks (0.008 rad/s at its quantum on the real arm).
+  const auto [creep_kind, creep_ratio] = run(10);
+  EXPECT_EQ(creep_kind, 0u);
+  EXPECT_LT(creep_ratio, 0.5);
+  const auto [slide_kind, slide_ratio] = run(params::kResidualSlideInterval);
+  EXPECT_EQ(slide_kind, static_cast<std::uint32_t>(kFaultDriveFault)) << slide_ratio;
+}
+
 // A still joint is judged against its whole static-friction band (Coulomb plus Stribeck at the
 // band's top, robot::kModelErrorBounds), which every friction preset of the arm lies within.
 TEST(Residual, AStillJointsThresholdCoversTheStaticFrictionOfEveryPreset) {

@@ -110,6 +110,14 @@ constexpr double kResidualSlowGain = 10;
 /// sweep of healthy runs checks exactly that (docs/safety.md); the rest is room for what the bounds
 /// leave out.
 constexpr double kResidualMargin = 2;
+/// A joint whose friction the residual monitor takes on the model's sliding curve has counted within
+/// this many ticks of its last count (besides counting one way, beyond its velocity noise and lag):
+/// 0.017-0.02 rad/s at the joints' quanta. Slower, a joint held against its static friction may
+/// creep in stick-slip, its friction anywhere within the static band while its velocity estimate
+/// shows a steady crawl, and it is judged against that band. Measured: J4 held after a noisy stream
+/// (Corke's friction, uncompensated) crept at 0.008 rad/s, a count every 10 ticks, for seconds;
+/// judged as sliding, it reached 1.03 of its change threshold (docs/safety.md).
+constexpr int kResidualSlideInterval = 5;
 /// Friction identified from the residual (the `momentum` law, osc/control/identification.hpp;
 /// docs/adaptation.md, "Identification from the residual"):
 /// - each joint's Kalman update comes every kIdentifyEvery ticks, the joints in turn (the filtered

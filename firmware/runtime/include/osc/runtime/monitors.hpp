@@ -154,6 +154,11 @@ struct EncoderActivity {
     return steady[c] && (direction[c] > 0) == up && move_interval[c] < kStuckIntervalCap &&
            tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
   }
+  /// Channel c counts the way `up` says (counting) at least every params::kResidualSlideInterval
+  /// ticks: a sliding joint, not one creeping in stick-slip.
+  bool sliding(int c, bool up, std::uint64_t tick) const {
+    return counting(c, up, tick) && move_interval[c] <= static_cast<std::uint32_t>(params::kResidualSlideInterval);
+  }
   /// Channel c was counting one way, fast: its last two changes of one sign, at most
   /// params::kStuckFastInterval ticks apart.
   bool was_fast(int c) const {
@@ -600,8 +605,9 @@ struct ResidualMonitor {
     e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
     // Static friction anywhere within the band, against whatever the estimate says.
     e.still = math::mul_add(c.vis_hi[i], moving, c.static_band[i]) + abs(in.tau_f(i));
-    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag.
-    e.moving = abs(in.qd(i)) > moving && activity.counting(i, in.qd(i) > S(0), tick);
+    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag;
+    // the joint slides (its friction on the model's curve) when it counts fast enough besides.
+    e.moving = abs(in.qd(i)) > moving && activity.sliding(i, in.qd(i) > S(0), tick);
     return e;
   }
   /// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
@@ -663,8 +669,9 @@ struct ResidualMonitor {
     // The friction error (theta - theta^)^T w: the band's distances times the regressors'
     // changes at the estimate of now, plus what the estimate's own change added.
     const S learnt = ch.estimate - mul_add(e.th_v, ch.vis, mul_add(e.th_c, ch.cou, e.th_s * ch.sti));
-    const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
-                       mul_add(c.vis_hi[i], velocity_noise(i), S(2) * mul_add(stillness(i), e.still, cross_friction(i)));
+    const S friction =
+        mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
+        mul_add(c.vis_hi[i], velocity_noise(i), S(2) * mul_add(stillness(i), e.still, cross_friction(i)));
     const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
                             c.armature_delta[i] * m.da[i]);
     const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
@@ -847,4 +854,3 @@ struct SaturationMonitor {
 };
 
 }  // namespace osc
-
