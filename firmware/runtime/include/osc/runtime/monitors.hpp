@@ -154,11 +154,9 @@ struct EncoderActivity {
     return steady[c] && (direction[c] > 0) == up && move_interval[c] < kStuckIntervalCap &&
            tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
   }
-  /// Channel c counts the way `up` says (counting) at least every params::kResidualSlideInterval
-  /// ticks: a sliding joint, not one creeping in stick-slip.
-  bool sliding(int c, bool up, std::uint64_t tick) const {
-    return counting(c, up, tick) && move_interval[c] <= static_cast<std::uint32_t>(params::kResidualSlideInterval);
-  }
+  /// Channel c's last two changes at most params::kResidualSlideInterval ticks apart: counting (as
+  /// above), a sliding joint, not one creeping in stick-slip.
+  bool sliding(int c) const { return move_interval[c] <= static_cast<std::uint32_t>(params::kResidualSlideInterval); }
   /// Channel c was counting one way, fast: its last two changes of one sign, at most
   /// params::kStuckFastInterval ticks apart.
   bool was_fast(int c) const {
@@ -363,12 +361,13 @@ struct ResidualMonitor {
   /// The model error's regressors, each filtered as r, then slowly (the change channel): the
   /// friction model's three columns, gravity, the Coriolis torque, the applied torque and its size.
   enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kRegressors };
-  /// One joint's friction against the band (robot::kModelErrorBounds): moving, the band's distance
-  /// from theta^ per coefficient; not moving, the static band's extent plus |tau_f^| (still).
+  /// One joint's friction against the band (robot::kModelErrorBounds): sliding, the band's distance
+  /// from theta^ per coefficient; not sliding, the static band's extent plus |tau_f^| (still).
   struct FrictionError {
     S th_v, th_c, th_s;  // theta^'s coefficients of the joint (0 without compensation)
     S dv, dc, ds, still;
-    bool moving;
+    bool moving;   // its direction known: counting one way, q^dot beyond its noise and lag
+    bool sliding;  // ... and counting fast enough that its friction is on the model's curve
   };
 
   Vec6<S> r;                             // the residual [N m]
@@ -606,8 +605,12 @@ struct ResidualMonitor {
     // Static friction anywhere within the band, against whatever the estimate says.
     e.still = math::mul_add(c.vis_hi[i], moving, c.static_band[i]) + abs(in.tau_f(i));
     // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag;
-    // the joint slides (its friction on the model's curve) when it counts fast enough besides.
-    e.moving = abs(in.qd(i)) > moving && activity.sliding(i, in.qd(i) > S(0), tick);
+    // the joint slides (its friction on the model's curve) when it counts fast enough besides. The
+    // stillness envelope and the identification's samples go by the first (a joint that crawls
+    // between counts resets neither).
+    const bool up = in.qd(i) > S(0);
+    e.moving = abs(in.qd(i)) > moving && activity.counting(i, up, tick);
+    e.sliding = e.moving && activity.sliding(i);
     return e;
   }
   /// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
@@ -616,9 +619,9 @@ struct ResidualMonitor {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::mul_add;
     // Moving: the band's distance from the estimate, coefficient by coefficient.
-    const S friction = e.moving ? mul_add(math::abs(in.qd(i)), e.dv,
-                                          mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
-                                : e.still;
+    const S friction = e.sliding ? mul_add(math::abs(in.qd(i)), e.dv,
+                                           mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
+                                 : e.still;
     const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
     return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(coriolis),
                    mul_add(c.gain_ripple, math::abs(tau_prev(i)), friction + cross_friction(i) + c.offset[i]));
@@ -669,9 +672,9 @@ struct ResidualMonitor {
     // The friction error (theta - theta^)^T w: the band's distances times the regressors'
     // changes at the estimate of now, plus what the estimate's own change added.
     const S learnt = ch.estimate - mul_add(e.th_v, ch.vis, mul_add(e.th_c, ch.cou, e.th_s * ch.sti));
-    const S friction =
-        mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
-        mul_add(c.vis_hi[i], velocity_noise(i), S(2) * mul_add(stillness(i), e.still, cross_friction(i)));
+    const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
+                       mul_add(c.vis_hi[i], velocity_noise(i),
+                               S(2) * mul_add(e.sliding ? stillness(i) : S(1), e.still, cross_friction(i)));
     const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
                             c.armature_delta[i] * m.da[i]);
     const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
