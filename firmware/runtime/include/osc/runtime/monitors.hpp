@@ -154,8 +154,8 @@ struct EncoderActivity {
     return steady[c] && (direction[c] > 0) == up && move_interval[c] < kStuckIntervalCap &&
            tick - last_move_tick[c] <= 2 * static_cast<std::uint64_t>(move_interval[c]) + 1;
   }
-  /// Channel c's last two changes at most params::kResidualSlideInterval ticks apart: counting (as
-  /// above), a sliding joint, not one creeping in stick-slip.
+  /// Channel c's last two changes at most params::kResidualSlideInterval ticks apart: with counting
+  /// (above), a sliding joint, not one creeping in stick-slip.
   bool sliding(int c) const { return move_interval[c] <= static_cast<std::uint32_t>(params::kResidualSlideInterval); }
   /// Channel c was counting one way, fast: its last two changes of one sign, at most
   /// params::kStuckFastInterval ticks apart.
@@ -250,7 +250,7 @@ struct StuckEncoderMonitor {
 };
 
 /// The residual monitor's constants of the arm, in the scalar S (robot::kModelErrorBounds, the
-/// drive train's motor-inertia sets, the DACs' full scale, the filters' gains at the control rate
+/// drive train's motor-inertia sets, the amplifiers' offsets, the filters' gains at the control rate
 /// params::kDt): built at compile time, so that a tick multiplies no two constants.
 template <class S>
 struct ResidualConstants {
@@ -261,7 +261,6 @@ struct ResidualConstants {
   S static_band[kDof];     // the Coulomb and Stribeck bands' upper ends together [N m]
   S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
   S offset[kDof];          // an amplifier's offset bound [N m]
-  S full_scale[kDof];      // a channel's full-scale torque [N m]
   S gain[kDof];            // the residual's filter gain K [1/s]
   S gain_dt[kDof];         // K dt
   S keep[kDof];            // 1 - K dt: what the filter keeps of its last value
@@ -282,7 +281,6 @@ struct ResidualConstants {
         static_band{},
         armature_delta{},
         offset{},
-        full_scale{},
         gain{},
         gain_dt{},
         keep{},
@@ -307,7 +305,6 @@ struct ResidualConstants {
       armature_delta[i] =
           lit<S>(abs_of(robot::kDriveTrain.motor_inertia_alt.jm[i] - robot::kArm.links[i].motor_inertia) * G * G);
       offset[i] = lit<S>(b.amp_offset * robot::kDrives.torque_limit[i]);
-      full_scale[i] = lit<S>(robot::kDrives.torque_limit[i]);
       const double K = params::kResidualGain[i];
       gain[i] = lit<S>(K);
       gain_dt[i] = lit<S>(K * params::kDt);
