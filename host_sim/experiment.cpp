@@ -86,6 +86,10 @@ class LocalController {
       res.position_peak_ratio[i] = residual_.position_peak_ratio[i];
     }
     const osc::ResidualMonitor<S>& m = task_->residual;
+    for (int i = 0; i < 6; ++i) {
+      const double limit = static_cast<double>(m.travel_limit(i));
+      res.travel_peak_ratio[i] = limit > 0 ? static_cast<double>(m.travel_peak(i)) / limit : 0;
+    }
     if (m.detected != 0) {
       res.residual_detected_s = static_cast<double>(m.detected_tick) / osc::params::kControlHz;
       res.residual_fault = m.detected;

@@ -71,9 +71,9 @@ struct ExperimentConfig {
   }
   double model_error = 0.0;  ///< controller's link mass/inertia relative error
   /// The residual monitor raises the faults in place of the stuck-encoder monitor (the runtime
-  /// parameter residual_monitor; in-process controller only: an image runs it as a trial unless its
-  /// parameter is set, docs/safety.md).
-  bool residual_monitor = false;
+  /// parameter residual_monitor, armed by default); false runs it as a trial (in-process controller
+  /// only: an image runs its parameter's default, docs/safety.md).
+  bool residual_monitor = osc::params::kResidualMonitorArmed;
   /// What a collision does, and each joint's collision threshold [N m] (0: the derived threshold
   /// alone); with residual_monitor only (osc::ControlTask::set_collision).
   osc::CollisionReaction collision_reaction = osc::CollisionReaction::kCategory0;

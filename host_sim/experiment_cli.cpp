@@ -215,11 +215,12 @@ bool parse_experiment_args(int argc, char** argv, ExperimentOptions& o, std::str
                    " applies to the host-built controller only, not with --qemu (the firmware image compiles in "
                    "uniform, uncoupled encoders)",
              false;
-    if (o.base.residual_monitor)
+    if (o.base.residual_monitor != osc::params::kResidualMonitorArmed)
       return err =
-                 "run.residual_monitor=on applies to the host-built controller only, not with --qemu (the "
-                 "runner does not set the image's parameters: it runs the residual monitor as a trial; a board "
-                 "arms it with its parameter residual_monitor, e.g. oscctl param set residual_monitor 1)",
+                 "run.residual_monitor=trial applies to the host-built controller only, not with --qemu (the "
+                 "runner does not set the image's parameters: the image runs its default, the residual monitor "
+                 "armed; a board makes it a trial with its parameter residual_monitor, e.g. oscctl param set "
+                 "residual_monitor 0)",
              false;
     if (!qemu_takes(o.base.injection, "--inject", err)) return false;
   }

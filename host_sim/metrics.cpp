@@ -265,6 +265,7 @@ void StuckMonitorPeaks::to_json(Json& j) const {
   j["residual_monitor_peak_Nm"] = json_array(residual_peak_Nm, 6);
   j["residual_monitor_threshold_at_peak_Nm"] = json_array(residual_threshold_Nm, 6);
   j["position_check_peak_ratio"] = json_array(position_peak_ratio, 6);
+  j["residual_monitor_travel_ratio"] = json_array(travel_peak_ratio, 6);
   j["residual_monitor_detection"] = residual_detected_s < 0 ? Json(nullptr)
                                                             : Json{{"t_s", residual_detected_s},
                                                                    {"fault", osc::fault_name(residual_fault)},

@@ -479,7 +479,10 @@ def parse_params(name, n):
     return vals
 
 
-STUCK_RUNS = [("--duration", "300", "--friction", fr) for fr in ("paper", "corke")]
+# The residual monitor is armed by default; TRIAL runs it as a trial, the stuck-encoder monitor's
+# trajectory-tuned criteria raising encoder_stuck (the tables that measure those criteria).
+TRIAL = ("--set", "run.residual_monitor=trial")
+STUCK_RUNS = [("--duration", "300", "--friction", fr, *TRIAL) for fr in ("paper", "corke")]
 
 
 @table("stuck_peaks", "docs/safety.md", "host")
@@ -491,14 +494,14 @@ def stuck_peaks():
         s = experiment(*args)
         for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
             r = run_of(s, mode)
-            lines.append(f"| torque change while still, {args[-1]} friction, {label} [N m] | "
+            lines.append(f"| torque change while still, {args[3]} friction, {label} [N m] | "
                          + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_Nm"]) + " |")
     lines.append("| threshold `kStuckTorque` [N m] | " + " | ".join(f"{v:g}" for v in dtau_max) + " |")
     for args in STUCK_RUNS:
         s = experiment(*args)
         for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
             r = run_of(s, mode)
-            lines.append(f"| torque change, moving joint silent, {args[-1]} friction, {label} [N m] | "
+            lines.append(f"| torque change, moving joint silent, {args[3]} friction, {label} [N m] | "
                          + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_silent_Nm"]) + " |")
     lines.append("| threshold `kStuckTorqueSilent` [N m] | "
                  + " | ".join(f"{v:g}" for v in parse_params("kStuckTorqueSilent", 6)) + " |")
@@ -506,7 +509,7 @@ def stuck_peaks():
         s = experiment(*args)
         for mode, label in (("adaptive", "compensated"), ("none", "no compensation")):
             r = run_of(s, mode)
-            lines.append(f"| reference motion while still, gated, {args[-1]} friction, {label} [counts] | "
+            lines.append(f"| reference motion while still, gated, {args[3]} friction, {label} [counts] | "
                          + " | ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_counts"]) + " |")
     lines.append("| threshold `kStuckMotionCounts` [counts] | " + " | ".join([f"{counts_max:g}"] * 6) + " |")
     return "\n".join(lines)
@@ -626,21 +629,19 @@ def identification_report():
 def monitors_hour():
     runs = [("--duration", "3600", "--friction", fr) for fr in ("paper", "corke")]
     prefetch(runs)
-    dtau_max, counts_max = parse_params("kStuckTorque", 6), parse_params("kStuckMotionCounts", 1)[0]
+    dtau_max = parse_params("kStuckTorque", 6)
     pos, ori = parse_params("kTrackingLimitPosition", 1)[0] * 1e3, parse_params("kTrackingLimitOrientation", 1)[0]
     lines = ["| one hour, fault-free: worst value (threshold) | " + " | ".join(
         f"{fr} friction, {m}" for fr in ("paper", "corke") for m in ("compensated", "no compensation")) + " |",
              "|---|---:|---:|---:|---:|"]
     rs = [run_of(experiment(*a), m) for a in runs for m in ("adaptive", "none")]
     lines.append("| faults | " + " | ".join(", ".join(r["faults"]) or "none" for r in rs) + " |")
-    lines.append(f"| reference motion while still, gated, J1..J6 [counts] ({counts_max:g}) | "
-                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_counts"]) for r in rs) + " |")
-    lines.append(f"| torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau_max)}) | "
+    lines.append("| residual monitor, \\|r\\| / threshold, J1..J6 (1) | "
+                 + " | ".join(", ".join(f"{v:.2f}" for v in r["residual_monitor_peak_ratio"]) for r in rs) + " |")
+    lines.append("| travel check, least travel / limit, J1..J6 (1) | "
+                 + " | ".join(", ".join(f"{v:.2f}" for v in r["residual_monitor_travel_ratio"]) for r in rs) + " |")
+    lines.append(f"| backstop: torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau_max)}) | "
                  + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_Nm"]) for r in rs) + " |")
-    silent = parse_params("kStuckTorqueSilent", 6)
-    lines.append(f"| torque change, moving joint silent, J1..J6 [N m] ({', '.join(f'{v:g}' for v in silent)}) | "
-                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_silent_Nm"]) for r in rs)
-                 + " |")
     lines.append(f"| tracking error, position [mm] ({pos:g}) | "
                  + " | ".join(f"{max(r['max_error_mm']):.2f}" for r in rs) + " |")
     lines.append(f"| tracking error, orientation [deg] ({math.degrees(ori):.2f}) | "
@@ -655,7 +656,6 @@ def monitors_hour():
 # ---------------------------------------------------------------- the residual monitor (issue 25)
 
 
-ARMED = ("--set", "run.residual_monitor=on")
 RESIDUAL_HEALTHY = [
     ("paper friction, 300 s", ("--duration", "300", "--friction", "paper")),
     ("corke friction, 300 s", ("--duration", "300", "--friction", "corke")),
@@ -671,7 +671,7 @@ RESIDUAL_HEALTHY = [
 def residual_healthy():
     """Healthy runs with the residual monitor armed: per joint, the worst |r| / threshold of either
     channel (at most 1 / kResidualMargin = 0.5 is the design: the residual within its derived bound)."""
-    runs = [a + ARMED for _, a in RESIDUAL_HEALTHY]
+    runs = [a for _, a in RESIDUAL_HEALTHY]
     prefetch(runs)
     lines = ["| healthy run, armed | mode | J1 | J2 | J3 | J4 | J5 | J6 | detection |",
              "|---|---|" + "---:|" * 6 + "---|"]
@@ -684,7 +684,7 @@ def residual_healthy():
     return "\n".join(lines)
 
 
-RESIDUAL_HOUR = ("--plant", "realistic", "--duration", "3600", "--mode", "adaptive", "--set", "run.window=600") + ARMED
+RESIDUAL_HOUR = ("--plant", "realistic", "--duration", "3600", "--mode", "adaptive", "--set", "run.window=600")
 
 
 @table("residual_hour", "docs/safety.md", "long")
@@ -708,7 +708,7 @@ RESIDUAL_TIMES = [20.0, 21.25, 22.5, 23.75]
 
 def armed_injection(spec, at, extra=()):
     """One armed run with an injection, ending 1.5 s after it; its `injection` record."""
-    r = experiment("--duration", f"{at + 1.5:g}", "--mode", "adaptive", "--inject", spec, *ARMED, *extra)
+    r = experiment("--duration", f"{at + 1.5:g}", "--mode", "adaptive", "--inject", spec, *extra)
     return r["runs"][0]
 
 
@@ -728,7 +728,7 @@ def residual_injection():
     backstop), ms after the injection, and the true tip's excursion."""
     specs = [(f"{k}:{j}@{t:g}", t) for k in ("encoder-stuck", "dac-stuck") for j in range(1, 7)
              for t in RESIDUAL_TIMES]
-    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s, *ARMED) for s, t in specs])
+    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s) for s, t in specs])
     lines = ["| kind | joint | " + " | ".join(f"at {t:g} s" for t in RESIDUAL_TIMES) + " |",
              "|---|---|" + "---|" * len(RESIDUAL_TIMES)]
     for k in ("encoder-stuck", "dac-stuck"):
@@ -754,7 +754,7 @@ def residual_contact():
     rows = [(f"`collision:{d}:50`", f"collision:{d}:50") for d in DIRECTIONS]
     rows += [(f"`wall:{d}:5`", f"wall:{d}:5") for d in DIRECTIONS]
     rows += [(f"`{k}:{j}`", f"{k}:{j}") for k in ("dac-zero", "dac-full", "amp-off") for j in range(1, 7)]
-    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", f"{spec}@{t:g}", *ARMED)
+    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", f"{spec}@{t:g}")
               for _, spec in rows for t in times])
     lines = ["| injection | " + " | ".join(f"at {t:g} s" for t in times) + " |", "|---|" + "---|" * len(times)]
     for label, spec in rows:
@@ -928,7 +928,7 @@ def plant_hour():
     runs = [(f"`realistic`, {name}", HOUR + ("--plant", "realistic") + a) for name, a in scalars]
     runs += [(f"`realistic`, {name}, `examples/real_arm.yaml`", HOUR + ("--plant", "realistic") + real_arm + a)
              for name, a in scalars]
-    # The trajectory-tuned stuck-encoder monitor may fire on this plant: that fault is the result.
+    # A monitor may fire on this plant: that fault is the result.
     EXPECTED_FAULTS.update(a for _, a in runs)
     text = adaptation_rows(runs)
     for _, a in runs:  # when each fault came
@@ -936,8 +936,7 @@ def plant_hour():
         if r["faults"]:
             names = ", ".join(r["faults"])
             text = text.replace(f"| {names} |", f"| {names} at {r['fault_time_s']:.1f} s |", 1)
-    counts_max = parse_params("kStuckMotionCounts", 1)[0]
-    dtau, silent = parse_params("kStuckTorque", 6), parse_params("kStuckTorqueSilent", 6)
+    dtau = parse_params("kStuckTorque", 6)
     lines = ["", "| monitor, worst over the hour (threshold) | " + " | ".join(n for n, _ in runs) + " |",
              "|---" * (len(runs) + 1) + "|"]
     rs = [run_of(experiment(*a), "adaptive") for _, a in runs]
@@ -945,12 +944,12 @@ def plant_hour():
     def peaks(key, lim):
         return " | ".join(", ".join(f"{v:.1f}" for v in r[key]) + f" ({max(v / t for v, t in zip(r[key], lim)):.2f} "
                           "of a threshold)" for r in rs)
-    lines.append(f"| reference motion while still, gated, J1..J6 [counts] ({counts_max:g}) | "
-                 + peaks("stuck_monitor_peak_counts", [counts_max] * 6) + " |")
-    lines.append(f"| torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau)}) | "
+    lines.append("| residual monitor, \\|r\\| / threshold, J1..J6 (1) | "
+                 + peaks("residual_monitor_peak_ratio", [1.0] * 6) + " |")
+    lines.append("| travel check, least travel / limit, J1..J6 (1) | "
+                 + peaks("residual_monitor_travel_ratio", [1.0] * 6) + " |")
+    lines.append(f"| backstop: torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau)}) | "
                  + peaks("stuck_monitor_peak_dtau_Nm", dtau) + " |")
-    lines.append(f"| torque change, moving joint silent, J1..J6 [N m] ({', '.join(f'{v:g}' for v in silent)}) | "
-                 + peaks("stuck_monitor_peak_dtau_silent_Nm", silent) + " |")
     return text + "\n" + "\n".join(lines)  # a blank line: the monitors' table is a table of its own
 
 
@@ -960,8 +959,9 @@ MONITOR_PERTURBATIONS = [(), ("--delay", "1e-4"), ("--delay", "3e-4"), ("--model
 
 @table("monitor_margins", "docs/safety.md", "long")
 def monitor_margins():
-    """The stuck-encoder monitor's fault-free peaks against its thresholds: 300 s in every scalar,
-    on both presets, in both modes, nominal and perturbed (72 runs of 300 s)."""
+    """The monitors' fault-free peaks against their thresholds: 300 s in every scalar, on both
+    presets, in both modes, nominal and perturbed (72 runs of 300 s), the residual monitor a trial
+    (the stuck-encoder monitor's criteria), then armed (the default)."""
     criteria = [("reference motion while still", "stuck_monitor_peak_counts",
                  [parse_params("kStuckMotionCounts", 1)[0]] * 6,
                  "counts"),
@@ -970,30 +970,43 @@ def monitor_margins():
                  parse_params("kStuckTorqueSilent", 6), "N m")]
     sets = [(scalar, friction, pert) for scalar in ("double", "float", "fixed") for friction in ("paper", "corke")
             for pert in MONITOR_PERTURBATIONS]
-    args = {k: ("--duration", "300", "--scalar", k[0], "--friction", k[1], *k[2]) for k in sets}
+    configs = [("the residual monitor a trial (`run.residual_monitor=trial`): the stuck-encoder monitor's criteria",
+                TRIAL, criteria),
+               ("the default: the residual monitor armed, the stuck-encoder monitor its backstop",
+                (), [("residual monitor, \\|r\\| / threshold", "residual_monitor_peak_ratio", [1.0] * 6, ""),
+                     ("travel check, least travel / limit", "residual_monitor_travel_ratio", [1.0] * 6, ""),
+                     ("backstop: torque change while still", "stuck_monitor_peak_dtau_Nm",
+                      parse_params("kStuckTorque", 6), "N m")])]
+    args = {(k, c[1]): ("--duration", "300", "--scalar", k[0], "--friction", k[1], *k[2], *c[1])
+            for k in sets for c in configs}
     EXPECTED_FAULTS.update(args.values())  # a false alarm on a healthy arm is this table's finding
     prefetch(list(args.values()))
-    runs = []
-    for (scalar, friction, pert) in sets:
-        for r in experiment(*args[(scalar, friction, pert)])["runs"]:
-            where = f"{scalar}, {friction}, {'compensated' if r['mode'] == 'adaptive' else 'no compensation'}"
-            runs.append((where + (f", `{' '.join(pert)}`" if pert else ""), r))
-    lines = ["| criterion | worst peak / threshold | where | per joint, worst of all runs (threshold) |",
-             "|---|---|---|---|"]
-    for label, key, limit, unit in criteria:
-        worst = max(((r[key][j] / limit[j], j, where, r[key][j]) for where, r in runs for j in range(6)))
-        per_joint = [max(r[key][j] for _, r in runs) for j in range(6)]
-        lines.append(f"| {label} | {worst[0]:.2f} | J{worst[1] + 1}, {worst[2]} ({worst[3]:.1f} of "
-                     f"{limit[worst[1]]:g} {unit}) | " + ", ".join(f"{v:.1f} ({t:g})" for v, t in zip(per_joint, limit))
-                     + " |")
-    lines.append("")
-    faulted = [(where, r) for where, r in runs if r.get("faults")]
-    if not faulted:
-        lines.append(f"{len(runs)} runs of 300 s on a healthy arm, no fault.")
-    else:
-        alarms = [f"{where}: {', '.join(r['faults'])} at {r['fault_time_s']:g} s" for where, r in faulted]
-        lines.append(f"{len(runs)} runs of 300 s on a healthy arm; **false alarms**: " + "; ".join(alarms)
-                     + " (its peaks are those until the fault).")
+    lines = []
+    for title, extra, crits in configs:
+        runs = []
+        for (scalar, friction, pert) in sets:
+            for r in experiment(*args[((scalar, friction, pert), extra)])["runs"]:
+                where = f"{scalar}, {friction}, {'compensated' if r['mode'] == 'adaptive' else 'no compensation'}"
+                runs.append((where + (f", `{' '.join(pert)}`" if pert else ""), r))
+        lines += [""] if lines else []
+        lines += [f"**{title[0].upper()}{title[1:]}.**", "",
+                  "| criterion | worst peak / threshold | where | per joint, worst of all runs (threshold) |",
+                  "|---|---|---|---|"]
+        for label, key, limit, unit in crits:
+            worst = max(((r[key][j] / limit[j], j, where, r[key][j]) for where, r in runs for j in range(6)))
+            per_joint = [max(r[key][j] for _, r in runs) for j in range(6)]
+            digits = 2 if not unit else 1
+            lines.append(f"| {label} | {worst[0]:.2f} | J{worst[1] + 1}, {worst[2]} ({worst[3]:.{digits}f} of "
+                         f"{limit[worst[1]]:g}{' ' + unit if unit else ''}) | "
+                         + ", ".join(f"{v:.{digits}f} ({t:g})" for v, t in zip(per_joint, limit)) + " |")
+        lines.append("")
+        faulted = [(where, r) for where, r in runs if r.get("faults")]
+        if not faulted:
+            lines.append(f"{len(runs)} runs of 300 s on a healthy arm, no fault.")
+        else:
+            alarms = [f"{where}: {', '.join(r['faults'])} at {r['fault_time_s']:g} s" for where, r in faulted]
+            lines.append(f"{len(runs)} runs of 300 s on a healthy arm; **false alarms**: " + "; ".join(alarms)
+                         + " (its peaks are those until the fault).")
     return "\n".join(lines)
 
 

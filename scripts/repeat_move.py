@@ -3,8 +3,7 @@
 motion for 120 s, a stop, then one short move (DX metres along x and back) repeated N times.
 
 usage: repeat_move.py [--dx 0.03] [--pairs 2400] > out/repeat_hour.yaml
-       puma_experiment --motion out/repeat_hour.yaml --adaptation momentum --set run.residual_monitor=on \\
-           --json out/repeat.json
+       puma_experiment --motion out/repeat_hour.yaml --adaptation momentum --json out/repeat.json
 The JSON's theta_hat_at_sent gives the friction estimates when each command was sent.
 """
 import argparse

@@ -28,7 +28,8 @@ unsigned env_or(const char* name, unsigned fallback) {
 
 struct SweepResult {
   double worst[kDof] = {};
-  std::string detail;  // who raised a fault
+  double travel[kDof] = {};  // the travel check's largest least travel / its limit
+  std::string detail;        // who raised a fault
   std::uint32_t faults = 0;
   int moves = 0, refused = 0, streams = 0, streams_cut = 0;
 };
@@ -135,8 +136,12 @@ SweepResult sweep(unsigned seed, int moves, int streams, const sim::PlantConfig&
     out.faults |= run_to_done(sim, id, 20000);
     for (int k = 0; k < 200 && out.faults == 0; ++k) out.faults |= sim.tick();  // hold a little
   }
-  for (int i = 0; i < kDof; ++i) out.worst[i] = static_cast<double>(sim.task().residual.peak_ratio(i));
   const auto& m = sim.task().residual;
+  for (int i = 0; i < kDof; ++i) {
+    out.worst[i] = static_cast<double>(m.peak_ratio(i));
+    const double limit = static_cast<double>(m.travel_limit(i));
+    out.travel[i] = limit > 0 ? static_cast<double>(m.travel_peak(i)) / limit : 0;
+  }
   const auto& b = sim.task().stuck.dtau_peak;
   char buf[200];
   std::snprintf(buf, sizeof buf, "residual: %s J%d; backstop torque-change peaks %.1f %.1f %.1f %.1f %.1f %.1f",
@@ -161,12 +166,18 @@ void check_sweep(const char* label, const osc::FrictionCoefficients& friction, F
       "cut), worst ratio",
       label, seed, seed, r.moves, r.refused, r.streams, r.streams_cut);
   for (double w : r.worst) std::printf(" %.3f", w);
+  std::printf(", travel check's worst share");
+  for (double w : r.travel) std::printf(" %.3f", w);
   std::printf("\n");
   EXPECT_EQ(r.faults, 0u) << fault_name(r.faults) << " (seed " << seed << "): " << r.detail;
   EXPECT_GE(r.moves, moves / 2) << "most random moves are accepted";
   EXPECT_GE(r.streams, r.streams_cut) << "most random streams run to their end";
   for (int i = 0; i < kDof; ++i)
     EXPECT_LE(r.worst[i], within_bound ? 1 / params::kResidualMargin : 1.0) << "J" << i + 1 << " (seed " << seed << ")";
+  // The travel check: a healthy joint's least travel without a count stays within the one count the
+  // geometry allows, half its limit.
+  for (int i = 0; i < kDof; ++i)
+    EXPECT_LE(r.travel[i], 1 / params::kResidualTravelCounts) << "J" << i + 1 << " (seed " << seed << ")";
 }
 
 const int kMoves = static_cast<int>(env_or("OSC_SWEEP_MOVES", 12));

@@ -558,6 +558,7 @@ TYPED_TEST(Monitors, ResidualIsolatesDriveCollisionAndStuckEncoder) {
   }
   {  // Not armed: the detection is recorded, never returned.
     ResidualRig<S> rig;
+    rig.m.armed = false;
     rig.step(Vec6<double>::Zero(), all);
     Vec6<double> ext = Vec6<double>::Zero();
     ext(1) = 3 * static_cast<double>(rig.m.threshold(1));
@@ -573,6 +574,9 @@ TYPED_TEST(Monitors, ResidualBelowItsThresholdNeverFaults) {
   using S = TypeParam;
   ResidualRig<S> rig;
   rig.m.armed = true;
+  // These torques hold the still joints beyond their static friction, which the travel check
+  // rightly calls a fault (TravelCheck* below): the residual's channels alone here.
+  rig.m.travel_limit.setZero();
   const bool still[kDof] = {};
   rig.step(Vec6<double>::Zero(), still);
   Vec6<double> ext;
@@ -581,6 +585,79 @@ TYPED_TEST(Monitors, ResidualBelowItsThresholdNeverFaults) {
   EXPECT_EQ(rig.m.detected, 0u);
   // Close to 0.8: the thresholds grew a little with the torque commanded (the amplifiers' share).
   for (int i = 0; i < kDof; ++i) EXPECT_GT(rig.m.peak_ratio(i), lit<S>(0.6)) << i;
+}
+
+/// The travel check's rig: joint j creeps forward, a count every 10 ticks, for 100 ticks, the arm
+/// held (its velocity estimate 0); then its encoder stands while the drive is told to give
+/// g_j + push. Returns the ticks from the last count to the first fault (-1: none in `ticks`).
+template <class S>
+int travel_ticks(ResidualRig<S>& rig, int j, double push, int ticks, std::uint32_t& kind) {
+  rig.m.armed = true;
+  bool creep[kDof] = {};
+  const bool none[kDof] = {};
+  for (int n = 0; n <= 100; ++n) {
+    creep[j] = n % 10 == 0;
+    EXPECT_EQ(rig.step(Vec6<double>::Zero(), creep, false), 0u) << n;
+  }
+  Vec6<double> ext = Vec6<double>::Zero();
+  ext(j) = -push;  // held: the monitor is told tau - ext = g + push was applied
+  kind = 0;
+  for (int n = 1; n <= ticks; ++n)
+    if ((kind = rig.step(ext, none, false)) != 0) return n;
+  return -1;
+}
+/// The least and the most of the torque joint j's travel check leaves to accelerate it [N m]:
+/// push less (more) the static band, the link inertia's share of gravity, the amplifier's gain,
+/// ripple and offset on the torque applied.
+double travel_force(int j, double g, double push, bool least) {
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
+  const double error = b.link_inertia * std::abs(g) + (b.amp_gain + b.ripple) * std::abs(g + push) +
+                       b.amp_offset * robot::kDrives.torque_limit[j];
+  return least ? push - band - error : push;
+}
+
+// A joint whose encoder stands while the torque applied is beyond what static friction and every
+// stated model error can hold must have moved: the travel check calls it encoder_stuck once its
+// least travel under the least net torque passes kResidualTravelCounts counts, t = sqrt(2 L A / F)
+// from rest; with the amplifier's lag and the largest inertia it takes at most 1.5 times that.
+TYPED_TEST(Monitors, TravelCheckCatchesAnEncoderThatStandsUnderATorqueBeyondStaticFriction) {
+  using S = TypeParam;
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  for (int j : {0, 2, 4}) {
+    ResidualRig<S> rig;
+    const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
+    const double push = 3 * band + 2 * b.link_inertia * std::abs(rig.g(j));
+    const double limit = params::kResidualTravelCounts / counts_per_rad(j);
+    const double G = std::abs(robot::kArm.links[j].gear_ratio);
+    const double arm =
+        std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
+    const double a_max = rig.A(j, j) * (1 + b.link_inertia) + arm, a_min = rig.A(j, j) * (1 - b.link_inertia) - arm;
+    const double fastest = std::sqrt(2 * limit * a_min / travel_force(j, rig.g(j), push, false)) / params::kDt;
+    const double slowest = std::sqrt(2 * limit * a_max / travel_force(j, rig.g(j), push, true)) / params::kDt;
+    std::uint32_t kind = 0;
+    const int n = travel_ticks(rig, j, push, 200, kind);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "J" << j + 1;
+    EXPECT_GE(n, static_cast<int>(fastest)) << "J" << j + 1;
+    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2) << "J" << j + 1 << " (" << slowest << " ticks)";
+    EXPECT_EQ(rig.m.joint, j);
+  }
+}
+
+// The same joint held by a torque within its static friction's weakest breakaway stays where it
+// is, as far as the check can tell: no fault in 10 s, its least travel nowhere near its limit.
+TYPED_TEST(Monitors, TravelCheckLeavesAJointThatStaticFrictionHolds) {
+  using S = TypeParam;
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  for (int j : {0, 2, 4}) {
+    ResidualRig<S> rig;
+    const double weakest = (b.friction_lo.cou[j] + b.friction_lo.sti[j]) / params::kResidualMargin;
+    const double push = 0.5 * weakest;
+    std::uint32_t kind = 0;
+    EXPECT_EQ(travel_ticks(rig, j, push, 10000, kind), -1) << "J" << j + 1 << ": " << fault_name(kind);
+    EXPECT_LT(static_cast<double>(rig.m.travel_peak(j)), 0.5 * static_cast<double>(rig.m.travel_limit(j)))
+        << "J" << j + 1;
+  }
 }
 
 }  // namespace

@@ -191,8 +191,9 @@ TEST(Parameters, EachBadSetIsRefusedByNameAndChangesNothing) {
   EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kTorqueOn);
   EXPECT_EQ(param_set(*t, law, 0, 0.0), ParamStatus::kTorqueOn);
   // The monitors are not swapped under a running arm.
-  EXPECT_EQ(param_set(*t, param_index("residual_monitor"), 0, 1.0), ParamStatus::kTorqueOn);
-  EXPECT_FALSE(t->residual.armed);
+  const double other = params::kResidualMonitorArmed ? 0.0 : 1.0;  // the switch away from its default
+  EXPECT_EQ(param_set(*t, param_index("residual_monitor"), 0, other), ParamStatus::kTorqueOn);
+  EXPECT_EQ(t->residual.armed, params::kResidualMonitorArmed);
   const ParamRecord mid = param_capture(*t);
   for (int k = 0; k < kParamSlots; ++k) EXPECT_EQ(mid.value[k], before.value[k]) << k;
   EXPECT_EQ(param_set(*t, thr, 0, 30.0), ParamStatus::kOk);

@@ -118,6 +118,19 @@ constexpr double kResidualMargin = 2;
 /// (Corke's friction, uncompensated) crept at 0.008 rad/s, a count every 10 ticks, for seconds;
 /// judged as sliding, it reached 1.03 of its change threshold (docs/safety.md).
 constexpr int kResidualSlideInterval = 5;
+/// The residual monitor raises its faults (encoder_stuck, drive_fault, collision) by default, the
+/// stuck-encoder monitor its backstop (the runtime parameter residual_monitor; docs/safety.md). Off,
+/// it is a trial: it records what it would raise, and the stuck-encoder monitor's trajectory-tuned
+/// criteria raise encoder_stuck as before.
+constexpr bool kResidualMonitorArmed = true;
+/// The residual monitor's travel check: a joint whose least motion since its encoder's last count,
+/// under the torque applied and the model's error bounds (its friction at the band's strongest),
+/// exceeds this many counts must have counted: its encoder (or something holding the joint) is at
+/// fault. One count is the geometry (the next edge, or the last one back); the second is margin.
+constexpr double kResidualTravelCounts = 2;
+/// ... its bounds advanced every this many ticks, each joint in turn (the M4F's tick budget; the
+/// count that restarts them is taken in its tick).
+constexpr int kResidualTravelEvery = 2;
 /// Friction identified from the residual (the `momentum` law, osc/control/identification.hpp;
 /// docs/adaptation.md, "Identification from the residual"):
 /// - each joint's Kalman update comes every kIdentifyEvery ticks, the joints in turn (the filtered

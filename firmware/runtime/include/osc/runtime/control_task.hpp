@@ -330,6 +330,7 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             adaptive ? &ad.theta_hat : nullptr};
   const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
   task.residual.sample_joint = identify ? task.identifier.take_turn() : -1;
+  task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick);
   if (identify) identify_friction(task);
   faults |= TrackingMonitor<S>::check(out.e);

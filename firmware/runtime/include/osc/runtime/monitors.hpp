@@ -259,6 +259,8 @@ struct ResidualConstants {
   S vis_mid[kDof], vis_half[kDof], cou_mid[kDof], cou_half[kDof], sti_mid[kDof], sti_half[kDof];
   S vis_hi[kDof];          // the viscous band's upper end [N m s/rad]
   S static_band[kDof];     // the Coulomb and Stribeck bands' upper ends together [N m]
+  S static_lo[kDof];       // ... their lower ends, the least breakaway torque, over kResidualMargin [N m]
+  S speed_cap[kDof];       // the joint's largest speed (robot::kDrives.max_joint_speed) [rad/s]
   S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
   S offset[kDof];          // an amplifier's offset bound [N m]
   S gain[kDof];            // the residual's filter gain K [1/s]
@@ -279,6 +281,8 @@ struct ResidualConstants {
         sti_half{},
         vis_hi{},
         static_band{},
+        static_lo{},
+        speed_cap{},
         armature_delta{},
         offset{},
         gain{},
@@ -301,6 +305,8 @@ struct ResidualConstants {
       sti_mid[i] = lit<S>(0.5 * (lo.sti[i] + hi.sti[i])), sti_half[i] = lit<S>(0.5 * (hi.sti[i] - lo.sti[i]));
       vis_hi[i] = lit<S>(hi.vis[i]);
       static_band[i] = lit<S>(hi.cou[i] + hi.sti[i]);
+      static_lo[i] = lit<S>((lo.cou[i] + lo.sti[i]) / params::kResidualMargin);
+      speed_cap[i] = lit<S>(robot::kDrives.max_joint_speed[i]);
       const double G = abs_of(robot::kArm.links[i].gear_ratio);
       armature_delta[i] =
           lit<S>(abs_of(robot::kDriveTrain.motor_inertia_alt.jm[i] - robot::kArm.links[i].motor_inertia) * G * G);
@@ -353,6 +359,9 @@ struct ResidualInput {
 ///    more than params::kStuckIntervals of its recent intervals between counts);
 ///  - drive_fault: the residual is on this drive alone (every other joint below half its threshold);
 ///  - collision: an external torque on several joints, as a contact gives.
+/// Beside the residual, the travel check (travel()): a joint whose least motion since its encoder's
+/// last count, from the torque applied and the same bounds, passes params::kResidualTravelCounts
+/// counts must have counted; it is a fault at once (classify_travel() names it).
 template <class S>
 struct ResidualMonitor {
   /// The model error's regressors, each filtered as r, then slowly (the change channel): the
@@ -389,7 +398,8 @@ struct ResidualMonitor {
   std::uint64_t detected_tick;           // ... its tick
   std::int8_t joint;                     // ... its joint (0-based), -1 none
   bool primed;                           // a previous step is on record
-  bool armed = false;  // its detections are faults, in place of StuckEncoderMonitor's (else only recorded)
+  /// Its detections are faults, in place of StuckEncoderMonitor's (else only recorded).
+  bool armed = params::kResidualMonitorArmed;
   /// The user's collision thresholds [N m] (ControlTask::set_collision): a collision is reported
   /// only once some joint's qualified residual is beyond its own too; 0, the default, leaves the derived
   /// thresholds alone. They never lower a derived threshold, nor touch the sensor and drive faults.
@@ -399,6 +409,15 @@ struct ResidualMonitor {
   int sample_joint = -1;
   FrictionSample<S> sample{};
   Vec6<S> noise_bound;  // this tick's bound on the velocity estimate's quantisation noise in r [N m]
+  /// The travel check (travel()): per joint, lower bounds on its speed and on its travel since its
+  /// encoder's last count, in that count's direction [rad/s, rad], the travel that must have made it count
+  /// (kResidualTravelCounts quanta; 0: the check is off, a joint whose encoder reads other joints too), and the largest
+  /// least travel seen (the check's peak; against travel_limit, its headroom).
+  Vec6<S> v_lo, p_lo, travel_limit, travel_peak;
+  Vec6<S> travel_quantum;  // set-up: each joint's encoder quantum [rad]
+  /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
+  /// force the model does not know: the travel check waits (it restarts every tick).
+  bool contact = false;
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
   /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
@@ -413,9 +432,14 @@ struct ResidualMonitor {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       double cross = 0;
-      for (int c = 0; c < kDof; ++c)
+      bool alone = true;  // encoder i reads joint i alone
+      for (int c = 0; c < kDof; ++c) {
         if (c != i) cross += abs_of(inverse[c][i]) * (b.friction_hi.cou[c] + b.friction_hi.sti[c]);
+        if (c != i && inverse[i][c] != 0) alone = false;
+      }
       cross_friction(i) = lit<S>(cross);
+      travel_limit(i) = alone ? lit<S>(params::kResidualTravelCounts) * quantum(i) : S(0);
+      travel_quantum(i) = quantum(i);
     }
   }
   /// Clears the filters and the record: the next check primes it (an enable, a restart).
@@ -429,6 +453,7 @@ struct ResidualMonitor {
     change_threshold.setZero();
     tau_prev.setZero();
     peak_ratio.setZero();
+    travel_peak.setZero();
     for (int i = 0; i < kDof; ++i) over[i] = 0, over_since[i] = 0;
     activity.reset();
     joint = -1;
@@ -458,11 +483,12 @@ struct ResidualMonitor {
       prime_change();
     }
     const Motion m = motion(in);
-    int worst = -1;
+    int worst = -1, moved_too_far = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) {
       const FrictionError e = friction_error(in, i, tick, m.moving_speed[i]);
-      const S b = pointwise_bound(in, e, i);
+      const S model = model_error(in, i);
+      const S b = pointwise_bound(in, e, i, model);
       Changes ch{};
       if (prime) {
         bound(i) = b;
@@ -474,6 +500,7 @@ struct ResidualMonitor {
         ch = update_change(in, e, i);
       }
       update_thresholds(e, ch, m, i);
+      if (travel(in, m, i, model, moved[i], prime || contact, tick)) moved_too_far = i;
       qd_prev(i) = in.qd(i);
       bias_prev(i) = in.bias(i);
       if (prime) {
@@ -490,9 +517,15 @@ struct ResidualMonitor {
       primed = true;
       return 0;
     }
-    if (worst < 0) return 0;
-    const std::uint32_t kind = classify(worst, io, tick);
-    if (kind == kFaultCollision && !beyond_collision_floor()) return 0;
+    std::uint32_t kind;
+    if (moved_too_far >= 0) {
+      worst = moved_too_far;
+      kind = classify_travel(worst);
+    } else {
+      if (worst < 0) return 0;
+      kind = classify(worst, io, tick);
+    }
+    if (kind == kFaultCollision && !beyond_collision_floor(moved_too_far < 0)) return 0;
     if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick;
     return armed ? kind : 0u;
   }
@@ -579,9 +612,11 @@ struct ResidualMonitor {
     }
     return s;
   }
-  bool beyond_collision_floor() const {
+  /// Some joint's residual beyond the user's collision threshold, qualified (the travel check's
+  /// findings need no qualification of the residual).
+  bool beyond_collision_floor(bool qualified) const {
     for (int j = 0; j < kDof; ++j)
-      if (over[j] >= params::kResidualQualifyTicks && math::abs(r(j)) > collision_floor(j)) return true;
+      if ((!qualified || over[j] >= params::kResidualQualifyTicks) && math::abs(r(j)) > collision_floor(j)) return true;
     return false;
   }
   /// Joint i's friction against the band (FrictionError); `moving` is the speed beyond which the
@@ -612,16 +647,24 @@ struct ResidualMonitor {
   }
   /// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
   /// friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
-  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i) const {
+  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::mul_add;
     // Moving: the band's distance from the estimate, coefficient by coefficient.
     const S friction = e.sliding ? mul_add(math::abs(in.qd(i)), e.dv,
                                            mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
                                  : e.still;
+    return friction + model;
+  }
+  /// Joint i's bound on the unexplained torque besides friction and the inertias: the link
+  /// inertia's share of gravity and Coriolis torques, the amplifier's gain, ripple and offset, and
+  /// the coupled motors' friction.
+  S model_error(const ResidualInput<S>& in, int i) const {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    using math::mul_add;
     const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
     return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(coriolis),
-                   mul_add(c.gain_ripple, math::abs(tau_prev(i)), friction + cross_friction(i) + c.offset[i]));
+                   mul_add(c.gain_ripple, math::abs(tau_prev(i)), cross_friction(i) + c.offset[i]));
   }
   /// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
   /// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
@@ -676,6 +719,83 @@ struct ResidualMonitor {
                             c.armature_delta[i] * m.da[i]);
     const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
     change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
+  }
+  /// Joint i's travel check: whether the joint must have counted. At a count the joint has just
+  /// crossed an edge in the direction `way` of the count; counting steadily, it crossed the one
+  /// before a count back, n ticks earlier: its mean speed that way since was at least a count over
+  /// n + 1 ticks, less the most it can have slowed over them. Then, every params::kResidualTravelEvery
+  /// ticks, the torque applied less gravity and Coriolis torques, with every error the model may
+  /// have against the motion (model_error(), the other joints' inertial torques with the link
+  /// inertia's share, the current loop's lag) and friction at the band's strongest against it (at
+  /// rest: the whole static band), over the diagonal inertia at its least or most, bounds its
+  /// speed that way from below, and its travel. A joint that comes to rest stays at rest while the
+  /// torque cannot break it away backwards (half the band's weakest static friction). Its least
+  /// travel beyond travel_limit crosses the next edge: the encoder should have counted. Before its
+  /// first count (a prime, a contact) the direction is unknown and nothing is bounded.
+  bool travel(const ResidualInput<S>& in, const Motion& m, int i, S model, bool count, bool restart,
+              std::uint64_t tick) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    using math::abs;
+    using math::mul_add;
+    const S limit = travel_limit(i);
+    if (limit == S(0)) return false;
+    if (restart) {
+      p_lo(i) = -limit;  // nothing known: no bound until a count
+      v_lo(i) = S(0);
+      return false;
+    }
+    static constexpr int kEvery = params::kResidualTravelEvery;
+    const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
+    if (!count && !turn) return false;
+    const S way = activity.direction[i] > 0 ? S(1) : S(-1);
+    const S drive = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
+    const S aii = in.A(i, i);
+    const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
+    const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
+    const S error = mul_add(c.link_inertia, others, others) + model + loop;
+    const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
+    if (count) {
+      const std::uint32_t n = activity.move_interval[i];
+      S slow = S(0);
+      if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval)) {
+        const S span = lit<S>(params::kDt) * S(static_cast<int>(n) + 1);
+        slow = travel_quantum(i) / span - (abs(drive) + error + c.static_band[i]) / a_min * span;
+        if (slow < S(0)) slow = S(0);
+      }
+      v_lo(i) = slow;
+      p_lo(i) = S(0);
+      return false;
+    }
+    static constexpr S kStep = lit<S>(kEvery * params::kDt);
+    // The least force that way: friction at its strongest against the motion (none when the joint
+    // may be going back, where it pushes forward).
+    const S lo = v_lo(i);
+    const S force = drive - error - (lo >= S(0) ? mul_add(c.vis_hi[i], lo, c.static_band[i]) : S(0));
+    const S a_max = mul_add(c.link_inertia, aii, aii) + c.armature_delta[i];
+    S next = mul_add(kStep, force / (force < S(0) ? a_min : a_max), lo);
+    // Static friction holds a joint at rest against what cannot break it away backwards.
+    if (lo >= S(0) && next < S(0) && drive - error + c.static_lo[i] > S(0)) next = S(0);
+    const S cap = c.speed_cap[i];
+    next = next < -cap ? -cap : (next > cap ? cap : next);
+    v_lo(i) = next;
+    // Over the step the speed was at least the lesser of both ends.
+    S p = mul_add(kStep, lo < next ? lo : next, p_lo(i));
+    if (p > travel_peak(i)) travel_peak(i) = p;
+    const bool beyond = p > limit;
+    // It did not count: its travel stays within a count either way.
+    p_lo(i) = p < -limit ? -limit : (beyond ? limit : p);
+    return beyond;
+  }
+  /// The kind of a travel check's finding on joint i: a joint that must have counted and did not.
+  /// Its encoder fell silent at once from counting fast (a joint that stops slows down first, its
+  /// intervals between counts growing): encoder_stuck. Otherwise something holds it, or its encoder
+  /// froze while it stood, which the same reading cannot tell apart: collision when the residual is
+  /// on other joints too (a contact at the tip loads several), else encoder_stuck.
+  std::uint32_t classify_travel(int i) const {
+    if (activity.was_fast(i)) return kFaultEncoderStuck;
+    for (int j = 0; j < kDof; ++j)
+      if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
+    return kFaultEncoderStuck;
   }
   /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
   /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
