@@ -187,7 +187,7 @@ void add_run_entries(std::vector<Entry>& t) {
   name(
       t, "run.residual_monitor",
       "on (default): the residual monitor raises encoder_stuck, drive_fault and collision, the stuck-encoder "
-      "monitor its backstop; trial: the residual monitor is computed and reported, the stuck-encoder monitor "
+      "monitor off but while homing; trial: the residual monitor is computed and reported, the stuck-encoder monitor "
       "raises encoder_stuck (docs/safety.md); the firmware's parameter residual_monitor (1 on, 0 trial)",
       {"trial", "on"}, false, [](const Settings& s) { return std::string(s.base.residual_monitor ? "on" : "trial"); },
       [](Settings& s, const std::string& m) { s.base.residual_monitor = m == "on"; });

@@ -629,7 +629,6 @@ def identification_report():
 def monitors_hour():
     runs = [("--duration", "3600", "--friction", fr) for fr in ("paper", "corke")]
     prefetch(runs)
-    dtau_max = parse_params("kStuckTorque", 6)
     pos, ori = parse_params("kTrackingLimitPosition", 1)[0] * 1e3, parse_params("kTrackingLimitOrientation", 1)[0]
     lines = ["| one hour, fault-free: worst value (threshold) | " + " | ".join(
         f"{fr} friction, {m}" for fr in ("paper", "corke") for m in ("compensated", "no compensation")) + " |",
@@ -640,8 +639,6 @@ def monitors_hour():
                  + " | ".join(", ".join(f"{v:.2f}" for v in r["residual_monitor_peak_ratio"]) for r in rs) + " |")
     lines.append("| travel check, least travel / limit, J1..J6 (1) | "
                  + " | ".join(", ".join(f"{v:.2f}" for v in r["residual_monitor_travel_ratio"]) for r in rs) + " |")
-    lines.append(f"| backstop: torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau_max)}) | "
-                 + " | ".join(", ".join(f"{v:.1f}" for v in r["stuck_monitor_peak_dtau_Nm"]) for r in rs) + " |")
     lines.append(f"| tracking error, position [mm] ({pos:g}) | "
                  + " | ".join(f"{max(r['max_error_mm']):.2f}" for r in rs) + " |")
     lines.append(f"| tracking error, orientation [deg] ({math.degrees(ori):.2f}) | "
@@ -724,8 +721,8 @@ def detection_cell(r):
 @table("residual_injection", "docs/safety.md", "long")
 def residual_injection():
     """Armed, the paper's motion: each joint's encoder stuck at four phases of one period; each drive
-    stuck at its last code. Cell: the fault raised (by the residual monitor, or by the stuck-encoder
-    backstop), ms after the injection, and the true tip's excursion."""
+    stuck at its last code. Cell: the fault raised (by the residual monitor, or by another monitor),
+    ms after the injection, and the true tip's excursion."""
     specs = [(f"{k}:{j}@{t:g}", t) for k in ("encoder-stuck", "dac-stuck") for j in range(1, 7)
              for t in RESIDUAL_TIMES]
     prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s) for s, t in specs])
@@ -936,7 +933,6 @@ def plant_hour():
         if r["faults"]:
             names = ", ".join(r["faults"])
             text = text.replace(f"| {names} |", f"| {names} at {r['fault_time_s']:.1f} s |", 1)
-    dtau = parse_params("kStuckTorque", 6)
     lines = ["", "| monitor, worst over the hour (threshold) | " + " | ".join(n for n, _ in runs) + " |",
              "|---" * (len(runs) + 1) + "|"]
     rs = [run_of(experiment(*a), "adaptive") for _, a in runs]
@@ -948,8 +944,6 @@ def plant_hour():
                  + peaks("residual_monitor_peak_ratio", [1.0] * 6) + " |")
     lines.append("| travel check, least travel / limit, J1..J6 (1) | "
                  + peaks("residual_monitor_travel_ratio", [1.0] * 6) + " |")
-    lines.append(f"| backstop: torque change while still, J1..J6 [N m] ({', '.join(f'{v:g}' for v in dtau)}) | "
-                 + peaks("stuck_monitor_peak_dtau_Nm", dtau) + " |")
     return text + "\n" + "\n".join(lines)  # a blank line: the monitors' table is a table of its own
 
 
@@ -972,11 +966,9 @@ def monitor_margins():
             for pert in MONITOR_PERTURBATIONS]
     configs = [("the residual monitor a trial (`run.residual_monitor=trial`): the stuck-encoder monitor's criteria",
                 TRIAL, criteria),
-               ("the default: the residual monitor armed, the stuck-encoder monitor its backstop",
+               ("the default: the residual monitor armed, the stuck-encoder monitor's fitted criteria off",
                 (), [("residual monitor, \\|r\\| / threshold", "residual_monitor_peak_ratio", [1.0] * 6, ""),
-                     ("travel check, least travel / limit", "residual_monitor_travel_ratio", [1.0] * 6, ""),
-                     ("backstop: torque change while still", "stuck_monitor_peak_dtau_Nm",
-                      parse_params("kStuckTorque", 6), "N m")])]
+                     ("travel check, least travel / limit", "residual_monitor_travel_ratio", [1.0] * 6, "")])]
     args = {(k, c[1]): ("--duration", "300", "--scalar", k[0], "--friction", k[1], *k[2], *c[1])
             for k in sets for c in configs}
     EXPECTED_FAULTS.update(args.values())  # a false alarm on a healthy arm is this table's finding

@@ -336,18 +336,16 @@ TEST(Injection, StuckAmplifierIsCaughtAndDisabledByTheFaultLine) {
   EXPECT_EQ(r.injection.max_torque_after, 0.0);
 }
 
-// The residual monitor armed (run.residual_monitor=on, a trial: docs/safety.md), the stuck-encoder
-// monitor behind it as a backstop: a stuck joint-2 encoder mid-motion is a stuck encoder (the
-// backstop may name it first; the residual names J2 when it does), a stuck joint-2 amplifier a
-// drive fault.
+// The residual monitor armed (run.residual_monitor=on, the default: docs/safety.md), the stuck-encoder
+// monitor's fitted criteria off: a stuck joint-2 encoder mid-motion is a stuck encoder that the
+// residual monitor names (J2), a stuck joint-2 amplifier a drive fault.
 TEST(Injection, ResidualMonitorIsolatesAStuckEncoderAndAStuckDrive) {
   const ExperimentResult e = inject("encoder-stuck:2@21.25", 21.6, osc::FrictionMode::kAdaptive, true);
   ASSERT_GE(e.injection.detected, 0);
   EXPECT_LE(e.injection.detected - 21.25, 0.1);
   EXPECT_EQ(e.injection.faults, static_cast<std::uint32_t>(osc::kFaultEncoderStuck));
-  if (e.residual_detected_s >= 0) {
-    EXPECT_EQ(e.residual_joint, 1);
-  }
+  EXPECT_GE(e.residual_detected_s, 0);
+  EXPECT_EQ(e.residual_joint, 1);
   const ExperimentResult d = inject("dac-stuck:2@21.25", 21.8, osc::FrictionMode::kAdaptive, true);
   ASSERT_GE(d.injection.detected, 0);
   EXPECT_LE(d.injection.detected - 21.25, 0.5);

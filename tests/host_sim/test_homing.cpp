@@ -53,7 +53,7 @@ std::unique_ptr<Sim> make_sim(const sim::Vec6& q0, const std::optional<sim::Vec6
                               const Gains<double>& gains = Gains<double>::paper()) {
   auto s = std::make_unique<Sim>(q0, inj, cfg.plant, FrictionMode::kAdaptive, gains, cfg.sensor_config(), power_on);
   // The realistic plant's monitoring (docs/experiment.md): the residual monitor armed, the
-  // trajectory-tuned stuck-encoder criteria its backstop.
+  // trajectory-tuned stuck-encoder criteria off (but while homing).
   s->task().residual.armed = !cfg.plant.ideal_drives();
   return s;
 }

@@ -556,14 +556,18 @@ TEST_F(Link, NearSingularJacobianFaults) {
 }
 
 TEST_F(Link, FrozenEncodersFaultAsStuck) {
-  // Encoders frozen while the trajectory moves away: the stuck-encoder monitor latches (before it,
-  // the torques clipped and stayed clipped until the saturation check).
+  // Encoders frozen while the trajectory moves away: the armed residual monitor (the default)
+  // latches once the torques leave the joints' static bands, within a second; every joint still
+  // under torque from rest reads as an arm held where it stands, a collision, or as a stuck
+  // encoder (before it, the torques clipped and stayed clipped until the saturation check).
   pil::ActuatorFrame a;
-  for (int k = 0; k < 20000; ++k) {
+  int k = 0;
+  for (; k < 20000; ++k) {
     a = exchange();
     if (a.faults) break;
   }
-  EXPECT_EQ(a.faults, static_cast<std::uint32_t>(osc::kFaultEncoderStuck));
+  EXPECT_TRUE(a.faults == osc::kFaultCollision || a.faults == osc::kFaultEncoderStuck) << a.faults;
+  EXPECT_LT(k, 1000);
   EXPECT_TRUE(zero(a));
 }
 

@@ -142,12 +142,8 @@ SweepResult sweep(unsigned seed, int moves, int streams, const sim::PlantConfig&
     const double limit = static_cast<double>(m.travel_limit(i));
     out.travel[i] = limit > 0 ? static_cast<double>(m.travel_peak(i)) / limit : 0;
   }
-  const auto& b = sim.task().stuck.dtau_peak;
   char buf[200];
-  std::snprintf(buf, sizeof buf, "residual: %s J%d; backstop torque-change peaks %.1f %.1f %.1f %.1f %.1f %.1f",
-                m.detected ? fault_name(m.detected) : "none", m.joint + 1, static_cast<double>(b(0)),
-                static_cast<double>(b(1)), static_cast<double>(b(2)), static_cast<double>(b(3)),
-                static_cast<double>(b(4)), static_cast<double>(b(5)));
+  std::snprintf(buf, sizeof buf, "residual: %s J%d", m.detected ? fault_name(m.detected) : "none", m.joint + 1);
   out.detail = buf;
   return out;
 }

@@ -212,15 +212,32 @@ TEST_F(TaskFixture, SingularPoseFaults) {
 }
 
 TEST_F(TaskFixture, FrozenEncodersWhileTheReferenceMovesFaultAsStuck) {
-  // The robot's encoders do not move while the trajectory runs away: the stuck-encoder monitor
-  // (reference motion or torque change while an encoder stands still) latches long before the
-  // torques clip (this used to take the saturation check hundreds of ticks at full scale).
+  // The robot's encoders do not move while the trajectory runs away. The residual monitor a trial:
+  // the stuck-encoder monitor's criteria (reference motion or torque change while an encoder stands
+  // still) latch long before the torques clip (this used to take the saturation check hundreds of
+  // ticks at full scale).
+  task->residual.armed = false;
   int k = 0;
   std::uint32_t f = 0;
   for (; k < 20000 && f == 0; ++k) f = run(1);
   EXPECT_EQ(f, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "after " << k << " ticks";
   EXPECT_EQ(task->sup.latched & kFaultSaturation, 0u);
   expect_latched(kFaultEncoderStuck);
+}
+
+TEST_F(TaskFixture, FrozenEncodersFaultTheArmedResidualMonitor) {
+  // The same, the residual monitor armed (the default): every joint still from rest under a rising
+  // torque is an arm held where it stands, which the sensors cannot tell from a contact on every
+  // joint; the residual monitor latches its fault once the torques leave the joints' static bands,
+  // before any torque clips (the saturation check) or the tracking bound.
+  ASSERT_TRUE(task->residual.armed);
+  int k = 0;
+  std::uint32_t f = 0;
+  for (; k < 20000 && f == 0; ++k) f = run(1);
+  EXPECT_TRUE(f == kFaultCollision || f == kFaultEncoderStuck) << f << " after " << k << " ticks";
+  EXPECT_LT(k, 1000);
+  EXPECT_EQ(task->sup.latched & (kFaultSaturation | kFaultTracking), 0u);
+  expect_latched(f);
 }
 
 TEST_F(TaskFixture, PersistentSaturationFaults) {

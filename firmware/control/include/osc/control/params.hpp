@@ -118,8 +118,9 @@ constexpr double kResidualMargin = 2;
 /// (Corke's friction, uncompensated) crept at 0.008 rad/s, a count every 10 ticks, for seconds;
 /// judged as sliding, it reached 1.03 of its change threshold (docs/safety.md).
 constexpr int kResidualSlideInterval = 5;
-/// The residual monitor raises its faults (encoder_stuck, drive_fault, collision) by default, the
-/// stuck-encoder monitor its backstop (the runtime parameter residual_monitor; docs/safety.md). Off,
+/// The residual monitor raises its faults (encoder_stuck, drive_fault, collision) by default, and the
+/// stuck-encoder monitor's fitted criteria are off but while homing (the runtime parameter
+/// residual_monitor; docs/safety.md). Off,
 /// it is a trial: it records what it would raise, and the stuck-encoder monitor's trajectory-tuned
 /// criteria raise encoder_stuck as before.
 constexpr bool kResidualMonitorArmed = true;

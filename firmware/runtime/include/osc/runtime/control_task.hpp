@@ -306,18 +306,20 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const bool coupled = task.io.coupled();
   const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
   const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
-  // The stuck-encoder monitor; a backstop with its torque criterion alone where the residual
-  // monitor is armed, and while homing, whose slow moves static friction holds and whose end names a
-  // motor that did not turn (homing_faults) (docs/safety.md). Yielding, the reference follows the arm and the torque
-  // follows gravity; against a contact the torque holds a joint that cannot move: neither says where the arm must go,
-  // so the stuck-encoder monitor waits, from a collision reacted to until the next motion (the residual monitor runs
-  // on).
+  // The stuck-encoder monitor (docs/safety.md): off where the residual monitor is armed (its residual
+  // and travel check judge every encoder), restarting from the tick it next runs; a trial's fitted
+  // criteria otherwise. While homing, whose slow moves static friction holds and whose end names a
+  // motor that did not turn (homing_faults), its torque criterion alone. Yielding, the reference follows the arm
+  // and the torque follows gravity; against a contact the torque holds a joint that cannot move: neither says where
+  // the arm must go, so it waits, from a collision reacted to until the next motion (the residual monitor runs on).
   std::uint32_t faults = 0;
-  if (task.machine.state == MotionState::kYielding || task.contact)
+  const bool homing = task.machine.state == MotionState::kHoming;
+  if (task.residual.armed && !homing)
+    task.stuck.restart = true;
+  else if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
   else
-    faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad,
-                              task.residual.armed || task.machine.state == MotionState::kHoming);
+    faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad, homing);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();

@@ -201,13 +201,13 @@ struct StuckEncoderMonitor {
   }
   /// After the step of tick `tick` that commanded the motor torques `tau` and reference motor rates
   /// `qd_ref` (both per encoder channel: the joints' own where each encoder reads its joint);
-  /// `counts` and `moved` from EncoderJumpMonitor. backstop: behind the armed residual monitor, the
-  /// torque criterion alone (kStuckTorque, beyond the torque that breaks any joint away from its
-  /// static friction); the criteria tuned on the paper's trajectory are off (the reference motion
-  /// while silent trips on slow moves of a joint that static friction holds, Corke's J1).
+  /// `counts` and `moved` from EncoderJumpMonitor. torque_only: the torque criterion alone
+  /// (kStuckTorque, beyond the torque that breaks any joint away from its static friction), as while
+  /// homing: the criteria tuned on the paper's trajectory are off (the reference motion while silent
+  /// trips on slow moves of a joint that static friction holds, Corke's J1).
   std::uint32_t check(const Vec6<S>& tau, const Vec6<S>& qd_ref, const std::int32_t counts[kDof],
                       const bool moved[kDof], std::uint64_t tick, S dt,
-                      const Vec6<math::io_scalar_t<S>>& counts_per_rad, bool backstop = false) {
+                      const Vec6<math::io_scalar_t<S>>& counts_per_rad, bool torque_only = false) {
     static constexpr std::array<S, kDof> kTorque = lit_array<S>(params::kStuckTorque);
     static constexpr std::array<S, kDof> kTorqueSilent = lit_array<S>(params::kStuckTorqueSilent);
     static constexpr S kMotionBound = lit<S>(kStuckMotionBound), kMotionCounts = lit<S>(params::kStuckMotionCounts);
@@ -238,7 +238,7 @@ struct StuckEncoderMonitor {
       // held by static friction, had long intervals already.
       if (!activity.silent(i, tick)) continue;
       if (m > peak(i)) peak(i) = m;
-      if (backstop) continue;
+      if (torque_only) continue;
       if (m > kMotionCounts) faults |= kFaultEncoderStuck;
       // A joint that was counting one way fast should have counted on.
       if (!activity.was_fast(i)) continue;

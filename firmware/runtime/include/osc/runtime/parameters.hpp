@@ -110,7 +110,7 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")          \
   X(ResidualMonitor, "residual_monitor", 1, "", 0, 1, params::kResidualMonitorArmed ? 1 : 0, TorqueOff, true,         \
     "1: the residual monitor armed: it raises encoder_stuck, drive_fault, collision (the stuck-encoder "              \
-    "monitor its backstop); 0: a trial (recorded; the stuck-encoder monitor raises encoder_stuck)")
+    "monitor off but homing); 0: a trial (recorded; the stuck-encoder monitor raises encoder_stuck)")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),
