@@ -24,7 +24,7 @@ constexpr Shorthand kShorthands[] = {
     {"--duration", "run.duration", "simulated seconds per run (default 120; 1..86400)"},
     {"--mode", "run.modes", "both | adaptive | none (default both)"},
     {"--scalar", "run.scalar", "the controller's arithmetic: double | float | fixed (default double)"},
-    {"--adaptation", "run.adaptation", "friction adaptation law: paper | robust | momentum (default robust)"},
+    {"--adaptation", "run.adaptation", "friction adaptation law: paper | robust | momentum (default momentum)"},
     {"--final-window", "run.final_window", "length of the \"last\" statistics in seconds (default 20; 1..3600)"},
     {"--plant", "plant.preset",
      "the simulated arm: ideal (the paper's tables) | realistic (every feature of docs/experiment.md's plant "

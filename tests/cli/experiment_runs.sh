@@ -49,11 +49,11 @@ fault_is_named_and_plotted)  # 0.2 m at 2 Hz is more than the robot can follow: 
     --set trajectory.envelope=10 --csv-dir "$d" --json "$d/summary.json" >"$d/run.log"
   status=$?
   test $status -eq 1 || fail "exit $status, not 1"
-  has_line "$d/run.log" 'FAULT saturation at tick 483, t = 0.483 s'
+  has_line "$d/run.log" 'FAULT saturation at tick 482, t = 0.482 s'
   has_line "$d/run.log" 'q .deg.:'
   has_line "$d/run.log" '(faulted)'
   plot
-  has_line "$d/plot.log" 'fault saturation at t = 0.483 s (tick 483): marked'
+  has_line "$d/plot.log" 'fault saturation at t = 0.482 s (tick 482): marked'
   test -f "$d/fig1_tracking_errors.png" || fail "no fig1_tracking_errors.png"
   ;;
 *)

@@ -77,15 +77,18 @@ assert got == [("enable", None, True), ("move_to", "not_homed", False), ("home",
                ("move_to", None, True), ("disable", None, True), ("declare_pose", "pots_disagree", False)], got
 PY
   ;;
-real_arm)  # docs/experiment.md: from power-on pose 5 the paper's gains vibrate the realistic wrist
-  # until a monitor stops it; examples/real_arm.yaml's (the observer's rotational k doubled) run clean
+real_arm)  # docs/experiment.md: from power-on pose 5 the paper's gains with the robust law vibrate the
+  # realistic wrist until a monitor stops it; examples/real_arm.yaml's (the observer's rotational k
+  # doubled) run clean, and so do the paper's gains with the momentum law (the default), which
+  # learns the wrist's friction within seconds
   run() {
     "$exe" --plant realistic --motion "$examples/home_then_paper.yaml" --set plant.power_on_pose=random:5 \
       --set run.residual_monitor=on --json "$d/$1.json" "${@:2}" >"$d/$1.txt" 2>&1
   }
-  run paper
+  run paper --adaptation robust
   rc=$?
   test $rc -eq 1 || fail "exit $rc, not 1 (a fault): $(cat "$d/paper.txt")"
+  run default || fail "exit $?: $(cat "$d/default.txt")"
   run real --config "$examples/real_arm.yaml" || fail "exit $?: $(cat "$d/real.txt")"
   "$py" - "$d/paper.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/real.txt")"
 import json, sys

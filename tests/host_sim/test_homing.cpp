@@ -362,17 +362,31 @@ WristRun wrist_run(std::uint32_t seed, const Gains<double>& gains, double second
 // plant's J4 and J6 counter-rotate at about 28 Hz, the observer's rotational error mode (x~'' + k x~'
 // + Lambda^-1 k_i x~ = 0: 27.5 Hz at this pose, damping ratio k / (2 sqrt(b)) = 0.09 with the paper's
 // k = 32 /s), which the amplifiers' current-loop lag leaves too little damped. Twice the damping
-// (k = 64 /s on the rotations) ends the vibration, and the monitors' false alarms with it.
+// (k = 64 /s on the rotations) ends the vibration, and the monitors' false alarms with it. Measured
+// with the robust law, as docs/experiment.md reports it; the momentum law (the default), which
+// learns the wrist's friction within seconds, leaves less of the vibration at the paper's k (J4's
+// error 0.027 rad/s, no fault) and about 0.018 rad/s with k_rot = 64, no fault either.
 TEST(Homing, OnTheRealisticPlantTheRotationsObserverDampingEndsTheWristVibration) {
-  Gains<double> damped = Gains<double>::paper();
+  Gains<double> plain = Gains<double>::paper();
+  plain.adaptation = AdaptationLaw::kRobust;
+  Gains<double> damped = plain;
   for (int i = 3; i < kDof; ++i) damped.k(i) = 2 * damped.k(i);
-  const WristRun paper = wrist_run(5, Gains<double>::paper(), 10);  // q4 24 deg, q5 24.5 deg
+  const WristRun paper = wrist_run(5, plain, 10);  // q4 24 deg, q5 24.5 deg
   const WristRun fixed = wrist_run(5, damped, 10);
   std::printf("J4's velocity-estimate error rms: paper's k %.4f rad/s (faults %s), k_rot = 64 %.4f rad/s\n", paper.rms,
               fault_name(paper.faults), fixed.rms);
   EXPECT_EQ(fixed.faults, 0u) << fault_name(fixed.faults);
   EXPECT_LT(fixed.rms, 0.012);          // the other poses' level (docs/experiment.md)
   EXPECT_GT(paper.rms, 2 * fixed.rms);  // the paper's gains vibrate
+  // The default law: no fault with either gain, the damped observer's error within 0.025 rad/s.
+  Gains<double> damped_default = Gains<double>::paper();
+  for (int i = 3; i < kDof; ++i) damped_default.k(i) = 2 * damped_default.k(i);
+  const WristRun d_paper = wrist_run(5, Gains<double>::paper(), 10), d_fixed = wrist_run(5, damped_default, 10);
+  std::printf("the default law: paper's k %.4f rad/s (faults %s), k_rot = 64 %.4f rad/s (faults %s)\n", d_paper.rms,
+              fault_name(d_paper.faults), d_fixed.rms, fault_name(d_fixed.faults));
+  EXPECT_EQ(d_paper.faults, 0u) << fault_name(d_paper.faults);
+  EXPECT_EQ(d_fixed.faults, 0u) << fault_name(d_fixed.faults);
+  EXPECT_LT(d_fixed.rms, 0.025);
 }
 
 TEST(Homing, RightAfterTheEnableOnTheIdealPlant) {

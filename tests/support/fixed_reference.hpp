@@ -49,10 +49,13 @@ void kernel_outputs(const Case& c, const Model<S>& model, Data<S>& data, OpSpace
 }
 
 /// Calls emit("tau", tau) for kSteps control steps from controller_init at the start pose, joint 2
-/// moving 1e-5 rad per step (adaptive, the paper's gains).
+/// moving 1e-5 rad per step (adaptive, the paper's gains, the robust law: the law whose update runs
+/// in the control step, so that the images check its arithmetic too; the momentum law's runs in the
+/// task).
 template <class S, class Emit>
 void step_outputs(const Model<S>& model, ControllerState<S>& st, Emit&& emit) {
-  const Gains<S> gains = Gains<S>::paper();
+  Gains<S> gains = Gains<S>::paper();
+  gains.adaptation = AdaptationLaw::kRobust;
   const Vec6<S> q0 = joint_vector<S>(robot::kQStart);
   controller_init(model, st, q0);
   const PaperMotion<S> paper{gains.trajectory, st.data.o[kDof]};

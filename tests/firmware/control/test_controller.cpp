@@ -325,7 +325,8 @@ TEST_F(Stages, AdaptationWaitsForItsFirstSampleThenFollowsEquation67) {
 }
 
 TEST_F(Stages, RobustLawUsesTheOlderRegressorLeaksAndProjects) {
-  ASSERT_EQ(G.adaptation, AdaptationLaw::kRobust);  // the default
+  EXPECT_EQ(Gains<double>::paper().adaptation, AdaptationLaw::kMomentum);  // the default
+  G.adaptation = AdaptationLaw::kRobust;
   AdaptationState<double> a{};
   for (int i = 0; i < 18; ++i) a.theta_hat(i) = 0.5 * params::kThetaMax[i];
   a.theta_hat(0) = params::kThetaMax[0] - 1e-9;  // pushed over its upper bound below

@@ -1,6 +1,7 @@
 // The controller's tunable parameters: gains (69), K_ad, tau_dec, the sample time, the task's
 // trajectory (68), and the choices a caller makes (friction mode, adaptation law). Defaults from params.hpp; the
-// adaptation law defaults to the robust one (docs/adaptation.md); AdaptationLaw::kPaper gives (67) exactly.
+// adaptation law defaults to the momentum law (kDefaultAdaptationLaw, docs/adaptation.md); AdaptationLaw::kPaper
+// gives (67) exactly, kRobust the robust law.
 #pragma once
 
 #include <cstdint>
@@ -19,10 +20,13 @@ enum class FrictionMode : std::uint8_t { kAdaptive, kNone };
 /// The law that updates the friction estimates (osc/control/adaptation.hpp).
 enum class AdaptationLaw : std::uint8_t {
   kPaper,     ///< the paper's sampled law (67), exactly
-  kRobust,    ///< (67)'s error with the regressor one sample older, projection, leakage (the default)
+  kRobust,    ///< (67)'s error with the regressor one sample older, projection, leakage
   kMomentum,  ///< identified from the residual monitor's momentum residual, a Kalman filter per joint
               ///< (osc/control/identification.hpp): the control step holds theta^, the task updates it
 };
+/// The default law (Gains::paper(), the runtime parameter adaptation): the momentum law, as fast as
+/// (67) in the first minutes and bounded for hours (docs/adaptation.md, section 5).
+constexpr AdaptationLaw kDefaultAdaptationLaw = AdaptationLaw::kMomentum;
 /// Names of the laws, in enum order (command lines, logs).
 constexpr const char* kAdaptationLawNames[] = {"paper", "robust", "momentum"};
 constexpr int kAdaptationLawCount = sizeof(kAdaptationLawNames) / sizeof(kAdaptationLawNames[0]);
@@ -114,7 +118,7 @@ constexpr GainParam none() { return {"", GainForm::kNone, 0, 0, ""}; }
     gain_param::every("tau_dec", 0.01, 100, "s^2/rad^2"))                                                          \
   X(S, dt, params::kDt, "the sample time [s]", gain_param::none())                                                 \
   X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition", gain_param::none()) \
-  X(AdaptationLaw, adaptation, AdaptationLaw::kRobust, "the friction adaptation law", gain_param::none())          \
+  X(AdaptationLaw, adaptation, kDefaultAdaptationLaw, "the friction adaptation law", gain_param::none())           \
   X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)",                \
     gain_param::none())                                                                                            \
   X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law",                                     \

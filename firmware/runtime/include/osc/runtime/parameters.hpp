@@ -92,7 +92,7 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
 // a list), access, persists, meaning): the runtime parameters besides the gains. A name is a key of
 // the host's run.* configuration where the host sets it too.
 #define OSC_RUNTIME_PARAM_LIST(X)                                                                                     \
-  X(Adaptation, "adaptation", 1, "", 0, kAdaptationLawCount - 1, static_cast<double>(AdaptationLaw::kRobust),         \
+  X(Adaptation, "adaptation", 1, "", 0, kAdaptationLawCount - 1, static_cast<double>(kDefaultAdaptationLaw),          \
     TorqueOff, true, "the friction adaptation law: 0 paper (67), 1 robust, 2 momentum")                               \
   X(MoveLinear, "move_linear", 3, "m/s, m/s^2, m/s^3", 1e-6, detail::kMoveLinearCap, params::kMoveLinear, Always,     \
     true, "a move's and a stream's maxima of the wrist centre's speed, acceleration, jerk")                           \
