@@ -367,10 +367,13 @@ WristRun wrist_run(std::uint32_t seed, const Gains<double>& gains, double second
 // learns the wrist's friction within seconds, leaves less of the vibration at the paper's k (J4's
 // error 0.027 rad/s, no fault) and about 0.018 rad/s with k_rot = 64, no fault either.
 TEST(Homing, OnTheRealisticPlantTheRotationsObserverDampingEndsTheWristVibration) {
+  const auto damp = [](Gains<double> g) {  // the observer's rotational k doubled
+    for (int i = 3; i < kDof; ++i) g.k(i) = 2 * g.k(i);
+    return g;
+  };
   Gains<double> plain = Gains<double>::paper();
   plain.adaptation = AdaptationLaw::kRobust;
-  Gains<double> damped = plain;
-  for (int i = 3; i < kDof; ++i) damped.k(i) = 2 * damped.k(i);
+  const Gains<double> damped = damp(plain);
   const WristRun paper = wrist_run(5, plain, 10);  // q4 24 deg, q5 24.5 deg
   const WristRun fixed = wrist_run(5, damped, 10);
   std::printf("J4's velocity-estimate error rms: paper's k %.4f rad/s (faults %s), k_rot = 64 %.4f rad/s\n", paper.rms,
@@ -379,9 +382,8 @@ TEST(Homing, OnTheRealisticPlantTheRotationsObserverDampingEndsTheWristVibration
   EXPECT_LT(fixed.rms, 0.012);          // the other poses' level (docs/experiment.md)
   EXPECT_GT(paper.rms, 2 * fixed.rms);  // the paper's gains vibrate
   // The default law: no fault with either gain, the damped observer's error within 0.025 rad/s.
-  Gains<double> damped_default = Gains<double>::paper();
-  for (int i = 3; i < kDof; ++i) damped_default.k(i) = 2 * damped_default.k(i);
-  const WristRun d_paper = wrist_run(5, Gains<double>::paper(), 10), d_fixed = wrist_run(5, damped_default, 10);
+  const WristRun d_paper = wrist_run(5, Gains<double>::paper(), 10),
+                 d_fixed = wrist_run(5, damp(Gains<double>::paper()), 10);
   std::printf("the default law: paper's k %.4f rad/s (faults %s), k_rot = 64 %.4f rad/s (faults %s)\n", d_paper.rms,
               fault_name(d_paper.faults), d_fixed.rms, fault_name(d_fixed.faults));
   EXPECT_EQ(d_paper.faults, 0u) << fault_name(d_paper.faults);

@@ -301,11 +301,6 @@ void identify_friction(ControlTask<S>& task) {
 template <class S>
 std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t counts[kDof], const bool moved[kDof]) {
   const StepOutput<S>& out = task.last;
-  // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
-  Vec6<S> tau_m, rate_m;
-  const bool coupled = task.io.coupled();
-  const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
-  const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
   // The stuck-encoder monitor (docs/safety.md): off where the residual monitor is armed (its residual
   // and travel check judge every encoder), restarting from the tick it next runs; a trial's fitted
   // criteria otherwise. While homing, whose slow moves static friction holds and whose end names a
@@ -318,8 +313,14 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
     task.stuck.restart = true;
   else if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
-  else
+  else {
+    // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
+    Vec6<S> tau_m, rate_m;
+    const bool coupled = task.io.coupled();
+    const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
+    const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
     faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad, homing);
+  }
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
