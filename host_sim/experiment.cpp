@@ -73,7 +73,19 @@ class LocalController {
     }
     return true;
   }
-  void skip_ticks(std::uint64_t n) { task_->tick += n; }
+  /// The counter jumps by n, as if the task had been running that much longer: the trajectory's
+  /// start stays (its time grows by n, the point of the jump), while the monitors' recent history
+  /// (each encoder's last change, a run over the threshold, the enable's ramp) moves with the clock,
+  /// as it would have in a task that had been running.
+  void skip_ticks(std::uint64_t n) {
+    task_->tick += n;
+    task_->ramp_start += n;
+    for (int i = 0; i < 6; ++i) {
+      task_->residual.activity.last_move_tick[i] += n;
+      task_->residual.over_since[i] += n;
+      task_->stuck.activity.last_move_tick[i] += n;
+    }
+  }
   void finish(ExperimentResult& res) {
     for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck.peak(i));
     for (int i = 0; i < 6; ++i) res.stuck_dtau_peak[i] = static_cast<double>(task_->stuck.dtau_peak(i));

@@ -95,18 +95,39 @@ TEST_F(WithFriction, EstimatedFrictionTorqueMatchesThePlant) {
 }
 
 TEST_F(WithFriction, CoefficientsApproachTheTrueValues) {
-  // The strongly excited parameters: Coulomb + Stribeck of joints 1-2 (large arm joints, every
-  // velocity reversal). After 30 s they are within 25 % of the truth; see docs/experiment.md for the
-  // full 120 s table and the weakly excited wrist parameters.
+  // The default (momentum) law on the paper's trajectory after 30 s. What the motion excites is each
+  // joint's breakaway friction, Coulomb + Stribeck (every velocity reversal of J1-J3), and the
+  // viscous terms; the Coulomb / Stribeck split is not (the joints turn too slowly for the Stribeck
+  // decay to show: docs/adaptation.md, section 5), and the identifier says so. The breakaway of J1-J2
+  // is within 10 % of the truth and reported identified, the viscous terms of J1-J3 within 25 %.
+  ASSERT_TRUE(adaptive.has_identification);
+  for (int j : {0, 1}) {
+    const double hat = adaptive.theta_hat[6 + j] + adaptive.theta_hat[12 + j];
+    const double truth = adaptive.theta_true[6 + j] + adaptive.theta_true[12 + j];
+    EXPECT_NEAR(hat, truth, 0.1 * truth) << "breakaway J" << j + 1;
+    EXPECT_TRUE(osc::friction_identified(hat, adaptive.breakaway_sd[j])) << "breakaway J" << j + 1;
+    EXPECT_FALSE(osc::split_excited(adaptive.split_excitation[j])) << "split J" << j + 1;
+  }
+  for (int j : {0, 1, 2})
+    EXPECT_NEAR(adaptive.theta_hat[j], adaptive.theta_true[j], 0.25 * adaptive.theta_true[j]) << "viscous J" << j + 1;
+  // Nothing diverged.
+  for (int i = 0; i < 18; ++i) EXPECT_LT(std::abs(adaptive.theta_hat[i]), 20.0) << i;
+}
+
+TEST_F(WithFriction, TheRobustLawSplitsCoulombAndStribeckOfJointsOneAndTwo) {
+  // The robust form of (67) learns from the tracking error instead, and its gradient does move the
+  // Coulomb and Stribeck terms apart: within 25 % of the truth each after 30 s (its full 120 s
+  // table: docs/experiment.md).
+  ExperimentConfig c = config(30, osc::FrictionMode::kAdaptive, osc::robot::kFrictionPaper);
+  c.gains.adaptation = osc::AdaptationLaw::kRobust;
+  const ExperimentResult robust = run_experiment(c);
+  ASSERT_EQ(robust.status, 0u);
   for (int j : {0, 1}) {
     for (int k : {1, 2}) {
       const int idx = 6 * k + j;
-      EXPECT_NEAR(adaptive.theta_hat[idx], adaptive.theta_true[idx], 0.25 * adaptive.theta_true[idx])
-          << "theta index " << idx;
+      EXPECT_NEAR(robust.theta_hat[idx], robust.theta_true[idx], 0.25 * robust.theta_true[idx]) << "theta " << idx;
     }
   }
-  // Nothing diverged.
-  for (int i = 0; i < 18; ++i) EXPECT_LT(std::abs(adaptive.theta_hat[i]), 20.0) << i;
 }
 
 TEST(ClosedLoop, TracksWithTenPercentModelError) {
@@ -164,7 +185,8 @@ TEST(Windows, PerWindowMaximaCoverTheRunAndAgreeWithTheWholeRunMaximum) {
   const ExperimentResult r = run_experiment(c);
   ASSERT_EQ(r.window_max.size(), 4u);  // [0,2) [2,4) [4,6) [6,7)
   ASSERT_EQ(r.window_theta_range.size(), 4u);
-  EXPECT_EQ(r.adaptation, "robust");  // the default
+  EXPECT_EQ(r.adaptation, "momentum");  // the default (osc::kDefaultAdaptationLaw)
+  EXPECT_EQ(r.adaptation, osc::adaptation_law_name(osc::kDefaultAdaptationLaw));
   for (int i = 0; i < 6; ++i) {
     double m = 0;
     for (const auto& w : r.window_max) m = std::max(m, w[i]);
@@ -273,6 +295,10 @@ ExperimentResult inject(const char* spec, double duration, osc::FrictionMode mod
                         bool residual_monitor = false) {
   ExperimentConfig c = config(duration, mode, osc::robot::kFrictionPaper);
   c.residual_monitor = residual_monitor;
+  // The trial's stuck-encoder criteria were fitted with the robust law's friction estimates (with the
+  // momentum law's, a J3 encoder stuck at 21.25 s is caught only by the position check, after
+  // 141 ms): the trial keeps the law they were fitted with.
+  if (!residual_monitor) c.gains.adaptation = osc::AdaptationLaw::kRobust;
   std::string err;
   EXPECT_TRUE(parse_injection(spec, c.injection, err)) << err;
   const ExperimentResult r = run_experiment(c);
