@@ -149,7 +149,7 @@ SweepResult sweep(unsigned seed, int moves, int streams, const sim::PlantConfig&
 }
 
 /// Known short with the momentum law (the default), compensated: J4 reaches 0.51 of its threshold in
-/// double and Q12.19 (seed 25, float 0.48) at 0.6 rad/s, just after the sweep's first fast wrist move
+/// double and Q12.19 (seed 25, float 0.41) at 0.6 rad/s, just after the sweep's first fast wrist move
 /// unlocked its Coulomb / Stribeck split (osc/control/identification.hpp). Fitted from two clusters
 /// of speeds, the reversals' and 0.6 rad/s, the split lands at a bound (Coulomb 0, Stribeck 2.56,
 /// viscous 0.49 against the plant's 1.0 / 1.5 / 0.1) and the change channel sees the fit's error at
