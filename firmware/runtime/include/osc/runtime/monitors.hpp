@@ -414,6 +414,11 @@ struct ResidualMonitor {
   /// (kResidualTravelCounts quanta; 0: the check is off, a joint whose encoder reads other joints too), and the largest
   /// least travel seen (the check's peak; against travel_limit, its headroom).
   Vec6<S> v_lo, p_lo, travel_limit, travel_peak;
+  /// The least drive that way (travel()) over the ticks of the travel check's current step: the
+  /// torque may alternate tick by tick (the friction compensation's sign term at a joint that
+  /// hunts about rest), and the step holds for kResidualTravelEvery ticks, not only its last.
+  Vec6<S> drive_lo;
+  static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
   Vec6<S> travel_quantum;  // set-up: each joint's encoder quantum [rad]
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
@@ -454,6 +459,7 @@ struct ResidualMonitor {
     tau_prev.setZero();
     peak_ratio.setZero();
     travel_peak.setZero();
+    drive_lo.setConstant(kNoDrive);
     for (int i = 0; i < kDof; ++i) over[i] = 0, over_since[i] = 0;
     activity.reset();
     joint = -1;
@@ -724,7 +730,7 @@ struct ResidualMonitor {
   /// crossed an edge in the direction `way` of the count; counting steadily, it crossed the one
   /// before a count back, n ticks earlier: its mean speed that way since was at least a count over
   /// n + 1 ticks, less the most it can have slowed over them. Then, every params::kResidualTravelEvery
-  /// ticks, the torque applied less gravity and Coriolis torques, with every error the model may
+  /// ticks, the torque applied less gravity and Coriolis torques (the least of the step's ticks), with every error the model may
   /// have against the motion (model_error(), the other joints' inertial torques with the link
   /// inertia's share, the current loop's lag) and friction at the band's strongest against it (at
   /// rest: the whole static band), over the diagonal inertia at its least or most, bounds its
@@ -742,13 +748,18 @@ struct ResidualMonitor {
     if (restart) {
       p_lo(i) = -limit;  // nothing known: no bound until a count
       v_lo(i) = S(0);
+      drive_lo(i) = kNoDrive;
       return false;
     }
     static constexpr int kEvery = params::kResidualTravelEvery;
     const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
-    if (!count && !turn) return false;
     const S way = activity.direction[i] > 0 ? S(1) : S(-1);
-    const S drive = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
+    const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
+    // This tick's drive at a count (the direction it sets), else the least over the step's ticks.
+    const S drive = count ? now : (now < drive_lo(i) ? now : drive_lo(i));
+    drive_lo(i) = drive;
+    if (!count && !turn) return false;
+    drive_lo(i) = kNoDrive;
     const S aii = in.A(i, i);
     const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
     const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
