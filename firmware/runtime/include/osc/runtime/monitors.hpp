@@ -419,7 +419,7 @@ struct ResidualMonitor {
   /// hunts about rest), and the step holds for kResidualTravelEvery ticks, not only its last.
   Vec6<S> drive_lo;
   static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
-  Vec6<S> travel_quantum;  // set-up: each joint's encoder quantum [rad]
+  Vec6<S> travel_quantum;                      // set-up: each joint's encoder quantum [rad]
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
@@ -730,13 +730,12 @@ struct ResidualMonitor {
   /// crossed an edge in the direction `way` of the count; counting steadily, it crossed the one
   /// before a count back, n ticks earlier: its mean speed that way since was at least a count over
   /// n + 1 ticks, less the most it can have slowed over them. Then, every params::kResidualTravelEvery
-  /// ticks, the torque applied less gravity and Coriolis torques (the least of the step's ticks), with every error the model may
-  /// have against the motion (model_error(), the other joints' inertial torques with the link
-  /// inertia's share, the current loop's lag) and friction at the band's strongest against it (at
-  /// rest: the whole static band), over the diagonal inertia at its least or most, bounds its
-  /// speed that way from below, and its travel. A joint that comes to rest stays at rest while the
-  /// torque cannot break it away backwards (half the band's weakest static friction). Its least
-  /// travel beyond travel_limit crosses the next edge: the encoder should have counted. Before its
+  /// ticks, the torque applied less gravity and Coriolis torques (the least of the step's ticks), with every error the
+  /// model may have against the motion (model_error(), the other joints' inertial torques with the link inertia's
+  /// share, the current loop's lag) and friction at the band's strongest against it (at rest: the whole static band),
+  /// over the diagonal inertia at its least or most, bounds its speed that way from below, and its travel. A joint that
+  /// comes to rest stays at rest while the torque cannot break it away backwards (half the band's weakest static
+  /// friction). Its least travel beyond travel_limit crosses the next edge: the encoder should have counted. Before its
   /// first count (a prime, a contact) the direction is unknown and nothing is bounded.
   bool travel(const ResidualInput<S>& in, const Motion& m, int i, S model, bool count, bool restart,
               std::uint64_t tick) {
