@@ -80,11 +80,9 @@ class LocalController {
   void skip_ticks(std::uint64_t n) {
     task_->tick += n;
     task_->ramp_start += n;
-    for (int i = 0; i < 6; ++i) {
-      task_->residual.activity.last_move_tick[i] += n;
-      task_->residual.over_since[i] += n;
-      task_->stuck.activity.last_move_tick[i] += n;
-    }
+    task_->residual.activity.shift(n);
+    task_->stuck.activity.shift(n);
+    for (std::uint64_t& t : task_->residual.over_since) t += n;
   }
   void finish(ExperimentResult& res) {
     for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck.peak(i));

@@ -589,9 +589,10 @@ TYPED_TEST(Monitors, ResidualBelowItsThresholdNeverFaults) {
 
 /// The travel check's rig: joint j creeps forward, a count every 10 ticks, for 100 ticks, the arm
 /// held (its velocity estimate 0); then its encoder stands while the drive is told to give
-/// g_j + push. Returns the ticks from the last count to the first fault (-1: none in `ticks`).
-template <class S>
-int travel_ticks(ResidualRig<S>& rig, int j, double push, int ticks, std::uint32_t& kind) {
+/// g_j + push(n) at the n-th tick. Returns the ticks from the last count to the first fault (-1:
+/// none in `ticks`).
+template <class S, class Push>
+int travel_ticks(ResidualRig<S>& rig, int j, Push push, int ticks, std::uint32_t& kind) {
   rig.m.armed = true;
   bool creep[kDof] = {};
   const bool none[kDof] = {};
@@ -600,11 +601,18 @@ int travel_ticks(ResidualRig<S>& rig, int j, double push, int ticks, std::uint32
     EXPECT_EQ(rig.step(Vec6<double>::Zero(), creep, false), 0u) << n;
   }
   Vec6<double> ext = Vec6<double>::Zero();
-  ext(j) = -push;  // held: the monitor is told tau - ext = g + push was applied
   kind = 0;
-  for (int n = 1; n <= ticks; ++n)
+  for (int n = 1; n <= ticks; ++n) {
+    ext(j) = -push(n);  // held: the monitor is told tau - ext = g + push was applied
     if ((kind = rig.step(ext, none, false)) != 0) return n;
+  }
   return -1;
+}
+/// ... under a constant push.
+template <class S>
+int travel_ticks(ResidualRig<S>& rig, int j, double push, int ticks, std::uint32_t& kind) {
+  return travel_ticks(
+      rig, j, [push](int) { return push; }, ticks, kind);
 }
 /// The least and the most of the torque joint j's travel check leaves to accelerate it [N m]:
 /// push less (more) the static band, the link inertia's share of gravity, the amplifier's gain,
@@ -677,20 +685,10 @@ TYPED_TEST(Monitors, TravelCheckTakesTheLeastTorqueOfItsStep) {
   for (int j : {0, 2, 4}) {
     for (int phase : {0, 1}) {
       ResidualRig<S> rig;
-      rig.m.armed = true;
-      bool creep[kDof] = {};
-      const bool none[kDof] = {};
-      for (int n = 0; n <= 100; ++n) {
-        creep[j] = n % 10 == 0;
-        ASSERT_EQ(rig.step(Vec6<double>::Zero(), creep, false), 0u) << n;
-      }
       const double push = 2 * (b.friction_hi.cou[j] + b.friction_hi.sti[j]) + 2 * b.link_inertia * std::abs(rig.g(j));
-      Vec6<double> ext = Vec6<double>::Zero();
+      const auto alternating = [&](int n) { return (n + phase) % 2 ? push : -push; };
       std::uint32_t kind = 0;
-      for (int n = 0; n < 2000 && kind == 0; ++n) {
-        ext(j) = (n + phase) % 2 ? push : -push;  // held: told g_j -+ push was applied
-        kind = rig.step(ext, none, false);
-      }
+      EXPECT_EQ(travel_ticks(rig, j, alternating, 2000, kind), -1) << "J" << j + 1 << " phase " << phase;
       EXPECT_EQ(kind, 0u) << "J" << j + 1 << " phase " << phase << ": " << fault_name(kind);
       EXPECT_LT(static_cast<double>(rig.m.travel_peak(j)), 0.5 * static_cast<double>(rig.m.travel_limit(j)))
           << "J" << j + 1 << " phase " << phase;

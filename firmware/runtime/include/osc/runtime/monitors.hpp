@@ -138,6 +138,10 @@ struct EncoderActivity {
       mark(i, tick);
     }
   }
+  /// The clock moved on by n ticks (a host test's jump of the uptime): the changes keep their age.
+  void shift(std::uint64_t n) {
+    for (std::uint64_t& t : last_move_tick) t += n;
+  }
   /// Every channel taken as just changed at `tick`, from `counts`; none counts one way yet.
   void restart(const std::int32_t counts[kDof], std::uint64_t tick) {
     for (int i = 0; i < kDof; ++i) last_counts[i] = counts[i], steady[i] = false, mark(i, tick);
@@ -756,9 +760,11 @@ struct ResidualMonitor {
     const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
     // This tick's drive at a count (the direction it sets), else the least over the step's ticks.
     const S drive = count ? now : (now < drive_lo(i) ? now : drive_lo(i));
-    drive_lo(i) = drive;
-    if (!count && !turn) return false;
-    drive_lo(i) = kNoDrive;
+    if (!count && !turn) {
+      drive_lo(i) = drive;
+      return false;
+    }
+    drive_lo(i) = kNoDrive;  // the next step starts
     const S aii = in.A(i, i);
     const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
     const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
