@@ -205,9 +205,58 @@ void converges_on_noisy_samples() {
   EXPECT_LT(std::abs(static_cast<double>(theta(2 * kDof + 1)) - truth(2)), 4 * std::sqrt(id.variance(1, 2)));
   EXPECT_LT(std::sqrt(id.variance(1, 2)),
             0.5 * std::sqrt(FrictionIdentifier<double>::prior(1)(2, 2)) / FrictionIdentifier<double>::scale_of(1));
+  // The travel check's proven friction: the truth within it, and at most 1.1 times the estimate
+  // (identified within 2.5 %); the joints that had no sample keep the band's tops.
+  const ModelErrorBounds& band = robot::kModelErrorBounds;
+  const double proven = static_cast<double>(id.proven.breakaway(1)), vis = static_cast<double>(id.proven.vis(1));
+  EXPECT_GE(proven, truth(1) + truth(2));
+  EXPECT_LE(proven, 1.1 * sum * (1 + 1e-5));
+  EXPECT_GE(vis, truth(0));
+  EXPECT_LT(vis, 1.4 * static_cast<double>(theta(1)));
+  for (int i : {0, 2, 3, 4, 5}) {
+    EXPECT_NEAR(static_cast<double>(id.proven.breakaway(i)), band.friction_hi.cou[i] + band.friction_hi.sti[i], 1e-4)
+        << i;
+    EXPECT_NEAR(static_cast<double>(id.proven.vis(i)), band.friction_hi.vis[i], 1e-4) << i;
+  }
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }
+
+// The proven breakaway while the joint stands (no samples, P drifting back toward the prior): it
+// steps up through its tiers, 1.1, 1.2, 1.4 and 1.8 times the estimate, each as the standard
+// deviation passes 2.5, 5, 10 and 20 % of it, and then is the band's top. Checked against the
+// standard deviation itself (sqrt of P, which prove() does not take) at every turn, for 20 minutes.
+TEST(FrictionIdentifier, ProvenBreakawayFollowsItsStandardDeviation) {
+  const Vec4 truth(3.7, 4.8, 4.3, -0.08);
+  const Regression d = samples(truth, 0.3, 20000, 7, 1.5);
+  FrictionIdentifier<double> id;
+  id.reset();
+  const Vec18<double> theta_max = Gains<double>::paper().theta_max;
+  Vec18<double> theta = Vec18<double>::Zero();
+  for (std::size_t k = 0; k < d.y.size(); ++k) id.update(1, sample_of(d, k), true, 1.0, 1.0, theta, theta_max);
+  const double z = id.z[1](1) / FrictionIdentifier<double>::scale_of(1);
+  const double top = robot::kModelErrorBounds.friction_hi.cou[1] + robot::kModelErrorBounds.friction_hi.sti[1];
+  const FrictionSample<double> still{0, Vec3<double>::Zero(), 0, false};
+  double last = 0;
+  int steps = 0;
+  const int turns = static_cast<int>(FrictionIdentifier<double>::kPerHour / 3);
+  for (int k = 0; k < turns; ++k) {
+    id.update(1, still, true, 1.0, 1.0, theta, theta_max);
+    const double proven = id.proven.breakaway(1), sd = std::sqrt(id.breakaway_variance(1));
+    double expected = top;
+    for (double f : {0.025, 0.05, 0.1, 0.2})
+      if (sd <= f * z) {
+        expected = std::min(top, (1 + params::kTravelIdentifiedSd * f) * z);
+        break;
+      }
+    ASSERT_NEAR(proven, expected, 1e-9) << k;
+    ASSERT_GE(proven, z + params::kTravelIdentifiedSd * std::min(sd, 0.2 * z) - 1e-9) << k;
+    steps += proven != last;
+    last = proven;
+  }
+  EXPECT_EQ(last, top);
+  EXPECT_EQ(steps, 5);  // 1.1, 1.2, 1.4, 1.8 z and the top
+}
 
 // The excitation monitor's gate: at the speeds of the paper's motion (0.15 rad/s) the Stribeck
 // decay hardly shows and the Coulomb and Stribeck columns are collinear. The split is held: the

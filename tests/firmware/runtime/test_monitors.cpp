@@ -313,6 +313,7 @@ struct ResidualRig {
   IoMap<S> io = IoMap<S>::of(robot::kEncodersUniform);
   std::uint64_t tick = 0;
   double dt = params::kDt;
+  const FrictionBounds<S>* proven = nullptr;  // the identification's friction (the travel check's)
 
   ResidualRig() {
     Model<double> model = Model<double>::of(robot::kArm);
@@ -340,7 +341,7 @@ struct ResidualRig {
     const Mat6<S> As = A.cast<S>();
     const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
     Vec6<S> decay = Vec6<S>::Ones();
-    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr};
+    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr, proven};
     const std::uint32_t f = m.check(in, io, counts, moved, tick);
     m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
     if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);
@@ -615,11 +616,11 @@ int travel_ticks(ResidualRig<S>& rig, int j, double push, int ticks, std::uint32
       rig, j, [push](int) { return push; }, ticks, kind);
 }
 /// The least and the most of the torque joint j's travel check leaves to accelerate it [N m]:
-/// push less (more) the static band, the link inertia's share of gravity, the amplifier's gain,
-/// ripple and offset on the torque applied.
-double travel_force(int j, double g, double push, bool least) {
+/// push less (more) the static band (`band`, or the band's top), the link inertia's share of
+/// gravity, the amplifier's gain, ripple and offset on the torque applied.
+double travel_force(int j, double g, double push, bool least, double band = -1) {
   const ModelErrorBounds& b = robot::kModelErrorBounds;
-  const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
+  if (band < 0) band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
   const double error = b.link_inertia * std::abs(g) + (b.amp_gain + b.ripple) * std::abs(g + push) +
                        b.amp_offset * robot::kDrives.torque_limit[j];
   return least ? push - band - error : push;
@@ -663,13 +664,15 @@ TYPED_TEST(Monitors, TravelCheckLeavesAJointThatStaticFrictionHolds) {
   using S = TypeParam;
   const ModelErrorBounds& b = robot::kModelErrorBounds;
   for (int j : {0, 2, 4}) {
-    ResidualRig<S> rig;
     const double weakest = (b.friction_lo.cou[j] + b.friction_lo.sti[j]) / params::kResidualMargin;
-    const double push = 0.5 * weakest;
-    std::uint32_t kind = 0;
-    EXPECT_EQ(travel_ticks(rig, j, push, 10000, kind), -1) << "J" << j + 1 << ": " << fault_name(kind);
-    EXPECT_LT(static_cast<double>(rig.m.travel_peak(j)), 0.5 * static_cast<double>(rig.m.travel_limit(j)))
-        << "J" << j + 1;
+    for (double sign : {1.0, -1.0}) {  // onward, and back against its last count
+      ResidualRig<S> held;
+      std::uint32_t kind = 0;
+      EXPECT_EQ(travel_ticks(held, j, sign * 0.5 * weakest, 10000, kind), -1)
+          << "J" << j + 1 << " " << sign << ": " << fault_name(kind);
+      EXPECT_LT(static_cast<double>(held.m.travel_peak(j)), 0.5 * static_cast<double>(held.m.travel_limit(j)))
+          << "J" << j + 1 << " " << sign;
+    }
   }
 }
 
@@ -692,6 +695,72 @@ TYPED_TEST(Monitors, TravelCheckTakesTheLeastTorqueOfItsStep) {
       EXPECT_EQ(kind, 0u) << "J" << j + 1 << " phase " << phase << ": " << fault_name(kind);
       EXPECT_LT(static_cast<double>(rig.m.travel_peak(j)), 0.5 * static_cast<double>(rig.m.travel_limit(j)))
           << "J" << j + 1 << " phase " << phase;
+    }
+  }
+}
+
+// A joint that reverses: it crept forward (a count every 10 ticks), then its encoder stands while
+// the torque pushes it back beyond its static friction and every model error. It must cross the
+// edge it last crossed, back: the check's second way catches it. Its speed forward at the count is
+// at most the count's pace (a count in 9 ticks) plus the most the band lets it change over 11
+// ticks; the push first takes that away, at the least net torque and the largest inertia, then moves
+// it the travel limit from rest (the check clamps the travel back at minus the limit while the bound
+// is negative: twice the limit), each within 1.5 times and a step of the check as onward.
+TYPED_TEST(Monitors, TravelCheckCatchesAJointThatReversesUnderATorqueBeyondStaticFriction) {
+  using S = TypeParam;
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  for (int j : {0, 2, 4}) {
+    ResidualRig<S> rig;
+    const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
+    const double push = 3 * band + 2 * b.link_inertia * std::abs(rig.g(j));
+    const double limit = params::kResidualTravelCounts / counts_per_rad(j), quantum = 1 / counts_per_rad(j);
+    const double G = std::abs(robot::kArm.links[j].gear_ratio);
+    const double arm =
+        std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
+    const double a_max = rig.A(j, j) * (1 + b.link_inertia) + arm, a_min = rig.A(j, j) * (1 - b.link_inertia) - arm;
+    const double error = -travel_force(j, rig.g(j), 0, true, 0);
+    const double ahead = quantum / (9 * params::kDt) + (error + band) / a_min * 11 * params::kDt;
+    const double least = travel_force(j, rig.g(j), push, true);
+    const double fastest = std::sqrt(2 * limit * a_min / push) / params::kDt;
+    const double slowest = (ahead * a_max / least + std::sqrt(4 * limit * a_max / least)) / params::kDt;
+    std::uint32_t kind = 0;
+    const int n = travel_ticks(rig, j, -push, 400, kind);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "J" << j + 1;
+    EXPECT_GE(n, static_cast<int>(fastest)) << "J" << j + 1;
+    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2 + 2 * params::kResidualTravelEvery)
+        << "J" << j + 1 << " (" << slowest << " ticks)";
+    EXPECT_EQ(rig.m.joint, j);
+  }
+}
+
+// The identified band (FrictionIdentifier::proven; docs/safety.md): with each joint's breakaway
+// proven at 1.1 times the paper's (J1 9.9 N m against the band's top of 39), a push of twice the
+// paper's breakaway, which the band's top holds without a fault, is caught both ways; one that the
+// paper's own breakaway holds (0.8 of it, less the model's error) is not, either way.
+TYPED_TEST(Monitors, TravelCheckTakesTheIdentifiedBand) {
+  using S = TypeParam;
+  const FrictionCoefficients& paper = robot::kFrictionPaper;
+  FrictionBounds<S> proven;
+  for (int i = 0; i < kDof; ++i) {
+    proven.vis(i) = lit<S>(1.1 * paper.vis[i]);
+    proven.breakaway(i) = lit<S>(1.1 * (paper.cou[i] + paper.sti[i]));
+  }
+  for (int j : {0, 2}) {
+    const double breakaway = paper.cou[j] + paper.sti[j];
+    for (double sign : {1.0, -1.0}) {
+      std::uint32_t kind = 0;
+      ResidualRig<S> top;
+      EXPECT_EQ(travel_ticks(top, j, sign * 2 * breakaway, 2000, kind), -1) << "J" << j + 1 << " " << sign;
+      ResidualRig<S> identified;
+      identified.proven = &proven;
+      EXPECT_GT(travel_ticks(identified, j, sign * 2 * breakaway, 2000, kind), 0) << "J" << j + 1 << " " << sign;
+      EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "J" << j + 1 << " " << sign;
+      ResidualRig<S> held;
+      held.proven = &proven;
+      const double error = -travel_force(j, held.g(j), 0, true, 0);
+      const double hold = 0.8 * breakaway - error;
+      EXPECT_EQ(travel_ticks(held, j, sign * hold, 2000, kind), -1)
+          << "J" << j + 1 << " " << sign << ": " << fault_name(kind);
     }
   }
 }

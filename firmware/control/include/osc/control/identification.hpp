@@ -62,6 +62,13 @@ struct FrictionSample {
   bool settled;
 };
 
+/// Upper bounds on each joint's friction [N m s/rad, N m]: its viscous coefficient and its breakaway
+/// torque (Coulomb + Stribeck, the friction at the onset of motion).
+template <class S>
+struct FrictionBounds {
+  Vec6<S> vis, breakaway;
+};
+
 /// What one joint's identification step did (for its counters and the tests).
 /// kFolded: the sample's turn went to the excitation monitor's block of moments (fold), one in
 /// params::kIdentifyExciteBlock + 1 counted turns, so that no tick does both (the budget is the worst
@@ -104,6 +111,9 @@ struct FrictionIdentifier {
   Vec6<S> split_excitation;      // the decay column's mean square unexplained by the others, times kDecayScale^2
   std::uint8_t block_count[kDof];
   std::uint8_t turn;  // the joint of the next update
+  /// The friction as far as the identification proves it (prove), for the residual monitor's travel
+  /// check: the band's tops (robot::kModelErrorBounds) until a coefficient is identified.
+  FrictionBounds<S> proven;
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
   /// The prior: theta^ anywhere from 0 to the band's top (robot::kModelErrorBounds), no counters.
@@ -120,6 +130,7 @@ struct FrictionIdentifier {
     }
     split_excitation.setZero();
     turn = 0;
+    for (int i = 0; i < kDof; ++i) proven.vis(i) = top(0, i), proven.breakaway(i) = top(1, i);
   }
   /// The joint whose update is due this tick; advances the turn.
   int take_turn() {
@@ -140,13 +151,13 @@ struct FrictionIdentifier {
   IdentifyOutcome update(int i, const FrictionSample<S>& s, bool residual_low, S bound_var, S correlation,
                          Vec18<S>& theta, const Vec18<S>& theta_max) {
     drift(i);
+    prove(i);
     if (!s.settled) return IdentifyOutcome::kNotSettled;
     if (!residual_low) return IdentifyOutcome::kResidualHigh;
     if (block_count[i] >= params::kIdentifyExciteBlock) {
       fold(i);
       return IdentifyOutcome::kFolded;
     }
-    static constexpr std::array<S, kDof> kUnscale = per_joint([](int j) { return 1 / scale_of(j); });
     static constexpr std::array<S, kDof> kInverseTorque =
         per_joint([](int j) { return 1 / robot::kDrives.torque_limit[j]; });
     const S sc = scale(i);
@@ -173,9 +184,35 @@ struct FrictionIdentifier {
     const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
     th += correct(i, Pphi, var, excite(i, phi)) * innovation;
     const Vec4 bounded = project(i, th, theta_max);
-    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * kUnscale[i];
+    for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * unscale(i);
     ++updates[i];
     return IdentifyOutcome::kUpdated;
+  }
+
+  /// Joint i's proven friction (proven), from its estimate z and covariance P as they stand (the
+  /// drift included: while a joint is not sampled, P grows back and the bound with it). Its viscous
+  /// coefficient and its breakaway torque are each at most z plus params::kTravelIdentifiedSd
+  /// standard deviations, taken without a root: the first of params::kTravelTiers tiers whose
+  /// standard deviation f z (f = params::kIdentifiedFraction, doubled tier by tier) covers sqrt(P)
+  /// gives (1 + kTravelIdentifiedSd f) z; beyond the last, or z <= 0, the band's top, and never
+  /// more. Measured with params::kIdentifyDrift: a joint identified within 2.5 % keeps 1.1 z for
+  /// about 9 s of rest, 1.2 z for 36 s, 1.4 z for 2.4 min and 1.8 z for 10 min (J2).
+  void prove(int i) {
+    static constexpr S kFraction = lit<S>(params::kIdentifiedFraction);
+    static constexpr S kStep = lit<S>(params::kTravelIdentifiedSd * params::kIdentifiedFraction);
+    const auto bound = [&](int c) {
+      const S v = z[i](c), hi = top(c, i), p = P[i](c, c);
+      if (!(v > S(0))) return hi;
+      S fv = kFraction * v, above = kStep;
+      for (int k = 0; k < params::kTravelTiers; ++k, fv += fv, above += above)
+        if (p <= fv * fv) {
+          const S b = (S(1) + above) * v * unscale(i);
+          return b < hi ? b : hi;
+        }
+      return hi;
+    };
+    proven.vis(i) = bound(0);
+    proven.breakaway(i) = bound(1);
   }
 
   /// The Kalman correction of joint i for a sample of innovation variance var, given P phi: P less
@@ -321,10 +358,23 @@ struct FrictionIdentifier {
 
  private:
   static constexpr double square(double v) { return v * v; }
-  /// scale_of(i) in the scalar S.
+  /// scale_of(i) in the scalar S, and its inverse.
   static S scale(int i) {
     static constexpr std::array<S, kDof> kScale = per_joint([](int j) { return scale_of(j); });
     return kScale[i];
+  }
+  static S unscale(int i) {
+    static constexpr std::array<S, kDof> kUnscale = per_joint([](int j) { return 1 / scale_of(j); });
+    return kUnscale[i];
+  }
+  /// The band's top of joint i's viscous coefficient (c = 0) or breakaway torque (c = 1, Coulomb +
+  /// Stribeck) [N m s/rad, N m].
+  static S top(int c, int i) {
+    static constexpr std::array<S, kDof> kVis = per_joint([](int j) { return robot::kModelErrorBounds.friction_hi.vis[j]; });
+    static constexpr std::array<S, kDof> kBreakaway = per_joint([](int j) {
+      return robot::kModelErrorBounds.friction_hi.cou[j] + robot::kModelErrorBounds.friction_hi.sti[j];
+    });
+    return c == 0 ? kVis[i] : kBreakaway[i];
   }
   template <class F>
   static constexpr std::array<S, kDof> per_joint(F f) {

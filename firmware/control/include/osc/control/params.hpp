@@ -154,6 +154,13 @@ constexpr double kIdentifyDrift = 0.3;
 constexpr int kIdentifyNoiseSamples = 256;
 /// A coefficient is reported identified when its standard deviation is at most this fraction of it.
 constexpr double kIdentifiedFraction = 0.025;
+/// The residual monitor's travel check takes each joint's identified viscous coefficient and
+/// breakaway torque (Coulomb + Stribeck) at this many standard deviations above its estimate, in
+/// place of the band's top (FrictionIdentifier::prove; docs/safety.md, "The identified band"): in
+/// kTravelTiers tiers of standard deviation, kIdentifiedFraction of the estimate doubled tier by
+/// tier, 1.1, 1.2, 1.4 and 1.8 times the estimate.
+constexpr double kTravelIdentifiedSd = 4;
+constexpr int kTravelTiers = 4;
 /// The excitation monitor's gate on the Coulomb / Stribeck split: the split is learned only while the
 /// recent motion makes the Stribeck decay column, sgn(qd) (exp(-tau_dec qd^2) - 1), vary independently
 /// of the viscous and Coulomb columns by at least this much (RMS, a fraction of the Stribeck level).

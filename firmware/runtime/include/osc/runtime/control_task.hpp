@@ -324,14 +324,15 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
+  const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
   const ResidualInput<S> in{task.state.data.A,
                             task.state.os.g,
                             out.tau_bias,
                             out.tau_f_hat,
                             ad.qd_hat_prev,
                             decay,
-                            adaptive ? &ad.theta_hat : nullptr};
-  const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
+                            adaptive ? &ad.theta_hat : nullptr,
+                            identify ? &task.identifier.proven : nullptr};
   task.residual.sample_joint = identify ? task.identifier.take_turn() : -1;
   task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick);

@@ -116,11 +116,12 @@ struct EncoderActivity {
   std::int32_t last_counts[kDof];      // its reading at its last change
   std::int8_t direction[kDof];         // the sign of its last change
   bool steady[kDof];                   // its last two changes had the same sign
+  bool reversed[kDof];                 // ... opposite signs
 
   void reset() {
     for (int i = 0; i < kDof; ++i)
       last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, last_counts[i] = 0, direction[i] = 0,
-      steady[i] = false;
+      steady[i] = false, reversed[i] = false;
   }
   /// Channel i changed (or is taken as changed) at `tick`.
   void mark(int i, std::uint64_t tick) {
@@ -133,6 +134,7 @@ struct EncoderActivity {
       if (!moved[i]) continue;
       const std::int8_t way = counts[i] > last_counts[i] ? 1 : -1;
       steady[i] = way == direction[i];
+      reversed[i] = way == -direction[i];
       direction[i] = way;
       last_counts[i] = counts[i];
       mark(i, tick);
@@ -144,7 +146,7 @@ struct EncoderActivity {
   }
   /// Every channel taken as just changed at `tick`, from `counts`; none counts one way yet.
   void restart(const std::int32_t counts[kDof], std::uint64_t tick) {
-    for (int i = 0; i < kDof; ++i) last_counts[i] = counts[i], steady[i] = false, mark(i, tick);
+    for (int i = 0; i < kDof; ++i) last_counts[i] = counts[i], steady[i] = reversed[i] = false, mark(i, tick);
   }
   /// Channel c has been silent for more than params::kStuckIntervals of its recent intervals.
   bool silent(int c, std::uint64_t tick) const {
@@ -344,6 +346,9 @@ struct ResidualInput {
   const Vec6<S>& qd;      // the observed joint velocity q^dot (28)
   const Vec6<S>& decay;   // |exp(-tau_dec q^dot^2)| where q^dot != 0 (the regressor's Stribeck column)
   const Vec18<S>* theta;  // theta^, or nullptr without compensation (tau_f^ = 0)
+  /// The friction the identification proves (FrictionIdentifier::proven; the travel check's), or
+  /// nullptr: the band's tops.
+  const FrictionBounds<S>* proven = nullptr;
 };
 
 /// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone;
@@ -413,15 +418,21 @@ struct ResidualMonitor {
   int sample_joint = -1;
   FrictionSample<S> sample{};
   Vec6<S> noise_bound;  // this tick's bound on the velocity estimate's quantisation noise in r [N m]
-  /// The travel check (travel()): per joint, lower bounds on its speed and on its travel since its
-  /// encoder's last count, in that count's direction [rad/s, rad], the travel that must have made it count
-  /// (kResidualTravelCounts quanta; 0: the check is off, a joint whose encoder reads other joints too), and the largest
-  /// least travel seen (the check's peak; against travel_limit, its headroom).
-  Vec6<S> v_lo, p_lo, travel_limit, travel_peak;
-  /// The least drive that way (travel()) over the ticks of the travel check's current step: the
-  /// torque may alternate tick by tick (the friction compensation's sign term at a joint that
-  /// hunts about rest), and the step holds for kResidualTravelEvery ticks, not only its last.
-  Vec6<S> drive_lo;
+  /// The travel check (travel()), one way: per joint, lower bounds on its speed and on its travel
+  /// that way since its encoder's last count [rad/s, rad], and the least drive that way over the ticks
+  /// of the check's current step [N m] (the torque may alternate tick by tick, the friction
+  /// compensation's sign term at a joint that hunts about rest, and the step holds for
+  /// kResidualTravelEvery ticks, not only its last).
+  struct Way {
+    Vec6<S> v, p, drive;
+  };
+  /// ahead: the way of the encoder's last count, toward its next edge; back: against it, toward the
+  /// edge it just crossed (a joint that reverses must count back).
+  Way ahead, back;
+  /// Per joint: the travel that must have made it count (kResidualTravelCounts quanta; 0: the check is
+  /// off, a joint whose encoder reads other joints too), and the largest least travel seen either way
+  /// (the check's peak; against travel_limit, its headroom).
+  Vec6<S> travel_limit, travel_peak;
   static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
   Vec6<S> travel_quantum;                      // set-up: each joint's encoder quantum [rad]
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
@@ -463,7 +474,8 @@ struct ResidualMonitor {
     tau_prev.setZero();
     peak_ratio.setZero();
     travel_peak.setZero();
-    drive_lo.setConstant(kNoDrive);
+    ahead.drive.setConstant(kNoDrive);
+    back.drive.setConstant(kNoDrive);
     for (int i = 0; i < kDof; ++i) over[i] = 0, over_since[i] = 0;
     activity.reset();
     joint = -1;
@@ -730,17 +742,21 @@ struct ResidualMonitor {
     const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
     change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
   }
-  /// Joint i's travel check: whether the joint must have counted. At a count the joint has just
-  /// crossed an edge in the direction `way` of the count; counting steadily, it crossed the one
-  /// before a count back, n ticks earlier: its mean speed that way since was at least a count over
-  /// n + 1 ticks, less the most it can have slowed over them. Then, every params::kResidualTravelEvery
-  /// ticks, the torque applied less gravity and Coriolis torques (the least of the step's ticks), with every error the
-  /// model may have against the motion (model_error(), the other joints' inertial torques with the link inertia's
-  /// share, the current loop's lag) and friction at the band's strongest against it (at rest: the whole static band),
-  /// over the diagonal inertia at its least or most, bounds its speed that way from below, and its travel. A joint that
-  /// comes to rest stays at rest while the torque cannot break it away backwards (half the band's weakest static
-  /// friction). Its least travel beyond travel_limit crosses the next edge: the encoder should have counted. Before its
-  /// first count (a prime, a contact) the direction is unknown and nothing is bounded.
+  /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
+  /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
+  /// one before a count back, n ticks earlier: its mean speed that way since was at least a count over
+  /// n + 1 ticks and at most one over n - 1, and its speed now differs from that mean by at most the
+  /// most it can have sped up or slowed down over them (after a reversal, the same edge twice: a mean
+  /// of 0). These bound its speed ahead from below, and back from below as minus its speed ahead at
+  /// most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied
+  /// that way less gravity and Coriolis torques (the least of the step's ticks), with every error the
+  /// model may have against the motion (model_error(), the other joints' inertial torques with the
+  /// link inertia's share, the current loop's lag) and friction at its strongest against it (at rest:
+  /// the whole breakaway torque; the band's top, or what the identification proves: in.proven), over
+  /// the diagonal inertia at its least or most, bounds its speed that way from below, and its travel.
+  /// Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the encoder
+  /// should have counted. Before its first count (a prime, a contact) the direction is unknown and
+  /// nothing is bounded.
   bool travel(const ResidualInput<S>& in, const Motion& m, int i, S model, bool count, bool restart,
               std::uint64_t tick) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
@@ -749,58 +765,90 @@ struct ResidualMonitor {
     const S limit = travel_limit(i);
     if (limit == S(0)) return false;
     if (restart) {
-      p_lo(i) = -limit;  // nothing known: no bound until a count
-      v_lo(i) = S(0);
-      drive_lo(i) = kNoDrive;
+      ahead.p(i) = back.p(i) = -limit;  // nothing known: no bound until a count
+      ahead.v(i) = S(0);
+      back.v(i) = -c.speed_cap[i];
+      ahead.drive(i) = back.drive(i) = kNoDrive;
       return false;
     }
     static constexpr int kEvery = params::kResidualTravelEvery;
     const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
     const S way = activity.direction[i] > 0 ? S(1) : S(-1);
     const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
-    // This tick's drive at a count (the direction it sets), else the least over the step's ticks.
-    const S drive = count ? now : (now < drive_lo(i) ? now : drive_lo(i));
+    // This tick's drive each way at a count (the direction it sets), else the least over the step's ticks.
+    const S drive = count || now < ahead.drive(i) ? now : ahead.drive(i);
+    const S drive_back = count || -now < back.drive(i) ? -now : back.drive(i);
     if (!count && !turn) {
-      drive_lo(i) = drive;
+      ahead.drive(i) = drive;
+      back.drive(i) = drive_back;
       return false;
     }
-    drive_lo(i) = kNoDrive;  // the next step starts
+    ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
+    const Friction f{in.proven ? in.proven->vis(i) : c.vis_hi[i],
+                     in.proven ? in.proven->breakaway(i) : c.static_band[i]};
     const S aii = in.A(i, i);
     const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
     const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
     const S error = mul_add(c.link_inertia, others, others) + model + loop;
     const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
     if (count) {
-      const std::uint32_t n = activity.move_interval[i];
-      S slow = S(0);
-      if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval)) {
-        const S span = lit<S>(params::kDt) * S(static_cast<int>(n) + 1);
-        slow = travel_quantum(i) / span - (abs(drive) + error + c.static_band[i]) / a_min * span;
-        if (slow < S(0)) slow = S(0);
-      }
-      v_lo(i) = slow;
-      p_lo(i) = S(0);
+      count_bounds(i, (abs(drive) + error + f.breakaway) / a_min);
       return false;
     }
-    static constexpr S kStep = lit<S>(kEvery * params::kDt);
-    // The least force that way: friction at its strongest against the motion (none when the joint
-    // may be going back, where it pushes forward).
-    const S lo = v_lo(i);
-    const S force = drive - error - (lo >= S(0) ? mul_add(c.vis_hi[i], lo, c.static_band[i]) : S(0));
     const S a_max = mul_add(c.link_inertia, aii, aii) + c.armature_delta[i];
-    S next = mul_add(kStep, force / (force < S(0) ? a_min : a_max), lo);
-    // Static friction holds a joint at rest against what cannot break it away backwards.
-    if (lo >= S(0) && next < S(0) && drive - error + c.static_lo[i] > S(0)) next = S(0);
+    const S p_ahead = advance(ahead, i, drive - error, f, a_min, a_max);
+    const S p_back = advance(back, i, drive_back - error, f, a_min, a_max);
+    const S p = p_ahead > p_back ? p_ahead : p_back;
+    if (p > travel_peak(i)) travel_peak(i) = p;
+    return p > limit;
+  }
+  /// The friction the travel check takes at its strongest against a motion: the viscous coefficient
+  /// [N m s/rad] and the breakaway torque [N m].
+  struct Friction {
+    S vis, breakaway;
+  };
+  /// Joint i's speed bounds at a count (travel()), from its pace and `change`, the most its speed can
+  /// change per second [rad/s^2]. Its spans are read up to kSpanMax ticks (slower, ahead is 0 and
+  /// back is its speed cap's).
+  void count_bounds(int i, S change) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    static constexpr std::uint32_t kSpanMax = 250;
+    static constexpr S kDt = lit<S>(params::kDt);
+    const std::uint32_t n = activity.move_interval[i];
+    S slow = S(0), fast = c.speed_cap[i];
+    if (n <= kSpanMax) {
+      const S span = kDt * S(static_cast<int>(n) + 1), drift = change * span;
+      if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval))
+        slow = travel_quantum(i) / span - drift;
+      if (activity.reversed[i])
+        fast = drift;  // it crossed the same edge back and forth: a mean speed of 0
+      else if (activity.steady[i] && n >= 2)
+        fast = travel_quantum(i) / (kDt * S(static_cast<int>(n) - 1)) + drift;
+    }
+    ahead.v(i) = slow > S(0) ? slow : S(0);
+    back.v(i) = fast < c.speed_cap[i] ? -fast : -c.speed_cap[i];
+    ahead.p(i) = back.p(i) = S(0);
+  }
+  /// One step of joint i's bounds one way: `force` is the least drive that way less the model's
+  /// error; friction is at its strongest against the motion (none when the joint may be going the
+  /// other way, where it pushes this way). Static friction holds a joint at rest against what cannot
+  /// break it away (half the band's weakest static friction). Returns the least travel (within a
+  /// count either way after it: the joint did not count).
+  S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    using math::mul_add;
+    static constexpr S kStep = lit<S>(params::kResidualTravelEvery * params::kDt);
+    const S lo = w.v(i), limit = travel_limit(i);
+    const S net = force - (lo >= S(0) ? mul_add(f.vis, lo, f.breakaway) : S(0));
+    S next = mul_add(kStep, net / (net < S(0) ? a_min : a_max), lo);
+    if (lo >= S(0) && next < S(0) && force + c.static_lo[i] > S(0)) next = S(0);
     const S cap = c.speed_cap[i];
     next = next < -cap ? -cap : (next > cap ? cap : next);
-    v_lo(i) = next;
+    w.v(i) = next;
     // Over the step the speed was at least the lesser of both ends.
-    S p = mul_add(kStep, lo < next ? lo : next, p_lo(i));
-    if (p > travel_peak(i)) travel_peak(i) = p;
-    const bool beyond = p > limit;
-    // It did not count: its travel stays within a count either way.
-    p_lo(i) = p < -limit ? -limit : (beyond ? limit : p);
-    return beyond;
+    const S p = mul_add(kStep, lo < next ? lo : next, w.p(i));
+    w.p(i) = p < -limit ? -limit : (p > limit ? limit : p);
+    return p;
   }
   /// The kind of a travel check's finding on joint i: a joint that must have counted and did not.
   /// Its encoder fell silent at once from counting fast (a joint that stops slows down first, its
