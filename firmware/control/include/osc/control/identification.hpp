@@ -370,7 +370,8 @@ struct FrictionIdentifier {
   /// The band's top of joint i's viscous coefficient (c = 0) or breakaway torque (c = 1, Coulomb +
   /// Stribeck) [N m s/rad, N m].
   static S top(int c, int i) {
-    static constexpr std::array<S, kDof> kVis = per_joint([](int j) { return robot::kModelErrorBounds.friction_hi.vis[j]; });
+    static constexpr std::array<S, kDof> kVis =
+        per_joint([](int j) { return robot::kModelErrorBounds.friction_hi.vis[j]; });
     static constexpr std::array<S, kDof> kBreakaway = per_joint([](int j) {
       return robot::kModelErrorBounds.friction_hi.cou[j] + robot::kModelErrorBounds.friction_hi.sti[j];
     });
