@@ -702,7 +702,7 @@ TYPED_TEST(Monitors, TravelCheckTakesTheLeastTorqueOfItsStep) {
 // A joint that reverses: it crept forward (a count every 10 ticks), then its encoder stands while
 // the torque pushes it back beyond its static friction and every model error. It must cross the
 // edge it last crossed, back: the check's second way catches it. Its speed forward at the count is
-// at most the count's pace (a count in 9 ticks) plus the most the band lets it change over 11
+// at most the count's pace (the edges' largest spacing in 9 ticks) plus the most the band lets it change over 11
 // ticks; the push first takes that away, at the least net torque and the largest inertia, then moves
 // it the travel limit from rest (the check clamps the travel back at minus the limit while the bound
 // is negative: twice the limit), each within 1.5 times and a step of the check as onward.
@@ -719,7 +719,8 @@ TYPED_TEST(Monitors, TravelCheckCatchesAJointThatReversesUnderATorqueBeyondStati
         std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
     const double a_max = rig.A(j, j) * (1 + b.link_inertia) + arm, a_min = rig.A(j, j) * (1 - b.link_inertia) - arm;
     const double error = -travel_force(j, rig.g(j), 0, true, 0);
-    const double ahead = quantum / (9 * params::kDt) + (error + band) / a_min * 11 * params::kDt;
+    const double spacing = quantum * (1 + 2 * b.encoder_edge);  // the edges' largest spacing
+    const double ahead = spacing / (9 * params::kDt) + (error + band) / a_min * 11 * params::kDt;
     const double least = travel_force(j, rig.g(j), push, true);
     const double fastest = std::sqrt(2 * limit * a_min / push) / params::kDt;
     const double slowest = (ahead * a_max / least + std::sqrt(4 * limit * a_max / least)) / params::kDt;

@@ -125,6 +125,7 @@ struct ModelErrorBounds {
   double amp_offset;    ///< an amplifier's offset, relative to its channel's full-scale torque
   double ripple;        ///< torque ripple, relative to the torque commanded
   double amp_lag;       ///< an amplifier's current loop, its first-order time constant at most [s]
+  double encoder_edge;  ///< an encoder edge's distance from its nominal place at most [counts]
   FrictionCoefficients friction_lo, friction_hi;  ///< the band the arm's friction lies in, drift included
 };
 

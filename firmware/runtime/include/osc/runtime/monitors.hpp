@@ -434,7 +434,9 @@ struct ResidualMonitor {
   /// (the check's peak; against travel_limit, its headroom).
   Vec6<S> travel_limit, travel_peak;
   static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
-  Vec6<S> travel_quantum;                      // set-up: each joint's encoder quantum [rad]
+  /// Set-up: each encoder's least and largest spacing of consecutive edges, its quantum less or
+  /// plus twice robot::kModelErrorBounds' encoder_edge [rad at the joint].
+  Vec6<S> spacing_lo, spacing_hi;
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
@@ -459,7 +461,8 @@ struct ResidualMonitor {
       }
       cross_friction(i) = lit<S>(cross);
       travel_limit(i) = alone ? lit<S>(params::kResidualTravelCounts) * quantum(i) : S(0);
-      travel_quantum(i) = quantum(i);
+      spacing_lo(i) = lit<S>(1 - 2 * b.encoder_edge) * quantum(i);
+      spacing_hi(i) = lit<S>(1 + 2 * b.encoder_edge) * quantum(i);
     }
   }
   /// Clears the filters and the record: the next check primes it (an enable, a restart).
@@ -744,8 +747,8 @@ struct ResidualMonitor {
   }
   /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
   /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
-  /// one before a count back, n ticks earlier: its mean speed that way since was at least a count over
-  /// n + 1 ticks and at most one over n - 1, and its speed now differs from that mean by at most the
+  /// one before a count back, n ticks earlier: its mean speed that way since was at least the edges'
+  /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now differs from that mean by at most the
   /// most it can have sped up or slowed down over them (after a reversal, the same edge twice: a mean
   /// of 0). These bound its speed ahead from below, and back from below as minus its speed ahead at
   /// most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied
@@ -819,11 +822,11 @@ struct ResidualMonitor {
     if (n <= kSpanMax) {
       const S span = kDt * S(static_cast<int>(n) + 1), drift = change * span;
       if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval))
-        slow = travel_quantum(i) / span - drift;
+        slow = spacing_lo(i) / span - drift;
       if (activity.reversed[i])
         fast = drift;  // it crossed the same edge back and forth: a mean speed of 0
       else if (activity.steady[i] && n >= 2)
-        fast = travel_quantum(i) / (kDt * S(static_cast<int>(n) - 1)) + drift;
+        fast = spacing_hi(i) / (kDt * S(static_cast<int>(n) - 1)) + drift;
     }
     ahead.v(i) = slow > S(0) ? slow : S(0);
     back.v(i) = fast < c.speed_cap[i] ? -fast : -c.speed_cap[i];

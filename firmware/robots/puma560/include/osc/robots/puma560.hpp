@@ -146,11 +146,13 @@ constexpr const FrictionCoefficients* kFrictionPresets[] = {&kFrictionPaper, &kF
 /// - amplifiers: gain within +-2 %, offset within 0.2 % of full scale, ripple within 3 % (estimates,
 ///   twice the realistic plant's mid values: docs/experiment.md), a current loop of at most 0.5 ms
 ///   (the top of the range the realistic plant's estimate states);
+/// - encoders: each edge within 0.2 counts of its nominal place (an estimate, twice the realistic
+///   plant's +-0.1: quadrature phase and line errors), so consecutive edges lie 0.6-1.4 counts apart;
 /// - friction: between the paper's Table II and the Corke/Armstrong-Helouvry values, coefficient by
 ///   coefficient, with +-30 % drift with temperature. (The motor inertias' two published sets are
 ///   the drive train's, kDriveTrain.motor_inertia_alt.)
 constexpr ModelErrorBounds model_error_bounds() {
-  ModelErrorBounds b{0.10, 0.02, 0.002, 0.03, 0.5e-3, {"band_lo", {}, {}, {}}, {"band_hi", {}, {}, {}}};
+  ModelErrorBounds b{0.10, 0.02, 0.002, 0.03, 0.5e-3, 0.2, {"band_lo", {}, {}, {}}, {"band_hi", {}, {}, {}}};
   const FrictionCoefficients* const measured[] = {&kFrictionPaper, &kFrictionCorke};
   friction_band(measured, 0.30, b.friction_lo, b.friction_hi);
   return b;
