@@ -748,18 +748,17 @@ struct ResidualMonitor {
   /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
   /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
   /// one before a count back, n ticks earlier: its mean speed that way since was at least the edges'
-  /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now differs from that mean by at most the
-  /// most it can have sped up or slowed down over them (after a reversal, the same edge twice: a mean
-  /// of 0). These bound its speed ahead from below, and back from below as minus its speed ahead at
-  /// most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied
-  /// that way less gravity and Coriolis torques (the least of the step's ticks), with every error the
-  /// model may have against the motion (model_error(), the other joints' inertial torques with the
-  /// link inertia's share, the current loop's lag) and friction at its strongest against it (at rest:
-  /// the whole breakaway torque; the band's top, or what the identification proves: in.proven), over
-  /// the diagonal inertia at its least or most, bounds its speed that way from below, and its travel.
-  /// Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the encoder
-  /// should have counted. Before its first count (a prime, a contact) the direction is unknown and
-  /// nothing is bounded.
+  /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now
+  /// differs from that mean by at most the most it can have sped up or slowed down over them (after a reversal, the
+  /// same edge twice: a mean of 0). These bound its speed ahead from below, and back from below as minus its speed
+  /// ahead at most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied that way
+  /// less gravity and Coriolis torques (the least of the step's ticks), with every error the model may have against the
+  /// motion (model_error(), the other joints' inertial torques with the link inertia's share, the current loop's lag)
+  /// and friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
+  /// identification proves: in.proven), over the diagonal inertia at its least or most, bounds its speed that way from
+  /// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
+  /// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
+  /// bounded.
   bool travel(const ResidualInput<S>& in, const Motion& m, int i, S model, bool count, bool restart,
               std::uint64_t tick) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
