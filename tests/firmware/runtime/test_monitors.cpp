@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <random>
+#include <utility>
 
 #include "osc/runtime/control_task.hpp"
 
@@ -626,6 +627,15 @@ double travel_force(int j, double g, double push, bool least, double band = -1) 
   return least ? push - band - error : push;
 }
 
+/// The least and the most of joint j's diagonal inertia the travel check takes [kg m^2]: the link
+/// inertia's 10 % and the other motor-inertia set's armature either way.
+std::pair<double, double> travel_inertia(const Mat6<double>& A, int j) {
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  const double G = std::abs(robot::kArm.links[j].gear_ratio);
+  const double arm = std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
+  return {A(j, j) * (1 - b.link_inertia) - arm, A(j, j) * (1 + b.link_inertia) + arm};
+}
+
 // A joint whose encoder stands while the torque applied is beyond what static friction and every
 // stated model error can hold must have moved: the travel check calls it encoder_stuck once its
 // least travel under the least net torque passes kResidualTravelCounts counts, t = sqrt(2 L A / F)
@@ -639,10 +649,7 @@ TYPED_TEST(Monitors, TravelCheckCatchesAnEncoderThatStandsUnderATorqueBeyondStat
     const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
     const double push = 3 * band + 2 * b.link_inertia * std::abs(rig.g(j));
     const double limit = params::kResidualTravelCounts / counts_per_rad(j);
-    const double G = std::abs(robot::kArm.links[j].gear_ratio);
-    const double arm =
-        std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
-    const double a_max = rig.A(j, j) * (1 + b.link_inertia) + arm, a_min = rig.A(j, j) * (1 - b.link_inertia) - arm;
+    const auto [a_min, a_max] = travel_inertia(rig.A, j);
     const double fastest = std::sqrt(2 * limit * a_min / travel_force(j, rig.g(j), push, false)) / params::kDt;
     const double slowest = std::sqrt(2 * limit * a_max / travel_force(j, rig.g(j), push, true)) / params::kDt;
     std::uint32_t kind = 0;
@@ -714,10 +721,7 @@ TYPED_TEST(Monitors, TravelCheckCatchesAJointThatReversesUnderATorqueBeyondStati
     const double band = b.friction_hi.cou[j] + b.friction_hi.sti[j];
     const double push = 3 * band + 2 * b.link_inertia * std::abs(rig.g(j));
     const double limit = params::kResidualTravelCounts / counts_per_rad(j), quantum = 1 / counts_per_rad(j);
-    const double G = std::abs(robot::kArm.links[j].gear_ratio);
-    const double arm =
-        std::abs(robot::kDriveTrain.motor_inertia_alt.jm[j] - robot::kArm.links[j].motor_inertia) * G * G;
-    const double a_max = rig.A(j, j) * (1 + b.link_inertia) + arm, a_min = rig.A(j, j) * (1 - b.link_inertia) - arm;
+    const auto [a_min, a_max] = travel_inertia(rig.A, j);
     const double error = -travel_force(j, rig.g(j), 0, true, 0);
     const double spacing = quantum * (1 + 2 * b.encoder_edge);  // the edges' largest spacing
     const double ahead = spacing / (9 * params::kDt) + (error + band) / a_min * 11 * params::kDt;
