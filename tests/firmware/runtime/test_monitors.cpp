@@ -770,6 +770,51 @@ TYPED_TEST(Monitors, TravelCheckTakesTheIdentifiedBand) {
   }
 }
 
+// The identified band narrows a still joint's thresholds too (docs/safety.md, "The identified band"):
+// static friction anywhere within the proven breakaway instead of the band's top, so each threshold
+// shrinks by exactly kResidualMargin times the peak factor times what the band's top exceeds the
+// proven breakaway by. A joint held still for 0.3 s, then under an unexplained torque midway between
+// the two thresholds, is a drive fault, where the band's top holds it without a fault (the residual
+// alone: the travel check, which would name a joint held under a torque beyond its breakaway first,
+// waits as it does against a contact the task reacted to).
+TYPED_TEST(Monitors, AStillJointsThresholdsTakeTheIdentifiedBand) {
+  using S = TypeParam;
+  const FrictionCoefficients &paper = robot::kFrictionPaper, &hi = robot::kModelErrorBounds.friction_hi;
+  FrictionBounds<S> proven;
+  for (int i = 0; i < kDof; ++i) {
+    proven.vis(i) = lit<S>(hi.vis[i]);  // the viscous band's top: only the breakaway narrows
+    proven.breakaway(i) = lit<S>(1.1 * (paper.cou[i] + paper.sti[i]));
+  }
+  const bool still[kDof] = {};
+  ResidualRig<S> top, identified;
+  identified.proven = &proven;
+  top.step(Vec6<double>::Zero(), still);
+  identified.step(Vec6<double>::Zero(), still);
+  for (int i = 0; i < kDof; ++i) {
+    const double narrower = params::kResidualMargin * params::kResidualPeakFactor[i] *
+                            (hi.cou[i] + hi.sti[i] - static_cast<double>(proven.breakaway(i)));
+    const double t_top = static_cast<double>(top.m.threshold(i));
+    EXPECT_NEAR(t_top - static_cast<double>(identified.m.threshold(i)), narrower, 1e-3 * t_top + kClosedFormTol<S>)
+        << "J" << i + 1;
+  }
+  for (int j : {0, 2}) {
+    Vec6<double> ext = Vec6<double>::Zero();
+    ext(j) = 0.5 * static_cast<double>(top.m.threshold(j) + identified.m.threshold(j));
+    std::uint32_t kind = 0;
+    ResidualRig<S> held_top;
+    held_top.m.armed = held_top.m.contact = true;
+    for (int n = 0; n < 300; ++n) held_top.step(Vec6<double>::Zero(), still);
+    EXPECT_EQ(ticks_to_fault(held_top, ext, still, kind), -1) << "J" << j + 1 << ": " << fault_name(kind);
+    ResidualRig<S> held;
+    held.proven = &proven;
+    held.m.armed = held.m.contact = true;
+    for (int n = 0; n < 300; ++n) held.step(Vec6<double>::Zero(), still);
+    EXPECT_GT(ticks_to_fault(held, ext, still, kind), params::kResidualQualifyTicks) << "J" << j + 1;
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultDriveFault)) << "J" << j + 1 << ": " << fault_name(kind);
+    EXPECT_EQ(held.m.joint, j);
+  }
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ the position cross-check

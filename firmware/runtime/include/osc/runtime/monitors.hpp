@@ -508,10 +508,12 @@ struct ResidualMonitor {
       prime_change();
     }
     const Motion m = motion(in);
+    const StrongestFriction strongest(in);
     int worst = -1, moved_too_far = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) {
-      const FrictionError e = friction_error(in, i, tick, m.moving_speed[i]);
+      const Friction f = strongest(i);
+      const FrictionError e = friction_error(in, f, i, tick, m.moving_speed[i]);
       const S model = model_error(in, i);
       const S b = pointwise_bound(in, e, i, model);
       Changes ch{};
@@ -525,7 +527,7 @@ struct ResidualMonitor {
         ch = update_change(in, e, i);
       }
       update_thresholds(e, ch, m, i);
-      if (travel(in, m, i, model, moved[i], prime || contact, tick)) moved_too_far = i;
+      if (travel(in, m, f, i, model, moved[i], prime || contact, tick)) moved_too_far = i;
       qd_prev(i) = in.qd(i);
       bias_prev(i) = in.bias(i);
       if (prime) {
@@ -644,9 +646,24 @@ struct ResidualMonitor {
       if ((!qualified || over[j] >= params::kResidualQualifyTicks) && math::abs(r(j)) > collision_floor(j)) return true;
     return false;
   }
-  /// Joint i's friction against the band (FrictionError); `moving` is the speed beyond which the
-  /// joint may count as moving (Motion::moving_speed).
-  FrictionError friction_error(const ResidualInput<S>& in, int i, std::uint64_t tick, S moving) const {
+  /// A joint's friction at its strongest: its viscous coefficient and breakaway torque.
+  struct Friction {
+    S vis, breakaway;
+  };
+  /// Friction at its strongest, per joint: the band's tops, or what the identification proves
+  /// (in.proven), chosen once a step.
+  struct StrongestFriction {
+    const S* vis;
+    const S* breakaway;
+    explicit StrongestFriction(const ResidualInput<S>& in)
+        : vis(in.proven ? in.proven->vis.data() : kResidualConstants<S>.vis_hi),
+          breakaway(in.proven ? in.proven->breakaway.data() : kResidualConstants<S>.static_band) {}
+    Friction operator()(int i) const { return Friction{vis[i], breakaway[i]}; }
+  };
+  /// Joint i's friction against the band (FrictionError), `f` at its strongest; `moving` is the speed
+  /// beyond which the joint may count as moving (Motion::moving_speed).
+  FrictionError friction_error(const ResidualInput<S>& in, const Friction& f, int i, std::uint64_t tick,
+                               S moving) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::abs;
     FrictionError e;
@@ -659,8 +676,9 @@ struct ResidualMonitor {
     e.dv = abs(e.th_v - c.vis_mid[i]) + c.vis_half[i];
     e.dc = abs(e.th_c - c.cou_mid[i]) + c.cou_half[i];
     e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
-    // Static friction anywhere within the band, against whatever the estimate says.
-    e.still = math::mul_add(c.vis_hi[i], moving, c.static_band[i]) + abs(in.tau_f(i));
+    // Static friction anywhere within the band (its top, or what the identification proves), against
+    // whatever the estimate says.
+    e.still = math::mul_add(f.vis, moving, f.breakaway) + abs(in.tau_f(i));
     // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag;
     // the joint slides (its friction on the model's curve) when it counts fast enough besides. The
     // stillness envelope and the identification's samples go by the first (a joint that crawls
@@ -755,11 +773,11 @@ struct ResidualMonitor {
   /// less gravity and Coriolis torques (the least of the step's ticks), with every error the model may have against the
   /// motion (model_error(), the other joints' inertial torques with the link inertia's share, the current loop's lag)
   /// and friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
-  /// identification proves: in.proven), over the diagonal inertia at its least or most, bounds its speed that way from
+  /// identification proves: `f`), over the diagonal inertia at its least or most, bounds its speed that way from
   /// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
   /// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
   /// bounded.
-  bool travel(const ResidualInput<S>& in, const Motion& m, int i, S model, bool count, bool restart,
+  bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, bool count, bool restart,
               std::uint64_t tick) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::abs;
@@ -786,8 +804,6 @@ struct ResidualMonitor {
       return false;
     }
     ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
-    const Friction f{in.proven ? in.proven->vis(i) : c.vis_hi[i],
-                     in.proven ? in.proven->breakaway(i) : c.static_band[i]};
     const S aii = in.A(i, i);
     const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
     const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
@@ -806,9 +822,6 @@ struct ResidualMonitor {
   }
   /// The friction the travel check takes at its strongest against a motion: the viscous coefficient
   /// [N m s/rad] and the breakaway torque [N m].
-  struct Friction {
-    S vis, breakaway;
-  };
   /// Joint i's speed bounds at a count (travel()), from its pace and `change`, the most its speed can
   /// change per second [rad/s^2]. Its spans are read up to kSpanMax ticks (slower, ahead is 0 and
   /// back is its speed cap's).
