@@ -797,21 +797,25 @@ TYPED_TEST(Monitors, AStillJointsThresholdsTakeTheIdentifiedBand) {
     EXPECT_NEAR(t_top - static_cast<double>(identified.m.threshold(i)), narrower, 1e-3 * t_top + kClosedFormTol<S>)
         << "J" << i + 1;
   }
+  // Held still for 0.3 s, then pushed by `ext`: the ticks to the fault (-1: none), its kind and joint.
+  const auto held_ticks = [&](const FrictionBounds<S>* band, const Vec6<double>& ext, std::uint32_t& kind, int& joint) {
+    ResidualRig<S> held;
+    held.proven = band;
+    held.m.armed = held.m.contact = true;
+    for (int n = 0; n < 300; ++n) held.step(Vec6<double>::Zero(), still);
+    const int ticks = ticks_to_fault(held, ext, still, kind);
+    joint = held.m.joint;
+    return ticks;
+  };
   for (int j : {0, 2}) {
     Vec6<double> ext = Vec6<double>::Zero();
     ext(j) = 0.5 * static_cast<double>(top.m.threshold(j) + identified.m.threshold(j));
     std::uint32_t kind = 0;
-    ResidualRig<S> held_top;
-    held_top.m.armed = held_top.m.contact = true;
-    for (int n = 0; n < 300; ++n) held_top.step(Vec6<double>::Zero(), still);
-    EXPECT_EQ(ticks_to_fault(held_top, ext, still, kind), -1) << "J" << j + 1 << ": " << fault_name(kind);
-    ResidualRig<S> held;
-    held.proven = &proven;
-    held.m.armed = held.m.contact = true;
-    for (int n = 0; n < 300; ++n) held.step(Vec6<double>::Zero(), still);
-    EXPECT_GT(ticks_to_fault(held, ext, still, kind), params::kResidualQualifyTicks) << "J" << j + 1;
+    int joint = -1;
+    EXPECT_EQ(held_ticks(nullptr, ext, kind, joint), -1) << "J" << j + 1 << ": " << fault_name(kind);
+    EXPECT_GT(held_ticks(&proven, ext, kind, joint), params::kResidualQualifyTicks) << "J" << j + 1;
     EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultDriveFault)) << "J" << j + 1 << ": " << fault_name(kind);
-    EXPECT_EQ(held.m.joint, j);
+    EXPECT_EQ(joint, j);
   }
 }
 

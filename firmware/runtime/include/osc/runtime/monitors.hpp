@@ -646,7 +646,8 @@ struct ResidualMonitor {
       if ((!qualified || over[j] >= params::kResidualQualifyTicks) && math::abs(r(j)) > collision_floor(j)) return true;
     return false;
   }
-  /// A joint's friction at its strongest: its viscous coefficient and breakaway torque.
+  /// A joint's friction at its strongest, which the still joint's thresholds and the travel check
+  /// take: its viscous coefficient [N m s/rad] and breakaway torque [N m].
   struct Friction {
     S vis, breakaway;
   };
@@ -820,8 +821,6 @@ struct ResidualMonitor {
     if (p > travel_peak(i)) travel_peak(i) = p;
     return p > limit;
   }
-  /// The friction the travel check takes at its strongest against a motion: the viscous coefficient
-  /// [N m s/rad] and the breakaway torque [N m].
   /// Joint i's speed bounds at a count (travel()), from its pace and `change`, the most its speed can
   /// change per second [rad/s^2]. Its spans are read up to kSpanMax ticks (slower, ahead is 0 and
   /// back is its speed cap's).
