@@ -352,7 +352,8 @@ void InjectionTracking::to_json(Json& j) const {
                     {"zero_torque_s", json_time(ir.zero_torque)},
                     {"excursion_mm", ir.excursion_mm},
                     {"max_torque_after_detection_Nm", ir.max_torque_after},
-                    {"peak_contact_force_N", ir.peak_contact_force}};
+                    {"peak_contact_force_N", ir.peak_contact_force},
+                    {"first_contact_s", json_time(ir.first_contact)}};
 }
 
 void InjectionTracking::print(const ExperimentResult& run) const {

@@ -211,6 +211,7 @@ struct InjectionResult {
   double max_torque_after = 0;    ///< largest |tau| an amplifier applied after detection [N m]
   int max_torque_joint = -1;      ///< its joint (0-based)
   double peak_contact_force = 0;  ///< largest |F| of an injected contact (collision, wall) [N]; 0: none
+  double first_contact = -1;      ///< [s] when it first pushed (-1: never)
 };
 
 /// The injected fault's detection, torque cut-off and tip excursion.

@@ -312,6 +312,19 @@ class HostArm {
   void finish(MotionRun& run) {
     run.controller = "in-process";
     run.peak_contact_force = sim_.plant().peak_contact_force();
+    run.first_contact_s = sim_.plant().first_contact_time();
+    const osc::ResidualMonitor<S>& m = sim_.task().residual;
+    run.has_residual = true;
+    for (int i = 0; i < 6; ++i) {
+      const double limit = static_cast<double>(m.travel_limit(i));
+      run.residual_peak_ratio[i] = static_cast<double>(m.peak_ratio(i));
+      run.residual_travel_ratio[i] = limit > 0 ? static_cast<double>(m.travel_peak(i)) / limit : 0;
+    }
+    if (m.detected != 0) {
+      run.residual_fault = m.detected;
+      run.residual_joint = static_cast<unsigned char>(m.joint);  // set: 0..5
+      run.residual_detected_s = static_cast<double>(m.detected_tick) / osc::params::kControlHz;
+    }
   }
 
  private:
@@ -345,6 +358,7 @@ class ScriptLinkedArm : public LinkedArm {
     run.pil_command = program();
     run.link = link_report();
     run.peak_contact_force = plant().peak_contact_force();
+    run.first_contact_s = plant().first_contact_time();
     stop();
   }
 
@@ -567,10 +581,23 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
     if (run.faults & (1u << i)) faults.push_back(osc::kFaultNames[i]);
   j["faults"] = faults;
   j["fault_s"] = run.fault_s >= 0 ? ordered_json(run.fault_s) : ordered_json(nullptr);
-  if (cfg.injection.enabled)
-    j["injection"] = {{"spec", to_string(cfg.injection)}, {"peak_contact_force_N", run.peak_contact_force}};
-  if (!run.error.empty()) j["error"] = run.error;
   auto time_or_null = [](double t) { return t >= 0 ? ordered_json(t) : ordered_json(nullptr); };
+  if (cfg.injection.enabled)
+    j["injection"] = {{"spec", to_string(cfg.injection)},
+                      {"peak_contact_force_N", run.peak_contact_force},
+                      {"first_contact_s", time_or_null(run.first_contact_s)}};
+  if (run.has_residual) {
+    ordered_json peak = ordered_json::array(), travel = ordered_json::array();
+    for (int i = 0; i < 6; ++i)
+      peak.push_back(run.residual_peak_ratio[i]), travel.push_back(run.residual_travel_ratio[i]);
+    j["residual_monitor"] = {{"peak_ratio", peak}, {"travel_ratio", travel}};
+    j["residual_monitor"]["detection"] = run.residual_fault == 0
+                                             ? ordered_json(nullptr)
+                                             : ordered_json{{"t_s", run.residual_detected_s},
+                                                            {"fault", osc::fault_name(run.residual_fault)},
+                                                            {"joint", run.residual_joint + 1}};
+  }
+  if (!run.error.empty()) j["error"] = run.error;
   auto name_or_null = [](const std::string& s) { return s.empty() ? ordered_json(nullptr) : ordered_json(s); };
   ordered_json cmds = ordered_json::array();
   for (const CommandRecord& r : run.commands)

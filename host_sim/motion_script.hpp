@@ -109,6 +109,14 @@ struct MotionRun {
   LinkReport link;                ///< pil: the link's health
   double wall_s = 0;              ///< wall-clock time of the run [s]
   double peak_contact_force = 0;  ///< an injected contact's largest |F| (Plant::peak_contact_force) [N]
+  double first_contact_s = -1;    ///< ... when it first pushed (Plant::first_contact_time) [s]; -1: never
+  /// The residual monitor of a controller in process (has_residual): each joint's worst |r| / threshold
+  /// and the travel check's worst share of its limit, and its first detection (fault bit, joint, time).
+  bool has_residual = false;
+  double residual_peak_ratio[6] = {}, residual_travel_ratio[6] = {};
+  std::uint32_t residual_fault = 0;
+  int residual_joint = -1;
+  double residual_detected_s = -1;
 };
 
 /// Plays the script against the simulated arm (plant set-up and injection from cfg: the caller puts

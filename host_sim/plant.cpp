@@ -369,6 +369,7 @@ void Plant::reset(const Vec6& q0, const Vec6& qd0) {
   t_ = 0;
   contact_phase_ = 0;
   peak_contact_ = 0;
+  first_contact_ = -1;
   if (ideal_) return;
   amp_.setZero();
   cmd_.setZero();
@@ -412,6 +413,7 @@ void Plant::set_contact(const Contact& c) {
   contact_ = c;
   contact_phase_ = 0;
   peak_contact_ = 0;
+  first_contact_ = -1;
 }
 
 Vec3 Plant::force_at(const Vec6& qd) const {
@@ -703,7 +705,11 @@ void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) 
     integrate(tau_old, d);
     integrate(tau_new, dt - d);
   }
-  if (contact_phase_ == 1) peak_contact_ = std::max(peak_contact_, contact_force(q_, qd_).norm());
+  if (contact_phase_ == 1) {
+    const double f = contact_force(q_, qd_).norm();
+    peak_contact_ = std::max(peak_contact_, f);
+    if (f > 0 && first_contact_ < 0) first_contact_ = t_;
+  }
 }
 
 double Plant::energy() const {

@@ -168,6 +168,8 @@ class Plant {
   Vec6 external_torque(const Vec6& q, const Vec6& qd) const;
   /// The largest |F| of the contact since reset(), sampled at the end of each advance_sample() [N].
   double peak_contact_force() const { return peak_contact_; }
+  /// The end of the first sample in which the contact pushed (|F| > 0) [s]; -1: none yet.
+  double first_contact_time() const { return first_contact_; }
 
   /// The joint torques of the drive train's friction at joint rates qd (model (2); with the coupling,
   /// C^-T f(C^-1 qd), the motors' friction referred to the joints; with the drift, at the plant's
@@ -273,9 +275,10 @@ class Plant {
 
   // The contact.
   Contact contact_;
-  int contact_phase_ = 0;    // 0 before its start, 1 acting, 2 after a pulse
-  double wall_plane_ = 0;    // direction . p on the wall's surface [m]
-  double peak_contact_ = 0;  // [N]
+  int contact_phase_ = 0;      // 0 before its start, 1 acting, 2 after a pulse
+  double wall_plane_ = 0;      // direction . p on the wall's surface [m]
+  double peak_contact_ = 0;    // [N]
+  double first_contact_ = -1;  // [s]
   osc::Model<double> kin_model_ = osc::Model<double>::of(osc::robot::kArm);  // the tip's kinematics
   mutable osc::Data<double> kin_;
 };

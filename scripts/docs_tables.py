@@ -778,6 +778,52 @@ def residual_contact():
     return "\n".join(lines)
 
 
+def motion_run(script):
+    """Plays a motion script (YAML text) on the simulated arm (puma_experiment --motion); its JSON."""
+    with tempfile.TemporaryDirectory() as d:
+        path, out = os.path.join(d, "s.yaml"), os.path.join(d, "s.json")
+        with open(path, "w") as f:
+            f.write(script)
+        cmd = [EXPERIMENT, "--motion", path, "--json", out]
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if not os.path.exists(out):
+            raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
+        with open(out) as f:
+            return json.load(f)
+
+
+WALL_MOVE = """inject: "wall:{d}:5@24"
+settle: 0.5
+steps:
+  - {{at: 0, cmd: enable}}
+  - {{at: 0.1, cmd: paper}}
+  - {{at: 20, cmd: stop}}
+  - {{at: 24, cmd: move_to, position: {p}, relative: true}}
+"""
+
+
+@table("residual_wall_move", "docs/safety.md", "long")
+def residual_wall_move():
+    """Armed: a stiff wall 5 mm from the tip in the path of a 10 mm move, in each direction, after
+    20 s of the paper's motion (the friction identified) and 4 s of holding. Cell: the fault, ms after
+    the wall first pushed, and the largest contact force."""
+    def script(d):
+        p = [0.0, 0.0, 0.0]
+        p["xyz".index(d[1])] = 0.010 if d[0] == "+" else -0.010
+        return WALL_MOVE.format(d=d, p="[" + ", ".join(f"{v:g}" for v in p) + "]")
+    with concurrent.futures.ThreadPoolExecutor(max_workers=2) as ex:
+        runs = list(ex.map(lambda d: motion_run(script(d)), DIRECTIONS))
+    lines = ["| wall in the path of a 10 mm move | fault | after first contact | largest contact force |",
+             "|---|---|---:|---:|"]
+    for d, r in zip(DIRECTIONS, runs):
+        inj = r["injection"]
+        first = inj.get("first_contact_s")
+        fault = ", ".join(r["faults"]) or "none"
+        after = f"{(r['fault_s'] - first) * 1e3:.0f} ms" if r.get("fault_s") is not None and first is not None else "-"
+        lines.append(f"| `wall:{d}:5` | {fault} | {after} | {inj['peak_contact_force_N']:.0f} N |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- the realistic plant (issue 24)
 
 

@@ -7,12 +7,12 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 # Set-up and build report on stderr: stdout is the experiment's (puma_experiment --print-config > c.yaml).
 bash scripts/setup.sh >&2
-cmake --preset host >/dev/null
+bash scripts/configure.sh host
 cmake --build --preset host --target puma_experiment osc_model_info >&2
 # --qemu runs the controller as the Cortex-M4F firmware image in QEMU: build it first.
 for a in "$@"; do
   if [ "$a" = "--qemu" ]; then
-    cmake --preset m4f >/dev/null
+    bash scripts/configure.sh m4f
     cmake --build --preset m4f --target pil_firmware >&2
   fi
 done

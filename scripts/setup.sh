@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages the project needs; quick and silent when all are present.
 set -euo pipefail
-pkgs=(cmake make g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-dev
+pkgs=(cmake ninja-build g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib binutils-arm-none-eabi
       qemu-system-arm python3 python3-matplotlib
       python3-serial                        # the Python client of the command protocol (clients/python/)

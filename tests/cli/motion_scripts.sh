@@ -165,7 +165,8 @@ inject_and_flag_both)  # one injection per run: the script's or --inject's, not 
   grep -qF -- "inject: and --inject both given" <<<"$out" || fail "$out"
   test ! -e "$d/out.json" || fail "a JSON was written"
   ;;
-wall_in_the_path)  # a wall 5 mm below the tip stops a move 10 mm down: the plant's contact, in the JSON
+wall_in_the_path)  # a wall 5 mm below the tip stops a move 10 mm down: the plant's contact (its largest
+  # force, when it first pushed) and the residual monitor's record, in the JSON
   cat >"$d/s.yaml" <<'YAML'
 inject: "wall:-z:5@0"
 settle: 0.5
@@ -180,7 +181,16 @@ j = json.load(open(sys.argv[1]))
 inj = j["injection"]
 assert inj["spec"] == "wall:-z:5@0", inj
 assert inj["peak_contact_force_N"] > 0, inj
-print("result", j["result"], j["faults"], "peak contact force", inj["peak_contact_force_N"], "N")
+# The move starts at 0.1 s and reaches the wall halfway, a few tenths of a second on.
+assert 0.2 < inj["first_contact_s"] < j["duration_s"], inj
+rm = j["residual_monitor"]
+assert len(rm["peak_ratio"]) == 6 and len(rm["travel_ratio"]) == 6, rm
+if j["faults"]:  # the monitor's detection is the run's fault, after the contact
+    assert rm["detection"]["fault"] in j["faults"] and rm["detection"]["t_s"] >= inj["first_contact_s"], (rm, inj)
+else:
+    assert rm["detection"] is None and max(rm["peak_ratio"]) <= 1, rm
+print("result", j["result"], j["faults"], "peak contact force", inj["peak_contact_force_N"], "N, first at",
+      inj["first_contact_s"], "s; residual monitor", rm["detection"])
 PY
   ;;
 with_qemu_needs_the_image)  # --qemu plays scripts too; without the image it says so, before anything runs

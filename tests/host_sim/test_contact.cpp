@@ -244,6 +244,7 @@ TEST(Contact, AContactThatDoesNotPushLeavesTheRunBitForBit) {
         ASSERT_EQ(std::memcmp(r.log[k].tau, none.log[k].tau, sizeof r.log[k].tau), 0) << preset << " sample " << k;
       }
       EXPECT_EQ(r.injection.peak_contact_force, 0) << preset;
+      EXPECT_EQ(r.injection.first_contact, -1) << preset << ": it never pushed";
     }
   }
 }
@@ -255,6 +256,7 @@ TEST(Contact, TheExperimentAndTheCommandedArmReportTheirContact) {
   ASSERT_TRUE(parse_injection("collision:+z:50@1", step, err)) << err;
   const ExperimentResult r = closed_loop(step, "ideal");
   EXPECT_EQ(r.injection.peak_contact_force, 50);
+  EXPECT_NEAR(r.injection.first_contact, 1.001, 1e-9) << "the end of the sample it began in";
   // MotionSim (the scripts' in-process arm): a wall 5 mm below the tip stops a move 10 mm down.
   Injection wall;
   ASSERT_TRUE(parse_injection("wall:-z:5@0", wall, err)) << err;
@@ -266,14 +268,17 @@ TEST(Contact, TheExperimentAndTheCommandedArmReportTheirContact) {
   down.relative = true;
   down.position = osc::Vec3<double>(0, 0, -0.010);
   sim.move_to(down, 2);
-  double lowest = z0;
+  double lowest = z0, reached = -1;  // when the tip first went 5 mm down [s]
+  EXPECT_EQ(sim.plant().first_contact_time(), -1);
   for (int k = 0; k < 2000; ++k) {
     sim.tick();
     lowest = std::min(lowest, sim.tip().z());
+    if (reached < 0 && z0 - lowest >= 5e-3) reached = sim.plant().time();
   }
   std::printf("a move 10 mm down onto a wall 5 mm below: the tip went %.3f mm down, peak force %.1f N\n",
               (z0 - lowest) * 1e3, sim.plant().peak_contact_force());
   EXPECT_GT(sim.plant().peak_contact_force(), 0);
+  EXPECT_NEAR(sim.plant().first_contact_time(), reached, 1.5e-3) << "its first push is the tip reaching it";
   EXPECT_LT(z0 - lowest, 5e-3 + sim.plant().peak_contact_force() / Contact::kWallStiffness + 1e-4);
 }
 
