@@ -200,7 +200,8 @@ with_qemu_needs_the_image)  # --qemu plays scripts too; without the image it say
   test ! -e "$d/out.json" || fail "a JSON was written"
   ;;
 qemu_tour)  # ELF SCALAR: the tour on the image in QEMU, and in process in the image's scalar: the same
-  # JSON but for the controller, the wall time and the in-process friction estimates, bit for bit
+  # JSON but for the controller, the wall time and the in-process friction estimates and residual
+  # monitor record, bit for bit
   # (in float, PUMA_EXPERIMENT is the host-scalar build's: its float controller has no SIMD, as the
   # M4F's; docs/motion.md).
   elf=$1 scalar=$2
@@ -220,6 +221,7 @@ for j in (host, qemu):
     del j["controller"], j["wall_s"]
 for c in host["commands"]:  # in process only: the friction estimates when each command was sent
     c.pop("theta_hat_at_sent", None)
+host.pop("residual_monitor", None)  # in process only: the residual monitor's record
 if host != qemu:
     for k in host:
         if host[k] != qemu[k]:
