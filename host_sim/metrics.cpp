@@ -28,6 +28,11 @@ Json json_faults(std::uint32_t bits) {
 
 Json json_array(const double* v, int n) { return Json(std::vector<double>(v, v + n)); }
 
+Json residual_detection_json(double t_s, std::uint32_t fault, int joint) {
+  if (fault == 0) return Json(nullptr);
+  return Json{{"t_s", t_s}, {"fault", osc::fault_name(fault)}, {"joint", joint + 1}};
+}
+
 // ---- FaultSnapshot
 
 void FaultSnapshot::observe(const Sample& s) {
@@ -266,10 +271,7 @@ void StuckMonitorPeaks::to_json(Json& j) const {
   j["residual_monitor_threshold_at_peak_Nm"] = json_array(residual_threshold_Nm, 6);
   j["position_check_peak_ratio"] = json_array(position_peak_ratio, 6);
   j["residual_monitor_travel_ratio"] = json_array(travel_peak_ratio, 6);
-  j["residual_monitor_detection"] = residual_detected_s < 0 ? Json(nullptr)
-                                                            : Json{{"t_s", residual_detected_s},
-                                                                   {"fault", osc::fault_name(residual_fault)},
-                                                                   {"joint", residual_joint + 1}};
+  j["residual_monitor_detection"] = residual_detection_json(residual_detected_s, residual_fault, residual_joint);
 }
 
 // ---- FirmwareReport

@@ -32,6 +32,9 @@ using Json = nlohmann::ordered_json;
 
 /// n numbers as a JSON array.
 Json json_array(const double* v, int n);
+/// The residual monitor's first detection as JSON: {t_s, fault, joint (1-based)}, or null for none
+/// (fault 0).
+Json residual_detection_json(double t_s, std::uint32_t fault, int joint);
 
 /// What the controller reports back each tick.
 struct TickReport {

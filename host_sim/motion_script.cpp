@@ -587,15 +587,10 @@ std::string motion_run_json(const MotionRun& run, const std::string& script_name
                       {"peak_contact_force_N", run.peak_contact_force},
                       {"first_contact_s", time_or_null(run.first_contact_s)}};
   if (run.has_residual) {
-    ordered_json peak = ordered_json::array(), travel = ordered_json::array();
-    for (int i = 0; i < 6; ++i)
-      peak.push_back(run.residual_peak_ratio[i]), travel.push_back(run.residual_travel_ratio[i]);
-    j["residual_monitor"] = {{"peak_ratio", peak}, {"travel_ratio", travel}};
-    j["residual_monitor"]["detection"] = run.residual_fault == 0
-                                             ? ordered_json(nullptr)
-                                             : ordered_json{{"t_s", run.residual_detected_s},
-                                                            {"fault", osc::fault_name(run.residual_fault)},
-                                                            {"joint", run.residual_joint + 1}};
+    j["residual_monitor"] = {
+        {"peak_ratio", json_array(run.residual_peak_ratio, 6)},
+        {"travel_ratio", json_array(run.residual_travel_ratio, 6)},
+        {"detection", residual_detection_json(run.residual_detected_s, run.residual_fault, run.residual_joint)}};
   }
   if (!run.error.empty()) j["error"] = run.error;
   auto name_or_null = [](const std::string& s) { return s.empty() ? ordered_json(nullptr) : ordered_json(s); };

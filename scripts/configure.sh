@@ -6,7 +6,10 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 preset=$1
 shift
-dir=$(sed -n "/\"name\": \"$preset\"/,/binaryDir/s/.*\"binaryDir\": \"\${sourceDir}\/\(.*\)\".*/\1/p" CMakePresets.json | head -1)
+dir=$(python3 -c 'import json, sys
+for p in json.load(open("CMakePresets.json"))["configurePresets"]:
+    if p["name"] == sys.argv[1]:
+        print(p["binaryDir"].replace("${sourceDir}/", ""))' "$preset")
 cache=${dir:+$dir/CMakeCache.txt}
 fresh=()
 if [ -n "$cache" ] && [ -f "$cache" ] && ! grep -q '^CMAKE_GENERATOR:INTERNAL=Ninja$' "$cache"; then
