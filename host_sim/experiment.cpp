@@ -6,8 +6,9 @@
 #include <limits>
 #include <memory>
 
-#include "osc/runtime/control_task.hpp"
+#include "control_tick_sim.hpp"
 #include "linked_arm.hpp"
+#include "osc/runtime/control_task.hpp"
 #include "plant_hal.hpp"
 
 namespace sim {

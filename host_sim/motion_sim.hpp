@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 
+#include "control_tick_sim.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "plant.hpp"
 #include "plant_hal.hpp"

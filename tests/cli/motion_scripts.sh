@@ -77,10 +77,12 @@ assert got == [("enable", None, True), ("move_to", "not_homed", False), ("home",
                ("move_to", None, True), ("disable", None, True), ("declare_pose", "pots_disagree", False)], got
 PY
   ;;
-real_arm)  # docs/experiment.md: from power-on pose 5 the paper's gains with the robust law vibrate the
-  # realistic wrist until a monitor stops it; examples/real_arm.yaml's (the observer's rotational k
-  # doubled) run clean, and so do the paper's gains with the momentum law (the default), which
-  # learns the wrist's friction within seconds
+real_arm)  # docs/experiment.md, "The paper's motion from other poses": from power-on pose 5 the paper's
+  # gains make the realistic wrist vibrate at about 28 Hz, which the velocity estimate does not follow.
+  # With the robust law a monitor stops it. With the default (momentum) law it still shows in the
+  # residual monitor's ratios, J4's or J6's over the design line of 0.5 (docs/safety.md, residual_homed;
+  # whether it also qualifies as a fault is not asserted: J6 peaks at 1.05 for under three ticks).
+  # examples/real_arm.yaml's gains (the observer's rotational k doubled) run clean, every ratio within 0.5.
   run() {
     "$exe" --plant realistic --motion "$examples/home_then_paper.yaml" --set plant.power_on_pose=random:5 \
       --set run.residual_monitor=on --json "$d/$1.json" "${@:2}" >"$d/$1.txt" 2>&1
@@ -88,13 +90,18 @@ real_arm)  # docs/experiment.md: from power-on pose 5 the paper's gains with the
   run paper --adaptation robust
   rc=$?
   test $rc -eq 1 || fail "exit $rc, not 1 (a fault): $(cat "$d/paper.txt")"
-  run default || fail "exit $?: $(cat "$d/default.txt")"
+  run default
+  rc=$?
+  test $rc -le 1 || fail "exit $rc: $(cat "$d/default.txt")"
   run real --config "$examples/real_arm.yaml" || fail "exit $?: $(cat "$d/real.txt")"
-  "$py" - "$d/paper.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/real.txt")"
+  "$py" - "$d/paper.json" "$d/default.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/real.txt")"
 import json, sys
-paper, real = (json.load(open(f)) for f in sys.argv[1:])
+paper, default, real = (json.load(open(f)) for f in sys.argv[1:])
 assert paper["faults"] in (["collision"], ["drive_fault"]), paper["faults"]
+vibration = max(default["residual_monitor"]["peak_ratio"][3:6:2])  # J4, J6
+assert vibration > 0.5, default["residual_monitor"]
 assert real["faults"] == [], real["faults"]
+assert max(real["residual_monitor"]["peak_ratio"]) <= 0.5, real["residual_monitor"]
 assert [(c["cmd"], c["refused"]) for c in real["commands"]][:3] == [("enable", None), ("home", None), ("paper", None)]
 PY
   ;;

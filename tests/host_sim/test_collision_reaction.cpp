@@ -9,6 +9,7 @@
 #include <cmath>
 #include <memory>
 
+#include "control_tick_sim.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "plant.hpp"
 #include "plant_hal.hpp"
