@@ -68,23 +68,28 @@ _runs = {}
 EXPECTED_FAULTS = set()  # argument lists whose runs may fault: the fault is the result
 
 
+def run_json(*args):
+    """Runs puma_experiment with these arguments and --json; its JSON and what it printed."""
+    with tempfile.TemporaryDirectory() as d:
+        out = os.path.join(d, "s.json")
+        cmd = [EXPERIMENT, *args, "--json", out]
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if not os.path.exists(out):
+            raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
+        with open(out) as f:
+            return json.load(f), p.stdout
+
+
 def experiment(*args):
     """Runs puma_experiment once per argument list (cached); returns its summary JSON."""
     key = tuple(args)
     if key not in _runs:
-        with tempfile.TemporaryDirectory() as d:
-            path = os.path.join(d, "s.json")
-            cmd = [EXPERIMENT, "--no-csv", "--no-progress", "--json", path, *args]
-            p = subprocess.run(cmd, capture_output=True, text=True)
-            if not os.path.exists(path):
-                raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
-            with open(path) as f:
-                _runs[key] = json.load(f)
-            # A table is never made of a faulted run's numbers (that run is no result).
-            for r in _runs[key]["runs"]:
-                if r.get("faults") and "--inject" not in args and key not in EXPECTED_FAULTS:
-                    raise RuntimeError(f"{' '.join(cmd)}: run '{r['mode']}' faulted: {r['faults']} at "
-                                       f"{r['fault_time_s']} s\n{p.stdout}")
+        _runs[key], printed = run_json("--no-csv", "--no-progress", *args)
+        # A table is never made of a faulted run's numbers (that run is no result).
+        for r in _runs[key]["runs"]:
+            if r.get("faults") and "--inject" not in args and key not in EXPECTED_FAULTS:
+                raise RuntimeError(f"puma_experiment {' '.join(args)}: run '{r['mode']}' faulted: {r['faults']} at "
+                                   f"{r['fault_time_s']} s\n{printed}")
     return _runs[key]
 
 
@@ -726,16 +731,8 @@ HOMED_GAINS = [("the paper's", ()),
 def homed_run(seed, extra):
     """examples/home_then_paper.yaml on the realistic plant from power-on pose random:SEED, armed: a
     motion run's JSON (its residual_monitor record)."""
-    with tempfile.TemporaryDirectory() as d:
-        out = os.path.join(d, "s.json")
-        cmd = [EXPERIMENT, "--plant", "realistic", "--motion", os.path.join(ROOT, "examples/home_then_paper.yaml"),
-               "--set", f"plant.power_on_pose=random:{seed}", "--set", "run.residual_monitor=on", *extra,
-               "--json", out]
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        if not os.path.exists(out):
-            raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
-        with open(out) as f:
-            return json.load(f)
+    return run_json("--plant", "realistic", "--motion", os.path.join(ROOT, "examples/home_then_paper.yaml"),
+                    "--set", f"plant.power_on_pose=random:{seed}", "--set", "run.residual_monitor=on", *extra)[0]
 
 
 @table("residual_homed", "docs/safety.md", "long")
@@ -817,15 +814,10 @@ def residual_contact():
 def motion_run(script):
     """Plays a motion script (YAML text) on the simulated arm (puma_experiment --motion); its JSON."""
     with tempfile.TemporaryDirectory() as d:
-        path, out = os.path.join(d, "s.yaml"), os.path.join(d, "s.json")
+        path = os.path.join(d, "s.yaml")
         with open(path, "w") as f:
             f.write(script)
-        cmd = [EXPERIMENT, "--motion", path, "--json", out]
-        p = subprocess.run(cmd, capture_output=True, text=True)
-        if not os.path.exists(out):
-            raise RuntimeError(f"{' '.join(cmd)} failed:\n{p.stdout}{p.stderr}")
-        with open(out) as f:
-            return json.load(f)
+        return run_json("--motion", path)[0]
 
 
 WALL_MOVE = """inject: "wall:{d}:5@24"

@@ -94,7 +94,7 @@ real_arm)  # docs/experiment.md, "The paper's motion from other poses": from pow
   rc=$?
   test $rc -le 1 || fail "exit $rc: $(cat "$d/default.txt")"
   run real --config "$examples/real_arm.yaml" || fail "exit $?: $(cat "$d/real.txt")"
-  "$py" - "$d/paper.json" "$d/default.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/real.txt")"
+  "$py" - "$d/paper.json" "$d/default.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/default.txt" "$d/real.txt")"
 import json, sys
 paper, default, real = (json.load(open(f)) for f in sys.argv[1:])
 assert paper["faults"] in (["collision"], ["drive_fault"]), paper["faults"]
