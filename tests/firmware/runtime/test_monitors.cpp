@@ -819,6 +819,95 @@ TYPED_TEST(Monitors, AStillJointsThresholdsTakeTheIdentifiedBand) {
   }
 }
 
+// The identified band narrows a sliding joint's Coulomb interval (docs/safety.md, "The identified
+// band"): its Coulomb level is within the band and at most the proven breakaway less the Stribeck
+// band's least, so with theta^ = 0 each absolute threshold shrinks by kResidualMargin times the peak
+// factor times what the Coulomb band's top exceeds that by. An unexplained torque that ramps over
+// 10 s (too slowly for the change channel) to midway between the two thresholds is a drive fault
+// with the proven band, and nothing with the band's top.
+TYPED_TEST(Monitors, ASlidingJointsThresholdsTakeTheIdentifiedBand) {
+  using S = TypeParam;
+  const FrictionCoefficients &paper = robot::kFrictionPaper, &lo = robot::kModelErrorBounds.friction_lo,
+                             &hi = robot::kModelErrorBounds.friction_hi;
+  static FrictionBounds<S> proven;
+  for (int i = 0; i < kDof; ++i) {
+    proven.vis(i) = lit<S>(hi.vis[i]);
+    proven.breakaway(i) = lit<S>(1.1 * (paper.cou[i] + paper.sti[i]));
+  }
+  const auto moving = [&](const FrictionBounds<S>* band) {
+    ResidualRig<S> rig;
+    rig.proven = band;
+    rig.m.armed = true;
+    rig.qd.setConstant(0.5);
+    const bool all[kDof] = {true, true, true, true, true, true};
+    for (int n = 0; n < 2000; ++n) EXPECT_EQ(rig.step(Vec6<double>::Zero(), all, false), 0u) << n;
+    return rig;
+  };
+  const ResidualRig<S> top = moving(nullptr), identified = moving(&proven);
+  for (int j : {0, 2}) {
+    const double cou_top = std::min(hi.cou[j], static_cast<double>(proven.breakaway(j)) - lo.sti[j]);
+    const double narrower = params::kResidualMargin * params::kResidualPeakFactor[j] * (hi.cou[j] - cou_top);
+    ASSERT_GT(narrower, 1.0) << "J" << j + 1;
+    const double t_top = static_cast<double>(top.m.threshold(j));
+    EXPECT_NEAR(t_top - static_cast<double>(identified.m.threshold(j)), narrower, 1e-3 * t_top + kClosedFormTol<S>)
+        << "J" << j + 1;
+    // The ramp to midway, then 0.5 s held there.
+    const double mid = 0.5 * (t_top + static_cast<double>(identified.m.threshold(j)));
+    const auto ramp_fault = [&](ResidualRig<S> rig) {
+      const bool all[kDof] = {true, true, true, true, true, true};
+      std::uint32_t kind = 0;
+      for (int n = 0; n < 10500 && kind == 0; ++n) {
+        Vec6<double> ext = Vec6<double>::Zero();
+        ext(j) = mid * std::min(1.0, n / 10000.0);
+        kind = rig.step(ext, all, false);
+      }
+      return std::make_pair(kind, static_cast<int>(rig.m.joint));
+    };
+    EXPECT_EQ(ramp_fault(top).first, 0u) << "J" << j + 1;
+    const auto [kind, joint] = ramp_fault(identified);
+    EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultDriveFault)) << "J" << j + 1 << ": " << fault_name(kind);
+    EXPECT_EQ(joint, j);
+  }
+}
+
+// A contact the task reacted to (ResidualMonitor::note_contact): the push stays in r while the arm
+// yields or holds against it. When the contact begins, the monitor notes it, so that the same push
+// raises nothing, however long it lasts, while a change of the push by several change thresholds
+// after it still does. When the contact ends, the floors drop back and a push still there is found
+// again.
+TYPED_TEST(Monitors, AContactsPushIsNotedAndWhatChangesAfterItJudged) {
+  using S = TypeParam;
+  const bool still[kDof] = {};
+  ResidualRig<S> rig;
+  rig.m.armed = true;
+  for (int n = 0; n < 300; ++n) ASSERT_EQ(rig.step(Vec6<double>::Zero(), still, false), 0u) << n;
+  // A push on J2 and J3 at twice their thresholds: a collision.
+  Vec6<double> ext = Vec6<double>::Zero();
+  ext(1) = 2 * static_cast<double>(rig.m.threshold(1));
+  ext(2) = 2 * static_cast<double>(rig.m.threshold(2));
+  std::uint32_t kind = 0;
+  for (int n = 0; n < 200 && kind == 0; ++n) kind = rig.step(ext, still, false);
+  ASSERT_EQ(kind, static_cast<std::uint32_t>(kFaultCollision)) << fault_name(kind);
+  // The task reacts (yield, or a category-2 stop): contact. The push lasts 1 s, and is let be.
+  rig.m.contact = true;
+  for (int n = 0; n < 1000; ++n) ASSERT_EQ(rig.step(ext, still, false), 0u) << n;
+  EXPECT_NEAR(static_cast<double>(rig.m.r(1)), ext(1), 0.02 * ext(1)) << "the push is still in r";
+  EXPECT_LT(rig.m.peak_ratio(1), lit<S>(2.5));
+  EXPECT_LT(rig.m.ratio_of(1), lit<S>(0.8));
+  // J3's push grows by three of its change thresholds: found, within 50 ms.
+  ResidualRig<S> grown = rig;
+  Vec6<double> more = ext;
+  more(2) += 3 * static_cast<double>(grown.m.change_threshold(2));
+  const int ticks = ticks_to_fault(grown, more, still, kind);
+  EXPECT_GT(ticks, 0);
+  EXPECT_LE(ticks, 50);
+  EXPECT_NE(kind, 0u);
+  // The contact ends with the push still there: found again once the bound has decayed.
+  rig.m.contact = false;
+  EXPECT_GT(ticks_to_fault(rig, ext, still, kind), 0);
+  EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultCollision)) << fault_name(kind);
+}
+
 }  // namespace
 
 // ------------------------------------------------------------------ the position cross-check

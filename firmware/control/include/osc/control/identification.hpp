@@ -195,8 +195,8 @@ struct FrictionIdentifier {
   /// standard deviations, taken without a root: the first of params::kTravelTiers tiers whose
   /// standard deviation f z (f = params::kIdentifiedFraction, doubled tier by tier) covers sqrt(P)
   /// gives (1 + kTravelIdentifiedSd f) z; beyond the last, or z <= 0, the band's top, and never
-  /// more. Measured with params::kIdentifyDrift: a joint identified within 2.5 % keeps 1.1 z for
-  /// about 9 s of rest, 1.2 z for 36 s, 1.4 z for 2.4 min and 1.8 z for 10 min (J2).
+  /// more, nor less than the band's bottom. Measured with params::kIdentifyDrift: a joint identified within 2.5 %
+  /// keeps 1.1 z for about 9 s of rest, 1.2 z for 36 s, 1.4 z for 2.4 min and 1.8 z for 10 min (J2).
   void prove(int i) {
     static constexpr S kFraction = lit<S>(params::kIdentifiedFraction);
     static constexpr S kStep = lit<S>(params::kTravelIdentifiedSd * params::kIdentifiedFraction);
@@ -206,8 +206,8 @@ struct FrictionIdentifier {
       S fv = kFraction * v, above = kStep;
       for (int k = 0; k < params::kTravelTiers; ++k, fv += fv, above += above)
         if (p <= fv * fv) {
-          const S b = (S(1) + above) * v * unscale(i);
-          return b < hi ? b : hi;
+          const S b = (S(1) + above) * v * unscale(i), lo = bottom(c, i);
+          return b < hi ? (b > lo ? b : lo) : hi;
         }
       return hi;
     };
@@ -368,13 +368,15 @@ struct FrictionIdentifier {
     return kUnscale[i];
   }
   /// The band's top of joint i's viscous coefficient (c = 0) or breakaway torque (c = 1, Coulomb +
-  /// Stribeck) [N m s/rad, N m].
-  static S top(int c, int i) {
-    static constexpr std::array<S, kDof> kVis =
-        per_joint([](int j) { return robot::kModelErrorBounds.friction_hi.vis[j]; });
-    static constexpr std::array<S, kDof> kBreakaway = per_joint([](int j) {
-      return robot::kModelErrorBounds.friction_hi.cou[j] + robot::kModelErrorBounds.friction_hi.sti[j];
-    });
+  /// Stribeck) [N m s/rad, N m]; bottom(): its bottom, what is proven is never less (the band is what
+  /// the arm's friction is known to lie within).
+  static S top(int c, int i) { return band_end<&ModelErrorBounds::friction_hi>(c, i); }
+  static S bottom(int c, int i) { return band_end<&ModelErrorBounds::friction_lo>(c, i); }
+  template <FrictionCoefficients ModelErrorBounds::*End>
+  static S band_end(int c, int i) {
+    static constexpr std::array<S, kDof> kVis = per_joint([](int j) { return (robot::kModelErrorBounds.*End).vis[j]; });
+    static constexpr std::array<S, kDof> kBreakaway = per_joint(
+        [](int j) { return (robot::kModelErrorBounds.*End).cou[j] + (robot::kModelErrorBounds.*End).sti[j]; });
     return c == 0 ? kVis[i] : kBreakaway[i];
   }
   template <class F>

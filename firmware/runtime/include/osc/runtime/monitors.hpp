@@ -262,7 +262,10 @@ template <class S>
 struct ResidualConstants {
   // The friction band per coefficient as its middle and half-width: theta^'s farthest distance from
   // the band is |theta^ - mid| + half.
-  S vis_mid[kDof], vis_half[kDof], cou_mid[kDof], cou_half[kDof], sti_mid[kDof], sti_half[kDof];
+  S vis_mid[kDof], vis_half[kDof], sti_mid[kDof], sti_half[kDof];
+  // The Coulomb band's ends, and the Stribeck band's lower end: a breakaway proven at B puts the
+  // Coulomb level at most B - sti_lo.
+  S cou_lo[kDof], cou_hi[kDof], sti_lo[kDof];
   S vis_hi[kDof];          // the viscous band's upper end [N m s/rad]
   S static_band[kDof];     // the Coulomb and Stribeck bands' upper ends together [N m]
   S static_lo[kDof];       // ... their lower ends, the least breakaway torque, over kResidualMargin [N m]
@@ -281,10 +284,11 @@ struct ResidualConstants {
   constexpr ResidualConstants()
       : vis_mid{},
         vis_half{},
-        cou_mid{},
-        cou_half{},
         sti_mid{},
         sti_half{},
+        cou_lo{},
+        cou_hi{},
+        sti_lo{},
         vis_hi{},
         static_band{},
         static_lo{},
@@ -307,7 +311,7 @@ struct ResidualConstants {
     const FrictionCoefficients &lo = b.friction_lo, &hi = b.friction_hi;
     for (int i = 0; i < kDof; ++i) {
       vis_mid[i] = lit<S>(0.5 * (lo.vis[i] + hi.vis[i])), vis_half[i] = lit<S>(0.5 * (hi.vis[i] - lo.vis[i]));
-      cou_mid[i] = lit<S>(0.5 * (lo.cou[i] + hi.cou[i])), cou_half[i] = lit<S>(0.5 * (hi.cou[i] - lo.cou[i]));
+      cou_lo[i] = lit<S>(lo.cou[i]), cou_hi[i] = lit<S>(hi.cou[i]), sti_lo[i] = lit<S>(lo.sti[i]);
       sti_mid[i] = lit<S>(0.5 * (lo.sti[i] + hi.sti[i])), sti_half[i] = lit<S>(0.5 * (hi.sti[i] - lo.sti[i]));
       vis_hi[i] = lit<S>(hi.vis[i]);
       static_band[i] = lit<S>(hi.cou[i] + hi.sti[i]);
@@ -385,28 +389,31 @@ struct ResidualMonitor {
     bool sliding;  // ... and counting fast enough that its friction is on the model's curve
   };
 
-  Vec6<S> r;                             // the residual [N m]
-  Vec6<S> bound;                         // the model-error bound's filtered pointwise terms [N m]
-  Vec6<S> acc;                           // the joint accelerations, filtered as r [rad/s^2]
-  Vec6<S> threshold;                     // this tick's thresholds [N m]
-  Vec6<S> d;                             // the change residual r - r_slow [N m]
-  Vec6<S> change_threshold;              // its thresholds [N m]
-  Vec6<S> r_slow, acc_slow;              // r and acc through the slow filter (params::kResidualSlowGain)
-  Vec6<S> reg[kRegressors];              // the regressors filtered as r
-  Vec6<S> reg_slow[kRegressors];         // ... then slowly
-  Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
-  Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
-  Vec6<S> velocity_noise;                // set-up: the velocity estimate's quantisation noise per joint [rad/s]
-  Vec6<S> cross_friction;                // set-up: the other motors' static friction a coupling adds [N m]
-  S k_max, lag;                          // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
-  Vec6<S> peak_ratio;                    // the largest |r| / threshold seen per joint
-  EncoderActivity activity;              // each encoder's changes
-  std::uint8_t over[kDof];               // consecutive ticks beyond the threshold
-  std::uint64_t over_since[kDof];        // the tick the current run of them began
-  std::uint32_t detected;                // the first detection's fault (kept while not armed too)
-  std::uint64_t detected_tick;           // ... its tick
-  std::int8_t joint;                     // ... its joint (0-based), -1 none
-  bool primed;                           // a previous step is on record
+  Vec6<S> r;                                 // the residual [N m]
+  Vec6<S> bound;                             // the model-error bound's filtered pointwise terms [N m]
+  Vec6<S> acc;                               // the joint accelerations, filtered as r [rad/s^2]
+  Vec6<S> threshold;                         // this tick's thresholds [N m]
+  Vec6<S> d;                                 // the change residual r - r_slow [N m]
+  Vec6<S> change_threshold;                  // its thresholds [N m]
+  Vec6<S> r_slow, acc_slow;                  // r and acc through the slow filter (params::kResidualSlowGain)
+  Vec6<S> reg[kRegressors];                  // the regressors filtered as r
+  Vec6<S> reg_slow[kRegressors];             // ... then slowly
+  Vec6<S> stillness;                         // 1 while a joint does not move, then decaying at the slow rate
+  Vec6<S> qd_prev, bias_prev, tau_prev;      // the previous step's q^dot and n, the torque applied since
+  Vec6<S> velocity_noise;                    // set-up: the velocity estimate's quantisation noise per joint [rad/s]
+  Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
+  /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
+  /// in contact, |r| as it was when the contact began (note_contact()) [N m].
+  Vec6<S> error_floor = Vec6<S>::Zero();
+  S k_max, lag;                    // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
+  Vec6<S> peak_ratio;              // the largest |r| / threshold seen per joint
+  EncoderActivity activity;        // each encoder's changes
+  std::uint8_t over[kDof];         // consecutive ticks beyond the threshold
+  std::uint64_t over_since[kDof];  // the tick the current run of them began
+  std::uint32_t detected;          // the first detection's fault (kept while not armed too)
+  std::uint64_t detected_tick;     // ... its tick
+  std::int8_t joint;               // ... its joint (0-based), -1 none
+  bool primed;                     // a previous step is on record
   /// Its detections are faults, in place of StuckEncoderMonitor's (else only recorded).
   bool armed = params::kResidualMonitorArmed;
   /// The user's collision thresholds [N m] (ControlTask::set_collision): a collision is reported
@@ -440,6 +447,7 @@ struct ResidualMonitor {
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
+  bool contact_noted = false;  // the contact error_floor holds (note_contact())
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
   /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
@@ -460,6 +468,7 @@ struct ResidualMonitor {
         if (c != i && inverse[i][c] != 0) alone = false;
       }
       cross_friction(i) = lit<S>(cross);
+      error_floor(i) = rest_floor(i);
       travel_limit(i) = alone ? lit<S>(params::kResidualTravelCounts) * quantum(i) : S(0);
       spacing_lo(i) = lit<S>(1 - 2 * b.encoder_edge) * quantum(i);
       spacing_hi(i) = lit<S>(1 + 2 * b.encoder_edge) * quantum(i);
@@ -485,6 +494,30 @@ struct ResidualMonitor {
     detected = 0;
     detected_tick = 0;
     primed = false;
+    contact_noted = false;
+    for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
+  }
+  /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
+  S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }
+  /// The contact the task reports (contact) began or ended. Its push, which the model does not know,
+  /// stays in r while it lasts and would be judged against thresholds meant for the model's error (a
+  /// firm push on a yielding arm named a drive_fault). When it begins, each joint's floor, its
+  /// filtered bound and the slow filter take |r| and r as they are: the absolute channel holds the
+  /// push as noted, and the change channel judges what changes after it. When it ends, the floors drop
+  /// back, and the bound decays at the filter's rate.
+  void note_contact() {
+    contact_noted = contact;
+    for (int i = 0; i < kDof; ++i) {
+      if (!contact) {
+        error_floor(i) = rest_floor(i);
+        continue;
+      }
+      const S push = math::abs(r(i));
+      error_floor(i) = rest_floor(i) + push;
+      bound(i) += push;
+      r_slow(i) = r(i);
+      d(i) = S(0);
+    }
   }
   /// The next step starts afresh (a tick without a step: the torque was off).
   void unprime() { primed = false; }
@@ -499,6 +532,7 @@ struct ResidualMonitor {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     activity.track(counts, moved, tick);
     sample.settled = false;
+    if (contact != contact_noted) note_contact();
     const bool prime = !primed;  // the first step after a reset: no previous step to difference
     if (prime) {
       qd_prev = in.qd;
@@ -514,7 +548,8 @@ struct ResidualMonitor {
     for (int i = 0; i < kDof; ++i) {
       const Friction f = strongest(i);
       const FrictionError e = friction_error(in, f, i, tick, m.moving_speed[i]);
-      const S model = model_error(in, i);
+      const Torques t = torques(in, i);
+      const S model = model_error(in, t, i);
       const S b = pointwise_bound(in, e, i, model);
       Changes ch{};
       if (prime) {
@@ -524,10 +559,10 @@ struct ResidualMonitor {
         r(i) = math::mul_add(c.gain[i], math::mul_add(kDt, bias_prev(i) - tau_prev(i), m.u[i]), c.keep[i] * r(i));
         low_pass(bound(i), b, c.gain_dt[i]);
         if (i == sample_joint) take_sample(i, e);
-        ch = update_change(in, e, i);
+        ch = update_change(in, e, t, i);
       }
-      update_thresholds(e, ch, m, i);
-      if (travel(in, m, f, i, model, moved[i], prime || contact, tick)) moved_too_far = i;
+      const S loop = update_thresholds(e, ch, m, i);
+      if (travel(in, m, f, i, model, loop, moved[i], prime || contact, tick)) moved_too_far = i;
       qd_prev(i) = in.qd(i);
       bias_prev(i) = in.bias(i);
       if (prime) {
@@ -675,7 +710,11 @@ struct ResidualMonitor {
       e.th_v = e.th_c = e.th_s = S(0);
     }
     e.dv = abs(e.th_v - c.vis_mid[i]) + c.vis_half[i];
-    e.dc = abs(e.th_c - c.cou_mid[i]) + c.cou_half[i];
+    // Coulomb's level lies within its band and below the strongest breakaway less the least Stribeck
+    // level (the identification's proven breakaway narrows it; the band's top leaves it as it is).
+    const S cap = f.breakaway - c.sti_lo[i], cou_top = cap < c.cou_hi[i] ? cap : c.cou_hi[i];
+    const S below = e.th_c - c.cou_lo[i], above = cou_top - e.th_c;
+    e.dc = below > above ? below : above;
     e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
     // Static friction anywhere within the band (its top, or what the identification proves), against
     // whatever the estimate says.
@@ -700,15 +739,22 @@ struct ResidualMonitor {
                                  : e.still;
     return friction + model;
   }
+  /// Joint i's Coriolis torque c = n - g - tau_f^ and the applied torque's size |tau|, which the
+  /// bound and the change channel both take: computed once a joint.
+  struct Torques {
+    S coriolis, size;
+  };
+  Torques torques(const ResidualInput<S>& in, int i) const {
+    return Torques{in.bias(i) - in.g(i) - in.tau_f(i), math::abs(tau_prev(i))};
+  }
   /// Joint i's bound on the unexplained torque besides friction and the inertias: the link
   /// inertia's share of gravity and Coriolis torques, the amplifier's gain, ripple and offset, and
-  /// the coupled motors' friction.
-  S model_error(const ResidualInput<S>& in, int i) const {
+  /// the coupled motors' friction (error_floor, with a contact's push while it lasts).
+  S model_error(const ResidualInput<S>& in, const Torques& t, int i) const {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::mul_add;
-    const S coriolis = in.bias(i) - in.g(i) - in.tau_f(i);
-    return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(coriolis),
-                   mul_add(c.gain_ripple, math::abs(tau_prev(i)), cross_friction(i) + c.offset[i]));
+    return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(t.coriolis),
+                   mul_add(c.gain_ripple, t.size, error_floor(i)));
   }
   /// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
   /// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
@@ -716,7 +762,7 @@ struct ResidualMonitor {
   /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
   /// anything within its static band, from one end to the other (twice the band), and keeps it in
   /// the change threshold until the slow filter forgets it.
-  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, int i) {
+  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t, int i) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     const S Ks = c.slow_dt, Kdt = c.gain_dt[i];
     const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
@@ -732,9 +778,9 @@ struct ResidualMonitor {
     ch.sti = band(kSti, sign * in.decay(i));
     ch.estimate = band(kEstimate, in.tau_f(i));
     ch.gravity = band(kGravity, in.g(i));
-    ch.coriolis = band(kCoriolis, in.bias(i) - in.g(i) - in.tau_f(i));
+    ch.coriolis = band(kCoriolis, t.coriolis);
     ch.torque = band(kTorque, tau_prev(i));
-    low_pass(reg[kTorqueSize](i), math::abs(tau_prev(i)), Kdt);  // |tau|: its size alone
+    low_pass(reg[kTorqueSize](i), t.size, Kdt);  // |tau|: its size alone
     low_pass(r_slow(i), r(i), Ks);
     d(i) = r(i) - r_slow(i);
     stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
@@ -742,8 +788,8 @@ struct ResidualMonitor {
   }
   /// Joint i's thresholds: the filtered bound, the inertias' error on the filtered accelerations, and
   /// the velocity estimate's noise through A and the filter. `ch`: the regressors' changes (zero
-  /// when priming).
-  void update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i) {
+  /// when priming). Returns the current loop's lag term (the travel check's too).
+  S update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::abs;
     using math::mul_add;
@@ -763,6 +809,7 @@ struct ResidualMonitor {
                             c.armature_delta[i] * m.da[i]);
     const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
     change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
+    return loop;
   }
   /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
   /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
@@ -777,9 +824,9 @@ struct ResidualMonitor {
   /// identification proves: `f`), over the diagonal inertia at its least or most, bounds its speed that way from
   /// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
   /// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
-  /// bounded.
-  bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, bool count, bool restart,
-              std::uint64_t tick) {
+  /// bounded. `model` and `loop`: model_error()'s and update_thresholds()' terms of this joint.
+  bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, S loop, bool count,
+              bool restart, std::uint64_t tick) {
     const ResidualConstants<S>& c = kResidualConstants<S>;
     using math::abs;
     using math::mul_add;
@@ -807,7 +854,6 @@ struct ResidualMonitor {
     ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
     const S aii = in.A(i, i);
     const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
-    const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
     const S error = mul_add(c.link_inertia, others, others) + model + loop;
     const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
     if (count) {
