@@ -78,29 +78,26 @@ assert got == [("enable", None, True), ("move_to", "not_homed", False), ("home",
 PY
   ;;
 real_arm)  # docs/experiment.md, "The paper's motion from other poses": from power-on pose 5 the paper's
-  # gains make the realistic wrist vibrate at about 28 Hz, which the velocity estimate does not follow.
-  # With the robust law a monitor stops it. With the default (momentum) law it still shows in the
-  # residual monitor's ratios, J4's or J6's over the design line of 0.5 (docs/safety.md, residual_homed;
-  # whether it also qualifies as a fault is not asserted: J6 peaks at 1.05 for under three ticks).
-  # examples/real_arm.yaml's gains (the observer's rotational k doubled) run clean, every ratio within 0.5.
+  # gains make the realistic wrist vibrate (about 28 Hz, J4 and J6 counter-rotating). No run faults:
+  # the velocity estimate's error there is within the bound of its noise through the observer's
+  # mixing (docs/safety.md, "The wrist's velocity noise"). With the robust law the vibration still shows
+  # in J4's or J6's ratio over the design line of 0.5; with the default (momentum) law and with
+  # examples/real_arm.yaml's gains (the observer's rotational k doubled) every ratio is within 0.5.
   run() {
     "$exe" --plant realistic --motion "$examples/home_then_paper.yaml" --set plant.power_on_pose=random:5 \
       --set run.residual_monitor=on --json "$d/$1.json" "${@:2}" >"$d/$1.txt" 2>&1
   }
-  run paper --adaptation robust
-  rc=$?
-  test $rc -eq 1 || fail "exit $rc, not 1 (a fault): $(cat "$d/paper.txt")"
-  run default
-  rc=$?
-  test $rc -le 1 || fail "exit $rc: $(cat "$d/default.txt")"
+  run paper --adaptation robust || fail "exit $?: $(cat "$d/paper.txt")"
+  run default || fail "exit $?: $(cat "$d/default.txt")"
   run real --config "$examples/real_arm.yaml" || fail "exit $?: $(cat "$d/real.txt")"
   "$py" - "$d/paper.json" "$d/default.json" "$d/real.json" <<'PY' || fail "$(cat "$d/paper.txt" "$d/default.txt" "$d/real.txt")"
 import json, sys
 paper, default, real = (json.load(open(f)) for f in sys.argv[1:])
-assert paper["faults"] in (["collision"], ["drive_fault"]), paper["faults"]
-vibration = max(default["residual_monitor"]["peak_ratio"][3:6:2])  # J4, J6
-assert vibration > 0.5, default["residual_monitor"]
-assert real["faults"] == [], real["faults"]
+for run in (paper, default, real):
+    assert run["faults"] == [], run["faults"]
+vibration = max(paper["residual_monitor"]["peak_ratio"][3:6:2])  # J4, J6
+assert vibration > 0.5, paper["residual_monitor"]
+assert max(default["residual_monitor"]["peak_ratio"]) <= 0.5, default["residual_monitor"]
 assert max(real["residual_monitor"]["peak_ratio"]) <= 0.5, real["residual_monitor"]
 assert [(c["cmd"], c["refused"]) for c in real["commands"]][:3] == [("enable", None), ("home", None), ("paper", None)]
 PY

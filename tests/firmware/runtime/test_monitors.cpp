@@ -819,6 +819,48 @@ TYPED_TEST(Monitors, AStillJointsThresholdsTakeTheIdentifiedBand) {
   }
 }
 
+// The wrist's velocity noise (ResidualMonitor::wrist_noise; docs/safety.md): the observer's estimate
+// carries the encoders' quantisation e as J^-1 diag(k) J e. Against that matrix, solved by Eigen's LU at
+// random poses (q5 from 0.06 rad to pi - 0.06), the monitor's noise bound covers every joint's worst
+// case sum_j |(J^-1 diag(k) J)_ij| delta_j / 2; on J4 and J6, where |sin q5| < 0.3 and the mixing
+// dominates, within kLoose times it (the bound takes the worst direction of the arm's rotation, which
+// at some poses lies along z5, where it is not amplified).
+TEST(Residual, TheWristsVelocityNoiseCoversTheObserversMixing) {
+  ResidualRig<double> rig;
+  const Vec6<double> k = Gains<double>::paper().k;
+  Mat6<double> Dk = k.asDiagonal();
+  std::mt19937 rng(7);
+  Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  double widest = 0, loosest = 0;
+  constexpr double kLoose = 10;  // measured 8.9: the bound takes the worst direction of J_21 e_arm
+  for (int n = 0; n < 200; ++n) {
+    Vec6<double> q;
+    for (int i = 0; i < kDof; ++i)
+      q(i) = std::uniform_real_distribution<double>(robot::kArm.q_min[i], robot::kArm.q_max[i])(rng);
+    const double s5 = std::abs(std::sin(q(4)));
+    if (s5 < std::sin(0.06)) continue;
+    forward_kinematics(model, data, q);
+    geometric_jacobian(data);
+    const Mat6<double> M = data.J.partialPivLu().solve(Dk * data.J);
+    rig.m.wrist_noise(data.J);
+    for (int i = 0; i < kDof; ++i) {
+      double exact = 0;
+      for (int j = 0; j < kDof; ++j) exact += std::abs(M(i, j)) * 0.5 / counts_per_rad(j);
+      EXPECT_GE(rig.m.velocity_noise(i), exact * (1 - 1e-9)) << "J" << i + 1 << " q5 " << q(4);
+      if (i == 3 || i == 5) {
+        if (s5 < 0.3) {
+          loosest = std::max(loosest, rig.m.velocity_noise(i) / exact);
+          EXPECT_LE(rig.m.velocity_noise(i), kLoose * exact) << "J" << i + 1 << " q5 " << q(4);
+        }
+        widest = std::max(widest, rig.m.velocity_noise(i) / rig.m.noise_base(i));
+      }
+    }
+  }
+  EXPECT_GT(widest, 10) << "some pose near the wrist singularity, where the mixing dominates";
+  std::printf("wrist noise bound / exact, |sin q5| < 0.3: at most %.2f\n", loosest);
+}
+
 // The identified band narrows a sliding joint's Coulomb interval (docs/safety.md, "The identified
 // band"): its Coulomb level is within the band and at most the proven breakaway less the Stribeck
 // band's least, so with theta^ = 0 each absolute threshold shrinks by kResidualMargin times the peak

@@ -332,7 +332,8 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             ad.qd_hat_prev,
                             decay,
                             adaptive ? &ad.theta_hat : nullptr,
-                            identify ? &task.identifier.proven : nullptr};
+                            identify ? &task.identifier.proven : nullptr,
+                            &task.state.data.J};
   task.residual.sample_joint = identify ? task.identifier.take_turn() : -1;
   task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick);

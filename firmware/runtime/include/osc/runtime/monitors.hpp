@@ -353,6 +353,10 @@ struct ResidualInput {
   /// The friction the identification proves (FrictionIdentifier::proven; the travel check's), or
   /// nullptr: the band's tops.
   const FrictionBounds<S>* proven = nullptr;
+  /// The geometric Jacobian of the wrist centre (Data::J), whose wrist columns carry the wrist's axes:
+  /// the velocity estimate's noise on the wrist (ResidualMonitor::wrist_noise), or nullptr: none
+  /// (a velocity that is not the observer's).
+  const Mat6<S>* J = nullptr;
 };
 
 /// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone;
@@ -389,18 +393,20 @@ struct ResidualMonitor {
     bool sliding;  // ... and counting fast enough that its friction is on the model's curve
   };
 
-  Vec6<S> r;                                 // the residual [N m]
-  Vec6<S> bound;                             // the model-error bound's filtered pointwise terms [N m]
-  Vec6<S> acc;                               // the joint accelerations, filtered as r [rad/s^2]
-  Vec6<S> threshold;                         // this tick's thresholds [N m]
-  Vec6<S> d;                                 // the change residual r - r_slow [N m]
-  Vec6<S> change_threshold;                  // its thresholds [N m]
-  Vec6<S> r_slow, acc_slow;                  // r and acc through the slow filter (params::kResidualSlowGain)
-  Vec6<S> reg[kRegressors];                  // the regressors filtered as r
-  Vec6<S> reg_slow[kRegressors];             // ... then slowly
-  Vec6<S> stillness;                         // 1 while a joint does not move, then decaying at the slow rate
-  Vec6<S> qd_prev, bias_prev, tau_prev;      // the previous step's q^dot and n, the torque applied since
-  Vec6<S> velocity_noise;                    // set-up: the velocity estimate's quantisation noise per joint [rad/s]
+  Vec6<S> r;                             // the residual [N m]
+  Vec6<S> bound;                         // the model-error bound's filtered pointwise terms [N m]
+  Vec6<S> acc;                           // the joint accelerations, filtered as r [rad/s^2]
+  Vec6<S> threshold;                     // this tick's thresholds [N m]
+  Vec6<S> d;                             // the change residual r - r_slow [N m]
+  Vec6<S> change_threshold;              // its thresholds [N m]
+  Vec6<S> r_slow, acc_slow;              // r and acc through the slow filter (params::kResidualSlowGain)
+  Vec6<S> reg[kRegressors];              // the regressors filtered as r
+  Vec6<S> reg_slow[kRegressors];         // ... then slowly
+  Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
+  Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
+  Vec6<S> velocity_noise;                // the velocity estimate's quantisation noise per joint [rad/s] (wrist_noise())
+  Vec6<S> noise_base;  // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
+  S wrist_mix;         // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
   Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
   /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
   /// in contact, |r| as it was when the contact began (note_contact()) [N m].
@@ -458,7 +464,9 @@ struct ResidualMonitor {
   void set(const Vec6<S>& quantum, const Vec6<S>& k, const double (&inverse)[kDof][kDof]) {
     k_max = k.maxCoeff();
     lag = S(1) / k.minCoeff();
-    velocity_noise = (lit<S>(0.5) * k_max) * quantum;
+    wrist_mix = lit<S>(0.5) * (k_max - k.minCoeff()) * (quantum(0) + quantum(1) + quantum(2));
+    velocity_noise = noise_base = (lit<S>(0.5) * k_max) * quantum;
+    velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share of the arm's (wrist_noise())
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       double cross = 0;
@@ -497,6 +505,25 @@ struct ResidualMonitor {
     contact_noted = false;
     for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
   }
+  /// The velocity estimate's noise on the wrist, this step. The observer's q^dot = J^-1 (y + k x~)
+  /// carries the encoders' quantisation e (x~'s share J e) as J^-1 diag(k) J e. With the operational
+  /// point at the wrist centre J is block-triangular, [J_11 0; J_21 J_22], and with equal gains per
+  /// block (k_t, k_r) the arm's rows are k_t e_arm, the wrist's k_r e_wrist + (k_r - k_t) J_22^-1 J_21
+  /// e_arm: an arm joint's quantum turns the wrist. J_21 e_arm is a rotation of at most the arm's
+  /// quanta summed; J_22^-1 splits it over the wrist's axes, J5's share at most that, J4's and J6's
+  /// at most that over |sin q5| (their axes are q5 apart: the dual basis of the plane they span has
+  /// norm 1 / |sin q5|). J5's share does not change: set() adds it once. Near the wrist singularity that is 20 times
+  /// J4's own noise (q5 = 0.08 rad: the 200-move sweep's J4 at 0.91 of its change threshold). |sin q5| is floored at
+  /// kWristSinFloor (2.9 degrees: 20 times the arm's share). Other gains: their spread, max k - min k.
+  void wrist_noise(const Mat6<S>& J) {
+    static constexpr double kWristSinFloor = 0.05;
+    static constexpr S kFloor = lit<S>(kWristSinFloor), kFloorSquared = lit<S>(kWristSinFloor * kWristSinFloor);
+    const S c5 = J(3, 3) * J(3, 5) + J(4, 3) * J(4, 5) + J(5, 3) * J(5, 5);  // z4 . z6 = cos q5
+    const S s2 = S(1) - c5 * c5;                                             // sin^2 q5
+    const S turn = wrist_mix / (s2 > kFloorSquared ? math::sqrt(s2) : kFloor);
+    velocity_noise(3) = noise_base(3) + turn;
+    velocity_noise(5) = noise_base(5) + turn;
+  }
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
   S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }
   /// The contact the task reports (contact) began or ended. Its push, which the model does not know,
@@ -533,6 +560,7 @@ struct ResidualMonitor {
     activity.track(counts, moved, tick);
     sample.settled = false;
     if (contact != contact_noted) note_contact();
+    if (in.J) wrist_noise(*in.J);
     const bool prime = !primed;  // the first step after a reset: no previous step to difference
     if (prime) {
       qd_prev = in.qd;
@@ -653,15 +681,17 @@ struct ResidualMonitor {
   /// the friction in r is the last period's (n_{k-1}). Settled: moving, its encoder counting, since
   /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
   /// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
-  /// noise is a share of the viscous column, and its errors in the variables a bias).
+  /// noise is a share of the viscous column, and its errors in the variables a bias): its own row's,
+  /// noise_base, without the wrist's mixing (wrist_noise()), which would leave the paper's slow wrist
+  /// motion to its few fast samples: J4's Coulomb / Stribeck split learnt from them, J4's and J6's
+  /// residuals reached 0.42 and 0.53 of their thresholds on the paper's motion (0.29 with this).
   void take_sample(int i, const FrictionError& e) {
     static constexpr std::array<S, kDof> kSettled = settled_stillness();
     sample.y = reg[kEstimate](i) - r(i);
     sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
     sample.gravity = reg[kGravity](i);
     static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
-    sample.settled =
-        e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * velocity_noise(i);
+    sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * noise_base(i);
   }
   /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
   static constexpr std::array<S, kDof> settled_stillness() {
