@@ -56,6 +56,12 @@ class ContactRun {
     return f;
   }
   double now() const { return static_cast<double>(k_) * params::kDt; }
+  /// Runs until the task yields, or 100 ms after the contact; the faults of those ticks.
+  std::uint32_t until_yielding() {
+    std::uint32_t f = 0;
+    while (task_->machine.state != MotionState::kYielding && now() < kContactAt + 0.1) f |= tick();
+    return f;
+  }
   V3 tip() {
     forward_kinematics(model_, data_, plant_.q());
     return data_.o[kDof];
@@ -120,8 +126,7 @@ TEST(CollisionReaction, CategoryTwoStopsAlongThePathAndHoldsWithoutAFault) {
 TEST(CollisionReaction, YieldGivesWayToTheForceUntilAStopHoldsThePoseReached) {
   ContactRun run(CollisionReaction::kYield, kDown);
   ASSERT_EQ(run.run_to(kContactAt), 0u);
-  std::uint32_t faults = 0;
-  while (run.task().machine.state != MotionState::kYielding && run.now() < kContactAt + 0.1) faults |= run.tick();
+  const std::uint32_t faults = run.until_yielding();
   EXPECT_EQ(faults, 0u) << fault_name(faults);
   ASSERT_EQ(run.task().machine.state, MotionState::kYielding);
   EXPECT_LE(run.now() - kContactAt, 0.020);
@@ -153,8 +158,7 @@ TEST(CollisionReaction, YieldHoldsAFirmPushThatLasts) {
     SCOPED_TRACE(testing::Message() << "force " << force.transpose() << " N");
     ContactRun run(CollisionReaction::kYield, force);
     ASSERT_EQ(run.run_to(kContactAt), 0u);
-    std::uint32_t faults = 0;
-    while (run.task().machine.state != MotionState::kYielding && run.now() < kContactAt + 0.1) faults |= run.tick();
+    std::uint32_t faults = run.until_yielding();
     EXPECT_EQ(faults, 0u) << fault_name(faults);
     ASSERT_EQ(run.task().machine.state, MotionState::kYielding);
     EXPECT_LE(run.now() - kContactAt, force.z() != 0 ? 0.020 : 0.045);

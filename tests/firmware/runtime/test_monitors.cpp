@@ -410,8 +410,9 @@ TYPED_TEST(Monitors, TheChangeResidualIsTheResidualLessItsSlowPart) {
 /// torque that drives the arm is what was commanded less `ext`), for 2 s: long enough for the
 /// static band to leave the change channel.
 template <class S>
-ResidualRig<S> moving_rig() {
+ResidualRig<S> moving_rig(const FrictionBounds<S>* proven = nullptr) {
   ResidualRig<S> rig;
+  rig.proven = proven;
   rig.m.armed = true;
   rig.qd.setConstant(0.5);
   const bool all[kDof] = {true, true, true, true, true, true};
@@ -876,16 +877,7 @@ TYPED_TEST(Monitors, ASlidingJointsThresholdsTakeTheIdentifiedBand) {
     proven.vis(i) = lit<S>(hi.vis[i]);
     proven.breakaway(i) = lit<S>(1.1 * (paper.cou[i] + paper.sti[i]));
   }
-  const auto moving = [&](const FrictionBounds<S>* band) {
-    ResidualRig<S> rig;
-    rig.proven = band;
-    rig.m.armed = true;
-    rig.qd.setConstant(0.5);
-    const bool all[kDof] = {true, true, true, true, true, true};
-    for (int n = 0; n < 2000; ++n) EXPECT_EQ(rig.step(Vec6<double>::Zero(), all, false), 0u) << n;
-    return rig;
-  };
-  const ResidualRig<S> top = moving(nullptr), identified = moving(&proven);
+  const ResidualRig<S> top = moving_rig<S>(), identified = moving_rig<S>(&proven);
   for (int j : {0, 2}) {
     const double cou_top = std::min(hi.cou[j], static_cast<double>(proven.breakaway(j)) - lo.sti[j]);
     const double narrower = params::kResidualMargin * params::kResidualPeakFactor[j] * (hi.cou[j] - cou_top);
