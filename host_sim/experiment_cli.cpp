@@ -56,14 +56,6 @@ struct Parsed {
   std::string pil_link;
 };
 
-/// --inject's help, its kinds from SIM_INJECTION_LIST.
-std::string inject_help() {
-  std::string kinds;
-  for (const InjectionInfo& k : kInjections) kinds += std::string(kinds.empty() ? "" : " | ") + k.name + syntax(k.form);
-  return "inject a fault of the simulated hardware, or a contact at the tip, at S seconds: " + kinds +
-         " (JOINT 1..6, default every joint; DIR +x -x +y -y +z -z, base frame; docs/safety.md)";
-}
-
 void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vector<std::string>>& values) {
   app.description(
       "The paper's experiment (Section VI) on the simulated PUMA 560, with adaptive friction compensation and "

@@ -142,4 +142,11 @@ std::string to_string(const Injection& inj) {
   return s + '@' + shortest(inj.at);
 }
 
+std::string inject_help() {
+  std::string kinds;
+  for (const InjectionInfo& k : kInjections) kinds += std::string(kinds.empty() ? "" : " | ") + k.name + syntax(k.form);
+  return "inject a fault of the simulated hardware, or a contact at the tip, at S seconds: " + kinds +
+         " (JOINT 1..6, default every joint; DIR +x -x +y -y +z -z, base frame; docs/safety.md)";
+}
+
 }  // namespace sim

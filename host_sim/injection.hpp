@@ -87,4 +87,7 @@ bool parse_injection(const std::string& text, Injection& out, std::string& err);
 /// its shortest form that reads back to the same value).
 std::string to_string(const Injection& inj);
 
+/// --inject's help (puma_experiment, osc_sim), its kinds from SIM_INJECTION_LIST.
+std::string inject_help();
+
 }  // namespace sim

@@ -332,8 +332,8 @@ class HostArm {
     return [this](const std::uint8_t* b, int n) {
       for (int i = 0; i < n; ++i) {
         pil::AnswerFrame a;
-        if (parser_.feed(b[i]) == pil::Parser::kFrame && parser_.decode(a))
-          reports_.push_back(osc::report_from_frame(a));
+        for (pil::Parser::Result r = parser_.feed(b[i]); r != pil::Parser::kPending; r = parser_.next())
+          if (r == pil::Parser::kFrame && parser_.decode(a)) reports_.push_back(osc::report_from_frame(a));
       }
     };
   }

@@ -20,8 +20,13 @@ namespace sim {
 
 RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, int len, int& pos, FirmwareFrame& f,
                               pil::LinkCounters& counters, std::string& err) {
-  while (pos < len) {
-    const pil::Parser::Result r = parser.feed(bytes[pos++]);
+  // The events of the bytes already fed first (parser.next()), then the next byte.
+  for (;;) {
+    pil::Parser::Result r = parser.next();
+    if (r == pil::Parser::kPending) {
+      if (pos >= len) break;
+      r = parser.feed(bytes[pos++]);
+    }
     switch (r) {
       case pil::Parser::kPending:
         break;
@@ -38,10 +43,12 @@ RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
       case pil::Parser::kBadChecksum:
       case pil::Parser::kBadHeader:
       case pil::Parser::kBadLength:
+      case pil::Parser::kShortFrame:
         ++counters[pil::Parser::error_of(r)];
         return err = r == pil::Parser::kBadChecksum ? "corrupted actuator frame (checksum mismatch)"
                      : r == pil::Parser::kBadHeader ? "corrupted actuator frame (bad header: unknown type)"
-                                                    : "corrupted actuator frame (bad header: wrong length)",
+                     : r == pil::Parser::kBadLength ? "corrupted actuator frame (bad header: wrong length)"
+                                                    : "actuator frame cut short",
                RxResult::kError;
     }
   }

@@ -46,13 +46,12 @@ int main() {
     pollfd p{STDIN_FILENO, POLLIN, 0};
     const int r = poll(&p, 1, timeout_ms);
     if (r == 0) {
-      node->on_timeout();
-      node->tick();
+      node->on_timeout([&] { node->tick(); });
       continue;
     }
     std::uint8_t b;
     const ssize_t n = read(STDIN_FILENO, &b, 1);
     if (n <= 0) return 0;  // host closed the link
-    if (node->on_byte(b)) node->tick();
+    node->on_byte(b, [&] { node->tick(); });
   }
 }

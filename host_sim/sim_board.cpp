@@ -10,6 +10,12 @@
 //   pty: /dev/pts/7
 //   $ oscctl --port /dev/pts/7 enable
 //
+// As a board whose encoders are local, it stops a motion when the client's link is silent for
+// params::kCommandLinkTimeout (link_silent; --no-link-watch turns that off), cuts a frame short after
+// params::kFrameTimeout of silence within it and scans its bytes again (pil::Parser), and counts the
+// link's errors into the state frames (field link). --inject KIND[:ARGS]@S injects a simulated
+// hardware fault or contact (injection.hpp), so that a client's fault handling can be tested.
+//
 // A tick that starts more than a period after its deadline is an overrun: the loop catches up
 // without sleeping (at most kMaxCatchUpNs of wall time behind; further behind, the schedule
 // restarts from now: a slip) and counts them; the counts are printed at exit. SIGINT and SIGTERM
@@ -42,6 +48,8 @@
 #include <vector>
 
 #include "cli_parse.hpp"
+#include "experiment_cli.hpp"  // qemu_takes
+#include "injection.hpp"
 #include "linked_arm.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
@@ -65,6 +73,8 @@ struct Options {
   double speed = 1;
   bool qemu = false;
   std::string elf = OSC_DEFAULT_PIL_ELF;  // the image puma_experiment --qemu runs by default
+  std::string inject;                     // KIND[:ARGS]@S (injection.hpp)
+  bool no_link_watch = false;             // the command link's silence does not stop a motion
 };
 
 /// The master side of a pseudo-terminal whose slave is in raw mode. Frames are written whole or not
@@ -182,30 +192,44 @@ double wall_seconds() {
 }
 
 /// The controller in process: the firmware's control task over the simulated arm (MotionSim), the
-/// client's frames through its command port.
+/// client's frames through its command port, and a board's command-link watch (CommandLinkWatch: a
+/// motion running after params::kCommandLinkTimeout without a frame from the client is stopped,
+/// link_silent), as on a board whose encoders are local; --no-link-watch turns it off.
 template <class S>
 class InProcessBoard {
  public:
-  InProcessBoard(const sim::Vec6& q0, int state_hz) : sim_(q0) {
+  InProcessBoard(const sim::Vec6& q0, int state_hz, const sim::Injection& inj, bool link_watch)
+      : sim_(q0, inj), link_watch_(link_watch) {
     port_.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / state_hz);
   }
   /// A complete frame from the client: a command or a setpoint is taken (true), any other type not.
+  /// Any valid frame keeps the command link alive.
   template <class Write>
   bool on_frame(const pil::Parser& p, Write&& write) {
+    watch_.heard();
     return port_.on_frame(sim_.task(), p, write);
   }
   /// One tick; its frames to write (an answer, a state frame when due).
   template <class Write>
   bool tick(Write&& write, std::string&) {
+    if (link_watch_) watch_.before_tick(sim_.task(), port_.commanded());
     sim_.tick();
     port_.after_tick_and_poll(sim_.task(), write);  // the tick's frames; the next command into the freed mailbox
     return true;
   }
-  bool report() const { return true; }
+  /// The counters of the client's link that the state frames carry.
+  pil::LinkCounters& link() { return port_.link; }
+  bool report() const {
+    std::fprintf(stderr, "osc_sim: command link watch %s: %u link_silent stop requests; %u resent commands\n",
+                 link_watch_ ? "on" : "off (--no-link-watch)", watch_.stops(), port_.resends);
+    return true;
+  }
 
  private:
   sim::MotionSim<S> sim_;
   osc::CommandPort<S> port_;
+  osc::CommandLinkWatch watch_;
+  bool link_watch_;
 };
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
@@ -246,10 +270,15 @@ class QemuBoard {
     if (!arm_.tick(view_, err)) return false;
     std::uint8_t buf[pil::kMaxFrame];
     for (const pil::AnswerFrame& f : arm_.replies().answers) write(buf, pil::encode(f, buf));
-    for (const pil::StateFrame& f : arm_.replies().states) write(buf, pil::encode(f, buf));
+    for (pil::StateFrame f : arm_.replies().states) {
+      f.link = link_;  // the client's link (this terminal's), not the image's PIL link
+      write(buf, pil::encode(f, buf));
+    }
     for (const pil::ParamAnswerFrame& f : arm_.replies().params) write(buf, pil::encode(f, buf));
     return true;
   }
+  /// The counters of the client's link that the state frames carry.
+  pil::LinkCounters& link() { return link_; }
   /// The link's health on stderr; whether it was clean.
   bool report() const {
     const sim::LinkReport r = arm_.link_report();
@@ -266,6 +295,7 @@ class QemuBoard {
   std::string elf_;
   std::string err_;  // a command or setpoint that could not be sent: the link is gone
   sim::TickView view_;
+  pil::LinkCounters link_;
 };
 
 /// Runs the board until the duration or a signal; prints the run's counts on stderr. Status 0, or 1
@@ -281,22 +311,33 @@ int serve(const Options& o, Board& board, PtyMaster& pty) {
   bool had_client = false;
   std::string err;
   const double t0 = wall_seconds();
+  double last_rx = t0;  // wall time of the last byte received
   for (; ticks < 0 || k < ticks; ++k) {
     if (!pacer.wait()) break;
     const bool client = pty.poll_client();
     if (client && !had_client) parser.reset();  // a new client: no half frame of the last one's
     had_client = client;
-    std::uint8_t buf[512];
-    for (int n; (n = pty.read(buf, sizeof buf)) > 0;)
-      for (int i = 0; i < n; ++i) {
-        const pil::Parser::Result r = parser.feed(buf[i]);
+    // Every event of the bytes received: frames to the board, errors counted for the client.
+    const auto take = [&](pil::Parser::Result r) {
+      for (; r != pil::Parser::kPending; r = parser.next()) {
         if (r == pil::Parser::kFrame) {
           ++frames;
           if (!board.on_frame(parser, write)) ++other_frames;
-        } else if (r != pil::Parser::kPending) {
+        } else {
           ++link_errors;
+          board.link()[pil::Parser::error_of(r)] +=
+              r == pil::Parser::kJunk ? static_cast<std::uint32_t>(parser.junk()) : 1u;
         }
       }
+    };
+    std::uint8_t buf[512];
+    const double now = wall_seconds();
+    for (int n; (n = pty.read(buf, sizeof buf)) > 0;) {
+      last_rx = now;
+      for (int i = 0; i < n; ++i) take(parser.feed(buf[i]));
+    }
+    // A frame begun and silent for the in-frame timeout (wall time): cut short, its bytes scanned again.
+    if (parser.in_frame() && now - last_rx >= osc::params::kFrameTimeout) take(parser.expire());
     if (!board.tick(write, err)) break;
     pty.flush();
   }
@@ -370,6 +411,15 @@ void build(CLI::App& app, Options& o) {
                "semihosting console), the arm simulated here; a lost link ends the run (status 1)");
   app.add_option("--elf", o.elf, "the firmware image for --qemu (default: the m4f build's pil_firmware.elf)")
       ->type_name("FILE");
+  app.add_option("--inject", o.inject,
+                 sim::inject_help() +
+                     "; S counts simulated seconds from the start (a way to test a client's fault "
+                     "handling; with --qemu the kinds the image's link carries)")
+      ->type_name("KIND[:ARGS]@S");
+  app.add_flag("--no-link-watch", o.no_link_watch,
+               "a motion goes on when the client's link is silent (by default, as on a board whose encoders are "
+               "local, a motion running 0.5 s without a frame from the client is stopped: link_silent); in process "
+               "only: with --qemu the image's link is the PIL link, and no command-link watch runs");
 }
 
 /// The options that the in-process controller and the image constrain differently; err on the first
@@ -380,10 +430,15 @@ bool check_options(const CLI::App& app, Options& o, sim::ExperimentConfig& cfg, 
     return err = "--state-hz " + std::to_string(o.state_hz) +
                  ": not 1000 / N for a whole N (1000, 500, 250, 200, 100, 50, ...)",
            false;
+  if (!o.inject.empty() || app.count("--inject") > 0)
+    if (!sim::parse_injection(o.inject, cfg.injection, err)) return err = "--inject: " + err, false;
   if (!o.qemu) {
     if (app.count("--elf") > 0) return err = "--elf applies with --qemu only", false;
     return start_pose(o, cfg.q_start, err);
   }
+  if (o.no_link_watch)
+    return err = "--no-link-watch applies in process only: with --qemu no command-link watch runs", false;
+  if (!sim::qemu_takes(cfg.injection, "--inject", err)) return false;
   constexpr int kImageStateHz = static_cast<int>(osc::params::kControlHz / osc::kStatePeriod);
   if (o.state_hz != kImageStateHz)
     return err = "--state-hz " + std::to_string(o.state_hz) + ": the firmware image sends " +
@@ -422,8 +477,8 @@ int run(const Options& o, Board& board) {
 }
 
 template <class S>
-int run_in_process(const Options& o, const sim::Vec6& q0) {
-  InProcessBoard<S> board(q0, o.state_hz);
+int run_in_process(const Options& o, const sim::ExperimentConfig& cfg) {
+  InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch);
   return run(o, board);
 }
 
@@ -448,7 +503,7 @@ int main(int argc, char** argv) {
     }
     return run(o, board);
   }
-  if (o.scalar == "float") return run_in_process<float>(o, cfg.q_start);
-  if (o.scalar == "fixed") return run_in_process<osc::Fixed>(o, cfg.q_start);
-  return run_in_process<double>(o, cfg.q_start);
+  if (o.scalar == "float") return run_in_process<float>(o, cfg);
+  if (o.scalar == "fixed") return run_in_process<osc::Fixed>(o, cfg);
+  return run_in_process<double>(o, cfg);
 }

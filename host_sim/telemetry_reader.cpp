@@ -92,31 +92,30 @@ int main(int argc, char** argv) {
   pil::ActuatorFrame first{}, last{};
   std::uint8_t buf[256];
   for (ssize_t n; (max_frames == 0 || frames < max_frames) && (n = read(fd, buf, sizeof buf)) > 0;) {
-    for (ssize_t i = 0; i < n; ++i) {
-      const pil::Parser::Result r = parser.feed(buf[i]);
-      if (r == pil::Parser::kPending) continue;
-      if (r == pil::Parser::kJunk) {
-        junk += parser.junk();
-        continue;
-      }
-      pil::ActuatorFrame a;
-      if (r != pil::Parser::kFrame) {
-        ++bad;
-      } else if (!parser.decode(a)) {
-        ++other_type;
-      } else {
-        if (frames++ == 0) first = a;
-        last = a;
-        if (as_json && !quiet) {
-          std::printf("%s\n", sim::frame_json(a).dump().c_str());
-        } else if (!quiet) {
-          std::printf("seq %u %s faults %s codes", a.seq, state_name(a.state), fault_names(a.faults).c_str());
-          for (std::int32_t c : a.codes) std::printf(" %d", c);
-          std::printf(" step %u max %u tick_max %u stack %u\n", a.step_cycles, a.max_cycles, a.tick_max_cycles,
-                      a.stack_used);
+    for (ssize_t i = 0; i < n; ++i)
+      for (pil::Parser::Result r = parser.feed(buf[i]); r != pil::Parser::kPending; r = parser.next()) {
+        if (r == pil::Parser::kJunk) {
+          junk += parser.junk();
+          continue;
+        }
+        pil::ActuatorFrame a;
+        if (r != pil::Parser::kFrame) {
+          ++bad;
+        } else if (!parser.decode(a)) {
+          ++other_type;
+        } else {
+          if (frames++ == 0) first = a;
+          last = a;
+          if (as_json && !quiet) {
+            std::printf("%s\n", sim::frame_json(a).dump().c_str());
+          } else if (!quiet) {
+            std::printf("seq %u %s faults %s codes", a.seq, state_name(a.state), fault_names(a.faults).c_str());
+            for (std::int32_t c : a.codes) std::printf(" %d", c);
+            std::printf(" step %u max %u tick_max %u stack %u\n", a.step_cycles, a.max_cycles, a.tick_max_cycles,
+                        a.stack_used);
+          }
         }
       }
-    }
   }
   close(fd);
   std::fprintf(as_json ? stderr : stdout,

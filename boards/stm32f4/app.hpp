@@ -51,6 +51,7 @@ struct App {
   osc::CommandPort<float>::PacedInputs paced;  ///< the port's copy of a command's inputs
   osc::CommandLinkWatch watch;
   pil::Parser parser;
+  std::uint32_t rx_tick = 0;  ///< the tick count when the last byte was read (the in-frame timeout)
   std::uint8_t frame[pil::kMaxFrame];
   /// The parameters' store: flash sectors 10 and 11 (param_store.hpp). QEMU models no flash
   /// controller: there the command port keeps them in RAM, and the boot says so.
@@ -130,7 +131,12 @@ struct App {
   /// The main loop's work: the received bytes through the parser into the port, the waiting
   /// commands prepared into the mailbox, the queued frames out.
   void serve() {
-    for (std::uint8_t b; board.uart.read(b);) on_byte(b);
+    for (std::uint8_t b; board.uart.read(b);) {
+      rx_tick = ticks;
+      on_result(parser.feed(b));
+    }
+    // A frame begun and silent for the in-frame timeout: cut short, its bytes scanned again.
+    if (parser.in_frame() && ticks - rx_tick >= osc::kFrameTimeoutTicks) on_result(parser.expire());
     if (port.waiting() > 0)
       port.poll_paced(
           task, paced, MainWrite{board.uart}, [](auto&& f) { with_tick_masked(f); }, [this] { board.uart.pump(); });
@@ -175,20 +181,21 @@ struct App {
     }
   };
 
-  /// One received byte: a valid frame is heard by the link watch and, a command or a setpoint,
-  /// taken by the port (with the tick masked: the FIFO, the setpoint mailbox).
-  void on_byte(std::uint8_t b) {
-    const pil::Parser::Result r = parser.feed(b);
-    if (r == pil::Parser::kPending) return;
-    if (r != pil::Parser::kFrame) {
-      ++rx_errors;
-      return;
+  /// A parser result and the further events of the bytes already received: a valid frame is heard
+  /// by the link watch and, a command or a setpoint, taken by the port (with the tick masked: the
+  /// FIFO, the setpoint mailbox); an error is counted.
+  void on_result(pil::Parser::Result r) {
+    for (; r != pil::Parser::kPending; r = parser.next()) {
+      if (r != pil::Parser::kFrame) {
+        ++rx_errors;
+        continue;
+      }
+      ++rx_frames;
+      watch.heard();
+      bool taken = false;
+      with_tick_masked([&] { taken = port.receive(task, parser, MainWrite{board.uart}); });
+      if (!taken) ++rx_other;
     }
-    ++rx_frames;
-    watch.heard();
-    bool taken = false;
-    with_tick_masked([&] { taken = port.receive(task, parser, MainWrite{board.uart}); });
-    if (!taken) ++rx_other;
   }
 };
 

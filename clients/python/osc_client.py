@@ -125,10 +125,22 @@ class Protocol:
 
 
 class Parser:
-    """Hunts for the sync pair, then type, length, payload and CRC; a bad frame is dropped."""
+    """Hunts for the sync pair, then type, length, payload and CRC. A frame that fails (an unknown type,
+    a wrong length, a bad CRC, or cut short: expire()) gives up its sync pair and the bytes after it are
+    scanned again, so a good frame among them is found (docs/protocol.md, "Framing and
+    resynchronisation")."""
+
+    FRAME_TIMEOUT = 0.02  # seconds: the in-frame timeout (params::kFrameTimeout)
 
     def __init__(self, protocol):
         self.p, self.buf = protocol, b""
+
+    def expire(self):
+        """The in-frame timeout: a frame begun is cut short; the frames in the bytes after its start."""
+        if not self.buf.startswith(self.p.sync[:1]):
+            return []
+        self.buf = self.buf[1:]
+        return self.feed(b"")
 
     def feed(self, data):
         """The complete, valid frames in the bytes so far, as (type name, payload)."""
@@ -253,6 +265,8 @@ class Client:
     """The command protocol over a serial device or pseudo-terminal (raw mode, any baud rate)."""
 
     HISTORY = 1024
+    RESEND = 0.5  # seconds without an answer before a command is sent again
+    SENT_KEPT = 64
 
     KEEPALIVE = 0.1  # seconds, as oscctl's default
 
@@ -283,6 +297,7 @@ class Client:
         self.answers, self.latest_state, self.states_seen = [], None, 0
         self.param_answer = None
         self.on_answer = self.on_state = None
+        self._sent = {}  # the frames of the last SENT_KEPT commands, by id (resent unchanged)
 
     def close(self):
         self.ser.close()
@@ -296,9 +311,13 @@ class Client:
         flags = ((self.p.command_flag["relative"] if relative else 0) | (self.p.command_flag["has_rpy"] if rpy else 0)
                  | (self.p.command_flag["replace"] if replace else 0)
                  | (self.p.command_flag["has_limits"] if limits else 0))
-        self._write(self.p.encode("command", {
+        frame = self.p.encode("command", {
             "id": cid, "verb": self.p.code_of("verbs", verb), "flags": flags, "position": list(position),
-            "rpy": list(rpy or (0.0, 0.0, 0.0)), "limits": list(limits or [0.0] * 6), "period": period}))
+            "rpy": list(rpy or (0.0, 0.0, 0.0)), "limits": list(limits or [0.0] * 6), "period": period})
+        self._sent[cid] = frame
+        if len(self._sent) > self.SENT_KEPT:
+            del self._sent[next(iter(self._sent))]
+        self._write(frame)
         return cid
 
     def enable(self):
@@ -392,13 +411,14 @@ class Client:
             else None
 
     def wait_answer(self, cid, timeout=10.0):
-        """accepted or refused (or timeout)."""
+        """accepted or refused (or timeout). Without an answer the command is sent again, the same frame,
+        every RESEND seconds: the board runs it once and answers a repeat with the answer it gave."""
         box = [None]
 
         def decided():
             box[0] = self._evaluate(cid, False)
             return box[0].status != "timeout"
-        self._read_until(time.monotonic() + timeout, decided)
+        self._read_until(time.monotonic() + timeout, decided, resend=cid)
         return box[0]
 
     def wait_done(self, cid, timeout=120.0):
@@ -409,7 +429,7 @@ class Client:
         def decided():
             box[0] = self._evaluate(cid, True)
             return box[0].status not in ("timeout", "accepted")
-        self._read_until(time.monotonic() + timeout, decided)
+        self._read_until(time.monotonic() + timeout, decided, resend=cid)
         if box[0].status == "accepted":
             box[0].status = "timeout"
         return box[0]
@@ -433,18 +453,33 @@ class Client:
             self._write(self.p.encode("state", {f["name"]: [0] * f["count"] if f["count"] > 1 else 0
                                                 for f in self.p.fields["state"]}))
 
-    def _read_until(self, deadline, done):
+    def _read_until(self, deadline, done, resend=None):
+        """Reads frames until done() or the deadline. resend: a command's id, whose frame is sent again
+        every RESEND seconds while it has no answer (a client's recovery rule: docs/protocol.md)."""
+        last_rx = sent = time.monotonic()
         while not done():
-            left = deadline - time.monotonic()
+            now = time.monotonic()
+            left = deadline - now
             if left <= 0:
                 return False
+            if resend in self._sent and now - sent >= self.RESEND:
+                if self._evaluate(resend, False).status == "timeout":  # no answer yet
+                    self._write(self._sent[resend])
+                sent = now
             self._keep_alive()
             try:
                 ready = select.select([self.ser.fileno()], [], [], min(left, 0.05))[0]
                 data = self.ser.read(4096) if ready else b""
             except (self._serial_error, OSError):
                 raise ClientError(f"{self.port}: hung up (the board or the simulator has gone)")
-            for frame, payload in self.parser.feed(data):
+            if data:
+                last_rx = time.monotonic()
+                frames = self.parser.feed(data)
+            elif time.monotonic() - last_rx >= Parser.FRAME_TIMEOUT:
+                frames = self.parser.expire()
+            else:
+                frames = []
+            for frame, payload in frames:
                 self._dispatch(frame, payload)
         return True
 

@@ -244,7 +244,16 @@ std::uint32_t Client::command(MotionVerb verb, const MoveRequest<double>& req) {
   const std::uint32_t id = next_id_++;
   if (next_id_ == 0) next_id_ = 1;
   std::uint8_t buf[pil::kMaxFrame];
-  return send(buf, encode_command(id, verb, req, buf)) ? id : 0;
+  const int n = encode_command(id, verb, req, buf);
+  sent_.emplace_back(id, std::vector<std::uint8_t>(buf, buf + n));
+  if (sent_.size() > kSentKept) sent_.pop_front();
+  return send(buf, n) ? id : 0;
+}
+
+bool Client::resend(std::uint32_t id) {
+  for (const auto& [sent_id, frame] : sent_)
+    if (sent_id == id) return send(frame.data(), static_cast<int>(frame.size()));
+  return true;
 }
 
 void Client::dispatch() {
@@ -275,10 +284,23 @@ bool Client::read_until(double deadline, const std::function<bool()>& done) {
     }
     const int n = t_->read(buf, sizeof buf, std::min({left, 0.05, keepalive_s > 0 ? keepalive_s : 0.05}));
     if (n < 0) return error_ = t_->error(), false;
-    for (int i = 0; i < n; ++i)
-      if (parser_.feed(buf[i]) == pil::Parser::kFrame) dispatch();
+    const double now = now_s();
+    if (n > 0) last_read_s_ = now;
+    for (int i = 0; i < n; ++i) take(parser_.feed(buf[i]));
+    // A frame begun and silent for the in-frame timeout: cut short, its bytes scanned again.
+    if (n == 0 && parser_.in_frame() && now - last_read_s_ >= params::kFrameTimeout) take(parser_.expire());
   }
   return true;
+}
+
+void Client::take(pil::Parser::Result r) {
+  for (; r != pil::Parser::kPending; r = parser_.next()) {
+    if (r == pil::Parser::kFrame)
+      dispatch();
+    else
+      link_errors_[pil::Parser::error_of(r)] +=
+          r == pil::Parser::kJunk ? static_cast<std::uint32_t>(parser_.junk()) : 1u;
+  }
 }
 
 bool Client::pump(double timeout_s) {
@@ -355,14 +377,21 @@ Outcome Client::evaluate(std::uint32_t id, bool until_done) const {
 
 Outcome Client::wait_answer(std::uint32_t id, double timeout_s) {
   Outcome o;
-  read_until(now_s() + timeout_s, [&] { return (o = evaluate(id, false)).status != Status::kTimeout; });
+  const double deadline = now_s() + timeout_s;
+  // Without an answer the same frame again every kResendS: the board runs it once (docs/protocol.md).
+  for (double until = std::min(deadline, now_s() + kResendS);; until = std::min(deadline, until + kResendS)) {
+    if (read_until(until, [&] { return (o = evaluate(id, false)).status != Status::kTimeout; })) break;
+    if (until >= deadline || !error_.empty() || !resend(id)) break;
+  }
   if (o.status == Status::kTimeout && !error_.empty()) o.status = Status::kError, o.error = error_;
   return o;
 }
 
 Outcome Client::wait_done(std::uint32_t id, double timeout_s) {
-  Outcome o;
-  read_until(now_s() + timeout_s, [&] {
+  const double deadline = now_s() + timeout_s;
+  Outcome o = wait_answer(id, timeout_s);  // resent until answered
+  if (o.status != Status::kAccepted) return o;
+  read_until(deadline, [&] {
     o = evaluate(id, true);
     return o.status != Status::kTimeout && o.status != Status::kAccepted;
   });

@@ -23,6 +23,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "osc/link/commands.hpp"
@@ -120,8 +121,11 @@ class Client {
   /// The latest state frame, received after this call (waiting up to timeout_s); nullopt on a
   /// timeout or an error (error()).
   std::optional<pil::StateFrame> state(double timeout_s = 5);
-  /// The command's answer: kAccepted or kRefused (or kTimeout, kError).
+  /// The command's answer: kAccepted or kRefused (or kTimeout, kError). Without an answer within
+  /// kResendS the command is sent again, the same frame (the recovery rule of docs/protocol.md: the
+  /// controller runs a command once and answers a repeat with the answer it gave).
   Outcome wait_answer(std::uint32_t id, double timeout_s);
+  static constexpr double kResendS = 0.5;
   /// The command's end: a motion (move_to, paper, stream) kDone when it reached its target at rest,
   /// kAborted with the reason when it (or the running motion it queued behind) was aborted; a stop
   /// or a disable that stops a motion kDone at rest; any other command kDone once accepted; kRefused
@@ -141,6 +145,8 @@ class Client {
 
   /// The last transport error ("" for none).
   const std::string& error() const { return error_; }
+  /// The link errors this client's parser counted in what the controller sent, by kind.
+  const pil::LinkCounters& link_errors() const { return link_errors_; }
 
   /// While it waits, a keep-alive frame (a state frame of zeros, which a controller takes as link
   /// activity and otherwise ignores) whenever nothing was sent for this long [s]; 0: none. A board
@@ -155,10 +161,18 @@ class Client {
   /// an error.
   bool read_until(double deadline, const std::function<bool()>& done);
   void dispatch();
+  /// A parser result and the further events of the bytes already received: frames dispatched,
+  /// errors counted.
+  void take(pil::Parser::Result r);
   /// The command's answer and end as far as the answers so far tell (kTimeout: not yet).
   Outcome evaluate(std::uint32_t id, bool until_done) const;
 
+  /// Sends the frame of command `id` again (true: sent, or no longer kept).
+  bool resend(std::uint32_t id);
+
+  static constexpr std::size_t kSentKept = 64;
   std::unique_ptr<Transport> t_;
+  std::deque<std::pair<std::uint32_t, std::vector<std::uint8_t>>> sent_;  // the last kSentKept commands
   pil::Parser parser_;
   std::uint32_t next_id_;
   std::deque<pil::AnswerFrame> answers_;  // the last kHistory answers
@@ -167,6 +181,8 @@ class Client {
   std::uint64_t states_seen_ = 0;
   std::string error_;
   double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)
+  double last_read_s_ = 0;   // steady clock [s] of the last byte received (the in-frame timeout)
+  pil::LinkCounters link_errors_;
 };
 
 }  // namespace osc::client

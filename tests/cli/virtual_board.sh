@@ -23,6 +23,7 @@
 #   oscctl_homing, python_homing       declare_pose (refused pots_disagree, accepted, refused torque_on;
 #                                      an unknown pose exit 2), home done
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
+#                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
 #   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
 #
@@ -196,12 +197,12 @@ stream() {
 
 case "$case_" in
   oscctl_sequence)
-    start_sim --speed 4
+    start_sim --speed 4 --no-link-watch  # a move left running between two clients: no link watch
     sequence "$ctl" --port "$port" --timeout 60
     stop_sim
     ;;
   python_sequence)
-    start_sim --speed 4 --scalar float
+    start_sim --speed 4 --scalar float --no-link-watch
     sequence "$py" "$client" --port "$port" --timeout 60
     stop_sim
     ;;
@@ -269,7 +270,13 @@ case "$case_" in
       "$sim" --pty --qemu --elf "$tmp/none.elf" --state-hz 100
     refuse "osc_sim: --start-pose: the firmware image starts at the robot's start pose" -- \
       "$sim" --pty --qemu --elf "$tmp/none.elf" --start-pose 10 30 -170 0 40 0
-    expect 0 'QEMU' -- "$sim" --help
+    # --inject's kinds (injection.hpp), and what applies in process only.
+    refuse 'osc_sim: --inject: ' -- "$sim" --pty --inject bogus@1
+    refuse 'osc_sim: --no-link-watch applies in process only' -- \
+      "$sim" --pty --qemu --elf "$tmp/none.elf" --no-link-watch
+    refuse 'osc_sim: --inject overrun applies to the host-built controller only' -- \
+      "$sim" --pty --qemu --elf "$tmp/none.elf" --inject overrun@1
+    expect 0 'QEMU' 'no-link-watch' 'encoder-stuck' -- "$sim" --help
     ;;
   sim_duration)
     expect 0 '^pty: /dev/pts/[0-9]+$' 'osc_sim: 500 ticks \(0\.500 s simulated\)' 'overruns' -- \

@@ -138,10 +138,16 @@ struct Checker {
       check_move(f, req, c);
   }
 
-  /// Feeds one byte; checks a completed frame. Returns the parser's result.
+  /// Feeds one byte; checks each completed frame among its events. Returns the first event.
   pil::Parser::Result feed(pil::Parser& p, std::uint8_t byte) {
-    const pil::Parser::Result r = p.feed(byte);
-    if (r != pil::Parser::kFrame) return r;
+    const pil::Parser::Result first = p.feed(byte);
+    for (pil::Parser::Result r = first; r != pil::Parser::kPending; r = p.next())
+      if (r == pil::Parser::kFrame) frame(p);
+    return first;
+  }
+
+  /// A completed frame: a command or a setpoint checked as the document says.
+  void frame(const pil::Parser& p) {
     pil::CommandFrame f;
     pil::SetpointFrame sp;
     pil::SetpointVelocityFrame sv;
@@ -154,7 +160,6 @@ struct Checker {
     else
       FUZZ_CHECK(p.type() != pil::kCommandFrame && p.type() != pil::kSetpointFrame &&
                  p.type() != pil::kSetpointVelocityFrame);
-    return r;
   }
 
   /// A setpoint, with its velocity or not: valid as the document says (flags end and has_rpy only,

@@ -4,9 +4,10 @@
 //
 // Invariants:
 //  - hello() writes one actuator frame: sequence kHelloSeq, zero codes, state kInit;
-//  - on_byte() asks for a tick exactly when a frame ends (valid, or with a bad checksum), as an
-//    independent parser fed the same bytes sees it; every tick writes exactly one actuator frame,
-//    nothing else, and it parses with a valid checksum;
+//  - on_byte() and on_timeout() ask for a tick exactly when a frame ends (valid but for the command
+//    protocol's, or bad, or cut short), as an independent parser fed the same bytes sees it, and in
+//    the same order (several in one byte after a resynchronisation); every tick writes exactly one
+//    actuator frame, nothing else, and it parses with a valid checksum;
 //  - every code written is within [-kDacMaxCode, kDacMaxCode]; the frame's state and fault bits are
 //    the node's supervisor's; whenever that state is not kRun every code is 0, and the board's fault
 //    line is on exactly in kFault;
@@ -107,55 +108,87 @@ struct Driver {
     ++ticks;
   }
 
-  void byte(std::uint8_t b) {
-    const pil::Parser::Result r = shadow.feed(b);
-    const bool due = node.on_byte(b);
-    // A command or a setpoint is the command port's: no tick, no link error (the node may answer a
-    // command at once: a refusal no tick gives).
-    if (r == pil::Parser::kFrame && (shadow.type() == pil::kCommandFrame || shadow.type() == pil::kSetpointFrame ||
-                                     shadow.type() == pil::kSetpointVelocityFrame)) {
-      FUZZ_CHECK(!due);
-      take_frames(false);
+  /// One shadow event, as the node must see it: whether it makes a tick due, and its bookkeeping.
+  struct Event {
+    pil::Parser::Result r;
+    pil::FrameType type;
+    bool sensor;  // a valid sensor frame (f)
+    pil::SensorFrame f;
+  };
+  static bool command_protocol(pil::FrameType t) {
+    return t == pil::kCommandFrame || t == pil::kSetpointFrame || t == pil::kSetpointVelocityFrame ||
+           t == pil::kParamFrame;
+  }
+  /// Any frame that ends, valid or not, is answered at once, but a command protocol's (the port's:
+  /// no tick, no link error); so is a header found bad and a frame cut short.
+  static bool due_of(const Event& e) {
+    return e.r != pil::Parser::kJunk && !(e.r == pil::Parser::kFrame && command_protocol(e.type));
+  }
+  std::vector<Event> drain(pil::Parser::Result r) {
+    std::vector<Event> ev;
+    for (; r != pil::Parser::kPending; r = shadow.next()) {
+      Event e{r, shadow.type(), false, {}};
+      if (r == pil::Parser::kFrame) e.sensor = shadow.decode(e.f);
+      ev.push_back(e);
+    }
+    return ev;
+  }
+  /// An event's bookkeeping (the node's expectations after it).
+  void note(const Event& e) {
+    if (e.r == pil::Parser::kFrame && command_protocol(e.type)) {
+      take_frames(false);  // the node may answer a command at once: a refusal no tick gives
       synced = true;
       return;
     }
-    // Any other frame that ends, valid or not, is answered at once; so is a header found bad.
-    if (r == pil::Parser::kFrame || r == pil::Parser::kBadChecksum) FUZZ_CHECK(due);
-    if (r == pil::Parser::kPending || r == pil::Parser::kJunk) FUZZ_CHECK(!due);
     FUZZ_CHECK(FakeBoard::out.empty());
-    if (r == pil::Parser::kBadChecksum || r == pil::Parser::kBadHeader || r == pil::Parser::kBadLength) {
+    if (e.r == pil::Parser::kJunk) {
+      if (synced) link_fault_due = true;  // junk after a valid frame is an error of its own
+      synced = false;
+      return;
+    }
+    if (e.r != pil::Parser::kFrame || !e.sensor) {  // lost: bad, cut short, or a frame of the wrong type
       link_fault_due = true;
       synced = false;
       ++expected_seq;  // a lost frame uses up its sequence number
+      return;
     }
-    if (r == pil::Parser::kJunk) {
-      if (synced) link_fault_due = true;  // junk after a valid frame is an error of its own
-      synced = false;
-    }
-    if (r == pil::Parser::kFrame) {
-      pil::SensorFrame f;
-      if (!shadow.decode(f)) {
-        link_fault_due = true;  // an actuator frame sent to the firmware
-        synced = false;
-        ++expected_seq;
-      } else {
-        if (seq_tracked && f.seq != expected_seq) link_fault_due = true;
-        expected_seq = f.seq + 1;
-        last_seq = f.seq;
-        seq_tracked = synced = seq_check = true;
-      }
-    }
-    if (due) {
+    if (seq_tracked && e.f.seq != expected_seq) link_fault_due = true;
+    expected_seq = e.f.seq + 1;
+    last_seq = e.f.seq;
+    seq_tracked = synced = seq_check = true;
+  }
+  /// The node's ticks interleaved with the shadow's events: each due() the node calls is the next
+  /// event that makes a tick due (the events before it noted first); none is left over.
+  template <class Run>
+  void run(const std::vector<Event>& ev, Run&& node_run) {
+    std::size_t next = 0;
+    node_run([&] {
+      while (next < ev.size() && !due_of(ev[next])) note(ev[next++]);
+      FUZZ_CHECK(next < ev.size());  // a tick the shadow does not expect
+      note(ev[next++]);
       node.tick();
       check_tick();
+    });
+    for (; next < ev.size(); ++next) {
+      FUZZ_CHECK(!due_of(ev[next]));  // a tick the node did not ask for
+      note(ev[next]);
     }
   }
 
+  void byte(std::uint8_t b) {
+    run(drain(shadow.feed(b)), [&](auto&& due) { node.on_byte(b, due); });
+  }
+
   void timeout() {
-    node.on_timeout();
-    shadow.reset();
+    if (shadow.in_frame()) {
+      run(drain(shadow.expire()), [&](auto&& due) { node.on_timeout(due); });
+      return;
+    }
+    node.on_timeout();  // junk then nothing (a lost frame), or a silence: one tick either way
+    if (!synced) ++expected_seq;
+    seq_tracked = false;  // a silence uses no number, a lost frame one: unknown here
     link_fault_due = true;
-    seq_tracked = synced = false;
+    synced = false;
     node.tick();
     check_tick();
   }

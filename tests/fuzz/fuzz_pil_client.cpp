@@ -9,7 +9,8 @@
 //  - the client's results do not depend on how the stream is split into reads: the same sequence
 //    of frames (bit for bit) and errors (same messages) either way;
 //  - a call consumes bytes only up to the end of its buffer and returns kNeedMore only there;
-//  - a kFrame is the actuator frame whose encoding are exactly the last bytes consumed; a kError
+//  - a kFrame is the actuator frame whose encoding are the bytes at the parser's offset (the last
+//    consumed, or, found after an error, earlier ones: the parser's resynchronisation); a kError
 //    comes with one of the client's four messages (unexpected frame type, checksum, header type,
 //    header length) and is counted once by its kind;
 //  - every well-formed actuator frame that starts while the parser is idle is received intact, and
@@ -30,10 +31,11 @@ struct Event {
   sim::RxResult r;
   std::string err;
   std::uint8_t frame[pil::kMaxFrame];
-  std::size_t end;  // stream offset just past the last byte consumed
+  std::size_t end;    // stream offset just past the last byte consumed
+  std::size_t start;  // stream offset of the frame (or the failed frame) the event is about
 
   bool operator==(const Event& o) const {
-    return r == o.r && err == o.err && end == o.end &&
+    return r == o.r && err == o.err && end == o.end && start == o.start &&
            (r != sim::RxResult::kFrame || std::memcmp(frame, o.frame, sizeof frame) == 0);
   }
 };
@@ -58,13 +60,14 @@ sim::RxResult step(pil::Parser& parser, const std::uint8_t* buf, int len, int& p
     FUZZ_CHECK(pos == len);
     return r;
   }
-  FUZZ_CHECK(pos > pos0);
-  Event e{r, err, {}, base + static_cast<std::size_t>(pos)};
+  // An event of bytes received before (a frame found after an error) consumes nothing new.
+  Event e{r, err, {}, base + static_cast<std::size_t>(pos), parser.offset()};
+  FUZZ_CHECK(e.start < e.end);
   if (r == sim::RxResult::kFrame) {
     const int n = pil::encode(f, e.frame);
     FUZZ_CHECK(n == pil::kActuatorPayload + pil::kOverhead);
-    FUZZ_CHECK(e.end >= static_cast<std::size_t>(n));
-    FUZZ_CHECK(std::memcmp(e.frame, stream.data() + e.end - n, static_cast<std::size_t>(n)) == 0);
+    FUZZ_CHECK(e.start + static_cast<std::size_t>(n) <= e.end);
+    FUZZ_CHECK(std::memcmp(e.frame, stream.data() + e.start, static_cast<std::size_t>(n)) == 0);
   } else {
     FUZZ_CHECK(std::find(std::begin(kErrors), std::end(kErrors), err) != std::end(kErrors));
   }
@@ -83,7 +86,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // The stream, and where the well-formed frames that must come through are.
   std::vector<std::uint8_t> stream;
   struct Expect {
-    std::size_t end;
+    std::size_t start;
     bool actuator;
   };
   std::vector<Expect> expect;
@@ -95,7 +98,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     pil::Parser idle;  // tracks whether a frame starting here starts from idle
     auto push = [&](std::uint8_t b) {
       stream.push_back(b);
-      idle.feed(b);
+      for (pil::Parser::Result r = idle.feed(b); r != pil::Parser::kPending; r = idle.next()) {
+      }
     };
     while (!in.empty()) {
       const std::uint8_t op = in.u8();
@@ -106,8 +110,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       const bool flip = (op & 0x30) == 0x30;
       if (flip) buf[4 + in.u8() % (len - 4)] ^= static_cast<std::uint8_t>(1u << (in.u8() & 7));
       const bool from_idle = !idle.in_frame();
+      const std::size_t start = stream.size();
       for (int i = 0; i < len; ++i) push(buf[i]);
-      if (from_idle && !flip) expect.push_back({stream.size(), actuator});
+      if (from_idle && !flip) expect.push_back({start, actuator});
     }
   }
 
@@ -141,7 +146,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 
   // Every well-formed frame that started from idle came through as itself.
   for (const Expect& x : expect) {
-    const auto it = std::find_if(whole.begin(), whole.end(), [&](const Event& e) { return e.end == x.end; });
+    const auto it = std::find_if(whole.begin(), whole.end(), [&](const Event& e) { return e.start == x.start; });
     FUZZ_CHECK(it != whole.end());
     if (x.actuator)
       FUZZ_CHECK(it->r == sim::RxResult::kFrame);

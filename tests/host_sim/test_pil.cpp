@@ -267,7 +267,8 @@ TEST(PilClientAmplifiers, OnlyAValidInRangeAnswerToTheTickIsApplied) {
   }
   EXPECT_EQ(c.code_range_errors(), 1u);
   EXPECT_EQ(c.link_counters()[pil::kErrCrc], 1u);
-  EXPECT_EQ(c.link_counters()[pil::kErrJunk], 3u);
+  // The junk, and the corrupt frame's bytes after its first (scanned again: no frame in them).
+  EXPECT_EQ(c.link_counters()[pil::kErrJunk], 3u + pil::kActuatorPayload + pil::kOverhead - 1);
   EXPECT_EQ(c.link_counters()[pil::kErrSeq], 2u);  // the stale answer and the one from the future
   EXPECT_EQ(c.link_counters()[pil::kErrSilence], 1u);
   EXPECT_FALSE(PilClient::codes_in_range(big));
@@ -489,8 +490,9 @@ TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
 
 TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
   healthy(5);
-  expect_zeroed_once(answer(with(frame(), 2, 0x0E)), pil::kErrHeader);                       // type 0x0F: unknown
-  EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + 2));  // the rest of it
+  expect_zeroed_once(answer(with(frame(), 2, 0x0E)), pil::kErrHeader);  // type 0x0F: unknown
+  // The rest of it: the bytes after its first, scanned again.
+  EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + pil::kOverhead - 1));
 }
 
 TEST_F(Link, JunkBetweenFramesZeroesTheNextTick) {

@@ -91,6 +91,12 @@ function(osc_add_virtual_board_test scalar)
                    $<TARGET_FILE:pil_firmware> ${scalar})
   # About 20 s simulated, in real time (slower on a busy machine: QEMU then falls behind).
   set_tests_properties(virtual_board_qemu_sequence PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600)
+  # The command link's recovery over the image (tests/cli/link_recovery.py --qemu): the same outcomes
+  # as in process.
+  add_test(NAME virtual_board_qemu_link_recovery
+           COMMAND ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/cli/link_recovery.py ${OSC_SIM_BOARD}
+                   ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py --qemu $<TARGET_FILE:pil_firmware>)
+  set_tests_properties(virtual_board_qemu_link_recovery PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 300)
 endfunction()
 
 # osc_add_motion_tests(SCALAR): scripted motions on this build's pil_firmware in QEMU (the host

@@ -180,15 +180,14 @@ int main() {
         board::watchdog_start();
         last_feed = board::cycles();
       }
-      if (g_node.on_byte(rx_read())) pend_tick();
+      g_node.on_byte(rx_read(), pend_tick);
       last = board::cycles();
       continue;
     }
     if (link_up) {
       const std::uint32_t now = board::cycles();
       if (now - last > kLinkTimeoutNs) {
-        g_node.on_timeout();
-        pend_tick();
+        g_node.on_timeout(pend_tick);
         last = board::cycles();
         continue;
       }

@@ -86,7 +86,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kCommandPayload, 4 + 1 + 1 + 12 + 12 + 24 + 1);
   EXPECT_EQ(pil::kSetpointPayload, 4 + 1 + 12 + 12);
   EXPECT_EQ(pil::kAnswerPayload, 4 + 1 + 1 + 1 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 4);
-  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4);
+  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4 + 4 * pil::kLinkErrorKinds);
   EXPECT_EQ(pil::kTracePayload, 4 + 4 + 1 + 3 * 24 + 36);
   EXPECT_EQ(pil::kParamFrame, 9);
   EXPECT_EQ(pil::kParamAnswerFrame, 10);
@@ -333,6 +333,7 @@ TEST(CommandFrames, StateRoundTripsFieldByField) {
   s.queued = 17;
   for (int i = 0; i < 6; ++i) s.x_d[i] = 0.5f * static_cast<float>(i) - 1.0f, s.x[i] = -0.25f * static_cast<float>(i);
   s.tick = 0xFFFFFFFEu;
+  for (int k = 0; k < pil::kLinkErrorKinds; ++k) s.link.count[k] = 1000u * static_cast<std::uint32_t>(k) + 7u;
   const pil::StateFrame t = decoded<pil::StateFrame>(parsed(bytes_of(s)));
   EXPECT_EQ(t.state, s.state);
   EXPECT_EQ(t.stop, s.stop);
@@ -343,6 +344,7 @@ TEST(CommandFrames, StateRoundTripsFieldByField) {
     EXPECT_EQ(t.x[i], s.x[i]);
   }
   EXPECT_EQ(t.tick, s.tick);
+  for (int k = 0; k < pil::kLinkErrorKinds; ++k) EXPECT_EQ(t.link.count[k], s.link.count[k]) << k;
 }
 
 // ---------------------------------------------------------------- refusals
@@ -766,6 +768,14 @@ TEST(CommandFrames, StateFrameInEveryScalar) {
 
 namespace {
 
+/// A relative move of 10 mm along z.
+pil::CommandFrame small_move(std::uint32_t id) {
+  MoveRequest<double> req;
+  req.relative = true;
+  req.position(2) = 0.01;
+  return frame_from_command(id, MotionVerb::kMoveTo, req);
+}
+
 /// A board that records what the node writes, frame by frame (any other byte is counted bad).
 struct RecordingBoard {
   static inline pil::Parser rx;
@@ -781,23 +791,23 @@ struct RecordingBoard {
     bad = 0;
   }
   static void link_write(const std::uint8_t* p, int n) {
-    for (int i = 0; i < n; ++i) {
-      const pil::Parser::Result r = rx.feed(p[i]);
-      if (r == pil::Parser::kPending) continue;
-      if (r != pil::Parser::kFrame) {
-        ++bad;
-        continue;
-      }
-      types.push_back(rx.type());
-      pil::ActuatorFrame act;
-      pil::AnswerFrame ans;
-      pil::StateFrame st;
-      pil::TraceFrame tr;
-      if (rx.decode(act)) actuators.push_back(act);
-      if (rx.decode(ans)) answers.push_back(ans);
-      if (rx.decode(st)) states.push_back(st);
-      if (rx.decode(tr)) traces.push_back(tr);
+    for (int i = 0; i < n; ++i)
+      for (pil::Parser::Result r = rx.feed(p[i]); r != pil::Parser::kPending; r = rx.next()) take(r);
+  }
+  static void take(pil::Parser::Result r) {
+    if (r != pil::Parser::kFrame) {
+      ++bad;
+      return;
     }
+    types.push_back(rx.type());
+    pil::ActuatorFrame act;
+    pil::AnswerFrame ans;
+    pil::StateFrame st;
+    pil::TraceFrame tr;
+    if (rx.decode(act)) actuators.push_back(act);
+    if (rx.decode(ans)) answers.push_back(ans);
+    if (rx.decode(st)) states.push_back(st);
+    if (rx.decode(tr)) traces.push_back(tr);
   }
   static std::uint32_t cycles() { return 0; }
   static std::uint32_t stack_used() { return 0; }
@@ -821,8 +831,7 @@ struct NodeFrames : ::testing::Test {
   template <class F>
   int arrive(const F& f) {
     int ticks = 0;
-    for (std::uint8_t b : bytes_of(f))
-      if (node->on_byte(b)) ++ticks, node->tick();
+    for (std::uint8_t b : bytes_of(f)) node->on_byte(b, [&] { ++ticks, node->tick(); });
     return ticks;
   }
   /// One tick: the next sensor frame (the arm at the start pose, its encoders dithering by a count).
@@ -882,6 +891,51 @@ TEST_F(NodeFrames, CommandsWaitForTheMailboxInOrderAndAreAnsweredOnce) {
   EXPECT_EQ(RecordingBoard::answers[0].state, static_cast<std::uint8_t>(MotionState::kHolding));
   EXPECT_EQ(RecordingBoard::answers[2].state, static_cast<std::uint8_t>(MotionState::kDisabled));
   EXPECT_EQ(node->port.waiting(), 0);
+}
+
+// Issue 53, defect 3: a command sent twice (a client that resends after missing the answer) runs
+// once. Waiting in the mailbox, the resend is left to the answer to come; answered, it is answered
+// again with the very answer it had. A 10 mm relative move sent twice queues one 10 mm move; a
+// refused one is refused again, not retried; the same id with other content is a new command.
+TEST_F(NodeFrames, AResentCommandIsAnsweredAgainAndRunsOnce) {
+  tick(pil::kConfigStartDisabled);
+  arrive(command(1, MotionVerb::kEnable));
+  for (int k = 0; k < 3; ++k) tick();
+  const Vec3<double> start = node->task.gen.queue_end().p;
+  const pil::CommandFrame move = small_move(2);
+  arrive(move);
+  arrive(move);  // in the mailbox still: left to the answer to come
+  EXPECT_EQ(node->port.waiting(), 0);
+  tick();
+  ASSERT_EQ(RecordingBoard::answers.size(), 2u);
+  const pil::AnswerFrame first = RecordingBoard::answers.back();
+  EXPECT_EQ(first.id, 2u);
+  EXPECT_EQ(first.outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  arrive(move);  // answered: answered again at once, the same frame
+  ASSERT_EQ(RecordingBoard::answers.size(), 3u);
+  EXPECT_EQ(bytes_of(RecordingBoard::answers.back()), bytes_of(first));
+  EXPECT_EQ(node->task.pending.verb, MotionVerb::kNone);
+  EXPECT_EQ(node->port.waiting(), 0);
+  tick();
+  EXPECT_EQ(node->task.gen.queued(), 1) << "one move, not two";
+  EXPECT_NEAR((node->task.gen.queue_end().p - start).norm(), 0.01, 1e-9) << "10 mm, not 20";
+  EXPECT_EQ(node->port.resends, 2u);
+  // A refused command is refused again, the same way.
+  arrive(command(3, MotionVerb::kDeclarePose));  // torque on: refused
+  tick();
+  const pil::AnswerFrame refused = RecordingBoard::answers.back();
+  EXPECT_EQ(refused.refusal, static_cast<std::uint8_t>(MotionReason::kTorqueOn));
+  arrive(command(3, MotionVerb::kDeclarePose));
+  EXPECT_EQ(bytes_of(RecordingBoard::answers.back()), bytes_of(refused));
+  // The same id with another frame: a new command, run.
+  const std::size_t answered = RecordingBoard::answers.size();
+  pil::CommandFrame other = small_move(2);
+  other.position[1] = 0.01f;
+  arrive(other);
+  tick();
+  ASSERT_EQ(RecordingBoard::answers.size(), answered + 1);
+  EXPECT_EQ(RecordingBoard::answers.back().tick, node->task.tick - 1);
+  EXPECT_EQ(node->task.gen.queued(), 2);
 }
 
 TEST_F(NodeFrames, FullFifoAndUnknownVerbAreRefusedAtOnce) {
@@ -1141,13 +1195,6 @@ struct PacedRig {
     written.emplace_back(b, b + n);
   }
 };
-
-pil::CommandFrame small_move(std::uint32_t id) {
-  MoveRequest<double> req;
-  req.relative = true;
-  req.position(2) = 0.01;
-  return frame_from_command(id, MotionVerb::kMoveTo, req);
-}
 
 TEST(CommandPortPaced, AMoveThatBrakesTheMotionGoesInJustBeforeItsPlannedTick) {
   PacedRig r(TaskStart::kPaper);  // the paper's motion runs: a move_to brakes it

@@ -251,4 +251,12 @@ constexpr int kLinkErrorWindow = 1000;
 /// setpoints (COM_OF_LOSS_T). The board counts it in ticks: kCommandLinkTimeout * kControlHz.
 constexpr double kCommandLinkTimeout = 0.5;
 
+/// The command link's in-frame timeout (pil::Parser::expire; docs/protocol.md, "Framing and
+/// resynchronisation"): a frame that has started and then receives no byte for this long [s] is cut
+/// short, and the bytes after its first are scanned again for a frame. Applied by every end of the
+/// command protocol: the STM32F4 board's USART (in ticks), the virtual board and the clients (wall
+/// time). A sender writes a frame's bytes back to back: at 115 200 baud a whole frame of the longest
+/// type (pil::kMaxFrame bytes) takes under 20 ms, its gaps none. The PIL link's is kLinkTimeout.
+constexpr double kFrameTimeout = 0.02;
+
 }  // namespace osc::params

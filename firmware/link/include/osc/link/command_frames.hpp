@@ -131,18 +131,22 @@ constexpr double kCommandMaxVelocity = 10.0;
   X(std::uint8_t, queued, , "", "moves in the motion queue after this tick, the running one included")         \
   X(std::uint32_t, tick, , "tick", "the number of the tick that answered (0: the first), low 32 bits")
 
-#define OSC_STATE_FIELDS(X)                                                                                   \
-  X(std::uint8_t, state, , "", "the motion state (Motion states)")                                            \
-  X(std::uint8_t, stop, , "", "the stop in effect (Stop categories)")                                         \
-  X(std::uint32_t, faults, , "", "the fault bits latched since the last accepted clear (Fault bits)")         \
-  X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included")                        \
-  X(std::uint32_t, running_id, , "", "the id of the running motion (move_to, stream, paper); 0: none")        \
-  X(std::uint32_t, dropped, , "", "setpoints dropped since start: no stream of their id running, or bad")     \
-  X(float, x_d, [6], "m, rad",                                                                                \
-    "the reference pose of the last control step: the wrist centre's position in the base frame, then roll, " \
-    "pitch, yaw of the orientation as move_to's absolute rpy")                                                \
-  X(float, x, [6], "m, rad", "the measured pose of the last control step, the same way")                      \
-  X(std::uint32_t, tick, , "tick", "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")
+#define OSC_STATE_FIELDS(X)                                                                                     \
+  X(std::uint8_t, state, , "", "the motion state (Motion states)")                                              \
+  X(std::uint8_t, stop, , "", "the stop in effect (Stop categories)")                                           \
+  X(std::uint32_t, faults, , "", "the fault bits latched since the last accepted clear (Fault bits)")           \
+  X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included")                          \
+  X(std::uint32_t, running_id, , "", "the id of the running motion (move_to, stream, paper); 0: none")          \
+  X(std::uint32_t, dropped, , "", "setpoints dropped since start: no stream of their id running, or bad")       \
+  X(float, x_d, [6], "m, rad",                                                                                  \
+    "the reference pose of the last control step: the wrist centre's position in the base frame, then roll, "   \
+    "pitch, yaw of the orientation as move_to's absolute rpy")                                                  \
+  X(float, x, [6], "m, rad", "the measured pose of the last control step, the same way")                        \
+  X(std::uint32_t, tick, , "tick",                                                                              \
+    "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")                        \
+  X(LinkCounters, link, , "",                                                                                   \
+    "the errors counted since start on the link this frame goes over, as its receiver at the controller's end " \
+    "sees the client's bytes: one u32 per kind (Link error counters; seq_errors and timeouts stay 0)")
 
 // X(Name, "name", meaning): what a param frame asks (the parameter table, osc/runtime/parameters.hpp).
 // Each is answered at once by a param_answer frame, in the order they come.

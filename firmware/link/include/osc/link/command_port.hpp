@@ -32,6 +32,10 @@ namespace osc {
 
 /// Command frames that can wait for the mailbox.
 constexpr int kCommandFifo = 4;
+/// The command link's in-frame timeout in ticks, for a board that counts it so (params::kFrameTimeout).
+constexpr std::uint32_t kFrameTimeoutTicks = stream::ticks(params::kFrameTimeout);
+static_assert(kFrameTimeoutTicks >= 2, "a frame's bytes may straddle a tick");
+
 /// The default period of the state frames [ticks]: 50 Hz.
 constexpr std::uint32_t kStatePeriod = 20;
 /// A timer-paced board (poll_paced): a move that brakes the running motion (a re-target, a move
@@ -114,13 +118,24 @@ class CommandPort {
   /// The board's parameter store (save, load); without one, the port keeps the record in RAM.
   void set_param_storage(const ParamStorage& s) { param_storage_ = s; }
 
-  /// A command frame into the FIFO; refused at once (queue_full) when it is full.
+  /// A command frame into the FIFO; refused at once (queue_full) when it is full. A resend (the same
+  /// frame again, nonzero id: a client that missed the answer) is not executed twice: answered
+  /// again with the answer it had, or, still waiting for its tick, left to the answer to come.
   template <class Write>
   void enqueue(const ControlTask<S>& task, const pil::CommandFrame& c, Write&& write) {
     commanded_ = true;
+    if (c.id != 0 && resend(task, c, write)) return;
     if (count_ == kCommandFifo) return refuse_now(task, c, MotionReason::kQueueFull, write);
     fifo_[(head_ + count_++) % kCommandFifo] = c;
   }
+
+  /// The link errors the transport's parser found in the client's bytes, into the state frames'
+  /// counters (pil::Parser results other than kPending and kFrame).
+  void count_link_error(pil::Parser::Result r, const pil::Parser& p) {
+    link[pil::Parser::error_of(r)] += r == pil::Parser::kJunk ? static_cast<std::uint32_t>(p.junk()) : 1u;
+  }
+  /// The link's error counters that the state frames carry (count_link_error, or the transport's).
+  pil::LinkCounters link;
 
   /// The mailbox free: the oldest waiting command, prepared into it (a move_to's path checked too:
   /// check_prepared_move). A verb outside the list is refused at once (bad_command).
@@ -139,6 +154,7 @@ class CommandPort {
       if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone) c = prepare_checked_home(task, f.id);
       if (c.verb == MotionVerb::kMoveTo) check_prepared_move(task, c);
       task.pending = c;
+      pending_print_ = fingerprint(f);
     }
   }
 
@@ -167,7 +183,10 @@ class CommandPort {
       TaskCommand<S> c = prepare_frame_command(in.gen, in.limits, planned, params::kControlHz, in.frame);
       if (c.verb == MotionVerb::kNone) {
         const MotionReason why = c.refusal == MotionReason::kNone ? MotionReason::kBadCommand : c.refusal;
-        masked([&] { refuse_now(task, in.frame, why, write); });
+        masked([&] {
+          refuse_now(task, in.frame, why, write);
+          preparing_ = false;
+        });
         continue;
       }
       if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone)
@@ -180,9 +199,13 @@ class CommandPort {
         c.q_end = pc.q_end;
       }
       const bool timed = c.verb == MotionVerb::kMoveTo && c.brake && c.refusal == MotionReason::kNone;
+      const std::uint16_t print = fingerprint(in.frame);
       bool placed = false;
       for (;;) {
-        masked([&] { placed = hand_over(task, c, timed ? planned : task.tick); });
+        masked([&] {
+          placed = hand_over(task, c, timed ? planned : task.tick);
+          if (placed) pending_print_ = print, preparing_ = false;
+        });
         if (placed) break;
         wait();
       }
@@ -192,14 +215,24 @@ class CommandPort {
   /// After each tick (control_tick or a tick without a step): its answer (once a command has come),
   /// then a state frame when due. Prepares nothing (safe in the control interrupt): poll() does.
   template <class Write>
-  void after_tick(const ControlTask<S>& task, Write&& write) const {
+  void after_tick(const ControlTask<S>& task, Write&& write) {
     std::uint8_t buf[pil::kMaxFrame];
-    if (commanded_ && answer_due(task.report)) write(buf, pil::encode(answer_frame(task), buf));
-    if (state_period != 0 && task.tick % state_period == 0) write(buf, pil::encode(state_frame_from_task(task), buf));
+    if (commanded_ && answer_due(task.report)) {
+      const pil::AnswerFrame a = answer_frame(task);
+      if (task.report.outcome != CommandOutcome::kNone) remember(a);
+      write(buf, pil::encode(a, buf));
+    }
+    if (state_period != 0 && task.tick % state_period == 0) {
+      pil::StateFrame f = state_frame_from_task(task);
+      f.link = link;
+      write(buf, pil::encode(f, buf));
+    }
   }
 
   /// Commands waiting for the mailbox.
   int waiting() const { return count_; }
+  /// Resent commands (the same frame again) answered again or left to their answer, not executed.
+  std::uint32_t resends = 0;
   /// Whether a command frame has come (answers are sent from then on).
   bool commanded() const { return commanded_; }
 
@@ -211,8 +244,47 @@ class CommandPort {
     r.verb = c.verb < MotionNames<MotionVerb>::kCount ? static_cast<MotionVerb>(c.verb) : MotionVerb::kNone;
     r.outcome = CommandOutcome::kRefused;
     r.refusal = why;
+    const pil::AnswerFrame a = frame_from_report(r, task.machine.state, task.gen.queued(), task.tick - 1);
+    remember(a, &c);
     std::uint8_t buf[pil::kMaxFrame];
-    write(buf, pil::encode(frame_from_report(r, task.machine.state, task.gen.queued(), task.tick - 1), buf));
+    write(buf, pil::encode(a, buf));
+  }
+
+  /// A command's fingerprint: the CRC of its encoding (a resend repeats the frame exactly).
+  static std::uint16_t fingerprint(const pil::CommandFrame& c) {
+    std::uint8_t buf[pil::kMaxFrame];
+    const int n = pil::encode(c, buf);
+    return pil::crc16(buf + 2, n - 2);
+  }
+  /// An answered command (its answer frame; `c`, the command when at hand, else the one the tick
+  /// took from the mailbox, whose fingerprint was kept), for resend().
+  void remember(const pil::AnswerFrame& a, const pil::CommandFrame* c = nullptr) {
+    if (a.id == 0) return;
+    Answered& e = answered_[answered_next_];
+    answered_next_ = (answered_next_ + 1) % kAnswersKept;
+    e.answer = a;
+    e.print = c ? fingerprint(*c) : pending_print_;
+  }
+  /// A resend of a command answered, waiting or in the mailbox: answered again as before (true),
+  /// or left to the answer to come (true); false for a new command.
+  template <class Write>
+  bool resend(const ControlTask<S>& task, const pil::CommandFrame& c, Write&& write) {
+    const std::uint16_t print = fingerprint(c);
+    for (const Answered& e : answered_) {
+      if (e.answer.id != c.id || e.print != print) continue;
+      std::uint8_t buf[pil::kMaxFrame];
+      write(buf, pil::encode(e.answer, buf));
+      ++resends;
+      return true;
+    }
+    bool waiting = (task.pending.verb != MotionVerb::kNone && task.pending.id == c.id && pending_print_ == print) ||
+                   (preparing_ && in_.id == c.id && in_.print == print);
+    for (int i = 0; i < count_ && !waiting; ++i) {
+      const pil::CommandFrame& f = fifo_[(head_ + i) % kCommandFifo];
+      waiting = f.id == c.id && fingerprint(f) == print;
+    }
+    if (waiting) ++resends;
+    return waiting;
   }
 
   /// poll_paced() step 1 (masked): the oldest waiting command and its inputs, when the mailbox is free.
@@ -221,6 +293,9 @@ class CommandPort {
     in.frame = fifo_[head_];
     head_ = (head_ + 1) % kCommandFifo;
     --count_;
+    preparing_ = true;
+    in_.id = in.frame.id;
+    in_.print = fingerprint(in.frame);
     in.gen = task.gen;
     in.limits = task.limits;
     in.home_limits = home_limits(task);
@@ -239,11 +314,27 @@ class CommandPort {
     return true;
   }
 
+  /// Answers kept for resends: a client that resends within this many other commands' answers
+  /// gets its own again.
+  static constexpr int kAnswersKept = 8;
+  struct Answered {
+    pil::AnswerFrame answer{};  // id 0: empty
+    std::uint16_t print = 0;
+  };
+
   ParamStorage param_storage_{};
   RamParamStore ram_params_;
   pil::CommandFrame fifo_[kCommandFifo] = {};
   int head_ = 0, count_ = 0;
   bool commanded_ = false;
+  Answered answered_[kAnswersKept] = {};
+  int answered_next_ = 0;
+  std::uint16_t pending_print_ = 0;  // the fingerprint of the command in the task's mailbox (or just taken)
+  bool preparing_ = false;           // poll_paced: a command out of the FIFO, not yet in the mailbox
+  struct {
+    std::uint32_t id = 0;
+    std::uint16_t print = 0;
+  } in_;  // ... that command
 };
 
 /// The command link's silence on a board whose encoders are local (a board's UART: losing the

@@ -375,73 +375,75 @@ constexpr int payload_length(std::uint8_t type) {
 #undef OSC_FRAME_CASE
 }
 
-/// Streaming frame parser: feed bytes one at a time. Every byte is accounted for: part of a frame
-/// (kPending, then kFrame, kBadChecksum, kBadHeader or kBadLength when the frame ends), or junk
-/// (kJunk: junk() bytes discarded while hunting for the sync pair).
+/// Streaming frame parser with resynchronisation: nothing that arrived whole is lost. Bytes are fed
+/// one at a time; feed() returns the first event the byte completes, and next() each further one
+/// (a caller drains them: `for (r = p.feed(b); r != Parser::kPending; r = p.next())`). After a kFrame,
+/// decode() reads its payload until the next call; after a kJunk, junk() counts its bytes. Every
+/// byte is accounted for: part of a frame (kFrame), the start of a frame that failed (kBadHeader,
+/// kBadLength, kBadChecksum, kShortFrame: its first sync byte), or junk (bytes discarded while
+/// hunting for the sync pair, coalesced into one kJunk).
+///
+/// The rule on every transport (docs/protocol.md, "Framing and resynchronisation"): a frame that
+/// fails (an unknown type, a wrong length, a CRC mismatch, or cut short: silence for the transport's
+/// in-frame timeout before its end, expire()) gives up only its first byte; the bytes received after
+/// it are scanned again from there, so that a good frame among them (the next command, sent after a
+/// frame was cut short) is found, whether its end has come already or comes later. Bytes that only
+/// look like a frame's start hold the frames after them at most until their length is reached or
+/// the timeout expires. Allocation-free: the buffer holds one frame.
 class Parser {
  public:
-  enum Result : std::uint8_t { kPending, kFrame, kJunk, kBadHeader, kBadLength, kBadChecksum };
+  enum Result : std::uint8_t { kPending, kFrame, kJunk, kBadHeader, kBadLength, kBadChecksum, kShortFrame };
 
+  /// One received byte: the first event it completes (kPending: none); next() gives the others.
   Result feed(std::uint8_t b) {
-    switch (stage_) {
-      case 0:  // hunting for the first sync byte; anything else is junk
-        if (b == kSync0) {
-          stage_ = 1;
-          return kPending;
-        }
-        junk_ = 1;
-        return kJunk;
-      case 1:
-        if (b == kSync1) {
-          stage_ = 2;
-          return kPending;
-        }
-        // Lost sync: the sync byte before was junk, and so is this one unless it starts a frame.
-        stage_ = b == kSync0 ? 1 : 0;
-        junk_ = b == kSync0 ? 1 : 2;
-        return kJunk;
-      case 2:
-        buf_[0] = b;
-        stage_ = 3;
-        return kPending;
-      case 3: {
-        buf_[1] = b;
-        const int expect = payload_length(buf_[0]);
-        if (expect < 0 || b != expect) {
-          stage_ = 0;
-          return expect < 0 ? kBadHeader : kBadLength;
-        }
-        need_ = b + 2;  // payload and CRC
-        have_ = 0;
-        stage_ = 4;
-        return kPending;
-      }
-      default: {
-        buf_[2 + have_++] = b;
-        if (have_ < need_) return kPending;
-        stage_ = 0;
-        const int n = buf_[1];
-        const std::uint16_t crc = static_cast<std::uint16_t>(buf_[2 + n] | (buf_[3 + n] << 8));
-        return crc16(buf_, n + 2) == crc ? kFrame : kBadChecksum;
-      }
+    settle();
+    if (n_ == kBuffer) compact();
+    if (n_ == kBuffer) {  // events not drained: the byte cannot be kept (counted as junk)
+      junk_ = 1;
+      offset_ = fed_++;
+      return kJunk;
     }
+    buf_[n_++] = b;
+    ++fed_;
+    return scan();
   }
-  /// Bytes the last kJunk result discarded (1 or 2).
+  /// The next event of the bytes already received (kPending: none left).
+  Result next() {
+    settle();
+    return scan();
+  }
+  /// The transport's in-frame timeout: the frame in progress, if any, is cut short (kShortFrame;
+  /// next() gives what the bytes after its first are found to hold). kPending when none was.
+  Result expire() {
+    settle();
+    if (pos_ == 0 || s_ + pos_ < n_) return scan();  // no frame in progress, or bytes not scanned yet
+    return fail(kShortFrame);
+  }
+
+  /// Bytes the last kJunk result discarded (1 or more).
   int junk() const { return junk_; }
   /// The error kind of a result other than kPending and kFrame.
   static constexpr LinkError error_of(Result r) {
-    return r == kJunk ? kErrJunk : r == kBadHeader ? kErrHeader : r == kBadLength ? kErrLength : kErrCrc;
+    return r == kJunk         ? kErrJunk
+           : r == kBadHeader  ? kErrHeader
+           : r == kBadLength  ? kErrLength
+           : r == kShortFrame ? kErrShortFrame
+                              : kErrCrc;
   }
-  /// True while a frame has started but not completed (a timeout here is a short frame).
-  bool in_frame() const { return stage_ != 0; }
-  void reset() { stage_ = 0; }
-  FrameType type() const { return static_cast<FrameType>(buf_[0]); }
+  /// True while a frame has started but not completed (the in-frame timeout applies).
+  bool in_frame() const { return pos_ != 0 && frame_ == 0; }
+  void reset() { s_ = n_ = pos_ = need_ = frame_ = junk_ = 0; }
+  /// After kFrame: the frame's type.
+  FrameType type() const { return static_cast<FrameType>(buf_[s_ + 2]); }
+  /// After an event: the offset in the byte stream (bytes fed since construction, mod 2^32) of the
+  /// frame's first byte; for kJunk, of its first byte.
+  std::uint32_t offset() const { return offset_; }
 
-  /// decode(frame): the last kFrame's payload into a frame of its type (false for another type).
+  /// decode(frame): after kFrame, its payload into a frame of its type (false for another type).
 #define OSC_FRAME_DECODE(Name, code, name, from, when, FIELDS) \
   bool decode(Name##Frame& f) const {                          \
-    if (type() != k##Name##Frame) return false;                \
-    detail::Reader r{buf_ + 2};                                \
+    if (frame_ == 0 || type() != k##Name##Frame) return false; \
+    detail::Reader r{buf_ + s_ + 4};                           \
     FIELDS(OSC_FIELD_GET)                                      \
     return true;                                               \
   }
@@ -449,8 +451,78 @@ class Parser {
 #undef OSC_FRAME_DECODE
 
  private:
-  std::uint8_t buf_[kMaxFrame] = {};
-  int stage_ = 0, need_ = 0, have_ = 0, junk_ = 0;
+  /// Room for a frame and the bytes after a candidate that failed near its end.
+  static constexpr int kBuffer = 2 * kMaxFrame;
+
+  /// The stream offset of buf_[s_].
+  std::uint32_t start_offset() const { return fed_ - static_cast<std::uint32_t>(n_ - s_); }
+  /// The frame the last call returned leaves the buffer.
+  void settle() {
+    if (frame_ == 0) return;
+    s_ += frame_;
+    frame_ = pos_ = 0;
+    if (s_ == n_) s_ = n_ = 0;
+  }
+
+  /// Scans the bytes not yet scanned up to the next event: buf_[s_, s_ + pos_) is the candidate
+  /// frame, buf_[s_ + pos_, n_) the bytes after it.
+  Result scan() {
+    int junk = 0;
+    const std::uint32_t junk_at = start_offset();
+    while (s_ + pos_ < n_) {
+      const std::uint8_t b = buf_[s_ + pos_];
+      if (pos_ == 0) {
+        if (b != kSync0) {
+          ++junk, ++s_;
+          continue;
+        }
+        if (junk > 0) break;  // the junk before this frame first
+        pos_ = 1;
+      } else if (pos_ == 1) {
+        if (b == kSync1) {
+          pos_ = 2;
+        } else {  // lost sync: the first sync byte was junk, this byte is scanned again
+          ++junk, ++s_;
+          pos_ = 0;
+        }
+      } else if (pos_ == 2) {
+        pos_ = 3;
+      } else if (pos_ == 3) {
+        const int expect = payload_length(buf_[s_ + 2]);
+        if (expect < 0 || b != expect) return fail(expect < 0 ? kBadHeader : kBadLength);
+        need_ = b + kOverhead;
+        pos_ = 4;
+      } else if (++pos_ == need_) {
+        const int len = buf_[s_ + 3];
+        const std::uint16_t crc = static_cast<std::uint16_t>(buf_[s_ + 4 + len] | (buf_[s_ + 5 + len] << 8));
+        if (crc16(buf_ + s_ + 2, len + 2) != crc) return fail(kBadChecksum);
+        offset_ = start_offset();
+        frame_ = need_;
+        return kFrame;
+      }
+    }
+    if (s_ == n_) s_ = n_ = 0;
+    if (junk == 0) return kPending;
+    junk_ = junk;
+    offset_ = junk_at;
+    return kJunk;
+  }
+  /// The candidate fails: its bytes after the first are scanned again by the next call.
+  Result fail(Result r) {
+    offset_ = start_offset();
+    ++s_;
+    pos_ = 0;
+    return r;
+  }
+  void compact() {
+    std::memmove(buf_, buf_ + s_, static_cast<std::size_t>(n_ - s_));
+    n_ -= s_;
+    s_ = 0;
+  }
+
+  std::uint8_t buf_[kBuffer] = {};
+  int s_ = 0, n_ = 0, pos_ = 0, need_ = 0, frame_ = 0, junk_ = 0;
+  std::uint32_t fed_ = 0, offset_ = 0;
 };
 
 #undef OSC_FIELD_PUT

@@ -4,9 +4,10 @@
 // received byte, and runs tick() from the control interrupt, paced in one of two ways:
 //
 //   lockstep (the host paces the ticks; pil_firmware under QEMU, pil_peer): a tick whenever
-//     on_byte() returns true (a frame ended, valid or not: each sensor frame is answered by exactly
+//     on_byte() calls its `due` (a frame ended, valid or not: each sensor frame is answered by exactly
 //     one actuator frame), and after on_timeout(), which the board calls when no byte came for
-//     params::kLinkTimeout of its time;
+//     params::kLinkTimeout of its time (the link's in-frame timeout: a frame cut short is scanned
+//     again for the frames after its start, pil::Parser);
 //   timer-paced (a board's control timer): a tick every period, whatever arrived; a tick with no
 //     frame and no error since the last one keeps the previous codes, for at most
 //     params::kLinkSilenceTicks ticks in a row; the next such tick is a silence error.
@@ -81,50 +82,42 @@ class PilNode {
     answer_seq_ = seq;
   }
 
-  /// Feeds one received byte. Returns true when a frame ended here, valid or not (in lockstep a
-  /// tick follows and answers it).
-  bool on_byte(std::uint8_t b) {
+  /// Feeds one received byte; calls due() for each frame that ended here, valid or not (in lockstep
+  /// a tick follows each and answers it: due() runs it, or pends it to run at once). More than one
+  /// when the parser, after an error, finds a frame in the bytes already received (pil::Parser's
+  /// resynchronisation); the tick of the first must run before the next is handled.
+  template <class Due>
+  void on_byte(std::uint8_t b, Due&& due) {
     note_rx_gap();
-    const pil::Parser::Result r = parser_.feed(b);
-    if (r == pil::Parser::kPending) return false;
-    if (r == pil::Parser::kJunk) {
-      counters_[pil::kErrJunk] += static_cast<std::uint32_t>(parser_.junk());
-      // Junk after a valid frame is a new error; junk after an error (the rest of a frame whose
-      // header or length was bad, or that lost sync) belongs to that error and is only counted.
-      if (synced_) errors_ |= 1u << pil::kErrJunk;
-      synced_ = false;
-      return false;
-    }
-    pil::SensorFrame f;
-    if (r != pil::Parser::kFrame) return lost_frame(pil::Parser::error_of(r));
-    if (!parser_.decode(f)) {
-      // A command or a setpoint: the port's (prepared at once once the first sensor frame has
-      // configured the task). Any other valid frame is of the wrong type.
-      if (!port.receive(task, parser_, LinkWrite{})) return lost_frame(pil::kErrHeader);
-      if (configured_) port.poll(task, LinkWrite{});
-      synced_ = true;
-      return false;
-    }
-    if (f.seq != expected_seq_) error(pil::kErrSeq);
-    if (!configured_) configure(f.inject);  // the first valid frame configures, once
-    port.poll(task, LinkWrite{});           // a waiting command into the free mailbox, before the tick
-    expected_seq_ = f.seq + 1;
-    answer_seq_ = f.seq;
-    frame_ = f;
-    fresh_ = synced_ = true;
-    return true;
+    for (pil::Parser::Result r = parser_.feed(b); r != pil::Parser::kPending; r = parser_.next())
+      if (on_result(r)) due();
+  }
+  /// on_byte() without ticks: the number of frames that ended.
+  int on_byte(std::uint8_t b) {
+    int ended = 0;
+    on_byte(b, [&] { ++ended; });
+    return ended;
   }
 
-  /// Lockstep: no byte for params::kLinkTimeout. A frame had started (or junk came instead of
-  /// one): it is lost (a short frame); otherwise a silence. A tick must follow.
-  void on_timeout() {
+  /// Lockstep: no byte for params::kLinkTimeout (the PIL link's in-frame timeout). A frame had
+  /// started: it is lost (a short frame), and the bytes after its start are scanned again (a frame
+  /// found there ends too); junk came instead of one: lost; otherwise a silence. due() once for
+  /// each (at least once: a tick must follow).
+  template <class Due>
+  void on_timeout(Due&& due) {
     if (parser_.in_frame()) {
-      lost_frame(pil::kErrShortFrame);
+      for (pil::Parser::Result r = parser_.expire(); r != pil::Parser::kPending; r = parser_.next())
+        if (on_result(r)) due();
     } else if (errors_ & (1u << pil::kErrJunk)) {
       lost_frame(pil::kErrSilence);  // a frame whose sync was destroyed: junk, then nothing
+      due();
     } else {
       error(pil::kErrSilence);
+      due();
     }
+  }
+  void on_timeout() {
+    on_timeout([] {});
   }
 
   /// One control tick on the latest sensor frame (runs in the control interrupt).
@@ -174,6 +167,36 @@ class PilNode {
   }
 
  private:
+  /// One parser event: 1 when a frame ended (a tick is due in lockstep), 0 otherwise.
+  int on_result(pil::Parser::Result r) {
+    if (r == pil::Parser::kJunk) {
+      counters_[pil::kErrJunk] += static_cast<std::uint32_t>(parser_.junk());
+      // Junk after a valid frame is a new error; junk after an error (the rest of a frame whose
+      // header or length was bad, or that lost sync) belongs to that error and is only counted.
+      if (synced_) errors_ |= 1u << pil::kErrJunk;
+      synced_ = false;
+      return 0;
+    }
+    if (r != pil::Parser::kFrame) return lost_frame(pil::Parser::error_of(r));
+    pil::SensorFrame f;
+    if (!parser_.decode(f)) {
+      // A command or a setpoint: the port's (prepared at once once the first sensor frame has
+      // configured the task). Any other valid frame is of the wrong type.
+      if (!port.receive(task, parser_, LinkWrite{})) return lost_frame(pil::kErrHeader);
+      if (configured_) port.poll(task, LinkWrite{});
+      synced_ = true;
+      return 0;
+    }
+    if (f.seq != expected_seq_) error(pil::kErrSeq);
+    if (!configured_) configure(f.inject);  // the first valid frame configures, once
+    port.poll(task, LinkWrite{});           // a waiting command into the free mailbox, before the tick
+    expected_seq_ = f.seq + 1;
+    answer_seq_ = f.seq;
+    frame_ = f;
+    fresh_ = synced_ = true;
+    return 1;
+  }
+
   /// Board::link_write as the port's writer.
   struct LinkWrite {
     void operator()(const std::uint8_t* bytes, int n) const { Board::link_write(bytes, n); }
@@ -182,6 +205,7 @@ class PilNode {
   /// The command protocol's frames after the tick's actuator frame: the port's answer and state
   /// frames, then the trace (faults: those the tick detected).
   void tick_frames(std::uint32_t faults) {
+    port.link = counters_;  // the state frames carry the PIL link's counters
     port.after_tick(task, LinkWrite{});
     if (!trace_) return;
     std::uint8_t buf[pil::kMaxFrame];
@@ -218,13 +242,12 @@ class PilNode {
     errors_ |= 1u << e;
   }
   /// A frame ended unreadable (or never ended): presumed to be the expected one, so that its answer
-  /// carries the sequence number the host is waiting for. Returns true (a tick is due).
-  bool lost_frame(pil::LinkError e) {
+  /// carries the sequence number the host is waiting for. Returns 1 (a tick is due).
+  int lost_frame(pil::LinkError e) {
     error(e);
-    parser_.reset();
     synced_ = false;
     answer_seq_ = expected_seq_++;
-    return true;
+    return 1;
   }
 
   /// Records a tick with link errors; returns the link fault to latch when it is the
