@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the tables of measured figures in docs/ from runs and test output.
 
-usage: docs_tables.py [--check] [--kind host|m4f|m3|long ...] [--only NAME ...] [--list]
+usage: docs_tables.py [--check] [--kind host|m4f|m3|long ...] [--only NAME ...] [--keep-going] [--list]
 
 A generated table sits between two markers in a docs/*.md file:
 
@@ -16,7 +16,8 @@ and is rewritten in place. Kinds:
   m3    the Cortex-M3 images (fixed point, and the soft-float alternative): the same figures;
         checked in CI (ctest docs_tables_m3 in the m3 preset)
   long  runs of minutes to hours (QEMU experiment, fault-injection matrix, benchmarks): regenerated
-        by hand with --kind long, never checked (wall-clock figures vary from run to run)
+        by hand with --kind long (scripts/long_runs.sh, docs/long_runs.md), never checked in CI
+        (hours of runs; wall-clock figures vary from run to run)
   protocol  the link protocol's tables in docs/protocol.md, from the host build's osc_protocol (the
         firmware's field lists, constants and encoder); checked exactly in CI (ctest docs_tables_protocol)
 
@@ -25,6 +26,8 @@ or numbers within 2 % (the host build computes the same bits on every x86-64 mac
 -DOSC_NATIVE_PLANT=ON does not, and its quantisation-level figures can move by more); exit 1 listing
 the stale tables.
 By default every host and m4f table whose build exists is regenerated (and written).
+--keep-going: a table that fails (a run that faulted where the table expects none, a build missing)
+is reported and the others are still done; the end line counts them, and the exit status is 1.
 """
 import argparse
 import concurrent.futures
@@ -35,6 +38,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 HOST = os.path.join(ROOT, "build", "host")
@@ -1511,6 +1515,8 @@ def main(argv):
                     help="the kinds of tables to do")
     ap.add_argument("--only", action="append", help="only these tables")
     ap.add_argument("--list", action="store_true", help="list the tables")
+    ap.add_argument("--keep-going", action="store_true",
+                    help="report a table that fails and go on with the others (exit 1 at the end)")
     ap.add_argument("--host-build", default=HOST, help="the host preset's build directory")
     ap.add_argument("--m4f-build", default=M4F, help="the m4f preset's build directory")
     ap.add_argument("--m3-build", default=M3, help="the m3 preset's build directory")
@@ -1529,7 +1535,7 @@ def main(argv):
     if "host" in kinds and not os.access(EXPERIMENT, os.X_OK):
         print(f"docs_tables.py: {EXPERIMENT} is not built (cmake --build --preset host)", file=sys.stderr)
         return 2
-    stale, done = [], 0
+    stale, failed, done = [], [], 0
     for name in names:
         doc, kind, fn = TABLES[name]
         path = os.path.join(ROOT, doc)
@@ -1537,7 +1543,15 @@ def main(argv):
             if not block_re(name).search(f.read()):
                 print(f"docs_tables.py: {doc} has no markers for table '{name}'", file=sys.stderr)
                 return 2
-        new = fn()
+        start = time.monotonic()
+        try:
+            new = fn()
+        except Exception as e:  # any failure of its runs is the table's
+            if not a.keep_going:
+                raise
+            print(f"FAILED  {name} ({doc}) after {time.monotonic() - start:.0f} s: {type(e).__name__}: {e}")
+            failed.append(name)
+            continue
         with open(path) as f:  # read again after a long run: the file may have been edited meanwhile
             text = f.read()
         m = block_re(name).search(text)
@@ -1553,13 +1567,16 @@ def main(argv):
             text = text[:m.start(2)] + new.strip() + text[m.end(2):]
             with open(path, "w") as f:
                 f.write(text)
-            print(f"wrote {name} ({doc})")
+            print(f"wrote {name} ({doc}) in {time.monotonic() - start:.0f} s")
         done += 1
     if a.check:
-        print(f"{done - len(stale)} of {done} tables current" + (f"; stale: {', '.join(stale)}" if stale else "")
+        print(f"{done - len(stale)} of {done + len(failed)} tables current"
+              + (f"; stale: {', '.join(stale)}" if stale else "") + (f"; failed: {', '.join(failed)}" if failed else "")
               + ("; regenerate with: python3 scripts/docs_tables.py" if stale else ""))
-        return 1 if stale else 0
-    return 0
+        return 1 if stale or failed else 0
+    if a.keep_going:
+        print(f"{done} of {done + len(failed)} tables written" + (f"; failed: {', '.join(failed)}" if failed else ""))
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

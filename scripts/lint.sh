@@ -5,6 +5,8 @@
 #                  them every project header they include (the firmware's, the HAL's, the STM32F4 board's)
 #   flake8         the Python scripts (setup.cfg)
 #   function lengths  no function of firmware/, host_sim/, boards/ or tests/boards/ over 80 lines
+#   docs figures   no frame size, fault bit or README instruction count typed in the hand-written
+#                  docs that disagrees with (or repeats) a generated table (scripts/docs_figures.py)
 # usage: scripts/lint.sh [HOST_BUILD_DIR]   (default build/host; it needs compile_commands.json)
 # Exit 1 when a check fails, with what to run to fix it.
 set -uo pipefail
@@ -43,6 +45,9 @@ fi
 
 step "function lengths"
 /usr/bin/python3 scripts/function_lengths.py --limit 80 --check || { echo "lint: functions over 80 lines"; status=1; }
+
+step "docs figures"
+/usr/bin/python3 scripts/docs_figures.py || { echo "lint: figures typed in the docs that a generated table holds"; status=1; }
 
 [ $status -eq 0 ] && echo "lint: pass" || echo "lint: FAIL"
 exit $status

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Sets up, builds, lints (scripts/lint.sh) and runs every test: host (kernels, simulator,
-# experiment), the Cortex-M4F and Cortex-M3 cross builds (image checks and firmware tests under QEMU; the M3 runs the fixed-point
-# controller), and the sanitizer build (the host tests under ASan + UBSan, and each libFuzzer target
-# for a fixed time: docs/fuzzing.md).
+# experiment; the closed-loop runs of label "long" included), the Cortex-M4F and Cortex-M3 cross
+# builds (image checks and firmware tests under QEMU; the M3 runs the fixed-point controller), and
+# the sanitizer build (the host tests but label "long" under ASan + UBSan, and each libFuzzer target
+# for a fixed time: docs/fuzzing.md). Not here: the hours of scripts/long_runs.sh (docs/long_runs.md).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Each stage's wall time, printed as it ends (CI must stay under 45 minutes on the 2-core machine).
@@ -15,6 +16,8 @@ cmake --build --preset host
 stage "host build"
 bash scripts/lint.sh build/host
 stage lint
+# Every host test, label "long" included (docs/long_runs.md): ctest's "Label Time Summary" at the
+# end of its output gives that label's share of this stage.
 ctest --preset host
 stage "host tests"
 if [ -f boards/CMakeLists.txt ]; then
