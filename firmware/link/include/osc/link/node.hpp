@@ -66,6 +66,7 @@ class PilNode {
     errors_ = 0;
     fresh_ = synced_ = sample_ = false;
     configured_ = false;
+    expire_due_ = false;
     silent_ticks_ = 0;
     latch_ = 0;
     error_count_ = error_next_ = 0;
@@ -89,6 +90,12 @@ class PilNode {
   template <class Due>
   void on_byte(std::uint8_t b, Due&& due) {
     note_rx_gap();
+    if (expire_due_) {  // a frame a timer-paced tick cut short (and counted): its bytes scanned again here
+      expire_due_ = false;
+      if (parser_.expire() != pil::Parser::kPending)
+        for (pil::Parser::Result r = parser_.next(); r != pil::Parser::kPending; r = parser_.next())
+          if (on_result(r)) due();
+    }
     for (pil::Parser::Result r = parser_.feed(b); r != pil::Parser::kPending; r = parser_.next())
       if (on_result(r)) due();
   }
@@ -129,7 +136,7 @@ class PilNode {
         tick_frames(0);
         return;
       }
-      on_timeout();
+      silence_in_tick();
     }
     sample_ = fresh_ && errors_ == 0;
     if (!sample_) latch_ |= count_error_tick();
@@ -167,6 +174,19 @@ class PilNode {
   }
 
  private:
+  /// Timer-paced: the silence rule fired in the tick (the control interrupt), which parses nothing:
+  /// a frame begun is a short frame, and the main loop's next on_byte() scans its bytes again.
+  void silence_in_tick() {
+    if (parser_.in_frame()) {
+      lost_frame(pil::kErrShortFrame);
+      expire_due_ = true;
+    } else if (errors_ & (1u << pil::kErrJunk)) {
+      lost_frame(pil::kErrSilence);
+    } else {
+      error(pil::kErrSilence);
+    }
+  }
+
   /// One parser event: 1 when a frame ended (a tick is due in lockstep), 0 otherwise.
   int on_result(pil::Parser::Result r) {
     if (r == pil::Parser::kJunk) {
@@ -284,9 +304,10 @@ class PilNode {
   bool synced_ = false;                        // the last thing received was a valid frame (junk now is a new error)
   bool sample_ = false;                        // this tick has a valid sample
   bool configured_ = false;
-  bool trace_ = false;                                       // a trace frame after every tick (kConfigTrace)
-  int silent_ticks_ = 0;                                     // timer-paced: ticks in a row without a frame
-  std::uint32_t latch_ = 0;                                  // link fault for io_faults()
+  bool expire_due_ = false;  // timer-paced: a short frame counted by the tick, to be scanned again
+  bool trace_ = false;       // a trace frame after every tick (kConfigTrace)
+  int silent_ticks_ = 0;     // timer-paced: ticks in a row without a frame
+  std::uint32_t latch_ = 0;  // link fault for io_faults()
   std::uint64_t error_ticks_[params::kLinkErrorLimit] = {};  // ticks of the latest error ticks
   int error_count_ = 0, error_next_ = 0;
   bool have_rx_ = false;
