@@ -148,8 +148,9 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
     return c;
   }
   // A re-target, or a move after the paper's motion, starts where the running motion comes to rest
-  // when braked in the tick after the command's.
-  c.brake = req.replace || gen.source() == MotionSource::kPaper;
+  // when braked in the tick after the command's (or where its brake ends: the moves waiting are
+  // dropped). A move while the paper's motion slows down for one is queued behind it.
+  c.brake = req.replace || (gen.source() == MotionSource::kPaper && !gen.braking());
   if (!c.brake && gen.queue_full()) {
     c.refusal = MotionReason::kQueueFull;
     return c;
