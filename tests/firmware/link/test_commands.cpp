@@ -1248,9 +1248,18 @@ TEST_F(NodeFrames, AFaultAbortsTheMoveAndDropsTheQueueInItsTickAndTheStateFrameS
   expect_nothing_queued(MotionState::kFault);
   tick();
   expect_nothing_queued(MotionState::kFault);
+  // The machine's refusals, not busy: no motion is left in the generator.
+  take(command(19, MotionVerb::kPaper));
+  EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kFaulted));
   take(command(20, MotionVerb::kClear));
   EXPECT_EQ(RecordingBoard::answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
   expect_nothing_queued(MotionState::kDisabled);
+  for (MotionVerb v : {MotionVerb::kPaper, MotionVerb::kStream}) {
+    pil::CommandFrame f = command(21, v);
+    f.period = 10;
+    take(f);
+    EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kNotEnabled));
+  }
   expect_each_ended_once(ids);
 }
 
