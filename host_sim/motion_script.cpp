@@ -514,13 +514,9 @@ void Player<Arm>::observe(double t, const osc::MotionReport& rep) {
     if (r->accepted && !motion && state_ != osc::MotionState::kStopping) r->done_s = t;
   }
   if (CommandRecord* r = record(rep.done_id)) r->done_s = t, r->running = false;
+  // Aborted, or dropped from the queue (an answer of its own): every motion ends in one answer.
   if (CommandRecord* r = rep.abort != osc::MotionReason::kNone ? record(rep.aborted_id) : nullptr)
     r->aborted = osc::motion_name(rep.abort), r->aborted_s = t, r->running = false;
-  // The moves waiting behind it are dropped with it (not the re-targeting move answered in this tick).
-  if (rep.abort != osc::MotionReason::kNone)
-    for (CommandRecord& r : run_.commands)
-      if (r.running && r.id != rep.aborted_id && !(rep.outcome != osc::CommandOutcome::kNone && r.id == rep.id))
-        r.aborted = osc::motion_name(rep.abort), r.aborted_s = t, r.running = false;
   if (rep.completion != osc::MotionCompletion::kNone)  // a stop or disable that reached rest
     for (CommandRecord& r : run_.commands)
       if (r.accepted && r.done_s < 0 && (r.cmd == "stop" || r.cmd == "disable")) r.done_s = t;

@@ -99,11 +99,17 @@ static_assert(10u * (pil::kMaxFrame * kControlHz / kTelemetryEvery +
                      (pil::kStatePayload + pil::kOverhead) * kControlHz / kStateEvery) <=
                   kTelemetryBaud * 6 / 10,
               "telemetry and state frames fill at most 60 % of the line: answers have room");
-/// Frames the transmitter queues: a tick gives at most three (answer, state, telemetry), and the
-/// main loop sends none while it checks a move's path (a tick or two).
-constexpr int kTxFrames = 8;
+/// Answer frames a tick may give: its own, and one for each move it drops from the motion queue (a
+/// stop behind a full queue: osc::MotionGenerator::kMaxWaiting).
+constexpr int kTxAnswers = 1 + osc::params::kMoveQueueLength + 1;
+/// Frames the transmitter queues (a power of two: the queue's indices wrap): a tick gives its
+/// answers, a state frame and a telemetry frame, and the main loop sends none while it checks a
+/// move's path (a tick or two).
+constexpr int kTxFrames = 32;
 /// Telemetry is offered only while this many slots stay free: an answer never waits behind it.
-constexpr int kTxAnswerReserve = 3;
+constexpr int kTxAnswerReserve = kTxAnswers + 2;
+static_assert(kTxFrames >= kTxAnswerReserve + 3 && (kTxFrames & (kTxFrames - 1)) == 0,
+              "room for a tick's answers, state and telemetry, and for telemetry behind the reserve");
 /// Received bytes the ring holds: 512 bytes are 11 ms of the line, far longer than the main loop's
 /// longest busy stretch (a path check, 1 to 2 ms).
 constexpr unsigned kRxBytes = 512;

@@ -516,18 +516,16 @@ class Client:
                     return o
                 motion = a["verb"] in motion_verbs
                 wait_rest = not motion and name("motion_states", a["state"]) == "stopping"
-                if not motion and not wait_rest or motion and a["done_id"] == cid:
+                if not motion and not wait_rest:
                     o.status = "done"
-                    return o
-                if motion and a["aborted_id"] == cid and name("reasons", a["abort"]) != "none":
-                    o.status, o.reason = "aborted", name("reasons", a["abort"])
                     return o
                 continue
             if wait_rest and name("completions", a["completion"]) != "none" or motion and a["done_id"] == cid:
                 o.answer, o.status = a, "done"
                 return o
-            # An abort after ours was accepted ends it too: the running motion, or the one it queued behind.
-            if motion and name("reasons", a["abort"]) != "none":
+            # A motion ends in exactly one answer naming it: done, or aborted with a reason (a move still
+            # queued when the motion ahead of it was stopped, re-targeted or faulted: dropped).
+            if motion and a["aborted_id"] == cid and name("reasons", a["abort"]) != "none":
                 o.answer, o.status, o.reason = a, "aborted", name("reasons", a["abort"])
                 return o
         return o

@@ -358,18 +358,16 @@ Outcome Client::evaluate(std::uint32_t id, bool until_done) const {
       motion = motion_verb(a.verb);
       wait_rest = !motion && a.state == static_cast<std::uint8_t>(MotionState::kStopping);
       if (!motion && !wait_rest) return o.status = Status::kDone, o;
-      if (motion && a.done_id == id) return o.status = Status::kDone, o;
-      if (motion && a.aborted_id == id && a.abort != 0)
-        return o.status = Status::kAborted, o.reason = static_cast<MotionReason>(a.abort), o;
       continue;
     }
     if (wait_rest && a.completion != static_cast<std::uint8_t>(MotionCompletion::kNone))
       return o.answer = a, o.status = Status::kDone, o;
-    if (motion && a.done_id == id) return o.answer = a, o.status = Status::kDone, o;
-    // An abort after ours was accepted ends it too: the running motion, or the one it queued behind
-    // (a stop, a re-target and a fault drop the waiting moves with the running one).
-    if (motion && a.abort != static_cast<std::uint8_t>(MotionReason::kNone))
-      return o.answer = a, o.status = Status::kAborted, o.reason = static_cast<MotionReason>(a.abort), o;
+    // A motion ends in exactly one answer frame naming it: done, or aborted with a reason (a move
+    // still queued when the motion ahead of it was stopped, re-targeted or faulted: dropped).
+    if (!motion || !answer_ends(a, id)) continue;
+    o.answer = a;
+    if (a.done_id == id) return o.status = Status::kDone, o;
+    return o.status = Status::kAborted, o.reason = static_cast<MotionReason>(a.abort), o;
   }
   o.status = Status::kTimeout;
   return o;

@@ -126,10 +126,11 @@ class Client {
   /// controller runs a command once and answers a repeat with the answer it gave).
   Outcome wait_answer(std::uint32_t id, double timeout_s);
   static constexpr double kResendS = 0.5;
-  /// The command's end: a motion (move_to, paper, stream) kDone when it reached its target at rest,
-  /// kAborted with the reason when it (or the running motion it queued behind) was aborted; a stop
-  /// or a disable that stops a motion kDone at rest; any other command kDone once accepted; kRefused
-  /// with the reason; or kTimeout, kError.
+  /// The command's end: a motion (move_to, paper, stream, home) kDone when it reached its target at
+  /// rest, kAborted with the reason when it was aborted (`dropped`: a move still queued when the
+  /// motion ahead of it was stopped, re-targeted or faulted), each from the one answer frame that
+  /// names its id; a stop or a disable that stops a motion kDone at rest; any other command kDone
+  /// once accepted; kRefused with the reason; or kTimeout, kError.
   Outcome wait_done(std::uint32_t id, double timeout_s);
 
   /// A parameter request (osc/link/param_frames.hpp): the param frame sent, its param_answer awaited

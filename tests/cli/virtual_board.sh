@@ -22,6 +22,9 @@
 #                                      refused torque_on while enabled
 #   oscctl_homing, python_homing       declare_pose (refused pots_disagree, accepted, refused torque_on;
 #                                      an unknown pose exit 2), home done
+#   python_queue                       the Python module: a slow move and two queued behind it, a stop:
+#                                      the running move aborted stop_command, each queued one aborted
+#                                      dropped (its own answer frame), the state frame's queue empty
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
@@ -250,6 +253,31 @@ case "$case_" in
   python_homing)
     start_sim --speed 4 --scalar float
     homing_sequence "$py" "$client" --port "$port" --timeout 60
+    stop_sim
+    ;;
+  python_queue)
+    start_sim --speed 4 --scalar float
+    "$py" - "$client" "$port" >"$tmp/queue.out" 2>&1 <<'PY' || fail "$(cat "$tmp/queue.out")"
+import os, sys
+sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[1])))
+import osc_client
+c = osc_client.Client(sys.argv[2])
+assert c.wait_answer(c.enable(), 60).status == "accepted"
+ids = [c.move_to((0, 0.02, 0), relative=True, limits=c.limits(v=0.01))]
+for dy in (-0.02, 0.02):
+    ids.append(c.move_to((0, dy, 0), relative=True))
+for i in ids:
+    assert c.wait_answer(i, 60).status == "accepted", i
+stop = c.stop()
+assert c.wait_answer(stop, 60).status == "accepted"
+got = [c.wait_done(i, 60).text() for i in ids]
+assert got == ["aborted: stop_command", "aborted: dropped", "aborted: dropped"], got
+assert c.wait_done(stop, 60).status == "done"
+s = c.state(10)
+assert (s["queued"], s["running_id"]) == (0, 0), s
+print("ok:", got)
+PY
+    cat "$tmp/queue.out"
     stop_sim
     ;;
   sim_options)

@@ -247,6 +247,12 @@ std::uint32_t homing_fault(sim::ExperimentConfig cfg, const sim::Injection& inj 
   EXPECT_FALSE(h.homed);
   EXPECT_FALSE(s->task().homed);
   EXPECT_EQ(s->task().machine.state, MotionState::kFault);
+  // The home command ends once, in the fault's tick: aborted faulted, not done (its move's end, in
+  // that tick when an index pulse is missing, is not the home's).
+  const MotionReport& rep = s->task().report;
+  EXPECT_EQ(rep.abort, MotionReason::kFaulted);
+  EXPECT_EQ(rep.aborted_id, 2u);
+  EXPECT_EQ(rep.done_id, 0u);
   return h.faults;
 }
 

@@ -82,6 +82,20 @@ struct OscClient : ::testing::Test {
     const Outcome o = c.wait_answer(c.enable(), 10);
     ASSERT_EQ(o.status, Status::kAccepted) << o.text();
   }
+  /// Every command of ids ended exactly once in the answers the client received (osc::answer_ends:
+  /// done, or aborted with a reason).
+  void expect_each_ended_once(const std::vector<std::uint32_t>& ids) const {
+    for (std::uint32_t id : ids)
+      EXPECT_EQ(std::count_if(answers.begin(), answers.end(),
+                              [id](const pil::AnswerFrame& a) { return osc::answer_ends(a, id); }),
+                1)
+          << "command " << id;
+  }
+  /// Every answer frame received.
+  std::vector<pil::AnswerFrame> answers;
+  void SetUp() override {
+    c.on_answer = [this](const pil::AnswerFrame& a) { answers.push_back(a); };
+  }
 };
 
 TEST_F(OscClient, RefusedWhileDisabledThenEnabledAndAMoveDone) {
@@ -149,26 +163,103 @@ TEST_F(OscClient, AGainSetOverTheLinkTakesEffectOnTheNextMove) {
   EXPECT_EQ(refused->value, 100.0f);
 }
 
-TEST_F(OscClient, AStopAbortsTheRunningMoveAndTheOneQueuedBehindIt) {
+TEST_F(OscClient, AStopAbortsTheRunningMoveAndDropsEveryMoveQueuedBehindIt) {
   enable();
-  const std::uint32_t a = c.move_to(relative(0, 0.05, 0, 0.01));
-  const std::uint32_t b = c.move_to(relative(0, -0.05, 0));
-  EXPECT_EQ(c.wait_answer(a, 10).status, Status::kAccepted);
-  EXPECT_EQ(c.wait_answer(b, 10).status, Status::kAccepted);
-  EXPECT_EQ(c.state(1)->queued, 2);
+  // A full queue: the running move and sixteen waiting, each sent once the one before was answered.
+  std::vector<std::uint32_t> ids;
+  for (int k = 0; k <= osc::params::kMoveQueueLength; ++k) {
+    ids.push_back(c.move_to(relative(0, k % 2 ? -0.002 : 0.002, 0, 0.01)));
+    ASSERT_EQ(c.wait_answer(ids.back(), 10).status, Status::kAccepted) << k;
+  }
+  const Outcome full = c.wait_answer(c.move_to(relative(0, 0.002, 0)), 10);
+  EXPECT_EQ(full.text(), "refused: queue_full");
+  EXPECT_EQ(c.state(1)->queued, ids.size());
   const std::uint32_t stop = c.stop();
   const Outcome s = c.wait_answer(stop, 10);
   ASSERT_EQ(s.status, Status::kAccepted);
-  EXPECT_EQ(s.answer.aborted_id, a);
-  for (std::uint32_t id : {a, b}) {
+  EXPECT_EQ(s.answer.aborted_id, ids[0]);
+  for (std::uint32_t id : ids) {
     const Outcome o = c.wait_done(id, 10);
     EXPECT_EQ(o.status, Status::kAborted) << id;
-    EXPECT_EQ(o.text(), "aborted: stop_command");
+    EXPECT_EQ(o.answer.aborted_id, id);
+    EXPECT_EQ(o.text(), id == ids[0] ? "aborted: stop_command" : "aborted: dropped");
   }
   const Outcome rest = c.wait_done(stop, 30);  // a stop is done at rest
   EXPECT_EQ(rest.status, Status::kDone);
   EXPECT_EQ(rest.answer.completion, static_cast<std::uint8_t>(osc::MotionCompletion::kStopped));
-  EXPECT_EQ(c.state(1)->state, static_cast<std::uint8_t>(osc::MotionState::kHolding));
+  expect_each_ended_once(ids);
+  const auto st = c.state(1);
+  ASSERT_TRUE(st);
+  EXPECT_EQ(st->state, static_cast<std::uint8_t>(osc::MotionState::kHolding));
+  EXPECT_EQ(st->queued, 0);
+  EXPECT_EQ(st->running_id, 0u);
+}
+
+/// A re-target drops the moves waiting; a second one while the first brakes drops the first's
+/// move (the braking motion was aborted already) and starts from where the braking motion comes
+/// to rest.
+TEST_F(OscClient, AReplaceDropsTheQueueAndASecondReplaceDuringItsBrakeTheFirstsMove) {
+  enable();
+  const auto s0 = c.state(1);
+  ASSERT_TRUE(s0);
+  const std::uint32_t a = c.move_to(relative(0, 0.02, 0, 0.01));
+  ASSERT_EQ(c.wait_answer(a, 10).status, Status::kAccepted);
+  const std::uint32_t b = c.move_to(relative(0, -0.02, 0));
+  ASSERT_EQ(c.wait_answer(b, 10).status, Status::kAccepted);
+  osc::MoveRequest<double> r = relative(0.02, 0, 0);
+  r.replace = true;
+  const std::uint32_t d = c.move_to(r);
+  const Outcome od = c.wait_answer(d, 10);
+  ASSERT_EQ(od.status, Status::kAccepted);
+  EXPECT_EQ(od.answer.aborted_id, a);
+  EXPECT_EQ(od.answer.abort, static_cast<std::uint8_t>(osc::MotionReason::kSuperseded));
+  r = relative(0, 0, 0.01);
+  r.replace = true;
+  const std::uint32_t e = c.move_to(r);
+  const Outcome oe = c.wait_answer(e, 10);
+  ASSERT_EQ(oe.status, Status::kAccepted);
+  EXPECT_EQ(oe.answer.aborted_id, 0u);  // the braking move was aborted already
+  EXPECT_EQ(c.wait_done(a, 1).text(), "aborted: superseded");
+  EXPECT_EQ(c.wait_done(b, 1).text(), "aborted: dropped");
+  EXPECT_EQ(c.wait_done(d, 1).text(), "aborted: dropped");
+  const Outcome done = c.wait_done(e, 60);
+  EXPECT_EQ(done.status, Status::kDone) << done.text();
+  expect_each_ended_once({a, b, d, e});
+  // e went 10 mm up from where a came to rest (a barely started along y: 10 mm/s for a few ticks),
+  // not from where d would have ended (20 mm along x).
+  const auto st = c.state(1);
+  ASSERT_TRUE(st);
+  EXPECT_NEAR(st->x_d[0] - s0->x_d[0], 0, 1e-4);
+  EXPECT_NEAR(st->x_d[1] - s0->x_d[1], 0, 1e-3);
+  EXPECT_NEAR(st->x_d[2] - s0->x_d[2], 0.01, 1e-4);
+  EXPECT_EQ(st->queued, 0);
+}
+
+TEST_F(OscClient, AFaultAbortsTheMoveAndDropsTheQueueAndTheStateFrameSaysSoUntilTheNextEnable) {
+  enable();
+  std::vector<std::uint32_t> ids;
+  for (int k = 0; k < 4; ++k) {
+    ids.push_back(c.move_to(relative(0, k % 2 ? -0.01 : 0.01, 0)));
+    ASSERT_EQ(c.wait_answer(ids.back(), 10).status, Status::kAccepted) << k;
+  }
+  t->sim().task().inject_nonfinite();  // the next tick's step is not finite: a fault
+  for (std::uint32_t id : ids) {
+    const Outcome o = c.wait_done(id, 1);
+    EXPECT_EQ(o.text(), id == ids[0] ? "aborted: faulted" : "aborted: dropped") << id;
+    EXPECT_EQ(o.answer.state, static_cast<std::uint8_t>(osc::MotionState::kFault));
+    EXPECT_EQ(o.answer.queued, 0);
+  }
+  expect_each_ended_once(ids);
+  const auto expect_nothing_queued = [this](osc::MotionState state) {
+    const auto st = c.state(1);
+    ASSERT_TRUE(st);
+    EXPECT_EQ(st->state, static_cast<std::uint8_t>(state));
+    EXPECT_EQ(st->queued, 0);
+    EXPECT_EQ(st->running_id, 0u);
+  };
+  expect_nothing_queued(osc::MotionState::kFault);
+  EXPECT_EQ(c.wait_answer(c.clear(), 10).status, Status::kAccepted);
+  expect_nothing_queued(osc::MotionState::kDisabled);
 }
 
 TEST_F(OscClient, StateIsAFreshFrameAndAnswersReachTheHandler) {

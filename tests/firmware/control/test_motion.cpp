@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "osc/control/motion.hpp"
 #include "osc/math/fixed.hpp"
@@ -37,6 +38,7 @@ struct Trace {
   double off_line = 0;                        // largest distance from the line p0 -> p1
   double derivative = 0;                      // largest mismatch of x, xd with the trapezoidal integrals of xd, xdd
   int finished = 0, stopped = 0;              // events
+  std::vector<std::uint32_t> done;            // the ids of the moves done, in order
   int ticks = 0;
   Desired<double> last{};
 };
@@ -72,6 +74,7 @@ Trace run(MotionGenerator<S>& g, std::uint64_t t0, int n, bool until_event, cons
       tr.off_line = std::max(tr.off_line, (r - u * r.dot(u)).norm());
     }
     tr.finished += ev.finished, tr.stopped += ev.stopped;
+    if (ev.done_id != 0) tr.done.push_back(ev.done_id);
     prev = d, w_prev = w;
     tr.last = d;
     ++tr.ticks;
@@ -238,6 +241,102 @@ TEST(MotionGenerator, RetargetBrakesAlongThePathThenMovesToTheNewTarget) {
   EXPECT_EQ(after.finished, 1);
   EXPECT_EQ(after.stopped, 0);
   EXPECT_LE((after.last.x.head<3>() - c.p).norm(), 1e-12);
+}
+
+/// The ids of the moves waiting in g.
+std::vector<std::uint32_t> waiting(const MotionGenerator<double>& g) {
+  std::uint32_t ids[MotionGenerator<double>::kMaxWaiting];
+  return {ids, ids + g.waiting_ids(ids, MotionGenerator<double>::kMaxWaiting)};
+}
+
+/// A re-target while the running move brakes for one before: the move that waited for that brake is
+/// dropped (named first by waiting_ids), the brake goes on, and the new move starts where it ends.
+TEST(MotionGenerator, ABrakeWhileBrakingDropsTheMovesWaitingAndTheBrakesEndStays) {
+  const Pose<double> a = pose(0.5, -0.2, 0.3, {0, 0, 0}), b = pose(0.5, 0.3, 0.3, {0, 0, 0}),
+                     c = pose(0.4, 0.0, 0.45, {0, 0, 0.5});
+  MotionGenerator<double> g;
+  g.hold(a, a.R);
+  CartesianMove<double> m;
+  ASSERT_EQ(m.plan(a, b, kLim, a.R), ProfileStatus::kOk);
+  for (std::uint32_t id : {1u, 2u, 3u}) ASSERT_TRUE(g.push(m, id));
+  g.start_moves(0);
+  EXPECT_EQ(waiting(g), (std::vector<std::uint32_t>{2, 3}));
+  run(g, 0, 1200, false);
+  g.brake(1200, kHz, kLim);
+  EXPECT_EQ(g.queued(), 1);
+  EXPECT_TRUE(waiting(g).empty());
+  const Pose<double> rest = g.brake_end(1250, kHz, kLim);  // braking already: where it comes to rest
+  EXPECT_EQ(rest.p, g.queue_end().p);
+  CartesianMove<double> r;
+  ASSERT_EQ(r.plan(rest, b, kLim, a.R), ProfileStatus::kOk);
+  ASSERT_TRUE(g.push(r, 4));
+  EXPECT_EQ(waiting(g), (std::vector<std::uint32_t>{4}));
+  const std::uint32_t epoch = g.epoch();
+  g.brake(1250, kHz, kLim);  // the second re-target
+  EXPECT_EQ(g.epoch(), epoch + 1);
+  EXPECT_EQ(g.queued(), 1);
+  EXPECT_TRUE(waiting(g).empty());
+  EXPECT_EQ(g.running_id(), 1u);  // still braking
+  EXPECT_EQ(g.brake_end(1300, kHz, kLim).p, rest.p);
+  ASSERT_EQ(r.plan(rest, c, kLim, a.R), ProfileStatus::kOk);
+  ASSERT_TRUE(g.push(r, 5));
+  const Trace after = run(g, 1250, 100000, true);
+  expect_within_limits(after);
+  EXPECT_EQ(after.finished, 1);
+  EXPECT_LE((after.last.x.head<3>() - c.p).norm(), 1e-12);
+  EXPECT_EQ(after.done, (std::vector<std::uint32_t>{5}));  // the braked move is never done
+}
+
+TEST(MotionGenerator, AHaltDropsEveryMotionAtOnce) {
+  const Pose<double> a = pose(0.5, -0.2, 0.3, {0, 0, 0}), b = pose(0.5, 0.3, 0.3, {0, 0, 0});
+  MotionGenerator<double> g;
+  g.hold(a, a.R);
+  CartesianMove<double> m;
+  ASSERT_EQ(m.plan(a, b, kLim, a.R), ProfileStatus::kOk);
+  for (std::uint32_t id : {1u, 2u, 3u}) ASSERT_TRUE(g.push(m, id));
+  g.start_moves(0);
+  run(g, 0, 500, false);
+  EXPECT_EQ(waiting(g), (std::vector<std::uint32_t>{2, 3}));
+  const std::uint32_t epoch = g.epoch();
+  g.halt();
+  EXPECT_EQ(g.epoch(), epoch + 1);
+  EXPECT_EQ(g.source(), MotionSource::kHold);
+  EXPECT_EQ(g.queued(), 0);
+  EXPECT_EQ(g.running_id(), 0u);
+  EXPECT_TRUE(waiting(g).empty());
+  const Trace after = run(g, 500, 10, false);  // the pose held last, at rest, no event
+  EXPECT_EQ(after.last.x.head<3>(), a.p);
+  EXPECT_EQ(after.v, 0.0);
+  EXPECT_EQ(after.finished + after.stopped, 0);
+  EXPECT_TRUE(after.done.empty());
+}
+
+/// Moves pushed while the paper's motion slows down wait behind it, all of them (none has started).
+TEST(MotionGenerator, MovesBehindThePapersSlowDownAllWaitAndABrakeDropsThem) {
+  const Pose<double> a = pose(0.5, 0, 0.3, {0, 0, 0});
+  MotionGenerator<double> g;
+  g.hold(a, a.R);
+  g.start_paper(TrajectorySpec<double>::paper(), 0, 7);
+  run(g, 0, 3000, false);
+  g.brake(3000, kHz, kLim);
+  int pushed = 0;
+  for (std::uint32_t id = 10;; ++id) {
+    CartesianMove<double> m;
+    ASSERT_EQ(m.plan(g.queue_end(), pose(0.45, 0.01 * pushed, 0.35, {0, 0, 0}), kLim, a.R), ProfileStatus::kOk);
+    if (!g.push(m, id)) break;
+    ++pushed;
+  }
+  EXPECT_EQ(pushed, MotionGenerator<double>::kMaxWaiting);
+  EXPECT_EQ(waiting(g).size(), static_cast<std::size_t>(pushed));
+  EXPECT_EQ(waiting(g).front(), 10u);
+  EXPECT_EQ(g.running_id(), 7u);
+  const Pose<double> rest = g.brake_end(3100, kHz, kLim);  // the slow-down's end, not the last move's
+  g.brake(3100, kHz, kLim);
+  EXPECT_EQ(g.queued(), 0);
+  EXPECT_EQ(g.queue_end().p, rest.p);
+  const Trace after = run(g, 3100, 100000, true);
+  EXPECT_EQ(after.finished, 1);
+  EXPECT_LE((after.last.x.head<3>() - rest.p).norm(), 1e-12);
 }
 
 TEST(MotionGenerator, PaperMotionSlowsDownAlongItsPathAndMayBeFollowedByMoves) {

@@ -66,6 +66,24 @@ F decoded(const pil::Parser& p) {
   return f;
 }
 
+/// A move_to of dz along z from where the queue ends (1 cm: half a second at the configured limits),
+/// with `replace` a re-target.
+pil::CommandFrame small_move(std::uint32_t id, double dz = 0.01, bool replace = false) {
+  MoveRequest<double> req;
+  req.relative = true;
+  req.replace = replace;
+  req.position(2) = dz;
+  return frame_from_command(id, MotionVerb::kMoveTo, req);
+}
+
+/// The answers that end command `id` (answer_ends: done, or aborted with a reason).
+std::vector<pil::AnswerFrame> endings(const std::vector<pil::AnswerFrame>& answers, std::uint32_t id) {
+  std::vector<pil::AnswerFrame> e;
+  for (const pil::AnswerFrame& a : answers)
+    if (answer_ends(a, id)) e.push_back(a);
+  return e;
+}
+
 // ---------------------------------------------------------------- layouts
 
 TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
@@ -547,7 +565,9 @@ TEST(CommandFrames, ReasonsListKeepsItsCodesAndEndsWithTheCollisionReasons) {
   EXPECT_EQ(static_cast<int>(MotionReason::kCollision), 16);
   EXPECT_EQ(static_cast<int>(MotionReason::kYielding), 17);
   EXPECT_EQ(static_cast<int>(MotionReason::kNotHomed), 18);  // issue 27's, after them
-  EXPECT_EQ(static_cast<int>(MotionReason::kUnknownPose) + 1, MotionNames<MotionReason>::kCount);
+  EXPECT_EQ(static_cast<int>(MotionReason::kUnknownPose), 22);
+  EXPECT_EQ(static_cast<int>(MotionReason::kDropped), 23);  // issue 53's, after them
+  EXPECT_EQ(static_cast<int>(MotionReason::kDropped) + 1, MotionNames<MotionReason>::kCount);
   // The states too: yielding after fault.
   EXPECT_EQ(static_cast<int>(MotionState::kFault), 4);
   EXPECT_EQ(static_cast<int>(MotionState::kYielding), 5);
@@ -768,14 +788,6 @@ TEST(CommandFrames, StateFrameInEveryScalar) {
 
 namespace {
 
-/// A relative move of 10 mm along z.
-pil::CommandFrame small_move(std::uint32_t id) {
-  MoveRequest<double> req;
-  req.relative = true;
-  req.position(2) = 0.01;
-  return frame_from_command(id, MotionVerb::kMoveTo, req);
-}
-
 /// A board that records what the node writes, frame by frame (any other byte is counted bad).
 struct RecordingBoard {
   static inline pil::Parser rx;
@@ -847,6 +859,33 @@ struct NodeFrames : ::testing::Test {
     f.id = id;
     f.verb = static_cast<std::uint8_t>(v);
     return f;
+  }
+  /// Started disabled, enabled (command 1) and past the torque ramp (the arm stays put: the counts are 0).
+  void enable() {
+    tick(pil::kConfigStartDisabled);
+    arrive(command(1, MotionVerb::kEnable));
+    for (int k = 0; k < 60; ++k) tick();
+  }
+  /// A command frame, then the tick that takes it from the mailbox (and answers it).
+  void take(const pil::CommandFrame& f) {
+    arrive(f);
+    tick();
+  }
+  /// The moves ids[0..n) queued, each accepted in its tick.
+  void queue(const std::vector<std::uint32_t>& ids) {
+    for (std::uint32_t id : ids) {
+      take(small_move(id, id % 2 ? -0.01 : 0.01));
+      ASSERT_EQ(RecordingBoard::answers.back().id, id);
+      ASSERT_EQ(RecordingBoard::answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted)) << id;
+    }
+  }
+  /// Ticks until a motion comes to rest (an answer with a completion), at most n.
+  void until_rest(int n = 3000) {
+    for (int k = 0; k < n; ++k) {
+      tick();
+      if (RecordingBoard::answers.back().completion != static_cast<std::uint8_t>(MotionCompletion::kNone)) return;
+    }
+    FAIL() << "no completion within " << n << " ticks";
   }
 };
 
@@ -1040,9 +1079,7 @@ TEST_F(NodeFrames, AHostThatNeverCommandsGetsActuatorFramesOnlyEvenWhenTheMotion
 }
 
 TEST_F(NodeFrames, AStreamFollowsItsSetpointsAndIsStopped) {
-  tick(pil::kConfigStartDisabled);
-  arrive(command(1, MotionVerb::kEnable));
-  for (int k = 0; k < 60; ++k) tick();  // past the torque ramp (the arm stays put: the counts are 0)
+  enable();
   pil::CommandFrame st = command(2, MotionVerb::kStream);
   st.flags = pil::kFlagRelative;
   st.period = 10;
@@ -1076,9 +1113,7 @@ TEST_F(NodeFrames, AStreamFollowsItsSetpointsAndIsStopped) {
 }
 
 TEST_F(NodeFrames, AStreamTakesSetpointsWithVelocity) {
-  tick(pil::kConfigStartDisabled);
-  arrive(command(1, MotionVerb::kEnable));
-  for (int k = 0; k < 60; ++k) tick();
+  enable();
   pil::CommandFrame st = command(2, MotionVerb::kStream);
   st.flags = pil::kFlagRelative;
   st.period = 10;
@@ -1101,6 +1136,210 @@ TEST_F(NodeFrames, AStreamTakesSetpointsWithVelocity) {
   EXPECT_GT(node->task.desired.xd(1), 0.0);
   EXPECT_NEAR(d(0), 0, 1e-9);
   EXPECT_EQ(node->link_counters().total(), 0u);
+}
+
+// ---------------------------------------------------------------- every accepted motion ends once
+
+/// Ids first, first + 1, ... (n of them).
+std::vector<std::uint32_t> ids_from(std::uint32_t first, int n) {
+  std::vector<std::uint32_t> ids;
+  for (int k = 0; k < n; ++k) ids.push_back(first + static_cast<std::uint32_t>(k));
+  return ids;
+}
+
+/// The answer frames of the tick that answered command `id` from its answer on: the tick's own,
+/// then one per move the tick dropped.
+std::vector<pil::AnswerFrame> tick_answers(std::uint32_t id) {
+  const std::vector<pil::AnswerFrame>& all = RecordingBoard::answers;
+  std::size_t i = 0;
+  while (i < all.size() && !(all[i].id == id && all[i].outcome != 0)) ++i;
+  std::vector<pil::AnswerFrame> t;
+  for (std::size_t k = i; k < all.size() && all[k].tick == all[i].tick; ++k) t.push_back(all[k]);
+  return t;
+}
+
+/// The answer frames after the tick's own that name the moves it dropped, in queue order: each
+/// aborted `dropped`, the tick's number, state and queue.
+void expect_dropped(const std::vector<pil::AnswerFrame>& tick, const std::vector<std::uint32_t>& dropped) {
+  ASSERT_EQ(tick.size(), 1 + dropped.size());
+  for (std::size_t k = 0; k < dropped.size(); ++k) {
+    const pil::AnswerFrame& a = tick[1 + k];
+    EXPECT_EQ(a.aborted_id, dropped[k]) << k;
+    EXPECT_STREQ(motion_name(static_cast<MotionReason>(a.abort)), "dropped") << k;
+    EXPECT_EQ(a.id, 0u);
+    EXPECT_EQ(a.outcome, static_cast<std::uint8_t>(CommandOutcome::kNone));
+    EXPECT_EQ(a.done_id, 0u);
+    EXPECT_EQ(a.tick, tick[0].tick);
+    EXPECT_EQ(a.state, tick[0].state);
+    EXPECT_EQ(a.queued, tick[0].queued);
+  }
+}
+
+/// Every move of ids ended exactly once in the answers so far.
+void expect_each_ended_once(const std::vector<std::uint32_t>& ids) {
+  for (std::uint32_t id : ids) EXPECT_EQ(endings(RecordingBoard::answers, id).size(), 1u) << "move " << id;
+}
+
+TEST_F(NodeFrames, AStopNamesEveryMoveItDropsFromAFullQueueInItsTick) {
+  enable();
+  const std::vector<std::uint32_t> ids = ids_from(10, MotionGenerator<double>::kQueueLength + 1);
+  queue(ids);  // the running move and sixteen waiting
+  take(small_move(99));
+  EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kQueueFull));
+  EXPECT_EQ(RecordingBoard::answers.back().queued, ids.size());
+  take(command(100, MotionVerb::kStop));
+  const std::vector<pil::AnswerFrame> t = tick_answers(100);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].aborted_id, ids[0]);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kStopCommand));
+  EXPECT_EQ(t[0].state, static_cast<std::uint8_t>(MotionState::kStopping));
+  EXPECT_EQ(t[0].queued, 1);  // the move braking
+  expect_dropped(t, std::vector<std::uint32_t>(ids.begin() + 1, ids.end()));
+  until_rest();
+  expect_each_ended_once(ids);
+  const pil::StateFrame s = state_frame_from_task(node->task);
+  EXPECT_EQ(s.state, static_cast<std::uint8_t>(MotionState::kHolding));
+  EXPECT_EQ(s.queued, 0);
+  EXPECT_EQ(s.running_id, 0u);
+}
+
+TEST_F(NodeFrames, ADisableDropsTheQueueAndTheArmDisabledAtRestHasNone) {
+  enable();
+  const std::vector<std::uint32_t> ids = ids_from(10, 3);
+  queue(ids);
+  take(command(20, MotionVerb::kDisable));
+  const std::vector<pil::AnswerFrame> t = tick_answers(20);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].aborted_id, ids[0]);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kDisableCommand));
+  expect_dropped(t, {ids[1], ids[2]});
+  until_rest();
+  EXPECT_EQ(RecordingBoard::answers.back().state, static_cast<std::uint8_t>(MotionState::kDisabled));
+  expect_each_ended_once(ids);
+  const pil::StateFrame s = state_frame_from_task(node->task);
+  EXPECT_EQ(s.queued, 0);
+  EXPECT_EQ(s.running_id, 0u);
+}
+
+TEST_F(NodeFrames, AFaultAbortsTheMoveAndDropsTheQueueInItsTickAndTheStateFrameSaysSoThroughClear) {
+  enable();
+  const std::vector<std::uint32_t> ids = ids_from(10, 4);
+  queue(ids);
+  EXPECT_EQ(state_frame_from_task(node->task).queued, 4);
+  EXPECT_EQ(state_frame_from_task(node->task).running_id, ids[0]);
+  const std::size_t before = RecordingBoard::answers.size();
+  tick(pil::kInjectNonFinite);
+  const std::vector<pil::AnswerFrame> t(RecordingBoard::answers.begin() + static_cast<std::ptrdiff_t>(before),
+                                        RecordingBoard::answers.end());
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].aborted_id, ids[0]);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kFaulted));
+  EXPECT_EQ(t[0].state, static_cast<std::uint8_t>(MotionState::kFault));
+  EXPECT_EQ(t[0].queued, 0);
+  expect_dropped(t, {ids[1], ids[2], ids[3]});
+  expect_each_ended_once(ids);
+  // From the fault's tick on, through the clear: nothing runs, nothing is queued.
+  const auto expect_nothing_queued = [this](MotionState state) {
+    const pil::StateFrame s = state_frame_from_task(node->task);
+    EXPECT_EQ(s.state, static_cast<std::uint8_t>(state));
+    EXPECT_EQ(s.queued, 0);
+    EXPECT_EQ(s.running_id, 0u);
+  };
+  expect_nothing_queued(MotionState::kFault);
+  tick();
+  expect_nothing_queued(MotionState::kFault);
+  // The machine's refusals, not busy: no motion is left in the generator.
+  take(command(19, MotionVerb::kPaper));
+  EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kFaulted));
+  take(command(20, MotionVerb::kClear));
+  EXPECT_EQ(RecordingBoard::answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  expect_nothing_queued(MotionState::kDisabled);
+  for (MotionVerb v : {MotionVerb::kPaper, MotionVerb::kStream}) {
+    pil::CommandFrame f = command(21, v);
+    f.period = 10;
+    take(f);
+    EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kNotEnabled));
+  }
+  expect_each_ended_once(ids);
+}
+
+TEST_F(NodeFrames, AReplaceDropsTheQueueAndAReplaceDuringItsBrakeDropsTheMoveBeforeIt) {
+  enable();
+  const std::vector<std::uint32_t> ids = ids_from(10, 3);
+  queue(ids);
+  take(small_move(13, 0.01, true));
+  std::vector<pil::AnswerFrame> t = tick_answers(13);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(t[0].aborted_id, ids[0]);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kSuperseded));
+  EXPECT_EQ(t[0].queued, 2);  // the move braking, then the new one
+  expect_dropped(t, {ids[1], ids[2]});
+  // Another re-target while the first brakes: the move braking was aborted already; the one that
+  // waited for it is dropped, and the new one waits in its place.
+  take(small_move(14, 0.01, true));
+  t = tick_answers(14);
+  ASSERT_FALSE(t.empty());
+  EXPECT_EQ(t[0].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(t[0].aborted_id, 0u);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kNone));
+  EXPECT_EQ(t[0].queued, 2);
+  expect_dropped(t, {13});
+  expect_each_ended_once({10, 11, 12, 13});
+  EXPECT_TRUE(endings(RecordingBoard::answers, 14).empty());  // it runs next
+  EXPECT_EQ(node->task.gen.queued(), 2);
+}
+
+/// The paper's motion (from the first tick, no id): the first move brakes it (aborted superseded),
+/// the next waits behind its slow-down too, a re-target drops both, and a stop drops the
+/// re-target's (the slow-down's abort was reported: the stop's names none).
+TEST_F(NodeFrames, MovesWaitBehindThePapersSlowDownAndAReplaceThenAStopDropThem) {
+  for (int k = 0; k < 20; ++k) tick();
+  take(small_move(10));
+  std::vector<pil::AnswerFrame> t = tick_answers(10);
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kSuperseded));
+  take(small_move(11));  // queued, not a second brake
+  t = tick_answers(11);
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_EQ(t[0].outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kNone));
+  EXPECT_EQ(t[0].queued, 2);
+  take(small_move(12, 0.01, true));
+  t = tick_answers(12);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kNone));
+  expect_dropped(t, {10, 11});
+  take(command(13, MotionVerb::kStop));
+  t = tick_answers(13);
+  EXPECT_EQ(t[0].abort, static_cast<std::uint8_t>(MotionReason::kStopCommand));
+  EXPECT_EQ(t[0].aborted_id, 0u);
+  EXPECT_EQ(t[0].queued, 0);
+  expect_dropped(t, {12});
+  expect_each_ended_once({10, 11, 12});
+}
+
+/// A collision to yield to and a stop (or a disable) in the same tick: the machine passes through
+/// yielding (the motion aborted collision) and leaves it at once; the moves end with it, none runs.
+TEST_F(NodeFrames, AYieldLeftInItsOwnTickEndsTheMotionAndItsQueue) {
+  for (MotionVerb v : {MotionVerb::kStop, MotionVerb::kDisable}) {
+    SetUp();
+    seq = 0;
+    enable();
+    queue({10, 11, 12});
+    ControlTask<double>& task = node->task;
+    arrive(command(20, v));
+    motion_update(task, 0, true, task.state.adapt.q_prev, MotionEvents{}, MotionReason::kNone, true);
+    const MotionReport& rep = task.report;
+    EXPECT_EQ(rep.outcome, CommandOutcome::kAccepted);
+    EXPECT_EQ(rep.abort, MotionReason::kCollision);
+    EXPECT_EQ(rep.aborted_id, 10u);
+    ASSERT_EQ(rep.dropped_moves, 2);
+    EXPECT_EQ(task.dropped_move_ids[0], 11u);
+    EXPECT_EQ(task.dropped_move_ids[1], 12u);
+    EXPECT_EQ(task.machine.state, v == MotionVerb::kStop ? MotionState::kHolding : MotionState::kDisabled);
+    EXPECT_EQ(task.gen.source(), MotionSource::kHold);
+    EXPECT_EQ(task.gen.queued(), 0);
+  }
 }
 
 TEST(CommandFrames, AnAnswerFrameReadsBackAsTheReport) {

@@ -67,6 +67,9 @@ template <class S>
 class MotionGenerator {
  public:
   static constexpr int kQueueLength = params::kMoveQueueLength;
+  /// Moves that can wait at once (not started): kQueueLength behind a running move, or every slot
+  /// of the queue behind the paper's slow-down.
+  static constexpr int kMaxWaiting = kQueueLength + 1;
 
   /// Holds `pose` (orientation coordinates relative to R_ref, the controller's), clears the queue.
   void hold(const Pose<S>& pose, const Mat3<S>& R_ref) {
@@ -130,15 +133,18 @@ class MotionGenerator {
     return hold_pose_;
   }
   /// Where the running motion would come to rest if brake() ran at sample `tick` (the start of a
-  /// re-target's move); the held pose when holding.
+  /// re-target's move), or comes to rest when it brakes already (the moves waiting behind it are not
+  /// counted: brake() drops them); the held pose when holding.
   Pose<S> brake_end(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) const {
-    if (source_ == MotionSource::kHold || braking_) return queue_end();
     if (source_ == MotionSource::kMove) {
+      if (braking_) return queue_[head_].end();
       CartesianMove<S> m = queue_[head_];
       m.stop(math::ratio<S>(tick - start_tick_, rate_hz), lim);
       return m.end();
     }
-    return paper_pose(paper_slow_down(tick, rate_hz).target());
+    if (source_ == MotionSource::kPaper)
+      return paper_pose(braking_ ? stop_tau_.target() : paper_slow_down(tick, rate_hz).target());
+    return queue_end();  // holding; a stream is not re-targeted (a move while it runs is busy)
   }
   /// Counts the changes of queue_end() other than a push (hold, paper, brake, stop; a motion that
   /// comes to rest ends where queue_end() said it would): a move planned
@@ -153,29 +159,48 @@ class MotionGenerator {
     start_tick_ = tick;
   }
   /// Decelerates the running motion along its path from sample `tick` on and drops the moves
-  /// waiting: a move by its profiles' hardest stops, the paper's motion by slowing its time. Moves
-  /// pushed afterwards start where it comes to rest (a re-target); with none, it ends in a hold
-  /// (MotionEvents::finished). Holding, or already braking: nothing changes.
+  /// waiting (waiting_ids() names them): a move by its profiles' hardest stops, the paper's motion by
+  /// slowing its time. Moves pushed afterwards start where it comes to rest (brake_end(): a
+  /// re-target); with none, it ends in a hold (MotionEvents::finished). Already braking: the moves
+  /// waiting are dropped, the brake goes on. Holding: nothing changes.
   void brake(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) {
-    if (source_ == MotionSource::kHold || braking_) return;
+    if (source_ == MotionSource::kHold) return;
+    count_ = source_ == MotionSource::kMove ? 1 : 0;  // the running move stays (a paper's or a stream's are none)
+    ++epoch_;
+    if (braking_) return;
     const S t = math::ratio<S>(tick - start_tick_, rate_hz);
-    if (source_ == MotionSource::kStream) {
+    if (source_ == MotionSource::kStream)
       stream_.stop();
-    } else if (source_ == MotionSource::kMove) {
+    else if (source_ == MotionSource::kMove)
       queue_[head_].stop(t, lim);
-      count_ = 1;
-    } else {
+    else
       stop_tau_ = paper_slow_down(tick, rate_hz);
-    }
     start_tick_ = tick;
     braking_ = true;
-    ++epoch_;
   }
   /// The category-2 stop: brake(), and the motion ends in a hold (MotionEvents::stopped) whatever is
   /// pushed afterwards (the state machine refuses moves while stopping).
   void stop(std::uint64_t tick, std::uint32_t rate_hz, const CartesianLimits<S>& lim) {
     brake(tick, rate_hz, lim);
     if (source_ != MotionSource::kHold) stopping_ = true;
+  }
+  /// The category-0 stop (a fault): the running motion and the moves waiting dropped at once (name
+  /// these first: waiting_ids()); nothing runs (queued() and running_id() 0) until the next hold(),
+  /// and the pose held last stays the held one.
+  void halt() {
+    source_ = MotionSource::kHold;
+    stopping_ = braking_ = false;
+    count_ = 0;
+    ++epoch_;
+  }
+  /// The ids of the moves waiting, not started (behind the running move, or behind the paper's
+  /// slow-down), in queue order, into out (at most max of them); returns how many. A brake(), a
+  /// stop(), a hold() and a halt() drop them.
+  int waiting_ids(std::uint32_t* out, int max) const {
+    int n = 0;
+    for (int i = source_ == MotionSource::kMove ? 1 : 0; i < count_ && n < max; ++i)
+      out[n++] = ids_[(head_ + i) % kQueueSlots];
+    return n;
   }
 
   /// d at sample `tick`; reports a motion's end at rest (then holds where it ended).

@@ -121,22 +121,30 @@ constexpr double kCommandMaxVelocity = 10.0;
   X(std::uint8_t, outcome, , "", "accepted or refused; none when no command was answered (Command outcomes)")  \
   X(std::uint8_t, refusal, , "", "why the command was refused (Reasons); none unless refused")                 \
   X(std::uint32_t, cause, , "", "with refusal faulted: the fault bits behind it (Fault bits)")                 \
-  X(std::uint32_t, done_id, , "", "the id of a move_to that reached its target at rest in this tick; 0: none") \
+  X(std::uint32_t, done_id, , "",                                                                              \
+    "the id of a motion done in this tick: a move_to at its target at rest, a stream at its last setpoint, a " \
+    "home with every index pulse found; 0: none")                                                              \
   X(std::uint32_t, aborted_id, , "",                                                                           \
-    "the id of a motion (move_to, paper) aborted in this tick; 0: none, or a motion without an id")            \
-  X(std::uint8_t, abort, , "", "why a running motion was aborted in this tick (Reasons); none: no abort")      \
+    "the id of a motion (move_to, paper, stream, home) aborted in this tick, or of a queued move dropped "     \
+    "(abort dropped: a frame of its own); 0: none, a motion without an id, or one aborted already (the "       \
+    "motion a re-target brakes)")                                                                              \
+  X(std::uint8_t, abort, , "",                                                                                 \
+    "why a running motion was aborted in this tick, or dropped for a queued move (Reasons); none: no abort")   \
   X(std::uint8_t, completion, , "", "a motion that came to rest in this tick (Completions)")                   \
   X(std::uint8_t, state, , "", "the motion state after this tick (Motion states)")                             \
   X(std::uint8_t, stop, , "", "the stop in effect after this tick (Stop categories)")                          \
-  X(std::uint8_t, queued, , "", "moves in the motion queue after this tick, the running one included")         \
+  X(std::uint8_t, queued, , "",                                                                                \
+    "moves in the motion queue after this tick, the running one included; 0 in fault and disabled")            \
   X(std::uint32_t, tick, , "tick", "the number of the tick that answered (0: the first), low 32 bits")
 
 #define OSC_STATE_FIELDS(X)                                                                                     \
   X(std::uint8_t, state, , "", "the motion state (Motion states)")                                              \
   X(std::uint8_t, stop, , "", "the stop in effect (Stop categories)")                                           \
   X(std::uint32_t, faults, , "", "the fault bits latched since the last accepted clear (Fault bits)")           \
-  X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included")                          \
-  X(std::uint32_t, running_id, , "", "the id of the running motion (move_to, stream, paper); 0: none")          \
+  X(std::uint8_t, queued, , "", "moves in the motion queue, the running one included; 0 in fault, disabled")    \
+  X(std::uint32_t, running_id, , "",                                                                            \
+    "the id of the running motion (move_to, stream, paper, home; braking after a stop or a re-target too); "    \
+    "0: none, always in fault and disabled")                                                                    \
   X(std::uint32_t, dropped, , "", "setpoints dropped since start: no stream of their id running, or bad")       \
   X(float, x_d, [6], "m, rad",                                                                                  \
     "the reference pose of the last control step: the wrist centre's position in the base frame, then roll, "   \

@@ -10,7 +10,8 @@
 //        A setpoint frame goes to the task's setpoint mailbox (offer_setpoint_frame).
 //   out  after each tick: its answer when there is one (answer_due) and the port has had a command
 //        (a host that never commands, e.g. the paper's experiment over the PIL link, gets no answer
-//        frames), and every state_period ticks a state frame.
+//        frames), an answer frame more for each move the tick dropped from the queue (aborted
+//        `dropped`), and every state_period ticks a state frame.
 //
 // The calls, for the two contexts of a board: receive() (a complete frame from the parser) and
 // poll() (prepares the waiting commands) where the link is read, outside the control interrupt:
@@ -213,7 +214,9 @@ class CommandPort {
   }
 
   /// After each tick (control_tick or a tick without a step): its answer (once a command has come),
-  /// then a state frame when due. Prepares nothing (safe in the control interrupt): poll() does.
+  /// then one answer frame for each move the tick dropped from the queue (dropped_answer_frame: only
+  /// in the ticks that drop moves), then a state frame when due. Prepares nothing (safe in the
+  /// control interrupt): poll() does.
   template <class Write>
   void after_tick(const ControlTask<S>& task, Write&& write) {
     std::uint8_t buf[pil::kMaxFrame];
@@ -221,6 +224,7 @@ class CommandPort {
       const pil::AnswerFrame a = answer_frame(task);
       if (task.report.outcome != CommandOutcome::kNone) remember(a);
       write(buf, pil::encode(a, buf));
+      for (int k = 0; k < task.report.dropped_moves; ++k) write(buf, pil::encode(dropped_answer_frame(task, k), buf));
     }
     if (state_period != 0 && task.tick % state_period == 0) {
       pil::StateFrame f = state_frame_from_task(task);

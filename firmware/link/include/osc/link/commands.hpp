@@ -4,9 +4,11 @@
 //   controller: command_from_frame (a command frame checked and decoded into a verb and a
 //               MoveRequest; a bad frame is refused: bad_command), prepare_frame_command (the same,
 //               prepared for the task's mailbox), answer_due / answer_frame (a tick's report as an
-//               answer frame), state_frame_from_task, trace_frame_from_task;
+//               answer frame), dropped_answer_frame (a move the tick dropped from the queue),
+//               state_frame_from_task, trace_frame_from_task;
 //   host:       frame_from_command / encode_command (a command as a frame), setpoint_frame,
-//               report_from_frame (an answer frame as the tick's report).
+//               report_from_frame (an answer frame as the tick's report), answer_ends (whether an
+//               answer frame ends a command's motion).
 //
 // The controller's end on a link: osc/link/command_port.hpp (in the PIL node, osc/link/node.hpp).
 #pragma once
@@ -209,10 +211,10 @@ int encode_command(std::uint32_t id, MotionVerb verb, const MoveRequest<S>& req,
 }
 
 /// Whether a tick's report has something to send: a command answered, a motion done or aborted, a
-/// completion.
+/// completion, moves dropped.
 constexpr bool answer_due(const MotionReport& r) {
   return r.outcome != CommandOutcome::kNone || r.done_id != 0 || r.aborted_id != 0 || r.abort != MotionReason::kNone ||
-         r.completion != MotionCompletion::kNone;
+         r.completion != MotionCompletion::kNone || r.dropped_moves != 0;
 }
 
 /// A tick's report as an answer frame, with the machine's state after the tick, the moves queued
@@ -239,6 +241,24 @@ inline pil::AnswerFrame frame_from_report(const MotionReport& r, MotionState sta
 template <class S>
 pil::AnswerFrame answer_frame(const ControlTask<S>& task) {
   return frame_from_report(task.report, task.machine.state, task.gen.queued(), task.tick - 1);
+}
+
+/// The answer frame that names the k-th move the tick control_tick() just ran dropped from the queue
+/// (k < task.report.dropped_moves): aborted_id its id, abort `dropped`, no command answered, the
+/// tick's state, queue and number (sent after the tick's own answer frame, one per move).
+template <class S>
+pil::AnswerFrame dropped_answer_frame(const ControlTask<S>& task, int k) {
+  MotionReport r;
+  r.aborted_id = task.dropped_move_ids[k];
+  r.abort = MotionReason::kDropped;
+  return frame_from_report(r, task.machine.state, task.gen.queued(), task.tick - 1);
+}
+
+/// Host side: whether an answer frame ends command `id`: its motion done (done_id), or aborted with
+/// a reason (aborted_id; dropped too). Every motion command accepted ends in exactly one such frame.
+constexpr bool answer_ends(const pil::AnswerFrame& a, std::uint32_t id) {
+  return id != 0 &&
+         (a.done_id == id || (a.aborted_id == id && a.abort != static_cast<std::uint8_t>(MotionReason::kNone)));
 }
 
 /// Host side: an answer frame as the report of the tick that sent it (frame_from_report's inverse;

@@ -177,6 +177,8 @@ struct ControlTask {
   Homing<S> homing;             // the homing in progress (state homing)
   IndexTicks index_ticks;       // the index positions of the encoders (set_encoders)
   std::array<S, 2> home_speed;  // the homing move's speeds [m/s, rad/s] (parameter home_speed)
+  // The ids of the moves the last tick dropped from the queue (report.dropped_moves of them).
+  std::uint32_t dropped_move_ids[MotionGenerator<S>::kMaxWaiting];
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -702,11 +704,64 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   return MotionCommand::kNone;
 }
 
-/// The generator holds the pose the last step measured (the next move's path starts at q).
+/// The moves waiting in the generator's queue, which this tick drops (a re-target's or a stop's
+/// brake, a hold, a fault's halt): their ids into the report, after any the tick dropped already
+/// (CommandPort::after_tick answers each, aborted dropped). Called only in the ticks that drop.
+template <class S>
+[[gnu::noinline]] void report_dropped(ControlTask<S>& task) {
+  constexpr int kMax = MotionGenerator<S>::kMaxWaiting;
+  const int n = task.report.dropped_moves;
+  task.report.dropped_moves = static_cast<std::uint8_t>(n + task.gen.waiting_ids(task.dropped_move_ids + n, kMax - n));
+}
+
+/// The generator holds the pose the last step measured (the next move's path starts at q); the
+/// moves waiting are dropped.
 template <class S>
 void hold_measured_pose(ControlTask<S>& task, const Vec6<S>& q) {
+  report_dropped(task);
   task.gen.hold({task.state.data.o[kDof], task.state.data.R[kDof]}, task.state.R_ref);
   task.q_queue_end = q;
+}
+
+/// The motion an abort of this tick ends, into the report: while homing, the home command (its
+/// move's end, which the generator reports done in a fault's tick at the end of the move, is not the
+/// home's: finish_homing reports that); otherwise the generator's running motion, unless a
+/// re-target brakes it (its abort, superseded, was reported: none). A yield (a collision) that a
+/// stop, an enable or a disable of the same tick left at once (holding, disabled) ends the motion
+/// here, at the measured pose q: motion_apply sees no change into or out of yielding.
+template <class S>
+[[gnu::noinline]] void report_abort(ControlTask<S>& task, MotionState before, const Vec6<S>& q, bool yield) {
+  MotionReport& rep = task.report;
+  if (before == MotionState::kHoming) {
+    rep.aborted_id = task.homing.id;
+    rep.done_id = 0;
+  } else {
+    rep.aborted_id = task.gen.braking() ? 0 : task.gen.running_id();
+  }
+  const MotionState s = task.machine.state;
+  if (yield && (s == MotionState::kHolding || s == MotionState::kDisabled)) hold_measured_pose(task, q);
+}
+
+/// A tick with faults (category 0): an encoder's fault unhomes the arm; the running motion (its
+/// abort reported) and the moves waiting (named, dropped) end at once, so that from this tick on
+/// nothing runs nor is queued (the state frame's queued and running_id 0) until an enable holds.
+template <class S>
+[[gnu::noinline]] void fault_motion(ControlTask<S>& task, std::uint32_t faults) {
+  if ((faults & kFaultsUnhoming) != 0) task.homed = false;
+  report_dropped(task);
+  task.gen.halt();
+}
+
+/// A re-target accepted: the running motion brakes from sample `next` on, aborted superseded (once:
+/// not again when it brakes already, for a re-target before), and the moves waiting are dropped.
+template <class S>
+[[gnu::noinline]] void retarget(ControlTask<S>& task, std::uint64_t next) {
+  if (task.gen.source() != MotionSource::kHold && !task.gen.braking()) {
+    task.report.aborted_id = task.gen.running_id();
+    task.report.abort = MotionReason::kSuperseded;
+  }
+  report_dropped(task);
+  task.gen.brake(next, params::kControlHz, task.limits);
 }
 
 /// What an accepted command and the machine's step ask of the generator and the controller, from
@@ -730,11 +785,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.ramp_start = next;
   }
   if (accepted && (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome)) {  // a planned move
-    if (cmd.brake) {  // a re-target (a home starts from holding only)
-      task.report.aborted_id = task.gen.running_id();
-      if (task.gen.source() != MotionSource::kHold) task.report.abort = MotionReason::kSuperseded;
-      task.gen.brake(next, params::kControlHz, task.limits);
-    }
+    if (cmd.brake) retarget(task, next);  // a home starts from holding only
     task.gen.push(cmd.move, cmd.id);
     task.gen.start_moves(next);
     task.q_queue_end = cmd.q_end;
@@ -750,6 +801,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {
+    report_dropped(task);
     task.gen.stop(next, params::kControlHz, task.limits);
     task.q_queue_end = q;  // near where the stop ends: the next check's Newton steps start the path there
   }
@@ -779,10 +831,8 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   in.motion_finished = ev.finished;
   in.stopped = ev.stopped;
   const MotionState before = task.machine.state;
-  const std::uint32_t running = task.gen.running_id();
   const MotionStep st = motion_next(task.machine, in);
   task.machine = st.machine;
-  if ((faults & kFaultsUnhoming) != 0) task.homed = false;
   MotionReport& rep = task.report;
   if (in.command != MotionCommand::kNone) {
     rep.outcome = st.outcome;
@@ -792,7 +842,8 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   rep.abort = st.abort;
   rep.completion = st.completion;
   rep.done_id = ev.done_id;
-  if (st.abort != MotionReason::kNone) rep.aborted_id = running;
+  if (st.abort != MotionReason::kNone) report_abort(task, before, q, yield);
+  if (faults != 0) fault_motion(task, faults);
   motion_apply(task, st, before, q);
   if (rep.verb != MotionVerb::kNone) task.pending.verb = MotionVerb::kNone;  // answered: taken
   return st.torque;

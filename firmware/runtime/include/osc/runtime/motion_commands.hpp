@@ -105,18 +105,26 @@ struct StreamSample {
   Vec6<S> v = Vec6<S>::Zero();  ///< the rates of x (position; roll, pitch, yaw)
 };
 
-/// What one tick reports: the answer to its command, and a motion's end.
+/// What one tick reports: the answer to its command, and the motions that ended. Every motion
+/// command accepted (move_to, paper, stream, home) ends in exactly one report: done (done_id),
+/// aborted (aborted_id, why), or, a move taken from the queue before it started, dropped (one of
+/// the tick's dropped_moves).
 struct MotionReport {
   std::uint32_t id = 0;  ///< the command answered in this tick (0 with outcome none)
   MotionVerb verb = MotionVerb::kNone;
   CommandOutcome outcome = CommandOutcome::kNone;
   MotionReason refusal = MotionReason::kNone;
   std::uint32_t cause = 0;  ///< with refusal faulted: the fault bits behind it
-  /// A motion command (move_to, paper) that ended in this tick: done (its move reached its target
-  /// at rest) or aborted (why); 0: none.
+  /// A motion command that ended in this tick: done (its move reached its target at rest, a stream
+  /// its last setpoint, a home every index pulse) or aborted (why); 0: none, or a motion whose end
+  /// was reported already (the motion a re-target brakes).
   std::uint32_t done_id = 0, aborted_id = 0;
   MotionReason abort = MotionReason::kNone;
   MotionCompletion completion = MotionCompletion::kNone;
+  /// Moves dropped from the queue in this tick, never started (their motion ahead stopped,
+  /// re-targeted or faulted): their ids are the task's dropped_move_ids[0, dropped_moves), each
+  /// aborted `dropped` (kept out of the report, which every tick clears).
+  std::uint8_t dropped_moves = 0;
 };
 
 /// The pose a move_to asks for, from where its move starts.
@@ -148,8 +156,9 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
     return c;
   }
   // A re-target, or a move after the paper's motion, starts where the running motion comes to rest
-  // when braked in the tick after the command's.
-  c.brake = req.replace || gen.source() == MotionSource::kPaper;
+  // when braked in the tick after the command's (or where its brake ends: the moves waiting are
+  // dropped). A move while the paper's motion slows down for one is queued behind it.
+  c.brake = req.replace || (gen.source() == MotionSource::kPaper && !gen.braking());
   if (!c.brake && gen.queue_full()) {
     c.refusal = MotionReason::kQueueFull;
     return c;

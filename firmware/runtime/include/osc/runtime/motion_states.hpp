@@ -46,8 +46,10 @@ namespace osc {
   X(DeclarePose, "declare_pose", "the operator asserts the arm stands at a named pose (torque off)")
 
 /// Why a command was refused or a running motion aborted. The geometric ones are decided by the
-/// motion generator, which refuses with them after this machine accepted; motion_next() decides the
-/// rest.
+/// motion generator, which refuses with them after this machine accepted; `dropped` by the runtime,
+/// for each move taken from the queue before it started (the tick that stopped, re-targeted or
+/// faulted the motion ahead of it names each: MotionReport::dropped_moves); motion_next() decides
+/// the rest.
 #define OSC_MOTION_REASON_LIST(X)                                                                                   \
   X(None, "none", "not refused, not aborted")                                                                       \
   X(OutOfWorkspace, "out_of_workspace", "the target is outside the workspace (motion generator)")                   \
@@ -73,7 +75,8 @@ namespace osc {
   X(PotsDisagree, "pots_disagree",                                                                                  \
     "a declare_pose whose pose a potentiometer contradicts by more than params::kDeclareBand (2 degrees)")          \
   X(TorqueOn, "torque_on", "a declare_pose while the torque is on: disable first")                                  \
-  X(UnknownPose, "unknown_pose", "a declare_pose of a pose code outside the robot's list of named poses")
+  X(UnknownPose, "unknown_pose", "a declare_pose of a pose code outside the robot's list of named poses")           \
+  X(Dropped, "dropped", "a queued move that never started: the motion ahead of it was stopped, re-targeted or faulted")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -124,7 +127,7 @@ OSC_MOTION_ENUM(CollisionReaction, OSC_COLLISION_REACTION_LIST);
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
 static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kHoming) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kDeclarePose) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kUnknownPose) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kDropped) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kHomed) + 1);
