@@ -38,6 +38,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <csignal>
@@ -198,8 +199,10 @@ double wall_seconds() {
 template <class S>
 class InProcessBoard {
  public:
-  InProcessBoard(const sim::Vec6& q0, int state_hz, const sim::Injection& inj, bool link_watch)
-      : sim_(q0, inj), link_watch_(link_watch) {
+  InProcessBoard(const sim::Vec6& q0, int state_hz, const sim::Injection& inj, bool link_watch, double speed)
+      : sim_(q0, inj),
+        watch_(static_cast<std::uint32_t>(std::lround(osc::CommandLinkWatch::kTimeoutTicks * std::max(1.0, speed)))),
+        link_watch_(link_watch) {
     port_.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / state_hz);
   }
   /// A complete frame from the client: a command or a setpoint is taken (true), any other type not.
@@ -220,8 +223,9 @@ class InProcessBoard {
   /// The counters of the client's link that the state frames carry.
   pil::LinkCounters& link() { return port_.link; }
   bool report() const {
-    std::fprintf(stderr, "osc_sim: command link watch %s: %u link_silent stop requests; %u resent commands\n",
-                 link_watch_ ? "on" : "off (--no-link-watch)", watch_.stops(), port_.resends);
+    std::fprintf(stderr,
+                 "osc_sim: command link watch %s (%u ticks): %u link_silent stop requests; %u resent commands\n",
+                 link_watch_ ? "on" : "off (--no-link-watch)", watch_.timeout_ticks(), watch_.stops(), port_.resends);
     return true;
   }
 
@@ -418,7 +422,8 @@ void build(CLI::App& app, Options& o) {
       ->type_name("KIND[:ARGS]@S");
   app.add_flag("--no-link-watch", o.no_link_watch,
                "a motion goes on when the client's link is silent (by default, as on a board whose encoders are "
-               "local, a motion running 0.5 s without a frame from the client is stopped: link_silent); in process "
+               "local, a motion running 0.5 s without a frame from the client is stopped: link_silent; 0.5 s of the "
+               "client's time, the wall clock's: 0.5 s times --speed of simulated time when above 1); in process "
                "only: with --qemu the image's link is the PIL link, and no command-link watch runs");
 }
 
@@ -478,7 +483,7 @@ int run(const Options& o, Board& board) {
 
 template <class S>
 int run_in_process(const Options& o, const sim::ExperimentConfig& cfg) {
-  InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch);
+  InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch, o.speed);
   return run(o, board);
 }
 

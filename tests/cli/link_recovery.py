@@ -11,8 +11,9 @@ declarations), one check per line, exit 0 when all pass:
   resend          a 10 mm relative move sent twice back to back, and again after its answer: one
                   move of 10 mm, one done, the same accepted answer each time
   link_counters   junk and a frame with a bad CRC: counted in the next state frame's link field
-  link_silent     (in process) a 2 s move, then the client silent: aborted link_silent within
-                  0.5 s of simulated silence (+ a tick); with --no-link-watch the same move ends done
+  link_silent     (in process, --speed 2) a 2 s move, then the client silent: aborted link_silent
+                  after 0.5 s of wall-clock silence, 1000 ticks (+ 20); with --no-link-watch the same
+                  move ends done
   inject          osc_sim --inject encoder-garbage:2@1: the state frames show fault and the
                   encoder's fault bit after 1 s, with no command sent after enable
 With --qemu IMAGE the controller is the PIL image in QEMU (the same checks but link_silent, which
@@ -174,7 +175,8 @@ def link_silent(watch):
     a = end[0]
     why = P.name_of("reasons", a["abort"]) if a["aborted_id"] == mid else "done"
     if watch:
-        check("link_silent", why == "link_silent" and a["tick"] - t0 <= 520,
+        # 0.5 s of the client's (wall) time: 1000 ticks at --speed 2, and not before 500.
+        check("link_silent", why == "link_silent" and 1000 <= a["tick"] - t0 <= 1020,
               f"{why} {a['tick'] - t0} ticks after the move's answer")
     else:
         check("link_silent_off", why == "done", f"{why} with --no-link-watch")

@@ -354,6 +354,12 @@ class CommandLinkWatch {
   static constexpr std::uint32_t kTimeoutTicks = stream::ticks(params::kCommandLinkTimeout);
   static_assert(kTimeoutTicks > 1, "the command link timeout is longer than a tick");
 
+  /// A board's watch: kTimeoutTicks. A simulated board that runs faster than real time counts the
+  /// timeout in its client's time, kTimeoutTicks times its speed (the client paces its keep-alive
+  /// by the wall clock).
+  explicit CommandLinkWatch(std::uint32_t timeout_ticks = kTimeoutTicks)
+      : timeout_(timeout_ticks > 1 ? timeout_ticks : 2) {}
+
   /// A valid frame came (main loop).
   void heard() { heard_ = true; }
   /// Before each tick (its context): counts the silence; true, and a stop requested, when the
@@ -363,22 +369,24 @@ class CommandLinkWatch {
     if (heard_) {
       heard_ = false;
       silent_ = 0;
-    } else if (silent_ < kTimeoutTicks) {
+    } else if (silent_ < timeout_) {
       ++silent_;
     }
-    if (!commanded || silent_ < kTimeoutTicks || !motion_running(task.machine.state)) return false;
+    if (!commanded || silent_ < timeout_ || !motion_running(task.machine.state)) return false;
     request_stop(task, MotionReason::kLinkSilent);
     ++stops_;
     return true;
   }
-  /// Ticks since the last frame (up to kTimeoutTicks).
+  /// Ticks since the last frame (up to the timeout).
   std::uint32_t silent_ticks() const { return silent_; }
+  /// The timeout [ticks].
+  std::uint32_t timeout_ticks() const { return timeout_; }
   /// Ticks that asked for a link_silent stop.
   std::uint32_t stops() const { return stops_; }
 
  private:
   volatile bool heard_ = false;
-  std::uint32_t silent_ = 0, stops_ = 0;
+  std::uint32_t timeout_, silent_ = 0, stops_ = 0;
 };
 
 }  // namespace osc
