@@ -2,6 +2,8 @@
 // yaml-cpp.
 #include "config.hpp"
 
+#include "osc/control/sampled_loop.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <charconv>
@@ -48,8 +50,9 @@ struct Entry {
   std::function<std::string(Settings&, const json&)> put = nullptr;
   std::function<bool(const Settings&)> shown = nullptr;  // printed only when true (null: always)
   std::function<void(const Settings&, double& lo, double& hi, int element)> element_range =
-      nullptr;    // per-element bounds
-  int count = 6;  // kList: its elements
+      nullptr;                  // per-element bounds
+  int count = 6;                // kList: its elements
+  std::string range_note = "";  // the comment's range where element_range gives them (empty: none shown)
 };
 
 json vec_json(const double* v, int n, double scale = 1) {
@@ -236,6 +239,14 @@ void add_gain(std::vector<Entry>& t, const osc::GainParam& p, const char* doc, T
   if constexpr (F == osc::GainForm::kPerAxis) {
     static_assert(std::is_same_v<T, Vec6>, "a per-axis parameter is a vector of six");
     list6(t, key, text, p.lo, p.hi, true, [gain](Settings& s) -> Vec6& { return s.base.gains.*gain; });
+    if (p.lo_each || p.hi_each) {  // each element its own range (the translations', the rotations')
+      t.back().element_range = [p](const Settings&, double& lo, double& hi, int k) {
+        lo = p.lo_of(k);
+        hi = p.hi_of(k);
+      };
+      t.back().range_note =
+          "x y z " + range_text(p.lo_of(0), p.hi_of(0)) + ", rotations " + range_text(p.lo_of(3), p.hi_of(3));
+    }
   } else if constexpr (F == osc::GainForm::kOne) {
     static_assert(std::is_same_v<T, double>, "a parameter of one number is a number");
     number(t, key, text, p.lo, p.hi, true, [gain](Settings& s) -> double& { return s.base.gains.*gain; });
@@ -741,6 +752,17 @@ bool validate_settings(const Settings& s, std::string& err) {
                   static_cast<double>(os.Jf.rcond), 2 * s.base.gains.min_rcond);
     return err = buf, false;
   }
+  // The gains' discrete-time checks at the start pose, as the board's param set makes them
+  // (osc/control/sampled_loop.hpp): each gain within its range can still lose the loop with others.
+  const osc::GainMargins m = osc::gain_margins(s.base.gains, osc::lambda_inverse(data.A, os.Ja));
+  if (!(m.observer > 1) || !(m.loop >= 1)) {
+    char buf[240];
+    std::snprintf(buf, sizeof buf,
+                  "controller: the gains would make the %s unstable at the start pose (observer margin %.3g, "
+                  "loop margin %.3g: the knd, k, ks, ki together; docs/protocol.md, \"Parameters\")",
+                  m.observer > 1 ? "sampled loop" : "discrete observer", m.observer, m.loop);
+    return err = buf, false;
+  }
   // A collision's settings act through the armed residual monitor alone.
   bool collision_set = s.base.collision_reaction != osc::CollisionReaction::kCategory0;
   for (double t : s.base.collision_threshold) collision_set = collision_set || t != 0;
@@ -782,6 +804,8 @@ std::string config_yaml(const Settings& s) {
       range = allowed_names(e);
     else if (!e.element_range)
       range = range_text(e.lo, e.hi);
+    else
+      range = e.range_note;
     out << YAML::Comment(std::string(e.doc) + (range.empty() ? "" : "; " + range));
   }
   while (!open.empty()) out << YAML::EndMap, open.pop_back();

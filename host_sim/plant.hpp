@@ -33,8 +33,8 @@ struct PlantConfig {
   /// Away from velocity reversals (every joint's velocity keeps its sign through the step, so the
   /// friction of model (2) is smooth) RK4 takes this many substeps at once; 1 = fixed step.
   int smooth_steps = 8;
-  double compute_delay = 0.2e-3;  ///< from the encoder sample to the DAC update [s]
-  double link_scale = 1.0;        ///< scales every link mass and inertia (model-error studies)
+  double compute_delay = osc::params::kActuationDelay;  ///< from the encoder sample to the DAC update [s]
+  double link_scale = 1.0;                              ///< scales every link mass and inertia (model-error studies)
 
   // The drive train's dynamics (issue 24), each off by default; all off, the plant computes exactly
   // what it did without them (the articulated-body path, bit for bit). The inputs of advance_sample()

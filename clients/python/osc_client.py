@@ -654,6 +654,8 @@ def margins_text(c, a):
         if a["flags"] & c.p.param_flag["warn_37"] else ""
     return (f"observer margin {a['margins'][0]:.3g} (stable above 1: (4 - 2 k dt) / (b dt^2), b <= "
             f"{a['margins'][1]:.4g} 1/s^2 at the last pose)\n"
+            f"loop margin {a['margins'][3]:.3g} (stable at 1 or above: the factor the gains may grow by "
+            f"at the last pose)\n"
             f"condition (37) {a['margins'][2]:.3g} (k_s k_nd / 2: above 1 it can hold){warn}")
 
 

@@ -200,6 +200,8 @@ int param_status(const Client& c, const std::optional<pil::ParamAnswerFrame>& r,
 void print_margins(const pil::ParamAnswerFrame& r) {
   std::printf("observer margin %.3g (stable above 1: (4 - 2 k dt) / (b dt^2), b <= %.4g 1/s^2 at the last pose)\n",
               static_cast<double>(r.margins[0]), static_cast<double>(r.margins[1]));
+  std::printf("loop margin %.3g (stable at 1 or above: the factor the gains may grow by at the last pose)\n",
+              static_cast<double>(r.margins[3]));
   std::printf("condition (37) %.3g (k_s k_nd / 2: above 1 it can hold)%s\n", static_cast<double>(r.margins[2]),
               (r.flags & pil::kParamFlagWarn37) ? ": warning, the paper's sufficient condition cannot hold" : "");
 }

@@ -141,15 +141,19 @@ sequence() {
 # The parameters with one client ("$@"): list, get, set, refusals, check, save / reset / load, a
 # smaller move maximum taking effect on the next move, a gain refused while enabled.
 param_sequence() {
-  expect 0 '^knd\[0\] = 120 \(0.001 to 100000; torque_off\)$' '^stream_timeout = 0.02 s \(0.002 to 0.1\)$' \
+  expect 0 '^knd\[0\] = 120 \(0.001 to 5000; torque_off\)$' '^knd\[3\] = 35 \(0.001 to 100; torque_off\)$' '^stream_timeout = 0.02 s \(0.002 to 0.1\)$' \
     '^collision_threshold\[5\] = 0 N m' -- "$@" param list
   expect 0 '^ks\[0\] = 80 ' '^ks\[5\] = 25 ' -- "$@" param set ks 80 80 80 25 25 25
-  expect 1 '^refused: unstable_observer' '^observer margin 0' -- "$@" param set k --element 0 2500
-  expect 0 '^k\[0\] = 108 ' -- "$@" param get k --element 0
+  # Each within its range, together beyond what the sampled loop takes at 1 kHz: the second refused.
+  expect 0 '^k\[3\] = 25 ' -- "$@" param set k --element 3 25
+  expect 1 '^refused: unstable_loop' '^loop margin 0[.0-9e-]* ' -- "$@" param set ki --element 3 3500
+  expect 0 '^ki\[3\] = 3000 ' -- "$@" param get ki --element 3
+  expect 0 '^k\[3\] = 32 ' -- "$@" param set k --element 3 32
+  expect 1 '^refused: out_of_range' -- "$@" param set k --element 0 2500
   expect 2 'param nosuch: no such parameter \(knd, k, ' -- "$@" param set nosuch 1
   expect 2 'param set ks: 6 values \(one per element' -- "$@" param set ks 1
   expect 2 'param k_ad --element 1: it has 1 element' -- "$@" param get k_ad --element 1
-  expect 0 '^observer margin [0-9.]+ ' '^condition \(37\) [0-9.e+]+ ' -- "$@" param check
+  expect 0 '^observer margin [0-9.]+ ' '^loop margin [0-9.]+ ' '^condition \(37\) [0-9.e+]+ ' -- "$@" param check
   expect 0 '^save: ok$' -- "$@" param save
   expect 0 '^reset: ok$' -- "$@" param reset
   expect 0 '^ks\[0\] = 97 ' -- "$@" param get ks --element 0

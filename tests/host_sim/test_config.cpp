@@ -262,6 +262,19 @@ TEST(Config, StartPoseAtASingularityIsRefused) {
   EXPECT_NE(err.find("start_pose: too close to a singularity"), std::string::npos) << err;
 }
 
+// Gains each within its range that together lose the sampled loop (issue 53, defect 4): refused
+// before the run, by name, as the board's param set refuses them.
+TEST(Config, GainsThatLoseTheSampledLoopAreRefused) {
+  Settings s;
+  std::string err;
+  ASSERT_TRUE(sim::apply_setting("controller.knd=[120, 120, 120, 100, 100, 100]", s, err)) << err;
+  EXPECT_TRUE(sim::validate_settings(s, err)) << err;
+  ASSERT_TRUE(sim::apply_setting("controller.ks=[97, 97, 97, 100, 100, 100]", s, err)) << err;
+  EXPECT_FALSE(sim::validate_settings(s, err));
+  EXPECT_NE(err.find("controller: the gains would make the sampled loop unstable at the start pose"), std::string::npos)
+      << err;
+}
+
 // The configured values reach the run: the trajectory's amplitude and the start pose change what
 // the robot does, not only what is printed.
 TEST(Config, ConfiguredTrajectoryAndStartPoseReachTheRun) {

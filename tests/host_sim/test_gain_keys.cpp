@@ -42,7 +42,13 @@ TEST(GainKeys, EveryGainWithAKeyIsAControllerEntryWithItsRangeAndUnit) {
     if (*p.unit) {
       EXPECT_NE(line.find(std::string(" [") + p.unit + "]; "), std::string::npos) << line;
     }
-    EXPECT_NE(line.find("; [" + number(p.lo) + ", " + number(p.hi) + "]"), std::string::npos) << line;
+    if (p.lo_each)  // each element's range: the translations', the rotations'
+      EXPECT_NE(line.find("; x y z [" + number(p.lo_of(0)) + ", " + number(p.hi_of(0)) + "], rotations [" +
+                          number(p.lo_of(3)) + ", " + number(p.hi_of(3)) + "]"),
+                std::string::npos)
+          << line;
+    else
+      EXPECT_NE(line.find("; [" + number(p.lo) + ", " + number(p.hi) + "]"), std::string::npos) << line;
     // The paper's value is inside the range, so that the printed configuration reads back.
     std::string err;
     sim::Settings s;
@@ -56,17 +62,24 @@ TEST(GainKeys, ARangeIsEnforcedAtItsBounds) {
   for (const osc::GainInfo& g : osc::kGainInfo) {
     const osc::GainParam& p = g.param;
     if (p.form == osc::GainForm::kNone) continue;
-    const auto value = [&p](double v) {
-      const std::string n = number(v);
-      return p.form == osc::GainForm::kPerAxis ? "[" + n + ", " + n + ", " + n + ", " + n + ", " + n + ", " + n + "]"
-                                               : n;
+    // Every element at its bound (scaled, shifted): a list of six, or the number.
+    const auto value = [&p](bool hi, double scale, double shift) {
+      if (p.form != osc::GainForm::kPerAxis) return number((hi ? p.hi : p.lo) * scale + shift);
+      std::string t = "[";
+      for (int e = 0; e < 6; ++e) t += (e ? ", " : "") + number((hi ? p.hi_of(e) : p.lo_of(e)) * scale + shift);
+      return t + "]";
     };
     sim::Settings s;
     std::string err;
     const std::string key = std::string("controller.") + p.key;
-    EXPECT_TRUE(sim::set_key(key, value(p.hi), s, err)) << err;
-    EXPECT_FALSE(sim::set_key(key, value(p.hi * 2 + 1), s, err)) << key;
+    EXPECT_TRUE(sim::set_key(key, value(true, 1, 0), s, err)) << err;
+    EXPECT_TRUE(sim::set_key(key, value(false, 1, 0), s, err)) << err;
+    EXPECT_FALSE(sim::set_key(key, value(true, 2, 1), s, err)) << key;
     EXPECT_NE(err.find("out of range"), std::string::npos) << err;
+    if (p.lo > 0) {
+      EXPECT_FALSE(sim::set_key(key, value(false, 0.5, 0), s, err)) << key;
+      EXPECT_NE(err.find("out of range"), std::string::npos) << err;
+    }
   }
 }
 

@@ -109,7 +109,8 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kParamFrame, 9);
   EXPECT_EQ(pil::kParamAnswerFrame, 10);
   EXPECT_EQ(pil::kParamPayload, 4 + 1 + 1 + 1 + 4);
-  EXPECT_EQ(pil::kParamAnswerPayload, 4 + 1 + 1 + 1 + 1 + 1 + 1 + 4 + 4 + 4 + 4 + 12);
+  EXPECT_EQ(pil::kParamAnswerPayload,
+            4 + 1 + 1 + 1 + 1 + 1 + 1 + 4 + 4 + 4 + 4 + 16);  // margins: observer, b bound, (37), loop
   ASSERT_EQ(pil::kFrameTypes, 10);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;

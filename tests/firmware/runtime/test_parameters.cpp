@@ -235,20 +235,67 @@ TEST(Parameters, ObserverMarginIsConservativeAgainstTheErrorMapsSpectralRadius) 
     }
   EXPECT_GT(stable, 10);
   EXPECT_GT(unstable_refused, 3);  // the sweep reaches unstable gains, and each is refused
-  // Through param_set: a k beyond 2 / dt, and a k_i that makes b dt^2 exceed the room, are refused.
-  EXPECT_EQ(param_set(*t, param_index("k"), 0, 2100.0), ParamStatus::kUnstableObserver);
-  EXPECT_EQ(param_set(*t, param_index("ki"), 3, 1e6), ParamStatus::kUnstableObserver);
-  EXPECT_EQ(param_set(*t, param_index("ki"), 3, 5000.0), ParamStatus::kOk);
+  // Through param_set: a k beyond 2 / dt, and a k_i that makes b dt^2 exceed the room, are outside
+  // their ranges now (the ranges keep the sampled loop stable, which asks more than the observer).
+  EXPECT_EQ(param_set(*t, param_index("k"), 0, 2100.0), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, param_index("ki"), 3, 1e6), ParamStatus::kOutOfRange);
+  // A record is judged by the same margin: k of 2100 in a stored record would be refused by it too.
+  Gains<double> g = Gains<double>::paper();
+  g.k(0) = 2100;
+  EXPECT_EQ(gain_status(gain_margins(g, li)), ParamStatus::kUnstableObserver);
+}
+
+/// Issue 53, defect 4: `param set ks 100000` was accepted and the next enable latched non_finite.
+/// Each gain's range now stops where the loop would be lost: every element's bounds are accepted at
+/// the start pose, with the other gains at the paper's values, and beyond them is out_of_range. Two
+/// gains within their ranges that together would lose the loop are refused unstable_loop, by name,
+/// and change nothing.
+TEST(Parameters, EveryGainBoundRunsAndBeyondItIsRefused) {
+  EXPECT_EQ((param_value_status<double>(param_index("ks"), 0, 1e5)), ParamStatus::kOutOfRange);
+  for (int i = 0; i < kParamCount; ++i) {
+    const ParamInfo& p = kParams[i];
+    if (p.gain < 0) continue;
+    for (int e = 0; e < p.count; ++e)
+      for (const bool top : {false, true}) {
+        auto t = disabled_task<double>();
+        const double v = top ? p.hi_of(e) : p.lo_of(e);
+        GainMargins m;
+        EXPECT_EQ(param_set(*t, i, e, v, &m), ParamStatus::kOk) << p.name << "[" << e << "] = " << v;
+        EXPECT_GE(m.loop, 1) << p.name << "[" << e << "] = " << v;
+        EXPECT_GT(m.observer, 1) << p.name << "[" << e << "] = " << v;
+        if (top || v > 0) {
+          const double beyond = top ? v * 1.01 : v * 0.99;
+          EXPECT_EQ(param_set(*t, i, e, beyond), ParamStatus::kOutOfRange) << p.name << "[" << e << "]";
+        }
+      }
+  }
+  // A rotation's k at its bottom (a lightly damped observer) and its k_i at its top.
+  auto t = disabled_task<double>();
+  const int k = param_index("k"), ki = param_index("ki");
+  ASSERT_EQ(param_set(*t, k, 3, 25.0), ParamStatus::kOk);
+  const ParamRecord before = param_capture(*t);
+  GainMargins m;
+  EXPECT_EQ(param_set(*t, ki, 3, 3500.0, &m), ParamStatus::kUnstableLoop);
+  EXPECT_LT(m.loop, 1);
+  EXPECT_GT(m.observer, 1);  // the observer alone would have taken it: the old check
+  const ParamRecord after = param_capture(*t);
+  for (int n = 0; n < kParamSlots; ++n) EXPECT_EQ(after.value[n], before.value[n]) << n;
+  // The whole rotation's k_nd and k_s at their tops lose the loop too.
+  auto u = disabled_task<double>();
+  for (int e = 3; e < 6; ++e) ASSERT_EQ(param_set(*u, param_index("knd"), e, 100.0), ParamStatus::kOk);
+  for (int e = 3; e < 5; ++e) ASSERT_EQ(param_set(*u, param_index("ks"), e, 100.0), ParamStatus::kOk);
+  EXPECT_EQ(param_set(*u, param_index("ks"), 5, 100.0), ParamStatus::kUnstableLoop);
 }
 
 TEST(Parameters, Condition37OnlyWarns) {
   auto t = disabled_task<double>();
   GainMargins m;
   // k_s k_nd / 2 <= 1: (37) cannot hold; set anyway, with the margin telling it.
-  ASSERT_EQ(param_set(*t, param_index("ks"), 2, 0.01, &m), ParamStatus::kOk);
+  ASSERT_EQ(param_set(*t, param_index("ks"), 3, 0.01, &m), ParamStatus::kOk);
   EXPECT_LE(m.condition37, 1);
   EXPECT_GT(m.observer, 1);
-  EXPECT_NEAR(m.condition37, 0.01 * 120 / 2, 1e-12);
+  EXPECT_GE(m.loop, 1);
+  EXPECT_NEAR(m.condition37, 0.01 * 35 / 2, 1e-12);
 }
 
 TEST(Parameters, RecordsApplyWholeOrNotAtAll) {
@@ -264,8 +311,11 @@ TEST(Parameters, RecordsApplyWholeOrNotAtAll) {
   EXPECT_EQ(param_apply(*t, bad), ParamStatus::kBadRecord);
   EXPECT_FLOAT_EQ(t->gains.ks(1), 50);  // unchanged
   ParamRecord unstable = param_defaults();
-  unstable.value[param_slot(param_index("k"))] = 2500;
-  EXPECT_EQ(param_apply(*t, unstable), ParamStatus::kUnstableObserver);
+  unstable.value[param_slot(param_index("k")) + 3] = 25;  // each within its range, together not
+  unstable.value[param_slot(param_index("ki")) + 3] = 3500;
+  EXPECT_EQ(param_apply(*t, unstable), ParamStatus::kUnstableLoop);
+  unstable.value[param_slot(param_index("k"))] = 2500;  // beyond its range
+  EXPECT_EQ(param_apply(*t, unstable), ParamStatus::kBadRecord);
   EXPECT_FLOAT_EQ(t->gains.ks(1), 50);
   t->machine.state = MotionState::kMoving;
   EXPECT_EQ(param_apply(*t, param_defaults()), ParamStatus::kTorqueOn);
@@ -381,9 +431,15 @@ TEST_F(ParamLink, SetSaveResetLoadGivesTheValuesBack) {
   EXPECT_DOUBLE_EQ(task->gains.ks(0), 80);
   // A refused set answers the value as it stays, and the reason.
   a = ask(pil::kParamOpSet, param_index("k"), 0, 2500);
-  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kUnstableObserver));
+  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOutOfRange));
   EXPECT_FLOAT_EQ(a.value, params::kK[0]);
-  EXPECT_LT(a.margins[0], 1);
+  EXPECT_EQ(ask(pil::kParamOpSet, param_index("k"), 3, 25).status, static_cast<std::uint8_t>(ParamStatus::kOk));
+  a = ask(pil::kParamOpSet, param_index("ki"), 3, 3500);
+  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kUnstableLoop));
+  EXPECT_FLOAT_EQ(a.value, params::kKi[3]);
+  EXPECT_GT(a.margins[0], 1);  // the observer's margin met, the loop's not
+  EXPECT_LT(a.margins[3], 1);
+  EXPECT_EQ(ask(pil::kParamOpSet, param_index("k"), 3, 32).status, static_cast<std::uint8_t>(ParamStatus::kOk));
   // Torque on: save, load and reset are refused.
   task->machine.state = MotionState::kHolding;
   for (std::uint8_t op : {pil::kParamOpSave, pil::kParamOpLoad, pil::kParamOpReset})
@@ -392,6 +448,7 @@ TEST_F(ParamLink, SetSaveResetLoadGivesTheValuesBack) {
   EXPECT_EQ(c.status, static_cast<std::uint8_t>(ParamStatus::kOk));
   EXPECT_GT(c.margins[0], 50);
   EXPECT_GT(c.margins[2], 1);
+  EXPECT_GT(c.margins[3], 2);  // the loop's, the paper's gains at the start pose
   EXPECT_EQ(c.flags & pil::kParamFlagWarn37, 0);
 }
 

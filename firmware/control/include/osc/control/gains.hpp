@@ -88,12 +88,23 @@ enum class GainForm : std::uint8_t {
 struct GainParam {
   const char* key;
   GainForm form;
-  double lo, hi;
-  const char* unit;  ///< "" where it has none (the gains of (69))
+  double lo, hi;                    ///< the range of every element (with lo_each / hi_each: the bounds of theirs)
+  const char* unit;                 ///< "" where it has none (the gains of (69))
+  const double* lo_each = nullptr;  ///< each element's range, where the axes' differ (kPerAxis)
+  const double* hi_each = nullptr;
+
+  constexpr double lo_of(int e) const { return lo_each ? lo_each[e] : lo; }
+  constexpr double hi_of(int e) const { return hi_each ? hi_each[e] : hi; }
 };
 namespace gain_param {
 constexpr GainParam per_axis(const char* key, double lo, double hi, const char* unit = "") {
   return {key, GainForm::kPerAxis, lo, hi, unit};
+}
+/// Six numbers, each element within its own range (the translational axes' and the rotations').
+constexpr GainParam per_axis(const char* key, const double (&lo)[6], const double (&hi)[6]) {
+  double l = lo[0], h = hi[0];
+  for (int i = 1; i < 6; ++i) l = lo[i] < l ? lo[i] : l, h = hi[i] > h ? hi[i] : h;
+  return {key, GainForm::kPerAxis, l, h, "", lo, hi};
 }
 constexpr GainParam one(const char* key, double lo, double hi, const char* unit = "") {
   return {key, GainForm::kOne, lo, hi, unit};
@@ -109,10 +120,13 @@ constexpr GainParam none() { return {"", GainForm::kNone, 0, 0, ""}; }
 // experiment's controller.<key> entries (host_sim/config.cpp) from its parameter column.
 #define OSC_GAINS_FIELDS(X)                                                                                        \
   X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz",                             \
-    gain_param::per_axis("knd", 1e-3, 1e5))                                                                        \
-  X(Vec6<S>, k, params::kK, "observer gain k of (69)", gain_param::per_axis("k", 1e-3, 1e5))                       \
-  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)", gain_param::per_axis("ks", 1e-3, 1e5))                \
-  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)", gain_param::per_axis("ki", 1e-3, 1e6))                \
+    gain_param::per_axis("knd", osc::params::kKndRange[0], osc::params::kKndRange[1]))                             \
+  X(Vec6<S>, k, params::kK, "observer gain k of (69)",                                                             \
+    gain_param::per_axis("k", osc::params::kKRange[0], osc::params::kKRange[1]))                                   \
+  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)",                                                       \
+    gain_param::per_axis("ks", osc::params::kKsRange[0], osc::params::kKsRange[1]))                                \
+  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)",                                                       \
+    gain_param::per_axis("ki", osc::params::kKiRange[0], osc::params::kKiRange[1]))                                \
   X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad", gain_param::one("k_ad", 0, 1e5))        \
   X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay tau_dec of model (2), every joint",        \
     gain_param::every("tau_dec", 0.01, 100, "s^2/rad^2"))                                                          \

@@ -9,12 +9,27 @@ namespace osc::params {
 
 constexpr unsigned kControlHz = 1000;     ///< control rate: the timer interrupt [Hz]
 constexpr double kDt = 1.0 / kControlHz;  ///< sampling time [s]
+/// From the encoder sample to the DAC update [s]: the simulated arm's delay, and the longest that the
+/// gains' check (osc/control/sampled_loop.hpp) assumes. The boards' worst-case ticks are within it
+/// on the STM32F4 at 168 MHz (16 000 cycles, 0.1 ms); a 72 MHz Cortex-M3 running the fixed-point
+/// build's 44 000 would take 0.6 ms (docs/protocol.md, "Parameters").
+constexpr double kActuationDelay = 0.2e-3;
 
 /// Gains (69), diagonal, one entry per operational axis: x, y, z, then the three rotations.
 constexpr double kKnd[6] = {120, 120, 120, 35, 35, 35};
 constexpr double kK[6] = {108, 108, 108, 32, 32, 32};
 constexpr double kKs[6] = {97, 97, 97, 30, 30, 30};
 constexpr double kKi[6] = {2000, 2000, 2000, 3000, 3000, 3000};
+/// The ranges of the gains (69) a user may set, each element's [lo; hi] (x y z, then the rotations).
+/// Each bound, the other gains at the paper's values, keeps the sampled closed loop stable at the
+/// start pose (osc/control/sampled_loop.hpp; tests/firmware/runtime/test_parameters.cpp checks each
+/// and how far it is from where the loop is lost) and holds the simulated arm
+/// (tests/host_sim/test_gain_extremes.cpp). A set within its range is judged again at the pose where
+/// it is made (param set: unstable_observer, unstable_loop).
+constexpr double kKndRange[2][6] = {{1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}, {5000, 5000, 5000, 100, 100, 100}};
+constexpr double kKRange[2][6] = {{1, 1, 1, 25, 25, 25}, {1000, 1000, 1000, 1000, 1000, 1000}};
+constexpr double kKsRange[2][6] = {{1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}, {1000, 1000, 1000, 100, 100, 100}};
+constexpr double kKiRange[2][6] = {{1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3}, {1e5, 1e5, 1e5, 3500, 3500, 3500}};
 constexpr double kKad = 500;   ///< every diagonal entry of K_ad (18x18)
 constexpr double kTauDec = 1;  ///< every tau_dec (known Stribeck coefficient) [s^2/rad^2]
 

@@ -164,7 +164,8 @@ constexpr double kCommandMaxVelocity = 10.0;
   X(Save, "save", "every value into the board's store (flash on the STM32F4, RAM on the QEMU boards); torque off") \
   X(Load, "load", "the store's newest valid record applied, checked as a whole; torque off")                       \
   X(Reset, "reset", "the table's defaults applied; torque off; the store is unchanged")                            \
-  X(Check, "check", "the gains' margins as they are: margins = observer, its b bound [1/s^2], condition (37)")
+  X(Check, "check",                                                                                                \
+    "the gains' margins as they are: margins = observer, its b bound [1/s^2], condition (37), the sampled loop")
 
 #define OSC_X_PREFIX kParamOp
 enum ParamOp : std::uint8_t { OSC_PARAM_OP_LIST(OSC_X_ENUMERATOR) kParamOpCount };
@@ -193,21 +194,22 @@ constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC
   X(std::uint8_t, element, , "", "get, set: the element of a vector parameter (0 for a number)") \
   X(float, value, , "the parameter's", "set: the new value")
 
-#define OSC_PARAM_ANSWER_FIELDS(X)                                                                           \
-  X(std::uint32_t, id, , "", "the request's id")                                                             \
-  X(std::uint8_t, op, , "", "its operation")                                                                 \
-  X(std::uint8_t, index, , "", "its parameter's index (get, set)")                                           \
-  X(std::uint8_t, element, , "", "its element (get, set)")                                                   \
-  X(std::uint8_t, status, , "", "ok, or why it was refused (Parameter statuses)")                            \
-  X(std::uint8_t, flags, , "", "warn_37, torque_off, persists (Parameter flags)")                            \
-  X(std::uint8_t, count, , "", "the number of parameters in the table")                                      \
-  X(std::uint32_t, layout, , "", "the table's layout version (a client with another table must not use it)") \
-  X(float, value, , "the parameter's",                                                                       \
-    "get, set: the element's value now (after a set: the new one, or the old when refused)")                 \
-  X(float, lo, , "the parameter's", "get, set: the element's least value")                                   \
-  X(float, hi, , "the parameter's", "get, set: the element's greatest value")                                \
-  X(float, margins, [3], "1, 1/s^2, 1",                                                                      \
-    "set of a gain, check: the observer's stability margin (above 1: stable), its bound on b, condition (37)'s")
+#define OSC_PARAM_ANSWER_FIELDS(X)                                                                                \
+  X(std::uint32_t, id, , "", "the request's id")                                                                  \
+  X(std::uint8_t, op, , "", "its operation")                                                                      \
+  X(std::uint8_t, index, , "", "its parameter's index (get, set)")                                                \
+  X(std::uint8_t, element, , "", "its element (get, set)")                                                        \
+  X(std::uint8_t, status, , "", "ok, or why it was refused (Parameter statuses)")                                 \
+  X(std::uint8_t, flags, , "", "warn_37, torque_off, persists (Parameter flags)")                                 \
+  X(std::uint8_t, count, , "", "the number of parameters in the table")                                           \
+  X(std::uint32_t, layout, , "", "the table's layout version (a client with another table must not use it)")      \
+  X(float, value, , "the parameter's",                                                                            \
+    "get, set: the element's value now (after a set: the new one, or the old when refused)")                      \
+  X(float, lo, , "the parameter's", "get, set: the element's least value")                                        \
+  X(float, hi, , "the parameter's", "get, set: the element's greatest value")                                     \
+  X(float, margins, [4], "1, 1/s^2, 1, 1",                                                                        \
+    "set of a gain, check: the observer's stability margin (above 1: stable), its bound on b, condition (37)'s, " \
+    "the sampled loop's gain margin (at least 1: stable)")
 
 // The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
 // (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as

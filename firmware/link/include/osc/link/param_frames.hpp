@@ -58,6 +58,7 @@ inline void param_answer_margins(pil::ParamAnswerFrame& a, const GainMargins& m)
   a.margins[0] = static_cast<float>(m.observer);
   a.margins[1] = static_cast<float>(m.b_max);
   a.margins[2] = static_cast<float>(m.condition37);
+  a.margins[3] = static_cast<float>(m.loop);
   if (!(m.condition37 > 1)) a.flags |= pil::kParamFlagWarn37;
 }
 }  // namespace detail

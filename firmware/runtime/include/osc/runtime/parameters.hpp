@@ -14,7 +14,8 @@
 // Setting a value (param_set) checks, in this order: the index and element, a finite number within
 // the range, torque off where the parameter asks it, and for a gain of (69) the observer's
 // discrete-time stability at the pose the controller last computed (gain_margins; the margin that
-// osc/control/observer.hpp states). A refusal names its reason (ParamStatus) and changes nothing.
+// osc/control/observer.hpp states), then the sampled closed loop's (osc/control/sampled_loop.hpp).
+// A refusal names its reason (ParamStatus) and changes nothing.
 // The paper's sufficient condition (37) is evaluated as far as it can be and only warns.
 //
 // Header-only, allocation-free; the checks run in double outside the control interrupt.
@@ -28,6 +29,7 @@
 #include <limits>
 #include <type_traits>
 
+#include "osc/control/sampled_loop.hpp"
 #include "osc/runtime/control_task.hpp"
 
 namespace osc {
@@ -38,19 +40,21 @@ namespace osc {
   X(TorqueOff, "torque_off", "only while the torque is off: disabled, or in fault (else refused torque_on)")
 
 /// Why a parameter operation was refused, or ok.
-#define OSC_PARAM_STATUS_LIST(X)                                                                                \
-  X(Ok, "ok", "done")                                                                                           \
-  X(UnknownParam, "unknown_param", "no parameter of that index")                                                \
-  X(BadElement, "bad_element", "the parameter has no element of that number")                                   \
-  X(BadOp, "bad_op", "an operation outside its list")                                                           \
-  X(NotFinite, "not_finite", "the value is not a finite number")                                                \
-  X(OutOfRange, "out_of_range", "the value is outside the parameter's range")                                   \
-  X(TorqueOn, "torque_on", "the parameter (or a save, load or reset) needs the torque off: disable first")      \
-  X(UnstableObserver, "unstable_observer",                                                                      \
-    "the gains would make the discrete observer unstable at the last computed pose (param check: margin)")      \
-  X(StoreFailed, "store_failed", "the parameter store could not write the record")                              \
-  X(NoRecord, "no_record", "load: the store holds no valid record (the values are unchanged)")                  \
-  X(LayoutMismatch, "layout_mismatch", "load: the stored record is of another table layout (values unchanged)") \
+#define OSC_PARAM_STATUS_LIST(X)                                                                                  \
+  X(Ok, "ok", "done")                                                                                             \
+  X(UnknownParam, "unknown_param", "no parameter of that index")                                                  \
+  X(BadElement, "bad_element", "the parameter has no element of that number")                                     \
+  X(BadOp, "bad_op", "an operation outside its list")                                                             \
+  X(NotFinite, "not_finite", "the value is not a finite number")                                                  \
+  X(OutOfRange, "out_of_range", "the value is outside the parameter's range")                                     \
+  X(TorqueOn, "torque_on", "the parameter (or a save, load or reset) needs the torque off: disable first")        \
+  X(UnstableObserver, "unstable_observer",                                                                        \
+    "the gains would make the discrete observer unstable at the last computed pose (param check: margin)")        \
+  X(UnstableLoop, "unstable_loop",                                                                                \
+    "the gains would make the sampled closed loop unstable at the last computed pose (param check: loop margin)") \
+  X(StoreFailed, "store_failed", "the parameter store could not write the record")                                \
+  X(NoRecord, "no_record", "load: the store holds no valid record (the values are unchanged)")                    \
+  X(LayoutMismatch, "layout_mismatch", "load: the stored record is of another table layout (values unchanged)")   \
   X(BadRecord, "bad_record", "load: a stored value is outside its range now (values unchanged)")
 
 #define OSC_X_PREFIX k
@@ -170,8 +174,8 @@ inline constexpr auto kParams = [] {
               static_cast<std::uint8_t>(detail::gain_elements(g.param.form)),
               g.param.lo,
               g.param.hi,
-              nullptr,
-              nullptr,
+              g.param.lo_each,
+              g.param.hi_each,
               0,
               nullptr,
               ParamAccess::kTorqueOff,
@@ -223,51 +227,6 @@ constexpr std::uint16_t kParamLayout = [] {
   }
   return static_cast<std::uint16_t>((h >> 16) ^ (h & 0xFFFFu));
 }();
-
-/// The observer's discrete-time stability and the paper's condition (37) for a set of gains, as
-/// margins (above 1: met). From osc/control/observer.hpp: per operational axis the linearised error
-/// map has determinant 1 - k dt and is stable for b dt^2 < 4 - 2 k dt, b an eigenvalue of
-/// Lambda^-1 k_i. b is bounded above by the largest row sum of |K_i^1/2 Lambda^-1 K_i^1/2| (which
-/// has the same eigenvalues; Gershgorin), at the pose the controller last computed:
-///   observer = min_axes (4 - 2 k dt) / (b_max dt^2)   (needs k dt < 2 too: else 0).
-/// (37) asks k_s > 1/k_n + zeta_e with k_n, zeta_e of the proof, not of the experiment; (33) gives
-/// k_nd >= 2 k_n, so (37) can hold only if k_s > 2 / k_nd: condition37 = min_axes k_s k_nd / 2. It is
-/// only sufficient (below 1 a warning, never a refusal).
-struct GainMargins {
-  double observer = 0;
-  double b_max = 0;  ///< the bound on b [1/s^2]
-  double condition37 = 0;
-};
-
-/// Lambda^-1 = J A^-1 J^T at a pose, from the controller's A and analytic Jacobian (double), by the
-/// kernels' L D L^T solves column by column (Eigen's decompositions would link the heap in).
-inline Mat6<double> lambda_inverse(const Mat6<double>& A, const Mat6<double>& Ja) {
-  LdltFactor<double, kDof> ldlt;
-  ldlt.compute(A);
-  Mat6<double> X;  // A^-1 J^T
-  for (int k = 0; k < kDof; ++k) X.col(k) = ldlt.solve(Vec6<double>(Ja.row(k).transpose()));
-  return Ja.lazyProduct(X);
-}
-
-inline GainMargins gain_margins(const Gains<double>& g, const Mat6<double>& lambda_inv) {
-  GainMargins m;
-  for (int i = 0; i < kDof; ++i) {
-    double row = 0;
-    for (int j = 0; j < kDof; ++j) row += std::fabs(std::sqrt(g.ki(i) * g.ki(j)) * lambda_inv(i, j));
-    if (row > m.b_max) m.b_max = row;
-  }
-  const double dt = g.dt;
-  m.observer = 1e300;
-  m.condition37 = 1e300;
-  for (int i = 0; i < kDof; ++i) {
-    const double room = 4 - 2 * g.k(i) * dt;
-    const double obs = g.k(i) * dt >= 2 || room <= 0 ? 0 : room / (m.b_max * dt * dt);
-    if (obs < m.observer) m.observer = obs;
-    const double c = g.ks(i) * g.knd(i) / 2;
-    if (c < m.condition37) m.condition37 = c;
-  }
-  return m;
-}
 
 namespace detail {
 /// Element e of a gain field, read or written in double (a number's only element is 0; a field of
@@ -459,6 +418,13 @@ Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
   return lambda_inverse(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
 }
 
+/// Whether gains of these margins may run: the observer's margin above 1, the loop's at least 1.
+inline ParamStatus gain_status(const GainMargins& m) {
+  if (!(m.observer > 1)) return ParamStatus::kUnstableObserver;
+  if (!(m.loop >= 1)) return ParamStatus::kUnstableLoop;
+  return ParamStatus::kOk;
+}
+
 /// The margins of the task's gains with element e of parameter i set to v (i < 0: as they are).
 template <class S>
 GainMargins param_margins(ControlTask<S>& task, int i = -1, int e = 0, double v = 0) {
@@ -479,7 +445,7 @@ ParamStatus param_set(ControlTask<S>& task, int i, int e, double v, GainMargins*
   if (p.gain >= 0) {
     const GainMargins m = param_margins(task, i, e, v);
     if (margins) *margins = m;
-    if (!(m.observer > 1)) return ParamStatus::kUnstableObserver;
+    if (const ParamStatus g = gain_status(m); g != ParamStatus::kOk) return g;
   }
   param_put(task, i, e, v);
   return ParamStatus::kOk;
@@ -518,7 +484,7 @@ ParamStatus param_apply(ControlTask<S>& task, const ParamRecord& r) {
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count && kParams[i].gain >= 0; ++e)
       detail::gain_put(g, kParams[i].gain, e, r.value[param_slot(i) + e]);
-  if (!(gain_margins(g, task_lambda_inverse(task)).observer > 1)) return ParamStatus::kUnstableObserver;
+  if (const ParamStatus st = gain_status(gain_margins(g, task_lambda_inverse(task))); st != ParamStatus::kOk) return st;
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e) param_put(task, i, e, r.value[param_slot(i) + e]);
   return ParamStatus::kOk;
