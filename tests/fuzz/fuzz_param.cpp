@@ -11,7 +11,7 @@
 //    changes that element only (a `every` gain: its vector), to the value asked within the scalar's
 //    resolution;
 //  - after any request every value is within its range and the gains keep the observer's margin
-//    above 1 (a set or a load never makes the observer unstable);
+//    above 1 and the sampled loop's at least 1 (a set or a load never makes either unstable);
 //  - with the torque on, nothing written torque_off changes, and save, load and reset are refused.
 #include <cmath>
 #include <cstdint>
@@ -119,7 +119,9 @@ void run(fuzz::Input& in, bool torque_on) {
         FUZZ_CHECK(std::isfinite(v));
         FUZZ_CHECK(v >= kParams[i].lo_of(e) - resolution<S>(v) && v <= kParams[i].hi_of(e) + resolution<S>(v));
       }
-    FUZZ_CHECK(param_margins(task).observer > 1);
+    const GainMargins m = param_margins(task);
+    FUZZ_CHECK(m.observer > 1);
+    FUZZ_CHECK(m.loop >= 1);
   }
 }
 

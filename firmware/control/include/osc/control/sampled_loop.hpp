@@ -42,6 +42,8 @@
 
 namespace osc::loop {
 
+constexpr double kSqrt2 = 1.4142135623730951;
+
 /// One axis of the sampled loop, in the sample time's units.
 struct Axis {
   double kappa;  ///< k dt
@@ -146,33 +148,80 @@ inline std::array<double, 6> polynomial(const Axis& x, double phi) {
 
 /// Whether every root of q_5 s^5 + ... + q_0 lies in the open left half plane: the first column of
 /// the Routh array, q_5, q_4, r_1, r_2, r_3, q_0, all positive.
-inline bool hurwitz_stable(const std::array<double, 6>& q) {
-  for (const double c : q)
+template <class T>
+bool hurwitz_stable(const std::array<T, 6>& q) {
+  for (const T c : q)
     if (!(c > 0)) return false;
-  const double r1 = q[3] - q[5] * q[2] / q[4];  // the s^3 row: r1, r1b
-  const double r1b = q[1] - q[5] * q[0] / q[4];
+  const T r1 = q[3] - q[5] * q[2] / q[4];  // the s^3 row: r1, r1b
+  const T r1b = q[1] - q[5] * q[0] / q[4];
   if (!(r1 > 0)) return false;
-  const double r2 = q[2] - q[4] * r1b / r1;  // the s^2 row: r2, q0
+  const T r2 = q[2] - q[4] * r1b / r1;  // the s^2 row: r2, q0
   if (!(r2 > 0)) return false;
-  const double r3 = r1b - r1 * q[0] / r2;  // the s^1 row
+  const T r3 = r1b - r1 * q[0] / r2;  // the s^1 row
   return r3 > 0;
 }
 
-/// Whether one axis's loop is stable at the delay phi.
+/// Whether one axis's loop is stable at the delay phi (double: the reference the tests use).
 inline bool axis_stable(const Axis& x, double phi) { return hurwitz_stable(polynomial(x, phi)); }
+
+/// The check's own arithmetic: float, which the boards' FPUs compute in hardware. The check runs in
+/// a board's main loop when a parameter frame comes, and a 25 MHz part's main loop must answer
+/// within a few milliseconds (the PIL firmware's watchdog): in software double it would take
+/// several. The bilinear form needs no more (no cancellation); the tests hold float's judgement to
+/// double's and to the coupled loop's.
+using Real = float;
+
+/// kLoopTerms at the DAC delay the check assumes (params::kActuationDelay).
+struct LoopWeights {
+  Real w[6][kTerms];
+};
+constexpr LoopWeights loop_weights(double phi) {
+  LoopWeights l{};
+  for (int k = 0; k < 6; ++k)
+    for (int t = 0; t < kTerms; ++t) {
+      const int* p = kLoopTerms[k][t];
+      l.w[k][t] = static_cast<Real>(p[0] + phi * (p[1] + phi * p[2]));
+    }
+  return l;
+}
+inline constexpr LoopWeights kLoopWeights = loop_weights(params::kActuationDelay / params::kDt);
+
+/// One axis at that delay as a function of the fraction f of its inverse mass bound:
+/// q_k(f) = A_k + f (B_k + f C_k) (the terms without a or b, with one of them, with both).
+struct AxisForm {
+  Real A[6], B[6], C[6];
+};
+inline AxisForm axis_form(Real kappa, Real sigma, Real a, Real b) {
+  // kLoopTerms' order: 0 a b sigma, 1 a b, 2 a kappa sigma, 3 a kappa, 4 a sigma, 5 a, 6 b sigma,
+  // 7 b, 8 kappa sigma, 9 kappa, 10 sigma, 11 1.
+  AxisForm x{};
+  const Real ks = kappa * sigma;
+  for (int k = 0; k < 6; ++k) {
+    const Real* w = kLoopWeights.w[k];
+    x.A[k] = w[8] * ks + w[9] * kappa + w[10] * sigma + w[11];
+    x.B[k] = a * (w[2] * ks + w[3] * kappa + w[4] * sigma + w[5]) + b * (w[6] * sigma + w[7]);
+    x.C[k] = a * b * (w[0] * sigma + w[1]);
+  }
+  return x;
+}
+inline bool form_stable(const AxisForm& x, Real f) {
+  std::array<Real, 6> q;
+  for (int k = 0; k < 6; ++k) q[static_cast<std::size_t>(k)] = x.A[k] + f * (x.B[k] + f * x.C[k]);
+  return hurwitz_stable(q);
+}
 
 /// The fractions of an axis's bound at which its loop is judged: 1, 1/2, ..., 1/256.
 constexpr int kMassSteps = 9;
 
 /// Whether the loop of every axis is stable with the gains scaled by s, every inverse mass from
 /// each axis's bound (a_max, b_max: of lambda = its row's bound) down.
-inline bool stable(const Gains<double>& g, const Vec6<double>& a_max, const Vec6<double>& b_max, double phi,
-                   double s = 1) {
-  for (int i = 0; i < kDof; ++i)
-    for (int m = 0; m < kMassSteps; ++m) {
-      const double f = s * std::ldexp(1.0, -m);
-      if (!axis_stable({s * g.k(i) * g.dt, s * g.ks(i) * g.dt, f * a_max(i), f * b_max(i)}, phi)) return false;
-    }
+inline bool stable(const Gains<double>& g, const Vec6<double>& a_max, const Vec6<double>& b_max, double s = 1) {
+  for (int i = 0; i < kDof; ++i) {
+    const AxisForm x = axis_form(static_cast<Real>(s * g.k(i) * g.dt), static_cast<Real>(s * g.ks(i) * g.dt),
+                                 static_cast<Real>(s * a_max(i)), static_cast<Real>(s * b_max(i)));
+    for (int m = 0; m < kMassSteps; ++m)
+      if (!form_stable(x, std::ldexp(Real(1), -m))) return false;
+  }
   return true;
 }
 
@@ -191,24 +240,28 @@ inline void axis_bounds(const Gains<double>& g, const Mat6<double>& lambda_inv, 
   }
 }
 
+/// The steps of the loop's gain margin: factors of sqrt 2, at most kMarginSteps of them each way.
+constexpr int kMarginSteps = 4;
+
 /// The loop's gain margin: the factor by which the gains k, k_s, k_nd, k_i together may grow before
-/// the loop is unstable, to about 1 %, within 2^-8 ... 2^8. At least 1 exactly when the loop is
-/// stable as they are; below 1 it is not, and the figure is the factor below which scaling them all
-/// down would restore it (0: not even at 2^-8; a low k loses the loop too, so shrinking is not always
-/// the way back).
-inline double gain_margin(const Gains<double>& g, const Mat6<double>& lambda_inv, double phi) {
+/// the loop is unstable, in steps of sqrt 2 (a lower bound: the loop is stable at it, not at the
+/// next step), up to 4. At least 1 exactly when the loop is stable as they are. Below 1 it is not,
+/// and the figure is the first step down (to 1/4) at which it would be (0: none; a low k loses the
+/// loop too, so shrinking every gain is not always the way back). At most kMarginSteps + 1
+/// evaluations of stable(), each a few thousand float operations.
+inline double gain_margin(const Gains<double>& g, const Mat6<double>& lambda_inv) {
   Vec6<double> a_max, b_max;
   axis_bounds(g, lambda_inv, a_max, b_max);
-  double lo = -8, hi = 8;  // log2 of the factor
-  const bool now = stable(g, a_max, b_max, phi);
-  if (now ? stable(g, a_max, b_max, phi, std::exp2(hi)) : !stable(g, a_max, b_max, phi, std::exp2(lo)))
-    return now ? std::exp2(hi) : 0.0;
-  (now ? lo : hi) = 0;
-  while (hi - lo > 0.015) {
-    const double mid = (lo + hi) / 2;
-    (stable(g, a_max, b_max, phi, std::exp2(mid)) ? lo : hi) = mid;
+  const bool now = stable(g, a_max, b_max);
+  double s = 1;
+  for (int n = 0; n < kMarginSteps; ++n) {
+    const double next = now ? s * kSqrt2 : s / kSqrt2;
+    const bool ok = stable(g, a_max, b_max, next);
+    if (now && !ok) return s;
+    if (!now && ok) return next;
+    s = next;
   }
-  return std::exp2(lo);
+  return now ? s : 0.0;
 }
 
 }  // namespace osc::loop
@@ -259,7 +312,7 @@ inline GainMargins gain_margins(const Gains<double>& g, const Mat6<double>& lamb
     const double c = g.ks(i) * g.knd(i) / 2;
     if (c < m.condition37) m.condition37 = c;
   }
-  m.loop = loop::gain_margin(g, lambda_inv, params::kActuationDelay / g.dt);
+  m.loop = loop::gain_margin(g, lambda_inv);
   return m;
 }
 
