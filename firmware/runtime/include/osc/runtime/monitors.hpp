@@ -10,7 +10,8 @@
 //                                            (EncoderActivity: each encoder's changes; qualify())
 //   osc/runtime/residual_monitor.hpp
 //     after the step   ResidualMonitor       the torque the model does not explain, and the travel check
-//                                            (its constants of the arm: residual_constants.hpp)
+//                                            (residual_constants.hpp, residual_thresholds.hpp and
+//                                            residual_travel.hpp: its constants, thresholds, travel check)
 //   osc/runtime/step_monitors.hpp
 //     after the step   TrackingMonitor       the tracking error e (36) within params::kTrackingLimit*
 //                      ThetaBandMonitor      the friction estimates within their band

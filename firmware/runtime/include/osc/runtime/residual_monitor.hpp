@@ -1,8 +1,10 @@
 // The residual monitor (ResidualMonitor; docs/safety.md, "The residual monitor"): the torque the
 // model does not explain, filtered per joint, against thresholds derived from the arm's stated error
 // bounds, and the travel check beside it. Run by control_tick() after the control step
-// (osc/runtime/monitors.hpp). Its constants of the arm and its input from the step are in
-// osc/runtime/residual_constants.hpp.
+// (osc/runtime/monitors.hpp). Its parts: the arm's constants and its input from the step
+// (osc/runtime/residual_constants.hpp), the type and its per-tick check (here), each joint's bound and
+// thresholds (osc/runtime/residual_thresholds.hpp) and the travel check
+// (osc/runtime/residual_travel.hpp), those two included at the end of this header.
 #pragma once
 
 #include <cstdint>
@@ -382,49 +384,6 @@ struct ResidualMonitor {
           breakaway(in.proven ? in.proven->breakaway.data() : kResidualConstants<S>.static_band) {}
     Friction operator()(int i) const { return Friction{vis[i], breakaway[i]}; }
   };
-  /// Joint i's friction against the band (FrictionError), `f` at its strongest; `moving` is the speed
-  /// beyond which the joint may count as moving (Motion::moving_speed).
-  FrictionError friction_error(const ResidualInput<S>& in, const Friction& f, int i, std::uint64_t tick,
-                               S moving) const {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::abs;
-    FrictionError e;
-    if (in.theta) {
-      const Vec18<S>& th = *in.theta;
-      e.th_v = th(i), e.th_c = th(kDof + i), e.th_s = th(2 * kDof + i);
-    } else {
-      e.th_v = e.th_c = e.th_s = S(0);
-    }
-    e.dv = abs(e.th_v - c.vis_mid[i]) + c.vis_half[i];
-    // Coulomb's level lies within its band and below the strongest breakaway less the least Stribeck
-    // level (the identification's proven breakaway narrows it; the band's top leaves it as it is).
-    const S cap = f.breakaway - c.sti_lo[i], cou_top = cap < c.cou_hi[i] ? cap : c.cou_hi[i];
-    const S below = e.th_c - c.cou_lo[i], above = cou_top - e.th_c;
-    e.dc = below > above ? below : above;
-    e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
-    // Static friction anywhere within the band (its top, or what the identification proves), against
-    // whatever the estimate says.
-    e.still = math::mul_add(f.vis, moving, f.breakaway) + abs(in.tau_f(i));
-    // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag;
-    // the joint slides (its friction on the model's curve) when it counts fast enough besides. The
-    // stillness envelope and the identification's samples go by the first (a joint that crawls
-    // between counts resets neither).
-    const bool up = in.qd(i) > S(0);
-    e.moving = abs(in.qd(i)) > moving && activity.counting(i, up, tick);
-    e.sliding = e.moving && activity.sliding(i);
-    return e;
-  }
-  /// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
-  /// friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
-  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::mul_add;
-    // Moving: the band's distance from the estimate, coefficient by coefficient.
-    const S friction = e.sliding ? mul_add(math::abs(in.qd(i)), e.dv,
-                                           mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
-                                 : e.still;
-    return friction + model;
-  }
   /// Joint i's Coriolis torque c = n - g - tau_f^ and the applied torque's size |tau|, which the
   /// bound and the change channel both take: computed once a joint.
   struct Torques {
@@ -433,180 +392,20 @@ struct ResidualMonitor {
   Torques torques(const ResidualInput<S>& in, int i) const {
     return Torques{in.bias(i) - in.g(i) - in.tau_f(i), math::abs(tau_prev(i))};
   }
-  /// Joint i's bound on the unexplained torque besides friction and the inertias: the link
-  /// inertia's share of gravity and Coriolis torques, the amplifier's gain, ripple and offset, and
-  /// the coupled motors' friction (error_floor, with a contact's push while it lasts).
-  S model_error(const ResidualInput<S>& in, const Torques& t, int i) const {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::mul_add;
-    return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(t.coriolis),
-                   mul_add(c.gain_ripple, t.size, error_floor(i)));
-  }
-  /// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
-  /// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
-  /// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
-  /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
-  /// anything within its static band, from one end to the other (twice the band), and keeps it in
-  /// the change threshold until the slow filter forgets it.
-  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t, int i) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    const S Ks = c.slow_dt, Kdt = c.gain_dt[i];
-    const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
-    // Filtered as r, then slowly: the regressor's change.
-    const auto band = [&](int k, S phi) {
-      low_pass(reg[k](i), phi, Kdt);
-      low_pass(reg_slow[k](i), reg[k](i), Ks);
-      return reg[k](i) - reg_slow[k](i);
-    };
-    Changes ch;
-    ch.vis = band(kVis, qd);
-    ch.cou = band(kCou, sign);
-    ch.sti = band(kSti, sign * in.decay(i));
-    ch.estimate = band(kEstimate, in.tau_f(i));
-    ch.gravity = band(kGravity, in.g(i));
-    ch.coriolis = band(kCoriolis, t.coriolis);
-    ch.torque = band(kTorque, tau_prev(i));
-    low_pass(reg[kTorqueSize](i), t.size, Kdt);  // |tau|: its size alone
-    low_pass(r_slow(i), r(i), Ks);
-    d(i) = r(i) - r_slow(i);
-    stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
-    return ch;
-  }
-  /// Joint i's thresholds: the filtered bound, the inertias' error on the filtered accelerations, and
-  /// the velocity estimate's noise through A and the filter. `ch`: the regressors' changes (zero
-  /// when priming). Returns the current loop's lag term (the travel check's too).
-  S update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::abs;
-    using math::mul_add;
-    const S quantum = c.quantum_gain[i] * m.noise[i], margin_quantum = c.margin * quantum;
-    noise_bound(i) = quantum;
-    // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
-    const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
-    const S pointwise = mul_add(c.link_inertia, m.inertia[i], mul_add(c.armature_delta[i], m.a[i], bound(i) + loop));
-    threshold(i) = mul_add(c.peak_margin[i], pointwise, margin_quantum);
-    // The friction error (theta - theta^)^T w: the band's distances times the regressors'
-    // changes at the estimate of now, plus what the estimate's own change added.
-    const S learnt = ch.estimate - mul_add(e.th_v, ch.vis, mul_add(e.th_c, ch.cou, e.th_s * ch.sti));
-    const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
-                       mul_add(c.vis_hi[i], velocity_noise(i),
-                               S(2) * mul_add(e.sliding ? stillness(i) : S(1), e.still, cross_friction(i)));
-    const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
-                            c.armature_delta[i] * m.da[i]);
-    const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
-    change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
-    return loop;
-  }
-  /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
-  /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
-  /// one before a count back, n ticks earlier: its mean speed that way since was at least the edges'
-  /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now
-  /// differs from that mean by at most the most it can have sped up or slowed down over them (after a reversal, the
-  /// same edge twice: a mean of 0). These bound its speed ahead from below, and back from below as minus its speed
-  /// ahead at most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied that way
-  /// less gravity and Coriolis torques (the least of the step's ticks), with every error the model may have against the
-  /// motion (model_error(), the other joints' inertial torques with the link inertia's share, the current loop's lag)
-  /// and friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
-  /// identification proves: `f`), over the diagonal inertia at its least or most, bounds its speed that way from
-  /// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
-  /// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
-  /// bounded. `model` and `loop`: model_error()'s and update_thresholds()' terms of this joint.
+  // Per joint: the friction error, the bound, the model error, the change channel and the thresholds
+  // (osc/runtime/residual_thresholds.hpp).
+  FrictionError friction_error(const ResidualInput<S>& in, const Friction& f, int i, std::uint64_t tick,
+                               S moving) const;
+  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const;
+  S model_error(const ResidualInput<S>& in, const Torques& t, int i) const;
+  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t, int i);
+  S update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i);
+  // The travel check (osc/runtime/residual_travel.hpp).
   bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, S loop, bool count,
-              bool restart, std::uint64_t tick) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::abs;
-    using math::mul_add;
-    const S limit = travel_limit(i);
-    if (limit == S(0)) return false;
-    if (restart) {
-      ahead.p(i) = back.p(i) = -limit;  // nothing known: no bound until a count
-      ahead.v(i) = S(0);
-      back.v(i) = -c.speed_cap[i];
-      ahead.drive(i) = back.drive(i) = kNoDrive;
-      return false;
-    }
-    static constexpr int kEvery = params::kResidualTravelEvery;
-    const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
-    const S way = activity.direction[i] > 0 ? S(1) : S(-1);
-    const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
-    // This tick's drive each way at a count (the direction it sets), else the least over the step's ticks.
-    const S drive = count || now < ahead.drive(i) ? now : ahead.drive(i);
-    const S drive_back = count || -now < back.drive(i) ? -now : back.drive(i);
-    if (!count && !turn) {
-      ahead.drive(i) = drive;
-      back.drive(i) = drive_back;
-      return false;
-    }
-    ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
-    const S aii = in.A(i, i);
-    const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
-    const S error = mul_add(c.link_inertia, others, others) + model + loop;
-    const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
-    if (count) {
-      count_bounds(i, (abs(drive) + error + f.breakaway) / a_min);
-      return false;
-    }
-    const S a_max = mul_add(c.link_inertia, aii, aii) + c.armature_delta[i];
-    const S p_ahead = advance(ahead, i, drive - error, f, a_min, a_max);
-    const S p_back = advance(back, i, drive_back - error, f, a_min, a_max);
-    const S p = p_ahead > p_back ? p_ahead : p_back;
-    if (p > travel_peak(i)) travel_peak(i) = p;
-    return p > limit;
-  }
-  /// Joint i's speed bounds at a count (travel()), from its pace and `change`, the most its speed can
-  /// change per second [rad/s^2]. Its spans are read up to kSpanMax ticks (slower, ahead is 0 and
-  /// back is its speed cap's).
-  void count_bounds(int i, S change) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    static constexpr std::uint32_t kSpanMax = 250;
-    static constexpr S kDt = lit<S>(params::kDt);
-    const std::uint32_t n = activity.move_interval[i];
-    S slow = S(0), fast = c.speed_cap[i];
-    if (n <= kSpanMax) {
-      const S span = kDt * S(static_cast<int>(n) + 1), drift = change * span;
-      if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval))
-        slow = spacing_lo(i) / span - drift;
-      if (activity.reversed[i])
-        fast = drift;  // it crossed the same edge back and forth: a mean speed of 0
-      else if (activity.steady[i] && n >= 2)
-        fast = spacing_hi(i) / (kDt * S(static_cast<int>(n) - 1)) + drift;
-    }
-    ahead.v(i) = slow > S(0) ? slow : S(0);
-    back.v(i) = fast < c.speed_cap[i] ? -fast : -c.speed_cap[i];
-    ahead.p(i) = back.p(i) = S(0);
-  }
-  /// One step of joint i's bounds one way: `force` is the least drive that way less the model's
-  /// error; friction is at its strongest against the motion (none when the joint may be going the
-  /// other way, where it pushes this way). Static friction holds a joint at rest against what cannot
-  /// break it away (half the band's weakest static friction). Returns the least travel (within a
-  /// count either way after it: the joint did not count).
-  S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    using math::mul_add;
-    static constexpr S kStep = lit<S>(params::kResidualTravelEvery * params::kDt);
-    const S lo = w.v(i), limit = travel_limit(i);
-    const S net = force - (lo >= S(0) ? mul_add(f.vis, lo, f.breakaway) : S(0));
-    S next = mul_add(kStep, net / (net < S(0) ? a_min : a_max), lo);
-    if (lo >= S(0) && next < S(0) && force + c.static_lo[i] > S(0)) next = S(0);
-    const S cap = c.speed_cap[i];
-    next = next < -cap ? -cap : (next > cap ? cap : next);
-    w.v(i) = next;
-    // Over the step the speed was at least the lesser of both ends.
-    const S p = mul_add(kStep, lo < next ? lo : next, w.p(i));
-    w.p(i) = p < -limit ? -limit : (p > limit ? limit : p);
-    return p;
-  }
-  /// The kind of a travel check's finding on joint i: a joint that must have counted and did not.
-  /// Its encoder fell silent at once from counting fast (a joint that stops slows down first, its
-  /// intervals between counts growing): encoder_stuck. Otherwise something holds it, or its encoder
-  /// froze while it stood, which the same reading cannot tell apart: collision when the residual is
-  /// on other joints too (a contact at the tip loads several), else encoder_stuck.
-  std::uint32_t classify_travel(int i) const {
-    if (activity.was_fast(i)) return kFaultEncoderStuck;
-    for (int j = 0; j < kDof; ++j)
-      if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
-    return kFaultEncoderStuck;
-  }
+              bool restart, std::uint64_t tick);
+  void count_bounds(int i, S change);
+  S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
+  std::uint32_t classify_travel(int i) const;
   /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
   /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
   bool silent_first(int c, int i, std::uint64_t tick) const {
@@ -628,3 +427,6 @@ struct ResidualMonitor {
 };
 
 }  // namespace osc
+
+#include "osc/runtime/residual_thresholds.hpp"
+#include "osc/runtime/residual_travel.hpp"
