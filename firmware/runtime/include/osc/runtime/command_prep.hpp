@@ -1,0 +1,94 @@
+// Commands to the task from outside the tick (a board's main loop, the host's driver): a move_to or a
+// home prepared in full, planned and path-checked (prepare_checked_move, prepare_checked_home), a
+// stream's setpoint into the task's mailbox (offer_setpoint) and a category-2 stop asked of the next
+// tick (request_stop), each left where the next tick takes it (task.pending, task.sample,
+// task.stop_request).
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/path_check.hpp"
+#include "osc/runtime/homing.hpp"
+#include "osc/runtime/motion_commands.hpp"
+
+namespace osc {
+
+/// The task (osc/runtime/control_task.hpp, which includes this header before it defines the type):
+/// the functions below take it by reference.
+template <class S>
+struct ControlTask;
+
+/// Asks the next tick for a category-2 stop of the running motion, for `why` (a reason of the
+/// runtime's, e.g. kLinkSilent): the tick takes it after its own (a reached limit, a stale stream)
+/// and only while moving (motion_next ignores a stop request in any other state). Call it where the
+/// tick runs (the control interrupt), before the tick; each tick takes the request it finds and
+/// clears it.
+template <class S>
+void request_stop(ControlTask<S>& task, MotionReason why) {
+  task.stop_request = why;
+}
+
+/// A path check's result as a refusal (none: the path is clear). A target beyond the arm's reach
+/// (kUnreachable) is out of its workspace.
+constexpr MotionReason path_refusal(PathStatus s) {
+  switch (s) {
+    case PathStatus::kOk:
+      return MotionReason::kNone;
+    case PathStatus::kNearSingular:
+      return MotionReason::kNearSingular;
+    case PathStatus::kOutOfWorkspace:
+    case PathStatus::kUnreachable:
+      break;
+  }
+  return MotionReason::kOutOfWorkspace;
+}
+
+/// The path check of a move_to prepare_move planned, or of a home's move (nothing if it refused it already).
+template <class S>
+void check_prepared_move(ControlTask<S>& task, TaskCommand<S>& c) {
+  if ((c.verb != MotionVerb::kMoveTo && c.verb != MotionVerb::kHome) || c.refusal != MotionReason::kNone) return;
+  const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
+  const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
+  c.refusal = path_refusal(pc.status);
+  c.q_end = pc.q_end;
+}
+
+/// Prepares a move_to in full, outside the tick (a board's main loop, the host's driver): the
+/// limits, the queue and the plan (prepare_move), then the path check (check_path) from the joint
+/// angles where the queue ends, or, for a move that starts where a braked motion comes to rest,
+/// from the last measured ones. Put the result in task.pending for the next tick.
+template <class S>
+TaskCommand<S> prepare_checked_move(ControlTask<S>& task, const MoveRequest<S>& req, std::uint32_t id) {
+  TaskCommand<S> c = prepare_move(task.gen, task.limits, task.tick, params::kControlHz, req, id);
+  check_prepared_move(task, c);
+  return c;
+}
+
+/// Prepares a home in full, outside the tick (like prepare_checked_move): the homing move from the
+/// last measured angles, path-checked.
+template <class S>
+TaskCommand<S> prepare_checked_home(ControlTask<S>& task, std::uint32_t id) {
+  TaskCommand<S> c =
+      prepare_home(task.gen, home_limits(task), task.model, task.check_data, task.io, task.state.adapt.q_prev, id);
+  check_prepared_move(task, c);
+  return c;
+}
+
+/// Puts a setpoint of stream `id` (with its velocity, or none) into the task's mailbox for the next
+/// tick (prepare_setpoint):
+/// false, counted in task.dropped, when no stream of that id runs; a setpoint not yet taken is
+/// replaced (and counted).
+template <class S>
+bool offer_setpoint(ControlTask<S>& task, std::uint32_t id, const Vec3<S>& position, const Vec3<S>& rpy, bool has_rpy,
+                    bool end, const Vec6<S>* velocity = nullptr) {
+  StreamSample<S> s;
+  if (!prepare_setpoint(task.gen, id, position, rpy, has_rpy, end, s, velocity)) {
+    ++task.dropped;
+    return false;
+  }
+  if (task.sample.valid) ++task.dropped;
+  task.sample = s;
+  return true;
+}
+
+}  // namespace osc

@@ -1,0 +1,432 @@
+// The residual monitor (ResidualMonitor; docs/safety.md, "The residual monitor"): the torque the
+// model does not explain, filtered per joint, against thresholds derived from the arm's stated error
+// bounds, and the travel check beside it. Run by control_tick() after the control step
+// (osc/runtime/monitors.hpp). Its parts: the arm's constants and its input from the step
+// (osc/runtime/residual_constants.hpp), the type and its per-tick check (here), each joint's bound and
+// thresholds (osc/runtime/residual_thresholds.hpp) and the travel check
+// (osc/runtime/residual_travel.hpp), those two included at the end of this header.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/controller.hpp"
+#include "osc/control/identification.hpp"
+#include "osc/runtime/encoder_monitors.hpp"
+#include "osc/runtime/io.hpp"
+#include "osc/runtime/residual_constants.hpp"
+
+namespace osc {
+
+/// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone;
+/// Haddadin, De Luca and Albu-Schaeffer 2017) in its sampled, acceleration-free form. Per joint,
+/// the torque the model does not explain, A(q) q^dot' + c + g + tau_f^ - tau, through a first-order
+/// filter of bandwidth K = params::kResidualGain:
+///   r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})],
+/// n = c + g + tau_f^, tau_{k-1} the torque applied over the last period, q^dot the observer's (no
+/// numerical differentiation: the velocity difference is integrated). On a healthy arm r is the
+/// model's error, and each joint's threshold bounds it from the arm's stated error bounds
+/// (robot::kModelErrorBounds): friction (a still joint: anywhere in its static band; a moving one:
+/// the band's distance from theta^), link inertia, motor inertia, the amplifiers, and the encoder
+/// quantum through the velocity estimate (docs/safety.md derives each term). A residual beyond its
+/// threshold for params::kResidualQualifyTicks ticks in a row is a fault, isolated by joint and
+/// kind:
+///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for
+///    more than params::kStuckIntervals of its recent intervals between counts);
+///  - drive_fault: the residual is on this drive alone (every other joint below half its threshold);
+///  - collision: an external torque on several joints, as a contact gives.
+/// Beside the residual, the travel check (travel()): a joint whose least motion since its encoder's
+/// last count, from the torque applied and the same bounds, passes params::kResidualTravelCounts
+/// counts must have counted; it is a fault at once (classify_travel() names it).
+template <class S>
+struct ResidualMonitor {
+  /// The model error's regressors, each filtered as r, then slowly (the change channel): the
+  /// friction model's three columns, gravity, the Coriolis torque, the applied torque and its size.
+  enum Regressor { kVis, kCou, kSti, kEstimate, kGravity, kCoriolis, kTorque, kTorqueSize, kRegressors };
+  /// One joint's friction against the band (robot::kModelErrorBounds): sliding, the band's distance
+  /// from theta^ per coefficient; not sliding, the static band's extent plus |tau_f^| (still).
+  struct FrictionError {
+    S th_v, th_c, th_s;  // theta^'s coefficients of the joint (0 without compensation)
+    S dv, dc, ds, still;
+    bool moving;   // its direction known: counting one way, q^dot beyond its noise and lag
+    bool sliding;  // ... and counting fast enough that its friction is on the model's curve
+  };
+
+  Vec6<S> r;                             // the residual [N m]
+  Vec6<S> bound;                         // the model-error bound's filtered pointwise terms [N m]
+  Vec6<S> acc;                           // the joint accelerations, filtered as r [rad/s^2]
+  Vec6<S> threshold;                     // this tick's thresholds [N m]
+  Vec6<S> d;                             // the change residual r - r_slow [N m]
+  Vec6<S> change_threshold;              // its thresholds [N m]
+  Vec6<S> r_slow, acc_slow;              // r and acc through the slow filter (params::kResidualSlowGain)
+  Vec6<S> reg[kRegressors];              // the regressors filtered as r
+  Vec6<S> reg_slow[kRegressors];         // ... then slowly
+  Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
+  Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
+  Vec6<S> velocity_noise;                // the velocity estimate's quantisation noise per joint [rad/s] (wrist_noise())
+  Vec6<S> noise_base;  // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
+  S wrist_mix;         // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
+  Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
+  /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
+  /// in contact, |r| as it was when the contact began (note_contact()) [N m].
+  Vec6<S> error_floor = Vec6<S>::Zero();
+  S k_max, lag;                    // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
+  Vec6<S> peak_ratio;              // the largest |r| / threshold seen per joint
+  EncoderActivity activity;        // each encoder's changes
+  std::uint8_t over[kDof];         // consecutive ticks beyond the threshold
+  std::uint64_t over_since[kDof];  // the tick the current run of them began
+  std::uint32_t detected;          // the first detection's fault (kept while not armed too)
+  std::uint64_t detected_tick;     // ... its tick
+  std::int8_t joint;               // ... its joint (0-based), -1 none
+  bool primed;                     // a previous step is on record
+  /// Its detections are faults, in place of StuckEncoderMonitor's (else only recorded).
+  bool armed = params::kResidualMonitorArmed;
+  /// The user's collision thresholds [N m] (ControlTask::set_collision): a collision is reported
+  /// only once some joint's qualified residual is beyond its own too; 0, the default, leaves the derived
+  /// thresholds alone. They never lower a derived threshold, nor touch the sensor and drive faults.
+  Vec6<S> collision_floor = Vec6<S>::Zero();
+  /// The friction identification's sample (osc/control/identification.hpp): the joint whose sample
+  /// the next check takes (-1: none), and the sample it took.
+  int sample_joint = -1;
+  FrictionSample<S> sample{};
+  Vec6<S> noise_bound;  // this tick's bound on the velocity estimate's quantisation noise in r [N m]
+  /// The travel check (travel()), one way: per joint, lower bounds on its speed and on its travel
+  /// that way since its encoder's last count [rad/s, rad], and the least drive that way over the ticks
+  /// of the check's current step [N m] (the torque may alternate tick by tick, the friction
+  /// compensation's sign term at a joint that hunts about rest, and the step holds for
+  /// kResidualTravelEvery ticks, not only its last).
+  struct Way {
+    Vec6<S> v, p, drive;
+  };
+  /// ahead: the way of the encoder's last count, toward its next edge; back: against it, toward the
+  /// edge it just crossed (a joint that reverses must count back).
+  Way ahead, back;
+  /// Per joint: the travel that must have made it count (kResidualTravelCounts quanta; 0: the check is
+  /// off, a joint whose encoder reads other joints too), and the largest least travel seen either way
+  /// (the check's peak; against travel_limit, its headroom).
+  Vec6<S> travel_limit, travel_peak;
+  static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
+  /// Set-up: each encoder's least and largest spacing of consecutive edges, its quantum less or
+  /// plus twice robot::kModelErrorBounds' encoder_edge [rad at the joint].
+  Vec6<S> spacing_lo, spacing_hi;
+  /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
+  /// force the model does not know: the travel check waits (it restarts every tick).
+  bool contact = false;
+  bool contact_noted = false;  // the contact error_floor holds (note_contact())
+
+  /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
+  /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
+  /// mean) times the largest k.
+  /// With a coupled drive train (inverse = C^-1, the identity without one), each motor's friction
+  /// reaches joint i as C^-T f_m: the model's per-joint friction leaves out the other motors'
+  /// shares, sum over c != i of |C^-1_ci| times their static band, which a reversal of motor c flips.
+  void set(const Vec6<S>& quantum, const Vec6<S>& k, const double (&inverse)[kDof][kDof]) {
+    k_max = k.maxCoeff();
+    lag = S(1) / k.minCoeff();
+    wrist_mix = lit<S>(0.5) * (k_max - k.minCoeff()) * (quantum(0) + quantum(1) + quantum(2));
+    velocity_noise = noise_base = (lit<S>(0.5) * k_max) * quantum;
+    velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share of the arm's (wrist_noise())
+    const ModelErrorBounds& b = robot::kModelErrorBounds;
+    for (int i = 0; i < kDof; ++i) {
+      double cross = 0;
+      bool alone = true;  // encoder i reads joint i alone
+      for (int c = 0; c < kDof; ++c) {
+        if (c != i) cross += abs_of(inverse[c][i]) * (b.friction_hi.cou[c] + b.friction_hi.sti[c]);
+        if (c != i && inverse[i][c] != 0) alone = false;
+      }
+      cross_friction(i) = lit<S>(cross);
+      error_floor(i) = rest_floor(i);
+      travel_limit(i) = alone ? lit<S>(params::kResidualTravelCounts) * quantum(i) : S(0);
+      spacing_lo(i) = lit<S>(1 - 2 * b.encoder_edge) * quantum(i);
+      spacing_hi(i) = lit<S>(1 + 2 * b.encoder_edge) * quantum(i);
+    }
+  }
+  /// Clears the filters and the record: the next check primes it (an enable, a restart).
+  void reset() {
+    r.setZero();
+    noise_bound.setZero();
+    bound.setZero();
+    acc.setZero();
+    threshold.setZero();
+    prime_change();
+    change_threshold.setZero();
+    tau_prev.setZero();
+    peak_ratio.setZero();
+    travel_peak.setZero();
+    ahead.drive.setConstant(kNoDrive);
+    back.drive.setConstant(kNoDrive);
+    for (int i = 0; i < kDof; ++i) over[i] = 0, over_since[i] = 0;
+    activity.reset();
+    joint = -1;
+    detected = 0;
+    detected_tick = 0;
+    primed = false;
+    contact_noted = false;
+    for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
+  }
+  /// The velocity estimate's noise on the wrist, this step. The observer's q^dot = J^-1 (y + k x~)
+  /// carries the encoders' quantisation e (x~'s share J e) as J^-1 diag(k) J e. With the operational
+  /// point at the wrist centre J is block-triangular, [J_11 0; J_21 J_22], and with equal gains per
+  /// block (k_t, k_r) the arm's rows are k_t e_arm, the wrist's k_r e_wrist + (k_r - k_t) J_22^-1 J_21
+  /// e_arm: an arm joint's quantum turns the wrist. J_21 e_arm is a rotation of at most the arm's
+  /// quanta summed; J_22^-1 splits it over the wrist's axes, J5's share at most that, J4's and J6's
+  /// at most that over |sin q5| (their axes are q5 apart: the dual basis of the plane they span has
+  /// norm 1 / |sin q5|). J5's share does not change: set() adds it once. Near the wrist singularity that is 20 times
+  /// J4's own noise (q5 = 0.08 rad: the 200-move sweep's J4 at 0.91 of its change threshold). |sin q5| is floored at
+  /// kWristSinFloor (2.9 degrees: 20 times the arm's share). Other gains: their spread, max k - min k.
+  void wrist_noise(const Mat6<S>& J) {
+    static constexpr double kWristSinFloor = 0.05;
+    static constexpr S kFloor = lit<S>(kWristSinFloor), kFloorSquared = lit<S>(kWristSinFloor * kWristSinFloor);
+    const S c5 = J(3, 3) * J(3, 5) + J(4, 3) * J(4, 5) + J(5, 3) * J(5, 5);  // z4 . z6 = cos q5
+    const S s2 = S(1) - c5 * c5;                                             // sin^2 q5
+    const S turn = wrist_mix / (s2 > kFloorSquared ? math::sqrt(s2) : kFloor);
+    velocity_noise(3) = noise_base(3) + turn;
+    velocity_noise(5) = noise_base(5) + turn;
+  }
+  /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
+  S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }
+  /// The contact the task reports (contact) began or ended. Its push, which the model does not know,
+  /// stays in r while it lasts and would be judged against thresholds meant for the model's error (a
+  /// firm push on a yielding arm named a drive_fault). When it begins, each joint's floor, its
+  /// filtered bound and the slow filter take |r| and r as they are: the absolute channel holds the
+  /// push as noted, and the change channel judges what changes after it. When it ends, the floors drop
+  /// back, and the bound decays at the filter's rate.
+  void note_contact() {
+    contact_noted = contact;
+    for (int i = 0; i < kDof; ++i) {
+      if (!contact) {
+        error_floor(i) = rest_floor(i);
+        continue;
+      }
+      const S push = math::abs(r(i));
+      error_floor(i) = rest_floor(i) + push;
+      bound(i) += push;
+      r_slow(i) = r(i);
+      d(i) = S(0);
+    }
+  }
+  /// The next step starts afresh (a tick without a step: the torque was off).
+  void unprime() { primed = false; }
+  /// The joint torque that reached the arm over the period that follows this tick.
+  void applied(const Vec6<S>& tau) { tau_prev = tau; }
+
+  /// The residual of this step and its faults (see the type's comment), a step every params::kDt.
+  /// The joints' accelerations and A's rows against them first (each joint's thresholds read every
+  /// joint's), then one pass per joint: its friction, bound, filters, change channel and thresholds.
+  std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
+                      const bool moved[kDof], std::uint64_t tick) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    activity.track(counts, moved, tick);
+    sample.settled = false;
+    if (contact != contact_noted) note_contact();
+    if (in.J) wrist_noise(*in.J);
+    const bool prime = !primed;  // the first step after a reset: no previous step to difference
+    if (prime) {
+      qd_prev = in.qd;
+      bias_prev = in.bias;
+      r.setZero();
+      acc.setZero();
+      prime_change();
+    }
+    const Motion m = motion(in);
+    const StrongestFriction strongest(in);
+    int worst = -1, moved_too_far = -1;
+    S worst_ratio = S(0);
+    for (int i = 0; i < kDof; ++i) {
+      const Friction f = strongest(i);
+      const FrictionError e = friction_error(in, f, i, tick, m.moving_speed[i]);
+      const Torques t = torques(in, i);
+      const S model = model_error(in, t, i);
+      const S b = pointwise_bound(in, e, i, model);
+      Changes ch{};
+      if (prime) {
+        bound(i) = b;
+      } else {
+        static constexpr S kDt = lit<S>(params::kDt);
+        r(i) = math::mul_add(c.gain[i], math::mul_add(kDt, bias_prev(i) - tau_prev(i), m.u[i]), c.keep[i] * r(i));
+        low_pass(bound(i), b, c.gain_dt[i]);
+        if (i == sample_joint) take_sample(i, e);
+        ch = update_change(in, e, t, i);
+      }
+      const S loop = update_thresholds(e, ch, m, i);
+      if (travel(in, m, f, i, model, loop, moved[i], prime || contact, tick)) moved_too_far = i;
+      qd_prev(i) = in.qd(i);
+      bias_prev(i) = in.bias(i);
+      if (prime) {
+        over[i] = 0;
+        continue;
+      }
+      const S ratio = ratio_of(i);
+      if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
+      if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
+      over[i] = qualify(over[i], ratio > S(1));
+      if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
+    }
+    if (prime) {
+      primed = true;
+      return 0;
+    }
+    std::uint32_t kind;
+    if (moved_too_far >= 0) {
+      worst = moved_too_far;
+      kind = classify_travel(worst);
+    } else {
+      if (worst < 0) return 0;
+      kind = classify(worst, io, tick);
+    }
+    if (kind == kFaultCollision && !beyond_collision_floor(moved_too_far < 0)) return 0;
+    if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick;
+    return armed ? kind : 0u;
+  }
+
+  /// Joint i's residual within `fraction` of its threshold on both channels (ratio_of(i) <= fraction,
+  /// without its divisions).
+  bool within(int i, S fraction) const {
+    return math::abs(r(i)) <= fraction * threshold(i) && math::abs(d(i)) <= fraction * change_threshold(i);
+  }
+  /// Joint i's residual against its threshold: the larger of the two channels' ratios.
+  S ratio_of(int i) const {
+    const S a = math::abs(r(i)) / threshold(i), c = math::abs(d(i)) / change_threshold(i);
+    return a > c ? a : c;
+  }
+
+ private:
+  /// This step's joint motion and A's rows against it: per joint, the speed beyond which it may
+  /// count as moving (its noise, and its lag at the acceleration filtered before this step), the
+  /// filtered acceleration's size and change, the residual's inertial input (A times q^dot's
+  /// change), and |A| times the accelerations, their changes and the velocity noise.
+  struct Motion {
+    S moving_speed[kDof], a[kDof], da[kDof];
+    S u[kDof], inertia[kDof], inertia_change[kDof], noise[kDof];
+  };
+  Motion motion(const ResidualInput<S>& in) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    Motion m;
+    S dqd[kDof];
+    for (int j = 0; j < kDof; ++j) {
+      m.moving_speed[j] = math::mul_add(lag, math::abs(acc(j)), velocity_noise(j));
+      dqd[j] = in.qd(j) - qd_prev(j);
+      acc(j) = math::mul_add(c.gain[j], dqd[j], c.keep[j] * acc(j));
+      low_pass(acc_slow(j), acc(j), c.slow_dt);
+      m.a[j] = math::abs(acc(j));
+      m.da[j] = math::abs(acc(j) - acc_slow(j));
+      m.u[j] = m.inertia[j] = m.inertia_change[j] = m.noise[j] = S(0);
+    }
+    // Column by column: each of A's coefficients is read once.
+    for (int j = 0; j < kDof; ++j)
+      for (int i = 0; i < kDof; ++i) {
+        const S aij = in.A(i, j), mag = math::abs(aij);
+        m.u[i] = math::mul_add(aij, dqd[j], m.u[i]);
+        m.inertia[i] = math::mul_add(mag, m.a[j], m.inertia[i]);
+        m.inertia_change[i] = math::mul_add(mag, m.da[j], m.inertia_change[i]);
+        m.noise[i] = math::mul_add(mag, velocity_noise(j), m.noise[i]);
+      }
+    return m;
+  }
+  /// y filtered toward x at the gain g (K dt): y + g (x - y), one rounding.
+  static void low_pass(S& y, S x, S g) { y = math::mul_add(g, x - y, y); }
+  /// A joint's regressor changes (their filtered values less their slow parts), signed.
+  struct Changes {
+    S vis, cou, sti, estimate, gravity, coriolis, torque;
+  };
+  void prime_change() {
+    d.setZero();
+    r_slow.setZero();
+    acc_slow.setZero();
+    for (int k = 0; k < kRegressors; ++k) reg[k].setZero(), reg_slow[k].setZero();
+    stillness.setOnes();  // until each joint is seen moving, its static friction may change at any time
+  }
+  /// Joint i's friction sample: r is this tick's, the filtered regressors still the last tick's, as
+  /// the friction in r is the last period's (n_{k-1}). Settled: moving, its encoder counting, since
+  /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
+  /// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
+  /// noise is a share of the viscous column, and its errors in the variables a bias): its own row's,
+  /// noise_base, without the wrist's mixing (wrist_noise()), which would leave the paper's slow wrist
+  /// motion to its few fast samples: J4's Coulomb / Stribeck split learnt from them, J4's and J6's
+  /// residuals reached 0.42 and 0.53 of their thresholds on the paper's motion (0.29 with this).
+  void take_sample(int i, const FrictionError& e) {
+    static constexpr std::array<S, kDof> kSettled = settled_stillness();
+    sample.y = reg[kEstimate](i) - r(i);
+    sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
+    sample.gravity = reg[kGravity](i);
+    static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
+    sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * noise_base(i);
+  }
+  /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
+  static constexpr std::array<S, kDof> settled_stillness() {
+    std::array<S, kDof> s{};
+    for (int i = 0; i < kDof; ++i) {
+      const double ticks = params::kIdentifySettle * params::kControlHz / params::kResidualGain[i];
+      double v = 1;
+      for (int t = 0; t < ticks; ++t) v *= 1 - params::kResidualSlowGain * params::kDt;
+      s[i] = lit<S>(v);
+    }
+    return s;
+  }
+  /// Some joint's residual beyond the user's collision threshold, qualified (the travel check's
+  /// findings need no qualification of the residual).
+  bool beyond_collision_floor(bool qualified) const {
+    for (int j = 0; j < kDof; ++j)
+      if ((!qualified || over[j] >= params::kResidualQualifyTicks) && math::abs(r(j)) > collision_floor(j)) return true;
+    return false;
+  }
+  /// A joint's friction at its strongest, which the still joint's thresholds and the travel check
+  /// take: its viscous coefficient [N m s/rad] and breakaway torque [N m].
+  struct Friction {
+    S vis, breakaway;
+  };
+  /// Friction at its strongest, per joint: the band's tops, or what the identification proves
+  /// (in.proven), chosen once a step.
+  struct StrongestFriction {
+    const S* vis;
+    const S* breakaway;
+    explicit StrongestFriction(const ResidualInput<S>& in)
+        : vis(in.proven ? in.proven->vis.data() : kResidualConstants<S>.vis_hi),
+          breakaway(in.proven ? in.proven->breakaway.data() : kResidualConstants<S>.static_band) {}
+    Friction operator()(int i) const { return Friction{vis[i], breakaway[i]}; }
+  };
+  /// Joint i's Coriolis torque c = n - g - tau_f^ and the applied torque's size |tau|, which the
+  /// bound and the change channel both take: computed once a joint.
+  struct Torques {
+    S coriolis, size;
+  };
+  Torques torques(const ResidualInput<S>& in, int i) const {
+    return Torques{in.bias(i) - in.g(i) - in.tau_f(i), math::abs(tau_prev(i))};
+  }
+  // Per joint: the friction error, the bound, the model error, the change channel and the thresholds
+  // (osc/runtime/residual_thresholds.hpp).
+  FrictionError friction_error(const ResidualInput<S>& in, const Friction& f, int i, std::uint64_t tick,
+                               S moving) const;
+  S pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const;
+  S model_error(const ResidualInput<S>& in, const Torques& t, int i) const;
+  Changes update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t, int i);
+  S update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i);
+  // The travel check (osc/runtime/residual_travel.hpp).
+  bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, S loop, bool count,
+              bool restart, std::uint64_t tick);
+  void count_bounds(int i, S change);
+  S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
+  std::uint32_t classify_travel(int i) const;
+  /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
+  /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
+  bool silent_first(int c, int i, std::uint64_t tick) const {
+    constexpr std::uint64_t kWindow = params::kControlHz / 4;  // a residual rises within 250 ms of it
+    const std::uint64_t last = activity.last_move_tick[c];
+    return activity.silent(c, tick) && last <= over_since[i] && over_since[i] - last <= kWindow;
+  }
+  /// The kind of a qualified residual on joint i (the worst).
+  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
+    // A stuck encoder: joint i's own encoder or one the coupling adds to it.
+    bool stuck = silent_first(i, i, tick);
+    for (int k = 0; k < io.terms; ++k)
+      if (io.row[k] == i && silent_first(io.col[k], i, tick)) stuck = true;
+    if (stuck) return kFaultEncoderStuck;
+    for (int j = 0; j < kDof; ++j)
+      if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
+    return kFaultDriveFault;
+  }
+};
+
+}  // namespace osc
+
+#include "osc/runtime/residual_thresholds.hpp"
+#include "osc/runtime/residual_travel.hpp"

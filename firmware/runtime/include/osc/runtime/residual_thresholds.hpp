@@ -1,0 +1,131 @@
+// The residual monitor's per-joint bound and thresholds (ResidualMonitor, osc/runtime/residual_monitor.hpp,
+// which includes this header at its end; docs/safety.md derives each term): the friction's error against
+// the band, the pointwise bound of the model's error filtered as r, the change channel's regressors and
+// the two channels' thresholds.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/runtime/residual_monitor.hpp"
+
+namespace osc {
+
+/// Joint i's friction against the band (FrictionError), `f` at its strongest; `moving` is the speed
+/// beyond which the joint may count as moving (Motion::moving_speed).
+template <class S>
+inline auto ResidualMonitor<S>::friction_error(const ResidualInput<S>& in, const Friction& f, int i, std::uint64_t tick,
+                                               S moving) const -> FrictionError {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::abs;
+  FrictionError e;
+  if (in.theta) {
+    const Vec18<S>& th = *in.theta;
+    e.th_v = th(i), e.th_c = th(kDof + i), e.th_s = th(2 * kDof + i);
+  } else {
+    e.th_v = e.th_c = e.th_s = S(0);
+  }
+  e.dv = abs(e.th_v - c.vis_mid[i]) + c.vis_half[i];
+  // Coulomb's level lies within its band and below the strongest breakaway less the least Stribeck
+  // level (the identification's proven breakaway narrows it; the band's top leaves it as it is).
+  const S cap = f.breakaway - c.sti_lo[i], cou_top = cap < c.cou_hi[i] ? cap : c.cou_hi[i];
+  const S below = e.th_c - c.cou_lo[i], above = cou_top - e.th_c;
+  e.dc = below > above ? below : above;
+  e.ds = abs(e.th_s - c.sti_mid[i]) + c.sti_half[i];
+  // Static friction anywhere within the band (its top, or what the identification proves), against
+  // whatever the estimate says.
+  e.still = math::mul_add(f.vis, moving, f.breakaway) + abs(in.tau_f(i));
+  // The direction of motion is known when the encoder counts and q^dot is beyond its noise and lag;
+  // the joint slides (its friction on the model's curve) when it counts fast enough besides. The
+  // stillness envelope and the identification's samples go by the first (a joint that crawls
+  // between counts resets neither).
+  const bool up = in.qd(i) > S(0);
+  e.moving = abs(in.qd(i)) > moving && activity.counting(i, up, tick);
+  e.sliding = e.moving && activity.sliding(i);
+  return e;
+}
+
+/// Joint i's bound on the unexplained torque that changes with the state (then filtered as r):
+/// friction, amplifiers, and the link inertia's share of gravity and Coriolis torques.
+template <class S>
+inline S ResidualMonitor<S>::pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::mul_add;
+  // Moving: the band's distance from the estimate, coefficient by coefficient.
+  const S friction = e.sliding ? mul_add(math::abs(in.qd(i)), e.dv,
+                                         mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
+                               : e.still;
+  return friction + model;
+}
+
+/// Joint i's bound on the unexplained torque besides friction and the inertias: the link
+/// inertia's share of gravity and Coriolis torques, the amplifier's gain, ripple and offset, and
+/// the coupled motors' friction (error_floor, with a contact's push while it lasts).
+template <class S>
+inline S ResidualMonitor<S>::model_error(const ResidualInput<S>& in, const Torques& t, int i) const {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::mul_add;
+  return mul_add(c.link_inertia, math::abs(in.g(i)) + math::abs(t.coriolis),
+                 mul_add(c.gain_ripple, t.size, error_floor(i)));
+}
+
+/// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
+/// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
+/// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
+/// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
+/// anything within its static band, from one end to the other (twice the band), and keeps it in
+/// the change threshold until the slow filter forgets it.
+template <class S>
+inline auto ResidualMonitor<S>::update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t,
+                                              int i) -> Changes {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  const S Ks = c.slow_dt, Kdt = c.gain_dt[i];
+  const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
+  // Filtered as r, then slowly: the regressor's change.
+  const auto band = [&](int k, S phi) {
+    low_pass(reg[k](i), phi, Kdt);
+    low_pass(reg_slow[k](i), reg[k](i), Ks);
+    return reg[k](i) - reg_slow[k](i);
+  };
+  Changes ch;
+  ch.vis = band(kVis, qd);
+  ch.cou = band(kCou, sign);
+  ch.sti = band(kSti, sign * in.decay(i));
+  ch.estimate = band(kEstimate, in.tau_f(i));
+  ch.gravity = band(kGravity, in.g(i));
+  ch.coriolis = band(kCoriolis, t.coriolis);
+  ch.torque = band(kTorque, tau_prev(i));
+  low_pass(reg[kTorqueSize](i), t.size, Kdt);  // |tau|: its size alone
+  low_pass(r_slow(i), r(i), Ks);
+  d(i) = r(i) - r_slow(i);
+  stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
+  return ch;
+}
+
+/// Joint i's thresholds: the filtered bound, the inertias' error on the filtered accelerations, and
+/// the velocity estimate's noise through A and the filter. `ch`: the regressors' changes (zero
+/// when priming). Returns the current loop's lag term (the travel check's too).
+template <class S>
+inline S ResidualMonitor<S>::update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i) {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::abs;
+  using math::mul_add;
+  const S quantum = c.quantum_gain[i] * m.noise[i], margin_quantum = c.margin * quantum;
+  noise_bound(i) = quantum;
+  // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
+  const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
+  const S pointwise = mul_add(c.link_inertia, m.inertia[i], mul_add(c.armature_delta[i], m.a[i], bound(i) + loop));
+  threshold(i) = mul_add(c.peak_margin[i], pointwise, margin_quantum);
+  // The friction error (theta - theta^)^T w: the band's distances times the regressors'
+  // changes at the estimate of now, plus what the estimate's own change added.
+  const S learnt = ch.estimate - mul_add(e.th_v, ch.vis, mul_add(e.th_c, ch.cou, e.th_s * ch.sti));
+  const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
+                     mul_add(c.vis_hi[i], velocity_noise(i),
+                             S(2) * mul_add(e.sliding ? stillness(i) : S(1), e.still, cross_friction(i)));
+  const S model =
+      mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis), c.armature_delta[i] * m.da[i]);
+  const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
+  change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
+  return loop;
+}
+
+}  // namespace osc

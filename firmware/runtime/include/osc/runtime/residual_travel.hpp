@@ -1,0 +1,131 @@
+// The residual monitor's travel check (ResidualMonitor::travel(), osc/runtime/residual_monitor.hpp, which
+// includes this header at its end; docs/safety.md): a joint whose least motion since its encoder's last
+// count, from the torque applied and the model's error bounds, passes params::kResidualTravelCounts counts
+// must have counted; classify_travel() names the finding.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/runtime/residual_monitor.hpp"
+
+namespace osc {
+
+/// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
+/// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
+/// one before a count back, n ticks earlier: its mean speed that way since was at least the edges'
+/// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now
+/// differs from that mean by at most the most it can have sped up or slowed down over them (after a reversal, the
+/// same edge twice: a mean of 0). These bound its speed ahead from below, and back from below as minus its speed
+/// ahead at most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied that way
+/// less gravity and Coriolis torques (the least of the step's ticks), with every error the model may have against the
+/// motion (model_error(), the other joints' inertial torques with the link inertia's share, the current loop's lag)
+/// and friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
+/// identification proves: `f`), over the diagonal inertia at its least or most, bounds its speed that way from
+/// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
+/// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
+/// bounded. `model` and `loop`: model_error()'s and update_thresholds()' terms of this joint.
+template <class S>
+inline bool ResidualMonitor<S>::travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model,
+                                       S loop, bool count, bool restart, std::uint64_t tick) {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::abs;
+  using math::mul_add;
+  const S limit = travel_limit(i);
+  if (limit == S(0)) return false;
+  if (restart) {
+    ahead.p(i) = back.p(i) = -limit;  // nothing known: no bound until a count
+    ahead.v(i) = S(0);
+    back.v(i) = -c.speed_cap[i];
+    ahead.drive(i) = back.drive(i) = kNoDrive;
+    return false;
+  }
+  static constexpr int kEvery = params::kResidualTravelEvery;
+  const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
+  const S way = activity.direction[i] > 0 ? S(1) : S(-1);
+  const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
+  // This tick's drive each way at a count (the direction it sets), else the least over the step's ticks.
+  const S drive = count || now < ahead.drive(i) ? now : ahead.drive(i);
+  const S drive_back = count || -now < back.drive(i) ? -now : back.drive(i);
+  if (!count && !turn) {
+    ahead.drive(i) = drive;
+    back.drive(i) = drive_back;
+    return false;
+  }
+  ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
+  const S aii = in.A(i, i);
+  const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
+  const S error = mul_add(c.link_inertia, others, others) + model + loop;
+  const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
+  if (count) {
+    count_bounds(i, (abs(drive) + error + f.breakaway) / a_min);
+    return false;
+  }
+  const S a_max = mul_add(c.link_inertia, aii, aii) + c.armature_delta[i];
+  const S p_ahead = advance(ahead, i, drive - error, f, a_min, a_max);
+  const S p_back = advance(back, i, drive_back - error, f, a_min, a_max);
+  const S p = p_ahead > p_back ? p_ahead : p_back;
+  if (p > travel_peak(i)) travel_peak(i) = p;
+  return p > limit;
+}
+
+/// Joint i's speed bounds at a count (travel()), from its pace and `change`, the most its speed can
+/// change per second [rad/s^2]. Its spans are read up to kSpanMax ticks (slower, ahead is 0 and
+/// back is its speed cap's).
+template <class S>
+inline void ResidualMonitor<S>::count_bounds(int i, S change) {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  static constexpr std::uint32_t kSpanMax = 250;
+  static constexpr S kDt = lit<S>(params::kDt);
+  const std::uint32_t n = activity.move_interval[i];
+  S slow = S(0), fast = c.speed_cap[i];
+  if (n <= kSpanMax) {
+    const S span = kDt * S(static_cast<int>(n) + 1), drift = change * span;
+    if (activity.steady[i] && n < static_cast<std::uint32_t>(params::kResidualSlideInterval))
+      slow = spacing_lo(i) / span - drift;
+    if (activity.reversed[i])
+      fast = drift;  // it crossed the same edge back and forth: a mean speed of 0
+    else if (activity.steady[i] && n >= 2)
+      fast = spacing_hi(i) / (kDt * S(static_cast<int>(n) - 1)) + drift;
+  }
+  ahead.v(i) = slow > S(0) ? slow : S(0);
+  back.v(i) = fast < c.speed_cap[i] ? -fast : -c.speed_cap[i];
+  ahead.p(i) = back.p(i) = S(0);
+}
+
+/// One step of joint i's bounds one way: `force` is the least drive that way less the model's
+/// error; friction is at its strongest against the motion (none when the joint may be going the
+/// other way, where it pushes this way). Static friction holds a joint at rest against what cannot
+/// break it away (half the band's weakest static friction). Returns the least travel (within a
+/// count either way after it: the joint did not count).
+template <class S>
+inline S ResidualMonitor<S>::advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max) {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  using math::mul_add;
+  static constexpr S kStep = lit<S>(params::kResidualTravelEvery * params::kDt);
+  const S lo = w.v(i), limit = travel_limit(i);
+  const S net = force - (lo >= S(0) ? mul_add(f.vis, lo, f.breakaway) : S(0));
+  S next = mul_add(kStep, net / (net < S(0) ? a_min : a_max), lo);
+  if (lo >= S(0) && next < S(0) && force + c.static_lo[i] > S(0)) next = S(0);
+  const S cap = c.speed_cap[i];
+  next = next < -cap ? -cap : (next > cap ? cap : next);
+  w.v(i) = next;
+  // Over the step the speed was at least the lesser of both ends.
+  const S p = mul_add(kStep, lo < next ? lo : next, w.p(i));
+  w.p(i) = p < -limit ? -limit : (p > limit ? limit : p);
+  return p;
+}
+
+/// The kind of a travel check's finding on joint i: a joint that must have counted and did not.
+/// Its encoder fell silent at once from counting fast (a joint that stops slows down first, its
+/// intervals between counts growing): encoder_stuck. Otherwise something holds it, or its encoder
+/// froze while it stood, which the same reading cannot tell apart: collision when the residual is
+/// on other joints too (a contact at the tip loads several), else encoder_stuck.
+template <class S>
+inline std::uint32_t ResidualMonitor<S>::classify_travel(int i) const {
+  if (activity.was_fast(i)) return kFaultEncoderStuck;
+  for (int j = 0; j < kDof; ++j)
+    if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
+  return kFaultEncoderStuck;
+}
+
+}  // namespace osc
