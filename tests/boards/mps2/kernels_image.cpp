@@ -7,6 +7,7 @@
 
 #include "board.hpp"
 #include "osc/control/jerk_profile.hpp"
+#include "osc/control/sampled_loop.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
@@ -266,6 +267,28 @@ void control_step_kernels(const Vec6<F>& q0) {
   check("control_step holds gravity at rest", d((g_state.obs.x_hat - g_os.x).norm()) < 1.0 ? 1.0 : 0.0, 1.0, 0.0);
 }
 
+/// A parameter set of a gain, as a board's main loop answers it (outside the tick): Lambda^-1 at the
+/// start pose in double, then the observer's and the sampled loop's checks (gain_margins; the loop's
+/// in float). The paper's gains keep a loop margin of 2.83 (in steps of sqrt 2) there.
+void gain_check_kernels(const Vec6<F>& q0) {
+  forward_kinematics(g_model, g_data, q0);
+  const Mat3<F> R = g_data.R[kDof];
+  opspace_update(g_model, g_data, g_os, q0, R);
+  Mat6<double> li;
+  GainMargins m;
+  {
+    Timer t("lambda_inverse in double (a param set's pose)");
+    li = lambda_inverse(g_data.A.template cast<double>(), g_os.Ja.template cast<double>());
+    keep(li);
+  }
+  {
+    Timer t("gain_margins (a param set of a gain: the observer's and the sampled loop's checks)");
+    m = gain_margins(Gains<double>::paper(), li);
+    keep(m);
+  }
+  check("the paper's gains: loop margin", m.loop, 2.83, 0.01);
+}
+
 /// The jerk-limited profile: plan() from a moving start (a bisection on the peak velocity) and the
 /// worst at() over the move at 1 ms, as the tick calls it; the end reached.
 JerkProfile<F> g_profile;
@@ -428,6 +451,7 @@ int main() {
   operational_inertia_kernels(q0, qn);
   operational_force_kernels(qd, fr);
   control_step_kernels(q0);
+  gain_check_kernels(q0);
   jerk_profile_kernels();
   fixed_reference_check();
   motion_kernels(q0);

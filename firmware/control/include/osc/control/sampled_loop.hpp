@@ -213,14 +213,19 @@ inline bool form_stable(const AxisForm& x, Real f) {
 /// The fractions of an axis's bound at which its loop is judged: 1, 1/2, ..., 1/256.
 constexpr int kMassSteps = 9;
 
+/// Each axis's loop at its bound: kappa, sigma, a and b (the last two at its row's bound of lambda).
+struct LoopBounds {
+  Real kappa[kDof], sigma[kDof], a[kDof], b[kDof];
+};
+
 /// Whether the loop of every axis is stable with the gains scaled by s, every inverse mass from
-/// each axis's bound (a_max, b_max: of lambda = its row's bound) down.
-inline bool stable(const Gains<double>& g, const Vec6<double>& a_max, const Vec6<double>& b_max, double s = 1) {
+/// each axis's bound down.
+inline bool stable(const LoopBounds& l, Real s = 1) {
   for (int i = 0; i < kDof; ++i) {
-    const AxisForm x = axis_form(static_cast<Real>(s * g.k(i) * g.dt), static_cast<Real>(s * g.ks(i) * g.dt),
-                                 static_cast<Real>(s * a_max(i)), static_cast<Real>(s * b_max(i)));
-    for (int m = 0; m < kMassSteps; ++m)
-      if (!form_stable(x, std::ldexp(Real(1), -m))) return false;
+    const AxisForm x = axis_form(s * l.kappa[i], s * l.sigma[i], s * l.a[i], s * l.b[i]);
+    Real f = 1;
+    for (int m = 0; m < kMassSteps; ++m, f *= Real(0.5))
+      if (!form_stable(x, f)) return false;
   }
   return true;
 }
@@ -228,15 +233,17 @@ inline bool stable(const Gains<double>& g, const Vec6<double>& a_max, const Vec6
 /// Each axis's bounds a_i and b_i (the header's comment) at Lambda^-1.
 inline void axis_bounds(const Gains<double>& g, const Mat6<double>& lambda_inv, Vec6<double>& a_max,
                         Vec6<double>& b_max) {
+  Vec6<double> rg, rk;  // the square roots of k_s + k_nd and of k_i: sqrt(g_i g_j) = rg_i rg_j
+  for (int i = 0; i < kDof; ++i) rg(i) = std::sqrt(g.ks(i) + g.knd(i)), rk(i) = std::sqrt(g.ki(i));
   for (int i = 0; i < kDof; ++i) {
     double a = 0, b = 0;
     for (int j = 0; j < kDof; ++j) {
       const double l = std::fabs(lambda_inv(i, j));
-      a += l * std::sqrt((g.ks(i) + g.knd(i)) * (g.ks(j) + g.knd(j)));
-      b += l * std::sqrt(g.ki(i) * g.ki(j));
+      a += l * rg(j);
+      b += l * rk(j);
     }
-    a_max(i) = a * g.dt;
-    b_max(i) = b * g.dt * g.dt;
+    a_max(i) = a * rg(i) * g.dt;
+    b_max(i) = b * rk(i) * g.dt * g.dt;
   }
 }
 
@@ -252,11 +259,17 @@ constexpr int kMarginSteps = 4;
 inline double gain_margin(const Gains<double>& g, const Mat6<double>& lambda_inv) {
   Vec6<double> a_max, b_max;
   axis_bounds(g, lambda_inv, a_max, b_max);
-  const bool now = stable(g, a_max, b_max);
-  double s = 1;
+  LoopBounds l;
+  for (int i = 0; i < kDof; ++i) {
+    l.kappa[i] = static_cast<Real>(g.k(i) * g.dt), l.sigma[i] = static_cast<Real>(g.ks(i) * g.dt);
+    l.a[i] = static_cast<Real>(a_max(i)), l.b[i] = static_cast<Real>(b_max(i));
+  }
+  const bool now = stable(l);
+  const Real root2 = static_cast<Real>(kSqrt2);
+  Real s = 1;
   for (int n = 0; n < kMarginSteps; ++n) {
-    const double next = now ? s * kSqrt2 : s / kSqrt2;
-    const bool ok = stable(g, a_max, b_max, next);
+    const Real next = now ? s * root2 : s / root2;
+    const bool ok = stable(l, next);
     if (now && !ok) return s;
     if (!now && ok) return next;
     s = next;
@@ -297,9 +310,12 @@ inline Mat6<double> lambda_inverse(const Mat6<double>& A, const Mat6<double>& Ja
 
 inline GainMargins gain_margins(const Gains<double>& g, const Mat6<double>& lambda_inv) {
   GainMargins m;
+  Vec6<double> rk;  // the square roots of k_i: sqrt(k_i,i k_i,j) = rk_i rk_j
+  for (int i = 0; i < kDof; ++i) rk(i) = std::sqrt(g.ki(i));
   for (int i = 0; i < kDof; ++i) {
     double row = 0;
-    for (int j = 0; j < kDof; ++j) row += std::fabs(std::sqrt(g.ki(i) * g.ki(j)) * lambda_inv(i, j));
+    for (int j = 0; j < kDof; ++j) row += std::fabs(lambda_inv(i, j)) * rk(j);
+    row *= rk(i);
     if (row > m.b_max) m.b_max = row;
   }
   const double dt = g.dt;
