@@ -755,12 +755,12 @@ bool validate_settings(const Settings& s, std::string& err) {
   // The gains' discrete-time checks at the start pose, as the board's param set makes them
   // (osc/control/sampled_loop.hpp): each gain within its range can still lose the loop with others.
   const osc::GainMargins m = osc::gain_margins(s.base.gains, osc::lambda_inverse(data.A, os.Ja));
-  if (!(m.observer > 1) || !(m.loop >= 1)) {
+  if (!m.observer_stable() || !m.loop_stable()) {
     char buf[240];
     std::snprintf(buf, sizeof buf,
                   "controller: the gains would make the %s unstable at the start pose (observer margin %.3g, "
                   "loop margin %.3g: the knd, k, ks, ki together; docs/protocol.md, \"Parameters\")",
-                  m.observer > 1 ? "sampled loop" : "discrete observer", m.observer, m.loop);
+                  m.observer_stable() ? "sampled loop" : "discrete observer", m.observer, m.loop);
     return err = buf, false;
   }
   // A collision's settings act through the armed residual monitor alone.

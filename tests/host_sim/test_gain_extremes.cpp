@@ -17,11 +17,7 @@ using sim::MotionSim;
 
 namespace {
 
-sim::Vec6 start_pose() {
-  sim::Vec6 q;
-  for (int i = 0; i < 6; ++i) q(i) = robot::kQStart[i];
-  return q;
-}
+sim::Vec6 start_pose() { return joint_vector<double>(robot::kQStart); }
 
 struct Held {
   std::uint32_t faults = 0;

@@ -55,80 +55,28 @@ struct Axis {
 constexpr int kTerms = 12;
 /// q_k = sum_t term_t * (P[k][t][0] + P[k][t][1] phi + P[k][t][2] phi^2), the terms in the order
 /// a b sigma, a b, a kappa sigma, a kappa, a sigma, a, b sigma, b, kappa sigma, kappa, sigma, 1.
+// clang-format off
 constexpr int kLoopTerms[6][kTerms][3] = {
-    {{1, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},  // q0 = a b sigma
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0}},
-    {{0, -2, 0},
-     {2, 0, 0},
-     {2, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},  // q1
-     {2, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0}},
-    {{-2, 0, 2},
-     {-2, -4, 0},
-     {-2, -4, 0},
-     {4, 0, 0},
-     {4, 0, 0},
-     {0, 0, 0},  // q2
-     {-2, -4, 0},
-     {4, 0, 0},
-     {4, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0},
-     {0, 0, 0}},
-    {{0, 4, -2},
-     {-2, 4, 4},
-     {-2, 4, 4},
-     {-8, -8, 0},
-     {0, -8, 0},
-     {8, 0, 0},  // q3
-     {-2, 4, 4},
-     {0, -8, 0},
-     {-8, -8, 0},
-     {8, 0, 0},
-     {8, 0, 0},
-     {0, 0, 0}},
-    {{1, 0, -2},
-     {2, 4, -8},
-     {2, 4, -8},
-     {-4, 0, 8},
-     {-4, 0, 8},
-     {0, 0, 0},  // q4
-     {2, 4, -8},
-     {-4, 0, 8},
-     {-4, 0, 8},
-     {0, 0, 0},
-     {0, 0, 0},
-     {16, 0, 0}},
-    {{0, -2, 2},
-     {0, -4, 4},
-     {0, -4, 4},
-     {8, 8, -8},
-     {0, 8, -8},
-     {-8, 0, 0},  // q5
-     {0, -4, 4},
-     {0, 8, -8},
-     {8, 8, -8},
-     {-8, 0, 0},
-     {-8, 0, 0},
-     {16, 0, 0}},
+    {{1, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0},  // q0 = a b sigma
+     {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}},
+    {{0, -2, 0}, {2, 0, 0}, {2, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0},  // q1
+     {2, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}},
+    {{-2, 0, 2}, {-2, -4, 0}, {-2, -4, 0}, {4, 0, 0}, {4, 0, 0}, {0, 0, 0},  // q2
+     {-2, -4, 0}, {4, 0, 0}, {4, 0, 0}, {0, 0, 0}, {0, 0, 0}, {0, 0, 0}},
+    {{0, 4, -2}, {-2, 4, 4}, {-2, 4, 4}, {-8, -8, 0}, {0, -8, 0}, {8, 0, 0},  // q3
+     {-2, 4, 4}, {0, -8, 0}, {-8, -8, 0}, {8, 0, 0}, {8, 0, 0}, {0, 0, 0}},
+    {{1, 0, -2}, {2, 4, -8}, {2, 4, -8}, {-4, 0, 8}, {-4, 0, 8}, {0, 0, 0},  // q4
+     {2, 4, -8}, {-4, 0, 8}, {-4, 0, 8}, {0, 0, 0}, {0, 0, 0}, {16, 0, 0}},
+    {{0, -2, 2}, {0, -4, 4}, {0, -4, 4}, {8, 8, -8}, {0, 8, -8}, {-8, 0, 0},  // q5
+     {0, -4, 4}, {0, 8, -8}, {8, 8, -8}, {-8, 0, 0}, {-8, 0, 0}, {16, 0, 0}},
 };
+// clang-format on
+
+/// P_kt(phi): term t's weight in q_k.
+constexpr double loop_weight(int k, int t, double phi) {
+  const int* p = kLoopTerms[k][t];
+  return p[0] + phi * (p[1] + phi * p[2]);
+}
 
 /// q_0 ... q_5 of the axis's loop with the DAC delay phi (of dt).
 inline std::array<double, 6> polynomial(const Axis& x, double phi) {
@@ -137,10 +85,7 @@ inline std::array<double, 6> polynomial(const Axis& x, double phi) {
   std::array<double, 6> q{};
   for (int k = 0; k < 6; ++k) {
     double v = 0;
-    for (int j = 0; j < kTerms; ++j) {
-      const int* p = kLoopTerms[k][j];
-      v += t[j] * (p[0] + phi * (p[1] + phi * p[2]));
-    }
+    for (int j = 0; j < kTerms; ++j) v += t[j] * loop_weight(k, j, phi);
     q[static_cast<std::size_t>(k)] = v;
   }
   return q;
@@ -178,10 +123,7 @@ struct LoopWeights {
 constexpr LoopWeights loop_weights(double phi) {
   LoopWeights l{};
   for (int k = 0; k < 6; ++k)
-    for (int t = 0; t < kTerms; ++t) {
-      const int* p = kLoopTerms[k][t];
-      l.w[k][t] = static_cast<Real>(p[0] + phi * (p[1] + phi * p[2]));
-    }
+    for (int t = 0; t < kTerms; ++t) l.w[k][t] = static_cast<Real>(loop_weight(k, t, phi));
   return l;
 }
 inline constexpr LoopWeights kLoopWeights = loop_weights(params::kActuationDelay / params::kDt);
@@ -230,11 +172,16 @@ inline bool stable(const LoopBounds& l, Real s = 1) {
   return true;
 }
 
-/// Each axis's bounds a_i and b_i (the header's comment) at Lambda^-1.
-inline void axis_bounds(const Gains<double>& g, const Mat6<double>& lambda_inv, Vec6<double>& a_max,
-                        Vec6<double>& b_max) {
-  Vec6<double> rg, rk;  // the square roots of k_s + k_nd and of k_i: sqrt(g_i g_j) = rg_i rg_j
+/// Each axis's row bounds (the header's comment) at Lambda^-1: of lambda (k_s + k_nd) and of
+/// lambda k_i, Gershgorin over the gains' square roots (sqrt(g_i g_j) = sqrt(g_i) sqrt(g_j)). The
+/// observer's margin reads the second too.
+struct RowBounds {
+  Vec6<double> g, ki;
+};
+inline RowBounds row_bounds(const Gains<double>& g, const Mat6<double>& lambda_inv) {
+  Vec6<double> rg, rk;  // the square roots of k_s + k_nd and of k_i
   for (int i = 0; i < kDof; ++i) rg(i) = std::sqrt(g.ks(i) + g.knd(i)), rk(i) = std::sqrt(g.ki(i));
+  RowBounds r;
   for (int i = 0; i < kDof; ++i) {
     double a = 0, b = 0;
     for (int j = 0; j < kDof; ++j) {
@@ -242,9 +189,20 @@ inline void axis_bounds(const Gains<double>& g, const Mat6<double>& lambda_inv, 
       a += l * rg(j);
       b += l * rk(j);
     }
-    a_max(i) = a * rg(i) * g.dt;
-    b_max(i) = b * rk(i) * g.dt * g.dt;
+    r.g(i) = a * rg(i);
+    r.ki(i) = b * rk(i);
   }
+  return r;
+}
+
+/// The loop of each axis at its row bounds, in the check's arithmetic: a = bound dt, b = bound dt^2.
+inline LoopBounds loop_bounds(const Gains<double>& g, const RowBounds& r) {
+  LoopBounds l;
+  for (int i = 0; i < kDof; ++i) {
+    l.kappa[i] = static_cast<Real>(g.k(i) * g.dt), l.sigma[i] = static_cast<Real>(g.ks(i) * g.dt);
+    l.a[i] = static_cast<Real>(r.g(i) * g.dt), l.b[i] = static_cast<Real>(r.ki(i) * g.dt * g.dt);
+  }
+  return l;
 }
 
 /// The steps of the loop's gain margin: factors of sqrt 2, at most kMarginSteps of them each way.
@@ -256,14 +214,7 @@ constexpr int kMarginSteps = 4;
 /// and the figure is the first step down (to 1/4) at which it would be (0: none; a low k loses the
 /// loop too, so shrinking every gain is not always the way back). At most kMarginSteps + 1
 /// evaluations of stable(), each a few thousand float operations.
-inline double gain_margin(const Gains<double>& g, const Mat6<double>& lambda_inv) {
-  Vec6<double> a_max, b_max;
-  axis_bounds(g, lambda_inv, a_max, b_max);
-  LoopBounds l;
-  for (int i = 0; i < kDof; ++i) {
-    l.kappa[i] = static_cast<Real>(g.k(i) * g.dt), l.sigma[i] = static_cast<Real>(g.ks(i) * g.dt);
-    l.a[i] = static_cast<Real>(a_max(i)), l.b[i] = static_cast<Real>(b_max(i));
-  }
+inline double gain_margin(const LoopBounds& l) {
   const bool now = stable(l);
   const Real root2 = static_cast<Real>(kSqrt2);
   Real s = 1;
@@ -296,6 +247,10 @@ struct GainMargins {
   double b_max = 0;  ///< the bound on b [1/s^2]
   double condition37 = 0;
   double loop = 0;
+
+  /// Whether gains of these margins may run: the observer's margin above 1, the loop's at least 1.
+  bool observer_stable() const { return observer > 1; }
+  bool loop_stable() const { return loop >= 1; }
 };
 
 /// Lambda^-1 = J A^-1 J^T at a pose, from the controller's A and analytic Jacobian (double), by the
@@ -310,14 +265,9 @@ inline Mat6<double> lambda_inverse(const Mat6<double>& A, const Mat6<double>& Ja
 
 inline GainMargins gain_margins(const Gains<double>& g, const Mat6<double>& lambda_inv) {
   GainMargins m;
-  Vec6<double> rk;  // the square roots of k_i: sqrt(k_i,i k_i,j) = rk_i rk_j
-  for (int i = 0; i < kDof; ++i) rk(i) = std::sqrt(g.ki(i));
-  for (int i = 0; i < kDof; ++i) {
-    double row = 0;
-    for (int j = 0; j < kDof; ++j) row += std::fabs(lambda_inv(i, j)) * rk(j);
-    row *= rk(i);
-    if (row > m.b_max) m.b_max = row;
-  }
+  const loop::RowBounds rows = loop::row_bounds(g, lambda_inv);
+  for (int i = 0; i < kDof; ++i)
+    if (rows.ki(i) > m.b_max) m.b_max = rows.ki(i);
   const double dt = g.dt;
   m.observer = 1e300;
   m.condition37 = 1e300;
@@ -328,7 +278,7 @@ inline GainMargins gain_margins(const Gains<double>& g, const Mat6<double>& lamb
     const double c = g.ks(i) * g.knd(i) / 2;
     if (c < m.condition37) m.condition37 = c;
   }
-  m.loop = loop::gain_margin(g, lambda_inv);
+  m.loop = loop::gain_margin(loop::loop_bounds(g, rows));
   return m;
 }
 

@@ -418,10 +418,10 @@ Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
   return lambda_inverse(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
 }
 
-/// Whether gains of these margins may run: the observer's margin above 1, the loop's at least 1.
+/// Whether gains of these margins may run (GainMargins' rules), and which check fails first.
 inline ParamStatus gain_status(const GainMargins& m) {
-  if (!(m.observer > 1)) return ParamStatus::kUnstableObserver;
-  if (!(m.loop >= 1)) return ParamStatus::kUnstableLoop;
+  if (!m.observer_stable()) return ParamStatus::kUnstableObserver;
+  if (!m.loop_stable()) return ParamStatus::kUnstableLoop;
   return ParamStatus::kOk;
 }
 
