@@ -410,8 +410,7 @@ def timer_step(out, what="whole tick in the 1 kHz timer interrupt (`timer_firmwa
     """The tick, then each of its stages (osc::TickStage; the image's clock counts 40 instructions a step)."""
     m = re.search(r"control step: max (\d+), mean (\d+) instructions", out)
     rows = [(what, f"{thousands(int(m.group(1)))} / {thousands(int(m.group(2)))}")] if m else []
-    stages = re.search(r"^tick stages, max/mean: (.*) instructions$", out, re.M)
-    for name, mx, mean in re.findall(r"(\w+) (\d+)/(\d+)", stages.group(1) if stages else ""):
+    for name, mx, mean in re.findall(r"^tick stage (\w+), max/mean: (\d+)/(\d+) instructions$", out, re.M):
         rows.append((f"&nbsp;&nbsp;tick stage `{name}`: max / mean", f"{thousands(int(mx))} / {thousands(int(mean))}"))
     return rows
 

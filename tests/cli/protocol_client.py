@@ -26,7 +26,7 @@ SENSOR, ACTUATOR = 1, 2
 SENSOR_LAYOUT = [("seq", "u32", 1), ("counts", "i32", 6), ("inject", "u8", 1)]
 ACTUATOR_LAYOUT = [("seq", "u32", 1), ("codes", "i32", 6), ("faults", "u32", 1), ("state", "u8", 1),
                    ("step_cycles", "u32", 1), ("max_cycles", "u32", 1), ("mean_cycles", "u32", 1),
-                   ("tick_max_cycles", "u32", 1), ("stage_cycles", "u32", 5), ("stack_used", "u32", 1),
+                   ("tick_max_cycles", "u32", 1), ("stage_cycles", "u32", 8), ("stack_used", "u32", 1),
                    ("theta_hat", "f32", 18), ("tau_f_hat", "f32", 6), ("link", "u32", 7), ("rx_gap_max", "u32", 1),
                    ("rx_long_gaps", "u32", 1)]
 CODE = {"u8": "B", "u32": "I", "i32": "i", "f32": "f"}

@@ -84,15 +84,21 @@ bool stack_sweep_agrees() {
   return never_above && equal && deeper_found;
 }
 
-/// Each stage of the tick (osc::TickStage): its worst and mean instructions.
+/// Each stage of the tick (osc::TickStage): its worst and mean instructions, a line each (the eight
+/// of them would not fit one line's buffer).
 void report_stages() {
-  cortex_m::text::Line line;
-  line.str("tick stages, max/mean:");
   for (int s = 0; s < osc::kTickStages; ++s) {
     const osc::StepTiming& t = g_task.stages.stage[s];
-    line.str(" ").str(osc::kTickStageNames[s]).str(" ").u32(t.max).str("/").u32(t.mean());
+    cortex_m::text::Line()
+        .str("tick stage ")
+        .str(osc::kTickStageNames[s])
+        .str(", max/mean: ")
+        .u32(t.max)
+        .str("/")
+        .u32(t.mean())
+        .str(" instructions")
+        .emit();
   }
-  line.str(" instructions").emit();
 }
 
 int main() {

@@ -87,10 +87,11 @@ std::vector<pil::AnswerFrame> endings(const std::vector<pil::AnswerFrame>& answe
 // ---------------------------------------------------------------- layouts
 
 TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
-  // The existing frames did not change (the QEMU PIL tests and the boards depend on them).
+  // The sensor and actuator frames (the QEMU PIL tests and the boards depend on them): the actuator
+  // frame grew by 12 bytes when the tick's stages went from 5 to 8 (issue 54: stage_cycles).
   EXPECT_EQ(pil::kSensorPayload, 29);
-  EXPECT_EQ(pil::kActuatorPayload, 205);
-  EXPECT_EQ(pil::kMaxFrame, 211);
+  EXPECT_EQ(pil::kActuatorPayload, 217);
+  EXPECT_EQ(pil::kMaxFrame, 223);
   EXPECT_EQ(pil::kSensorFrame, 1);
   EXPECT_EQ(pil::kActuatorFrame, 2);
   // The new ones: fixed lengths (a change is a protocol change: docs/protocol.md).
@@ -124,7 +125,8 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
 }
 
 TEST(CommandFrames, SensorAndActuatorFramesUnchangedByteForByte) {
-  // docs/protocol.md's worked examples, as encoded before the command frames existed.
+  // docs/protocol.md's worked examples, as encoded before the command frames existed (the actuator
+  // frame with the 8 tick stages of issue 54).
   pil::SensorFrame s;
   s.seq = 1234;
   const std::int32_t counts[pil::kJoints] = {1500, -2750, 40, -3, 0, 12};
@@ -148,11 +150,11 @@ TEST(CommandFrames, SensorAndActuatorFramesUnchangedByteForByte) {
   a.link[pil::kErrSeq] = 1;
   a.rx_gap_max = 250000;
   const Bytes b = bytes_of(a);
-  ASSERT_EQ(b.size(), 211u);
-  EXPECT_EQ(b[3], 205);
-  EXPECT_EQ(b[209], 0x66);  // the CRC covers every byte before it
-  EXPECT_EQ(b[210], 0xD6);
-  EXPECT_EQ(b[4 + 169 + 4 * pil::kErrSeq], 1);  // the link counters' offset
+  ASSERT_EQ(b.size(), 223u);
+  EXPECT_EQ(b[3], 217);
+  EXPECT_EQ(b[221], 0xED);  // the CRC covers every byte before it
+  EXPECT_EQ(b[222], 0x01);
+  EXPECT_EQ(b[4 + 181 + 4 * pil::kErrSeq], 1);  // the link counters' offset
 }
 
 // ---------------------------------------------------------------- round trips

@@ -141,7 +141,7 @@ TEST(Parser, AFrameCutShortAtAnyPointLosesNotTheNextFrame) {
 // A long frame's header whose length swallows a whole short frame: the short one is found once the
 // long one fails (its CRC, with the bytes after it) or expires (nothing after it).
 TEST(Parser, AFrameInsideAFailedCandidateIsFound) {
-  const Bytes actuator = frame_of(1, 5);  // 211 bytes
+  const Bytes actuator = frame_of(1, 5);  // 223 bytes
   const Bytes inner = clear_command(9);
   const Bytes head(actuator.begin(), actuator.begin() + 10);
   // Nothing after: found at the timeout.

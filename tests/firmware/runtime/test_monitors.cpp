@@ -287,16 +287,21 @@ TEST(TickStages, EveryStageTimedAndTheyAddUpToTheTick) {
       sum += s.last;
     }
     EXPECT_EQ(sum, task->timing.last);
-    // Marks at calls n+1 .. n+8 (the step's two reads and the overrun check between): the clock
-    // advances by the sum of the call numbers in between, and the step stage holds three calls.
+    // Marks at calls n+1 .. n+12 (the step's two reads, and the overrun check's read in the codes
+    // stage): the clock advances by the sum of the call numbers in between, the step stage holds
+    // three calls, the codes stage two.
     const std::uint32_t n = calls_before;
     EXPECT_EQ(task->stages.stage[kStageRead].last, n + 2);
     EXPECT_EQ(task->stages.stage[kStageChecks].last, n + 3);
-    EXPECT_EQ(task->stages.stage[kStageStep].last, (n + 4) + (n + 5) + (n + 6));
-    EXPECT_EQ(task->stages.stage[kStageMonitors].last, n + 7);
-    EXPECT_EQ(task->stages.stage[kStageOutput].last, (n + 8) + (n + 9));
+    EXPECT_EQ(task->stages.stage[kStageReference].last, n + 4);
+    EXPECT_EQ(task->stages.stage[kStageStep].last, (n + 5) + (n + 6) + (n + 7));
+    EXPECT_EQ(task->stages.stage[kStageMonitors].last, n + 8);
+    EXPECT_EQ(task->stages.stage[kStageCodes].last, (n + 9) + (n + 10));
+    EXPECT_EQ(task->stages.stage[kStageDecide].last, n + 11);
+    EXPECT_EQ(task->stages.stage[kStageOutput].last, n + 12);
   }
   EXPECT_STREQ(kTickStageNames[kStageStep], "step");
+  EXPECT_EQ(static_cast<int>(kTickStages), 8);
 }
 
 // ---- The residual monitor (docs/safety.md, "The residual monitor")

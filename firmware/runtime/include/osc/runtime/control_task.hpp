@@ -1,12 +1,13 @@
-// The control task the 1 kHz timer interrupt runs: read encoders -> angles -> control step
-// (observer, controller, adaptation) -> torques -> DAC codes -> write, under the supervisor.
+// The control task the 1 kHz timer interrupt runs: read encoders -> checks -> angles ->
+// reference -> control step (observer, controller, adaptation) -> monitors -> torques to DAC
+// codes -> the supervisor and the motion state machine decide -> write.
 // Bound to a HAL at compile time; the same code runs against the simulated plant on the host and
 // on the targets.
 // The HAL is the concept hal::ControlHal (hal/hal.hpp).
-// This header gives all of the task: the type (ControlTask) and its tick (control_tick, hold_tick,
-// the monitors' stage) are here; it includes homing (osc/runtime/homing.hpp), the tick's motion stage
-// (osc/runtime/motion_stage.hpp) and the commands' preparation outside the tick
-// (osc/runtime/command_prep.hpp).
+// This header gives all of the task: the type (ControlTask) and its tick (control_tick, a call per
+// stage of OSC_TICK_STAGE_LIST: stage_read .. stage_output; hold_tick) are here; it includes
+// homing (osc/runtime/homing.hpp), the tick's motion stage (osc/runtime/motion_stage.hpp) and the
+// commands' preparation outside the tick (osc/runtime/command_prep.hpp).
 #pragma once
 
 #include <array>
@@ -314,88 +315,153 @@ std::uint32_t index_faults(ControlTask<S>& task, Hal& hal, const std::int32_t co
   return 0;
 }
 
-/// One tick, the block diagram in five timed stages (TickStage): read, checks, step, monitors,
-/// output; then the supervisor and the motion state machine. Returns the fault bits detected in
-/// this tick. On any fault, whenever the supervisor is not in kRun or the motion state machine has
-/// the torque off, and in a tick without a valid sample (read_encoders() false: no control step),
-/// every DAC gets code 0 in this same tick.
+/// What the stages of one tick hand each other (control_tick): the block diagram's wires.
+template <class S>
+struct TickData {
+  std::uint32_t faults = 0;   // the fault bits detected in this tick so far
+  std::int32_t counts[kDof];  // the encoder sample (read)
+  bool sampled = false;       // read_encoders() gave a sample
+  bool moved[kDof] = {};      // the channels whose count changed (the jump monitor)
+  bool measured = false;      // the sample passed the checks: q holds its angles
+  bool stepped = false;       // the control step runs in this tick
+  Vec6<S> q;                  // the measured angles (the start pose otherwise, unused)
+  MotionEvents ev;            // the motion source's events of this tick
+  // The reaction to the residual monitor's collision (category 0: none, or the fault stays).
+  CollisionReaction collision = CollisionReaction::kCategory0;
+  bool clipped = false;  // a DAC code was clipped at its range
+  bool torque = false;   // the supervisor and the motion state machine let torque reach the DACs
+};
+
+/// read: the HAL's I/O faults (E-stop, drives) and the encoder sample.
 template <class S, hal::ControlHal Hal>
-std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
-  std::uint32_t mark[kTickStages + 1];
-  mark[kStageRead] = hal.cycles();
-  // read
-  std::uint32_t faults = hal.io_faults();
-  std::int32_t counts[kDof];
-  const bool sampled = hal.read_encoders(counts);
-  mark[kStageChecks] = hal.cycles();
-  // checks
-  bool moved[kDof] = {};
+void stage_read(Hal& hal, TickData<S>& t) {
+  t.faults = hal.io_faults();
+  t.sampled = hal.read_encoders(t.counts);
+}
+
+/// checks: the encoder monitors (range, jump); the angles of a sample that passed them (the others
+/// are not converted: a wild count would saturate a fixed-point angle), the start pose otherwise,
+/// unused; whether the control step runs.
+template <class S>
+void stage_checks(ControlTask<S>& task, TickData<S>& t) {
   task.jump.tick();
-  if (sampled) faults |= task.range.check(counts) | task.jump.check(counts, moved);
-  mark[kStageStep] = hal.cycles();
-  // step
-  for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
-  // The angles of a sample that passed the checks (the others are not converted: a wild count
-  // would saturate a fixed-point angle); the start pose otherwise, unused.
-  const bool measured = sampled && faults == 0;
-  const Vec6<S> q = measured ? angles_from_counts(task.q_start, task.io, counts) : task.q_start;
-  const bool stepped = measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
-  MotionEvents ev;
+  if (t.sampled) t.faults |= task.range.check(t.counts) | task.jump.check(t.counts, t.moved);
+  t.measured = t.sampled && t.faults == 0;
+  t.q = t.measured ? angles_from_counts(task.q_start, task.io, t.counts) : task.q_start;
+  t.stepped = t.measured && task.sup.state != SupervisorState::kFault && motion_powered(task.machine.state);
+}
+
+/// reference: the stream setpoint handed to the motion source, then the desired state of a tick
+/// that steps: the motion source's (its events in t.ev), a yielding arm's own pose.
+template <class S>
+void stage_reference(ControlTask<S>& task, TickData<S>& t) {
   if (task.sample.valid) {
     task.gen.stream_setpoint(task.sample.x, task.sample.end, task.sample.has_velocity ? &task.sample.v : nullptr);
     task.sample.valid = false;
   }
-  if (stepped) {
-    const bool yielding = task.machine.state == MotionState::kYielding;
-    task.desired = yielding ? yield_reference(task) : task.gen.at_tick(task.tick, params::kControlHz, ev);
-    const std::uint32_t s0 = hal.cycles();
-    task.last = control_step(task.model, task.gains, task.mode, task.state, q, task.desired);
-    task.step_timing.add(hal.cycles() - s0);
-    faults |= task.last.status;  // non_finite, singular
-  }
-  mark[kStageMonitors] = hal.cycles();
-  // monitors
-  if (stepped && task.last.status == kFaultNone) faults |= step_monitor_faults(task, counts, moved);
-  if (measured) faults |= position_faults(task, hal, q);
-  const CollisionReaction collision = take_collision(task, faults);
-  mark[kStageOutput] = hal.cycles();
-  // output
-  if (stepped && task.ramping) ramp_torque(task);
-  bool clipped = false;
-  if (stepped) {
+  if (!t.stepped) return;
+  const bool yielding = task.machine.state == MotionState::kYielding;
+  task.desired = yielding ? yield_reference(task) : task.gen.at_tick(task.tick, params::kControlHz, t.ev);
+}
+
+/// step: the control step (observer, controller, adaptation), timed alone.
+template <class S, hal::ControlHal Hal>
+void stage_step(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
+  if (!t.stepped) return;
+  const std::uint32_t s0 = hal.cycles();
+  task.last = control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired);
+  task.step_timing.add(hal.cycles() - s0);
+  t.faults |= task.last.status;  // non_finite, singular
+}
+
+/// monitors: those of a completed step (step_monitor_faults: stuck encoder, residual, the momentum
+/// law's identification, tracking, friction-estimate band), the position cross-check of a measured
+/// sample; then a collision's reaction (take_collision).
+template <class S, hal::ControlHal Hal>
+void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
+  if (t.stepped && task.last.status == kFaultNone) t.faults |= step_monitor_faults(task, t.counts, t.moved);
+  if (t.measured) t.faults |= position_faults(task, hal, t.q);
+  t.collision = take_collision(task, t.faults);
+}
+
+/// codes: the step's torques (through the enable's ramp) to DAC codes, 0 without a step; the
+/// saturation monitor, a fixed-point overflow of the monitors or the conversion (the step reports
+/// its own), and the overrun: the tick so far, from its first mark (start), against the period (the
+/// next tick would have arrived).
+template <class S, hal::ControlHal Hal>
+void stage_codes(ControlTask<S>& task, Hal& hal, TickData<S>& t, std::uint32_t start) {
+  for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
+  if (t.stepped) {
+    if (task.ramping) ramp_torque(task);
     // Each DAC drives a motor: C^T tau where the drive train couples the joints.
     Vec6<S> tau_m;
     const Vec6<S>& tau = task.io.coupled() ? (tau_m = motor_torques(task.io, task.last.tau)) : task.last.tau;
     for (int i = 0; i < kDof; ++i) {
       const bool c = torque_to_code(i, tau(i), task.codes[i]);
-      clipped = clipped || c;
-      faults |= task.saturation.check(i, c);
+      t.clipped = t.clipped || c;
+      t.faults |= task.saturation.check(i, c);
     }
   }
-  // A fixed-point saturation in the monitors or the torque conversion (the step reports its own).
-  if (math::take_arithmetic_fault<S>()) faults |= kFaultOverflow;
-  // The step's own duration against the period (the next tick would have arrived).
-  const std::uint32_t elapsed = hal.cycles() - mark[kStageRead];
-  if (task.period_cycles != 0 && elapsed > task.period_cycles) faults |= kFaultOverrun;
+  if (math::take_arithmetic_fault<S>()) t.faults |= kFaultOverflow;
+  const std::uint32_t elapsed = hal.cycles() - start;
+  if (task.period_cycles != 0 && elapsed > task.period_cycles) t.faults |= kFaultOverrun;
+}
 
-  if (measured) faults |= index_faults(task, hal, counts, ev);
-  task.sup = supervisor_next(task.sup, {faults, task.jump.have_counts});
-  const MotionReason stop_request = tick_stop_request(task, stepped, q, collision);
-  const bool torque =
-      motion_update(task, faults, measured, q, ev, stop_request, collision == CollisionReaction::kYield);
-  if (!torque_enabled(task.sup) || !torque)
+/// decide: homing's index faults, the supervisor, the tick's category-2 stop request and the motion
+/// state machine, from every fault of the tick; whether torque may reach the DACs.
+template <class S, hal::ControlHal Hal>
+void stage_decide(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
+  if (t.measured) t.faults |= index_faults(task, hal, t.counts, t.ev);
+  task.sup = supervisor_next(task.sup, {t.faults, task.jump.have_counts});
+  const MotionReason stop_request = tick_stop_request(task, t.stepped, t.q, t.collision);
+  const bool yield = t.collision == CollisionReaction::kYield;
+  t.torque = motion_update(task, t.faults, t.measured, t.q, t.ev, stop_request, yield) && torque_enabled(task.sup);
+}
+
+/// output: the codes (0 where the decision has the torque off), the torque the residual monitor
+/// takes as applied (none without it), the DAC write and the fault line.
+template <class S, hal::ControlHal Hal>
+void stage_output(ControlTask<S>& task, Hal& hal, const TickData<S>& t) {
+  if (!t.torque)
     for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
-  if (!stepped || !torque_enabled(task.sup) || !torque)
+  if (!t.stepped || !t.torque)
     task.residual.unprime();
   else
-    task.residual.applied(clipped ? applied_torque(task) : task.last.tau);
+    task.residual.applied(t.clipped ? applied_torque(task) : task.last.tau);
   hal.write_dacs(task.codes);
   hal.fault_output(task.sup.state == SupervisorState::kFault);
+}
+
+/// One tick, the block diagram of its stages (TickStage, OSC_TICK_STAGE_LIST), each one call, timed:
+/// read, checks, reference, step, monitors, codes, decide, output. Returns the fault bits detected
+/// in this tick. On any fault, whenever the supervisor is not in kRun or the motion state machine
+/// has the torque off, and in a tick without a valid sample (read_encoders() false: no control
+/// step), every DAC gets code 0 in this same tick.
+template <class S, hal::ControlHal Hal>
+std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
+  TickData<S> t;
+  std::uint32_t mark[kTickStages + 1];
+  mark[kStageRead] = hal.cycles();
+  stage_read(hal, t);
+  mark[kStageChecks] = hal.cycles();
+  stage_checks(task, t);
+  mark[kStageReference] = hal.cycles();
+  stage_reference(task, t);
+  mark[kStageStep] = hal.cycles();
+  stage_step(task, hal, t);
+  mark[kStageMonitors] = hal.cycles();
+  stage_monitors(task, hal, t);
+  mark[kStageCodes] = hal.cycles();
+  stage_codes(task, hal, t, mark[kStageRead]);
+  mark[kStageDecide] = hal.cycles();
+  stage_decide(task, hal, t);
+  mark[kStageOutput] = hal.cycles();
+  stage_output(task, hal, t);
   mark[kTickStages] = hal.cycles();
   task.stages.add(mark);
   task.timing.add(mark[kTickStages] - mark[kStageRead]);
   ++task.tick;
-  return faults;
+  return t.faults;
 }
 
 /// A tick without a new sample in which the I/O layer keeps the outputs (a short, bounded gap, e.g.

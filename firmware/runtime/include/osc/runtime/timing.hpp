@@ -23,15 +23,32 @@ struct StepTiming {
   }
 };
 
-/// The stages of a tick, in order: the block diagram of control_tick().
+/// The stages of a tick, in the order the data flows: the block diagram of control_tick(), one call
+/// (stage_<name>, osc/runtime/control_task.hpp) each. The torques become DAC codes before the
+/// decision: the supervisor and the motion state machine judge every fault of the tick, the codes'
+/// saturation, overflow and overrun among them; the output writes the codes the decision allows.
 // X(Name, "name", what the stage does)
-#define OSC_TICK_STAGE_LIST(X)                                                                                  \
-  X(Read, "read", "the HAL's I/O faults and the encoder read")                                                  \
-  X(Checks, "checks", "the encoder monitors: range, jump (EncoderRangeMonitor, EncoderJumpMonitor)")            \
-  X(Step, "step",                                                                                               \
-    "counts to angles, the motion source's desired state, the control step (observer, controller, adaptation)") \
-  X(Monitors, "monitors", "the step's monitors: stuck encoder, tracking, friction-estimate band")               \
-  X(Output, "output", "torques to DAC codes, saturation, overflow and overrun, supervisor, DAC write")
+#define OSC_TICK_STAGE_LIST(X)                                                                               \
+  X(Read, "read", "the HAL's I/O faults (E-stop, drives) and the encoder read")                              \
+  X(Checks, "checks",                                                                                        \
+    "the encoder monitors: range, jump (EncoderRangeMonitor, EncoderJumpMonitor); the counts of a sample "   \
+    "that passed them to joint angles")                                                                      \
+  X(Reference, "reference",                                                                                  \
+    "the stream setpoint handed to the motion source, then the desired state: the motion source's "          \
+    "(MotionGenerator::at_tick), a yielding arm's own pose")                                                 \
+  X(Step, "step", "the control step: observer, controller, adaptation (control_step)")                       \
+  X(Monitors, "monitors",                                                                                    \
+    "every monitor of the step and the sample: stuck encoder, residual (collision, drive fault), the "       \
+    "momentum law's friction identification, tracking, friction-estimate band, position cross-check; "       \
+    "a collision's reaction")                                                                                \
+  X(Codes, "codes",                                                                                          \
+    "the enable's torque ramp, torques to DAC codes, saturation, fixed-point overflow, overrun (the cycles " \
+    "since the tick's first mark)")                                                                          \
+  X(Decide, "decide",                                                                                        \
+    "homing's index faults, the supervisor, the tick's category-2 stop request, the motion state machine")   \
+  X(Output, "output",                                                                                        \
+    "the codes the supervisor and the motion state allow (0 otherwise), the residual monitor's applied "     \
+    "torque, the DAC write, the fault line")
 
 #define OSC_X_PREFIX kStage
 enum TickStage : std::uint8_t { OSC_TICK_STAGE_LIST(OSC_X_ENUMERATOR) kTickStages };
