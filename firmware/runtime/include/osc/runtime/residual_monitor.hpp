@@ -255,16 +255,29 @@ struct ResidualMonitor {
         over[i] = 0;
         continue;
       }
-      const S ratio = ratio_of(i);
-      if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
-      if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
-      over[i] = qualify(over[i], ratio > S(1));
-      if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
+      qualify_joint(i, tick, worst, worst_ratio);
     }
     if (prime) {
       primed = true;
       return 0;
     }
+    return decide(worst, moved_too_far, io, tick);
+  }
+
+  /// Joint i's residual against its thresholds after a step: its peak ratio, its run over them, and
+  /// whether it is the worst joint so far that has been over them long enough (worst, worst_ratio).
+  void qualify_joint(int i, std::uint64_t tick, int& worst, S& worst_ratio) {
+    const S ratio = ratio_of(i);
+    if (ratio > peak_ratio(i)) peak_ratio(i) = ratio;
+    if (ratio > S(1) && over[i] == 0) over_since[i] = tick;
+    over[i] = qualify(over[i], ratio > S(1));
+    if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
+  }
+
+  /// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over
+  /// its thresholds, classified; a collision below the collision floor is none. The first fault is
+  /// recorded (detected, joint, detected_tick); reported only when armed.
+  std::uint32_t decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick) {
     std::uint32_t kind;
     if (moved_too_far >= 0) {
       worst = moved_too_far;
