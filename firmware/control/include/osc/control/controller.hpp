@@ -99,25 +99,30 @@ ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Da
   return c;
 }
 
-/// One sample of the adaptive observer-controller: encoder angles q, desired state d (a motion
-/// source's, motion.hpp).
+/// A step that stops short with `status`: every output 0 but those already set (the pose and J's
+/// condition of a singular or failed step); the torque 0.
 template <class S>
-StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, ControllerState<S>& st,
-                           const Vec6In<S>& q, const Desired<S>& d) {
-  StepOutput<S> out{};
+void step_stopped(StepOutput<S>& out, std::uint32_t status) {
   out.tau.setZero();
-  out.x.setZero();
   out.e.setZero();
   out.x_tilde.setZero();
   out.xd_hat.setZero();
   out.tau_f_hat.setZero();
   out.qd_ref.setZero();
   out.tau_bias.setZero();
-  out.rcond = S(0);
-  out.status = kFaultNone;
+  out.status = status;
+}
+
+/// One sample of the adaptive observer-controller: encoder angles q, desired state d (a motion
+/// source's, motion.hpp). Writes every field of `out` (the control task's record of its last step,
+/// without a copy of it).
+template <class S>
+void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, ControllerState<S>& st,
+                  const Vec6In<S>& q, const Desired<S>& d, StepOutput<S>& out) {
   if (!math::all_finite(q) || !math::all_finite(d.x) || !math::all_finite(d.xd) || !math::all_finite(d.xdd)) {
-    out.status = kFaultNonFinite;
-    return out;
+    out.x.setZero();
+    out.rcond = S(0);
+    return step_stopped(out, kFaultNonFinite);
   }
   OpSpace<S>& os = st.os;
   opspace_update(model, st.data, os, q, st.R_ref);
@@ -127,8 +132,7 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
     // Factoring a singular J divides by near-zeros: in fixed point those saturations are this
     // fault, not another one.
     math::take_arithmetic_fault<S>();
-    out.status = kFaultSingular;
-    return out;
+    return step_stopped(out, kFaultSingular);
   }
   const bool adaptive = mode == FrictionMode::kAdaptive;
   const Vec18<S> theta_hat = adaptive ? adaptation_step(G, st.adapt, q) : st.adapt.theta_hat;
@@ -140,15 +144,10 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);
   if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat) ||
-      !math::all_finite(theta_hat)) {
-    out.status = kFaultNonFinite;
-    return out;
-  }
+      !math::all_finite(theta_hat))
+    return step_stopped(out, kFaultNonFinite);
   // A fixed-point result that saturated anywhere in the step (math::take_arithmetic_fault).
-  if (math::take_arithmetic_fault<S>()) {
-    out.status = kFaultOverflow;
-    return out;
-  }
+  if (math::take_arithmetic_fault<S>()) return step_stopped(out, kFaultOverflow);
   st.obs = next;
   adaptation_record(st.adapt, theta_hat, Vec6<S>(q), ob.qd_hat, w);
   out.tau = tau;
@@ -158,6 +157,15 @@ StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMod
   out.tau_f_hat = tau_f_hat;
   out.qd_ref = os.Jf.solve(d.xd);
   out.tau_bias = c.bias.tau;
+  out.status = kFaultNone;
+}
+
+/// The same, returning the step's output.
+template <class S>
+StepOutput<S> control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, ControllerState<S>& st,
+                           const Vec6In<S>& q, const Desired<S>& d) {
+  StepOutput<S> out;
+  control_step(model, G, mode, st, q, d, out);
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 
 #include "osc/math/fixed.hpp"
 
@@ -219,13 +220,26 @@ S sgn(S v) {
   return v > S(0) ? S(1) : (v < S(0) ? S(-1) : S(0));
 }
 
-/// True when every coefficient of an Eigen expression is finite.
+/// True when every coefficient of an Eigen expression is finite. In float and double without a
+/// branch per coefficient: v - v is 0 for a finite v and NaN for an infinite or NaN one (IEEE 754;
+/// the build has no -ffast-math, so the compiler may not fold it), and a NaN in the sum stays NaN.
 template <class Derived>
 bool all_finite(const Derived& m) {
-  for (int j = 0; j < m.cols(); ++j)
-    for (int i = 0; i < m.rows(); ++i)
-      if (!isfinite(m(i, j))) return false;
-  return true;
+  using S = typename Derived::Scalar;
+  if constexpr (std::is_floating_point_v<S>) {
+    S sum = S(0);
+    for (int j = 0; j < m.cols(); ++j)
+      for (int i = 0; i < m.rows(); ++i) {
+        const S v = m(i, j);
+        sum += v - v;
+      }
+    return sum == S(0);
+  } else {
+    for (int j = 0; j < m.cols(); ++j)
+      for (int i = 0; i < m.rows(); ++i)
+        if (!isfinite(m(i, j))) return false;
+    return true;
+  }
 }
 
 /// Reads and clears the scalar's sticky arithmetic flags (fixed point: a saturated overflow, a

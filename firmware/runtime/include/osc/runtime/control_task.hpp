@@ -369,7 +369,7 @@ template <class S, hal::ControlHal Hal>
 void stage_step(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
   if (!t.stepped) return;
   const std::uint32_t s0 = hal.cycles();
-  task.last = control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired);
+  control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired, task.last);
   task.step_timing.add(hal.cycles() - s0);
   t.faults |= task.last.status;  // non_finite, singular
 }
