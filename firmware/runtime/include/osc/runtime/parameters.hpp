@@ -334,7 +334,7 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
   switch (p.runtime) {
     case RuntimeParam::kParamAdaptation: {
       const auto law = static_cast<AdaptationLaw>(static_cast<int>(v));
-      if (law != task.gains.adaptation) task.identifier.reset();  // the momentum law starts from its prior
+      if (law != task.gains.adaptation) task.state.adapt.identifier.reset();  // the momentum law: from its prior
       task.gains.adaptation = law;
       break;
     }
