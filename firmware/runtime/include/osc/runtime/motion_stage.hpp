@@ -242,6 +242,7 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   in.command = motion_command_of_tick(task, measured, q);
   in.homed = task.homed;
   in.faults = faults;
+  in.latched = task.sup.latched;  // the one latch: the supervisor's, this tick's faults in it (stage_decide)
   in.stop_request = stop_request;
   in.yield = yield;
   in.motion_finished = ev.finished;
