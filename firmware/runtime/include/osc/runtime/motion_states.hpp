@@ -182,6 +182,18 @@ struct MotionStep {
 /// A motion runs: a client's (moving) or homing's. Both end in holding, or stop like a motion.
 constexpr bool motion_running(MotionState s) { return s == MotionState::kMoving || s == MotionState::kHoming; }
 
+/// The states with the torque on: the control step runs and torque reaches the DACs (the supervisor
+/// allowing). The one list of them: motion_next's torque, the tick's step, the enable's ramp, the
+/// parameters written only with the torque off (param_torque_off), the simulated arm's brakes.
+constexpr bool motion_powered(MotionState s) {
+  return s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
+}
+/// The torque known to be off: a state of the list not powered (disabled, fault); a state code
+/// outside the list is not known to be off.
+constexpr bool motion_torque_off(MotionState s) {
+  return static_cast<int>(s) < MotionNames<MotionState>::kCount && !motion_powered(s);
+}
+
 namespace detail {
 
 constexpr bool motion_state_known(MotionState s) { return static_cast<int>(s) < MotionNames<MotionState>::kCount; }
@@ -324,6 +336,7 @@ constexpr void motion_command(MotionStep& r, MotionCommand c, bool homed) {
 ///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
 ///   [3] refused not_homed until the encoders' offsets are known (MotionInput::homed).
 ///   [4] the runtime sets the offsets from the named pose (declare_pose, after its pots check).
+/// The states with the torque on are motion_powered's.
 /// Torque is on in holding, moving, homing, stopping, yielding; the stop in effect is category 0 in fault, 2 in
 /// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable,
 /// finished, stopped). Decisions: a command whose end state already holds is accepted and does nothing (enable when
@@ -347,8 +360,7 @@ constexpr MotionStep motion_next(const MotionMachine& m, const MotionInput& in) 
   detail::motion_command(r, c, in.homed);
   const MotionState s = r.machine.state;
   r.stop = s == MotionState::kStopping ? StopCategory::kCategory2 : StopCategory::kNone;
-  r.torque =
-      s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
+  r.torque = motion_powered(s);
   r.capture_pose = s == MotionState::kHolding && m.state != MotionState::kHolding;
   return r;
 }

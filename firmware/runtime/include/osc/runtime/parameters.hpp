@@ -371,7 +371,7 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
 /// Whether the task's torque is off (a torque_off parameter, a save, a load or a reset may be written).
 template <class S>
 bool param_torque_off(const ControlTask<S>& task) {
-  return task.machine.state == MotionState::kDisabled || task.machine.state == MotionState::kFault;
+  return motion_torque_off(task.machine.state);
 }
 
 /// The largest magnitude the build's scalar holds: a fixed-point build (Q12.19: 4096) refuses a
