@@ -556,7 +556,7 @@ TEST(MotionSequences, RepeatedCommandsAreAcceptedAndChangeNothing) {
 }
 
 TEST(MotionSequences, AnUnreadableStateCodeFaults) {
-  const MotionStep t = motion_next({static_cast<S>(kStates), 0, false}, {.command = C::kMove});
+  const MotionStep t = motion_next({static_cast<S>(kStates), false}, {.command = C::kMove});
   EXPECT_EQ(t.machine.state, S::kFault);
   EXPECT_FALSE(t.torque);
   EXPECT_EQ(t.refusal, R::kFaulted);
@@ -565,7 +565,7 @@ TEST(MotionSequences, AnUnreadableStateCodeFaults) {
 }  // namespace
 
 TEST(MotionSequences, AYieldAbortsTheMotionWithCollisionAndAStopHoldsThePoseItReached) {
-  MotionMachine m{S::kMoving, 0, false};
+  MotionMachine m{S::kMoving, false};
   MotionStep t = motion_next(m, {.yield = true});
   EXPECT_EQ(t.machine.state, S::kYielding);
   EXPECT_EQ(t.abort, R::kCollision);
@@ -585,7 +585,7 @@ TEST(MotionSequences, AYieldAbortsTheMotionWithCollisionAndAStopHoldsThePoseItRe
   EXPECT_EQ(t.machine.state, S::kFault);
   EXPECT_FALSE(t.torque);
   // A stop to disable that meets a collision yields; the pending disable is dropped.
-  t = motion_next({S::kStopping, 0, true}, {.yield = true});
+  t = motion_next({S::kStopping, true}, {.yield = true});
   EXPECT_EQ(t.machine.state, S::kYielding);
   EXPECT_FALSE(t.machine.disable_at_rest);
   // Disabled, nothing yields: no torque to yield with.
