@@ -47,7 +47,7 @@ class LocalController {
     for (int i = 0; i < 18; ++i) r.theta_hat[i] = static_cast<double>(task_->state.adapt.theta_hat(i));
     r.has_identification = task_->gains.adaptation == osc::AdaptationLaw::kMomentum;
     if (r.has_identification) {
-      const osc::FrictionIdentifier<S>& id = task_->identifier;
+      const osc::FrictionIdentifier<S>& id = task_->state.adapt.identifier;
       for (int i = 0; i < 6; ++i) {
         for (int c = 0; c < 3; ++c) r.theta_sd[6 * c + i] = std::sqrt(std::max(0.0, id.variance(i, c)));
         r.breakaway_sd[i] = std::sqrt(std::max(0.0, id.breakaway_variance(i)));

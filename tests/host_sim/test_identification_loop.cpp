@@ -161,7 +161,7 @@ TEST(FrictionIdentification, RepeatedShortMoveHoldsTheUnexcitedSplit) {
   sim.task().gains.adaptation = osc::AdaptationLaw::kMomentum;
   std::uint32_t faults = learn_then_hold(sim, 30000);
   ASSERT_EQ(sim.task().machine.state, osc::MotionState::kHolding);
-  const osc::FrictionIdentifier<double> before = sim.task().identifier;
+  const osc::FrictionIdentifier<double> before = sim.task().state.adapt.identifier;
   std::uint32_t id = 4;
   double dx = 0.03;
   for (int k = 0; k < 60000; ++k) {
@@ -176,7 +176,7 @@ TEST(FrictionIdentification, RepeatedShortMoveHoldsTheUnexcitedSplit) {
   }
   EXPECT_EQ(faults, 0u);
   EXPECT_GT(id, 40u);  // the moves were made
-  const osc::FrictionIdentifier<double>& after = sim.task().identifier;
+  const osc::FrictionIdentifier<double>& after = sim.task().state.adapt.identifier;
   for (int j = 1; j < 3; ++j)  // J2 and J3 carry the move (J1 hardly turns)
     EXPECT_GT(after.updates[j], before.updates[j] + 100) << "J" << j + 1 << ": the move's samples count";
   for (int j = 0; j < 3; ++j) {

@@ -1266,6 +1266,38 @@ TEST_F(NodeFrames, AFaultAbortsTheMoveAndDropsTheQueueInItsTickAndTheStateFrameS
   expect_each_ended_once(ids);
 }
 
+// One latch of fault bits (the supervisor's, which the motion machine reads): the actuator frame, the
+// state frame and a refusal's cause report the same bits after a fault, and none after the clear;
+// a second fault after it is latched again, alone.
+TEST_F(NodeFrames, OneLatchTheFramesAndARefusalReportTheSameFaultsThroughAClear) {
+  enable();
+  tick(pil::kInjectNonFinite);
+  const std::uint32_t latched = node->task.sup.latched;
+  EXPECT_EQ(latched, static_cast<std::uint32_t>(kFaultNonFinite));
+  EXPECT_EQ(node->task.machine.state, MotionState::kFault);
+  EXPECT_EQ(RecordingBoard::actuators.back().faults, latched);
+  EXPECT_EQ(state_frame_from_task(node->task).faults, latched);
+  take(command(19, MotionVerb::kEnable));
+  EXPECT_EQ(RecordingBoard::answers.back().refusal, static_cast<std::uint8_t>(MotionReason::kFaulted));
+  EXPECT_EQ(RecordingBoard::answers.back().cause, latched);
+  EXPECT_EQ(RecordingBoard::actuators.back().faults, latched);
+  EXPECT_EQ(state_frame_from_task(node->task).faults, latched);
+  take(command(20, MotionVerb::kClear));
+  EXPECT_EQ(RecordingBoard::answers.back().outcome, static_cast<std::uint8_t>(CommandOutcome::kAccepted));
+  EXPECT_EQ(node->task.machine.state, MotionState::kDisabled);
+  EXPECT_EQ(node->task.sup.latched, 0u);
+  EXPECT_EQ(state_frame_from_task(node->task).faults, 0u);
+  tick();
+  EXPECT_EQ(RecordingBoard::actuators.back().faults, 0u);
+  arrive(command(21, MotionVerb::kEnable));
+  for (int k = 0; k < 5; ++k) tick();
+  ASSERT_EQ(node->task.machine.state, MotionState::kHolding);
+  tick(pil::kInjectNonFinite);
+  EXPECT_EQ(node->task.sup.latched, static_cast<std::uint32_t>(kFaultNonFinite));
+  EXPECT_EQ(state_frame_from_task(node->task).faults, node->task.sup.latched);
+  EXPECT_EQ(RecordingBoard::actuators.back().faults, node->task.sup.latched);
+}
+
 TEST_F(NodeFrames, AReplaceDropsTheQueueAndAReplaceDuringItsBrakeDropsTheMoveBeforeIt) {
   enable();
   const std::vector<std::uint32_t> ids = ids_from(10, 3);

@@ -90,6 +90,48 @@ TYPED_TEST(IoMaps, CoupledCountsGiveTheJointAnglesOfTheWrittenOutMatrix) {
   EXPECT_LT(worst, tol);
 }
 
+// One joint <- motor map (joint_from_motor): the angles of counts are q0 + C e by it, bit for bit, and
+// homing's correction through it (finish_homing: the encoders' zero moved by C de, the motors by de)
+// gives the angles of the corrected motor angles: q0 + C (e + de), against the written-out matrix.
+TYPED_TEST(IoMaps, HomingsCorrectionAndTheAnglesOfCountsAreOneMap) {
+  using S = TypeParam;
+  const EncoderMap& map = robot::kDriveTrain.encoders;
+  const IoMap<S> io = IoMap<S>::of(map);
+  ASSERT_TRUE(io.coupled());
+  const M6 C = published_coupling();
+  const V6 q0 = joint_vector<double>(robot::kQStart);
+  const Vec6<S> q0_s = q0.cast<S>();
+  const double tol = std::is_same_v<S, double> ? 1e-12 : 4e-5;
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<std::int32_t> u(-40000, 40000), turn(-2000, 2000);
+  for (int k = 0; k < 500; ++k) {
+    std::int32_t counts[kDof], shifted[kDof];
+    V6 e, de;
+    Vec6<S> e_s, de_s;
+    for (int i = 0; i < kDof; ++i) {
+      counts[i] = u(rng);
+      const std::int32_t d = turn(rng);  // a correction of whole counts
+      shifted[i] = counts[i] + d;
+      e(i) = counts[i] / map.counts_per_rad[i], de(i) = d / map.counts_per_rad[i];
+      e_s(i) = math::quotient<S>(counts[i], io.counts_per_rad(i));
+      de_s(i) = math::quotient<S>(d, io.counts_per_rad(i));
+    }
+    const Vec6<S> q = angles_from_counts(q0_s, io, counts);
+    const Vec6<S> by_map = joint_from_motor(io, e_s, q0_s);
+    for (int i = 0; i < kDof; ++i) ASSERT_EQ(q(i), by_map(i)) << i;  // the same sums, in the same order
+    const V6 ce = joint_from_motor(io, e_s).template cast<double>();
+    ASSERT_LT((ce - C * e).cwiseAbs().maxCoeff(), tol);
+    // Homing's correction de: the zero moved (q0 + C de), the same counts.
+    const Vec6<S> q_start = q0_s + joint_from_motor(io, de_s);
+    const V6 homed = angles_from_counts(q_start, io, counts).template cast<double>();
+    const V6 expect = q0 + C * (e + de);
+    ASSERT_LT((homed - expect).cwiseAbs().maxCoeff(), tol) << k;
+    // The same angles as the counts of the corrected motors from the old zero.
+    const V6 moved = angles_from_counts(q0_s, io, shifted).template cast<double>();
+    ASSERT_LT((homed - moved).cwiseAbs().maxCoeff(), 2 * tol) << k;
+  }
+}
+
 TYPED_TEST(IoMaps, CountsToAnglesToCountsRoundTrips) {
   // The encoder side of the plant counts floor(e counts_per_rad) with e = C^-1 (q - q0); the
   // firmware's angles of those counts, counted again, give the same counts (at the lattice points

@@ -91,21 +91,22 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
   MotionStep w{};
   const C cmd = code(in.command) < kCommands ? in.command : C::kNone;
   const bool unknown_state = code(m.state) >= kStates;
-  // Faults: a new one, a latched one, the fault state, an unreadable state.
-  if (in.faults || m.latched || m.state == S::kFault || unknown_state) {
+  // Faults: a new one, a latched one (the supervisor's), the fault state, an unreadable state.
+  const std::uint32_t latched = in.latched | in.faults;
+  if (latched || m.state == S::kFault || unknown_state) {
     if (running(m.state)) w.abort = R::kFaulted;
     const std::uint32_t now = in.faults | in.causes;
     if (cmd == C::kClear && now == 0) {
-      w.machine = MotionMachine{S::kDisabled, 0, false};
+      w.machine = MotionMachine{S::kDisabled, false};
       w.outcome = CommandOutcome::kAccepted;
       return w;
     }
-    w.machine = MotionMachine{S::kFault, m.latched | in.faults, false};
+    w.machine = MotionMachine{S::kFault, false};
     w.stop = StopCategory::kCategory0;
     if (cmd != C::kNone) {
       w.outcome = CommandOutcome::kRefused;
       w.refusal = R::kFaulted;
-      w.cause = cmd == C::kClear ? now : (m.latched | in.faults);
+      w.cause = cmd == C::kClear ? now : latched;
     }
     return w;
   }
@@ -139,7 +140,7 @@ MotionStep oracle(MotionMachine m, MotionInput in) {
     if (cell.pending != Pending::kKeep) pending = cell.pending == Pending::kSet;
     w.enabling = cell.enabling;
   }
-  w.machine = MotionMachine{s, 0, s == S::kStopping && pending};
+  w.machine = MotionMachine{s, s == S::kStopping && pending};
   w.torque = !(s == S::kDisabled || s == S::kFault);
   if (s == S::kStopping) w.stop = StopCategory::kCategory2;
   w.capture_pose = s == S::kHolding && m.state != S::kHolding;
@@ -151,16 +152,16 @@ std::string describe(const MotionStep& t) {
   auto f = [](const char* name, auto v) {
     return std::string(name) + "=" + motion_name(v) + "(" + std::to_string(static_cast<int>(v)) + ") ";
   };
-  return f("state", t.machine.state) + "latched=" + std::to_string(t.machine.latched) +
-         " pending=" + std::to_string(t.machine.disable_at_rest) + " " + f("outcome", t.outcome) +
-         f("refusal", t.refusal) + "cause=" + std::to_string(t.cause) + " " + f("abort", t.abort) +
-         f("completion", t.completion) + f("stop", t.stop) + "torque=" + std::to_string(t.torque) +
-         " capture=" + std::to_string(t.capture_pose) + " enabling=" + std::to_string(t.enabling);
+  return f("state", t.machine.state) + "pending=" + std::to_string(t.machine.disable_at_rest) + " " +
+         f("outcome", t.outcome) + f("refusal", t.refusal) + "cause=" + std::to_string(t.cause) + " " +
+         f("abort", t.abort) + f("completion", t.completion) + f("stop", t.stop) +
+         "torque=" + std::to_string(t.torque) + " capture=" + std::to_string(t.capture_pose) +
+         " enabling=" + std::to_string(t.enabling);
 }
 
 std::string describe(const MotionMachine& m, const MotionInput& in) {
   return std::string("from ") + motion_name(m.state) + "(" + std::to_string(code(m.state)) +
-         ") latched=" + std::to_string(m.latched) + " pending=" + std::to_string(m.disable_at_rest) +
+         ") pending=" + std::to_string(m.disable_at_rest) + " latched=" + std::to_string(in.latched) +
          " command=" + motion_name(in.command) + "(" + std::to_string(code(in.command)) +
          ") faults=" + std::to_string(in.faults) + " causes=" + std::to_string(in.causes) +
          " stop_request=" + motion_name(in.stop_request) + " finished=" + std::to_string(in.motion_finished) +
@@ -175,19 +176,18 @@ bool torque_state(S s) {
 /// The safety properties of one tick, whatever the table says.
 void check_properties(const MotionMachine& m, const MotionInput& in, const MotionStep& t) {
   const S to = t.machine.state;
-  const bool was_fault = m.state == S::kFault || m.latched != 0 || code(m.state) >= kStates;
-  // A fault is category 0, torque off, in the same tick, and latched as it came.
+  const bool was_fault = m.state == S::kFault || in.latched != 0 || code(m.state) >= kStates;
+  // A fault is category 0, torque off, in the same tick, and named as it came by a refusal's cause.
   if (in.faults != 0) {
     ASSERT_EQ(to, S::kFault);
     ASSERT_EQ(t.stop, StopCategory::kCategory0);
     ASSERT_FALSE(t.torque);
-    ASSERT_EQ(t.machine.latched & in.faults, in.faults);
+    ASSERT_TRUE(t.refusal != R::kFaulted || in.command == C::kClear || (t.cause & in.faults) == in.faults);
   }
   // Torque and the stop in effect follow the state; the output keeps the machine's invariants.
   ASSERT_EQ(t.torque, torque_state(to));
   ASSERT_EQ(t.stop == StopCategory::kCategory0, to == S::kFault);
   ASSERT_EQ(t.stop == StopCategory::kCategory2, to == S::kStopping);
-  ASSERT_EQ(t.machine.latched != 0, to == S::kFault && (m.latched | in.faults) != 0);
   ASSERT_TRUE(!t.machine.disable_at_rest || to == S::kStopping);
   // Faults are sticky: only an accepted clear with no cause present leaves fault, for disabled.
   if (was_fault && to != S::kFault) {
@@ -195,9 +195,9 @@ void check_properties(const MotionMachine& m, const MotionInput& in, const Motio
     ASSERT_EQ(t.outcome, CommandOutcome::kAccepted);
     ASSERT_EQ(in.faults | in.causes, 0u);
     ASSERT_EQ(to, S::kDisabled);
-    ASSERT_EQ(t.machine.latched, 0u);
   }
-  ASSERT_TRUE(!(was_fault && to == S::kFault) || (t.machine.latched & m.latched) == m.latched);
+  // The machine keeps no latch of its own: a refusal `faulted` names the supervisor's, with this tick's faults.
+  ASSERT_TRUE(t.refusal != R::kFaulted || in.command == C::kClear || t.cause == (in.latched | in.faults));
   if (was_fault && in.command == C::kClear && (in.faults | in.causes) != 0) {
     ASSERT_EQ(t.refusal, R::kFaulted);
     ASSERT_EQ(t.cause, in.faults | in.causes);  // the refusal names the cause still present
@@ -254,8 +254,9 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
             for (std::uint32_t cause : causes)
               for (int req = 0; req < kReasons; ++req)
                 for (int ev = 0; ev < 16; ++ev) {
-                  const MotionMachine m{static_cast<S>(st), latched, pending != 0};
+                  const MotionMachine m{static_cast<S>(st), pending != 0};
                   MotionInput in{};
+                  in.latched = latched;
                   in.command = static_cast<C>(cmd);
                   in.faults = f;
                   in.causes = cause;
@@ -281,26 +282,40 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
 
 // ---- Properties over whole runs. ----
 
+/// The supervisor's latch after a tick (Supervisor::latched, the one latch): this tick's faults added,
+/// cleared by an accepted clear (the runtime re-initialises the supervisor).
+std::uint32_t latch_after(std::uint32_t latched, const MotionInput& in, const MotionStep& t) {
+  return in.command == C::kClear && t.outcome == CommandOutcome::kAccepted ? 0u : latched | in.faults;
+}
+
 /// The states reachable from disabled, over every input (faults: none or one named) but those
 /// with a command left out.
 std::set<int> reachable(std::set<C> left_out) {
-  std::vector<MotionMachine> todo{MotionMachine{}};
+  std::vector<std::pair<MotionMachine, std::uint32_t>> todo{{MotionMachine{}, 0u}};  // with the latch
   std::set<std::vector<std::uint32_t>> seen;
   std::set<int> states;
   while (!todo.empty()) {
-    const MotionMachine m = todo.back();
+    const auto [m, latched] = todo.back();
     todo.pop_back();
-    if (!seen.insert({static_cast<std::uint32_t>(code(m.state)), m.latched, m.disable_at_rest}).second) continue;
+    if (!seen.insert({static_cast<std::uint32_t>(code(m.state)), latched, m.disable_at_rest}).second) continue;
     states.insert(code(m.state));
     for (int cmd = 0; cmd < kCommands; ++cmd)
       for (std::uint32_t f : {0u, static_cast<std::uint32_t>(kFaultEstop)})
         for (int req = 0; req < kReasons; ++req)
           for (int ev = 0; ev < 8; ++ev) {
             if (left_out.count(static_cast<C>(cmd)) != 0) continue;
-            MotionInput in{static_cast<C>(cmd), f, f, static_cast<R>(req), (ev & 1) != 0, (ev & 2) != 0, (ev & 4) != 0};
-            todo.push_back(motion_next(m, in).machine);
-            in.causes = 0;
-            todo.push_back(motion_next(m, in).machine);
+            MotionInput in{.command = static_cast<C>(cmd),
+                           .faults = f,
+                           .latched = latched | f,
+                           .causes = f,
+                           .stop_request = static_cast<R>(req),
+                           .motion_finished = (ev & 1) != 0,
+                           .stopped = (ev & 2) != 0,
+                           .yield = (ev & 4) != 0};
+            for (int present = 0; present < 2; ++present, in.causes = 0) {
+              const MotionStep t = motion_next(m, in);
+              todo.push_back({t.machine, latch_after(latched, in, t)});
+            }
           }
   }
   return states;
@@ -320,11 +335,12 @@ TEST(MotionStates, NoPathReachesMovingWithoutEnable) {
 TEST(MotionStates, AFaultIsCategoryZeroWithTorqueOffInTheSameTickFromEveryState) {
   for (int st = 0; st < kStates; ++st)
     for (std::uint32_t f : {static_cast<std::uint32_t>(kFaultEstop), kUndefinedBit}) {
-      const MotionStep t = motion_next({static_cast<S>(st), 0, false}, {.faults = f});
+      const MotionStep t = motion_next({static_cast<S>(st), false}, {.command = C::kMove, .faults = f});
       EXPECT_EQ(t.machine.state, S::kFault) << st;
       EXPECT_EQ(t.stop, StopCategory::kCategory0);
       EXPECT_FALSE(t.torque);
-      EXPECT_EQ(t.machine.latched, f);
+      EXPECT_EQ(t.refusal, R::kFaulted);
+      EXPECT_EQ(t.cause, f);  // the tick's fault, not yet in the supervisor's latch, named all the same
       EXPECT_EQ(t.abort, running(static_cast<S>(st)) ? R::kFaulted : R::kNone);
     }
 }
@@ -380,13 +396,16 @@ TEST(MotionStates, TheIssuesNamesAreTheNamesInTelemetry) {
 
 // ---- Sequences. ----
 
-/// A machine driven tick by tick.
+/// A machine driven tick by tick, with the supervisor's latch as the runtime keeps it (latch_after).
 struct Arm {
   MotionMachine m{};
+  std::uint32_t latched = 0;
   MotionStep last{};
-  MotionStep tick(const MotionInput& in) {
+  MotionStep tick(MotionInput in) {
+    in.latched = latched | in.faults;
     last = motion_next(m, in);
     m = last.machine;
+    latched = latch_after(latched, in, last);
     return last;
   }
   MotionStep command(C c) { return tick({.command = c}); }
@@ -459,7 +478,7 @@ TEST(MotionSequences, AStaleStreamStopsWithCategoryTwoAndHoldsWithoutAFault) {
   EXPECT_EQ(move.refusal, R::kStopping);
   const MotionStep h = a.tick({.stopped = true});
   EXPECT_EQ(h.machine.state, S::kHolding);
-  EXPECT_EQ(h.machine.latched, 0u);
+  EXPECT_EQ(a.latched, 0u);
   EXPECT_TRUE(h.torque);
   EXPECT_EQ(a.command(C::kMove).outcome, CommandOutcome::kAccepted);  // at rest, a move starts again
 }
@@ -471,7 +490,7 @@ TEST(MotionSequences, ASilentCommandLinkStopsWithCategoryTwoOnlyWhileMoving) {
   EXPECT_EQ(a.tick({.stop_request = R::kLinkSilent}).abort, R::kNone);  // reported once
   const MotionStep h = a.tick({.stopped = true});
   EXPECT_EQ(h.machine.state, S::kHolding);
-  EXPECT_EQ(h.machine.latched, 0u);
+  EXPECT_EQ(a.latched, 0u);
   EXPECT_EQ(a.tick({.stop_request = R::kLinkSilent}).machine.state, S::kHolding);  // holding: nothing to stop
   Arm d;
   EXPECT_EQ(d.tick({.stop_request = R::kLinkSilent}).machine.state, S::kDisabled);
@@ -516,7 +535,7 @@ TEST(MotionSequences, AFaultLatchesUntilAClearWithItsCauseGoneThenDisabled) {
   const MotionStep cleared = a.command(C::kClear);
   EXPECT_EQ(cleared.outcome, CommandOutcome::kAccepted);
   EXPECT_EQ(cleared.machine.state, S::kDisabled);
-  EXPECT_EQ(cleared.machine.latched, 0u);
+  EXPECT_EQ(a.latched, 0u);
   EXPECT_FALSE(cleared.torque);
   EXPECT_EQ(a.command(C::kMove).refusal, R::kNotEnabled);
   EXPECT_TRUE(a.command(C::kEnable).enabling);
@@ -537,7 +556,7 @@ TEST(MotionSequences, RepeatedCommandsAreAcceptedAndChangeNothing) {
 }
 
 TEST(MotionSequences, AnUnreadableStateCodeFaults) {
-  const MotionStep t = motion_next({static_cast<S>(kStates), 0, false}, {.command = C::kMove});
+  const MotionStep t = motion_next({static_cast<S>(kStates), false}, {.command = C::kMove});
   EXPECT_EQ(t.machine.state, S::kFault);
   EXPECT_FALSE(t.torque);
   EXPECT_EQ(t.refusal, R::kFaulted);
@@ -546,7 +565,7 @@ TEST(MotionSequences, AnUnreadableStateCodeFaults) {
 }  // namespace
 
 TEST(MotionSequences, AYieldAbortsTheMotionWithCollisionAndAStopHoldsThePoseItReached) {
-  MotionMachine m{S::kMoving, 0, false};
+  MotionMachine m{S::kMoving, false};
   MotionStep t = motion_next(m, {.yield = true});
   EXPECT_EQ(t.machine.state, S::kYielding);
   EXPECT_EQ(t.abort, R::kCollision);
@@ -566,7 +585,7 @@ TEST(MotionSequences, AYieldAbortsTheMotionWithCollisionAndAStopHoldsThePoseItRe
   EXPECT_EQ(t.machine.state, S::kFault);
   EXPECT_FALSE(t.torque);
   // A stop to disable that meets a collision yields; the pending disable is dropped.
-  t = motion_next({S::kStopping, 0, true}, {.yield = true});
+  t = motion_next({S::kStopping, true}, {.yield = true});
   EXPECT_EQ(t.machine.state, S::kYielding);
   EXPECT_FALSE(t.machine.disable_at_rest);
   // Disabled, nothing yields: no torque to yield with.

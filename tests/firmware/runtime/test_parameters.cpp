@@ -201,6 +201,30 @@ TEST(Parameters, EachBadSetIsRefusedByNameAndChangesNothing) {
   EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kOk);
 }
 
+// The torque-on states are one list (motion_powered): a torque_off parameter is written in exactly the
+// states of the machine's list the tick does not power (disabled, fault), checked here against the
+// list written out, and against the state machine's own torque; an unreadable state code is refused.
+TEST(Parameters, TorqueOffIsEveryStateTheMachineDoesNotPower) {
+  auto t = disabled_task<double>();
+  const int knd = param_index("knd");
+  const double value = Gains<double>::paper().knd(0);
+  for (int code = 0; code <= MotionNames<MotionState>::kCount; ++code) {
+    const auto s = static_cast<MotionState>(code);
+    const bool on = s == MotionState::kHolding || s == MotionState::kMoving || s == MotionState::kHoming ||
+                    s == MotionState::kStopping || s == MotionState::kYielding;
+    const bool known = code < MotionNames<MotionState>::kCount;
+    EXPECT_EQ(motion_powered(s), on) << code;
+    t->machine.state = s;
+    EXPECT_EQ(param_torque_off(*t), known && !on) << code;
+    EXPECT_EQ(param_set(*t, knd, 0, value), known && !on ? ParamStatus::kOk : ParamStatus::kTorqueOn) << code;
+    if (known && s != MotionState::kFault) {
+      MotionInput in{};
+      in.command = MotionCommand::kNone;
+      EXPECT_EQ(motion_next({s, false}, in).torque, on) << code;
+    }
+  }
+}
+
 /// The margin against the discrete observer's error map: wherever the margin says stable (above 1),
 /// the map's spectral radius is below 1 (the margin bounds b from above), and gains whose map is
 /// unstable are refused. Swept over k and k_i of one axis group at a time, at the start pose.

@@ -1,6 +1,20 @@
-// Friction adaptation (26) in its sampled form (67), a robust variant of it, and the friction
-// estimate (30)-(31). The law is the caller's choice (Gains::adaptation); docs/adaptation.md has
-// the analysis and the measurements behind the robust law.
+// Friction adaptation: the control law's stage that learns theta^ = [tau_vis; tau_cou; tau_sti] (20),
+// and the friction estimate (30)-(31) it feeds. Three laws, each a stage of the control law; the
+// gains select one (Gains::adaptation, AdaptationLaw), as does the runtime parameter `adaptation`;
+// docs/adaptation.md has the analysis and the measurements behind each:
+//   law       stage                equation, reference                                  runs
+//   paper     adaptation_paper     (26) in its sampled form (67)                         in control_step
+//   robust    adaptation_robust    (67)'s error, the regressor one sample older,         (adaptation_step),
+//                                  leakage, projection (below; docs/adaptation.md 1-3)  before the observer
+//   momentum  adaptation_identify  a Kalman filter per joint on the momentum residual's  after the step, on the
+//                                  friction sample (docs/adaptation.md section 5;       residual's sample of it
+//                                  osc/control/identification.hpp)                      (MomentumSample)
+// The momentum law learns from the torque the step commanded and the drives applied, which the
+// residual monitor (osc/runtime/residual_monitor.hpp) filters after the step: its update is the last
+// stage of the tick's control law, called by the runtime with that sample between the monitors that
+// take it and the check of theta^'s band (osc/runtime/control_task.hpp, step_monitor_faults). Its
+// filter (FrictionIdentifier) is part of the adaptation's state. adaptation_step leaves theta^ as it
+// is under this law.
 //
 // (67): theta^(t) = theta^(t-dt) - K_ad W_j^T(q^dot(t-dt)) Dq,  Dq = q(t) - q(t-dt) - q^dot(t-dt) dt.
 // Why it drifts: q(t-dt) carries the encoder quantisation nu(t-dt), and the observed velocity
@@ -21,6 +35,7 @@
 #pragma once
 
 #include "osc/control/gains.hpp"
+#include "osc/control/identification.hpp"
 #include "osc/kernels/friction.hpp"
 #include "osc/kernels/opspace.hpp"
 
@@ -37,6 +52,19 @@ struct AdaptationState {
   // samples (each costs six exponentials).
   RegressorDiagonals<S> w_prev, w_prev2;
   int samples;  // samples recorded so far (saturates at 2)
+  // The momentum law's filter: each joint's estimate, covariance and excitation (identification.hpp).
+  FrictionIdentifier<S> identifier;
+};
+
+/// The momentum law's input: one joint's friction sample, which the residual monitor took after the
+/// step (osc/runtime/residual_monitor.hpp), and what weighs it in the update (FrictionIdentifier::update).
+template <class S>
+struct MomentumSample {
+  int joint;                 // the joint sampled (momentum_turn)
+  FrictionSample<S> sample;  // y = H(tau_f), phi = H(W_j), H(g), whether the joint moved long enough
+  bool residual_low;         // the joint's residual within params::kIdentifyMaxRatio of its threshold
+  S noise_var;               // the variance the residual's quantisation bound implies [N^2 m^2]
+  S correlation;             // samples correlated through the residual's filter: each counts this many times less
 };
 
 /// The error signal of (67): the measured increment less the observer's prediction,
@@ -46,7 +74,7 @@ Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Ve
   return q - a.q_prev - a.qd_hat_prev * G.dt;
 }
 
-/// The paper's sampled law (67).
+/// The paper's law (26) in its sampled form (67).
 template <class S>
 Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   const Vec6<S> Dq = increment_error(G, a, q);
@@ -66,9 +94,8 @@ Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const
   return theta;
 }
 
-/// theta^(t) by the law the gains select; unchanged until the law has the samples it needs. The
-/// `momentum` law leaves it as it is: the control task identifies it from the residual monitor
-/// (osc/control/identification.hpp), which needs the torque the drives applied.
+/// theta^(t) by the law the gains select, paper (67) or robust; unchanged until the law has the
+/// samples it needs. The `momentum` law leaves it as it is here: its stage is adaptation_identify.
 template <class S>
 Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
   if (G.adaptation == AdaptationLaw::kMomentum) return a.theta_hat;
@@ -76,16 +103,40 @@ Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const V
   return a.samples >= 1 ? adaptation_paper(G, a, q) : a.theta_hat;
 }
 
-/// Starts the adaptation at theta^(0) = 0 with no samples.
+/// The joint whose friction sample the momentum law takes in this tick (the residual monitor takes it
+/// after the step): the joints take turns, params::kIdentifyEvery ticks apart each.
 template <class S>
-void adaptation_init(AdaptationState<S>& a, const Vec6<S>& q0) {
-  a.theta_hat.setZero();
-  a.q_prev = q0;
+int momentum_turn(AdaptationState<S>& a) {
+  return a.identifier.take_turn();
+}
+
+/// The momentum law (docs/adaptation.md, section 5): joint s.joint's Kalman update from the residual's
+/// friction sample s, and that joint's coefficients of theta^ the new estimate projected within
+/// [0, theta_max] in the metric of P^-1 (FrictionIdentifier::update). Runs after the step whose
+/// torque the sample compares, once per tick the law is selected.
+template <class S>
+IdentifyOutcome adaptation_identify(const Gains<S>& G, AdaptationState<S>& a, const MomentumSample<S>& s) {
+  return a.identifier.update(s.joint, s.sample, s.residual_low, s.noise_var, s.correlation, a.theta_hat, G.theta_max);
+}
+
+/// Restarts the samples at q (an enable, a homing's end): what the laws learnt, theta^ and the
+/// momentum law's filter, is kept.
+template <class S>
+void adaptation_restart(AdaptationState<S>& a, const Vec6<S>& q) {
+  a.q_prev = q;
   a.qd_hat_prev.setZero();
   a.qd_hat_prev2.setZero();
   a.w_prev.vis.setZero(), a.w_prev.cou.setZero(), a.w_prev.sti.setZero();  // the regressor at rest
   a.w_prev2 = a.w_prev;
   a.samples = 0;
+}
+
+/// Starts the adaptation at theta^(0) = 0 with no samples, the momentum law's filter at its prior.
+template <class S>
+void adaptation_init(AdaptationState<S>& a, const Vec6<S>& q0) {
+  a.theta_hat.setZero();
+  a.identifier.reset();
+  adaptation_restart(a, q0);
 }
 
 /// Records the sample t for the next update: theta^(t), q(t), q^dot(t) and the regressor at q^dot(t).

@@ -3,12 +3,14 @@
 // a motion source (motion.hpp; the paper's is trajectory (68)). It reads as the block diagram, one
 // stage per call:
 //   kinematics and dynamics at q           opspace_update          (4), (5)
-//   friction adaptation                    adaptation_step         (67) or robust   adaptation.hpp
+//   friction adaptation                    adaptation_step         (26)/(67) or robust  adaptation.hpp
 //   observer output                        observer_output         (21), (23), (28)  observer.hpp
 //   friction estimate                      friction_estimate       (30)
 //   force command                          force_command           (31)-(36)
 //   joint torques                          joint_torques           (5)
 //   observer update                        observer_update         (22)      observer.hpp
+// and, after the step, the `momentum` law's stage, adaptation_identify (adaptation.hpp; docs/adaptation.md
+// section 5), on the residual monitor's sample of this step, which the runtime passes it.
 // The operational forces of (35) and (22) (Lambda a, Psi, p, f) are summed in their joint-space form,
 // J^{-T} tau + Lambda a, and each sum costs one solve with J^T (operational_force) or one L D L^T solve
 // with A (operational_acceleration), not one per term. All state lives in ControllerState; nothing is
@@ -30,7 +32,7 @@ template <class S>
 struct ControllerState {
   Mat3<S> R_ref;             // start orientation: reference of the orientation coordinates
   ObserverState<S> obs;      // x^, y (21)-(22)
-  AdaptationState<S> adapt;  // theta^ and the previous sample (67)
+  AdaptationState<S> adapt;  // theta^, the previous sample (67), the momentum law's filter
   Data<S> data;              // workspace
   OpSpace<S> os;
 };
@@ -49,24 +51,33 @@ struct StepOutput {
   std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular / kFaultOverflow (then tau = 0)
 };
 
-/// Starts the observer at the measured pose: x^(0) = x(0), y(0) = -k x~(0) = 0; theta^(0) = 0. The
-/// orientation coordinates are taken relative to the orientation at q0 (R_ref).
+namespace detail {
+/// The observer at the measured pose q: x^ = x(q), y = -k x~ = 0; the orientation coordinates taken
+/// relative to the orientation at q (R_ref).
 template <class S>
-void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q0) {
-  forward_kinematics(model, st.data, q0);
+void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
+  forward_kinematics(model, st.data, q);
   st.R_ref = st.data.R[kDof];
   st.obs.x_hat << st.data.o[kDof], Vec3<S>::Zero();
   st.obs.y.setZero();
+}
+}  // namespace detail
+
+/// Starts the observer at the measured pose: x^(0) = x(0), y(0) = -k x~(0) = 0; theta^(0) = 0 and the
+/// momentum law's filter at its prior. The orientation coordinates are taken relative to the
+/// orientation at q0 (R_ref).
+template <class S>
+void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q0) {
+  detail::observer_start(model, st, q0);
   adaptation_init(st.adapt, Vec6<S>(q0));
 }
 
 /// Restarts the observer at the measured pose q (an enable after a disable or a cleared fault):
-/// as controller_init, but the friction estimates theta^ learnt so far are kept.
+/// as controller_init, but what the adaptation learnt so far (theta^, the momentum law's filter) is kept.
 template <class S>
 void controller_restart(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
-  const Vec18<S> theta_hat = st.adapt.theta_hat;
-  controller_init(model, st, q);
-  st.adapt.theta_hat = theta_hat;
+  detail::observer_start(model, st, q);
+  adaptation_restart(st.adapt, Vec6<S>(q));
 }
 
 template <class S>

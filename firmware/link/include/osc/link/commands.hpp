@@ -300,7 +300,7 @@ pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
   pil::StateFrame f;
   f.state = static_cast<std::uint8_t>(task.machine.state);
   f.stop = static_cast<std::uint8_t>(stop_category_of(task.machine.state));
-  f.faults = task.machine.latched | task.sup.latched;
+  f.faults = task.sup.latched;  // the one latch (the machine reads it: MotionInput::latched)
   const int queued = task.gen.queued();
   f.queued = static_cast<std::uint8_t>(queued > 255 ? 255 : queued);
   f.running_id = task.gen.running_id();

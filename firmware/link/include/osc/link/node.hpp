@@ -247,7 +247,7 @@ class PilNode {
       // The host's simulated arm stands at the start pose, which the host declares (as the in-process
       // simulator's arm does: sim::MotionSim): homed.
       task.homed = true;
-      if (sup.state == SupervisorState::kFault) task.machine = {MotionState::kFault, sup.latched, false};
+      if (sup.state == SupervisorState::kFault) task.machine = {MotionState::kFault, false};
     }
     if (config & pil::kConfigStateFrames) port.state_period = kStatePeriod;
     trace_ = (config & pil::kConfigTrace) != 0;

@@ -72,7 +72,6 @@ struct ControlTask {
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
   ResidualMonitor<S> residual;
-  FrictionIdentifier<S> identifier;      // the `momentum` law's (osc/control/identification.hpp)
   CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
   std::uint32_t stream_timeout_ticks;    // a stream is stale after max(2 periods, this) without a setpoint
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
@@ -121,7 +120,6 @@ struct ControlTask {
     stuck.reset();
     residual.reset();
     residual.collision_floor.setZero();
-    identifier.reset();
     collision_reaction = CollisionReaction::kCategory0;
     stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
@@ -187,13 +185,13 @@ struct ControlTask {
   void inject_nonfinite() { state.obs.y(0) = S(0) / S(0); }
 };
 
-/// The `momentum` law's update of the joint whose turn it is (FrictionIdentifier), from the sample the
-/// residual monitor took. The sample's noise is at most the residual's quantisation bound taken as
-/// twice its standard deviation; samples params::kIdentifyEvery ticks apart that the filter
-/// correlates over 1 / K count as 2 / (K dt kIdentifyEvery) times fewer independent ones (the
+/// The `momentum` law's input (MomentumSample, osc/control/adaptation.hpp), from the sample the residual
+/// monitor took of the joint whose turn it is. The sample's noise is at most the residual's quantisation
+/// bound taken as twice its standard deviation; samples params::kIdentifyEvery ticks apart that the
+/// filter correlates over 1 / K count as 2 / (K dt kIdentifyEvery) times fewer independent ones (the
 /// integral scale of a first-order filter's correlation exp(-K |t|) is 2 / K).
 template <class S>
-void identify_friction(ControlTask<S>& task) {
+MomentumSample<S> momentum_sample(const ResidualMonitor<S>& m) {
   static constexpr std::array<S, kDof> kCorrelation = [] {
     std::array<S, kDof> c{};
     for (int i = 0; i < kDof; ++i) {
@@ -203,11 +201,9 @@ void identify_friction(ControlTask<S>& task) {
     return c;
   }();
   static constexpr S kMaxRatio = lit<S>(params::kIdentifyMaxRatio);
-  ResidualMonitor<S>& m = task.residual;
   const int i = m.sample_joint;
   const S half = lit<S>(0.5) * m.noise_bound(i);
-  task.identifier.update(i, m.sample, m.within(i, kMaxRatio), half * half, kCorrelation[i], task.state.adapt.theta_hat,
-                         task.gains.theta_max);
+  return {i, m.sample, m.within(i, kMaxRatio), half * half, kCorrelation[i]};
 }
 
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
@@ -246,12 +242,13 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             ad.qd_hat_prev,
                             decay,
                             adaptive ? &ad.theta_hat : nullptr,
-                            identify ? &task.identifier.proven : nullptr,
+                            identify ? &ad.identifier.proven : nullptr,
                             &task.state.data.J};
-  task.residual.sample_joint = identify ? task.identifier.take_turn() : -1;
+  task.residual.sample_joint = identify ? momentum_turn(task.state.adapt) : -1;
   task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick);
-  if (identify) identify_friction(task);
+  // The momentum law's stage of the control law, on the sample the residual monitor just took.
+  if (identify) adaptation_identify(task.gains, task.state.adapt, momentum_sample(task.residual));
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check_part(task.state.adapt.theta_hat, task.gains.theta_max,
@@ -374,9 +371,9 @@ void stage_step(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
   t.faults |= task.last.status;  // non_finite, singular
 }
 
-/// monitors: those of a completed step (step_monitor_faults: stuck encoder, residual, the momentum
-/// law's identification, tracking, friction-estimate band), the position cross-check of a measured
-/// sample; then a collision's reaction (take_collision).
+/// monitors: those of a completed step (step_monitor_faults: stuck encoder, residual, then the momentum
+/// law's update on the residual's sample (adaptation_identify), tracking, friction-estimate band), the position
+/// cross-check of a measured sample; then a collision's reaction (take_collision).
 template <class S, hal::ControlHal Hal>
 void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
   if (t.stepped && task.last.status == kFaultNone) t.faults |= step_monitor_faults(task, t.counts, t.moved);

@@ -117,14 +117,6 @@ struct Homing {
 template <class S>
 struct ControlTask;
 
-/// The joint angles of motor angles e (referred to their joints): C e.
-template <class S>
-Vec6<S> joint_from_motor(const IoMap<S>& io, const Vec6<S>& e) {
-  Vec6<S> q = e;
-  for (int k = 0; k < io.terms; ++k) q(io.row[k]) += io.c[k] * e(io.col[k]);
-  return q;
-}
-
 /// The encoders' zero moves: the joint angles at count 0 by dq (motor angles by de = C^-1 dq), and
 /// the plausible counts (EncoderRangeMonitor) with them, to the count.
 template <class S>

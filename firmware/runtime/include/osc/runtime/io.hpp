@@ -85,19 +85,37 @@ struct IoMap {
   }
 };
 
-/// Encoder counts to joint angles: q = q_start + C e, e_i = counts_i / counts_per_rad_i.
+namespace detail {
+/// The coupling's terms of C e added to q (C unit lower triangular: its diagonal's e is in q already).
+template <class S>
+void add_coupling(const IoMap<S>& io, const Vec6<S>& e, Vec6<S>& q) {
+  for (int k = 0; k < io.terms; ++k) q(io.row[k]) += io.c[k] * e(io.col[k]);
+}
+}  // namespace detail
+
+/// The joint <- motor map of the drive train, the one the task uses (its angles from the encoders,
+/// homing's corrections and turns): the joint angles q0 + C e of motor angles e (referred to their
+/// joints), q0 the joints' at e = 0, summed as (q0 + e) + C's terms off the diagonal.
+template <class S>
+Vec6<S> joint_from_motor(const IoMap<S>& io, const Vec6<S>& e, const Vec6<S>& q0) {
+  Vec6<S> q = q0 + e;
+  detail::add_coupling(io, e, q);
+  return q;
+}
+/// The same from zero: the joints' angles C e of motor angles e.
+template <class S>
+Vec6<S> joint_from_motor(const IoMap<S>& io, const Vec6<S>& e) {
+  Vec6<S> q = e;
+  detail::add_coupling(io, e, q);
+  return q;
+}
+
+/// Encoder counts to joint angles: q = q_start + C e, e_i = counts_i / counts_per_rad_i (joint_from_motor).
 template <class S>
 Vec6<S> angles_from_counts(const Vec6<S>& q_start, const IoMap<S>& io, const std::int32_t counts[kDof]) {
-  Vec6<S> q;
-  if (!io.coupled()) {
-    for (int i = 0; i < kDof; ++i) q(i) = counts_to_angle<S>(counts[i], io.counts_per_rad(i), q_start(i));
-    return q;
-  }
   Vec6<S> e;
   for (int i = 0; i < kDof; ++i) e(i) = math::quotient<S>(counts[i], io.counts_per_rad(i));
-  q = q_start + e;
-  for (int k = 0; k < io.terms; ++k) q(io.row[k]) += io.c[k] * e(io.col[k]);
-  return q;
+  return joint_from_motor(io, e, q_start);
 }
 
 /// The motors' torques, referred to their joints, that give joint torques tau: C^T tau.

@@ -20,11 +20,6 @@ namespace osc {
 template <class S>
 struct ControlTask;
 
-/// The states in which the control step runs and torque reaches the DACs.
-constexpr bool motion_powered(MotionState s) {
-  return s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
-}
-
 /// The reference of a yielding arm (a collision's reaction yield): the arm's own pose and observed
 /// velocity one sample old, no acceleration. Then e = x_{k-1} - x_k and eta = x^dot^_{k-1} - x^dot^_k +
 /// k_s e are of the order of one sample's motion, and (32) reduces to the bias force of (35) (gravity,
@@ -242,6 +237,7 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   in.command = motion_command_of_tick(task, measured, q);
   in.homed = task.homed;
   in.faults = faults;
+  in.latched = task.sup.latched;  // the one latch: the supervisor's, this tick's faults in it (stage_decide)
   in.stop_request = stop_request;
   in.yield = yield;
   in.motion_finished = ev.finished;

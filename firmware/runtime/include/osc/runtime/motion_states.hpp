@@ -1,11 +1,13 @@
 // The motion state machine (issue 23): a pure function from (machine, one tick's command and events)
 // to the next machine and what the tick must do: accept or refuse the command with a named reason,
 // the stop category in effect, torque on or off, capture the pose to hold, report an aborted or a
-// completed motion. Not yet wired into the tick.
+// completed motion. The tick's motion stage runs it (osc/runtime/motion_stage.hpp).
 //
-// How it combines with the Supervisor (osc/runtime/supervisor.hpp, unchanged): the supervisor stays
-// the category-0 latch below this machine. A tick's fault bits go to both, and both are in fault in
-// that tick; torque reaches the DACs only when both allow it (torque_enabled(sup) && step.torque).
+// How it combines with the Supervisor (osc/runtime/supervisor.hpp): the supervisor is the
+// category-0 latch below this machine, and the one latch of fault bits (Supervisor::latched): the
+// machine keeps none, it reads the supervisor's (MotionInput::latched) for its fault rows and a
+// refusal's cause. A tick's fault bits go to both, and both are in fault in that tick; torque
+// reaches the DACs only when both allow it (torque_enabled(sup) && step.torque).
 // The runtime passes an enable only once the supervisor runs (kRun: a measured pose exists to hold).
 // supervisor_next never leaves kFault, so a clear that this machine accepts (causes gone) is the one
 // event on which the runtime re-initialises the supervisor ({kInit, 0}, with the task's init at the
@@ -142,7 +144,6 @@ constexpr const char* motion_name(E e) {
 
 struct MotionMachine {
   MotionState state = MotionState::kDisabled;
-  std::uint32_t latched = 0;     ///< fault bits since the last accepted clear (nonzero only in kFault)
   bool disable_at_rest = false;  ///< kStopping only: the stop ends in kDisabled, not kHolding
 };
 
@@ -150,6 +151,9 @@ struct MotionMachine {
 struct MotionInput {
   MotionCommand command = MotionCommand::kNone;
   std::uint32_t faults = 0;  ///< fault bits detected in this tick (category 0), in the catalogue or not
+  /// The fault bits latched since the last accepted clear: the supervisor's (Supervisor::latched, the
+  /// one latch), this tick's faults among them or not (the machine adds them).
+  std::uint32_t latched = 0;
   std::uint32_t causes = 0;  ///< fault conditions still present (e.g. the E-stop held): a clear needs none
   /// The runtime's category-2 stop of a motion (kStaleStream, kLimitReached, kLinkSilent); kNone: no request.
   MotionReason stop_request = MotionReason::kNone;
@@ -164,7 +168,8 @@ struct MotionStep {
   MotionMachine machine;
   CommandOutcome outcome = CommandOutcome::kNone;  ///< of this tick's command
   MotionReason refusal = MotionReason::kNone;      ///< why it was refused (kNone unless refused)
-  /// With a refusal `faulted`: the bits behind it (a clear's: those present now; else the latched).
+  /// With a refusal `faulted`: the bits behind it (a clear's: those present now; else the latched,
+  /// this tick's included).
   std::uint32_t cause = 0;
   MotionReason abort = MotionReason::kNone;  ///< a running motion was aborted in this tick, and why
   MotionCompletion completion = MotionCompletion::kNone;
@@ -177,6 +182,18 @@ struct MotionStep {
 /// A motion runs: a client's (moving) or homing's. Both end in holding, or stop like a motion.
 constexpr bool motion_running(MotionState s) { return s == MotionState::kMoving || s == MotionState::kHoming; }
 
+/// The states with the torque on: the control step runs and torque reaches the DACs (the supervisor
+/// allowing). The one list of them: motion_next's torque, the tick's step, the enable's ramp, the
+/// parameters written only with the torque off (param_torque_off), the simulated arm's brakes.
+constexpr bool motion_powered(MotionState s) {
+  return s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
+}
+/// The torque known to be off: a state of the list not powered (disabled, fault); a state code
+/// outside the list is not known to be off.
+constexpr bool motion_torque_off(MotionState s) {
+  return static_cast<int>(s) < MotionNames<MotionState>::kCount && !motion_powered(s);
+}
+
 namespace detail {
 
 constexpr bool motion_state_known(MotionState s) { return static_cast<int>(s) < MotionNames<MotionState>::kCount; }
@@ -187,16 +204,16 @@ constexpr MotionStep motion_fault_tick(const MotionMachine& m, const MotionInput
   if (motion_running(m.state)) r.abort = MotionReason::kFaulted;
   const std::uint32_t present = in.faults | in.causes;
   if (c == MotionCommand::kClear && present == 0) {
-    r.machine = {MotionState::kDisabled, 0, false};
+    r.machine = {MotionState::kDisabled, false};
     r.outcome = CommandOutcome::kAccepted;
     return r;
   }
-  r.machine = {MotionState::kFault, m.latched | in.faults, false};
+  r.machine = {MotionState::kFault, false};
   r.stop = StopCategory::kCategory0;
   if (c == MotionCommand::kNone) return r;
   r.outcome = CommandOutcome::kRefused;
   r.refusal = MotionReason::kFaulted;
-  r.cause = c == MotionCommand::kClear ? present : r.machine.latched;
+  r.cause = c == MotionCommand::kClear ? present : in.latched | in.faults;
   return r;
 }
 
@@ -204,10 +221,10 @@ constexpr MotionStep motion_fault_tick(const MotionMachine& m, const MotionInput
 /// runtime's stop request. A state they do not name ignores them.
 constexpr MotionStep motion_events(const MotionMachine& m, const MotionInput& in) {
   MotionStep r{};
-  r.machine = {m.state, 0, m.state == MotionState::kStopping && m.disable_at_rest};
+  r.machine = {m.state, m.state == MotionState::kStopping && m.disable_at_rest};
   if (in.yield && m.state != MotionState::kDisabled) {
     // A collision to yield to: whatever the arm did (a motion, its stop), it now gives way.
-    r.machine = {MotionState::kYielding, 0, false};
+    r.machine = {MotionState::kYielding, false};
     if (motion_running(m.state)) r.abort = MotionReason::kCollision;
   } else if (motion_running(m.state) && in.motion_finished) {
     r.machine.state = MotionState::kHolding;
@@ -216,7 +233,7 @@ constexpr MotionStep motion_events(const MotionMachine& m, const MotionInput& in
     r.machine.state = MotionState::kStopping;
     r.abort = in.stop_request;
   } else if (m.state == MotionState::kStopping && in.stopped) {
-    r.machine = {m.disable_at_rest ? MotionState::kDisabled : MotionState::kHolding, 0, false};
+    r.machine = {m.disable_at_rest ? MotionState::kDisabled : MotionState::kHolding, false};
     r.completion = MotionCompletion::kStopped;
   }
   return r;
@@ -286,11 +303,11 @@ constexpr void motion_command(MotionStep& r, MotionCommand c, bool homed) {
 
 /// Transition table. One tick: the fault rows first; otherwise the events, then the command on the
 /// state they left.
-///   any state, faults != 0, or latched != 0, or a state code outside the list:
-///                                -> fault, latched |= faults (a bit outside the catalogue too);
+///   any state, faults != 0, or latched != 0 (the supervisor's), or a state code outside the list:
+///                                -> fault (a bit outside the catalogue too);
 ///                                   category 0, torque off in this tick; a motion in progress is
-///                                   aborted: faulted; a command is refused: faulted (cause: latched)
-///   fault, clear, faults | causes == 0   -> disabled, latched cleared, accepted
+///                                   aborted: faulted; a command is refused: faulted (cause: latched | faults)
+///   fault, clear, faults | causes == 0   -> disabled, accepted (the runtime clears the supervisor's latch)
 ///   fault, clear, a cause present        -> fault, refused: faulted (cause: faults | causes)
 ///   events (states not named ignore them):
 ///   moving, motion finished              -> holding, completion finished, pose captured
@@ -319,6 +336,7 @@ constexpr void motion_command(MotionStep& r, MotionCommand c, bool homed) {
 ///   [1] aborted: disable_command; at rest, disabled.  [2] aborted: stop_command.
 ///   [3] refused not_homed until the encoders' offsets are known (MotionInput::homed).
 ///   [4] the runtime sets the offsets from the named pose (declare_pose, after its pots check).
+/// The states with the torque on are motion_powered's.
 /// Torque is on in holding, moving, homing, stopping, yielding; the stop in effect is category 0 in fault, 2 in
 /// stopping (yielding is a reaction, not a stop: none). The pose is captured whenever holding is entered (enable,
 /// finished, stopped). Decisions: a command whose end state already holds is accepted and does nothing (enable when
@@ -336,14 +354,13 @@ constexpr void motion_command(MotionStep& r, MotionCommand c, bool homed) {
 constexpr MotionStep motion_next(const MotionMachine& m, const MotionInput& in) {
   const bool known_command = static_cast<int>(in.command) < MotionNames<MotionCommand>::kCount;
   const MotionCommand c = known_command ? in.command : MotionCommand::kNone;
-  if (in.faults != 0 || m.latched != 0 || m.state == MotionState::kFault || !detail::motion_state_known(m.state))
+  if ((in.faults | in.latched) != 0 || m.state == MotionState::kFault || !detail::motion_state_known(m.state))
     return detail::motion_fault_tick(m, in, c);
   MotionStep r = detail::motion_events(m, in);
   detail::motion_command(r, c, in.homed);
   const MotionState s = r.machine.state;
   r.stop = s == MotionState::kStopping ? StopCategory::kCategory2 : StopCategory::kNone;
-  r.torque =
-      s == MotionState::kHolding || motion_running(s) || s == MotionState::kStopping || s == MotionState::kYielding;
+  r.torque = motion_powered(s);
   r.capture_pose = s == MotionState::kHolding && m.state != MotionState::kHolding;
   return r;
 }

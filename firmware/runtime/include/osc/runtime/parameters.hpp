@@ -131,7 +131,7 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
   switch (p.runtime) {
     case RuntimeParam::kParamAdaptation: {
       const auto law = static_cast<AdaptationLaw>(static_cast<int>(v));
-      if (law != task.gains.adaptation) task.identifier.reset();  // the momentum law starts from its prior
+      if (law != task.gains.adaptation) task.state.adapt.identifier.reset();  // the momentum law: from its prior
       task.gains.adaptation = law;
       break;
     }
@@ -168,7 +168,7 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
 /// Whether the task's torque is off (a torque_off parameter, a save, a load or a reset may be written).
 template <class S>
 bool param_torque_off(const ControlTask<S>& task) {
-  return task.machine.state == MotionState::kDisabled || task.machine.state == MotionState::kFault;
+  return motion_torque_off(task.machine.state);
 }
 
 /// The largest magnitude the build's scalar holds: a fixed-point build (Q12.19: 4096) refuses a

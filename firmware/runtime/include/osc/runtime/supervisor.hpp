@@ -1,6 +1,9 @@
 // The supervisor: a pure function from (state, fault conditions) to the next state, with named,
 // sticky fault bits. Any fault commands zero torque in the same tick and stays latched until a
-// reset; no transition leaves kFault.
+// reset (the runtime re-initialises the supervisor on a clear the motion state machine accepts);
+// no transition leaves kFault. Its latch is the task's one latch of fault bits: the motion state
+// machine reads it (MotionInput::latched, osc/runtime/motion_states.hpp), the telemetry and state
+// frames report it.
 #pragma once
 
 #include <cstdint>
@@ -26,7 +29,7 @@ struct SupervisorInput {
 
 struct Supervisor {
   SupervisorState state;
-  std::uint32_t latched;  ///< sticky fault bits
+  std::uint32_t latched;  ///< sticky fault bits: the task's one latch
 };
 
 /// Transition table:
