@@ -3,9 +3,11 @@
 
 Runs IMAGE (a timer image: its tick is the interrupt handler HANDLER, its main function spins
 between ticks) in its board's QEMU with `-d in_asm,exec,nochain`, the main function's addresses
-filtered out of the log (`-dfilter`), and counts every instruction executed from one entry of the handler to the next (the
-last two, which hold main's report, are dropped). Each instruction's address is mapped to its source with
-`addr2line -f -i` (the chain of inlined functions). Prints, per tick, the instructions of:
+filtered out of the log (`-dfilter`), and counts every instruction executed from an entry of the
+handler to its return (the calls it makes followed: the stage of an out-of-line function is its
+caller's), over every tick but the last two (main's report may hold them). Each instruction's
+address is mapped to its source with `addr2line -f -i` (the chain of inlined functions). Prints,
+per tick, the instructions of:
   - each tick stage (the outermost `osc::stage_<name>` of the chain),
   - each function (the innermost of the chain, or the K-th level below the stage with --depth),
   - each source line (--lines).
@@ -25,7 +27,8 @@ import tempfile
 
 TRACE = re.compile(r"^Trace \d+: 0x[0-9a-f]+ \[[0-9a-f]+/([0-9a-f]+)/")
 STAGE = re.compile(r"\bstage_(\w+)")
-INSN = re.compile(r"^0x([0-9a-f]+):\s+((?:[0-9a-f]{4} ?)+)\s+(\S+)")
+INSN = re.compile(r"^0x([0-9a-f]+):\s+((?:[0-9a-f]{4} ?)+)\s+(\S+)\s*(.*)")
+RETURN = re.compile(r"^(pop(\.w)?\s.*\bpc\b|bx\s+lr\b|ldm.*\bpc\b)")
 
 
 def symbol_range(elf, nm, name):
@@ -50,7 +53,8 @@ def run_trace(args, log):
 def parse(log, handler_pc):
     """Per (call sites, address): the instructions executed in the ticks, and the number of ticks.
     The call sites are the out-of-line calls (bl, blx) the instruction is under, from the handler
-    down: a call pushes its return address, a block that starts at the top one pops it."""
+    down: a call pushes its return address, a block that starts at the top one pops it; a return
+    with no call open is the handler's own, which ends the tick's window."""
     blocks = {}  # block start -> [(address, size, is_call)]
     counts = collections.Counter()
     windows = []  # per handler entry: the instructions until the next entry
@@ -66,7 +70,9 @@ def parse(log, handler_pc):
                 m = INSN.match(line)
                 if m:
                     size = 2 * len(m.group(2).split())
-                    current.append((int(m.group(1), 16), size, m.group(3) in ("bl", "blx")))
+                    kind = "call" if m.group(3) in ("bl", "blx") else "return" if RETURN.match(
+                        f"{m.group(3)} {m.group(4)}") else ""
+                    current.append((int(m.group(1), 16), size, kind))
                     continue
                 if current:
                     blocks[current[0][0]] = current
@@ -83,14 +89,16 @@ def parse(log, handler_pc):
                 continue
             while stack and stack[-1][0] == pc:
                 stack.pop()
-            block = blocks.get(pc, [(pc, 2, False)])
+            block = blocks.get(pc, [(pc, 2, "")])
             sites = tuple(site for _, site in stack)
             w = windows[-1]
             for a, _, _ in block:
                 w[(sites, a)] += 1
-            a, size, call = block[-1]
-            if call:
+            a, size, kind = block[-1]
+            if kind == "call":
                 stack.append((a + size, a))
+            elif kind == "return" and not stack:
+                inside = False  # the handler returned: what follows is main's until the next tick
     # The last two windows hold main's report (the image's last ticks interrupt it).
     for w in windows[:-2]:
         counts.update(w)
