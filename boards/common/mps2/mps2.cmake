@@ -54,6 +54,13 @@ function(osc_add_mps2_board)
   # The image feeds the watchdog; under -no-reboot a watchdog reset would end QEMU with status 0,
   # so the test also needs the image's own verdict.
   set_tests_properties(timer_firmware_qemu PROPERTIES PASS_REGULAR_EXPRESSION "timer_firmware: pass")
+  # The same image measuring the tick's worst case (docs/benchmarks.md): the momentum law's gates
+  # open and its blocks of 4 samples (params::kTickWorstCase), so that its 200 ticks hold Kalman
+  # updates and folds although the arm is at rest. A measurement image only.
+  osc_board_image(${B_NAME} timer_worst_firmware ${OSC_MPS2_TESTS_DIR}/timer_firmware.cpp)
+  target_compile_definitions(timer_worst_firmware PRIVATE OSC_TICK_WORST_CASE)
+  add_test(NAME timer_worst_firmware_qemu COMMAND timer_worst_firmware)
+  set_tests_properties(timer_worst_firmware_qemu PROPERTIES PASS_REGULAR_EXPRESSION "timer_firmware: pass")
 
   # The watchdog end to end: healthy ticks feed it; a hung tick, a latched fault and a disabled
   # control interrupt each let it reset the board (QEMU reboots the image; a record in .noinit RAM

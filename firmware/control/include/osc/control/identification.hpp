@@ -152,8 +152,8 @@ struct FrictionIdentifier {
                          Vec18<S>& theta, const Vec18<S>& theta_max) {
     drift(i);
     prove(i);
-    if (!s.settled) return IdentifyOutcome::kNotSettled;
-    if (!residual_low) return IdentifyOutcome::kResidualHigh;
+    if (!s.settled && !params::kTickWorstCase) return IdentifyOutcome::kNotSettled;
+    if (!residual_low && !params::kTickWorstCase) return IdentifyOutcome::kResidualHigh;
     if (block_count[i] >= params::kIdentifyExciteBlock) {
       fold(i);
       return IdentifyOutcome::kFolded;
@@ -175,7 +175,7 @@ struct FrictionIdentifier {
     const S floor = bound * lit<S>(1.0 / 256);
     noise = noise < floor ? floor : (noise > bound ? bound : noise);
     static constexpr S kGateSquaredInverse = lit<S>(1.0 / (params::kIdentifyGate * params::kIdentifyGate));
-    if (e2 * kGateSquaredInverse > explained + noise) {
+    if (e2 * kGateSquaredInverse > explained + noise && !params::kTickWorstCase) {
       ++outliers[i];
       return IdentifyOutcome::kOutlier;
     }

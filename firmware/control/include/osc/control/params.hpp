@@ -186,7 +186,16 @@ constexpr int kTravelTiers = 4;
 /// The motion's moments are averaged over blocks of kIdentifyExciteBlock counted samples per joint,
 /// and the blocks over kIdentifyExciteBlocks of them (4 096 samples, about 25 s of motion).
 constexpr double kIdentifySplitExcitation = 0.02;
-constexpr int kIdentifyExciteBlock = 64;
+/// A measurement build's switch, never a product image's: OSC_TICK_WORST_CASE (the timer image
+/// timer_worst_firmware, docs/benchmarks.md) makes every turn of the momentum law take its longest
+/// path, so that the tick's worst case is measured on an arm at rest: every sample counts (settled,
+/// the residual low, no outlier) and a block of moments folds every 4 samples.
+#ifdef OSC_TICK_WORST_CASE
+constexpr bool kTickWorstCase = true;
+#else
+constexpr bool kTickWorstCase = false;
+#endif
+constexpr int kIdentifyExciteBlock = kTickWorstCase ? 4 : 64;
 constexpr int kIdentifyExciteBlocks = 64;
 /// The position cross-check (osc/runtime/monitors.hpp, PositionCrossCheck; docs/safety.md, "The
 /// position cross-check"): each joint's potentiometer angle minus its encoder angle, low-pass filtered
