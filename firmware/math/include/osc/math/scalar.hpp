@@ -231,7 +231,7 @@ bool all_finite(const Derived& m) {
     for (int j = 0; j < m.cols(); ++j)
       for (int i = 0; i < m.rows(); ++i) {
         const S v = m(i, j);
-        sum += v - v;
+        sum += v - v;  // NOLINT(misc-redundant-expression): 0 for a finite v, NaN otherwise
       }
     return sum == S(0);
   } else {
