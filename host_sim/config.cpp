@@ -188,6 +188,17 @@ void add_run_entries(std::vector<Entry>& t) {
       [](const Settings& s) { return std::string(osc::adaptation_law_name(s.base.gains.adaptation)); },
       [](Settings& s, const std::string& m) { osc::adaptation_law_from_name(m, s.base.gains.adaptation); });
   name(
+      t, "run.model_rate",
+      "how often the control step refreshes the arm's dynamics model: alternate (default) computes A(q), its factors "
+      "and g(q) on one step and the velocity products on the next, each held a step; every_step computes both every "
+      "step (osc/control/controller.hpp, dynamics_turn)",
+      std::vector<std::string>(osc::kModelRateNames, osc::kModelRateNames + osc::kModelRateCount), true,
+      [](const Settings& s) { return std::string(osc::kModelRateNames[static_cast<int>(s.base.gains.model_rate)]); },
+      [](Settings& s, const std::string& m) {
+        for (int i = 0; i < osc::kModelRateCount; ++i)
+          if (m == osc::kModelRateNames[i]) s.base.gains.model_rate = static_cast<osc::ModelRate>(i);
+      });
+  name(
       t, "run.residual_monitor",
       "on (default): the residual monitor raises encoder_stuck, drive_fault and collision, the stuck-encoder "
       "monitor off but while homing; trial: the residual monitor is computed and reported, the stuck-encoder monitor "

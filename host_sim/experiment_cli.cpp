@@ -42,7 +42,7 @@ constexpr Shorthand kShorthands[] = {
 constexpr const char* kHostOnlyKeys[] = {
     "controller.knd",      "controller.k",       "controller.ks",          "controller.ki",        "controller.k_ad",
     "controller.tau_dec",  "controller.leakage", "controller.model_error", "trajectory.amplitude", "trajectory.period",
-    "trajectory.envelope", "start_pose",         "plant.encoder_cpr",      "plant.power_on_pose"};
+    "trajectory.envelope", "start_pose",         "plant.encoder_cpr",      "plant.power_on_pose",  "run.model_rate"};
 
 constexpr const char* kPowerOnNeedsMotion =
     "plant.power_on_pose applies to a motion script (--motion), whose steps home the arm or declare its pose; the "

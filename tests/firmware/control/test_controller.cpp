@@ -368,7 +368,8 @@ TEST_F(Stages, ForceCommandIsEquations31_36) {
   ob.xd_hat = v6(0.02, -0.01, 0.03, 0.01, -0.02, 0.01);
   ob.qd_hat = os.Jf.solve(ob.xd_hat);
   const Vec6<double> tau_f_hat = v6(1, -1, 2, 0.1, 0.2, -0.1);
-  const ForceCommand<double> c = force_command(model, G, data, os, d, ob, tau_f_hat);
+  PsiTerms<double> psi;
+  const ForceCommand<double> c = force_command(model, G, data, os, d, ob, tau_f_hat, psi, true);
   // Each operational force on its own, as the paper writes (35), with Lambda formed.
   const Vec6<double> e = d.x - os.x;  // (36)
   const Vec6<double> v = d.xd + G.ks.cwiseProduct(e);
@@ -389,3 +390,64 @@ TEST_F(Stages, ForceCommandIsEquations31_36) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------- the model's rate
+// ModelRate::kAlternate: the model (A, its factors, g) on the controller's even steps, Psi's velocity
+// products on its odd ones, each held one step; kEveryStep: both every step.
+TEST(ModelRate, TurnsAlternateFromTheFirstStepWhichComputesTheModel) {
+  for (std::uint32_t n = 0; n < 6; ++n) {
+    const DynamicsTurn a = dynamics_turn(ModelRate::kAlternate, n), e = dynamics_turn(ModelRate::kEveryStep, n);
+    EXPECT_EQ(a.model, n % 2 == 0) << n;
+    EXPECT_NE(a.model, a.velocity) << n;
+    EXPECT_TRUE(e.model && e.velocity) << n;
+  }
+  EXPECT_EQ(Gains<double>::paper().model_rate, ModelRate::kAlternate);  // the default (kDefaultModelRate)
+}
+
+// Two controllers, one at each rate, given the same measured angles (a joint-space ramp about the start pose) and
+// the paper's motion. The first step is the same to the last bit but for rounding (the observer starts at rest:
+// every velocity product is 0, which the alternate controller holds). After it, each step's held terms are those
+// the other computes one step earlier: A and g of the previous angles, Psi of the previous velocity.
+TEST(ModelRate, AlternateHoldsEachTermOneStepAndTracksTheEveryStepController) {
+  const Model<double> model = Model<double>::of(robot::kArm);
+  Gains<double> Ge = Gains<double>::paper(), Ga = Ge;
+  Ge.model_rate = ModelRate::kEveryStep;
+  Ga.model_rate = ModelRate::kAlternate;
+  auto se = std::make_unique<ControllerState<double>>(), sa = std::make_unique<ControllerState<double>>();
+  Vec6<double> q = q_start();
+  controller_init(model, *se, q);
+  controller_init(model, *sa, q);
+  const PaperMotion<double> paper{Ge.trajectory, se->data.o[kDof], 0};
+  const Vec6<double> rate = (Vec6<double>() << 0.2, -0.15, 0.25, 0.4, -0.3, 0.5).finished();  // rad/s
+  Mat6<double> A_prev;
+  Vec6<double> g_prev;
+  PsiTerms<double> psi_prev{};
+  double worst = 0, scale = 0;
+  for (int k = 0; k < 400; ++k) {
+    q += rate * 1e-3;
+    const Desired<double> d = paper.at_tick(static_cast<std::uint64_t>(k), 1000);
+    const StepOutput<double> oe = control_step(model, Ge, FrictionMode::kAdaptive, *se, q, d);
+    const StepOutput<double> oa = control_step(model, Ga, FrictionMode::kAdaptive, *sa, q, d);
+    ASSERT_EQ(oe.status, kFaultNone);
+    ASSERT_EQ(oa.status, kFaultNone);
+    if (k == 0) {
+      EXPECT_LT((oa.tau - oe.tau).norm(), 1e-12 * oe.tau.norm());
+    } else if (k % 2 == 1) {  // a velocity turn: the model of the step before
+      EXPECT_EQ(sa->data.A, A_prev) << k;
+      EXPECT_EQ(sa->os.g, g_prev) << k;
+    } else {  // a model turn: the velocity products of the step before
+      EXPECT_EQ(sa->psi.c_yy, psi_prev.c_yy) << k;
+      EXPECT_EQ(sa->psi.c_yz, psi_prev.c_yz) << k;
+      EXPECT_EQ(sa->data.A, se->data.A) << k;  // computed now, at the same angles
+    }
+    A_prev = se->data.A;
+    g_prev = se->os.g;
+    psi_prev = sa->psi;
+    worst = std::max(worst, (oa.tau - oe.tau).cwiseAbs().maxCoeff());
+    scale = std::max(scale, oe.tau.cwiseAbs().maxCoeff());
+  }
+  // A term one period old differs by its rate times 1 ms: a few 1e-4 of the torque at these speeds.
+  std::printf("alternate model rate: worst torque difference %.3g N m of %.3g N m\n", worst, scale);
+  EXPECT_GT(worst, 0.0);
+  EXPECT_LT(worst, 2e-3 * scale);
+}

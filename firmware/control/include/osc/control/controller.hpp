@@ -2,7 +2,8 @@
 // angles q(t) and the desired state d = (x_d, x_d dot, x_d ddot) in, joint torques out. d comes from
 // a motion source (motion.hpp; the paper's is trajectory (68)). It reads as the block diagram, one
 // stage per call:
-//   kinematics and dynamics at q           opspace_update          (4), (5)
+//   kinematics and dynamics at q           opspace_update          (4), (5)   (the dynamics on its turns:
+//                                                                             dynamics_turn, Gains::model_rate)
 //   friction adaptation                    adaptation_step         (26)/(67) or robust  adaptation.hpp
 //   observer output                        observer_output         (21), (23), (28)  observer.hpp
 //   friction estimate                      friction_estimate       (30)
@@ -35,7 +36,28 @@ struct ControllerState {
   AdaptationState<S> adapt;  // theta^, the previous sample (67), the momentum law's filter
   Data<S> data;              // workspace
   OpSpace<S> os;
+  /// Psi's joint-space terms (force_command), held between the steps that compute them (ModelRate::kAlternate).
+  PsiTerms<S> psi;
+  /// The steps since the controller (re)started: whose turn it is (dynamics_turn).
+  std::uint32_t steps = 0;
 };
+
+/// Which parts of the arm's dynamics a step computes; the others are held from the step before.
+struct DynamicsTurn {
+  bool model;     // A(q), its L D L^T factors, g(q) (opspace_update)
+  bool velocity;  // Psi's velocity products (psi_terms, force_command)
+};
+
+/// Every step computes both (ModelRate::kEveryStep), or they alternate (kAlternate): the model on a
+/// controller's first step and every other one after it, the velocity products on the steps between. A step
+/// then solves with the A and g of the step before, or adds the Psi terms of the step before, each one period
+/// (params::kDt) old. The first step needs no Psi of its own: the observer starts at rest (y = 0, x~ = 0), so
+/// q^dot = 0 and every velocity product is 0, as controller_init and controller_restart set them.
+inline DynamicsTurn dynamics_turn(ModelRate rate, std::uint32_t steps) {
+  if (rate == ModelRate::kEveryStep) return {true, true};
+  const bool model = (steps & 1u) == 0;
+  return {model, !model};
+}
 
 /// What one step produced (for logging, supervision and tests).
 template <class S>
@@ -60,6 +82,11 @@ void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<
   st.R_ref = st.data.R[kDof];
   st.obs.x_hat << st.data.o[kDof], Vec3<S>::Zero();
   st.obs.y.setZero();
+  st.psi.c_yy.setZero();
+  st.psi.jdot_yy.setZero();
+  st.psi.c_yz.setZero();
+  st.psi.jdot_yz.setZero();
+  st.steps = 0;
 }
 }  // namespace detail
 
@@ -89,16 +116,18 @@ struct ForceCommand {
 
 /// The force command (32) with w_e (35), the tracking error (36) and the observed filtered
 /// tracking error (34), at the measured x and the observed velocity x^dot, with the estimated joint
-/// friction tau_f^ (30).
+/// friction tau_f^ (30). Psi's terms are computed into `psi` on the steps whose turn it is (`velocity`,
+/// dynamics_turn), and those of the step before used otherwise.
 template <class S>
 ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Data<S>& data, const OpSpace<S>& os,
-                              const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& tau_f_hat) {
+                              const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& tau_f_hat,
+                              PsiTerms<S>& psi, bool velocity) {
   ForceCommand<S> c;
   c.e = d.x - os.x;  // (36)
   const Vec6<S> v = d.xd + G.ks.cwiseProduct(c.e);
   const Vec6<S> eta_p = v - ob.xd_hat;  // (34)
   // Psi(x, x^dot) x^dot and Psi(x, x^dot) v in their joint-space parts, from one pass (q^dot = J^{-1} x^dot).
-  const PsiTerms<S> psi = psi_terms(model, data, os, ob.qd_hat, v);
+  if (velocity) psi = psi_terms(model, data, os, ob.qd_hat, v);
   // (35): w_e = Lambda a_r + Psi(x, x^dot) v + p + f^, a_r = x_d ddot + k_s (x_d dot - x^dot). Each term
   // is an operational_force, so their sum is one: J^{-T}[A J^{-1}(a_r - Jdot_a(q^dot, q_v)) + B(q, q^dot) q_v
   // + g + tau_f^], with f^ = J^{-T} tau_f^ (31).
@@ -136,7 +165,8 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
     return step_stopped(out, kFaultNonFinite);
   }
   OpSpace<S>& os = st.os;
-  opspace_update(model, st.data, os, q, st.R_ref);
+  const DynamicsTurn turn = dynamics_turn(G.model_rate, st.steps++);
+  opspace_update(model, st.data, os, q, st.R_ref, turn.model);
   out.rcond = os.Jf.rcond;
   out.x = os.x;
   if (!(os.Jf.rcond >= G.min_rcond)) {
@@ -151,7 +181,7 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
   // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
   const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
   const Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
-  const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat);
+  const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat, st.psi, turn.velocity);
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);
   if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat) ||

@@ -42,6 +42,19 @@ constexpr bool adaptation_law_from_name(std::string_view name, AdaptationLaw& la
   return false;
 }
 
+/// How often the control step refreshes the arm's dynamics model (controller.hpp, dynamics_turn). The kinematics
+/// (x, J and its factors), the observer, the controller and the adaptation run every step either way.
+enum class ModelRate : std::uint8_t {
+  kEveryStep,  ///< A(q), its factors, g(q) and Psi's velocity products every step (the paper's sampled law)
+  kAlternate,  ///< A(q), its factors and g(q) on one step, Psi's velocity products on the next, each held for the
+               ///< step between: the dynamics at half the rate, each term at most one period old
+};
+/// The default rate (Gains::paper()): alternate, the firmware's tick budget (docs/benchmarks.md).
+constexpr ModelRate kDefaultModelRate = ModelRate::kAlternate;
+/// Names of the rates, in enum order (command lines, logs).
+constexpr const char* kModelRateNames[] = {"every_step", "alternate"};
+constexpr int kModelRateCount = sizeof(kModelRateNames) / sizeof(kModelRateNames[0]);
+
 namespace detail {
 /// A gain's paper value in the scalar of its field: a list of params.hpp, a number (every element of
 /// a vector gets it), or a value of the field's own type (an enum, the trajectory).
@@ -118,25 +131,26 @@ constexpr GainParam none() { return {"", GainForm::kNone, 0, 0, ""}; }
 // X(type, name, paper value, meaning, parameter): the controller's parameters, each declared once;
 // the struct, Gains::paper(), Gains::cast() and kGainInfo are made from this list, and the host
 // experiment's controller.<key> entries (host_sim/config.cpp) from its parameter column.
-#define OSC_GAINS_FIELDS(X)                                                                                        \
-  X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz",                             \
-    gain_param::per_axis("knd", osc::params::kKndRange[0], osc::params::kKndRange[1]))                             \
-  X(Vec6<S>, k, params::kK, "observer gain k of (69)",                                                             \
-    gain_param::per_axis("k", osc::params::kKRange[0], osc::params::kKRange[1]))                                   \
-  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)",                                                       \
-    gain_param::per_axis("ks", osc::params::kKsRange[0], osc::params::kKsRange[1]))                                \
-  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)",                                                       \
-    gain_param::per_axis("ki", osc::params::kKiRange[0], osc::params::kKiRange[1]))                                \
-  X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad", gain_param::one("k_ad", 0, 1e5))        \
-  X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay tau_dec of model (2), every joint",        \
-    gain_param::every("tau_dec", 0.01, 100, "s^2/rad^2"))                                                          \
-  X(S, dt, params::kDt, "the sample time [s]", gain_param::none())                                                 \
-  X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition", gain_param::none()) \
-  X(AdaptationLaw, adaptation, kDefaultAdaptationLaw, "the friction adaptation law", gain_param::none())           \
-  X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)",                \
-    gain_param::none())                                                                                            \
-  X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law",                                     \
-    gain_param::one("leakage", 0, 1, "1/s"))                                                                       \
+#define OSC_GAINS_FIELDS(X)                                                                                          \
+  X(Vec6<S>, knd, params::kKnd, "observer gain k_nd of (69), per axis x y z rx ry rz",                               \
+    gain_param::per_axis("knd", osc::params::kKndRange[0], osc::params::kKndRange[1]))                               \
+  X(Vec6<S>, k, params::kK, "observer gain k of (69)",                                                               \
+    gain_param::per_axis("k", osc::params::kKRange[0], osc::params::kKRange[1]))                                     \
+  X(Vec6<S>, ks, params::kKs, "controller gain k_s of (69)",                                                         \
+    gain_param::per_axis("ks", osc::params::kKsRange[0], osc::params::kKsRange[1]))                                  \
+  X(Vec6<S>, ki, params::kKi, "controller gain k_i of (69)",                                                         \
+    gain_param::per_axis("ki", osc::params::kKiRange[0], osc::params::kKiRange[1]))                                  \
+  X(S, kad, params::kKad, "adaptation gain: every diagonal entry of K_ad", gain_param::one("k_ad", 0, 1e5))          \
+  X(Vec6<S>, tau_dec, params::kTauDec, "the controller's Stribeck decay tau_dec of model (2), every joint",          \
+    gain_param::every("tau_dec", 0.01, 100, "s^2/rad^2"))                                                            \
+  X(S, dt, params::kDt, "the sample time [s]", gain_param::none())                                                   \
+  X(S, min_rcond, params::kMinJacobianRcond, "the Jacobian test's least reciprocal condition", gain_param::none())   \
+  X(AdaptationLaw, adaptation, kDefaultAdaptationLaw, "the friction adaptation law", gain_param::none())             \
+  X(ModelRate, model_rate, kDefaultModelRate, "how often the step refreshes the dynamics model", gain_param::none()) \
+  X(Vec18<S>, theta_max, params::kThetaMax, "projection bounds of the robust law (lower bounds 0)",                  \
+    gain_param::none())                                                                                              \
+  X(S, leakage, params::kAdaptationLeakage, "leakage sigma of the robust law",                                       \
+    gain_param::one("leakage", 0, 1, "1/s"))                                                                         \
   X(TrajectorySpec<S>, trajectory, TrajectorySpec<S>::paper(), "the task (68)", gain_param::none())
 
 /// Each parameter's name, meaning and parameter facts, in the list's order.

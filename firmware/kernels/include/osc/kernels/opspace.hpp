@@ -147,16 +147,20 @@ struct OpSpace {
   Vec6<S> g;                           // joint gravity torques
 };
 
-/// Computes kinematics, A(q), g(q), Ja, its factorisation and the L D L^T factors of A at q.
+/// Computes kinematics, Ja and its factorisation at q and, with `dynamics` (the default), A(q), its L D L^T
+/// factors and g(q); without, data.A, os.A_ldlt and os.g keep the values of the last update that computed them
+/// (the control step's alternate model rate, osc/control/controller.hpp).
 template <class S>
-void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q, const Mat3<S>& R_ref) {
+void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q, const Mat3<S>& R_ref,
+                    bool dynamics = true) {
   forward_kinematics(model, data, q);
   geometric_jacobian(data);
-  joint_inertia(model, data);
   os.x = operational_coordinates(data, R_ref);
   os.E = phi_rate(Vec3<S>(os.x.template tail<3>()));
   os.Ja = analytic_jacobian(data.J, os.E);
   os.Jf.compute(os.Ja);
+  if (!dynamics) return;
+  joint_inertia(model, data);
   os.A_ldlt.compute(data.A);
   os.g = gravity_torques(model, data);
 }
