@@ -405,8 +405,8 @@ TEST(ModelRate, TurnsAlternateFromTheFirstStepWhichComputesTheModel) {
 }
 
 // Two controllers, one at each rate, given the same measured angles (a joint-space ramp about the start pose) and
-// the paper's motion. The first step is the same to the last bit but for rounding (the observer starts at rest:
-// every velocity product is 0, which the alternate controller holds). After it, each step's held terms are those
+// the paper's motion. The first step, at the pose they started at, is the same but for rounding (the observer
+// starts at rest: every velocity product is 0, which the alternate controller holds). After it, each step's held terms are those
 // the other computes one step earlier: A and g of the previous angles, Psi of the previous velocity.
 TEST(ModelRate, AlternateHoldsEachTermOneStepAndTracksTheEveryStepController) {
   const Model<double> model = Model<double>::of(robot::kArm);
@@ -424,7 +424,7 @@ TEST(ModelRate, AlternateHoldsEachTermOneStepAndTracksTheEveryStepController) {
   PsiTerms<double> psi_prev{};
   double worst = 0, scale = 0;
   for (int k = 0; k < 400; ++k) {
-    q += rate * 1e-3;
+    if (k > 0) q += rate * 1e-3;  // the first step at the pose the controllers started at
     const Desired<double> d = paper.at_tick(static_cast<std::uint64_t>(k), 1000);
     const StepOutput<double> oe = control_step(model, Ge, FrictionMode::kAdaptive, *se, q, d);
     const StepOutput<double> oa = control_step(model, Ga, FrictionMode::kAdaptive, *sa, q, d);

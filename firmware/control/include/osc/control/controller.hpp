@@ -51,8 +51,9 @@ struct DynamicsTurn {
 /// Every step computes both (ModelRate::kEveryStep), or they alternate (kAlternate): the model on a
 /// controller's first step and every other one after it, the velocity products on the steps between. A step
 /// then solves with the A and g of the step before, or adds the Psi terms of the step before, each one period
-/// (params::kDt) old. The first step needs no Psi of its own: the observer starts at rest (y = 0, x~ = 0), so
-/// q^dot = 0 and every velocity product is 0, as controller_init and controller_restart set them.
+/// (params::kDt) old. The first step needs no Psi of its own: the observer starts at rest at the pose it is
+/// started at (y = 0, x~ = 0), so q^dot = 0 there and every velocity product is 0, as controller_init and
+/// controller_restart set them (a count away from that pose, q^dot = J^-1 k x~ and the products are of its square).
 inline DynamicsTurn dynamics_turn(ModelRate rate, std::uint32_t steps) {
   if (rate == ModelRate::kEveryStep) return {true, true};
   const bool model = (steps & 1u) == 0;
