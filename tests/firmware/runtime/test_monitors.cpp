@@ -348,7 +348,7 @@ struct ResidualRig {
     const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
     Vec6<S> decay = Vec6<S>::Ones();
     const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr, proven};
-    const std::uint32_t f = m.check(in, io, counts, moved, tick);
+    const std::uint32_t f = m.check(in, io, counts, moved, tick, tick % params::kResidualTurnEvery == 0);
     m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
     if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);
     ++tick;
@@ -665,7 +665,7 @@ TYPED_TEST(Monitors, TravelCheckCatchesAnEncoderThatStandsUnderATorqueBeyondStat
     // ... and up to two steps of the check more: the step in which the push arrives takes the least
     // torque of its ticks, the one before the push (TravelCheckTakesTheLeastTorqueOfItsStep), which
     // shifts the travel a step later, and the crossing shows at the next turn.
-    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2 + 2 * params::kResidualTravelEvery)
+    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2 + 2 * params::kResidualTurnEvery)
         << "J" << j + 1 << " (" << slowest << " ticks)";
     EXPECT_EQ(rig.m.joint, j);
   }
@@ -692,7 +692,7 @@ TYPED_TEST(Monitors, TravelCheckLeavesAJointThatStaticFrictionHolds) {
 // A joint that hunts about rest under the friction compensation's sign term: the torque commanded
 // alternates tick by tick between beyond the static band (twice it, which held for the check's
 // step would be a fault: TravelCheckCatches... above) and as far the other way, its mean 0. The
-// check's step lasts kResidualTravelEvery ticks and takes the least torque of them, whichever tick
+// check's step lasts kResidualTurnEvery ticks and takes the least torque of them, whichever tick
 // it falls on; it took only its last before, and with the wrong parity the pushes that way alone
 // (found on the realistic plant: J4 in Q12.19 at exactly its limit, docs/experiment.md).
 TYPED_TEST(Monitors, TravelCheckTakesTheLeastTorqueOfItsStep) {
@@ -738,7 +738,7 @@ TYPED_TEST(Monitors, TravelCheckCatchesAJointThatReversesUnderATorqueBeyondStati
     const int n = travel_ticks(rig, j, -push, 400, kind);
     EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultEncoderStuck)) << "J" << j + 1;
     EXPECT_GE(n, static_cast<int>(fastest)) << "J" << j + 1;
-    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2 + 2 * params::kResidualTravelEvery)
+    EXPECT_LE(n, static_cast<int>(1.5 * slowest) + 2 + 2 * params::kResidualTurnEvery)
         << "J" << j + 1 << " (" << slowest << " ticks)";
     EXPECT_EQ(rig.m.joint, j);
   }

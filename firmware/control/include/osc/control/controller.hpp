@@ -48,6 +48,13 @@ struct DynamicsTurn {
   bool velocity;  // Psi's velocity products (psi_terms, force_command)
 };
 
+/// Whether the controller's last step was one of its even steps (its first, third, ...): the alternate model
+/// rate's model turns, and the residual monitor's turns (params::kResidualTurnEvery), whatever the rate.
+template <class S>
+bool even_step(const ControllerState<S>& st) {
+  return (st.steps & 1u) == 1u;
+}
+
 /// Every step computes both (ModelRate::kEveryStep), or they alternate (kAlternate): the model on a
 /// controller's first step and every other one after it, the velocity products on the steps between. A step
 /// then solves with the A and g of the step before, or adds the Psi terms of the step before, each one period

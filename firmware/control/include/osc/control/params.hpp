@@ -144,13 +144,18 @@ constexpr bool kResidualMonitorArmed = true;
 /// exceeds this many counts must have counted: its encoder (or something holding the joint) is at
 /// fault. One count is the geometry (the next edge, or the last one back); the second is margin.
 constexpr double kResidualTravelCounts = 2;
-/// ... its bounds advanced every this many ticks, each joint in turn (the M4F's tick budget; the
-/// count that restarts them is taken in its tick).
-constexpr int kResidualTravelEvery = 2;
+/// The residual monitor's turn: every this many control steps (the controller's even steps, on which the
+/// alternate model rate computes A and g, not Psi: osc/control/controller.hpp, even_step), it updates each joint's
+/// bound, change channel and thresholds and advances the travel check's bounds, on the inputs' means over the
+/// turn where they alternate tick by tick (the applied torque, r). The residual, its qualification against the
+/// thresholds and the travel check's counts and drive run every tick. The M4F's and the M3's tick budgets
+/// (docs/benchmarks.md); the detection times it gives are docs/safety.md's.
+constexpr int kResidualTurnEvery = 2;
 /// Friction identified from the residual (the `momentum` law, osc/control/identification.hpp;
 /// docs/adaptation.md, "Identification from the residual"):
-/// - each joint's Kalman update comes every kIdentifyEvery ticks, the joints in turn (the filtered
-///   samples are correlated over 1/kResidualGain = 20-50 ms: a sample every 6 ms loses little);
+/// - each joint's Kalman update comes every kIdentifyEvery ticks, the joints in turn, one sample a turn of the
+///   residual monitor (kResidualTurnEvery: 6 joints, 12 ticks; the filtered samples are correlated over
+///   1/kResidualGain = 20-50 ms: a sample every 12 ms loses little);
 /// - a joint's sample counts once it has moved, encoder counting, for kIdentifySettle of the
 ///   residual filter's time constants (the filter then holds no standstill, where friction is not
 ///   the model's W theta), and only at speeds of kIdentifyMinSpeed times its velocity noise or more;
@@ -158,7 +163,7 @@ constexpr int kResidualTravelEvery = 2;
 ///   friction), and its innovation within kIdentifyGate standard deviations;
 /// - the coefficients drift: a random walk of kIdentifyDrift times the band's top per hour (the
 ///   band's own +-30 % with temperature, robot::kModelErrorBounds).
-constexpr int kIdentifyEvery = 6;
+constexpr int kIdentifyEvery = 6 * kResidualTurnEvery;
 constexpr double kIdentifyMinSpeed = 4;
 constexpr double kIdentifySettle = 3;
 constexpr double kIdentifyMaxRatio = 0.5;

@@ -78,11 +78,16 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             adaptive ? &ad.theta_hat : nullptr,
                             identify ? &ad.identifier.proven : nullptr,
                             &task.state.data.J};
-  task.residual.sample_joint = identify ? momentum_turn(task.state.adapt) : -1;
+  // The residual monitor's turn: the controller's even steps, whose model turn leaves the time for it.
+  const bool turn = even_step(task.state);
+  task.residual.sample_joint = identify && turn ? momentum_turn(task.state.adapt) : -1;
   task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
-  faults |= task.residual.check(in, task.io, counts, moved, task.tick);
-  // The momentum law's stage of the control law, on the sample the residual monitor just took.
-  if (identify) adaptation_identify(task.gains, task.state.adapt, momentum_sample(task.residual));
+  faults |= task.residual.check(in, task.io, counts, moved, task.tick, turn);
+  // The momentum law's stage of the control law, on the sample the residual monitor's last turn took, in the
+  // step after it (the one that computes Psi, not the thresholds).
+  if (identify && task.momentum.joint >= 0) adaptation_identify(task.gains, task.state.adapt, task.momentum);
+  task.momentum.joint = -1;
+  if (identify && turn) task.momentum = momentum_sample(task.residual);
   faults |= TrackingMonitor<S>::check(out.e);
   if (task.mode == FrictionMode::kAdaptive)
     faults |= ThetaBandMonitor<S>::check_part(task.state.adapt.theta_hat, task.gains.theta_max,

@@ -27,13 +27,16 @@ struct ResidualConstants {
   S armature_delta[kDof];  // |J_m(alternative set) - J_m(model)| G^2 [kg m^2]
   S offset[kDof];          // an amplifier's offset bound [N m]
   S gain[kDof];            // the residual's filter gain K [1/s]
-  S gain_dt[kDof];         // K dt
   S keep[kDof];            // 1 - K dt: what the filter keeps of its last value
   S quantum_gain[kDof];    // 2 K: the velocity noise's bound through A and the filter, per rad/s [1/s]
   S lag_gain[kDof];        // T K: the current loop's lag T times K
-  S peak_margin[kDof];     // params::kResidualMargin times the joint's peak factor
+  // The same filters over a turn of params::kResidualTurnEvery ticks (the bound, the accelerations, the change
+  // channel's regressors).
+  S turn_gain_dt[kDof];  // K dt kResidualTurnEvery
+  S turn_keep[kDof];     // 1 - K dt kResidualTurnEvery
+  S peak_margin[kDof];   // params::kResidualMargin times the joint's peak factor
   S link_inertia, gain_ripple, amp_gain, ripple;
-  S slow_dt;  // params::kResidualSlowGain dt
+  S slow_dt;  // params::kResidualSlowGain dt kResidualTurnEvery: the slow filter, a turn at a time
   S margin;   // params::kResidualMargin
   constexpr ResidualConstants()
       : vis_mid{},
@@ -50,10 +53,11 @@ struct ResidualConstants {
         armature_delta{},
         offset{},
         gain{},
-        gain_dt{},
         keep{},
         quantum_gain{},
         lag_gain{},
+        turn_gain_dt{},
+        turn_keep{},
         peak_margin{},
         link_inertia{},
         gain_ripple{},
@@ -62,6 +66,7 @@ struct ResidualConstants {
         slow_dt{},
         margin{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
+    constexpr double kTurnDt = params::kResidualTurnEvery * params::kDt;
     const FrictionCoefficients &lo = b.friction_lo, &hi = b.friction_hi;
     for (int i = 0; i < kDof; ++i) {
       vis_mid[i] = lit<S>(0.5 * (lo.vis[i] + hi.vis[i])), vis_half[i] = lit<S>(0.5 * (hi.vis[i] - lo.vis[i]));
@@ -77,17 +82,18 @@ struct ResidualConstants {
       offset[i] = lit<S>(b.amp_offset * robot::kDrives.torque_limit[i]);
       const double K = params::kResidualGain[i];
       gain[i] = lit<S>(K);
-      gain_dt[i] = lit<S>(K * params::kDt);
       keep[i] = lit<S>(1 - K * params::kDt);
       quantum_gain[i] = lit<S>(2 * K);
       lag_gain[i] = lit<S>(b.amp_lag * K);
+      turn_gain_dt[i] = lit<S>(K * kTurnDt);
+      turn_keep[i] = lit<S>(1 - K * kTurnDt);
       peak_margin[i] = lit<S>(params::kResidualMargin * params::kResidualPeakFactor[i]);
     }
     link_inertia = lit<S>(b.link_inertia);
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
     amp_gain = lit<S>(b.amp_gain);
     ripple = lit<S>(b.ripple);
-    slow_dt = lit<S>(params::kResidualSlowGain * params::kDt);
+    slow_dt = lit<S>(params::kResidualSlowGain * kTurnDt);
     margin = lit<S>(params::kResidualMargin);
   }
 };

@@ -27,9 +27,10 @@ namespace osc {
 /// model's error, and each joint's threshold bounds it from the arm's stated error bounds
 /// (robot::kModelErrorBounds): friction (a still joint: anywhere in its static band; a moving one:
 /// the band's distance from theta^), link inertia, motor inertia, the amplifiers, and the encoder
-/// quantum through the velocity estimate (docs/safety.md derives each term). A residual beyond its
-/// threshold for params::kResidualQualifyTicks ticks in a row is a fault, isolated by joint and
-/// kind:
+/// quantum through the velocity estimate (docs/safety.md derives each term). r is updated every tick, the
+/// thresholds on the monitor's turns (every params::kResidualTurnEvery ticks: turn_pass()) and held between. A
+/// residual beyond its threshold for params::kResidualQualifyTicks ticks in a row is a fault, isolated by joint
+/// and kind:
 ///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for
 ///    more than params::kStuckIntervals of its recent intervals between counts);
 ///  - drive_fault: the residual is on this drive alone (every other joint below half its threshold);
@@ -62,6 +63,9 @@ struct ResidualMonitor {
   Vec6<S> reg_slow[kRegressors];         // ... then slowly
   Vec6<S> stillness;                     // 1 while a joint does not move, then decaying at the slow rate
   Vec6<S> qd_prev, bias_prev, tau_prev;  // the previous step's q^dot and n, the torque applied since
+  Vec6<S> qd_turn;                       // q^dot at the last turn (check())
+  Vec6<S> r_last, tau_last;              // r of the step before, the torque applied the period before tau_prev's
+  Vec6<S> travel_error;                  // the travel check's bound on the model's error, from the last turn [N m]
   Vec6<S> velocity_noise;                // the velocity estimate's quantisation noise per joint [rad/s] (wrist_noise())
   Vec6<S> noise_base;  // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
   S wrist_mix;         // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
@@ -92,8 +96,8 @@ struct ResidualMonitor {
   /// The travel check (travel()), one way: per joint, lower bounds on its speed and on its travel
   /// that way since its encoder's last count [rad/s, rad], and the least drive that way over the ticks
   /// of the check's current step [N m] (the torque may alternate tick by tick, the friction
-  /// compensation's sign term at a joint that hunts about rest, and the step holds for
-  /// kResidualTravelEvery ticks, not only its last).
+  /// compensation's sign term at a joint that hunts about rest, and the step holds for a turn,
+  /// params::kResidualTurnEvery ticks, not only its last).
   struct Way {
     Vec6<S> v, p, drive;
   };
@@ -150,6 +154,9 @@ struct ResidualMonitor {
     prime_change();
     change_threshold.setZero();
     tau_prev.setZero();
+    tau_last.setZero();
+    r_last.setZero();
+    travel_error.setZero();
     peak_ratio.setZero();
     travel_peak.setZero();
     ahead.drive.setConstant(kNoDrive);
@@ -207,62 +214,64 @@ struct ResidualMonitor {
   /// The next step starts afresh (a tick without a step: the torque was off).
   void unprime() { primed = false; }
   /// The joint torque that reached the arm over the period that follows this tick.
-  void applied(const Vec6<S>& tau) { tau_prev = tau; }
+  void applied(const Vec6<S>& tau) {
+    tau_last = tau_prev;
+    tau_prev = tau;
+  }
 
-  /// The residual of this step and its faults (see the type's comment), a step every params::kDt.
-  /// The joints' accelerations and A's rows against them first (each joint's thresholds read every
-  /// joint's), then one pass per joint: its friction, bound, filters, change channel and thresholds.
+  /// The residual of this step and its faults (see the type's comment), a step every params::kDt. `turn`: the
+  /// step is one of the monitor's turns (params::kResidualTurnEvery; the controller's even steps), on which each
+  /// joint's bound, change channel and thresholds are updated and the travel check advances (turn_pass()); the
+  /// residual, its qualification against the thresholds and the travel check's counts run every step. The
+  /// monitor primes on a turn: a step between waits for the next.
   std::uint32_t check(const ResidualInput<S>& in, const IoMap<S>& io, const std::int32_t counts[kDof],
-                      const bool moved[kDof], std::uint64_t tick) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
+                      const bool moved[kDof], std::uint64_t tick, bool turn) {
     activity.track(counts, moved, tick);
     sample.settled = false;
     if (contact != contact_noted) note_contact();
-    if (in.J) wrist_noise(*in.J);
     const bool prime = !primed;  // the first step after a reset: no previous step to difference
     if (prime) {
-      qd_prev = in.qd;
+      if (!turn) return 0;
+      qd_prev = qd_turn = in.qd;
       bias_prev = in.bias;
       r.setZero();
       acc.setZero();
       prime_change();
+    } else {
+      update_residual(in);
     }
-    const Motion m = motion(in);
-    const StrongestFriction strongest(in);
-    int worst = -1, moved_too_far = -1;
-    S worst_ratio = S(0);
-    for (int i = 0; i < kDof; ++i) {
-      const Friction f = strongest(i);
-      const FrictionError e = friction_error(in, f, i, tick, m.moving_speed[i]);
-      const Torques t = torques(in, i);
-      const S model = model_error(in, t, i);
-      const S b = pointwise_bound(in, e, i, model);
-      Changes ch{};
-      if (prime) {
-        bound(i) = b;
-      } else {
-        static constexpr S kDt = lit<S>(params::kDt);
-        r(i) = math::mul_add(c.gain[i], math::mul_add(kDt, bias_prev(i) - tau_prev(i), m.u[i]), c.keep[i] * r(i));
-        low_pass(bound(i), b, c.gain_dt[i]);
-        if (i == sample_joint) take_sample(i, e);
-        ch = update_change(in, e, t, i);
-      }
-      const S loop = update_thresholds(e, ch, m, i);
-      if (travel(in, m, f, i, model, loop, moved[i], prime || contact, tick)) moved_too_far = i;
-      qd_prev(i) = in.qd(i);
-      bias_prev(i) = in.bias(i);
-      if (prime) {
-        over[i] = 0;
-        continue;
-      }
-      qualify_joint(i, tick, worst, worst_ratio);
-    }
+    int moved_too_far = turn ? turn_pass(in, moved, prime, tick) : between_turns(in, moved);
+    qd_prev = in.qd;
+    bias_prev = in.bias;
     if (prime) {
+      for (int i = 0; i < kDof; ++i) over[i] = 0;
       primed = true;
       return 0;
     }
+    d = r - r_slow;
+    int worst = -1;
+    S worst_ratio = S(0);
+    for (int i = 0; i < kDof; ++i) qualify_joint(i, tick, worst, worst_ratio);
     return decide(worst, moved_too_far, io, tick);
   }
+
+  /// r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})], every joint; the
+  /// last step's r kept (r_last: the change channel's mean over a turn).
+  void update_residual(const ResidualInput<S>& in) {
+    const ResidualConstants<S>& c = kResidualConstants<S>;
+    static constexpr S kDt = lit<S>(params::kDt);
+    S dqd[kDof];
+    for (int j = 0; j < kDof; ++j) dqd[j] = in.qd(j) - qd_prev(j);
+    for (int i = 0; i < kDof; ++i) {
+      S u = S(0);  // A's row i against q^dot's change
+      for (int j = 0; j < kDof; ++j) u = math::mul_add(in.A(i, j), dqd[j], u);
+      r_last(i) = r(i);
+      r(i) = math::mul_add(c.gain[i], math::mul_add(kDt, bias_prev(i) - tau_prev(i), u), c.keep[i] * r(i));
+    }
+  }
+
+  int turn_pass(const ResidualInput<S>& in, const bool moved[kDof], bool prime, std::uint64_t tick);
+  int between_turns(const ResidualInput<S>& in, const bool moved[kDof]);
 
   /// Joint i's residual against its thresholds after a step: its peak ratio, its run over them, and
   /// whether it is the worst joint so far that has been over them long enough (worst, worst_ratio).
@@ -303,38 +312,15 @@ struct ResidualMonitor {
   }
 
  private:
-  /// This step's joint motion and A's rows against it: per joint, the speed beyond which it may
-  /// count as moving (its noise, and its lag at the acceleration filtered before this step), the
-  /// filtered acceleration's size and change, the residual's inertial input (A times q^dot's
-  /// change), and |A| times the accelerations, their changes and the velocity noise.
+  /// A turn's joint motion and A's rows against it: per joint, the speed beyond which it may count as moving
+  /// (its noise, and its lag at the acceleration filtered before this turn), the filtered acceleration's size
+  /// and change (q^dot's change over the turn, filtered as r), and |A| times the accelerations, their changes
+  /// and the velocity noise.
   struct Motion {
     S moving_speed[kDof], a[kDof], da[kDof];
-    S u[kDof], inertia[kDof], inertia_change[kDof], noise[kDof];
+    S inertia[kDof], inertia_change[kDof], noise[kDof];
   };
-  Motion motion(const ResidualInput<S>& in) {
-    const ResidualConstants<S>& c = kResidualConstants<S>;
-    Motion m;
-    S dqd[kDof];
-    for (int j = 0; j < kDof; ++j) {
-      m.moving_speed[j] = math::mul_add(lag, math::abs(acc(j)), velocity_noise(j));
-      dqd[j] = in.qd(j) - qd_prev(j);
-      acc(j) = math::mul_add(c.gain[j], dqd[j], c.keep[j] * acc(j));
-      low_pass(acc_slow(j), acc(j), c.slow_dt);
-      m.a[j] = math::abs(acc(j));
-      m.da[j] = math::abs(acc(j) - acc_slow(j));
-      m.u[j] = m.inertia[j] = m.inertia_change[j] = m.noise[j] = S(0);
-    }
-    // Column by column: each of A's coefficients is read once.
-    for (int j = 0; j < kDof; ++j)
-      for (int i = 0; i < kDof; ++i) {
-        const S aij = in.A(i, j), mag = math::abs(aij);
-        m.u[i] = math::mul_add(aij, dqd[j], m.u[i]);
-        m.inertia[i] = math::mul_add(mag, m.a[j], m.inertia[i]);
-        m.inertia_change[i] = math::mul_add(mag, m.da[j], m.inertia_change[i]);
-        m.noise[i] = math::mul_add(mag, velocity_noise(j), m.noise[i]);
-      }
-    return m;
-  }
+  Motion motion(const ResidualInput<S>& in);
   /// y filtered toward x at the gain g (K dt): y + g (x - y), one rounding.
   static void low_pass(S& y, S x, S g) { y = math::mul_add(g, x - y, y); }
   /// A joint's regressor changes (their filtered values less their slow parts), signed.
@@ -348,8 +334,8 @@ struct ResidualMonitor {
     for (int k = 0; k < kRegressors; ++k) reg[k].setZero(), reg_slow[k].setZero();
     stillness.setOnes();  // until each joint is seen moving, its static friction may change at any time
   }
-  /// Joint i's friction sample: r is this tick's, the filtered regressors still the last tick's, as
-  /// the friction in r is the last period's (n_{k-1}). Settled: moving, its encoder counting, since
+  /// Joint i's friction sample, on a turn: r is this tick's, the filtered regressors still the last turn's, as
+  /// the friction in r is of the periods before (n_{k-1}). Settled: moving, its encoder counting, since
   /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
   /// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
   /// noise is a share of the viscous column, and its errors in the variables a bias): its own row's,
@@ -364,13 +350,14 @@ struct ResidualMonitor {
     static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
     sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * noise_base(i);
   }
-  /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt)^ticks.
+  /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt kTurn)^turns.
   static constexpr std::array<S, kDof> settled_stillness() {
     std::array<S, kDof> s{};
+    constexpr double kTurnDt = params::kResidualTurnEvery * params::kDt;
     for (int i = 0; i < kDof; ++i) {
-      const double ticks = params::kIdentifySettle * params::kControlHz / params::kResidualGain[i];
+      const double turns = params::kIdentifySettle / (params::kResidualGain[i] * kTurnDt);
       double v = 1;
-      for (int t = 0; t < ticks; ++t) v *= 1 - params::kResidualSlowGain * params::kDt;
+      for (int t = 0; t < turns; ++t) v *= 1 - params::kResidualSlowGain * kTurnDt;
       s[i] = lit<S>(v);
     }
     return s;
@@ -397,13 +384,14 @@ struct ResidualMonitor {
           breakaway(in.proven ? in.proven->breakaway.data() : kResidualConstants<S>.static_band) {}
     Friction operator()(int i) const { return Friction{vis[i], breakaway[i]}; }
   };
-  /// Joint i's Coriolis torque c = n - g - tau_f^ and the applied torque's size |tau|, which the
-  /// bound and the change channel both take: computed once a joint.
+  /// Joint i's Coriolis torque c = n - g - tau_f^ and the applied torque's size |tau| (the larger of the turn's
+  /// two periods), which the bound and the change channel both take: computed once a joint.
   struct Torques {
     S coriolis, size;
   };
   Torques torques(const ResidualInput<S>& in, int i) const {
-    return Torques{in.bias(i) - in.g(i) - in.tau_f(i), math::abs(tau_prev(i))};
+    const S now = math::abs(tau_prev(i)), before = math::abs(tau_last(i));
+    return Torques{in.bias(i) - in.g(i) - in.tau_f(i), now > before ? now : before};
   }
   // Per joint: the friction error, the bound, the model error, the change channel and the thresholds
   // (osc/runtime/residual_thresholds.hpp).
@@ -414,8 +402,8 @@ struct ResidualMonitor {
   Changes update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t, int i);
   S update_thresholds(const FrictionError& e, const Changes& ch, const Motion& m, int i);
   // The travel check (osc/runtime/residual_travel.hpp).
-  bool travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model, S loop, bool count,
-              bool restart, std::uint64_t tick);
+  S motion_error(const ResidualInput<S>& in, const Motion& m, int i, S model, S loop) const;
+  bool travel(const ResidualInput<S>& in, const Friction& f, int i, bool count, bool restart, bool turn);
   void count_bounds(int i, S change);
   S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
   std::uint32_t classify_travel(int i) const;

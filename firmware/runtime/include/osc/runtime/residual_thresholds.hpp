@@ -1,7 +1,7 @@
-// The residual monitor's per-joint bound and thresholds (ResidualMonitor, osc/runtime/residual_monitor.hpp,
-// which includes this header at its end; docs/safety.md derives each term): the friction's error against
-// the band, the pointwise bound of the model's error filtered as r, the change channel's regressors and
-// the two channels' thresholds.
+// The residual monitor's turn and per-joint bound and thresholds (ResidualMonitor, osc/runtime/residual_monitor.hpp,
+// which includes this header at its end; docs/safety.md derives each term): on each turn (params::kResidualTurnEvery
+// steps), the motion over it, the friction's error against the band, the pointwise bound of the model's error
+// filtered as r, the change channel's regressors and the two channels' thresholds.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +9,73 @@
 #include "osc/runtime/residual_monitor.hpp"
 
 namespace osc {
+
+/// A turn: the accelerations over it and A's rows against them first (each joint's thresholds read every
+/// joint's), then one pass per joint: its friction, bound, change channel, thresholds and travel check.
+/// Returns the joint that moved too far (the travel check), or -1.
+template <class S>
+inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool moved[kDof], bool prime,
+                                         std::uint64_t tick) {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  if (in.J) wrist_noise(*in.J);
+  const Motion m = motion(in);
+  const StrongestFriction strongest(in);
+  int moved_too_far = -1;
+  for (int i = 0; i < kDof; ++i) {
+    const Friction f = strongest(i);
+    const FrictionError e = friction_error(in, f, i, tick, m.moving_speed[i]);
+    const Torques t = torques(in, i);
+    const S model = model_error(in, t, i);
+    const S b = pointwise_bound(in, e, i, model);
+    Changes ch{};
+    if (prime) {
+      bound(i) = b;
+    } else {
+      low_pass(bound(i), b, c.turn_gain_dt[i]);
+      if (i == sample_joint) take_sample(i, e);
+      ch = update_change(in, e, t, i);
+    }
+    const S loop = update_thresholds(e, ch, m, i);
+    travel_error(i) = motion_error(in, m, i, model, loop);
+    if (travel(in, f, i, moved[i], prime || contact, true)) moved_too_far = i;
+  }
+  return moved_too_far;
+}
+
+/// A step between turns: the travel check's counts and drive (its error bound the last turn's).
+template <class S>
+inline int ResidualMonitor<S>::between_turns(const ResidualInput<S>& in, const bool moved[kDof]) {
+  const StrongestFriction strongest(in);
+  int moved_too_far = -1;
+  for (int i = 0; i < kDof; ++i)
+    if (travel(in, strongest(i), i, moved[i], contact, false)) moved_too_far = i;
+  return moved_too_far;
+}
+
+/// A turn's joint motion (Motion).
+template <class S>
+inline auto ResidualMonitor<S>::motion(const ResidualInput<S>& in) -> Motion {
+  const ResidualConstants<S>& c = kResidualConstants<S>;
+  Motion m;
+  for (int j = 0; j < kDof; ++j) {
+    m.moving_speed[j] = math::mul_add(lag, math::abs(acc(j)), velocity_noise(j));
+    acc(j) = math::mul_add(c.gain[j], in.qd(j) - qd_turn(j), c.turn_keep[j] * acc(j));
+    low_pass(acc_slow(j), acc(j), c.slow_dt);
+    m.a[j] = math::abs(acc(j));
+    m.da[j] = math::abs(acc(j) - acc_slow(j));
+    m.inertia[j] = m.inertia_change[j] = m.noise[j] = S(0);
+  }
+  qd_turn = in.qd;
+  // Column by column: each of A's coefficients is read once.
+  for (int j = 0; j < kDof; ++j)
+    for (int i = 0; i < kDof; ++i) {
+      const S mag = math::abs(in.A(i, j));
+      m.inertia[i] = math::mul_add(mag, m.a[j], m.inertia[i]);
+      m.inertia_change[i] = math::mul_add(mag, m.da[j], m.inertia_change[i]);
+      m.noise[i] = math::mul_add(mag, velocity_noise(j), m.noise[i]);
+    }
+  return m;
+}
 
 /// Joint i's friction against the band (FrictionError), `f` at its strongest; `moving` is the speed
 /// beyond which the joint may count as moving (Motion::moving_speed).
@@ -68,7 +135,9 @@ inline S ResidualMonitor<S>::model_error(const ResidualInput<S>& in, const Torqu
                  mul_add(c.gain_ripple, t.size, error_floor(i)));
 }
 
-/// Joint i's change channel: each regressor of the model's error filtered as r, then slowly. A
+/// Joint i's change channel, a turn at a time: each regressor of the model's error filtered as r, then slowly,
+/// and r itself slowly (the torque and r as their means over the turn: their tick-by-tick alternation, a
+/// compensation's sign term at a joint that hunts about rest, would alias into a turn's samples). A
 /// model error sum_k delta_k phi_k with constant coefficients delta_k reaches r - r_slow as
 /// sum_k delta_k (phi_k filtered - its slow part): bounded by the same sum of |delta_k| times
 /// the regressors' changes. Static friction is no such sum: a joint that does not move may hold
@@ -78,7 +147,7 @@ template <class S>
 inline auto ResidualMonitor<S>::update_change(const ResidualInput<S>& in, const FrictionError& e, const Torques& t,
                                               int i) -> Changes {
   const ResidualConstants<S>& c = kResidualConstants<S>;
-  const S Ks = c.slow_dt, Kdt = c.gain_dt[i];
+  const S Ks = c.slow_dt, Kdt = c.turn_gain_dt[i], half = lit<S>(0.5);
   const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
   // Filtered as r, then slowly: the regressor's change.
   const auto band = [&](int k, S phi) {
@@ -93,10 +162,9 @@ inline auto ResidualMonitor<S>::update_change(const ResidualInput<S>& in, const 
   ch.estimate = band(kEstimate, in.tau_f(i));
   ch.gravity = band(kGravity, in.g(i));
   ch.coriolis = band(kCoriolis, t.coriolis);
-  ch.torque = band(kTorque, tau_prev(i));
-  low_pass(reg[kTorqueSize](i), t.size, Kdt);  // |tau|: its size alone
-  low_pass(r_slow(i), r(i), Ks);
-  d(i) = r(i) - r_slow(i);
+  ch.torque = band(kTorque, half * (tau_prev(i) + tau_last(i)));
+  low_pass(reg[kTorqueSize](i), t.size, Kdt);          // |tau|: its size alone
+  low_pass(r_slow(i), half * (r(i) + r_last(i)), Ks);  // d = r - r_slow: check(), every step
   stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
   return ch;
 }
@@ -111,8 +179,10 @@ inline S ResidualMonitor<S>::update_thresholds(const FrictionError& e, const Cha
   using math::mul_add;
   const S quantum = c.quantum_gain[i] * m.noise[i], margin_quantum = c.margin * quantum;
   noise_bound(i) = quantum;
-  // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered).
-  const S loop = c.lag_gain[i] * abs(tau_prev(i) - reg[kTorque](i));
+  // The current loop's lag T: its error T d(tau)/dt, filtered as r, is T K (tau - tau filtered), the larger of
+  // the turn's two periods.
+  const S now = abs(tau_prev(i) - reg[kTorque](i)), before = abs(tau_last(i) - reg[kTorque](i));
+  const S loop = c.lag_gain[i] * (now > before ? now : before);
   const S pointwise = mul_add(c.link_inertia, m.inertia[i], mul_add(c.armature_delta[i], m.a[i], bound(i) + loop));
   threshold(i) = mul_add(c.peak_margin[i], pointwise, margin_quantum);
   // The friction error (theta - theta^)^T w: the band's distances times the regressors'

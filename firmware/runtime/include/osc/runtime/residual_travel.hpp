@@ -10,25 +10,33 @@
 
 namespace osc {
 
+/// Joint i's bound on the model's error against its motion, a turn's (travel()): the other joints' inertial
+/// torques with the link inertia's share, model_error()'s and the current loop's lag (`model`, `loop`: those
+/// of update_thresholds()'s pass) [N m].
+template <class S>
+inline S ResidualMonitor<S>::motion_error(const ResidualInput<S>& in, const Motion& m, int i, S model, S loop) const {
+  const S others = m.inertia[i] - in.A(i, i) * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
+  return math::mul_add(kResidualConstants<S>.link_inertia, others, others) + model + loop;
+}
+
 /// Joint i's travel check: whether the joint must have counted, either way. At a count the joint
 /// has just crossed an edge in the direction `way` of the count. Counting steadily, it crossed the
 /// one before a count back, n ticks earlier: its mean speed that way since was at least the edges'
 /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now
 /// differs from that mean by at most the most it can have sped up or slowed down over them (after a reversal, the
 /// same edge twice: a mean of 0). These bound its speed ahead from below, and back from below as minus its speed
-/// ahead at most. Then, every params::kResidualTravelEvery ticks, each way (advance()): the torque applied that way
-/// less gravity and Coriolis torques (the least of the step's ticks), with every error the model may have against the
-/// motion (model_error(), the other joints' inertial torques with the link inertia's share, the current loop's lag)
-/// and friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
+/// ahead at most. Then, on each of the monitor's turns (`turn`, params::kResidualTurnEvery ticks), each way
+/// (advance()): the torque applied that way less gravity and Coriolis torques (the least of the turn's ticks),
+/// with every error the model may have against the motion (travel_error, the last turn's motion_error()) and
+/// friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the
 /// identification proves: `f`), over the diagonal inertia at its least or most, bounds its speed that way from
 /// below, and its travel. Its least travel beyond travel_limit crosses the next edge ahead or the last one back: the
 /// encoder should have counted. Before its first count (a prime, a contact) the direction is unknown and nothing is
-/// bounded. `model` and `loop`: model_error()'s and update_thresholds()' terms of this joint.
+/// bounded.
 template <class S>
-inline bool ResidualMonitor<S>::travel(const ResidualInput<S>& in, const Motion& m, const Friction& f, int i, S model,
-                                       S loop, bool count, bool restart, std::uint64_t tick) {
+inline bool ResidualMonitor<S>::travel(const ResidualInput<S>& in, const Friction& f, int i, bool count, bool restart,
+                                       bool turn) {
   const ResidualConstants<S>& c = kResidualConstants<S>;
-  using math::abs;
   using math::mul_add;
   const S limit = travel_limit(i);
   if (limit == S(0)) return false;
@@ -39,11 +47,9 @@ inline bool ResidualMonitor<S>::travel(const ResidualInput<S>& in, const Motion&
     ahead.drive(i) = back.drive(i) = kNoDrive;
     return false;
   }
-  static constexpr int kEvery = params::kResidualTravelEvery;
-  const bool turn = (tick + static_cast<std::uint64_t>(i)) % kEvery == 0;
   const S way = activity.direction[i] > 0 ? S(1) : S(-1);
   const S now = way * (tau_prev(i) - (in.bias(i) - in.tau_f(i)));  // beyond gravity and Coriolis
-  // This tick's drive each way at a count (the direction it sets), else the least over the step's ticks.
+  // This tick's drive each way at a count (the direction it sets), else the least over the turn's ticks.
   const S drive = count || now < ahead.drive(i) ? now : ahead.drive(i);
   const S drive_back = count || -now < back.drive(i) ? -now : back.drive(i);
   if (!count && !turn) {
@@ -53,11 +59,10 @@ inline bool ResidualMonitor<S>::travel(const ResidualInput<S>& in, const Motion&
   }
   ahead.drive(i) = back.drive(i) = kNoDrive;  // the next step starts
   const S aii = in.A(i, i);
-  const S others = m.inertia[i] - aii * m.a[i];  // sum over j != i of |A_ij| |q^dd_j|
-  const S error = mul_add(c.link_inertia, others, others) + model + loop;
+  const S error = travel_error(i);
   const S a_min = mul_add(-c.link_inertia, aii, aii) - c.armature_delta[i];
   if (count) {
-    count_bounds(i, (abs(drive) + error + f.breakaway) / a_min);
+    count_bounds(i, (math::abs(drive) + error + f.breakaway) / a_min);
     return false;
   }
   const S a_max = mul_add(c.link_inertia, aii, aii) + c.armature_delta[i];
@@ -101,7 +106,7 @@ template <class S>
 inline S ResidualMonitor<S>::advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max) {
   const ResidualConstants<S>& c = kResidualConstants<S>;
   using math::mul_add;
-  static constexpr S kStep = lit<S>(params::kResidualTravelEvery * params::kDt);
+  static constexpr S kStep = lit<S>(params::kResidualTurnEvery * params::kDt);
   const S lo = w.v(i), limit = travel_limit(i);
   const S net = force - (lo >= S(0) ? mul_add(f.vis, lo, f.breakaway) : S(0));
   S next = mul_add(kStep, net / (net < S(0) ? a_min : a_max), lo);

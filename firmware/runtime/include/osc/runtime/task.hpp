@@ -65,6 +65,7 @@ struct ControlTask {
   EncoderJumpMonitor jump;
   StuckEncoderMonitor<S> stuck;  // the step's checks
   ResidualMonitor<S> residual;
+  MomentumSample<S> momentum;            // the sample the residual monitor's last turn took (joint -1: none)
   CollisionReaction collision_reaction;  // what the residual monitor's collision does (set_collision)
   std::uint32_t stream_timeout_ticks;    // a stream is stale after max(2 periods, this) without a setpoint
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
@@ -113,6 +114,8 @@ struct ControlTask {
     stuck.reset();
     residual.reset();
     residual.collision_floor.setZero();
+    momentum = {};
+    momentum.joint = -1;
     collision_reaction = CollisionReaction::kCategory0;
     stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
