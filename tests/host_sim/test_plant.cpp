@@ -148,9 +148,12 @@ TEST(Plant, HalvingTheStepChangesA10sClosedLoopRunByLessThanTolerance) {
       "closed loop, step %.0e vs %.0e s: max sample difference %.3f mm %.4f deg; max-error statistics "
       "differ by %.4f mm %.5f deg\n",
       a.plant.substep, b.plant.substep, dpos, dang, dmax_pos, dmax_ang);
-  // Stated tolerance on the table entries: one encoder quantum at the start pose (0.069 mm) and 0.01 deg.
+  // Stated tolerance on the table entries: one encoder quantum at the start pose (0.069 mm) and 0.05 deg. The
+  // orientation's peak over the last 5 s moves with any count that flips: measured on 2026-12-02 over substeps of
+  // 4e-5 .. 1e-4 s, e_phz's peak spans 0.053-0.088 deg with the alternate model rate and 0.056-0.079 deg with
+  // the model every step (the 0.01 deg stated before held for this one pair of steps by chance).
   EXPECT_LT(dmax_pos, 0.069);
-  EXPECT_LT(dmax_ang, 0.01);
+  EXPECT_LT(dmax_ang, 0.05);
   // Samples: two to three encoder quanta (measured 0.10 mm).
   EXPECT_LT(dpos, 0.2);
 }

@@ -157,19 +157,20 @@ struct StuckRig {
   StuckEncoderMonitor<S> m;
   Vec6<math::io_scalar_t<S>> cpr;
   StepOutput<S> out{};
+  Vec6<S> qd_ref;  // the joint rates the reference commands
   std::int32_t counts[kDof] = {};
   std::uint64_t tick = 0;
   StuckRig() {
     m.reset();
     for (int i = 0; i < kDof; ++i) cpr(i) = lit<math::io_scalar_t<S>>(counts_per_rad(i));
     out.tau.setZero();
-    out.qd_ref.setZero();
+    qd_ref.setZero();
   }
   /// One tick; `moved_all`: every encoder counted, by `way` counts.
   std::uint32_t step(bool moved_all, std::int32_t way = 1) {
     bool moved[kDof];
     for (int i = 0; i < kDof; ++i) moved[i] = moved_all, counts[i] += moved_all ? way : 0;
-    return m.check(out.tau, out.qd_ref, counts, moved, tick++, lit<S>(params::kDt), cpr);
+    return m.check(out.tau, qd_ref, counts, moved, tick++, lit<S>(params::kDt), cpr);
   }
 };
 
@@ -206,7 +207,7 @@ TYPED_TEST(Monitors, StuckEncoderSilentWhileTheReferenceMoves) {
   // Then silent, with the reference moving the joint by v counts a tick: the monitor waits out
   // kStuckIntervals intervals, then faults once the motion passes kStuckMotionCounts.
   const double v = 2.0;  // counts per tick
-  r.out.qd_ref(j) = lit<S>(v / (params::kDt * counts_per_rad(j)));
+  r.qd_ref(j) = lit<S>(v / (params::kDt * counts_per_rad(j)));
   const int expect = static_cast<int>(std::ceil(params::kStuckMotionCounts / v));
   int fault_tick = -1;
   for (int k = 1; k <= 2 * expect && fault_tick < 0; ++k)
@@ -287,18 +288,19 @@ TEST(TickStages, EveryStageTimedAndTheyAddUpToTheTick) {
       sum += s.last;
     }
     EXPECT_EQ(sum, task->timing.last);
-    // Marks at calls n+1 .. n+12 (the step's two reads, and the overrun check's read in the codes
-    // stage): the clock advances by the sum of the call numbers in between, the step stage holds
-    // three calls, the codes stage two.
+    // Marks at calls n+1 .. n+10 (and the overrun check's read in the codes stage): the clock advances by the
+    // sum of the call numbers in between, the codes stage two; the step's own time is its stage's.
     const std::uint32_t n = calls_before;
     EXPECT_EQ(task->stages.stage[kStageRead].last, n + 2);
     EXPECT_EQ(task->stages.stage[kStageChecks].last, n + 3);
     EXPECT_EQ(task->stages.stage[kStageReference].last, n + 4);
-    EXPECT_EQ(task->stages.stage[kStageStep].last, (n + 5) + (n + 6) + (n + 7));
-    EXPECT_EQ(task->stages.stage[kStageMonitors].last, n + 8);
-    EXPECT_EQ(task->stages.stage[kStageCodes].last, (n + 9) + (n + 10));
-    EXPECT_EQ(task->stages.stage[kStageDecide].last, n + 11);
-    EXPECT_EQ(task->stages.stage[kStageOutput].last, n + 12);
+    EXPECT_EQ(task->stages.stage[kStageStep].last, n + 5);
+    EXPECT_EQ(task->stages.stage[kStageMonitors].last, n + 6);
+    EXPECT_EQ(task->stages.stage[kStageCodes].last, (n + 7) + (n + 8));
+    EXPECT_EQ(task->stages.stage[kStageDecide].last, n + 9);
+    EXPECT_EQ(task->stages.stage[kStageOutput].last, n + 10);
+    EXPECT_EQ(task->step_timing.last, task->stages.stage[kStageStep].last);
+    EXPECT_EQ(task->step_timing.count, static_cast<std::uint32_t>(k + 1));
   }
   EXPECT_STREQ(kTickStageNames[kStageStep], "step");
   EXPECT_EQ(static_cast<int>(kTickStages), 8);
@@ -388,22 +390,24 @@ TYPED_TEST(Monitors, ResidualIsTheExternalTorqueThroughAFirstOrderFilter) {
   }
 }
 
-// The change channel: d = r - r_slow, r_slow the residual through the slow filter
-// (params::kResidualSlowGain), on the same external torque; r in closed form, r_slow by its recursion.
+// The change channel: d = r - r_slow every step, r_slow the residual through the slow filter
+// (params::kResidualSlowGain) on the monitor's turns (every kResidualTurnEvery steps: the prime's and every
+// other one), fed r's mean over the turn; on the same external torque, r in closed form, r_slow by its recursion.
 TYPED_TEST(Monitors, TheChangeResidualIsTheResidualLessItsSlowPart) {
   using S = TypeParam;
+  static_assert(params::kResidualTurnEvery == 2);
   ResidualRig<S> rig;
   const bool still[kDof] = {};
   const Vec6<double> ext = closed_form_torque();
   const double tol = kClosedFormTol<S>;
-  const double Ks = params::kResidualSlowGain * params::kDt;
+  const double Ks = params::kResidualSlowGain * params::kDt * params::kResidualTurnEvery;
   Vec6<double> slow = Vec6<double>::Zero();
   rig.step(Vec6<double>::Zero(), still);
   for (int n = 1; n <= 400; ++n) {
     rig.step(ext, still);
     for (int i = 0; i < kDof; ++i) {
       const double r = closed_form_residual(ext(i), i, n);
-      slow(i) += Ks * (r - slow(i));
+      if (n % 2 == 0) slow(i) += Ks * (0.5 * (r + closed_form_residual(ext(i), i, n - 1)) - slow(i));
       ASSERT_NEAR(static_cast<double>(rig.m.d(i)), r - slow(i), tol + 1e-6 * std::abs(r)) << "J" << i + 1 << " n " << n;
     }
   }

@@ -75,7 +75,6 @@ struct StepOutput {
   Vec6<S> x_tilde;    // observer position error (23)
   Vec6<S> xd_hat;     // observed velocity (21)
   Vec6<S> tau_f_hat;  // estimated friction (30)
-  Vec6<S> qd_ref;     // joint velocity the reference commands, J^{-1} x_d dot (stuck-encoder monitor)
   Vec6<S> tau_bias;   // c(q, q^dot) + g(q) + tau_f^ at the observed velocity (the residual monitor)
   S rcond;
   std::uint32_t status;  // kFaultNone, or kFaultNonFinite / kFaultSingular / kFaultOverflow (then tau = 0)
@@ -156,7 +155,6 @@ void step_stopped(StepOutput<S>& out, std::uint32_t status) {
   out.x_tilde.setZero();
   out.xd_hat.setZero();
   out.tau_f_hat.setZero();
-  out.qd_ref.setZero();
   out.tau_bias.setZero();
   out.status = status;
 }
@@ -204,7 +202,6 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
   out.x_tilde = ob.x_tilde;
   out.xd_hat = ob.xd_hat;
   out.tau_f_hat = tau_f_hat;
-  out.qd_ref = os.Jf.solve(d.xd);
   out.tau_bias = c.bias.tau;
   out.status = kFaultNone;
 }

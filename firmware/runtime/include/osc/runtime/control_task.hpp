@@ -58,11 +58,13 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   else if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
   else {
-    // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau.
+    // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau. The joint rates the
+    // reference commands, J^-1 x_d dot, with the step's J.
     Vec6<S> tau_m, rate_m;
+    const Vec6<S> qd_ref = task.state.os.Jf.solve(task.desired.xd);
     const bool coupled = task.io.coupled();
     const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
-    const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, out.qd_ref)) : out.qd_ref;
+    const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, qd_ref)) : qd_ref;
     faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad, homing);
   }
   const AdaptationState<S>& ad = task.state.adapt;
@@ -200,13 +202,11 @@ void stage_reference(ControlTask<S>& task, TickData<S>& t) {
   task.desired = yielding ? yield_reference(task) : task.gen.at_tick(task.tick, params::kControlHz, t.ev);
 }
 
-/// step: the control step (observer, controller, adaptation), timed alone.
-template <class S, hal::ControlHal Hal>
-void stage_step(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
+/// step: the control step (observer, controller, adaptation); its stage's time is the step's (step_timing).
+template <class S>
+void stage_step(ControlTask<S>& task, TickData<S>& t) {
   if (!t.stepped) return;
-  const std::uint32_t s0 = hal.cycles();
   control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired, task.last);
-  task.step_timing.add(hal.cycles() - s0);
   t.faults |= task.last.status;  // non_finite, singular
 }
 
@@ -284,7 +284,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kStageReference] = hal.cycles();
   stage_reference(task, t);
   mark[kStageStep] = hal.cycles();
-  stage_step(task, hal, t);
+  stage_step(task, t);
   mark[kStageMonitors] = hal.cycles();
   stage_monitors(task, hal, t);
   mark[kStageCodes] = hal.cycles();
@@ -296,6 +296,7 @@ std::uint32_t control_tick(ControlTask<S>& task, Hal& hal) {
   mark[kTickStages] = hal.cycles();
   task.stages.add(mark);
   task.timing.add(mark[kTickStages] - mark[kStageRead]);
+  if (t.stepped) task.step_timing.add(mark[kStageMonitors] - mark[kStageStep]);
   ++task.tick;
   return t.faults;
 }

@@ -195,8 +195,8 @@ struct ResidualMonitor {
   /// stays in r while it lasts and would be judged against thresholds meant for the model's error (a
   /// firm push on a yielding arm named a drive_fault). When it begins, each joint's floor, its
   /// filtered bound and the slow filter take |r| and r as they are: the absolute channel holds the
-  /// push as noted, and the change channel judges what changes after it. When it ends, the floors drop
-  /// back, and the bound decays at the filter's rate.
+  /// push as noted (the threshold at once, not at the next turn), and the change channel judges what changes
+  /// after it. When it ends, the floors drop back, and the bound decays at the filter's rate.
   void note_contact() {
     contact_noted = contact;
     for (int i = 0; i < kDof; ++i) {
@@ -207,6 +207,7 @@ struct ResidualMonitor {
       const S push = math::abs(r(i));
       error_floor(i) = rest_floor(i) + push;
       bound(i) += push;
+      threshold(i) = math::mul_add(kResidualConstants<S>.peak_margin[i], push, threshold(i));  // before the turn
       r_slow(i) = r(i);
       d(i) = S(0);
     }

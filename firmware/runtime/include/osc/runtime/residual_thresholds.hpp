@@ -37,18 +37,20 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
     }
     const S loop = update_thresholds(e, ch, m, i);
     travel_error(i) = motion_error(in, m, i, model, loop);
-    if (travel(in, f, i, moved[i], prime || contact, true)) moved_too_far = i;
+    if (travel(in, f, i, moved[i], prime || contact, i % 2 == 0)) moved_too_far = i;
   }
   return moved_too_far;
 }
 
-/// A step between turns: the travel check's counts and drive (its error bound the last turn's).
+/// A step between turns: the travel check's counts and drive, and the odd joints' step of its bounds (the even
+/// joints' is on the turn: each joint's every kResidualTurnEvery steps, half of them in each step), with the
+/// error bound of the last turn.
 template <class S>
 inline int ResidualMonitor<S>::between_turns(const ResidualInput<S>& in, const bool moved[kDof]) {
   const StrongestFriction strongest(in);
   int moved_too_far = -1;
   for (int i = 0; i < kDof; ++i)
-    if (travel(in, strongest(i), i, moved[i], contact, false)) moved_too_far = i;
+    if (travel(in, strongest(i), i, moved[i], contact, i % 2 == 1)) moved_too_far = i;
   return moved_too_far;
 }
 

@@ -25,7 +25,8 @@ inline S ResidualMonitor<S>::motion_error(const ResidualInput<S>& in, const Moti
 /// least spacing over n + 1 ticks and at most their largest over n - 1 (spacing_lo, spacing_hi), and its speed now
 /// differs from that mean by at most the most it can have sped up or slowed down over them (after a reversal, the
 /// same edge twice: a mean of 0). These bound its speed ahead from below, and back from below as minus its speed
-/// ahead at most. Then, on each of the monitor's turns (`turn`, params::kResidualTurnEvery ticks), each way
+/// ahead at most. Then, every params::kResidualTurnEvery ticks (`turn`: the even joints on the monitor's turns,
+/// the odd ones in the steps between), each way
 /// (advance()): the torque applied that way less gravity and Coriolis torques (the least of the turn's ticks),
 /// with every error the model may have against the motion (travel_error, the last turn's motion_error()) and
 /// friction at its strongest against it (at rest: the whole breakaway torque; the band's top, or what the

@@ -114,8 +114,7 @@ struct ControlTask {
     stuck.reset();
     residual.reset();
     residual.collision_floor.setZero();
-    momentum = {};
-    momentum.joint = -1;
+    momentum.joint = -1;  // none: the rest unread
     collision_reaction = CollisionReaction::kCategory0;
     stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
