@@ -139,11 +139,10 @@ void adaptation_init(AdaptationState<S>& a, const Vec6<S>& q0) {
   adaptation_restart(a, q0);
 }
 
-/// Records the sample t for the next update: theta^(t), q(t), q^dot(t) and the regressor at q^dot(t).
+/// Records the sample t for the next update: q(t), q^dot(t) and the regressor at q^dot(t) (theta^(t): the
+/// caller's, adaptation_step's where it changed).
 template <class S>
-void adaptation_record(AdaptationState<S>& a, const Vec18<S>& theta_hat, const Vec6<S>& q, const Vec6<S>& qd_hat,
-                       const RegressorDiagonals<S>& w) {
-  a.theta_hat = theta_hat;
+void adaptation_record(AdaptationState<S>& a, const Vec6<S>& q, const Vec6<S>& qd_hat, const RegressorDiagonals<S>& w) {
   a.q_prev = q;
   a.qd_hat_prev2 = a.qd_hat_prev;
   a.qd_hat_prev = qd_hat;
@@ -151,11 +150,12 @@ void adaptation_record(AdaptationState<S>& a, const Vec18<S>& theta_hat, const V
   a.w_prev = w;
   if (a.samples < 2) ++a.samples;
 }
-/// The same, computing the regressor at q^dot(t).
+/// The same with theta^(t), computing the regressor at q^dot(t).
 template <class S>
 void adaptation_record(const Gains<S>& G, AdaptationState<S>& a, const Vec18<S>& theta_hat, const Vec6<S>& q,
                        const Vec6<S>& qd_hat) {
-  adaptation_record(a, theta_hat, q, qd_hat, friction_regressor_diagonals(qd_hat, G.tau_dec));
+  a.theta_hat = theta_hat;
+  adaptation_record(a, q, qd_hat, friction_regressor_diagonals(qd_hat, G.tau_dec));
 }
 
 /// Estimated joint friction (30): tau_f^ = W_j(q^dot) theta^.

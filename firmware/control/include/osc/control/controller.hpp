@@ -182,7 +182,12 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
     return step_stopped(out, kFaultSingular);
   }
   const bool adaptive = mode == FrictionMode::kAdaptive;
-  const Vec18<S> theta_hat = adaptive ? adaptation_step(G, st.adapt, q) : st.adapt.theta_hat;
+  // theta^(t): the paper's law (67) or the robust law update it in the step; the momentum law's stage runs after
+  // the step (adaptation_identify), so it is used as it is, without a copy.
+  const bool updates = adaptive && G.adaptation != AdaptationLaw::kMomentum;
+  Vec18<S> theta_next;
+  if (updates) theta_next = adaptation_step(G, st.adapt, q);
+  const Vec18<S>& theta_hat = updates ? theta_next : st.adapt.theta_hat;
   const ObserverOutput<S> ob = observer_output(G, os, st.obs.x_hat, st.obs.y);
   // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
   const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
@@ -196,7 +201,8 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
   // A fixed-point result that saturated anywhere in the step (math::take_arithmetic_fault).
   if (math::take_arithmetic_fault<S>()) return step_stopped(out, kFaultOverflow);
   st.obs = next;
-  adaptation_record(st.adapt, theta_hat, Vec6<S>(q), ob.qd_hat, w);
+  if (updates) st.adapt.theta_hat = theta_next;
+  adaptation_record(st.adapt, Vec6<S>(q), ob.qd_hat, w);
   out.tau = tau;
   out.e = c.e;
   out.x_tilde = ob.x_tilde;

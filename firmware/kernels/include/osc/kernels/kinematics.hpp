@@ -127,11 +127,17 @@ Mat3<S> phi_rate_to_angular(const Vec3<S>& phi) {
   return E;
 }
 
-/// Analytic Jacobian Ja = blockdiag(I, E^{-1}(phi)) J, so that x_dot = Ja q_dot.
+/// Analytic Jacobian Ja = blockdiag(I, E^{-1}(phi)) J, so that x_dot = Ja q_dot, written into Ja (the control
+/// step's, without a copy of it).
+template <class S>
+void analytic_jacobian(const Mat6<S>& J, const PhiRate<S>& E, Mat6<S>& Ja) {
+  Ja.template topRows<3>() = J.template topRows<3>();
+  Ja.template bottomRows<3>() = E.Einv * J.template bottomRows<3>();
+}
 template <class S>
 Mat6<S> analytic_jacobian(const Mat6<S>& J, const PhiRate<S>& E) {
-  Mat6<S> Ja = J;
-  Ja.template bottomRows<3>() = E.Einv * J.template bottomRows<3>();
+  Mat6<S> Ja;
+  analytic_jacobian(J, E, Ja);
   return Ja;
 }
 template <class S>

@@ -157,7 +157,7 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
   geometric_jacobian(data);
   os.x = operational_coordinates(data, R_ref);
   os.E = phi_rate(Vec3<S>(os.x.template tail<3>()));
-  os.Ja = analytic_jacobian(data.J, os.E);
+  analytic_jacobian(data.J, os.E, os.Ja);
   os.Jf.compute(os.Ja);
   if (!dynamics) return;
   joint_inertia(model, data);
