@@ -173,6 +173,21 @@ TEST_F(ControlStep, FaultsCommandZeroTorque) {
   EXPECT_TRUE(math::all_finite(out.tau));
 }
 
+// A non-finite friction estimate, any of its 18 coefficients, NaN or infinite, stops the step with non_finite
+// and zero torque: it reaches tau through tau_f^ = W theta^ even where its regressor column is 0 (at rest, the
+// first step: 0 times NaN or infinity is NaN), so the step checks tau, not theta^ itself.
+TEST_F(ControlStep, NonFiniteFrictionEstimateStopsTheStep) {
+  for (const double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()})
+    for (int k = 0; k < 3 * kDof; ++k) {
+      auto s = std::make_unique<ControllerState<double>>();
+      controller_init(model, *s, q_start());
+      s->adapt.theta_hat(k) = bad;
+      const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *s, q_start(), paper.at_time(0.0));
+      EXPECT_EQ(out.status, kFaultNonFinite) << k << " " << bad;
+      EXPECT_EQ(out.tau.norm(), 0.0) << k;
+    }
+}
+
 TEST_F(ControlStep, AtRestAtTheStartItHoldsGravity) {
   // x = x_d, observer at rest: F = p(x), so Gamma = J^T p = g(q).
   const StepOutput<double> out = control_step(model, G, FrictionMode::kAdaptive, *st, q_start(), paper.at_time(0.0));

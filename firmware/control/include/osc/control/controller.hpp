@@ -195,8 +195,9 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
   const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat, st.psi, turn.velocity);
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);
-  if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat) ||
-      !math::all_finite(theta_hat))
+  // A non-finite theta^ shows in tau: every coefficient enters tau_f^ = W theta^ as a product (0 times NaN or
+  // infinity is NaN), tau_f^ enters F, and F tau (test_controller: NonFiniteFrictionEstimateStopsTheStep).
+  if (!math::all_finite(tau) || !math::all_finite(next.y) || !math::all_finite(next.x_hat))
     return step_stopped(out, kFaultNonFinite);
   // A fixed-point result that saturated anywhere in the step (math::take_arithmetic_fault).
   if (math::take_arithmetic_fault<S>()) return step_stopped(out, kFaultOverflow);
