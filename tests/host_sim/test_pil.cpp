@@ -446,10 +446,12 @@ struct Link : ::testing::Test {
 
 TEST_F(Link, HealthyExchangesCarryTorqueAndTelemetry) {
   healthy(20);
-  // The tick's stages: each timed by the peer's nominal clock (1000 a read: one mark each, the codes stage's
-  // overrun check one more); the control step's time is its stage's.
-  for (int s = 0; s < osc::kTickStages; ++s)
-    EXPECT_EQ(last.stage_cycles[s], s == osc::kStageCodes ? 2000u : 1000u) << osc::kTickStageNames[s];
+  // The tick's stages: each timed (the host peer's nominal clock gives 1000 a read, an image's its counter's
+  // cycles); the control step's time is its stage's.
+  std::uint64_t stages = 0;
+  for (int s = 0; s < osc::kTickStages; ++s) stages += last.stage_cycles[s];
+  EXPECT_GT(last.stage_cycles[osc::kStageStep], 0u);
+  EXPECT_GT(stages, static_cast<std::uint64_t>(last.stage_cycles[osc::kStageStep]));
   EXPECT_EQ(last.step_cycles, last.stage_cycles[osc::kStageStep]);
 }
 
