@@ -26,6 +26,15 @@ M6 published_coupling() {
   return C;
 }
 
+/// The arm's coupled drive train in the scalar S, its matrix written out, and the start pose.
+template <class S>
+struct CoupledDrive {
+  const EncoderMap& map = robot::kDriveTrain.encoders;
+  const IoMap<S> io = IoMap<S>::of(map);
+  const M6 C = published_coupling();
+  const V6 q0 = joint_vector<double>(robot::kQStart);
+};
+
 template <class S>
 class IoMaps : public ::testing::Test {};
 using Scalars = ::testing::Types<double, float, Fixed>;
@@ -69,11 +78,9 @@ TYPED_TEST(IoMaps, UncoupledMapsAreTodaysPerJointConversionBitForBit) {
 
 TYPED_TEST(IoMaps, CoupledCountsGiveTheJointAnglesOfTheWrittenOutMatrix) {
   using S = TypeParam;
-  const EncoderMap& map = robot::kDriveTrain.encoders;
-  const IoMap<S> io = IoMap<S>::of(map);
+  const CoupledDrive<S> drive;
+  const auto& [map, io, C, q0] = drive;
   ASSERT_TRUE(io.coupled());
-  const M6 C = published_coupling();
-  const V6 q0 = joint_vector<double>(robot::kQStart);
   const double tol = std::is_same_v<S, double> ? 1e-12 : 2e-5;  // float: 24 bits; Q12.19: 2^-19 per term
   std::mt19937 rng(4);
   std::uniform_int_distribution<std::int32_t> u(-40000, 40000);
@@ -83,7 +90,7 @@ TYPED_TEST(IoMaps, CoupledCountsGiveTheJointAnglesOfTheWrittenOutMatrix) {
     V6 e;
     for (int i = 0; i < kDof; ++i) counts[i] = u(rng), e(i) = counts[i] / map.counts_per_rad[i];
     const V6 expect = q0 + C * e;
-    const Vec6<S> q = angles_from_counts(Vec6<S>(q0.cast<S>()), io, counts);
+    const Vec6<S> q = angles_from_counts(Vec6<S>(q0.template cast<S>()), io, counts);
     for (int i = 0; i < kDof; ++i) worst = std::max(worst, std::abs(static_cast<double>(q(i)) - expect(i)));
   }
   std::printf("coupled counts -> angles, worst error: %.3g rad\n", worst);
@@ -95,12 +102,10 @@ TYPED_TEST(IoMaps, CoupledCountsGiveTheJointAnglesOfTheWrittenOutMatrix) {
 // gives the angles of the corrected motor angles: q0 + C (e + de), against the written-out matrix.
 TYPED_TEST(IoMaps, HomingsCorrectionAndTheAnglesOfCountsAreOneMap) {
   using S = TypeParam;
-  const EncoderMap& map = robot::kDriveTrain.encoders;
-  const IoMap<S> io = IoMap<S>::of(map);
+  const CoupledDrive<S> drive;
+  const auto& [map, io, C, q0] = drive;
   ASSERT_TRUE(io.coupled());
-  const M6 C = published_coupling();
-  const V6 q0 = joint_vector<double>(robot::kQStart);
-  const Vec6<S> q0_s = q0.cast<S>();
+  const Vec6<S> q0_s = q0.template cast<S>();
   const double tol = std::is_same_v<S, double> ? 1e-12 : 4e-5;
   std::mt19937 rng(7);
   std::uniform_int_distribution<std::int32_t> u(-40000, 40000), turn(-2000, 2000);

@@ -48,11 +48,14 @@ struct DynamicsTurn {
   bool velocity;  // Psi's velocity products (psi_terms, force_command)
 };
 
+/// Whether the controller's step number n (0: its first since a (re)start) is one of its even steps.
+constexpr bool is_even_step(std::uint32_t n) { return (n & 1u) == 0; }
+
 /// Whether the controller's last step was one of its even steps (its first, third, ...): the alternate model
 /// rate's model turns, and the residual monitor's turns (params::kResidualTurnEvery), whatever the rate.
 template <class S>
 bool even_step(const ControllerState<S>& st) {
-  return (st.steps & 1u) == 1u;
+  return is_even_step(st.steps - 1u);
 }
 
 /// Every step computes both (ModelRate::kEveryStep), or they alternate (kAlternate): the model on a
@@ -63,7 +66,7 @@ bool even_step(const ControllerState<S>& st) {
 /// controller_restart set them (a count away from that pose, q^dot = J^-1 k x~ and the products are of its square).
 inline DynamicsTurn dynamics_turn(ModelRate rate, std::uint32_t steps) {
   if (rate == ModelRate::kEveryStep) return {true, true};
-  const bool model = (steps & 1u) == 0;
+  const bool model = is_even_step(steps);
   return {model, !model};
 }
 

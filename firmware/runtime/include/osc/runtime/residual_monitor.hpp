@@ -405,6 +405,8 @@ struct ResidualMonitor {
   // The travel check (osc/runtime/residual_travel.hpp).
   S motion_error(const ResidualInput<S>& in, const Motion& m, int i, S model, S loop) const;
   bool travel(const ResidualInput<S>& in, const Friction& f, int i, bool count, bool restart, bool turn);
+  /// Joint i's travel bounds step in this tick: the even joints' on the monitor's turns, the odd ones' between.
+  static bool travel_turn(int i, bool turn) { return (i % 2 == 0) == turn; }
   void count_bounds(int i, S change);
   S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
   std::uint32_t classify_travel(int i) const;

@@ -37,7 +37,7 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
     }
     const S loop = update_thresholds(e, ch, m, i);
     travel_error(i) = motion_error(in, m, i, model, loop);
-    if (travel(in, f, i, moved[i], prime || contact, i % 2 == 0)) moved_too_far = i;
+    if (travel(in, f, i, moved[i], prime || contact, travel_turn(i, true))) moved_too_far = i;
   }
   return moved_too_far;
 }
@@ -50,7 +50,7 @@ inline int ResidualMonitor<S>::between_turns(const ResidualInput<S>& in, const b
   const StrongestFriction strongest(in);
   int moved_too_far = -1;
   for (int i = 0; i < kDof; ++i)
-    if (travel(in, strongest(i), i, moved[i], contact, i % 2 == 1)) moved_too_far = i;
+    if (travel(in, strongest(i), i, moved[i], contact, travel_turn(i, false))) moved_too_far = i;
   return moved_too_far;
 }
 
