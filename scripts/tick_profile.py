@@ -13,7 +13,7 @@ per tick, the instructions of:
   - each source line (--lines).
 
 Usage: scripts/tick_profile.py build/m4f/boards/mps2_an386/timer_firmware.elf [--machine mps2-an386]
-       [--top 40] [--depth N] [--lines] [--stage monitors]
+       [--top 40] [--depth N] [--lines] [--stage monitors] [--phase 0|1]
 The counts are of translated blocks' instructions times their executions (an exception that leaves a
 block early is not seen: the figure can exceed icount's by a few instructions per tick).
 """
@@ -50,7 +50,7 @@ def run_trace(args, log):
     return r.stdout + r.stderr
 
 
-def parse(log, handler_pc):
+def parse(log, handler_pc, phase=None):
     """Per (call sites, address): the instructions executed in the ticks, and the number of ticks.
     The call sites are the out-of-line calls (bl, blx) the instruction is under, from the handler
     down: a call pushes its return address, a block that starts at the top one pops it; a return
@@ -100,9 +100,10 @@ def parse(log, handler_pc):
             elif kind == "return" and not stack:
                 inside = False  # the handler returned: what follows is main's until the next tick
     # The last two windows hold main's report (the image's last ticks interrupt it).
-    for w in windows[:-2]:
+    kept = [w for k, w in enumerate(windows[:-2]) if phase is None or k % 2 == phase]
+    for w in kept:
         counts.update(w)
-    return counts, max(len(windows) - 2, 0)
+    return counts, len(kept)
 
 
 def chains(elf, addr2line, addresses):
@@ -134,6 +135,8 @@ def main():
     p.add_argument("--depth", type=int, default=0, help="the function K levels below the stage (0: the innermost)")
     p.add_argument("--stage", help="only this stage's instructions")
     p.add_argument("--lines", action="store_true", help="rank source lines instead of functions")
+    p.add_argument("--phase", type=int, choices=(0, 1),
+                   help="only every other tick, from the first (0) or the second (1): the tick's two turns apart")
     p.add_argument("--qemu", default="qemu-system-arm")
     p.add_argument("--nm", default="arm-none-eabi-nm")
     p.add_argument("--addr2line", default="arm-none-eabi-addr2line")
@@ -143,7 +146,7 @@ def main():
     with tempfile.TemporaryDirectory() as d:
         log = os.path.join(d, "trace.log")
         output = run_trace(args, log)
-        counts, ticks = parse(log, handler_lo & ~1)
+        counts, ticks = parse(log, handler_lo & ~1, args.phase)
     if ticks == 0:
         sys.exit(f"tick_profile: no tick seen (the image's output: {output.strip()[-400:]})")
     addresses = sorted({a for sites, a in counts} | {c for sites, _ in counts for c in sites})

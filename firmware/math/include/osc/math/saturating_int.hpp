@@ -199,8 +199,41 @@ inline std::uint32_t udiv64_32(std::uint64_t n, std::uint32_t d) {
 #endif
 }
 
-/// floor(sqrt(n)) for a 64-bit n, digit by digit.
-inline std::uint64_t isqrt64(std::uint64_t n) {
+/// ceil(sqrt((i + 1) 2^26)) for i = 16 .. 63: at least the root of any 32-bit word whose top six
+/// bits are i, within 2^10 + 1 of it (isqrt_top's first estimate).
+struct SqrtTop {
+  std::uint32_t v[48]{};
+  constexpr SqrtTop() {
+    for (int i = 16; i < 64; ++i) {
+      const std::uint64_t n = static_cast<std::uint64_t>(i + 1) << 26;
+      std::uint64_t lo = 0, hi = std::uint64_t{1} << 17;  // the least s with s^2 >= n, by bisection
+      while (lo < hi) {
+        const std::uint64_t mid = (lo + hi) / 2;
+        if (mid * mid >= n)
+          hi = mid;
+        else
+          lo = mid + 1;
+      }
+      v[i - 16] = static_cast<std::uint32_t>(lo);
+    }
+  }
+};
+inline constexpr SqrtTop kSqrtTop{};
+
+/// floor(sqrt(h)) for h in [2^30, 2^32): the table's estimate (above the root by at most 2^10 + 1),
+/// two Newton steps from above in 32 bits (the error e becomes at most e^2 / 2^16 + 1: 17, then 1),
+/// and one correction. Each step is one hardware division on the targets. Exact for every h: checked
+/// for all 2^32 words once, and in test_fixed around every square and table cell.
+inline std::uint32_t isqrt_top(std::uint32_t h) {
+  std::uint32_t s = kSqrtTop.v[(h >> 26) - 16];
+  s = (s + h / s) >> 1;
+  s = (s + h / s) >> 1;
+  return static_cast<std::uint64_t>(s) * s > h ? s - 1 : s;
+}
+
+/// floor(sqrt(n)) for a 64-bit n, digit by digit: two bits of n a step (the reference the fast root
+/// below is tested against).
+inline std::uint64_t isqrt64_digits(std::uint64_t n) {
   std::uint64_t res = 0, bit = std::uint64_t{1} << 62;
   while (bit > n) bit >>= 2;
   while (bit != 0) {
@@ -213,6 +246,35 @@ inline std::uint64_t isqrt64(std::uint64_t n) {
     bit >>= 2;
   }
   return res;
+}
+
+/// floor(sqrt(n)) for a 64-bit n. With m = n 4^k normalised (its top word in [2^30, 2^32)),
+/// floor(sqrt(n)) = floor(sqrt(m)) >> k. The top word's root s1 (isqrt_top) gives
+/// x0 = (s1 + 1) 2^16, at most 2^16 above sqrt(m) >= 2^31; one Newton step from above,
+/// x1 = floor((x0 + floor(m / x0)) / 2), is then at least floor(sqrt(m)) (as every such step) and
+/// at most sqrt(m) + (x0 - sqrt(m))^2 / (2 x0) <= sqrt(m) + 1, so one correction ends it. One
+/// 64-by-32-bit division instead of the 31 steps of 64-bit arithmetic of the digit-by-digit root
+/// (on the Cortex-M3 about 370 instructions, a sixth of the stream follower's tick).
+inline std::uint64_t isqrt64(std::uint64_t n) {
+  const std::uint32_t top = static_cast<std::uint32_t>(n >> 32);
+  if (top == 0) {
+    const std::uint32_t lo = static_cast<std::uint32_t>(n);
+    if (lo == 0) return 0;
+    const int k = clz32(lo) / 2;
+    return isqrt_top(lo << (2 * k)) >> k;
+  }
+  const int k = clz32(top) / 2;
+  const std::uint64_t m = n << (2 * k);
+  const std::uint32_t s1 = isqrt_top(static_cast<std::uint32_t>(m >> 32));
+  // (s1 + 1) 2^16 = 2^32 does not fit: 2^32 - 1 is then above sqrt(m), but for the m whose root is
+  // itself 2^32 - 1.
+  constexpr std::uint64_t kTopSquare = 0xFFFFFFFE00000001u;  // (2^32 - 1)^2
+  if (s1 == 0xFFFFu && m >= kTopSquare) return std::uint64_t{0xFFFFFFFFu} >> k;
+  const std::uint32_t x0 = s1 == 0xFFFFu ? 0xFFFFFFFFu : (s1 + 1) << 16;
+  const std::uint32_t q = udiv64_32(m, x0);  // <= sqrt(m) < 2^32: fits
+  std::uint32_t x = (x0 >> 1) + (q >> 1) + (x0 & q & 1u);
+  if (static_cast<std::uint64_t>(x) * x > m) --x;
+  return x >> k;
 }
 
 /// round(sqrt(n)): floor, plus one when n - floor^2 > floor (then sqrt(n) > floor + 1/2).
