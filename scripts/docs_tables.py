@@ -485,6 +485,34 @@ def m3_instructions():
     return "\n".join(lines)
 
 
+@table("m3_cycles", "docs/fixed_point.md", "m3")
+def m3_cycles():
+    """The M3's worst-case tick in cycles: an estimate from its QEMU trace (scripts/tick_profile.py
+    --m3-cycles: the instructions executed and the branches taken, with the Cortex-M3 TRM's timings at
+    their worst), and the any-motion bound at the same cycles per instruction."""
+    elf = os.path.join(M3, "boards", "mps2_an385", "timer_worst_firmware.elf")
+    out = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "tick_profile.py"), elf, "--machine",
+                          "mps2-an385", "--m3-cycles"], capture_output=True, text=True, check=True).stdout
+    n = re.search(r"per tick: (\d+) instructions, (\d+) taken branches", out)
+    zero = re.search(r"zero wait states: (\d+) \(cycles per instruction ([\d.]+)\)", out)
+    flash = re.search(r"72 MHz flash \(2 wait states\): (\d+) \(cycles per instruction ([\d.]+)", out)
+    bound = any_motion_bound(m3_output("kernels_image"), m3_output("timer_worst_firmware"))
+    period = 72000  # cycles in 1 ms at 72 MHz
+    lines = ["| Cortex-M3, worst-case tick (`timer_worst_firmware`) | cycles per tick | per instruction | "
+             "of a 72 MHz part's 1 ms |", "|---|---|---|---|",
+             f"| instructions (from the trace) / taken branches | {thousands(int(n.group(1)))} / "
+             f"{thousands(int(n.group(2)))} | | |"]
+    for what, m in (("zero wait states (the TRM's timings at their worst)", zero),
+                    ("from a 72 MHz STM32F103's flash (2 wait states, prefetch)", flash)):
+        c = int(m.group(1))
+        lines.append(f"| {what} | {thousands(c)} | {m.group(2)} | {100 * c / period:.0f} % |")
+    if bound:
+        b = int(bound[0][1].replace(" ", "")) * float(flash.group(2))
+        lines.append(f"| the any-motion bound ({bound[0][1]} instructions) at the flash's cycles per instruction | "
+                     f"{thousands(round(b))} | {flash.group(2)} | {100 * b / period:.0f} % |")
+    return "\n".join(lines)
+
+
 # ---------------------------------------------------------------- long tables
 
 

@@ -13,7 +13,10 @@ per tick, the instructions of:
   - each source line (--lines).
 
 Usage: scripts/tick_profile.py build/m4f/boards/mps2_an386/timer_firmware.elf [--machine mps2-an386]
-       [--top 40] [--depth N] [--lines] [--stage monitors] [--phase 0|1]
+       [--top 40] [--depth N] [--lines] [--stage monitors] [--phase 0|1] [--m3-cycles]
+--m3-cycles: the tick's cycles on a Cortex-M3 instead, an estimate from the instructions executed and
+the branches taken with the TRM's timings at their worst, at zero wait states and from a 72 MHz
+STM32F103's flash (m3_estimate).
 The counts are of translated blocks' instructions times their executions (an exception that leaves a
 block early is not seen: the figure can exceed icount's by a few instructions per tick).
 """
@@ -55,9 +58,12 @@ def parse(log, handler_pc, phase=None):
     The call sites are the out-of-line calls (bl, blx) the instruction is under, from the handler
     down: a call pushes its return address, a block that starts at the top one pops it; a return
     with no call open is the handler's own, which ends the tick's window."""
-    blocks = {}  # block start -> [(address, size, is_call)]
+    blocks = {}  # block start -> [(address, size, kind)]
+    insns = {}  # address -> (mnemonic, operands, size)
     counts = collections.Counter()
     windows = []  # per handler entry: the instructions until the next entry
+    taken = []  # per handler entry: the blocks that ended in a taken branch (a jump, a call, a return)
+    fall = None  # where the last block executed in a tick falls through to
     inside = False
     current = None
     stack = []  # (return address, call site)
@@ -73,6 +79,7 @@ def parse(log, handler_pc, phase=None):
                     kind = "call" if m.group(3) in ("bl", "blx") else "return" if RETURN.match(
                         f"{m.group(3)} {m.group(4)}") else ""
                     current.append((int(m.group(1), 16), size, kind))
+                    insns[int(m.group(1), 16)] = (m.group(3), m.group(4), size)
                     continue
                 if current:
                     blocks[current[0][0]] = current
@@ -83,10 +90,14 @@ def parse(log, handler_pc, phase=None):
             pc = int(m.group(1), 16)
             if pc == handler_pc:
                 windows.append(collections.Counter())
+                taken.append(0)
                 inside = True
                 stack = []
+                fall = None
             if not inside:
                 continue
+            if fall is not None and pc != fall:
+                taken[-1] += 1
             while stack and stack[-1][0] == pc:
                 stack.pop()
             block = blocks.get(pc, [(pc, 2, "")])
@@ -95,15 +106,65 @@ def parse(log, handler_pc, phase=None):
             for a, _, _ in block:
                 w[(sites, a)] += 1
             a, size, kind = block[-1]
+            fall = a + size
             if kind == "call":
                 stack.append((a + size, a))
             elif kind == "return" and not stack:
                 inside = False  # the handler returned: what follows is main's until the next tick
     # The last two windows hold main's report (the image's last ticks interrupt it).
-    kept = [w for k, w in enumerate(windows[:-2]) if phase is None or k % 2 == phase]
-    for w in kept:
-        counts.update(w)
-    return counts, len(kept)
+    kept = [k for k in range(len(windows) - 2) if phase is None or k % 2 == phase]
+    for k in kept:
+        counts.update(windows[k])
+    return counts, len(kept), insns, sum(taken[k] for k in kept)
+
+
+# Cortex-M3 instruction timings (ARM DDI 0337, Cortex-M3 Technical Reference Manual, "Processor
+# instruction timings", zero wait states), each at its worst: a long multiply 5 (3 to 5), a long
+# multiply-accumulate 7 (4 to 7), a division 12 (2 to 12), a load or store 2 (a neighbour's pipelining
+# not counted), a multiple one 1 + N; a branch 1, and P = 3 (1 to 3) more when taken.
+M3_CYCLES = {"smull": 5, "umull": 5, "smlal": 7, "umlal": 7, "sdiv": 12, "udiv": 12, "mla": 2, "mls": 2,
+             "ldrd": 3, "strd": 3}
+M3_REFILL = 3
+M3_EXCEPTION = 12 + 12  # entry and return (the TRM's interrupt latency; a return is as long, at most)
+# A 72 MHz STM32F103's flash: 2 wait states (RM0008, 3.3.3), behind a prefetch buffer of two 64-bit
+# words. Modelled: a taken branch waits for its line (2 more cycles), and a line of 8 bytes takes 3 cycles.
+FLASH_WAIT = 2
+FLASH_BYTES_PER_CYCLE = 8 / 3
+
+
+def m3_cycles(mnemonic, operands):
+    """Cycles of one instruction on the Cortex-M3 at zero wait states, a branch as not taken."""
+    base = mnemonic.split(".")[0]
+    if base in M3_CYCLES:
+        return M3_CYCLES[base]
+    if base.startswith(("ldm", "stm", "push", "pop")):
+        return 1 + len(re.findall(r"\b(r\d+|sb|sl|fp|ip|sp|lr|pc)\b", operands.split("{")[-1]))
+    if base.startswith(("ldr", "str")):
+        return 2
+    return 1
+
+
+def m3_estimate(counts, insns, taken, ticks):
+    """The tick's cycles on a Cortex-M3, from its instructions and taken branches: at zero wait
+    states, and from a 72 MHz STM32F103's flash (the larger of the core's cycles and the fetches')."""
+    n = sum(counts.values())
+    core = sum(k * m3_cycles(*insns[a][:2]) for (_, a), k in counts.items() if a in insns)
+    core += taken * M3_REFILL + ticks * M3_EXCEPTION
+    fetch = sum(k * insns[a][2] for (_, a), k in counts.items() if a in insns) / FLASH_BYTES_PER_CYCLE
+    flash = max(core, fetch) + taken * FLASH_WAIT
+    return n / ticks, core / ticks, flash / ticks
+
+
+def m3_classes(counts, insns, ticks):
+    """Per class of instruction (its mnemonic without suffix or condition): instructions and cycles per tick."""
+    out = collections.defaultdict(lambda: [0, 0])
+    for (_, a), k in counts.items():
+        if a in insns:
+            m, ops, _ = insns[a]
+            key = m.split(".")[0]
+            out[key][0] += k
+            out[key][1] += k * m3_cycles(m, ops)
+    return sorted(((key, n / ticks, c / ticks) for key, (n, c) in out.items()), key=lambda r: -r[2])
 
 
 def chains(elf, addr2line, addresses):
@@ -137,6 +198,8 @@ def main():
     p.add_argument("--lines", action="store_true", help="rank source lines instead of functions")
     p.add_argument("--phase", type=int, choices=(0, 1),
                    help="only every other tick, from the first (0) or the second (1): the tick's two turns apart")
+    p.add_argument("--m3-cycles", action="store_true",
+                   help="estimate the tick's cycles on a Cortex-M3 (the TRM's timings) and from a 72 MHz part's flash")
     p.add_argument("--qemu", default="qemu-system-arm")
     p.add_argument("--nm", default="arm-none-eabi-nm")
     p.add_argument("--addr2line", default="arm-none-eabi-addr2line")
@@ -146,9 +209,20 @@ def main():
     with tempfile.TemporaryDirectory() as d:
         log = os.path.join(d, "trace.log")
         output = run_trace(args, log)
-        counts, ticks = parse(log, handler_lo & ~1, args.phase)
+        counts, ticks, insns, taken = parse(log, handler_lo & ~1, args.phase)
     if ticks == 0:
         sys.exit(f"tick_profile: no tick seen (the image's output: {output.strip()[-400:]})")
+    if args.m3_cycles:
+        n, core, flash = m3_estimate(counts, insns, taken, ticks)
+        print(f"{ticks} ticks; per tick: {n:.0f} instructions, {taken / ticks:.0f} taken branches")
+        print(f"Cortex-M3 cycles per tick, zero wait states: {core:.0f} (cycles per instruction {core / n:.2f})")
+        print(f"Cortex-M3 cycles per tick, 72 MHz flash (2 wait states): {flash:.0f} (cycles per instruction "
+              f"{flash / n:.2f}; {flash / 72:.0f} us at 72 MHz)")
+        print(f"  taken branches' refills: {taken / ticks * M3_REFILL:.0f} cycles; exception entry and return: "
+              f"{M3_EXCEPTION}")
+        for key, k, c in m3_classes(counts, insns, ticks)[:args.top]:
+            print(f"  {key:10s} {k:8.0f} instructions {c:8.0f} cycles")
+        return
     addresses = sorted({a for sites, a in counts} | {c for sites, _ in counts for c in sites})
     ch = chains(args.image, args.addr2line, addresses)
     stages, funcs = collections.Counter(), collections.Counter()
