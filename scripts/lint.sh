@@ -29,7 +29,7 @@ step "flake8, ${#py[@]} files"
 flake8 "${py[@]}" || { echo "lint: flake8 failed"; status=1; }
 
 if [ -f "$build/compile_commands.json" ]; then
-  tidy=(host_sim/*.cpp tests/boards/stm32f4/test_stm32f4.cpp tests/boards/persist/test_record_store.cpp tests/firmware/runtime/test_supervisor.cpp tests/firmware/runtime/test_motion_states.cpp tests/firmware/link/test_link.cpp)
+  tidy=(host_sim/*.cpp tests/boards/stm32f4/test_stm32f4.cpp tests/boards/persist/test_record_store.cpp tests/firmware/runtime/test_supervisor.cpp tests/firmware/runtime/test_control_task.cpp tests/firmware/runtime/test_motion_states.cpp tests/firmware/link/test_link.cpp)
   step "clang-tidy, ${#tidy[@]} translation units"
   findings=$(printf '%s\n' "${tidy[@]}" | xargs -P 2 -n 1 clang-tidy -p "$build" --quiet 2>/dev/null |
              grep -E 'error:|warning:' | sort -u)
