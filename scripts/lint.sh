@@ -5,6 +5,7 @@
 #                  them every project header they include (the firmware's, the HAL's, the STM32F4 board's)
 #   flake8         the Python scripts (setup.cfg)
 #   function lengths  no function of firmware/, host_sim/, boards/ or tests/boards/ over 80 lines
+#   firmware's parts  no firmware function over 60 lines, no header over 450, none without its test file
 #   docs figures   no frame size, fault bit or README instruction count typed in the hand-written
 #                  docs that disagrees with (or repeats) a generated table (scripts/docs_figures.py)
 # usage: scripts/lint.sh [HOST_BUILD_DIR]   (default build/host; it needs compile_commands.json)
@@ -29,7 +30,7 @@ step "flake8, ${#py[@]} files"
 flake8 "${py[@]}" || { echo "lint: flake8 failed"; status=1; }
 
 if [ -f "$build/compile_commands.json" ]; then
-  tidy=(host_sim/*.cpp tests/boards/stm32f4/test_stm32f4.cpp tests/boards/persist/test_record_store.cpp tests/firmware/runtime/test_supervisor.cpp tests/firmware/runtime/test_motion_states.cpp tests/firmware/link/test_link.cpp)
+  tidy=(host_sim/*.cpp tests/boards/stm32f4/test_stm32f4.cpp tests/boards/persist/test_record_store.cpp tests/firmware/runtime/test_supervisor.cpp tests/firmware/runtime/test_control_task.cpp tests/firmware/runtime/test_motion_states.cpp tests/firmware/link/test_link.cpp)
   step "clang-tidy, ${#tidy[@]} translation units"
   findings=$(printf '%s\n' "${tidy[@]}" | xargs -P 2 -n 1 clang-tidy -p "$build" --quiet 2>/dev/null |
              grep -E 'error:|warning:' | sort -u)
@@ -51,6 +52,24 @@ long_headers=$(find firmware -name '*.hpp' -exec wc -l {} + | awk '$2 != "total"
 if [ -n "$long_headers" ]; then
   echo "$long_headers"
   echo "lint: firmware headers over 450 lines"
+  status=1
+fi
+# The tests mirror the firmware at file level (issue 54): each header of a layer the tests mirror,
+# firmware/<layer>/include/osc/<layer>/<header>.hpp, has its tests in tests/firmware/<layer>/test_<header>.cpp,
+# built by tests/CMakeLists.txt.
+missing_tests=$(for layer in math kernels control runtime link; do
+  for h in firmware/$layer/include/osc/$layer/*.hpp; do
+    t=tests/firmware/$layer/test_$(basename "$h" .hpp).cpp
+    if [ ! -f "$t" ]; then
+      echo "$t: missing (the tests of $h)"
+    elif ! grep -q "firmware/$layer/$(basename "$t")" tests/CMakeLists.txt; then
+      echo "$t: in no test executable of tests/CMakeLists.txt (the tests of $h)"
+    fi
+  done
+done)
+if [ -n "$missing_tests" ]; then
+  echo "$missing_tests"
+  echo "lint: firmware headers without their test file (tests/firmware/<layer>/test_<header>.cpp, in tests/CMakeLists.txt)"
   status=1
 fi
 

@@ -31,7 +31,7 @@ struct FuzzHal {
   std::uint32_t clock = 0;
   bool read_encoders(std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) c[i] = next[i];
-    return true;  // a sample every tick (ticks without one: tests/firmware/runtime/test_supervisor.cpp)
+    return true;  // a sample every tick (ticks without one: tests/firmware/runtime/test_control_task.cpp)
   }
   void write_dacs(const std::int32_t c[osc::kDof]) {
     for (int i = 0; i < osc::kDof; ++i) written[i] = c[i];

@@ -3,7 +3,7 @@
 // (the wrist centre) from 10 s on, entering the plant as J_v^T F. Category 0 cuts the torque in the
 // tick of the detection; category 2 stops along the path and holds, without a fault; yield gives
 // way to the force until a stop holds the pose reached. A user's collision threshold above the
-// contact's torque lets it pass; one outside its bounds is refused.
+// contact's torque lets it pass (one outside its bounds is refused: tests/firmware/runtime/test_task.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -174,22 +174,6 @@ TEST(CollisionReaction, AThresholdAboveTheContactsTorqueLetsItPass) {
   const double floor[kDof] = {60, 60, 60, 20, 20, 20};  // above the 50 N contact's joint torques
   ContactRun run(CollisionReaction::kCategory0, kDown, floor);
   EXPECT_EQ(run.run_to(kContactAt + 0.2) & kFaultCollision, 0u);
-}
-
-TEST(CollisionReaction, ThresholdsOutsideTheirBoundsAreRefusedAndChangeNothing) {
-  std::unique_ptr<ControlTask<double>> task(new ControlTask<double>);
-  task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,
-             joint_vector<double>(robot::kQStart));
-  const double ok[kDof] = {10, 10, 10, 5, 5, 5};
-  ASSERT_TRUE(task->set_collision(CollisionReaction::kYield, ok));
-  double bad[kDof] = {10, 10, 10, 5, 5, 5};
-  for (const double v : {-1.0, std::nan(""), robot::kDrives.torque_limit[4] * 1.01}) {
-    bad[4] = v;
-    EXPECT_FALSE(task->set_collision(CollisionReaction::kCategory2, bad)) << v;
-    EXPECT_EQ(task->collision_reaction, CollisionReaction::kYield);
-    EXPECT_EQ(task->residual.collision_floor(4), 5.0);
-  }
-  EXPECT_FALSE(task->set_collision(static_cast<CollisionReaction>(3), ok));
 }
 
 }  // namespace

@@ -455,24 +455,4 @@ void homes_in_scalar() {
 }
 TEST(Homing, InFloat) { homes_in_scalar<float>(); }
 TEST(Homing, InFixedPoint) { homes_in_scalar<Fixed>(); }
-
-TEST(Homing, TicksRoundTripInEveryScalar) {
-  const double cpr = robot::kDriveTrain.encoders.counts_per_rad[1];  // J2: 13 669 counts/rad
-  for (double x : {-3.9, -0.123456, 0.0, 1e-4, 2.5}) {
-    const std::int64_t want = std::llround(x * cpr * 65536);
-    EXPECT_NEAR(static_cast<double>(detail::to_ticks<double>(x, cpr)), static_cast<double>(want), 1.0) << x;
-    EXPECT_NEAR(static_cast<double>(detail::to_ticks<float>(static_cast<float>(x), static_cast<float>(cpr))),
-                static_cast<double>(want), 0.02 * 65536)
-        << x;  // float's 24 bits: 0.005 counts at 5e4
-    // Q12.19's angle resolution, 1.9e-6 rad: 0.026 counts at J2's 13 669 counts/rad.
-    EXPECT_NEAR(static_cast<double>(detail::to_ticks<Fixed>(Fixed(x), FixedIo(cpr))), static_cast<double>(want),
-                0.03 * 65536)
-        << x;
-    EXPECT_NEAR(detail::from_ticks<double>(want, cpr), x, 1e-9);
-    EXPECT_NEAR(static_cast<double>(detail::from_ticks<Fixed>(want, FixedIo(cpr))), x, 2e-5) << x;
-  }
-  EXPECT_EQ(detail::floor_div(-7, 2), -4);
-  EXPECT_EQ(detail::floor_div(7, 2), 3);
-  EXPECT_EQ(detail::floor_div(-8, 2), -4);
-}
 }  // namespace

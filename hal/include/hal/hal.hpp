@@ -3,7 +3,7 @@
 // binding states that it satisfies it (static_assert), and control_tick() requires it:
 //   host_sim/plant_hal.hpp (the simulated PUMA 560), the link node (osc/link/node.hpp, the PIL
 //   firmware's encoders and DACs), boards/<board>/ (e.g. the still-robot stub of timer_firmware),
-//   and the scripted HAL of tests/firmware/runtime/test_supervisor.cpp.
+//   and the scripted HAL of tests/firmware/runtime/test_control_task.cpp.
 // The periodic control timer is the board's (boards/<board>/board.hpp: control_timer_start()); its
 // interrupt calls osc::control_tick(). Telemetry: the task's StepTiming, supervisor state and fault
 // bits; over the PIL link every actuator frame carries them (osc/link/frames.hpp).

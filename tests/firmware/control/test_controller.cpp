@@ -1,58 +1,18 @@
-// Control kernels of issue 3: trajectory (68), adaptation (67), observer discretisation, faults,
-// allocation-free stepping.
+// Control kernels of issue 3: adaptation (67), faults, allocation-free stepping, each stage of the step
+// against its equations, and the dynamics model's rate. The trajectory (68) and the observer's
+// discretisation are in test_trajectory.cpp and test_observer.cpp.
 #include <gtest/gtest.h>
 
-#include <Eigen/Eigenvalues>
+#include <cstdio>
 
+#include "controller_fixtures.hpp"
 #include "osc/control/controller.hpp"
 #include "test_util.hpp"
 
 using namespace osc;
+using namespace osc::test;
 
 namespace {
-
-Vec6<double> q_start() { return joint_vector<double>(robot::kQStart); }
-
-constexpr TrajectorySpec<double> kPaperTrajectory = TrajectorySpec<double>::paper();
-
-TEST(Trajectory, SpecFromPeriodAndEnvelopeReproducesThePapersAndScalesToOthers) {
-  const TrajectorySpec<double> s = trajectory_spec(params::kAmplitude, 5000, params::kEnvelope, params::kDt);
-  EXPECT_EQ(s.period_ticks, kTrajectoryPeriodTicks);
-  EXPECT_EQ(s.settled_ticks, kEnvelopeSettledTicks);
-  EXPECT_NEAR(s.omega, params::kOmega, 1e-15);
-  // A 2 s period with a slower envelope: c t^3 >= 400 first at t = 20 s (c = 0.05) -> 10 periods;
-  // c = 0.01: t >= 34.2 s -> 18 periods of 2 s = 36 s.
-  const TrajectorySpec<double> f = trajectory_spec(0.02, 2000, 0.01, params::kDt);
-  EXPECT_EQ(f.settled_ticks, 36000u);
-  EXPECT_NEAR(f.omega, kPi, 1e-15);
-  // The phase after settling repeats with the configured period.
-  const Vec3<double> p0(0.5, 0, 0.3);
-  for (std::uint64_t n : {36000ull, 36000ull + 777, 1000000ull + 3}) {
-    const double t1 = trajectory_time(f, n, 1000), t2 = trajectory_time(f, n + 2000, 1000);
-    EXPECT_EQ(t1, t2);
-    EXPECT_NEAR(trajectory(f, p0, t1).x(0) - p0(0), 0.02 * std::sin(kPi * static_cast<double>(n) * 1e-3), 1e-9) << n;
-  }
-}
-
-TEST(Trajectory, StartsAtRestAndDerivativesMatchFiniteDifferences) {
-  const Vec3<double> p0(0.6, -0.15, 0.0);
-  const Desired<double> d0 = trajectory(kPaperTrajectory, p0, 0.0);
-  EXPECT_LT((d0.x.head<3>() - p0).norm(), 1e-15);
-  EXPECT_LT(d0.xd.norm(), 1e-15);
-  EXPECT_LT(d0.xdd.norm(), 1e-15);
-  EXPECT_EQ(d0.x.tail<3>().norm(), 0.0);  // orientation held
-  const double h = 1e-5;
-  for (double t : {0.3, 1.7, 4.2, 9.9, 33.3, 119.0}) {
-    const Desired<double> d = trajectory(kPaperTrajectory, p0, t), dp = trajectory(kPaperTrajectory, p0, t + h),
-                          dm = trajectory(kPaperTrajectory, p0, t - h);
-    EXPECT_LT(((dp.x - dm.x) / (2 * h) - d.xd).norm(), 1e-8) << t;
-    EXPECT_LT(((dp.xd - dm.xd) / (2 * h) - d.xdd).norm(), 1e-7) << t;
-  }
-  // After the envelope: +-50 mm, y and z equal (f = 1).
-  const Desired<double> d = trajectory(kPaperTrajectory, p0, 100.0 + 1.25);  // sin = 1 at a quarter period
-  EXPECT_NEAR(d.x(0) - p0(0), params::kAmplitude, 1e-9);
-  EXPECT_NEAR(d.x(1) - p0(1), d.x(2) - p0(2), 1e-15);
-}
 
 TEST(Adaptation, SampledLawMatchesEquation67) {
   // Two steps at rest-free poses: the second step's theta^ must equal
@@ -96,47 +56,6 @@ TEST(Adaptation, NoCompensationModeNeverAdapts) {
     EXPECT_EQ(out.tau_f_hat.norm(), 0.0);
   }
   EXPECT_EQ(st->adapt.theta_hat.norm(), 0.0);
-}
-
-// The discrete observer error map of the semi-implicit Euler scheme, linearised about a pose:
-// [x~; y~]_{n+1} = [[I - k dt - B dt^2, -dt I], [B dt, I]] [x~; y~]_n with B = Lambda^{-1} k_i.
-// Its spectral radius must be below 1 at the start pose and along the trajectory.
-double spectral_radius(const Mat6<double>& Lambda, bool semi_implicit) {
-  const Gains<double> G = Gains<double>::paper();
-  const double dt = G.dt;
-  const Mat6<double> B = Lambda.llt().solve(Mat6<double>(G.ki.asDiagonal()));
-  Eigen::Matrix<double, 12, 12> M;
-  const Mat6<double> I = Mat6<double>::Identity();
-  const Mat6<double> K = G.k.asDiagonal();
-  M.topLeftCorner<6, 6>() = I - K * dt - (semi_implicit ? Mat6<double>(B * dt * dt) : Mat6<double>::Zero());
-  M.topRightCorner<6, 6>() = -dt * I;
-  M.bottomLeftCorner<6, 6>() = B * dt;
-  M.bottomRightCorner<6, 6>() = I;
-  return M.eigenvalues().cwiseAbs().maxCoeff();
-}
-
-TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
-  const Model<double> model = Model<double>::of(robot::kArm);
-  Data<double> data;
-  OpSpace<double> os;
-  forward_kinematics(model, data, q_start());
-  const Mat3<double> R_ref = data.R[kDof];
-  double worst_semi = 0, worst_explicit = 0;
-  // Along a sweep of the task workspace around the start pose.
-  for (double s = -1; s <= 1; s += 0.25) {
-    Vec6<double> q = q_start();
-    q(0) += 0.1 * s;
-    q(1) += 0.08 * s;
-    q(2) -= 0.1 * s;
-    opspace_update(model, data, os, q, R_ref);
-    worst_semi = std::max(worst_semi, spectral_radius(operational_inertia(data, os), true));
-    worst_explicit = std::max(worst_explicit, spectral_radius(operational_inertia(data, os), false));
-  }
-  RecordProperty("spectral_radius_semi_implicit", std::to_string(worst_semi));
-  RecordProperty("spectral_radius_explicit", std::to_string(worst_explicit));
-  std::printf("observer error map spectral radius: semi-implicit %.6f, explicit Euler %.6f\n", worst_semi,
-              worst_explicit);
-  EXPECT_LT(worst_semi, 1.0);
 }
 
 /// A controller in double just initialised at the start pose, with the paper's motion about it.
@@ -252,55 +171,6 @@ void run_steps_without_allocation() {
 TEST(ControlStepScalars, AllocationFreeInDoubleAndFloat) {
   run_steps_without_allocation<double>();
   run_steps_without_allocation<float>();
-}
-
-// ---------------------------------------------------------------- the stages, one at a time
-// Each stage of control_step against an independent evaluation of its equations (dense solves with
-// Lambda and the analytic Jacobian, Psi by the other polarisation), at an off-task state.
-struct Stages : ::testing::Test {
-  Model<double> model = Model<double>::of(robot::kArm);
-  Gains<double> G = Gains<double>::paper();
-  Data<double> data{};
-  OpSpace<double> os{};
-  Vec6<double> q = q_start();
-  void SetUp() override {
-    forward_kinematics(model, data, q);
-    const Mat3<double> R_ref = data.R[kDof];
-    q << q(0) + 0.05, q(1) - 0.04, q(2) + 0.03, q(3) + 0.1, q(4) - 0.05, q(5) + 0.2;  // phi != 0
-    opspace_update(model, data, os, q, R_ref);
-  }
-  static Vec6<double> v6(double a, double b, double c, double d, double e, double f) {
-    Vec6<double> v;
-    v << a, b, c, d, e, f;
-    return v;
-  }
-};
-
-TEST_F(Stages, ObserverOutputIsEquations21_23_28) {
-  const Vec6<double> x_hat = os.x + v6(1e-3, -2e-3, 5e-4, 1e-3, 0, -1e-3);
-  const Vec6<double> y = v6(0.02, -0.01, 0.03, 0.1, -0.05, 0.02);
-  const ObserverOutput<double> o = observer_output(G, os, x_hat, y);
-  EXPECT_LT((o.x_tilde - (os.x - x_hat)).norm(), 1e-15);
-  for (int i = 0; i < kDof; ++i) EXPECT_NEAR(o.xd_hat(i), y(i) + G.k(i) * o.x_tilde(i), 1e-15);
-  EXPECT_LT((os.Ja * o.qd_hat - o.xd_hat).norm(), 1e-12);  // (28): x^dot = Ja q^dot
-}
-
-TEST_F(Stages, ObserverUpdateIsEquation22) {
-  const Vec6<double> x_hat = os.x + v6(1e-3, -2e-3, 5e-4, 1e-3, 0, -1e-3);
-  const Vec6<double> y = v6(0.02, -0.01, 0.03, 0.1, -0.05, 0.02);
-  const Vec6<double> F = v6(10, -20, 35, 1, -2, 0.5);
-  BiasForce<double> bias;  // h + p + f = J^-T tau - Lambda a
-  bias.tau = v6(3, -40, 12, 0.5, -0.3, 0.1);
-  bias.a = v6(0.2, -0.1, 0.3, 1.0, -2.0, 0.5);
-  const Vec6<double> xt = os.x - x_hat;
-  const ObserverState<double> n = observer_update(G, os, x_hat, y, xt, F, bias);
-  // Lambda (y' - y) / dt = F - (h + p + f) + k_i x~, with Lambda formed and everything solved densely here.
-  const Mat6<double> Lambda = operational_inertia(data, os);
-  const Vec6<double> hpf = os.Ja.transpose().partialPivLu().solve(bias.tau) - Lambda * bias.a;
-  const Vec6<double> rhs = F - hpf + G.ki.cwiseProduct(xt);
-  const Vec6<double> y_expect = y + G.dt * Lambda.partialPivLu().solve(rhs);
-  EXPECT_LT((n.y - y_expect).norm(), 1e-9 * (1 + y_expect.norm()));
-  EXPECT_LT((n.x_hat - (x_hat + G.dt * (n.y + G.k.cwiseProduct(xt)))).norm(), 1e-15);
 }
 
 TEST_F(Stages, FrictionEstimateIsEquation30) {

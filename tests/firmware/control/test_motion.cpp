@@ -1,9 +1,6 @@
-// The motion generator (osc/control/motion.hpp) and its point-to-point move
-// (osc/control/cartesian_move.hpp): the reference a move produces, sampled every millisecond, against
-// its limits (speed, acceleration and jerk of the translation and of the rotation, the rotation's
-// from E(phi) phi_dot, not from the profile), the straight line and the single axis, its end, the
-// orientation coordinates' rates against finite differences; a stop along the path; the queue; the
-// re-target; the paper's motion and its slow-down; float and Q12.19 against double.
+// The motion generator (osc/control/motion.hpp): a stop along the path; the queue; the re-target; the
+// paper's motion and its slow-down; float and Q12.19 against double. Each reference sampled every
+// millisecond against its limits (motion_fixtures.hpp). The move itself: test_cartesian_move.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -11,162 +8,14 @@
 #include <random>
 #include <vector>
 
+#include "motion_fixtures.hpp"
 #include "osc/control/motion.hpp"
 #include "osc/math/fixed.hpp"
 
 using namespace osc;
+using namespace osc::test;
 
 namespace {
-
-constexpr std::uint32_t kHz = params::kControlHz;
-
-Pose<double> pose(double x, double y, double z, const Vec3<double>& rpy) {
-  return {Vec3<double>(x, y, z), rpy_rotation<double>(rpy)};
-}
-
-/// The base angular velocity and acceleration of a reference in orientation coordinates:
-/// w = E(phi) phi_dot (E^{-1} inverted numerically: an independent path from the one at() takes).
-Vec3<double> angular_velocity(const Desired<double>& d) {
-  const Mat3<double> Einv = angular_to_phi_rate<double>(d.x.tail<3>());
-  return Einv.inverse() * d.xd.tail<3>();
-}
-
-/// What a reference did over a run of ticks.
-struct Trace {
-  double v = 0, a = 0, j = 0, w = 0, wd = 0;  // peak linear speed, acceleration, jerk; angular speed, acceleration
-  double jump = 0;                            // largest change of x, xd, xdd in one tick beyond what the limits allow
-  double off_line = 0;                        // largest distance from the line p0 -> p1
-  double derivative = 0;                      // largest mismatch of x, xd with the trapezoidal integrals of xd, xdd
-  int finished = 0, stopped = 0;              // events
-  std::vector<std::uint32_t> done;            // the ids of the moves done, in order
-  int ticks = 0;
-  Desired<double> last{};
-};
-
-/// Runs the generator from tick t0 for n ticks (or until an event when until_event), recording the
-/// reference's peaks; jerk from the difference of accelerations.
-template <class S>
-Trace run(MotionGenerator<S>& g, std::uint64_t t0, int n, bool until_event, const Vec3<double>* line = nullptr) {
-  Trace tr;
-  Desired<double> prev{Vec6<double>::Zero(), Vec6<double>::Zero(), Vec6<double>::Zero()};
-  Vec3<double> w_prev = Vec3<double>::Zero();
-  for (int i = 0; i < n; ++i) {
-    MotionEvents ev;
-    const Desired<S> ds = g.at_tick(t0 + i, kHz, ev);
-    Desired<double> d{ds.x.template cast<double>(), ds.xd.template cast<double>(), ds.xdd.template cast<double>()};
-    tr.v = std::max(tr.v, d.xd.head<3>().norm());
-    tr.a = std::max(tr.a, d.xdd.head<3>().norm());
-    const Vec3<double> w = angular_velocity(d);
-    tr.w = std::max(tr.w, w.norm());
-    if (i > 0) {
-      tr.j = std::max(tr.j, (d.xdd.head<3>() - prev.xdd.head<3>()).norm() * kHz);
-      tr.wd = std::max(tr.wd, (w - w_prev).norm() * kHz);
-      // Continuity: the position moves by at most v dt, the velocity by at most a dt (plus slack).
-      tr.jump = std::max(tr.jump, (d.x.head<3>() - prev.x.head<3>()).norm() - 1.01 * params::kMoveLinear[0] / kHz);
-      tr.jump = std::max(tr.jump, (d.xd.head<3>() - prev.xd.head<3>()).norm() - 1.01 * params::kMoveLinear[1] / kHz);
-      // xd and xdd are the derivatives of x and xd: the trapezoidal rule over one tick errs by at most
-      // j dt / 8 where the jerk switches inside it (3e-4 at 2.5 m/s^3, 1.25e-3 at 10 rad/s^3).
-      tr.derivative = std::max(tr.derivative, ((d.x - prev.x) * kHz - (d.xd + prev.xd) / 2).cwiseAbs().maxCoeff());
-      tr.derivative = std::max(tr.derivative, ((d.xd - prev.xd) * kHz - (d.xdd + prev.xdd) / 2).cwiseAbs().maxCoeff());
-    }
-    if (line) {
-      const Vec3<double> r = d.x.head<3>() - line[0], u = (line[1] - line[0]).normalized();
-      tr.off_line = std::max(tr.off_line, (r - u * r.dot(u)).norm());
-    }
-    tr.finished += ev.finished, tr.stopped += ev.stopped;
-    if (ev.done_id != 0) tr.done.push_back(ev.done_id);
-    prev = d, w_prev = w;
-    tr.last = d;
-    ++tr.ticks;
-    if (until_event && (ev.finished || ev.stopped)) break;
-  }
-  return tr;
-}
-
-const CartesianLimits<double> kLim = CartesianLimits<double>::defaults();
-
-void expect_within_limits(const Trace& tr, double slack = 1e-9) {
-  EXPECT_LE(tr.v, params::kMoveLinear[0] * (1 + slack));
-  EXPECT_LE(tr.a, params::kMoveLinear[1] * (1 + slack));
-  EXPECT_LE(tr.j, params::kMoveLinear[2] * (1 + 1e-6));  // a difference quotient of a piecewise-linear a
-  EXPECT_LE(tr.w, params::kMoveAngular[0] * (1 + 1e-6));
-  EXPECT_LE(tr.wd, params::kMoveAngular[1] * (1 + 1e-3));
-  EXPECT_LE(tr.jump, 0.0);
-  EXPECT_LE(tr.derivative, 0.25 * params::kMoveAngular[2] / kHz);
-}
-
-TEST(CartesianMove, StraightLineAboutOneAxisWithinItsLimitsEndingAtTheTarget) {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> U(-1, 1);
-  for (int trial = 0; trial < 20; ++trial) {
-    const Pose<double> a =
-        pose(0.4 + 0.1 * U(rng), 0.1 * U(rng), 0.3 + 0.1 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
-    const Pose<double> b =
-        pose(0.4 + 0.2 * U(rng), 0.2 * U(rng), 0.3 + 0.2 * U(rng), {0.3 * U(rng), 0.3 * U(rng), U(rng)});
-    const Mat3<double> R_ref = rpy_rotation<double>({0.1, -0.2, 0.3});
-    CartesianMove<double> m;
-    ASSERT_EQ(m.plan(a, b, kLim, R_ref), ProfileStatus::kOk);
-    // Synchronised: both profiles last the move's duration (or are empty).
-    for (double dur : {m.linear().duration(), m.angular().duration()}) {
-      if (dur > 0) {
-        EXPECT_NEAR(dur, m.duration(), 1e-9);
-      }
-    }
-    MotionGenerator<double> g;
-    g.hold(a, R_ref);
-    ASSERT_TRUE(g.push(m));
-    g.start_moves(100);
-    const Vec3<double> line[2] = {a.p, b.p};
-    const Trace tr = run(g, 100, 20000, true, line);
-    expect_within_limits(tr);
-    EXPECT_LE(tr.off_line, 1e-12);
-    EXPECT_EQ(tr.finished, 1);
-    EXPECT_NEAR(tr.ticks - 1, m.duration() * kHz, 1.0);
-    // It ends holding the target: position and orientation coordinates of b.
-    EXPECT_LE((tr.last.x.head<3>() - b.p).norm(), 1e-12);
-    EXPECT_LE((tr.last.x.tail<3>() - orientation_coordinates<double>(b.R, R_ref)).norm(), 1e-9);
-    EXPECT_EQ(tr.last.xd.norm(), 0.0);
-  }
-}
-
-TEST(CartesianMove, OrientationRatesAreTheDerivativesOfItsCoordinates) {
-  const Mat3<double> R_ref = rpy_rotation<double>({0.2, 0.1, -0.4});
-  CartesianMove<double> m;
-  ASSERT_EQ(m.plan(pose(0.5, 0, 0.3, {0, 0, 0}), pose(0.5, 0.05, 0.3, {0.5, -0.4, 0.9}), kLim, R_ref),
-            ProfileStatus::kOk);
-  const double h = 1e-6;
-  double worst_v = 0, worst_a = 0;
-  for (double t = 0.01; t < m.duration(); t += 0.037) {
-    const Desired<double> d = m.at(t), dp = m.at(t + h), dm = m.at(t - h);
-    worst_v = std::max(worst_v, ((dp.x - dm.x) / (2 * h) - d.xd).norm());
-    worst_a = std::max(worst_a, ((dp.xd - dm.xd) / (2 * h) - d.xdd).norm());
-    // The orientation is the rotation about the one axis: R(t) R0^T = Rot(k, psi(t)).
-    const Mat3<double> R = rpy_rotation<double>(d.x.tail<3>()) * R_ref;
-    const Mat3<double> Rd = R * rpy_rotation<double>({0, 0, 0}).transpose();
-    Vec3<double> k;
-    double angle;
-    rotation_axis_angle<double>(Rd, k, angle);
-    EXPECT_NEAR(std::abs(k.dot(m.axis())), 1.0, 1e-9) << t;
-    EXPECT_NEAR(angle, m.angular().at(t).p, 1e-9) << t;
-  }
-  EXPECT_LE(worst_v, 1e-6);
-  EXPECT_LE(worst_a, 1e-4);
-}
-
-TEST(CartesianMove, RefusesRotationsBeyondTheLimitAndNonFiniteTargets) {
-  CartesianMove<double> m;
-  const Pose<double> a = pose(0.5, 0, 0.3, {0, 0, 0});
-  EXPECT_EQ(m.plan(a, pose(0.5, 0, 0.3, {0, 0, 3.0}), kLim, a.R), ProfileStatus::kBadTarget);
-  EXPECT_EQ(m.plan(a, pose(NAN, 0, 0.3, {0, 0, 0}), kLim, a.R), ProfileStatus::kBadTarget);
-  CartesianLimits<double> bad = kLim;
-  bad.linear.v = 0;
-  EXPECT_EQ(m.plan(a, pose(0.6, 0, 0.3, {0, 0, 0}), bad, a.R), ProfileStatus::kBadLimits);
-  EXPECT_FALSE(bad.within(kLim));
-  bad = kLim;
-  bad.angular.j *= 1.01;
-  EXPECT_FALSE(bad.within(kLim));
-  EXPECT_TRUE(kLim.within(kLim));
-}
 
 TEST(MotionGenerator, StopDeceleratesAlongThePathWithinTheLimits) {
   const Pose<double> a = pose(0.5, -0.2, 0.3, {0, 0, 0}), b = pose(0.5, 0.3, 0.2, {0, 0, 1.2});

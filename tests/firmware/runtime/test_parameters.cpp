@@ -1,33 +1,23 @@
-// The runtime parameter table (osc/runtime/parameters.hpp) and its link (osc/link/param_frames.hpp,
-// through the command port): one declaration, checked sets, the observer's stability margin against
-// the spectral radius of the discrete observer's error map, records, and save / reset / load.
+// The runtime parameters' access (osc/runtime/parameters.hpp): the defaults a new task has, checked sets,
+// the observer's stability margin against the spectral radius of the discrete observer's error map, every
+// gain's bounds, records, the pots switch. The table itself: test_param_table.cpp; its link:
+// tests/firmware/link/test_param_frames.cpp.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <memory>
-#include <set>
-#include <string>
-#include <vector>
 
-#include "osc/link/command_port.hpp"
 #include "osc/math/fixed.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/parameters.hpp"
+#include "task_util.hpp"
 
 namespace {
 
 using namespace osc;
-
-template <class S>
-std::unique_ptr<ControlTask<S>> disabled_task() {
-  auto t = std::make_unique<ControlTask<S>>();
-  t->init(Model<S>::of(robot::kArm), Gains<S>::paper(), FrictionMode::kAdaptive, joint_vector<S>(robot::kQStart), 0,
-          TaskStart::kDisabled);
-  return t;
-}
+using osc::test::disabled_task;
 
 /// The spectral radius of the observer's linearised error map at a pose, from observer.hpp's
 /// discretisation with the arm still (x fixed, F and the bias forces cancelling to first order):
@@ -42,38 +32,6 @@ double observer_spectral_radius(const Gains<double>& g, const Mat6<double>& lamb
   A.bottomLeftCorner<6, 6>() = dt * M;
   A.bottomRightCorner<6, 6>() = Mat6<double>::Identity();
   return Eigen::EigenSolver<Eigen::Matrix<double, 12, 12>>(A).eigenvalues().cwiseAbs().maxCoeff();
-}
-
-TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
-  std::set<std::string> names;
-  int gains = 0, slots = 0;
-  for (int i = 0; i < kParamCount; ++i) {
-    const ParamInfo& p = kParams[i];
-    EXPECT_TRUE(names.insert(p.name).second) << p.name << " twice";
-    EXPECT_EQ(param_index(p.name), i);
-    EXPECT_EQ(param_slot(i), slots);
-    slots += p.count;
-    EXPECT_TRUE(p.count >= 1 && p.count <= kDof) << p.name;
-    for (int e = 0; e < p.count; ++e) {
-      EXPECT_LT(p.lo_of(e), p.hi_of(e)) << p.name;
-      EXPECT_EQ(param_value_status(i, e, param_default(i, e)), ParamStatus::kOk) << p.name << "[" << e << "]";
-    }
-    if (p.gain >= 0) {
-      // The gains come first, with their key, range and unit from OSC_GAINS_FIELDS.
-      EXPECT_EQ(i, gains++);
-      const GainParam& g = kGainInfo[p.gain].param;
-      EXPECT_STREQ(p.name, g.key);
-      EXPECT_EQ(p.lo, g.lo);
-      EXPECT_EQ(p.hi, g.hi);
-      EXPECT_STREQ(p.unit, g.unit);
-      EXPECT_EQ(p.access, ParamAccess::kTorqueOff);
-    }
-  }
-  EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
-  EXPECT_EQ(slots, kParamSlots);
-  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2 + 1));
-  EXPECT_EQ(param_index("no_such"), -1);
-  EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
 }
 
 /// The table's defaults are what a task starts with: the gains' paper values, the configured
@@ -379,127 +337,6 @@ TEST(Parameters, PotsZeroTurnsThePositionCrossCheckOff) {
   ASSERT_EQ(param_set(*t, param_index("pots"), 0, 1.0), ParamStatus::kOk);
   control_tick(*t, hal);
   EXPECT_EQ(hal.pot_reads, 2);
-}
-
-TEST(Parameters, LayoutVersionIsOfTheTable) {
-  EXPECT_NE(kParamLayout, 0);
-  // A fixed value: a change of any name or element count changes it, and this test with it (the
-  // stored records of the old table are then not loaded: layout_mismatch).
-  EXPECT_EQ(kParamLayout, 2123);
-}
-
-// ------------------------------------------------------------------------------- over the link
-
-struct ParamLink : ::testing::Test {
-  std::unique_ptr<ControlTask<double>> task = disabled_task<double>();
-  CommandPort<double> port;
-  std::vector<pil::ParamAnswerFrame> answers;
-
-  pil::ParamAnswerFrame ask(std::uint8_t op, int index = 0, int element = 0, float value = 0) {
-    pil::ParamFrame f;
-    f.id = static_cast<std::uint32_t>(answers.size() + 1);
-    f.op = op;
-    f.index = static_cast<std::uint8_t>(index);
-    f.element = static_cast<std::uint8_t>(element);
-    f.value = value;
-    std::uint8_t buf[pil::kMaxFrame];
-    const int n = pil::encode(f, buf);
-    pil::Parser parser;
-    bool taken = false;
-    for (int k = 0; k < n; ++k)
-      if (parser.feed(buf[k]) == pil::Parser::kFrame)
-        taken = port.receive(*task, parser, [this](const std::uint8_t* b, int len) {
-          pil::Parser p;
-          for (int j = 0; j < len; ++j)
-            if (p.feed(b[j]) == pil::Parser::kFrame) {
-              pil::ParamAnswerFrame a;
-              if (p.decode(a)) answers.push_back(a);
-            }
-        });
-    EXPECT_TRUE(taken);
-    EXPECT_EQ(answers.size(), f.id);
-    return answers.empty() ? pil::ParamAnswerFrame{} : answers.back();
-  }
-};
-
-TEST_F(ParamLink, GetListsEveryParameterWithItsRangeAndTheLayout) {
-  for (int i = 0; i < kParamCount; ++i) {
-    const pil::ParamAnswerFrame a = ask(pil::kParamOpGet, i, kParams[i].count - 1);
-    EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOk)) << kParams[i].name;
-    EXPECT_EQ(a.count, kParamCount);
-    EXPECT_EQ(a.layout, kParamLayout);
-    EXPECT_FLOAT_EQ(a.value, static_cast<float>(param_default(i, kParams[i].count - 1)));
-    EXPECT_FLOAT_EQ(a.hi, static_cast<float>(kParams[i].hi_of(kParams[i].count - 1)));
-    EXPECT_EQ((a.flags & pil::kParamFlagTorqueOff) != 0, kParams[i].access == ParamAccess::kTorqueOff);
-  }
-  EXPECT_EQ(ask(pil::kParamOpGet, kParamCount).status, static_cast<std::uint8_t>(ParamStatus::kUnknownParam));
-  EXPECT_EQ(ask(pil::kParamOpGet, 0, 6).status, static_cast<std::uint8_t>(ParamStatus::kBadElement));
-  EXPECT_EQ(ask(pil::kParamOpCount).status, static_cast<std::uint8_t>(ParamStatus::kBadOp));
-}
-
-TEST_F(ParamLink, SetSaveResetLoadGivesTheValuesBack) {
-  const int ks = param_index("ks"), thr = param_index("collision_threshold");
-  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kNoRecord));
-  pil::ParamAnswerFrame a = ask(pil::kParamOpSet, ks, 0, 80);
-  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_FLOAT_EQ(a.value, 80);
-  EXPECT_GT(a.margins[0], 1);  // judged: the observer's margin
-  EXPECT_EQ(ask(pil::kParamOpSet, thr, 2, 15).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_EQ(ask(pil::kParamOpReset).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, ks, 0).value, params::kKs[0]);
-  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, thr, 2).value, 0);
-  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, ks, 0).value, 80);
-  EXPECT_FLOAT_EQ(ask(pil::kParamOpGet, thr, 2).value, 15);
-  EXPECT_DOUBLE_EQ(task->gains.ks(0), 80);
-  // A refused set answers the value as it stays, and the reason.
-  a = ask(pil::kParamOpSet, param_index("k"), 0, 2500);
-  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kOutOfRange));
-  EXPECT_FLOAT_EQ(a.value, params::kK[0]);
-  EXPECT_EQ(ask(pil::kParamOpSet, param_index("k"), 3, 25).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  a = ask(pil::kParamOpSet, param_index("ki"), 3, 3500);
-  EXPECT_EQ(a.status, static_cast<std::uint8_t>(ParamStatus::kUnstableLoop));
-  EXPECT_FLOAT_EQ(a.value, params::kKi[3]);
-  EXPECT_GT(a.margins[0], 1);  // the observer's margin met, the loop's not
-  EXPECT_LT(a.margins[3], 1);
-  EXPECT_EQ(ask(pil::kParamOpSet, param_index("k"), 3, 32).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  // Torque on: save, load and reset are refused.
-  task->machine.state = MotionState::kHolding;
-  for (std::uint8_t op : {pil::kParamOpSave, pil::kParamOpLoad, pil::kParamOpReset})
-    EXPECT_EQ(ask(op).status, static_cast<std::uint8_t>(ParamStatus::kTorqueOn)) << pil::kParamOpNames[op];
-  const pil::ParamAnswerFrame c = ask(pil::kParamOpCheck);
-  EXPECT_EQ(c.status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_GT(c.margins[0], 50);
-  EXPECT_GT(c.margins[2], 1);
-  EXPECT_GT(c.margins[3], 2);  // the loop's, the paper's gains at the start pose
-  EXPECT_EQ(c.flags & pil::kParamFlagWarn37, 0);
-}
-
-TEST_F(ParamLink, ABoardsStoreTakesSaveAndLoad) {
-  struct Counting {
-    ParamRecord r{};
-    int saves = 0, loads = 0;
-  } c;
-  ParamStorage s;
-  s.ctx = &c;
-  s.save = [](void* ctx, const ParamRecord& r) {
-    auto* k = static_cast<Counting*>(ctx);
-    k->r = r;
-    return ++k->saves < 2;  // the second save fails
-  };
-  s.load = [](void* ctx, ParamRecord& r) {
-    auto* k = static_cast<Counting*>(ctx);
-    ++k->loads;
-    r = k->r;
-    return ParamStatus::kLayoutMismatch;
-  };
-  port.set_param_storage(s);
-  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kOk));
-  EXPECT_EQ(ask(pil::kParamOpSave).status, static_cast<std::uint8_t>(ParamStatus::kStoreFailed));
-  EXPECT_EQ(ask(pil::kParamOpLoad).status, static_cast<std::uint8_t>(ParamStatus::kLayoutMismatch));
-  EXPECT_EQ(c.saves, 2);
-  EXPECT_EQ(c.loads, 1);
 }
 
 }  // namespace

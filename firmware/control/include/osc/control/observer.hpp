@@ -10,7 +10,7 @@
 // 2.7e4 s^-2 (rotational rows, Lambda eigenvalues down to 0.11), so b dt^2 = 0.027 against a bound of
 // 3.9: a wide margin. Explicit Euler would need b dt < k, i.e. 26.6 < 32 there: stable by a margin of
 // only 1.2, and lost for Lambda eigenvalues below k_i dt / k = 0.094. The paper's gains need nothing
-// else at 1 ms (tests/firmware/control/test_controller.cpp checks the spectral radius along the task).
+// else at 1 ms (tests/firmware/control/test_observer.cpp checks the spectral radius along the task).
 #pragma once
 
 #include "osc/control/gains.hpp"

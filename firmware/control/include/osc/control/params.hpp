@@ -207,7 +207,7 @@ constexpr int kIdentifyExciteBlocks = 64;
 /// (time constant kPositionFilter [s], the joints updated in turn, kPositionJointsPerTick a tick), must
 /// stay within kPositionBand [rad] of its value once settled (after kPositionSettle filter time
 /// constants), for kPositionQualify updates in a row, else position_mismatch. The band per joint is
-/// derived, not fitted (tests/firmware/runtime/test_monitors.cpp recomputes it):
+/// derived, not fitted (tests/firmware/control/test_params.cpp recomputes it):
 ///   6 codes of the potentiometer (its span / 4095: 0.94 to 2.35 mrad): the filtered difference of a
 ///     noise of up to 4 codes rms (twice the realistic plant's estimate) and the quantisation, the
 ///     settled value's own error included (sigma about 1 code);

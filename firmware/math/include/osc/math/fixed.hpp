@@ -18,7 +18,7 @@
 //   Q1.30 in 32 bits and Q30 / Q61 in 64 bits: inside the elementary functions only.
 // The elementary functions (sin, cos, exp, atan2, asin, sqrt) take and return Q<F>; their maximum
 // errors against double over the whole input range are stated at each and tested in
-// tests/firmware/math/test_fixed.cpp.
+// tests/firmware/math/test_q_functions.cpp.
 //
 // The parts: osc/math/saturating_int.hpp (the flags and the saturating integer arithmetic),
 // osc/math/q.hpp (the type Q<F>, Fixed and FixedIo), osc/math/q_functions.hpp (the elementary

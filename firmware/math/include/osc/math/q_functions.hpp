@@ -1,7 +1,7 @@
 // The elementary functions of the fixed-point scalar Q<F> (osc/math/q.hpp): sin, cos, exp, sqrt,
 // atan2, asin, abs and the classification functions, and the integer quotients of the I/O boundary.
 // Each computes in Q30 / Q61 integers and rounds once into Q<F>; its maximum error against double
-// over the whole input range is stated at each and tested in tests/firmware/math/test_fixed.cpp.
+// over the whole input range is stated at each and tested in tests/firmware/math/test_q_functions.cpp.
 #pragma once
 
 #include <cstdint>
@@ -22,7 +22,7 @@ constexpr std::int64_t kPio2Q30 = 1686629713LL;    // round(pi/2 2^30)
 constexpr std::int64_t kPiQ30 = 3373259426LL;      // round(pi 2^30)
 constexpr std::int32_t kTwoOverPiQ30 = 683565276;  // round(2/pi 2^30)
 constexpr std::int32_t kInvLn2Q30 = 1549082005;    // round(2^30 / ln 2)
-/// atan(i / 8) in Q30, i = 0..8 (mpmath, 200 bits; tests/firmware/math/test_fixed.cpp checks each).
+/// atan(i / 8) in Q30, i = 0..8 (mpmath, 200 bits; tests/firmware/math/test_q_functions.cpp checks each).
 constexpr std::int32_t kAtanEighthsQ30[9] = {0,         133525159, 263043837, 385227074, 497837829,
                                              599791448, 690954054, 771837835, 843314857};
 
@@ -92,7 +92,7 @@ inline std::int64_t atan2_abs_q30(std::uint64_t ay, std::uint64_t ax) {
 
 // ---------------------------------------------------------------- elementary functions
 // Errors are against double evaluated at the same (quantised) argument, over the whole input
-// range, in units of the result's last bit (LSB = 2^-F); tests/firmware/math/test_fixed.cpp measures them.
+// range, in units of the result's last bit (LSB = 2^-F); tests/firmware/math/test_q_functions.cpp measures them.
 
 template <int F>
 [[gnu::always_inline]] inline Q<F> abs(Q<F> v) {

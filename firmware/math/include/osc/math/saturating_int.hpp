@@ -223,7 +223,7 @@ inline constexpr SqrtTop kSqrtTop{};
 /// floor(sqrt(h)) for h in [2^30, 2^32): the table's estimate (above the root by at most 2^10 + 1),
 /// two Newton steps from above in 32 bits (the error e becomes at most e^2 / 2^16 + 1: 17, then 1),
 /// and one correction. Each step is one hardware division on the targets. Exact for every h: checked
-/// for all 2^32 words once, and in test_fixed around every square and table cell.
+/// for all 2^32 words once, and in test_saturating_int around every square and table cell.
 inline std::uint32_t isqrt_top(std::uint32_t h) {
   std::uint32_t s = kSqrtTop.v[(h >> 26) - 16];
   s = (s + h / s) >> 1;
