@@ -144,27 +144,29 @@ def m3_cycles(mnemonic, operands):
     return 1
 
 
-def m3_estimate(counts, insns, taken, ticks):
-    """The tick's cycles on a Cortex-M3, from its instructions and taken branches: at zero wait
-    states, and from a 72 MHz STM32F103's flash (the larger of the core's cycles and the fetches')."""
-    n = sum(counts.values())
-    core = sum(k * m3_cycles(*insns[a][:2]) for (_, a), k in counts.items() if a in insns)
-    core += taken * M3_REFILL + ticks * M3_EXCEPTION
-    fetch = sum(k * insns[a][2] for (_, a), k in counts.items() if a in insns) / FLASH_BYTES_PER_CYCLE
-    flash = max(core, fetch) + taken * FLASH_WAIT
-    return n / ticks, core / ticks, flash / ticks
-
-
-def m3_classes(counts, insns, ticks):
-    """Per class of instruction (its mnemonic without suffix or condition): instructions and cycles per tick."""
+def m3_classes(counts, insns):
+    """Per class of instruction (its mnemonic without suffix or condition): instructions and cycles,
+    at zero wait states with every branch as not taken."""
     out = collections.defaultdict(lambda: [0, 0])
     for (_, a), k in counts.items():
         if a in insns:
             m, ops, _ = insns[a]
-            key = m.split(".")[0]
-            out[key][0] += k
-            out[key][1] += k * m3_cycles(m, ops)
-    return sorted(((key, n / ticks, c / ticks) for key, (n, c) in out.items()), key=lambda r: -r[2])
+            out[m.split(".")[0]][0] += k
+            out[m.split(".")[0]][1] += k * m3_cycles(m, ops)
+    return out
+
+
+def m3_estimate(counts, insns, taken, ticks):
+    """The tick's cycles on a Cortex-M3, from its instructions and taken branches: at zero wait
+    states, and from a 72 MHz STM32F103's flash (the larger of the core's cycles and the fetches'),
+    and per class of instruction (per tick, most cycles first)."""
+    classes = m3_classes(counts, insns)
+    n = sum(counts.values())
+    core = sum(c for _, c in classes.values()) + taken * M3_REFILL + ticks * M3_EXCEPTION
+    fetch = sum(k * insns[a][2] for (_, a), k in counts.items() if a in insns) / FLASH_BYTES_PER_CYCLE
+    flash = max(core, fetch) + taken * FLASH_WAIT
+    per_class = sorted(((key, k / ticks, c / ticks) for key, (k, c) in classes.items()), key=lambda r: -r[2])
+    return n / ticks, core / ticks, flash / ticks, per_class
 
 
 def chains(elf, addr2line, addresses):
@@ -213,14 +215,14 @@ def main():
     if ticks == 0:
         sys.exit(f"tick_profile: no tick seen (the image's output: {output.strip()[-400:]})")
     if args.m3_cycles:
-        n, core, flash = m3_estimate(counts, insns, taken, ticks)
+        n, core, flash, per_class = m3_estimate(counts, insns, taken, ticks)
         print(f"{ticks} ticks; per tick: {n:.0f} instructions, {taken / ticks:.0f} taken branches")
         print(f"Cortex-M3 cycles per tick, zero wait states: {core:.0f} (cycles per instruction {core / n:.2f})")
         print(f"Cortex-M3 cycles per tick, 72 MHz flash (2 wait states): {flash:.0f} (cycles per instruction "
               f"{flash / n:.2f}; {flash / 72:.0f} us at 72 MHz)")
         print(f"  taken branches' refills: {taken / ticks * M3_REFILL:.0f} cycles; exception entry and return: "
               f"{M3_EXCEPTION}")
-        for key, k, c in m3_classes(counts, insns, ticks)[:args.top]:
+        for key, k, c in per_class[:args.top]:
             print(f"  {key:10s} {k:8.0f} instructions {c:8.0f} cycles")
         return
     addresses = sorted({a for sites, a in counts} | {c for sites, _ in counts for c in sites})

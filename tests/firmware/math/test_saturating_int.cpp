@@ -33,11 +33,27 @@ TEST(FixedArithmetic, TargetDivisionRoutineIsExact) {
   }
 }
 
+/// floor(sqrt(n)) digit by digit, two bits of n a step: the root the targets used before isqrt64.
+std::uint64_t isqrt64_digits(std::uint64_t n) {
+  std::uint64_t res = 0, bit = std::uint64_t{1} << 62;
+  while (bit > n) bit >>= 2;
+  while (bit != 0) {
+    if (n >= res + bit) {
+      n -= res + bit;
+      res = (res >> 1) + bit;
+    } else {
+      res >>= 1;
+    }
+    bit >>= 2;
+  }
+  return res;
+}
+
 TEST(FixedArithmetic, TargetSquareRootIsExact) {
   // Against the digit-by-digit root and the definition r^2 <= n < (r + 1)^2 (in 128 bits).
   auto check = [](std::uint64_t n) {
     const std::uint64_t r = fixed::detail::isqrt64(n);
-    ASSERT_EQ(r, fixed::detail::isqrt64_digits(n)) << n;
+    ASSERT_EQ(r, isqrt64_digits(n)) << n;
     const I128 r2 = static_cast<I128>(r) * static_cast<I128>(r), next = r2 + 2 * static_cast<I128>(r) + 1;
     ASSERT_TRUE(r2 <= static_cast<I128>(n) && static_cast<I128>(n) < next) << n;
   };

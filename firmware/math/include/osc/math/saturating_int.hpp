@@ -231,23 +231,6 @@ inline std::uint32_t isqrt_top(std::uint32_t h) {
   return static_cast<std::uint64_t>(s) * s > h ? s - 1 : s;
 }
 
-/// floor(sqrt(n)) for a 64-bit n, digit by digit: two bits of n a step (the reference the fast root
-/// below is tested against).
-inline std::uint64_t isqrt64_digits(std::uint64_t n) {
-  std::uint64_t res = 0, bit = std::uint64_t{1} << 62;
-  while (bit > n) bit >>= 2;
-  while (bit != 0) {
-    if (n >= res + bit) {
-      n -= res + bit;
-      res = (res >> 1) + bit;
-    } else {
-      res >>= 1;
-    }
-    bit >>= 2;
-  }
-  return res;
-}
-
 /// floor(sqrt(n)) for a 64-bit n. With m = n 4^k normalised (its top word in [2^30, 2^32)),
 /// floor(sqrt(n)) = floor(sqrt(m)) >> k. The top word's root s1 (isqrt_top) gives
 /// x0 = (s1 + 1) 2^16, at most 2^16 above sqrt(m) >= 2^31; one Newton step from above,
