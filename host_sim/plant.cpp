@@ -19,11 +19,6 @@ Mat3 skew(const Vec3& v) {
   m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
   return m;
 }
-Mat3 rot_x(double a) {
-  Mat3 m;
-  m << 1, 0, 0, 0, std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a);
-  return m;
-}
 /// [a; b]. (Not Eigen's comma initializer: GCC 12 under -march=native reads the initializer of a
 /// 6-vector from two 3-vectors as an AVX load past the end of the second, a false -Warray-bounds.)
 Vec6 join(const Vec3& a, const Vec3& b) {
@@ -105,30 +100,32 @@ bool PlantConfig::ideal_drives() const {
          friction_drift == 0 && elastic_hz == 0 && backlash == 0;
 }
 
+namespace {
+/// A placement's rotation and translation as Eigen values.
+Mat3 rotation_of(const osc::Placement& P) {
+  Mat3 R;
+  R << P.R[0][0], P.R[0][1], P.R[0][2], P.R[1][0], P.R[1][1], P.R[1][2], P.R[2][0], P.R[2][1], P.R[2][2];
+  return R;
+}
+Vec3 translation_of(const osc::Placement& P) { return Vec3(P.p[0], P.p[1], P.p[2]); }
+}  // namespace
+
 ArticulatedBody::ArticulatedBody(double link_scale) {
-  const osc::LinkParams* kLinks = osc::robot::kArm.links;
+  const osc::ArmDescription& arm = osc::robot::kArm;
   for (int i = 0; i < 6; ++i) {
-    const auto& L = kLinks[i];
-    // Link i in its joint frame B_i = F_{i-1} Rz(q_i): F_i = B_i Tz(d) Tx(a) Rx(alpha).
-    const Mat3 Ra = rot_x(L.alpha);
-    const Vec3 c = Vec3(L.a, 0, L.d) + Ra * Vec3(L.com[0], L.com[1], L.com[2]);
-    const Mat3 Ic = Ra * Vec3(L.inertia[0], L.inertia[1], L.inertia[2]).asDiagonal() * Ra.transpose() * link_scale;
-    const double m = L.mass * link_scale;
-    body_[i] = Body{m, c, Ic};
-    axes_cs_[i][0] = std::cos(L.alpha);
-    axes_cs_[i][1] = std::sin(L.alpha);
-    moments_[i] = Vec3(L.inertia[0], L.inertia[1], L.inertia[2]) * link_scale;
-    fixed_cs_[i][0] = i == 0 ? 1.0 : std::cos(kLinks[i - 1].alpha);
-    fixed_cs_[i][1] = i == 0 ? 0.0 : std::sin(kLinks[i - 1].alpha);
+    const auto& L = arm.links[i];
+    // Link i in its joint frame B_i = F_{i-1} Rz(q_i): F_i = B_i P_i, P_i = (R, p) its placement.
+    const Mat3 R = rotation_of(L.placement);
+    const Vec3 c = translation_of(L.placement) + R * Vec3(L.com[0], L.com[1], L.com[2]);
+    Mat3 I;  // about the COM, axes of F_i
+    I << L.inertia[0], L.inertia[3], L.inertia[4], L.inertia[3], L.inertia[1], L.inertia[5], L.inertia[4],
+        L.inertia[5], L.inertia[2];
+    body_[i] = Body{L.mass * link_scale, c, R * I * R.transpose() * link_scale};
     armature_[i] = L.gear_ratio * L.gear_ratio * L.motor_inertia;
-    if (i == 0) {
-      rot_fixed_[i] = Mat3::Identity();
-      pos_fixed_[i] = Vec3::Zero();
-    } else {
-      const auto& P = kLinks[i - 1];
-      rot_fixed_[i] = rot_x(P.alpha);
-      pos_fixed_[i] = Vec3(P.a, 0, P.d);
-    }
+    // F_{i-1} in B_{i-1} (F_0 in the base frame for the first joint).
+    const osc::Placement& P = i == 0 ? arm.base : arm.links[i - 1].placement;
+    rot_fixed_[i] = rotation_of(P);
+    pos_fixed_[i] = translation_of(P);
   }
 }
 
@@ -212,13 +209,7 @@ struct RigidInertia {
 }  // namespace
 
 namespace {
-/// W Rx(a) for Rx given as (cos a, sin a): the columns 1 and 2 of W turned, 12 products instead of 27.
-void turn_x(Mat3& W, double c, double s) {
-  const Vec3 w1 = W.col(1), w2 = W.col(2);
-  W.col(1) = c * w1 + s * w2;
-  W.col(2) = c * w2 - s * w1;
-}
-/// W Rz(q), likewise with the columns 0 and 1.
+/// W Rz(q): the columns 0 and 1 of W turned, 6 products instead of 27.
 void turn_z(Mat3& W, double c, double s) {
   const Vec3 w0 = W.col(0), w1 = W.col(1);
   W.col(0) = c * w0 + s * w1;
@@ -232,14 +223,13 @@ void ArticulatedBody::inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, V
   // Pass 1, base to tip, as in forward_dynamics() (every quantity at the base origin, in base axes):
   // axes S = [z; o x z], velocities V = [w; v], link inertias; the accelerations at q_dd = 0 (gravity
   // as an upward base acceleration, plus the velocity products V x S qd) and each link's force
-  // I a + V x* I V (recursive Newton-Euler). The rotations turn two columns at a time (turn_x,
-  // turn_z) and a link's rotational inertia is built from its principal axes.
+  // I a + V x* I V (recursive Newton-Euler). The joint rotations turn two columns at a time (turn_z).
   Mat3 W = Mat3::Identity();
   Vec3 o = Vec3::Zero(), w = Vec3::Zero(), v = Vec3::Zero();
   Vec3 aw = Vec3::Zero(), av(0, 0, osc::robot::kArm.gravity);
   for (int i = 0; i < 6; ++i) {
     o += W * pos_fixed_[i];
-    turn_x(W, fixed_cs_[i][0], fixed_cs_[i][1]);
+    W = W * rot_fixed_[i];
     turn_z(W, std::cos(q(i)), std::sin(q(i)));
     const Vec3 z = W.col(2), oz = o.cross(z);
     S[i] = join(z, oz);
@@ -253,16 +243,13 @@ void ArticulatedBody::inertia_and_bias(const Vec6& q, const Vec6& qd, Mat6& M, V
     RigidInertia& I = Ic[i];
     I.m = b.mass;
     I.h = b.mass * com;
-    // About the origin: U diag(moments) U^T (U = W Rx(alpha_i), the principal axes) plus
+    // About the origin: W I_B W^T (the link's inertia about its COM, axes of B_i) plus
     // m (|c|^2 1 - c c^T) (parallel axes).
-    Mat3 U = W;
-    turn_x(U, axes_cs_[i][0], axes_cs_[i][1]);
-    const Vec3& d = moments_[i];
+    const Mat3 Iw = W * b.inertia * W.transpose();
     const double cc = b.mass * com.squaredNorm();
     for (int r = 0; r < 3; ++r)
       for (int c = r; c < 3; ++c) {
-        const double e = d(0) * U(r, 0) * U(c, 0) + d(1) * U(r, 1) * U(c, 1) + d(2) * U(r, 2) * U(c, 2) -
-                         b.mass * com(r) * com(c) + (r == c ? cc : 0.0);
+        const double e = Iw(r, c) - b.mass * com(r) * com(c) + (r == c ? cc : 0.0);
         I.I(r, c) = I.I(c, r) = e;
       }
     // f = I a + V x* (I V): I [w; v] = [I w + h x v; m v - h x w].

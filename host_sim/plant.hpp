@@ -101,7 +101,7 @@ struct Contact {
 /// enough to be far above the control bandwidth, soft enough for the plant's RK4 step.
 constexpr double kBacklashStiffHz = 60.0;
 
-/// Articulated-body forward dynamics of the PUMA 560 (armature on each joint's scalar inertia),
+/// Articulated-body forward dynamics of the built arm (armature on each joint's scalar inertia),
 /// Featherstone's algorithm with every spatial quantity expressed at the base origin in base axes,
 /// so that no transform is needed between links.
 class ArticulatedBody {
@@ -126,13 +126,9 @@ class ArticulatedBody {
     Mat3 inertia;  // about the COM, axes of B_i
   };
   Body body_[6];
-  Mat3 rot_fixed_[6];  // rotation of F_{i-1} in B_{i-1}: Rx(alpha_{i-1})
-  Vec3 pos_fixed_[6];  // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1})
+  Mat3 rot_fixed_[6];  // rotation of F_{i-1} in B_{i-1} (of F_0 in the base frame for i = 0)
+  Vec3 pos_fixed_[6];  // origin of F_{i-1} in B_{i-1}: (a_{i-1}, 0, d_{i-1}) for a DH row
   double armature_[6];
-  // The composite-rigid-body path's own view of the same links: the rotations Rx(alpha) as their
-  // cosine and sine (of rot_fixed_, and of each link's principal axes in B_i), the principal moments.
-  double fixed_cs_[6][2], axes_cs_[6][2];
-  Vec3 moments_[6];
 };
 
 /// The robot: state, drive train, friction, integration.

@@ -11,6 +11,7 @@ pkgs=(cmake ninja-build g++ libeigen3-dev libgtest-dev libbenchmark-dev liboroco
                                             # libFuzzer runtimes, llvm-symbolizer for the reports
       libyaml-cpp-dev libcli11-dev nlohmann-json3-dev   # the experiment's configuration file, command
                                                         # line and JSON (host tools only)
+      liburdfdom-dev                        # the arm generator reads an arm's URDF (tools/armgen)
       clang-format clang-tidy flake8 universal-ctags)   # scripts/lint.sh: style, naming, Python,
                                                         # function lengths
 missing=()

@@ -1,5 +1,5 @@
-// The PUMA 560 as an Orocos KDL chain, built from the same parameter table as the kernels
-// (osc::robot::kArm.links in osc/puma560.hpp, no numbers repeated here), for independent cross-checks.
+// An arm's table as an Orocos KDL chain, built from the same parameter table as the kernels
+// (osc::robot::kArm for the built robot, no numbers repeated here), for independent cross-checks.
 #pragma once
 
 #include <kdl/chain.hpp>
@@ -17,8 +17,16 @@ inline double armature(int i) {
   return L.gear_ratio * L.gear_ratio * L.motor_inertia;
 }
 
-/// Standard DH: segment i = revolute joint about z of frame i-1, then
-/// KDL::Frame::DH(a, alpha, d, 0) = Rz(0) Tz(d) Tx(a) Rx(alpha) to frame i (the joint adds Rz(q_i)).
+/// A placement (osc/robots/arm.hpp) as a KDL frame.
+inline KDL::Frame kdl_frame(const Placement& P) {
+  return KDL::Frame(KDL::Rotation(P.R[0][0], P.R[0][1], P.R[0][2], P.R[1][0], P.R[1][1], P.R[1][2], P.R[2][0],
+                                  P.R[2][1], P.R[2][2]),
+                    KDL::Vector(P.p[0], P.p[1], P.p[2]));
+}
+
+/// An arm's table as a KDL chain: a fixed segment to frame 0 (the base placement), then segment i =
+/// revolute joint about z of frame i-1 followed by the placement P_i to frame i (the joint adds
+/// Rz(q_i); for a DH row P_i = KDL::Frame::DH(a, alpha, d, 0) = Tz(d) Tx(a) Rx(alpha)).
 /// A segment's RigidBodyInertia is expressed in its tip frame, i.e. frame i, as in the reference
 /// table; KDL's constructor takes the COG position and the rotational inertia *about the COG*
 /// (rigidbodyinertia.hpp), which is what the table gives.
@@ -26,18 +34,23 @@ inline double armature(int i) {
 /// ChainDynParam::JntToMass, as armature * qdd_i in ChainIdSolver_RNE, and (through both) in
 /// ChainFdSolver_RNE; test_kdl.cpp (KdlConvention) checks this against a chain built with
 /// with_armature = false.
-inline KDL::Chain puma560_chain(bool with_armature = true) {
+inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true) {
   KDL::Chain chain;
+  chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), kdl_frame(arm.base)));
   for (int i = 0; i < kDof; ++i) {
-    const LinkParams& L = robot::kArm.links[i];
-    const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0,
-                           /*inertia=*/with_armature ? armature(i) : 0.0);
-    const KDL::RigidBodyInertia I(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),
-                                  KDL::RotationalInertia(L.inertia[0], L.inertia[1], L.inertia[2], 0, 0, 0));
-    chain.addSegment(KDL::Segment(joint, KDL::Frame::DH(L.a, L.alpha, L.d, 0.0), I));
+    const LinkParams& L = arm.links[i];
+    const double jm = L.gear_ratio * L.gear_ratio * L.motor_inertia;
+    const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0, /*inertia=*/with_armature ? jm : 0.0);
+    const double* I = L.inertia;
+    const KDL::RigidBodyInertia inertia(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),
+                                        KDL::RotationalInertia(I[0], I[1], I[2], I[3], I[4], I[5]));
+    chain.addSegment(KDL::Segment(joint, kdl_frame(L.placement), inertia));
   }
   return chain;
 }
+
+/// The built robot's chain.
+inline KDL::Chain puma560_chain(bool with_armature = true) { return arm_chain(robot::kArm, with_armature); }
 
 inline KDL::JntArray to_kdl(const Vec6<double>& v) {
   KDL::JntArray a(kDof);

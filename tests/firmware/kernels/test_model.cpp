@@ -1,9 +1,10 @@
-// The robot model (osc/kernels/model.hpp): the DH twists as the structure forward_kinematics uses; the
+// The robot model (osc/kernels/model.hpp): the placements' forms that forward_kinematics uses; the
 // model of an arm description, its mass-inertia error on the masses and inertias only; and its products in
 // fixed point rounded once, where rounding each term would lose the sum (values of a few LSB).
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string_view>
 
 #include "osc/kernels/model.hpp"
 #include "osc/math/fixed.hpp"
@@ -13,25 +14,41 @@ using namespace osc;
 
 namespace {
 
-TEST(Model, TwistsAreTheDhAnglesStructure) {
-  EXPECT_EQ(twist_of(0.0), Twist::kZero);
-  EXPECT_EQ(twist_of(kPi / 2), Twist::kPlusHalfPi);
-  EXPECT_EQ(twist_of(-kPi / 2), Twist::kMinusHalfPi);
-  EXPECT_EQ(twist_of(0.3), Twist::kGeneral);
-  EXPECT_EQ(twist_of(kPi / 2 + 1e-9), Twist::kGeneral);
-  EXPECT_EQ(twist_of(kPi), Twist::kGeneral);
-  // The model's cosine and sine of each link's twist: exact where the structure replaces the product.
+TEST(Model, PlacementFormsAreTheStructureOfEachPlacement) {
+  // The DH twists 0, +-pi/2 and pi are signed permutations; other angles are general rotations.
+  const PlacementForm plus = placement_form(dh_placement(0.1, 0.2, kPi / 2));
+  ASSERT_TRUE(plus.permutation);
+  EXPECT_EQ(plus.column[0], 1);   // x stays
+  EXPECT_EQ(plus.column[1], 3);   // y' = z
+  EXPECT_EQ(plus.column[2], -2);  // z' = -y
+  EXPECT_TRUE(plus.planar);
+  const PlacementForm minus = placement_form(dh_placement(0, 0, -kPi / 2));
+  EXPECT_EQ(minus.column[1], -3);
+  EXPECT_EQ(minus.column[2], 2);
+  const PlacementForm half = placement_form(dh_placement(0, 0, kPi));
+  EXPECT_TRUE(half.permutation);
+  EXPECT_EQ(half.column[1], -2);
+  EXPECT_EQ(half.column[2], -3);
+  Placement tilted = dh_placement(0, 0, 0);
+  tilted.R[1][1] = tilted.R[2][2] = std::cos(0.3);
+  tilted.R[2][1] = std::sin(0.3), tilted.R[1][2] = -std::sin(0.3);
+  tilted.p[1] = 0.05;
+  const PlacementForm general = placement_form(tilted);
+  EXPECT_FALSE(general.permutation);
+  EXPECT_FALSE(general.planar);
+  // The built arm's placements: the model's copy is the table's, and every PUMA link has the fast forms.
   const Model<double> m = Model<double>::of(robot::kArm);
   for (int i = 0; i < kDof; ++i) {
-    const Model<double>::Link& l = m.link[i];
-    if (l.twist == Twist::kGeneral) {
-      EXPECT_NEAR(l.cos_alpha * l.cos_alpha + l.sin_alpha * l.sin_alpha, 1.0, 1e-15) << i;
-      continue;
+    const Placement& P = robot::kArm.links[i].placement;
+    for (int r = 0; r < 3; ++r) {
+      EXPECT_EQ(m.link[i].p(r), P.p[r]) << i;
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(m.link[i].R(r, c), P.R[r][c]) << i;
     }
-    const double c = l.twist == Twist::kZero ? 1 : 0, s = l.twist == Twist::kZero ? 0 : 1;
-    EXPECT_EQ(l.cos_alpha, c) << i;
-    EXPECT_EQ(std::abs(l.sin_alpha), s) << i;
-    EXPECT_EQ(l.sin_alpha < 0, l.twist == Twist::kMinusHalfPi) << i;
+    if (std::string_view(robot::kArm.name) == "PUMA 560") {
+      EXPECT_TRUE(m.link[i].form.permutation) << i;
+      EXPECT_TRUE(m.link[i].form.planar) << i;
+      EXPECT_TRUE(m.link[i].diagonal) << i;
+    }
   }
 }
 
@@ -41,10 +58,11 @@ TEST(Model, AMassInertiaErrorScalesTheLinksMassesAndInertiasOnly) {
     EXPECT_NEAR(h.link[i].mass, 1.1 * m.link[i].mass, 1e-12) << i;
     for (int a = 0; a < 3; ++a) {
       EXPECT_NEAR(h.link[i].inertia(a), 1.1 * m.link[i].inertia(a), 1e-15) << i;
+      EXPECT_NEAR(h.link[i].products(a), 1.1 * m.link[i].products(a), 1e-15) << i;
       EXPECT_EQ(h.link[i].com(a), m.link[i].com(a)) << i;  // where the mass is: unchanged
     }
-    EXPECT_EQ(h.link[i].a, m.link[i].a) << i;
-    EXPECT_EQ(h.link[i].d, m.link[i].d) << i;
+    EXPECT_EQ(h.link[i].R, m.link[i].R) << i;
+    EXPECT_EQ(h.link[i].p, m.link[i].p) << i;
     EXPECT_EQ(h.armature(i), m.armature(i)) << i;  // the motors' inertia: not the links'
     const double G = robot::kArm.links[i].gear_ratio;
     EXPECT_NEAR(m.armature(i), G * G * robot::kArm.links[i].motor_inertia, 1e-15) << i;

@@ -15,14 +15,14 @@ namespace osc {
 
 /// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic; the
 /// joint axes' moments o_i x z_i into data.vO (the CRBA's and the RNEA passes' joint projections).
-/// R_{i+1} = R_i Rz(q_i) Rx(alpha_i): Rz turns the first two columns of R_i by q_i (x, y below),
-/// and Rx(alpha) mixes y with the third column, a permutation with a sign for the twists 0 and
-/// +-pi/2 that the robot table states (Model::Link::twist). o_{i+1} = o_i + R_i (a c, a s, d) =
-/// o_i + a x + d z.
+/// F_{i+1} = F_i Rz(q_i) P_i (osc/robots/arm.hpp): Rz turns the first two columns of R_i by q_i
+/// (x, y below, z unchanged), and the placement's rotation mixes them (a permutation with signs
+/// for the DH twists 0 and +-pi/2 and a URDF's quarter turns: Model::Link::form). o_{i+1} = o_i +
+/// p_x x + p_y y + p_z z (a x + d z for a DH row).
 template <class S>
 void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q) {
-  data.R[0].setIdentity();
-  data.o[0].setZero();
+  data.R[0] = model.base_R;
+  data.o[0] = model.base_o;
   // The joints' sines and cosines first: independent of each other, unlike the frames below.
   S sq[kDof], cq[kDof];
   for (int i = 0; i < kDof; ++i) math::sincos(q(i), sq[i], cq[i]);
@@ -31,29 +31,30 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
     const S s = sq[i], c = cq[i];
     const Mat3<S>& R = data.R[i];
     Mat3<S>& Rn = data.R[i + 1];
-    const Vec3<S> x = combine(c, R.col(0), s, R.col(1));   // R Rz(q) e_x
-    const Vec3<S> y = combine(c, R.col(1), -s, R.col(0));  // R Rz(q) e_y
-    const Vec3<S> z = R.col(2);
-    Rn.col(0) = x;
-    switch (l.twist) {
-      case Twist::kZero:
-        Rn.col(1) = y, Rn.col(2) = z;
-        break;
-      case Twist::kPlusHalfPi:
-        Rn.col(1) = z, Rn.col(2) = -y;
-        break;
-      case Twist::kMinusHalfPi:
-        Rn.col(1) = -z, Rn.col(2) = y;
-        break;
-      case Twist::kGeneral:
-        Rn.col(1) = combine(l.cos_alpha, y, l.sin_alpha, z);
-        Rn.col(2) = combine(l.cos_alpha, z, S(-l.sin_alpha), y);
-        break;
+    const Vec3<S> turned[3] = {combine(c, R.col(0), s, R.col(1)),   // R Rz(q) e_x
+                               combine(c, R.col(1), -s, R.col(0)),  // R Rz(q) e_y
+                               R.col(2)};
+    const Vec3<S>&x = turned[0], &y = turned[1], &z = turned[2];
+    if (l.form.permutation) {
+      for (int k = 0; k < 3; ++k) {
+        const int from = l.form.column[k];
+        Rn.col(k) = from > 0 ? turned[from - 1] : Vec3<S>(-turned[-from - 1]);
+      }
+    } else {
+      for (int k = 0; k < 3; ++k) Rn.col(k) = sum3(l.R(0, k), x, l.R(1, k), y, l.R(2, k), z);
     }
-    data.o[i + 1] = data.o[i] + combine(l.a, x, l.d, z);
+    data.o[i + 1] = data.o[i] + (l.form.planar ? combine(l.p(0), x, l.p(2), z) : sum3(l.p(0), x, l.p(1), y, l.p(2), z));
     data.com[i + 1] = data.o[i + 1] + Rn * l.com;
-    // Ic = Rn diag(I) Rn^T, symmetric: six of its entries.
-    const Mat3<S> M = Rn * l.inertia.asDiagonal();
+    // Ic = Rn I Rn^T, symmetric: six of its entries.
+    Mat3<S> M;
+    if (l.diagonal) {
+      M = Rn * l.inertia.asDiagonal();
+    } else {
+      Mat3<S> I;
+      I << l.inertia(0), l.products(0), l.products(1), l.products(0), l.inertia(1), l.products(2), l.products(1),
+          l.products(2), l.inertia(2);
+      M = Rn * I;
+    }
     Mat3<S>& Ic = data.Ic[i + 1];
     for (int r = 0; r < 3; ++r)
       for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));

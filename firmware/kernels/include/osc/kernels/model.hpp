@@ -68,55 +68,81 @@ template <class S, class U, class V>
                  sum_of_products(a, S(u(2)), b, S(v(2))));
 }
 
-/// The twist alpha of a DH link as the structure it gives the frames: 0 and +-pi/2 (every PUMA 560
-/// link) turn the rotation Rx(alpha) into a permutation of columns with a sign, which
-/// forward_kinematics applies without a product; any other angle is kGeneral.
-enum class Twist : unsigned char { kZero, kPlusHalfPi, kMinusHalfPi, kGeneral };
-
-constexpr Twist twist_of(double alpha) {
-  constexpr double kTol = 1e-12;
-  if (alpha > -kTol && alpha < kTol) return Twist::kZero;
-  if (alpha - kPi / 2 > -kTol && alpha - kPi / 2 < kTol) return Twist::kPlusHalfPi;
-  if (alpha + kPi / 2 > -kTol && alpha + kPi / 2 < kTol) return Twist::kMinusHalfPi;
-  return Twist::kGeneral;
+/// a u + b v + c w of three 3-vectors, each component by math::sum_of_products (one rounding in
+/// fixed point).
+template <class S>
+[[gnu::always_inline]] inline Vec3<S> sum3(S a, const Vec3<S>& u, S b, const Vec3<S>& v, S c, const Vec3<S>& w) {
+  using math::sum_of_products;
+  return Vec3<S>(sum_of_products(a, u(0), b, v(0), c, w(0)), sum_of_products(a, u(1), b, v(1), c, w(1)),
+                 sum_of_products(a, u(2), b, v(2), c, w(2)));
 }
 
-/// Constant parameters of a 6-joint standard-DH arm, in the kernel's scalar.
+/// How a link's placement P = (R, p) places its frame, for forward_kinematics: a rotation that is
+/// a signed permutation (every DH twist of 0 or +-pi/2, and a URDF's quarter turns) moves columns
+/// with a sign instead of a product; a translation (a, 0, d) in the turned frame (every DH row) is a
+/// two-term sum.
+struct PlacementForm {
+  signed char column[3];  ///< a permutation: column k of R is sign(column[k]) e_{|column[k]| - 1}; 0: general
+  bool permutation;
+  bool planar;  ///< p(1) == 0
+};
+
+constexpr PlacementForm placement_form(const Placement& P) {
+  PlacementForm f{{0, 0, 0}, is_signed_permutation(P), P.p[1] == 0};
+  if (f.permutation)
+    for (int c = 0; c < 3; ++c)
+      for (int r = 0; r < 3; ++r)
+        if (P.R[r][c] != 0) f.column[c] = static_cast<signed char>(P.R[r][c] > 0 ? r + 1 : -(r + 1));
+  return f;
+}
+
+/// Constant parameters of a 6-joint revolute arm (osc/robots/arm.hpp), in the kernel's scalar.
 template <class S>
 struct Model {
   struct Link {
-    S a, d, cos_alpha, sin_alpha;
-    Twist twist;  // the structure of alpha (kGeneral: use cos_alpha, sin_alpha)
+    Mat3<S> R;  // the placement P_i: frame i in the turned frame F_{i-1} Rz(q_i)
+    Vec3<S> p;
+    PlacementForm form;
     S mass;
-    Vec3<S> com;      // COM in frame i
-    Vec3<S> inertia;  // principal moments about the COM, axes of frame i
+    Vec3<S> com;       // COM in frame i
+    Vec3<S> inertia;   // Ixx, Iyy, Izz about the COM, axes of frame i
+    Vec3<S> products;  // Ixy, Ixz, Iyz
+    bool diagonal;     // products all zero
   };
+  Mat3<S> base_R;  // frame 0 in the base frame
+  Vec3<S> base_o;
   Link link[kDof];
   Vec6<S> armature;  // G^2 * Jm, added to the diagonal of A(q)
-  S gravity;         // along -z0
+  S gravity;         // along -z of the base frame
 
   /// The model of an arm from its description (osc/robots/arm.hpp), with every link mass and
   /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error).
   static Model of(const ArmDescription& arm, double mass_inertia_error = 0.0) {
     Model m{};
     const double s = 1.0 + mass_inertia_error;
+    placement(arm.base, m.base_R, m.base_o);
     for (int i = 0; i < kDof; ++i) {
       const LinkParams& p = arm.links[i];
       Link& l = m.link[i];
-      l.a = lit<S>(p.a);
-      l.d = lit<S>(p.d);
-      l.cos_alpha = lit<S>(std::cos(p.alpha));
-      l.sin_alpha = lit<S>(std::sin(p.alpha));
-      // Snap cos/sin of +-pi/2 to exact zeros so the DH structure is exact.
-      if (std::fabs(std::cos(p.alpha)) < 1e-12) l.cos_alpha = S(0);
-      l.twist = twist_of(p.alpha);
+      placement(p.placement, l.R, l.p);
+      l.form = placement_form(p.placement);
       l.mass = lit<S>(p.mass * s);
       l.com = Vec3<S>(lit<S>(p.com[0]), lit<S>(p.com[1]), lit<S>(p.com[2]));
       l.inertia = Vec3<S>(lit<S>(p.inertia[0] * s), lit<S>(p.inertia[1] * s), lit<S>(p.inertia[2] * s));
+      l.products = Vec3<S>(lit<S>(p.inertia[3] * s), lit<S>(p.inertia[4] * s), lit<S>(p.inertia[5] * s));
+      l.diagonal = p.inertia[3] == 0 && p.inertia[4] == 0 && p.inertia[5] == 0;
       m.armature(i) = lit<S>(p.gear_ratio * p.gear_ratio * p.motor_inertia);
     }
     m.gravity = lit<S>(arm.gravity);
     return m;
+  }
+
+ private:
+  static void placement(const Placement& P, Mat3<S>& R, Vec3<S>& p) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) R(r, c) = lit<S>(P.R[r][c]);
+      p(r) = lit<S>(P.p[r]);
+    }
   }
 };
 

@@ -1,6 +1,11 @@
-// The robot description format: what a 6-joint, standard-DH, revolute arm is to the firmware.
+// The robot description format: what a 6-joint revolute arm is to the firmware.
 // A robot is one constant table in this format (firmware/robots/<arm>/), and the build selects
 // one (osc/robot.hpp, CMake OSC_ROBOT); nothing above this layer names a particular arm.
+//
+// The chain: frame 0 is placed in the base frame by ArmDescription::base; joint i turns about the z
+// axis of frame i-1, and link i's frame is F_i = F_{i-1} Rz(q_i) P_i, with P_i its constant
+// placement. Standard DH is the case P_i = Tz(d) Tx(a) Rx(alpha) (dh_placement); a URDF's joint
+// origins, axes and tool offset are the general case (tools/armgen writes them in this form).
 #pragma once
 
 namespace osc {
@@ -9,12 +14,43 @@ namespace osc {
 constexpr int kDof = 6;
 constexpr double kPi = 3.14159265358979323846;
 
-/// Standard DH row and inertial data of one link (inertia about the COM, axes of frame i).
+/// A constant rigid transform: a frame's axes R (columns, row-major here) and origin p [m] in its
+/// parent frame, x_parent = R x + p.
+struct Placement {
+  double R[3][3];
+  double p[3];
+};
+constexpr Placement kIdentityPlacement = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
+
+/// Not defined: a table that reaches it does not compile (not a constant expression).
+void alpha_is_not_a_quarter_turn();
+
+/// cos and sin of a quarter turn k pi/2, exact (the twists a DH table uses for perpendicular and
+/// parallel axes). Any other angle is not a constant expression here: a table of general angles is
+/// written as matrices (the generator's output), not through dh_placement.
+constexpr void quarter_turn(double alpha, double& c, double& s) {
+  constexpr double kTol = 1e-12;
+  const double k = alpha / (kPi / 2);
+  const long n = k < 0 ? -static_cast<long>(-k + 0.5) : static_cast<long>(k + 0.5);
+  if (k - static_cast<double>(n) > kTol || static_cast<double>(n) - k > kTol) alpha_is_not_a_quarter_turn();
+  const int m = static_cast<int>(((n % 4) + 4) % 4);
+  c = m == 0 ? 1.0 : (m == 2 ? -1.0 : 0.0);
+  s = m == 1 ? 1.0 : (m == 3 ? -1.0 : 0.0);
+}
+
+/// The standard DH placement Tz(d) Tx(a) Rx(alpha) (alpha a multiple of pi/2).
+constexpr Placement dh_placement(double a, double d, double alpha) {
+  double c = 0, s = 0;
+  quarter_turn(alpha, c, s);
+  return {{{1, 0, 0}, {0, c, -s}, {0, s, c}}, {a, 0, d}};
+}
+
+/// Inertial and drive data of one link.
 struct LinkParams {
-  double a, d, alpha;    // [m], [m], [rad]
+  Placement placement;   // P_i: frame i in joint i's turned frame F_{i-1} Rz(q_i)
   double mass;           // [kg]
   double com[3];         // COM in frame i [m]
-  double inertia[3];     // Ixx, Iyy, Izz about the COM [kg m^2]; products are 0
+  double inertia[6];     // about the COM, axes of frame i: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2]
   double motor_inertia;  // Jm [kg m^2], motor side
   double gear_ratio;     // G (signed), motor turns per joint turn
 };
@@ -22,8 +58,9 @@ struct LinkParams {
 /// The arm: kinematics, inertia, gravity and joint limits.
 struct ArmDescription {
   const char* name;
+  Placement base;  ///< frame 0 in the base frame
   LinkParams links[kDof];
-  double gravity;      ///< magnitude [m/s^2]; gravity acts along -z0
+  double gravity;      ///< magnitude [m/s^2]; gravity acts along -z of the base frame
   double q_min[kDof];  ///< joint limits [rad]
   double q_max[kDof];
 };
@@ -153,11 +190,32 @@ constexpr void friction_band(const FrictionCoefficients* const (&presets)[N], do
 constexpr long dac_max_code(const DriveParams& drives) { return (1L << (drives.dac_bits - 1)) - 1; }
 
 /// True when the last three joint axes meet at the frame-6 origin (a spherical wrist with the
-/// operational point at its centre): a4 = a5 = a6 = 0 and d5 = d6 = 0. Then the linear rows of the
-/// Jacobian do not depend on joints 4-6, and J is block lower-triangular (kernels/opspace.hpp).
+/// operational point at its centre): link 4's origin lies on joint 4's axis (P_4's translation along
+/// z only) and links 5 and 6 add no translation. Then o4 = o5 = o6 lies on the axes of joints 4-6,
+/// the linear rows of the Jacobian do not depend on joints 4-6, and J is block lower-triangular
+/// (kernels/opspace.hpp). In DH terms: a4 = a5 = a6 = 0 and d5 = d6 = 0.
 constexpr bool has_spherical_wrist(const ArmDescription& arm) {
-  return arm.links[3].a == 0 && arm.links[4].a == 0 && arm.links[5].a == 0 && arm.links[4].d == 0 &&
-         arm.links[5].d == 0;
+  const double* p4 = arm.links[3].placement.p;
+  const double* p5 = arm.links[4].placement.p;
+  const double* p6 = arm.links[5].placement.p;
+  return p4[0] == 0 && p4[1] == 0 && p5[0] == 0 && p5[1] == 0 && p5[2] == 0 && p6[0] == 0 && p6[1] == 0 &&
+         p6[2] == 0;
+}
+
+/// True when the rotation of a placement is a permutation of the axes with signs (every entry 0 or
+/// +-1): the DH twists 0 and +-pi/2, and a URDF's quarter-turn rpy. The kernels then place a frame
+/// by moving columns, without a product.
+constexpr bool is_signed_permutation(const Placement& P) {
+  for (int r = 0; r < 3; ++r) {
+    int nonzero = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double v = P.R[r][c];
+      if (v != 0 && v != 1 && v != -1) return false;
+      nonzero += v != 0;
+    }
+    if (nonzero != 1) return false;
+  }
+  return true;
 }
 
 }  // namespace osc
