@@ -24,7 +24,8 @@ inline KDL::Frame kdl_frame(const Placement& P) {
                     KDL::Vector(P.p[0], P.p[1], P.p[2]));
 }
 
-/// An arm's table as a KDL chain: a fixed segment to frame 0 (the base placement), then segment i =
+/// An arm's table as a KDL chain: a fixed segment to frame 0 (the base placement, where it is not the
+/// identity: then the chain has 7 segments, the first fixed), then segment i =
 /// revolute joint about z of frame i-1 followed by the placement P_i to frame i (the joint adds
 /// Rz(q_i); for a DH row P_i = KDL::Frame::DH(a, alpha, d, 0) = Tz(d) Tx(a) Rx(alpha)).
 /// A segment's RigidBodyInertia is expressed in its tip frame, i.e. frame i, as in the reference
@@ -36,7 +37,8 @@ inline KDL::Frame kdl_frame(const Placement& P) {
 /// with_armature = false.
 inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true) {
   KDL::Chain chain;
-  chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), kdl_frame(arm.base)));
+  const KDL::Frame base = kdl_frame(arm.base);
+  if (!KDL::Equal(base, KDL::Frame::Identity(), 1e-15)) chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), base));
   for (int i = 0; i < kDof; ++i) {
     const LinkParams& L = arm.links[i];
     const double jm = L.gear_ratio * L.gear_ratio * L.motor_inertia;

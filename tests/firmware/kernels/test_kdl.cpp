@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
+#include <random>
 #include <cstdio>
 #include <kdl/chaindynparam.hpp>
 #include <kdl/chainfdsolver_recursive_newton_euler.hpp>
@@ -134,6 +136,106 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
     ASSERT_GE(jacdot.JntToJacDot(KDL::JntArrayVel(kq, kqd), t), 0);
     const Vec6<double> kjd = from_kdl(t);
     w_jd.add((kjd - jdqd).norm(), kjd.norm(), kFloor);
+  }
+  for (const Worst* w : {&w_fk, &w_jac, &w_A, &w_c, &w_g, &w_jd}) {
+    w->report();
+    EXPECT_LE(w->value, kTol) << w->name;
+  }
+}
+
+/// A random 6R arm in the general form: a base placement, link placements with arbitrary rotations
+/// and translations (no DH structure: no permutation, no planar offset), full inertia tensors (a box's
+/// principal moments turned by a random rotation: positive definite, triangle inequality held).
+ArmDescription random_general_arm(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
+  const auto rotation = [&] {
+    return Eigen::AngleAxisd(kPi * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+  };
+  const auto placement = [&](double reach) {
+    Placement P{};
+    const Eigen::Matrix3d R = rotation();
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) P.R[r][c] = R(r, c);
+      P.p[r] = reach * u(rng);
+    }
+    return P;
+  };
+  ArmDescription arm{"random", placement(0.2), {}, 9.81, {}, {}};
+  for (LinkParams& L : arm.links) {
+    L.placement = placement(0.4);
+    L.mass = 5 * pos(rng);
+    for (double& c : L.com) c = 0.2 * u(rng);
+    const Eigen::Vector3d box(0.3 * pos(rng), 0.3 * pos(rng), 0.3 * pos(rng));  // edge lengths [m]
+    const Eigen::Vector3d b2 = box.cwiseProduct(box);
+    const Eigen::Matrix3d R = rotation();
+    const Eigen::Matrix3d I =
+        R * (L.mass / 12 * Eigen::Vector3d(b2(1) + b2(2), b2(0) + b2(2), b2(0) + b2(1))).asDiagonal() * R.transpose();
+    const double in[6] = {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)};
+    for (int k = 0; k < 6; ++k) L.inertia[k] = in[k];
+    L.motor_inertia = 2e-5 * pos(rng);
+    L.gear_ratio = 100 * u(rng);
+  }
+  return arm;
+}
+
+// The kernels' general paths (a base placement, rotations that are not permutations, offsets off the
+// DH plane, products of inertia), which the PUMA's table never takes, against KDL on random arms.
+TEST(Kdl, GeneralArmsKernelsAgreeOnRandomStates) {
+  std::mt19937_64 rng(2026);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Worst w_fk{"general arms: FK [R p]"}, w_jac{"general arms: J"}, w_A{"general arms: A(q)"},
+      w_c{"general arms: c(q, qd)"}, w_g{"general arms: g(q)"}, w_jd{"general arms: Jdot qd"};
+  for (int a = 0; a < 20; ++a) {
+    const ArmDescription arm = random_general_arm(rng);
+    const Model<double> model = Model<double>::of(arm);
+    for (const auto& l : model.link) {
+      ASSERT_FALSE(l.form.permutation);
+      ASSERT_FALSE(l.form.planar);
+      ASSERT_FALSE(l.diagonal);
+    }
+    const KDL::Chain chain = test::arm_chain(arm);
+    ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof + 1));  // the base segment first
+    KDL::ChainFkSolverPos_recursive fk(chain);
+    KDL::ChainJntToJacSolver jac(chain);
+    KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -arm.gravity));
+    KDL::ChainJntToJacDotSolver jacdot(chain);
+    jacdot.setRepresentation(KDL::ChainJntToJacDotSolver::HYBRID);
+    Data<double> data;
+    KDL::Jacobian J(kDof);
+    KDL::JntSpaceInertiaMatrix H(kDof);
+    KDL::JntArray C(kDof), G(kDof);
+    for (int k = 0; k < 50; ++k) {
+      Vec6<double> q, qd;
+      for (int i = 0; i < kDof; ++i) q(i) = kPi * u(rng), qd(i) = 2 * u(rng);
+      const KDL::JntArray kq = to_kdl(q), kqd = to_kdl(qd);
+      forward_kinematics(model, data, q);
+      geometric_jacobian(data);
+      joint_inertia(model, data);
+      const VelocityProducts<double> vp = velocity_products(model, data, qd);
+      const Vec6<double> g = gravity_torques(model, data);
+      for (int i = 0; i <= kDof; ++i) {  // frame i is KDL's after segment i + 1 (the base segment first)
+        KDL::Frame F;
+        ASSERT_GE(fk.JntToCart(kq, F, i + 1), 0);
+        Eigen::Matrix<double, 3, 4> ours, ref;
+        ours << data.R[i], data.o[i];
+        for (int r = 0; r < 3; ++r) {
+          for (int s = 0; s < 3; ++s) ref(r, s) = F.M(r, s);
+          ref(r, 3) = F.p(r);
+        }
+        w_fk.add((ours - ref).norm(), ref.norm(), 0.0);
+      }
+      ASSERT_GE(jac.JntToJac(kq, J), 0);
+      w_jac.add((J.data - data.J).norm(), J.data.norm(), 0.0);
+      ASSERT_GE(dyn.JntToMass(kq, H), 0);
+      ASSERT_GE(dyn.JntToCoriolis(kq, kqd, C), 0);
+      ASSERT_GE(dyn.JntToGravity(kq, G), 0);
+      w_A.add((H.data - data.A).norm(), H.data.norm(), 0.0);
+      w_c.add((C.data - vp.c).norm(), C.data.norm(), kFloor);
+      w_g.add((G.data - g).norm(), G.data.norm(), kFloor);
+      KDL::Twist t;
+      ASSERT_GE(jacdot.JntToJacDot(KDL::JntArrayVel(kq, kqd), t), 0);
+      w_jd.add((from_kdl(t) - vp.jdot_qd).norm(), from_kdl(t).norm(), kFloor);
+    }
   }
   for (const Worst* w : {&w_fk, &w_jac, &w_A, &w_c, &w_g, &w_jd}) {
     w->report();
