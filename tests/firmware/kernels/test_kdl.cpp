@@ -10,6 +10,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <random>
 #include <cstdio>
 #include <kdl/chaindynparam.hpp>
@@ -146,10 +147,19 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
 /// A random 6R arm in the general form: a base placement, link placements with arbitrary rotations
 /// and translations (no DH structure: no permutation, no planar offset), full inertia tensors (a box's
 /// principal moments turned by a random rotation: positive definite, triangle inequality held).
-ArmDescription random_general_arm(std::mt19937_64& rng) {
+/// With `quarter_turns`, every placement's rotation is a random signed permutation (a URDF's quarter
+/// turns: the kernels' permutation path) instead.
+ArmDescription random_general_arm(std::mt19937_64& rng, bool quarter_turns) {
   std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.2, 1.0);
   const auto rotation = [&] {
-    return Eigen::AngleAxisd(kPi * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+    if (!quarter_turns)
+      return Eigen::AngleAxisd(kPi * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized()).toRotationMatrix();
+    Eigen::Matrix3d R = Eigen::Matrix3d::Zero();
+    int perm[3] = {0, 1, 2};
+    std::shuffle(perm, perm + 3, rng);
+    for (int c = 0; c < 3; ++c) R(perm[c], c) = u(rng) < 0 ? -1.0 : 1.0;
+    if (R.determinant() < 0) R.col(2) = -R.col(2);  // a rotation, not a reflection
+    return R;
   };
   const auto placement = [&](double reach) {
     Placement P{};
@@ -178,20 +188,26 @@ ArmDescription random_general_arm(std::mt19937_64& rng) {
   return arm;
 }
 
-// The kernels' general paths (a base placement, rotations that are not permutations, offsets off the
-// DH plane, products of inertia), which the PUMA's table never takes, against KDL on random arms.
+// The kernels' general paths (a base placement, rotations that are not permutations or are any signed
+// permutation, offsets off the DH plane, products of inertia), which the PUMA's table never takes,
+// against KDL on random arms.
 TEST(Kdl, GeneralArmsKernelsAgreeOnRandomStates) {
   std::mt19937_64 rng(2026);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   Worst w_fk{"general arms: FK [R p]"}, w_jac{"general arms: J"}, w_A{"general arms: A(q)"},
       w_c{"general arms: c(q, qd)"}, w_g{"general arms: g(q)"}, w_jd{"general arms: Jdot qd"};
-  for (int a = 0; a < 20; ++a) {
-    const ArmDescription arm = random_general_arm(rng);
+  for (int a = 0; a < 40; ++a) {
+    const bool quarter_turns = a % 2 == 1;
+    const ArmDescription arm = random_general_arm(rng, quarter_turns);
     const Model<double> model = Model<double>::of(arm);
+    ASSERT_FALSE(model.base_identity);
     for (const auto& l : model.link) {
-      ASSERT_FALSE(l.form.permutation);
+      if (quarter_turns)
+        ASSERT_NE(l.form.rotation, Rotation::kGeneral);
+      else
+        ASSERT_EQ(l.form.rotation, Rotation::kGeneral);
       ASSERT_FALSE(l.form.planar);
-      ASSERT_FALSE(l.diagonal);
+      ASSERT_TRUE(quarter_turns || !l.diagonal);  // a box turned by quarter turns stays diagonal
     }
     const KDL::Chain chain = test::arm_chain(arm);
     ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof + 1));  // the base segment first

@@ -16,17 +16,19 @@ namespace {
 
 TEST(Model, PlacementFormsAreTheStructureOfEachPlacement) {
   // The DH twists 0, +-pi/2 and pi are signed permutations; other angles are general rotations.
+  EXPECT_EQ(placement_form(dh_placement(0.1, 0.2, 0)).rotation, Rotation::kIdentity);
   const PlacementForm plus = placement_form(dh_placement(0.1, 0.2, kPi / 2));
-  ASSERT_TRUE(plus.permutation);
+  EXPECT_EQ(plus.rotation, Rotation::kRxPlusHalfPi);
   EXPECT_EQ(plus.column[0], 1);   // x stays
   EXPECT_EQ(plus.column[1], 3);   // y' = z
   EXPECT_EQ(plus.column[2], -2);  // z' = -y
   EXPECT_TRUE(plus.planar);
   const PlacementForm minus = placement_form(dh_placement(0, 0, -kPi / 2));
+  EXPECT_EQ(minus.rotation, Rotation::kRxMinusHalfPi);
   EXPECT_EQ(minus.column[1], -3);
   EXPECT_EQ(minus.column[2], 2);
   const PlacementForm half = placement_form(dh_placement(0, 0, kPi));
-  EXPECT_TRUE(half.permutation);
+  EXPECT_EQ(half.rotation, Rotation::kPermutation);
   EXPECT_EQ(half.column[1], -2);
   EXPECT_EQ(half.column[2], -3);
   Placement tilted = dh_placement(0, 0, 0);
@@ -34,7 +36,7 @@ TEST(Model, PlacementFormsAreTheStructureOfEachPlacement) {
   tilted.R[2][1] = std::sin(0.3), tilted.R[1][2] = -std::sin(0.3);
   tilted.p[1] = 0.05;
   const PlacementForm general = placement_form(tilted);
-  EXPECT_FALSE(general.permutation);
+  EXPECT_EQ(general.rotation, Rotation::kGeneral);
   EXPECT_FALSE(general.planar);
   // The built arm's placements: the model's copy is the table's, and every PUMA link has the fast forms.
   const Model<double> m = Model<double>::of(robot::kArm);
@@ -45,7 +47,8 @@ TEST(Model, PlacementFormsAreTheStructureOfEachPlacement) {
       for (int c = 0; c < 3; ++c) EXPECT_EQ(m.link[i].R(r, c), P.R[r][c]) << i;
     }
     if (std::string_view(robot::kArm.name) == "PUMA 560") {
-      EXPECT_TRUE(m.link[i].form.permutation) << i;
+      EXPECT_NE(m.link[i].form.rotation, Rotation::kPermutation) << i;  // the DH forms
+      EXPECT_NE(m.link[i].form.rotation, Rotation::kGeneral) << i;
       EXPECT_TRUE(m.link[i].form.planar) << i;
       EXPECT_TRUE(m.link[i].diagonal) << i;
     }

@@ -13,6 +13,18 @@
 
 namespace osc {
 
+/// Ic += Rn P Rn^T for the products of inertia P (zero diagonal; Ixy, Ixz, Iyz off it): the part of a
+/// link's inertia that a table of principal moments lacks. Apart, so that the arms without products
+/// (every DH table of principal moments) keep their frames' registers.
+template <class S>
+[[gnu::noinline]] void add_products_of_inertia(const Mat3<S>& Rn, const Vec3<S>& products, Mat3<S>& Ic) {
+  Mat3<S> P;
+  P << S(0), products(0), products(1), products(0), S(0), products(2), products(1), products(2), S(0);
+  const Mat3<S> M = Rn * P;
+  for (int r = 0; r < 3; ++r)
+    for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = Ic(r, k) + M.row(r).dot(Rn.row(k));
+}
+
 /// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic; the
 /// joint axes' moments o_i x z_i into data.vO (the CRBA's and the RNEA passes' joint projections).
 /// F_{i+1} = F_i Rz(q_i) P_i (osc/robots/arm.hpp): Rz turns the first two columns of R_i by q_i
@@ -21,8 +33,13 @@ namespace osc {
 /// p_x x + p_y y + p_z z (a x + d z for a DH row).
 template <class S>
 void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q) {
-  data.R[0] = model.base_R;
-  data.o[0] = model.base_o;
+  if (model.base_identity) {
+    data.R[0].setIdentity();
+    data.o[0].setZero();
+  } else {
+    data.R[0] = model.base_R;
+    data.o[0] = model.base_o;
+  }
   // The joints' sines and cosines first: independent of each other, unlike the frames below.
   S sq[kDof], cq[kDof];
   for (int i = 0; i < kDof; ++i) math::sincos(q(i), sq[i], cq[i]);
@@ -31,33 +48,34 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
     const S s = sq[i], c = cq[i];
     const Mat3<S>& R = data.R[i];
     Mat3<S>& Rn = data.R[i + 1];
-    const Vec3<S> turned[3] = {combine(c, R.col(0), s, R.col(1)),   // R Rz(q) e_x
-                               combine(c, R.col(1), -s, R.col(0)),  // R Rz(q) e_y
-                               R.col(2)};
-    const Vec3<S>&x = turned[0], &y = turned[1], &z = turned[2];
-    if (l.form.permutation) {
-      for (int k = 0; k < 3; ++k) {
-        const int from = l.form.column[k];
-        Rn.col(k) = from > 0 ? turned[from - 1] : Vec3<S>(-turned[-from - 1]);
-      }
-    } else {
-      for (int k = 0; k < 3; ++k) Rn.col(k) = sum3(l.R(0, k), x, l.R(1, k), y, l.R(2, k), z);
+    const Vec3<S> x = combine(c, R.col(0), s, R.col(1));   // R Rz(q) e_x
+    const Vec3<S> y = combine(c, R.col(1), -s, R.col(0));  // R Rz(q) e_y
+    const Vec3<S> z = R.col(2);
+    switch (l.form.rotation) {
+      case Rotation::kIdentity:
+        Rn.col(0) = x, Rn.col(1) = y, Rn.col(2) = z;
+        break;
+      case Rotation::kRxPlusHalfPi:
+        Rn.col(0) = x, Rn.col(1) = z, Rn.col(2) = -y;
+        break;
+      case Rotation::kRxMinusHalfPi:
+        Rn.col(0) = x, Rn.col(1) = -z, Rn.col(2) = y;
+        break;
+      case Rotation::kPermutation:
+      case Rotation::kGeneral:
+        for (int k = 0; k < 3; ++k) Rn.col(k) = sum3(l.R(0, k), x, l.R(1, k), y, l.R(2, k), z);
+        break;
     }
-    data.o[i + 1] = data.o[i] + (l.form.planar ? combine(l.p(0), x, l.p(2), z) : sum3(l.p(0), x, l.p(1), y, l.p(2), z));
+    data.o[i + 1] = data.o[i] + combine(l.p(0), x, l.p(2), z);
+    if (!l.form.planar) data.o[i + 1] += l.p(1) * y;  // off the DH plane: a URDF's offset
     data.com[i + 1] = data.o[i + 1] + Rn * l.com;
-    // Ic = Rn I Rn^T, symmetric: six of its entries.
-    Mat3<S> M;
-    if (l.diagonal) {
-      M = Rn * l.inertia.asDiagonal();
-    } else {
-      Mat3<S> I;
-      I << l.inertia(0), l.products(0), l.products(1), l.products(0), l.inertia(1), l.products(2), l.products(1),
-          l.products(2), l.inertia(2);
-      M = Rn * I;
-    }
+    // Ic = Rn I Rn^T, symmetric: six of its entries; the principal part diag(Ixx, Iyy, Izz) first, and the
+    // products (Ixy, Ixz, Iyz) after, only for a link that has them.
+    const Mat3<S> M = Rn * l.inertia.asDiagonal();
     Mat3<S>& Ic = data.Ic[i + 1];
     for (int r = 0; r < 3; ++r)
       for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));
+    if (!l.diagonal) add_products_of_inertia(Rn, l.products, Ic);
   }
   for (int i = 0; i < kDof; ++i) data.vO[i] = cross(data.o[i], data.R[i].col(2));
 }

@@ -77,22 +77,29 @@ template <class S>
                  sum_of_products(a, u(2), b, v(2), c, w(2)));
 }
 
-/// How a link's placement P = (R, p) places its frame, for forward_kinematics: a rotation that is
-/// a signed permutation (every DH twist of 0 or +-pi/2, and a URDF's quarter turns) moves columns
-/// with a sign instead of a product; a translation (a, 0, d) in the turned frame (every DH row) is a
-/// two-term sum.
+/// How a link's placement P = (R, p) places its frame, for forward_kinematics. The rotations of a
+/// DH table (Rx of 0 and +-pi/2: every PUMA 560 link) move two columns, one with a sign; any other
+/// signed permutation (a URDF's quarter turns) moves all three by its codes; only a general rotation
+/// takes a product. A translation (a, 0, d) in the turned frame (every DH row) is a two-term sum.
+enum class Rotation : unsigned char { kIdentity, kRxPlusHalfPi, kRxMinusHalfPi, kPermutation, kGeneral };
+
 struct PlacementForm {
-  signed char column[3];  ///< a permutation: column k of R is sign(column[k]) e_{|column[k]| - 1}; 0: general
-  bool permutation;
-  bool planar;  ///< p(1) == 0
+  Rotation rotation;
+  signed char column[3];  ///< kPermutation: column k of R is sign(column[k]) e_{|column[k]| - 1}
+  bool planar;            ///< p(1) == 0
 };
 
 constexpr PlacementForm placement_form(const Placement& P) {
-  PlacementForm f{{0, 0, 0}, is_signed_permutation(P), P.p[1] == 0};
-  if (f.permutation)
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < 3; ++r)
-        if (P.R[r][c] != 0) f.column[c] = static_cast<signed char>(P.R[r][c] > 0 ? r + 1 : -(r + 1));
+  PlacementForm f{Rotation::kGeneral, {0, 0, 0}, P.p[1] == 0};
+  if (!is_signed_permutation(P)) return f;
+  for (int c = 0; c < 3; ++c)
+    for (int r = 0; r < 3; ++r)
+      if (P.R[r][c] != 0) f.column[c] = static_cast<signed char>(P.R[r][c] > 0 ? r + 1 : -(r + 1));
+  const auto is = [&f](int a, int b, int c) { return f.column[0] == a && f.column[1] == b && f.column[2] == c; };
+  f.rotation = is(1, 2, 3)    ? Rotation::kIdentity
+               : is(1, 3, -2) ? Rotation::kRxPlusHalfPi
+               : is(1, -3, 2) ? Rotation::kRxMinusHalfPi
+                              : Rotation::kPermutation;
   return f;
 }
 
@@ -111,6 +118,7 @@ struct Model {
   };
   Mat3<S> base_R;  // frame 0 in the base frame
   Vec3<S> base_o;
+  bool base_identity;  // frame 0 is the base frame
   Link link[kDof];
   Vec6<S> armature;  // G^2 * Jm, added to the diagonal of A(q)
   S gravity;         // along -z of the base frame
@@ -121,6 +129,8 @@ struct Model {
     Model m{};
     const double s = 1.0 + mass_inertia_error;
     placement(arm.base, m.base_R, m.base_o);
+    m.base_identity = placement_form(arm.base).rotation == Rotation::kIdentity && arm.base.p[0] == 0 &&
+                      arm.base.p[1] == 0 && arm.base.p[2] == 0;
     for (int i = 0; i < kDof; ++i) {
       const LinkParams& p = arm.links[i];
       Link& l = m.link[i];
