@@ -64,9 +64,9 @@ Inertial link_inertial(const urdf::Link& link, bool exempt) {
   const Eigen::Vector3d l = Eigen::SelfAdjointEigenSolver<Mat3>(Ic).eigenvalues();  // ascending
   const double tol = 1e-12 * std::max(1e-300, l.cwiseAbs().maxCoeff());
   if (exempt ? l(0) < -tol : l(0) <= 0)
-    throw Error("inertia_not_positive_definite",
-                where + ": principal moments " + number(l(0)) + ", " + number(l(1)) + ", " + number(l(2)) +
-                    (exempt ? " (one negative)" : " (each must be > 0)"));
+    throw Error("inertia_not_positive_definite", where + ": principal moments " + number(l(0)) + ", " + number(l(1)) +
+                                                     ", " + number(l(2)) +
+                                                     (exempt ? " (one negative)" : " (each must be > 0)"));
   if (!exempt && l(0) + l(1) < l(2) - tol)
     throw Error("inertia_not_positive_definite", where + ": principal moments " + number(l(0)) + ", " + number(l(1)) +
                                                      ", " + number(l(2)) + " break the triangle inequality (" +
@@ -124,8 +124,8 @@ struct Walk {
         moving.push_back({j, body, O});
         visit(*child, static_cast<int>(moving.size()) - 1, Frame{});
       } else {
-        const char* kind = j->type == urdf::Joint::PRISMATIC ? "prismatic"
-                           : j->type == urdf::Joint::PLANAR  ? "planar"
+        const char* kind = j->type == urdf::Joint::PRISMATIC  ? "prismatic"
+                           : j->type == urdf::Joint::PLANAR   ? "planar"
                            : j->type == urdf::Joint::FLOATING ? "floating"
                                                               : "of unknown type";
         throw Error("joint_type",
@@ -166,8 +166,8 @@ Joint read_joint(const urdf::Joint& j) {
     require_finite({j.limits->lower, j.limits->upper}, "joint " + j.name + "'s limits");
     out.lower = j.limits->lower, out.upper = j.limits->upper;
     if (out.lower >= out.upper)
-      throw Error("limits_inverted", "joint " + j.name + ": lower limit " + number(out.lower) + " >= upper limit " +
-                                         number(out.upper));
+      throw Error("limits_inverted",
+                  "joint " + j.name + ": lower limit " + number(out.lower) + " >= upper limit " + number(out.upper));
   }
   return out;
 }
@@ -191,8 +191,9 @@ Chain read_chain(const std::string& urdf_path, const Sheet& sheet) {
     c.joints[i] = read_joint(*w.moving[i].joint);
     A[i] = axis_rotation(c.joints[i].axis);
     const urdf::LinkConstSharedPtr link = model->getLink(c.joints[i].child);
-    if (!link->inertial) throw Error("missing_inertial", "link " + link->name + " moves (joint " + c.joints[i].name +
-                                                             ") but has no <inertial>");
+    if (!link->inertial)
+      throw Error("missing_inertial",
+                  "link " + link->name + " moves (joint " + c.joints[i].name + ") but has no <inertial>");
     inertial_L[i] = link_inertial(*link, sheet.inertial_exceptions.count(link->name) > 0);
     for (const auto& [in, T] : w.lumped[i]) inertial_L[i] = lump(inertial_L[i], in, T);
   }

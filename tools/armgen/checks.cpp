@@ -11,16 +11,16 @@ namespace armgen {
 
 namespace {
 
-constexpr double kRange = 4096;                    // Q12.19
-constexpr double kResolution = 1.0 / (1 << 19);    // Q12.19
-constexpr double kIoRange = 524288;                // Q19.12
+constexpr double kRange = 4096;                  // Q12.19
+constexpr double kResolution = 1.0 / (1 << 19);  // Q12.19
+constexpr double kIoRange = 524288;              // Q19.12
 constexpr double kPi = 3.14159265358979323846;
 const char* const kJoint[] = {"1", "2", "3", "4", "5", "6"};
 
 void range(double v, const std::string& what, double limit = kRange, const char* format = "Q12.19") {
   if (!(std::abs(v) < limit))
-    throw Error("fixed_point_range", what + " = " + number(v) + " overflows the firmware's " + format + " (range +-" +
-                                         number(limit) + ")");
+    throw Error("fixed_point_range",
+                what + " = " + number(v) + " overflows the firmware's " + format + " (range +-" + number(limit) + ")");
 }
 
 /// In range, and not rounded to 0 or by more than 10 % (`reference`: the magnitude the rounding is
@@ -62,8 +62,7 @@ void check_links(const Chain& c, double gravity) {
       if (I(k, k) > 0 && (smallest == 0 || I(k, k) < smallest)) smallest = I(k, k);
     const char* names[3][3] = {{"Ixx", "Ixy", "Ixz"}, {"Ixy", "Iyy", "Iyz"}, {"Ixz", "Iyz", "Izz"}};
     for (int r = 0; r < 3; ++r)
-      for (int k = r; k < 3; ++k)
-        resolved(I(r, k), link + "'s inertia " + names[r][k], r == k ? 0 : smallest);
+      for (int k = r; k < 3; ++k) resolved(I(r, k), link + "'s inertia " + names[r][k], r == k ? 0 : smallest);
   }
   // Gravity torques: joint j's at most g sum_{k>=j} m_k (sum_{l=j..k} |p_l| + |com_k|).
   for (int j = 0; j < 6; ++j) {

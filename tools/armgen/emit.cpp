@@ -121,15 +121,17 @@ std::string placement(const Frame& P, bool identity_name) {
 void emit_arm(std::ostream& o, const Sheet& s, const Chain& c) {
   const std::string jm = "kMotorInertia" + camel(s.motor_sets[0].name);
   for (const MotorSet& m : s.motor_sets) {
-    group(o, "/// ", "Motor inertias [kg m^2], motor side: set \"" + m.name + "\"" +
-                         (&m == &s.motor_sets[0] ? " (the model's: kArm)" : "") + ".",
+    group(o, "/// ",
+          "Motor inertias [kg m^2], motor side: set \"" + m.name + "\"" +
+              (&m == &s.motor_sets[0] ? " (the model's: kArm)" : "") + ".",
           m.text);
-    o << "inline constexpr MotorInertias kMotorInertia" << camel(m.name) << " = {" << cstr(m.name) << ", "
-      << six(m.jm) << "};\n";
+    o << "inline constexpr MotorInertias kMotorInertia" << camel(m.name) << " = {" << cstr(m.name) << ", " << six(m.jm)
+      << "};\n";
   }
   if (!s.motor_text.source.empty() || !s.motor_text.estimate.empty()) group(o, "/// ", "Motor inertias:", s.motor_text);
   o << "\n";
-  group(o, "/// ", "The arm, from " + c.root + " (the base frame) to " + c.joints[5].child + ": kinematics and inertia.",
+  group(o, "/// ",
+        "The arm, from " + c.root + " (the base frame) to " + c.joints[5].child + ": kinematics and inertia.",
         s.kinematics);
   group(o, "/// ", "Gear ratios G (signed, motor turns per joint turn).", s.gear_text);
   group(o, "/// ", "Gravity [m/s^2], along -z of the base frame.", s.gravity_text);
@@ -142,8 +144,8 @@ void emit_arm(std::ostream& o, const Sheet& s, const Chain& c) {
       << ")\n";
     const auto ex = s.inertial_exceptions.find(j.child);
     if (ex != s.inertial_exceptions.end()) group(o, "        // ", "Its inertial is no body's:", ex->second);
-    o << "        {" << placement(c.placement[i], false) << ", " << number(L.mass) << ", {" << number(L.com(0))
-      << ", " << number(L.com(1)) << ", " << number(L.com(2)) << "}, {" << number(L.inertia(0, 0)) << ", "
+    o << "        {" << placement(c.placement[i], false) << ", " << number(L.mass) << ", {" << number(L.com(0)) << ", "
+      << number(L.com(1)) << ", " << number(L.com(2)) << "}, {" << number(L.inertia(0, 0)) << ", "
       << number(L.inertia(1, 1)) << ", " << number(L.inertia(2, 2)) << ", " << number(L.inertia(0, 1)) << ", "
       << number(L.inertia(0, 2)) << ", " << number(L.inertia(1, 2)) << "}, " << jm << ".jm[" << i << "], "
       << s.gear[i].text << "},\n";
@@ -165,8 +167,9 @@ void emit_arm(std::ostream& o, const Sheet& s, const Chain& c) {
   else
     o << "static_assert(!has_spherical_wrist(kArm), \"the wrist axes do not meet at the frame-6 origin\");\n\n";
 
-  group(o, "/// ", "The operational point (frame 6 of kArm) in the last moving link's URDF frame (" + c.joints[5].child +
-                       "), from " + c.tool_frame + ".",
+  group(o, "/// ",
+        "The operational point (frame 6 of kArm) in the last moving link's URDF frame (" + c.joints[5].child +
+            "), from " + c.tool_frame + ".",
         s.op_text);
   o << "constexpr Placement kToolOffset = " << placement(c.tool, true) << ";\n\n";
 }
@@ -176,7 +179,8 @@ void emit_poses(std::ostream& o, const Sheet& s) {
   o << "constexpr double kQStart[kDof] = " << six(s.start.q) << ";\n";
   if (!s.named.empty()) group(o, "/// ", "Named poses [rad]:", s.named_text);
   for (const Pose& p : s.named)
-    if (!p.symbol.empty()) o << "constexpr double " << p.symbol << "[kDof] = " << six(p.q) << ";  // " << p.name << "\n";
+    if (!p.symbol.empty())
+      o << "constexpr double " << p.symbol << "[kDof] = " << six(p.q) << ";  // " << p.name << "\n";
   if (!s.reference.empty()) {
     group(o, "/// ", "Reference poses [rad] (not declarable, not held to the joint limits):", s.reference_text);
     for (const Pose& p : s.reference) {
@@ -217,8 +221,8 @@ void emit_drives(std::ostream& o, const Sheet& s) {
        "kDrives.encoder_counts_per_motor_rev);\n\n";
 
   o << "/// The arm's own drive train.\nconstexpr DriveTrain kDriveTrain = {\n";
-  group(o, "    // ", "Encoders (" + s.encoder_unit + ", " + (s.absolute ? "absolute" : "incremental") + "):",
-        s.encoder_text);
+  group(o, "    // ",
+        "Encoders (" + s.encoder_unit + ", " + (s.absolute ? "absolute" : "incremental") + "):", s.encoder_text);
   o << "    {" << cstr(s.encoder_name) << ",\n     {";
   for (int i = 0; i < 6; ++i) o << (i ? ", " : "") << encoder_counts(s, i);
   o << "},\n     " << s.coupling.size() << ",\n     {";
@@ -252,8 +256,9 @@ void emit_friction(std::ostream& o, const Sheet& s) {
   for (const FrictionPreset& f : s.friction) {
     const std::string sym = "kFriction" + camel(f.name);
     if (f.motor) {
-      group(o, "/// ", "\"" + f.name + "\": motor-side viscous B and Coulomb Tc+, Tc-, referred to the link " +
-                           "(friction_from_motor).",
+      group(o, "/// ",
+            "\"" + f.name + "\": motor-side viscous B and Coulomb Tc+, Tc-, referred to the link " +
+                "(friction_from_motor).",
             f.text);
       o << "constexpr MotorFriction kMotorFriction" << camel(f.name) << " = {" << six(f.a) << ", " << six(f.b) << ", "
         << six(f.c) << "};\n";
@@ -289,8 +294,11 @@ void emit_friction(std::ostream& o, const Sheet& s) {
     << s.encoder_edge.text << ", {\"band_lo\", {}, {}, {}}, {\"band_hi\", {}, {}, {}}},\n    kFrictionBandPresets, "
     << s.drift.text << ");\n\n";
 
-  group(o, "/// ", "Cartesian motion limits: velocity [m/s], acceleration [m/s^2], jerk [m/s^3].", s.cart_text);
-  o << "constexpr CartesianLimits kCartesianLimits = {" << s.cart_velocity.text << ", " << s.cart_acceleration.text
+  group(o, "/// ",
+        "Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3] "
+        "(carried for the motion generator; params.hpp's kMoveLinear is what it uses today).",
+        s.cart_text);
+  o << "constexpr CartesianMaxima kCartesianMaxima = {" << s.cart_velocity.text << ", " << s.cart_acceleration.text
     << ", " << s.cart_jerk.text << "};\n\n";
 }
 
@@ -298,18 +306,20 @@ void emit_friction(std::ostream& o, const Sheet& s) {
 
 std::string emit_header(const Sheet& s, const Chain& c, const std::string& sheet_name, const std::string& urdf_name) {
   std::ostringstream o;
-  comment(o, "// ", s.name + ": the arm's constant table (osc/robots/arm.hpp's format), generated by tools/armgen from " +
-                        urdf_name + " (kinematics, inertia, joint limits) and " + sheet_name +
-                        " (drives, friction, poses, bounds; each group's source or estimate is copied here). "
-                        "Do not edit: change the description and regenerate with scripts/gen_arms.sh (the host "
-                        "build fails while this file differs from what its description generates).");
+  comment(o, "// ",
+          s.name + ": the arm's constant table (osc/robots/arm.hpp's format), generated by tools/armgen from " +
+              urdf_name + " (kinematics, inertia, joint limits) and " + sheet_name +
+              " (drives, friction, poses, bounds; each group's source or estimate is copied here). "
+              "Do not edit: change the description and regenerate with scripts/gen_arms.sh (the host "
+              "build fails while this file differs from what its description generates).");
   if (!s.about.empty()) {
     o << "//\n";
     comment(o, "// ", s.about);
   }
   o << "//\n";
   comment(o, "// ", kRules);
-  o << "#pragma once\n\n#include <string_view>\n\n#include \"osc/robots/arm.hpp\"\n\n// clang-format off\nnamespace osc::"
+  o << "#pragma once\n\n#include <string_view>\n\n#include \"osc/robots/arm.hpp\"\n\n// clang-format off\nnamespace "
+       "osc::"
     << s.arm << " {\n\n";
   emit_arm(o, s, c);
   emit_poses(o, s);

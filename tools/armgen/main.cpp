@@ -39,7 +39,8 @@ int main(int argc, char** argv) {
   std::string header;
   try {
     const armgen::Sheet sheet = armgen::read_sheet(sheet_path);
-    const fs::path urdf = urdf_override.empty() ? fs::path(sheet_path).parent_path() / sheet.urdf : fs::path(urdf_override);
+    const fs::path urdf =
+        urdf_override.empty() ? fs::path(sheet_path).parent_path() / sheet.urdf : fs::path(urdf_override);
     const armgen::Chain chain = armgen::read_chain(urdf.string(), sheet);
     armgen::check_description(sheet, chain);
     header = armgen::emit_header(sheet, chain, shown(sheet_path, root), shown(urdf, root));
@@ -61,8 +62,8 @@ int main(int argc, char** argv) {
     std::stringstream committed;
     committed << in.rdbuf();
     if (!in || committed.str() != header) {
-      std::cerr << "armgen: error: stale_header: " << check << " differs from what " << sheet_path
-                << " generates" << (output.empty() ? "" : " (" + output + ")")
+      std::cerr << "armgen: error: stale_header: " << check << " differs from what " << sheet_path << " generates"
+                << (output.empty() ? "" : " (" + output + ")")
                 << ". Nobody edits it by hand: regenerate it with scripts/gen_arms.sh and commit it.\n";
       return 1;
     }

@@ -26,7 +26,8 @@ class Reader {
   Reader at(const std::string& key) const {
     if (!node_.IsMap()) throw Error("sheet_value", where() + " is not a map");
     const YAML::Node n = node_[key];
-    if (!n) throw Error("sheet_missing_field", "no " + child_path(key) + " in " + (path_.empty() ? "the sheet" : path_));
+    if (!n)
+      throw Error("sheet_missing_field", "no " + child_path(key) + " in " + (path_.empty() ? "the sheet" : path_));
     return {n, child_path(key)};
   }
   /// The keys of a map, each one of `allowed` (sheet_unknown_field).
@@ -49,7 +50,8 @@ class Reader {
   Six six() const {
     if (!node_.IsSequence()) throw Error("sheet_value", where() + " is not a list of six values");
     if (node_.size() != 6)
-      throw Error("sheet_wrong_length", path_ + " has " + std::to_string(node_.size()) + " values, not 6 (one per joint)");
+      throw Error("sheet_wrong_length",
+                  path_ + " has " + std::to_string(node_.size()) + " values, not 6 (one per joint)");
     Six s;
     for (std::size_t i = 0; i < 6; ++i) s[i] = Reader(node_[i], path_ + "[" + std::to_string(i) + "]").value();
     return s;
@@ -95,7 +97,8 @@ class Reader {
 
 bool identifier(const std::string& s) {
   if (s.empty() || !(std::isalpha(static_cast<unsigned char>(s[0])) || s[0] == '_')) return false;
-  return std::all_of(s.begin(), s.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  return std::all_of(s.begin(), s.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
 }
 
 void require_identifier(const std::string& s, const std::string& where) {
@@ -106,8 +109,8 @@ void require_identifier(const std::string& s, const std::string& where) {
 void require_positive(const Six& s, const std::string& where, bool zero_ok = false) {
   for (int i = 0; i < 6; ++i)
     if (s[i].v < 0 || (!zero_ok && s[i].v == 0))
-      throw Error("sheet_value", where + "[" + std::to_string(i) + "] = " + s[i].text + ": must be " +
-                                     (zero_ok ? ">= 0" : "> 0"));
+      throw Error("sheet_value",
+                  where + "[" + std::to_string(i) + "] = " + s[i].text + ": must be " + (zero_ok ? ">= 0" : "> 0"));
 }
 void require_positive(const Value& v, const std::string& where, bool zero_ok = false) {
   if (v.v < 0 || (!zero_ok && v.v == 0))
@@ -120,7 +123,8 @@ void read_drives(const Reader& r, Sheet& s) {
   s.gear = gear.at("value").six();
   s.gear_text = gear.text();
   for (int i = 0; i < 6; ++i)
-    if (s.gear[i].v == 0) throw Error("sheet_value", gear.child_path("value") + ": gear ratio 0 on joint " + std::to_string(i + 1));
+    if (s.gear[i].v == 0)
+      throw Error("sheet_value", gear.child_path("value") + ": gear ratio 0 on joint " + std::to_string(i + 1));
 
   const Reader motor = r.at("motor_inertia");
   motor.only({"sets", "alternative", "source", "estimate"});
@@ -137,7 +141,8 @@ void read_drives(const Reader& r, Sheet& s) {
   if (motor.has("alternative")) {
     const std::string alt = motor.at("alternative").str();
     auto it = std::find_if(s.motor_sets.begin(), s.motor_sets.end(), [&](const MotorSet& m) { return m.name == alt; });
-    if (it == s.motor_sets.end()) throw Error("sheet_value", motor.child_path("alternative") + " = " + alt + ": no such set");
+    if (it == s.motor_sets.end())
+      throw Error("sheet_value", motor.child_path("alternative") + " = " + alt + ": no such set");
     s.motor_alt = static_cast<int>(it - s.motor_sets.begin());
   }
 
@@ -173,7 +178,8 @@ void read_drives(const Reader& r, Sheet& s) {
         throw Error("sheet_value", c.path() + ": joint > motor (the coupling matrix is unit lower triangular)");
       s.coupling.push_back(k);
     }
-  if (s.coupling.size() > 6) throw Error("sheet_value", arm.child_path("coupling") + ": at most 6 terms (kMaxCouplingTerms)");
+  if (s.coupling.size() > 6)
+    throw Error("sheet_value", arm.child_path("coupling") + ": at most 6 terms (kMaxCouplingTerms)");
   s.encoder_text = arm.text();
 
   const Reader dac = r.at("dac");
@@ -247,9 +253,10 @@ void read_friction(const Reader& r, Sheet& s) {
   const Reader b = r.at("model_error_bounds");
   b.only({"link_inertia", "amp_gain", "amp_offset", "ripple", "amp_lag", "encoder_edge", "friction_band", "source",
           "estimate"});
-  const std::pair<const char*, Value*> scalars[] = {{"link_inertia", &s.link_inertia}, {"amp_gain", &s.amp_gain},
-                                                    {"amp_offset", &s.amp_offset},     {"ripple", &s.ripple},
-                                                    {"amp_lag", &s.amp_lag},           {"encoder_edge", &s.encoder_edge}};
+  const std::pair<const char*, Value*> scalars[] = {
+      {"link_inertia", &s.link_inertia}, {"amp_gain", &s.amp_gain},
+      {"amp_offset", &s.amp_offset},     {"ripple", &s.ripple},
+      {"amp_lag", &s.amp_lag},           {"encoder_edge", &s.encoder_edge}};
   for (const auto& [key, v] : scalars) {
     *v = b.at(key).value();
     require_positive(*v, b.child_path(key), true);
@@ -303,7 +310,8 @@ void read_poses(const Reader& r, Sheet& s) {
         throw Error("sheet_value", p.child_path("name") + " = " + s.named.back().name + ": used twice");
     }
   }
-  if (s.named.size() + 1 > 255) throw Error("sheet_value", "poses: more than 255 named poses (a pose's code is a byte)");
+  if (s.named.size() + 1 > 255)
+    throw Error("sheet_value", "poses: more than 255 named poses (a pose's code is a byte)");
   if (poses.has("reference")) {
     const Reader ref = poses.at("reference");
     ref.only({"list", "source", "estimate"});
@@ -333,7 +341,7 @@ void read_rest(const Reader& r, Sheet& s) {
   }
   s.op_text = op.text();
 
-  const Reader c = r.at("cartesian_limits");
+  const Reader c = r.at("cartesian_maxima");
   c.only({"velocity", "acceleration", "jerk", "source", "estimate"});
   s.cart_velocity = c.at("velocity").value();
   s.cart_acceleration = c.at("acceleration").value();
@@ -354,10 +362,28 @@ Sheet read_sheet(const std::string& path) {
     throw Error("sheet_parse", path + ": " + e.what());
   }
   const Reader r(root, "");
-  r.only({"arm", "name", "urdf", "about", "kinematics", "joint_limits", "inertial_exceptions", "gravity", "gear_ratio",
-          "motor_inertia", "encoders", "dac", "torque_constant", "motor_torque_limit", "plausible_joint_speed",
-          "potentiometers", "index_pulses", "friction", "model_error_bounds", "poses", "operational_point",
-          "cartesian_limits"});
+  r.only({"arm",
+          "name",
+          "urdf",
+          "about",
+          "kinematics",
+          "joint_limits",
+          "inertial_exceptions",
+          "gravity",
+          "gear_ratio",
+          "motor_inertia",
+          "encoders",
+          "dac",
+          "torque_constant",
+          "motor_torque_limit",
+          "plausible_joint_speed",
+          "potentiometers",
+          "index_pulses",
+          "friction",
+          "model_error_bounds",
+          "poses",
+          "operational_point",
+          "cartesian_maxima"});
   Sheet s;
   s.path = path;
   s.arm = r.at("arm").str();

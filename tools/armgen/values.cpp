@@ -145,9 +145,7 @@ Vec3 snap_translation(const Vec3& p) {
   return s;
 }
 
-Frame compose(const Frame& a, const Frame& b) {
-  return {snap_rotation(a.R * b.R), snap_translation(a.R * b.p + a.p)};
-}
+Frame compose(const Frame& a, const Frame& b) { return {snap_rotation(a.R * b.R), snap_translation(a.R * b.p + a.p)}; }
 
 Frame inverse(const Frame& a) {
   const Mat3 Rt = a.R.transpose();

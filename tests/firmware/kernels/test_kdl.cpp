@@ -57,7 +57,7 @@ TEST(KdlConvention, JointInertiaIsTheArmatureInMassMatrixIdAndFd) {
   for (int i = 0; i < kDof; ++i) arm(i) = test::armature(i);
   ASSERT_GT(arm.minCoeff(), 0.1);  // so that a missing armature could not hide in round-off
   test::RandomStates rs;
-  const KDL::Wrenches f_ext(kDof, KDL::Wrench::Zero());
+  const KDL::Wrenches f_ext(with.getNrOfSegments(), KDL::Wrench::Zero());  // the base's fixed segment too
   for (int k = 0; k < 50; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(2.0), qdd = rs.vec(5.0), tau = rs.vec(40.0);
     KDL::JntSpaceInertiaMatrix Hw(kDof), Hwo(kDof);
@@ -110,10 +110,10 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
       jdqd = vp.jdot_qd;
       g = gravity_torques(model, data);
     }
-    // Every link frame: KDL's frame after segment i is our frame i.
+    // Every link frame: KDL's frame after segment i + 1 is our frame i (segment 1: the base placement).
     for (int i = 1; i <= kDof; ++i) {
       KDL::Frame F;
-      ASSERT_GE(fk.JntToCart(kq, F, i), 0);
+      ASSERT_GE(fk.JntToCart(kq, F, i + 1), 0);
       Eigen::Matrix<double, 3, 4> ours, ref;
       ours << data.R[i], data.o[i];
       for (int r = 0; r < 3; ++r) {
