@@ -26,12 +26,15 @@ struct Error : std::runtime_error {
 struct Value {
   double v = 0;
   std::string text = "0";
-  bool simple = true;  ///< one number or pi, without an operator
+  bool simple = true;     ///< one number or pi, without an operator
+  bool integer = false;  ///< an integer literal in C++ (its text has no '.' or exponent)
 };
 using Six = std::array<Value, 6>;
 
 /// `src` as a Value; `where` names it in an error (sheet_value, not_finite).
 Value parse_value(const std::string& src, const std::string& where);
+/// `text` as a double literal when it is an integer literal ("12" -> "12.0"), else unchanged.
+std::string as_double(const std::string& text);
 /// A double as the header prints it: 15 significant digits, no negative zero.
 std::string number(double v);
 /// An angle as the header prints it: d * kPi / 180 when within 1e-12 rad of a whole number d of

@@ -41,8 +41,9 @@ void check_poses(const Sheet& s, const Chain& c) {
   for (const Pose* p : named)
     for (int i = 0; i < 6; ++i)
       if (p->q[i].v < c.joints[i].lower || p->q[i].v > c.joints[i].upper)
-        throw Error("pose_outside_limits", "named pose " + p->name + ": joint " + kJoint[i] + " at " + p->q[i].text +
-                                               " = " + number(p->q[i].v) + " rad, outside the limits [" +
+        throw Error("pose_outside_limits", "named pose " + p->name + ": joint " + kJoint[i] + " at " +
+                                               (p->q[i].text == number(p->q[i].v) ? "" : p->q[i].text + " = ") +
+                                               number(p->q[i].v) + " rad, outside the limits [" +
                                                number(c.joints[i].lower) + ", " + number(c.joints[i].upper) + "] of " +
                                                c.joints[i].name);
 }

@@ -204,8 +204,9 @@ void emit_poses(std::ostream& o, const Sheet& s) {
 std::string encoder_counts(const Sheet& s, int i) {
   const Value& e = s.encoder[i];
   if (s.encoder_unit == "rad_per_count") return "1 / " + paren(e);
-  if (s.encoder_unit == "counts_per_motor_rev") return paren(e) + " * " + absolute(s.gear[i]) + " / (2 * kPi)";
-  return paren(e) + " / (2 * kPi)";
+  if (s.encoder_unit == "counts_per_motor_rev")
+    return as_double(paren(e)) + " * " + as_double(absolute(s.gear[i])) + " / (2 * kPi)";
+  return as_double(paren(e)) + " / (2 * kPi)";
 }
 
 void emit_drives(std::ostream& o, const Sheet& s) {

@@ -14,6 +14,14 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
+/// a op b in C++ text: when both are integers (literals or their sums and products), the left one
+/// is written as a double literal ("150.0 / 101"), so that C++ never divides (or multiplies into an
+/// overflow) in integers where the generator computed in doubles.
+Value binary(double v, const Value& a, const char* op, const Value& b) {
+  Value r{v, (a.integer && b.integer ? as_double(a.text) : a.text) + " " + op + " " + b.text, false};
+  return r;
+}
+
 /// A recursive-descent parser of expr := term {(+|-) term}; term := unary {(*|/) unary};
 /// unary := - unary | primary; primary := number | pi | ( expr ). It evaluates as C++ does (the
 /// same operations in the same order, each rounded once) and rebuilds the text.
@@ -49,10 +57,10 @@ class Parser {
     for (;;) {
       if (take('+')) {
         const Value b = term();
-        a = {a.v + b.v, a.text + " + " + b.text, false};
+        a = binary(a.v + b.v, a, "+", b);
       } else if (take('-')) {
         const Value b = term();
-        a = {a.v - b.v, a.text + " - " + b.text, false};
+        a = binary(a.v - b.v, a, "-", b);
       } else {
         return a;
       }
@@ -63,10 +71,10 @@ class Parser {
     for (;;) {
       if (take('*')) {
         const Value b = unary();
-        a = {a.v * b.v, a.text + " * " + b.text, false};
+        a = binary(a.v * b.v, a, "*", b);
       } else if (take('/')) {
         const Value b = unary();
-        a = {a.v / b.v, a.text + " / " + b.text, false};
+        a = binary(a.v / b.v, a, "/", b);
       } else {
         return a;
       }
@@ -75,7 +83,7 @@ class Parser {
   Value unary() {
     if (take('-')) {
       const Value a = unary();
-      return {-a.v, a.text[0] == '-' ? "-(" + a.text + ")" : "-" + a.text, a.simple && a.text[0] != '-'};
+      return {-a.v, a.text[0] == '-' ? "-(" + a.text + ")" : "-" + a.text, a.simple && a.text[0] != '-', a.integer};
     }
     return primary();
   }
@@ -84,7 +92,7 @@ class Parser {
     if (take('(')) {
       const Value a = expr();
       if (!take(')')) fail("missing ')'");
-      return {a.v, "(" + a.text + ")", false};
+      return {a.v, "(" + a.text + ")", false, a.integer};
     }
     if (s_.compare(i_, 2, "pi") == 0) {
       i_ += 2;
@@ -97,7 +105,8 @@ class Parser {
     if (end == begin) fail("a number");
     i_ += static_cast<std::size_t>(end - begin);
     if (!std::isfinite(v)) throw Error("not_finite", where_ + ": " + s_ + " is not a finite number");
-    return {v, number(v), true};
+    const std::string text = number(v);
+    return {v, text, true, as_double(text) != text};
   }
 
   std::string s_, where_;
@@ -113,6 +122,12 @@ Value parse_value(const std::string& src, const std::string& where) {
   for (const char* special : {".nan", "nan", ".inf", "inf", "+.inf", "-.inf", "-inf", "+inf"})
     if (lower == special) throw Error("not_finite", where + ": " + src + " is not a finite number");
   return Parser(src, where).parse();
+}
+
+std::string as_double(const std::string& text) {
+  const std::size_t digits = text[0] == '-' ? 1 : 0;
+  if (text.size() > digits && text.find_first_not_of("0123456789", digits) == std::string::npos) return text + ".0";
+  return text;
 }
 
 std::string number(double v) {
