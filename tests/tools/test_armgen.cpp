@@ -72,6 +72,8 @@ TEST_P(ArmgenRefuses, WithExitStatusTwoAndTheErrorsName) {
 
 const Case kCasesList[] = {
     {"urdf_parse.urdf", "urdf_parse"},
+    {"not_a_number.urdf", "urdf_parse"},
+    {"nan_mass.urdf", "not_finite"},
     {"five_joints.urdf", "chain_joints"},
     {"branched.urdf", "chain_joints"},
     {"mimic.urdf", "mimic_joint"},

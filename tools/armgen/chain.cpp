@@ -7,8 +7,13 @@
 //   P_6 = A_6^T (the operational point in the last link's URDF frame);
 // the URDF link frame L_j = F_j (A_j P_j)^-1, so link j's inertial (COM c, inertia I in L_j) is
 // com = Q_R^T (c - Q_p), I_F = Q_R^T I Q_R with Q = A_j P_j.
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <map>
+#include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -172,9 +177,41 @@ Joint read_joint(const urdf::Joint& j) {
   return out;
 }
 
+/// The URDF's numbers checked before urdfdom reads them: urdfdom drops an inertial it cannot read
+/// (a NaN mass becomes a link without mass) and refuses infinities as text. Every number of the
+/// elements the conversion reads (origin, axis, mass, inertia, limit) must be a finite number.
+void scan_numbers(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("urdf_parse", path + ": cannot be read");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string xml = text.str();
+  static const std::regex element(R"(<(origin|axis|mass|inertia|limit)\b([^>]*)>)");
+  static const std::regex attribute(R"re((\w+)\s*=\s*"([^"]*)")re");
+  for (auto e = std::sregex_iterator(xml.begin(), xml.end(), element); e != std::sregex_iterator(); ++e) {
+    const std::string attrs = (*e)[2];
+    const long line = 1 + std::count(xml.begin(), xml.begin() + e->position(), '\n');
+    for (auto a = std::sregex_iterator(attrs.begin(), attrs.end(), attribute); a != std::sregex_iterator(); ++a) {
+      const std::string name = (*a)[1], value = (*a)[2];
+      if (name == "name" || name == "joint") continue;
+      std::istringstream tokens(value);
+      std::string token;
+      while (tokens >> token) {
+        const std::string where =
+            path + ":" + std::to_string(line) + ": <" + std::string((*e)[1]) + " " + name + "=\"" + value + "\">";
+        char* end = nullptr;
+        const double v = std::strtod(token.c_str(), &end);
+        if (end != token.c_str() + token.size()) throw Error("urdf_parse", where + ": " + token + " is not a number");
+        if (!std::isfinite(v)) throw Error("not_finite", where + ": " + token + " is not a finite number");
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Chain read_chain(const std::string& urdf_path, const Sheet& sheet) {
+  scan_numbers(urdf_path);
   const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(urdf_path);
   if (!model) throw Error("urdf_parse", urdf_path + ": not a URDF urdfdom reads (its message above)");
   for (const auto& [name, j] : model->joints_)

@@ -117,35 +117,7 @@ void require_positive(const Value& v, const std::string& where, bool zero_ok = f
     throw Error("sheet_value", where + " = " + v.text + ": must be " + (zero_ok ? ">= 0" : "> 0"));
 }
 
-void read_drives(const Reader& r, Sheet& s) {
-  const Reader gear = r.at("gear_ratio");
-  gear.only({"value", "source", "estimate"});
-  s.gear = gear.at("value").six();
-  s.gear_text = gear.text();
-  for (int i = 0; i < 6; ++i)
-    if (s.gear[i].v == 0)
-      throw Error("sheet_value", gear.child_path("value") + ": gear ratio 0 on joint " + std::to_string(i + 1));
-
-  const Reader motor = r.at("motor_inertia");
-  motor.only({"sets", "alternative", "source", "estimate"});
-  if (motor.has("source") || motor.has("estimate")) s.motor_text = motor.text();
-  for (const Reader& set : motor.at("sets").list()) {
-    set.only({"name", "value", "source", "estimate"});
-    MotorSet m{set.at("name").str(), set.at("value").six(), set.text()};
-    require_identifier(m.name, set.child_path("name"));
-    require_positive(m.jm, set.child_path("value"), true);
-    s.motor_sets.push_back(m);
-  }
-  if (s.motor_sets.empty()) throw Error("sheet_missing_field", motor.child_path("sets") + " is empty");
-  s.motor_alt = 0;
-  if (motor.has("alternative")) {
-    const std::string alt = motor.at("alternative").str();
-    auto it = std::find_if(s.motor_sets.begin(), s.motor_sets.end(), [&](const MotorSet& m) { return m.name == alt; });
-    if (it == s.motor_sets.end())
-      throw Error("sheet_value", motor.child_path("alternative") + " = " + alt + ": no such set");
-    s.motor_alt = static_cast<int>(it - s.motor_sets.begin());
-  }
-
+void read_encoders(const Reader& r, Sheet& s) {
   const Reader enc = r.at("encoders");
   enc.only({"model", "arm"});
   const Reader model = enc.at("model");
@@ -181,6 +153,38 @@ void read_drives(const Reader& r, Sheet& s) {
   if (s.coupling.size() > 6)
     throw Error("sheet_value", arm.child_path("coupling") + ": at most 6 terms (kMaxCouplingTerms)");
   s.encoder_text = arm.text();
+}
+
+void read_drives(const Reader& r, Sheet& s) {
+  const Reader gear = r.at("gear_ratio");
+  gear.only({"value", "source", "estimate"});
+  s.gear = gear.at("value").six();
+  s.gear_text = gear.text();
+  for (int i = 0; i < 6; ++i)
+    if (s.gear[i].v == 0)
+      throw Error("sheet_value", gear.child_path("value") + ": gear ratio 0 on joint " + std::to_string(i + 1));
+
+  const Reader motor = r.at("motor_inertia");
+  motor.only({"sets", "alternative", "source", "estimate"});
+  if (motor.has("source") || motor.has("estimate")) s.motor_text = motor.text();
+  for (const Reader& set : motor.at("sets").list()) {
+    set.only({"name", "value", "source", "estimate"});
+    MotorSet m{set.at("name").str(), set.at("value").six(), set.text()};
+    require_identifier(m.name, set.child_path("name"));
+    require_positive(m.jm, set.child_path("value"), true);
+    s.motor_sets.push_back(m);
+  }
+  if (s.motor_sets.empty()) throw Error("sheet_missing_field", motor.child_path("sets") + " is empty");
+  s.motor_alt = 0;
+  if (motor.has("alternative")) {
+    const std::string alt = motor.at("alternative").str();
+    auto it = std::find_if(s.motor_sets.begin(), s.motor_sets.end(), [&](const MotorSet& m) { return m.name == alt; });
+    if (it == s.motor_sets.end())
+      throw Error("sheet_value", motor.child_path("alternative") + " = " + alt + ": no such set");
+    s.motor_alt = static_cast<int>(it - s.motor_sets.begin());
+  }
+
+  read_encoders(r, s);
 
   const Reader dac = r.at("dac");
   dac.only({"bits", "full_scale_torque", "source", "estimate"});
