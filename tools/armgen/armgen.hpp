@@ -26,7 +26,7 @@ struct Error : std::runtime_error {
 struct Value {
   double v = 0;
   std::string text = "0";
-  bool simple = true;     ///< one number or pi, without an operator
+  bool simple = true;    ///< one number or pi, without an operator
   bool integer = false;  ///< an integer literal in C++ (its text has no '.' or exponent)
 };
 using Six = std::array<Value, 6>;
