@@ -103,7 +103,7 @@ TEST(Contact, ExternalTorqueIsJvTransposeFAgainstKdl) {
 
     KDL::Frame f6;
     ASSERT_GE(fk.JntToCart(osc::test::to_kdl(q), f6), 0);
-    KDL::Wrenches none(osc::kDof, KDL::Wrench::Zero()), pushed = none;
+    KDL::Wrenches none(chain.getNrOfSegments(), KDL::Wrench::Zero()), pushed = none;  // the base segment too
     pushed.back() = KDL::Wrench(f6.M.Inverse(KDL::Vector(F.x(), F.y(), F.z())), KDL::Vector::Zero());
     KDL::JntArray t0(osc::kDof), t1(osc::kDof), zero(osc::kDof);
     ASSERT_GE(id.CartToJnt(osc::test::to_kdl(q), osc::test::to_kdl(qd), zero, none, t0), 0);

@@ -345,7 +345,7 @@ TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
 // beyond the wrist centre's reach from the shoulder (at the base origin, d1 = 0),
 // sqrt((a2 + sqrt(a3^2 + d4^2))^2 + d3^2) = 0.877 m.
 TEST(PathCheck, TargetOutOfReachIsUnreachable) {
-  const auto& L = robot::kArm.links;  // DH rows: placement p = (a, 0, d)
+  const auto& L = robot::kArm.links;  // DH rows: a placement's translation is (a, 0, d)
   const double a2 = L[1].placement.p[0], a3 = L[2].placement.p[0], d3 = L[2].placement.p[2], d4 = L[3].placement.p[2];
   const double reach = std::hypot(a2 + std::hypot(a3, d4), d3);
   const Vec6<double> q0 = test::from_array(robot::kQStart);

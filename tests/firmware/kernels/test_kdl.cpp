@@ -60,7 +60,7 @@ TEST(KdlConvention, JointInertiaIsTheArmatureInMassMatrixIdAndFd) {
   for (int i = 0; i < kDof; ++i) arm(i) = test::armature(i);
   ASSERT_GT(arm.minCoeff(), 0.1);  // so that a missing armature could not hide in round-off
   test::RandomStates rs;
-  const KDL::Wrenches f_ext(kDof, KDL::Wrench::Zero());
+  const KDL::Wrenches f_ext(with.getNrOfSegments(), KDL::Wrench::Zero());
   for (int k = 0; k < 50; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(2.0), qdd = rs.vec(5.0), tau = rs.vec(40.0);
     KDL::JntSpaceInertiaMatrix Hw(kDof), Hwo(kDof);
@@ -113,7 +113,9 @@ TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
       jdqd = vp.jdot_qd;
       g = gravity_torques(model, data);
     }
-    // Every link frame: KDL's frame after segment i is our frame i.
+    // Every link frame: KDL's frame after segment i is our frame i (the PUMA's base placement is the
+    // identity: no base segment, test::arm_chain).
+    ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof));
     for (int i = 1; i <= kDof; ++i) {
       KDL::Frame F;
       ASSERT_GE(fk.JntToCart(kq, F, i), 0);
