@@ -8,10 +8,12 @@
 // The rounding bounds (first order, Higham, "Accuracy and Stability of Numerical Algorithms", 2nd ed.,
 // thm 9.4 and 8.5, for this factor's operation order), the double reference taken at the same
 // rounded J and b so that only the factor's own rounding is measured:
-//   float (unit roundoff u = 2^-24): every entry of L U is one dot product and at most two products
-//   (the multipliers by the pivot's rounded reciprocal), every step of a triangular solve one dot
-//   product and a product by the rounded reciprocal: P^T L^ U^ = J + E and the solves' perturbations
-//   of L and U are each within gamma_{n+2} |L^||U^| (gamma_k = k u / (1 - k u)), so
+//   float (unit roundoff u = 2^-24, gamma_k = k u / (1 - k u)): an entry of U is a dot product of at
+//   most n - 1 terms and a difference, a multiplier that and two products (by the pivot's rounded
+//   reciprocal), so P^T L^ U^ = J + P^T E with |E| <= gamma_{n+2} |L^||U^|; the forward substitution
+//   solves (L^ + dL) y = P b with |dL| <= gamma_n |L^|, the back substitution (products by the rounded
+//   reciprocals) (U^ + dU) x = y with |dU| <= gamma_{n+2} |U^|. To first order, with gamma_{3n+4}
+//   rounded up to gamma_{3n+6},
 //     |x^ - x| <= gamma_{3n+6} |J^{-1}| P^T |L^||U^| |x^|        (solve; J^{-T} and its transpose for
 //   solve_transpose), componentwise.
 //   fixed point (every rounding at most eta = half an LSB, absolute; dot products rounded once):
@@ -487,8 +489,8 @@ TEST(PivotedLu, FixedPointAgreesWithDoubleWithinTheRoundingBound) {
   agrees_with_double_on_both<Fixed>("Q12.19", 10 * std::ldexp(0.5, -Fixed::kFractionBits));  // 10 eta
 }
 
-TEST(PivotedLu, FixedPointEstimateBeyondTheRangeIsZeroAndLeavesTheFlagsAlone) {
-  // A J whose inverse exceeds the Q12.19 range (sigma_min 1e-5): the estimate saturates; rcond is 0
+TEST(PivotedLu, FixedPointRcondBeyondTheRangeIsZeroAndLeavesTheFlagsAlone) {
+  // A J whose inverse exceeds the Q12.19 range (sigma_min 1e-5): its norm saturates; rcond is 0
   // and the flags are those before compute (here one raised before, kept).
   RandomMatrices rm;
   for (int k = 0; k < 20; ++k) {

@@ -21,10 +21,10 @@
 // rcond = 1 / (||J||_1 ||J^{-1}||_1), exact (like the block factor's), not estimated: ||J^{-1}||_1 is
 // the largest 1-norm of the six columns U^{-1} L^{-1} P e_j, each reduced to its norm as the factors'
 // substitutions produce it (no inverse is stored). At n = 6 that is six back substitutions and six
-// sparse forward ones, 160 multiply-adds: about what Hager's estimator (Higham's form, LAPACK's
-// xLACN2) spends, 3 to 11 solves of 36 each, and that estimate falls short of ||J^{-1}||_1 by more
-// than a factor 3 on about 0.1 % of random 6x6 matrices (by up to 8; test_lu.cpp measures it), where
-// this is exact at a fixed cost the tick can budget. In fixed point a norm beyond the range (rcond below about
+// sparse forward ones, 160 multiply-adds at a fixed cost: about what Hager's estimator (Higham's
+// form, LAPACK's xLACN2) spends, 4 to 11 solves of 36 (4.7 on average), and that estimate falls short
+// of ||J^{-1}||_1 by more than a factor 3 on about 0.2 % of random 6x6 matrices (by up to 10;
+// test_lu.cpp measures it). In fixed point a norm beyond the range (rcond below about
 // 1 / (4096 ||J||_1)) gives rcond 0, and its saturations are not the caller's: the flags are taken
 // and restored around it.
 //
