@@ -13,6 +13,7 @@
 #include "kdl_puma.hpp"
 #include "osc/control/controller.hpp"
 #include "osc/control/jerk_profile.hpp"
+#include "osc/kernels/lu.hpp"
 #include "plant.hpp"
 
 using namespace osc;
@@ -85,6 +86,52 @@ void BM_jacobian_factor_solve(benchmark::State& st) {
     benchmark::DoNotOptimize(jf.solve(f.v));
   }
 }
+/// The pivoted LU factor of J (osc/kernels/lu.hpp: arms without a spherical wrist) at the same J:
+/// compute + solve as above, compute alone (the factorisation and the exact rcond), a solve alone;
+/// the block factor's compute and solve alone beside them.
+template <class S>
+void BM_lu_factor_solve(benchmark::State& st) {
+  Fixture<S> f;
+  PivotedLuJacobianFactor<S> lu;
+  for (auto _ : st) {
+    lu.compute(f.os.Ja);
+    benchmark::DoNotOptimize(lu.solve(f.v));
+  }
+}
+template <class S>
+void BM_lu_factor_compute(benchmark::State& st) {
+  Fixture<S> f;
+  PivotedLuJacobianFactor<S> lu;
+  for (auto _ : st) {
+    lu.compute(f.os.Ja);
+    benchmark::DoNotOptimize(lu.rcond);
+    benchmark::ClobberMemory();
+  }
+}
+template <class S>
+void BM_lu_factor_solve_only(benchmark::State& st) {
+  Fixture<S> f;
+  PivotedLuJacobianFactor<S> lu;
+  lu.compute(f.os.Ja);
+  for (auto _ : st) benchmark::DoNotOptimize(lu.solve(f.v));
+}
+template <class S>
+void BM_jacobian_factor_compute(benchmark::State& st) {
+  Fixture<S> f;
+  SphericalWristJacobianFactor<S> jf;
+  for (auto _ : st) {
+    jf.compute(f.os.Ja);
+    benchmark::DoNotOptimize(jf.rcond);
+    benchmark::ClobberMemory();
+  }
+}
+template <class S>
+void BM_jacobian_factor_solve_only(benchmark::State& st) {
+  Fixture<S> f;
+  SphericalWristJacobianFactor<S> jf;
+  jf.compute(f.os.Ja);
+  for (auto _ : st) benchmark::DoNotOptimize(jf.solve(f.v));
+}
 template <class S>
 void BM_operational_inertia(benchmark::State& st) {
   Fixture<S> f;
@@ -155,6 +202,11 @@ OSC_BENCH(BM_gravity);
 OSC_BENCH(BM_velocity_products);
 OSC_BENCH(BM_friction_regressor);
 OSC_BENCH(BM_jacobian_factor_solve);
+OSC_BENCH(BM_jacobian_factor_compute);
+OSC_BENCH(BM_jacobian_factor_solve_only);
+OSC_BENCH(BM_lu_factor_solve);
+OSC_BENCH(BM_lu_factor_compute);
+OSC_BENCH(BM_lu_factor_solve_only);
 OSC_BENCH(BM_operational_inertia);
 OSC_BENCH(BM_opspace_update);
 OSC_BENCH(BM_psi_quadratic);

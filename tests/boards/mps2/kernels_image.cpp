@@ -8,6 +8,7 @@
 #include "board.hpp"
 #include "osc/control/jerk_profile.hpp"
 #include "osc/control/sampled_loop.hpp"
+#include "osc/kernels/lu.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
@@ -183,6 +184,13 @@ void operational_inertia_kernels(const Vec6<F>& q0, const Vec6<F>& qn) {
     Jg.compute(g_data.J);
     keep(Jg);
   }
+  // The general factor (arms without a spherical wrist) at the same J: the same solutions.
+  PivotedLuJacobianFactor<F> Jlu;
+  {
+    Timer t("PivotedLuJacobianFactor::compute (LU, exact rcond)");
+    Jlu.compute(g_data.J);
+    keep(Jlu);
+  }
   {
     Timer t("operational_inertia (Lambda)");
     Lg = operational_inertia(g_data.A, Jg);
@@ -192,6 +200,11 @@ void operational_inertia_kernels(const Vec6<F>& q0, const Vec6<F>& qn) {
   check("Lambda(3,3)", d(Lg(2, 2)), published::kLambdaQn[6 * 2 + 2], 0.05);
   check("Lambda(6,6)", d(Lg(5, 5)), published::kLambdaQn[6 * 5 + 5], 2e-3);
   check("rcond(qn) > 1e-3", d(Jg.rcond) > 1e-3 ? 1.0 : 0.0, 1.0, 0.0);
+  Vec6<F> b;
+  b << lit<F>(0.3), lit<F>(-0.2), lit<F>(0.1), lit<F>(0.5), lit<F>(-0.4), lit<F>(0.2);
+  check("LU solve = block solve", d((Jlu.solve(b) - Jg.solve(b)).norm()), 0.0, 1e-3);
+  check("LU solve_transpose = block", d((Jlu.solve_transpose(b) - Jg.solve_transpose(b)).norm()), 0.0, 1e-3);
+  check("LU rcond(qn) > 1e-3", d(Jlu.rcond) > 1e-3 ? 1.0 : 0.0, 1.0, 0.0);
   // Back to q0 for what follows.
   opspace_update(g_model, g_data, g_os, q0, R_ref);
 }
