@@ -20,6 +20,7 @@
 #include <kdl/chainjnttojacdotsolver.hpp>
 #include <kdl/chainjnttojacsolver.hpp>
 
+#include "kdl_compare.hpp"
 #include "kdl_puma.hpp"
 #include "osc/kernels/dynamics.hpp"
 #include "plant.hpp"
@@ -38,13 +39,7 @@ constexpr double kFloor = 1e-3;
 
 const KDL::Vector kGravityVec(0, 0, -robot::kArm.gravity);
 
-/// Running maximum of the relative error of one quantity.
-struct Worst {
-  const char* name;
-  double value = 0;
-  void add(double err, double ref_norm, double floor) { value = std::max(value, err / std::max(ref_norm, floor)); }
-  void report() const { std::printf("max relative error vs KDL, %-30s %.2e\n", name, value); }
-};
+using test::Worst;
 
 Mat6<double> to_eigen(const KDL::JntSpaceInertiaMatrix& H) { return H.data; }
 
@@ -84,66 +79,19 @@ TEST(KdlConvention, JointInertiaIsTheArmatureInMassMatrixIdAndFd) {
 }
 
 TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
+  // Every link frame: KDL's frame after segment i is our frame i (the PUMA's base placement is the
+  // identity: no base segment, test::arm_chain).
   const KDL::Chain chain = test::puma560_chain();
-  KDL::ChainFkSolverPos_recursive fk(chain);
-  KDL::ChainJntToJacSolver jac(chain);
-  KDL::ChainDynParam dyn(chain, kGravityVec);
-  KDL::ChainJntToJacDotSolver jacdot(chain);
-  jacdot.setRepresentation(KDL::ChainJntToJacDotSolver::HYBRID);  // ref point frame-6 origin, base axes
-
+  ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof));
+  test::KdlComparison cmp(chain, robot::kArm.gravity, 1, 0, true, kFloor);
   const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
   test::RandomStates rs;
-  Worst w_fk{"FK, all link frames [R p]"}, w_jac{"geometric Jacobian"}, w_A{"A(q) with armature"}, w_c{"c(q, qd)"},
-      w_g{"g(q)"}, w_jd{"Jdot qd (HYBRID)"};
-  KDL::Jacobian J(kDof);
-  KDL::JntSpaceInertiaMatrix H(kDof);
-  KDL::JntArray C(kDof), G(kDof);
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(2.0);
-    const KDL::JntArray kq = to_kdl(q), kqd = to_kdl(qd);
-    Vec6<double> c, g, jdqd;
-    {
-      test::NoMalloc guard;
-      forward_kinematics(model, data, q);
-      geometric_jacobian(data);
-      joint_inertia(model, data);
-      const VelocityProducts<double> vp = velocity_products(model, data, qd);
-      c = vp.c;
-      jdqd = vp.jdot_qd;
-      g = gravity_torques(model, data);
-    }
-    // Every link frame: KDL's frame after segment i is our frame i (the PUMA's base placement is the
-    // identity: no base segment, test::arm_chain).
-    ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof));
-    for (int i = 1; i <= kDof; ++i) {
-      KDL::Frame F;
-      ASSERT_GE(fk.JntToCart(kq, F, i), 0);
-      Eigen::Matrix<double, 3, 4> ours, ref;
-      ours << data.R[i], data.o[i];
-      for (int r = 0; r < 3; ++r) {
-        for (int s = 0; s < 3; ++s) ref(r, s) = F.M(r, s);
-        ref(r, 3) = F.p(r);
-      }
-      w_fk.add((ours - ref).norm(), ref.norm(), 0.0);
-    }
-    ASSERT_GE(jac.JntToJac(kq, J), 0);
-    w_jac.add((J.data - data.J).norm(), J.data.norm(), 0.0);
-    ASSERT_GE(dyn.JntToMass(kq, H), 0);
-    ASSERT_GE(dyn.JntToCoriolis(kq, kqd, C), 0);
-    ASSERT_GE(dyn.JntToGravity(kq, G), 0);
-    w_A.add((H.data - data.A).norm(), H.data.norm(), 0.0);
-    w_c.add((C.data - c).norm(), C.data.norm(), kFloor);
-    w_g.add((G.data - g).norm(), G.data.norm(), kFloor);
-    KDL::Twist t;
-    ASSERT_GE(jacdot.JntToJacDot(KDL::JntArrayVel(kq, kqd), t), 0);
-    const Vec6<double> kjd = from_kdl(t);
-    w_jd.add((kjd - jdqd).norm(), kjd.norm(), kFloor);
+    cmp.add(model, data, q, qd);
   }
-  for (const Worst* w : {&w_fk, &w_jac, &w_A, &w_c, &w_g, &w_jd}) {
-    w->report();
-    EXPECT_LE(w->value, kTol) << w->name;
-  }
+  cmp.expect_within(kTol);
 }
 
 /// A random 6R arm in the general form: a base placement, link placements with arbitrary rotations
@@ -196,8 +144,8 @@ ArmDescription random_general_arm(std::mt19937_64& rng, bool quarter_turns) {
 TEST(Kdl, GeneralArmsKernelsAgreeOnRandomStates) {
   std::mt19937_64 rng(2026);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  Worst w_fk{"general arms: FK [R p]"}, w_jac{"general arms: J"}, w_A{"general arms: A(q)"},
-      w_c{"general arms: c(q, qd)"}, w_g{"general arms: g(q)"}, w_jd{"general arms: Jdot qd"};
+  test::Worst worst[6] = {{"general arms: FK [R p]"}, {"general arms: J"},      {"general arms: A(q)"},
+                          {"general arms: c(q, qd)"}, {"general arms: g(q)"}, {"general arms: Jdot qd"}};
   for (int a = 0; a < 40; ++a) {
     const bool quarter_turns = a % 2 == 1;
     const ArmDescription arm = random_general_arm(rng, quarter_turns);
@@ -213,51 +161,19 @@ TEST(Kdl, GeneralArmsKernelsAgreeOnRandomStates) {
     }
     const KDL::Chain chain = test::arm_chain(arm);
     ASSERT_EQ(chain.getNrOfSegments(), static_cast<unsigned>(kDof + 1));  // the base segment first
-    KDL::ChainFkSolverPos_recursive fk(chain);
-    KDL::ChainJntToJacSolver jac(chain);
-    KDL::ChainDynParam dyn(chain, KDL::Vector(0, 0, -arm.gravity));
-    KDL::ChainJntToJacDotSolver jacdot(chain);
-    jacdot.setRepresentation(KDL::ChainJntToJacDotSolver::HYBRID);
+    // Frame i (0..6) is KDL's after segment i + 1.
+    test::KdlComparison one(chain, arm.gravity, 0, 1, true, kFloor);
     Data<double> data;
-    KDL::Jacobian J(kDof);
-    KDL::JntSpaceInertiaMatrix H(kDof);
-    KDL::JntArray C(kDof), G(kDof);
     for (int k = 0; k < 50; ++k) {
       Vec6<double> q, qd;
       for (int i = 0; i < kDof; ++i) q(i) = kPi * u(rng), qd(i) = 2 * u(rng);
-      const KDL::JntArray kq = to_kdl(q), kqd = to_kdl(qd);
-      forward_kinematics(model, data, q);
-      geometric_jacobian(data);
-      joint_inertia(model, data);
-      const VelocityProducts<double> vp = velocity_products(model, data, qd);
-      const Vec6<double> g = gravity_torques(model, data);
-      for (int i = 0; i <= kDof; ++i) {  // frame i is KDL's after segment i + 1 (the base segment first)
-        KDL::Frame F;
-        ASSERT_GE(fk.JntToCart(kq, F, i + 1), 0);
-        Eigen::Matrix<double, 3, 4> ours, ref;
-        ours << data.R[i], data.o[i];
-        for (int r = 0; r < 3; ++r) {
-          for (int s = 0; s < 3; ++s) ref(r, s) = F.M(r, s);
-          ref(r, 3) = F.p(r);
-        }
-        w_fk.add((ours - ref).norm(), ref.norm(), 0.0);
-      }
-      ASSERT_GE(jac.JntToJac(kq, J), 0);
-      w_jac.add((J.data - data.J).norm(), J.data.norm(), 0.0);
-      ASSERT_GE(dyn.JntToMass(kq, H), 0);
-      ASSERT_GE(dyn.JntToCoriolis(kq, kqd, C), 0);
-      ASSERT_GE(dyn.JntToGravity(kq, G), 0);
-      w_A.add((H.data - data.A).norm(), H.data.norm(), 0.0);
-      w_c.add((C.data - vp.c).norm(), C.data.norm(), kFloor);
-      w_g.add((G.data - g).norm(), G.data.norm(), kFloor);
-      KDL::Twist t;
-      ASSERT_GE(jacdot.JntToJacDot(KDL::JntArrayVel(kq, kqd), t), 0);
-      w_jd.add((from_kdl(t) - vp.jdot_qd).norm(), from_kdl(t).norm(), kFloor);
+      one.add(model, data, q, qd);
     }
+    for (int w = 0; w < 6; ++w) worst[w].value = std::max(worst[w].value, one.worst(w));
   }
-  for (const Worst* w : {&w_fk, &w_jac, &w_A, &w_c, &w_g, &w_jd}) {
-    w->report();
-    EXPECT_LE(w->value, kTol) << w->name;
+  for (const test::Worst& w : worst) {
+    w.report();
+    EXPECT_LE(w.value, kTol) << w.name;
   }
 }
 
