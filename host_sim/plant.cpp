@@ -118,8 +118,8 @@ ArticulatedBody::ArticulatedBody(double link_scale) {
     const Mat3 R = rotation_of(L.placement);
     const Vec3 c = translation_of(L.placement) + R * Vec3(L.com[0], L.com[1], L.com[2]);
     Mat3 I;  // about the COM, axes of F_i
-    I << L.inertia[0], L.inertia[3], L.inertia[4], L.inertia[3], L.inertia[1], L.inertia[5], L.inertia[4],
-        L.inertia[5], L.inertia[2];
+    I << L.inertia[0], L.inertia[3], L.inertia[4], L.inertia[3], L.inertia[1], L.inertia[5], L.inertia[4], L.inertia[5],
+        L.inertia[2];
     body_[i] = Body{L.mass * link_scale, c, R * I * R.transpose() * link_scale};
     armature_[i] = L.gear_ratio * L.gear_ratio * L.motor_inertia;
     // F_{i-1} in B_{i-1} (F_0 in the base frame for the first joint).

@@ -77,60 +77,57 @@ void BM_friction_regressor(benchmark::State& st) {
   const Vec6<S> dec = Vec6<S>::Ones();
   for (auto _ : st) benchmark::DoNotOptimize(friction_regressor(f.qd, dec));
 }
-template <class S>
-void BM_jacobian_factor_solve(benchmark::State& st) {
+/// A factor of J (F: the spherical wrist's block factor, or the pivoted LU of osc/kernels/lu.hpp for
+/// arms without one) at the fixture's J: compute + solve, compute alone (with its rcond), a solve alone.
+template <class S, template <class> class F>
+void factor_solve(benchmark::State& st) {
   Fixture<S> f;
-  SphericalWristJacobianFactor<S> jf;
+  F<S> jf;
   for (auto _ : st) {
     jf.compute(f.os.Ja);
     benchmark::DoNotOptimize(jf.solve(f.v));
   }
 }
-/// The pivoted LU factor of J (osc/kernels/lu.hpp: arms without a spherical wrist) at the same J:
-/// compute + solve as above, compute alone (the factorisation and the exact rcond), a solve alone;
-/// the block factor's compute and solve alone beside them.
-template <class S>
-void BM_lu_factor_solve(benchmark::State& st) {
+template <class S, template <class> class F>
+void factor_compute(benchmark::State& st) {
   Fixture<S> f;
-  PivotedLuJacobianFactor<S> lu;
-  for (auto _ : st) {
-    lu.compute(f.os.Ja);
-    benchmark::DoNotOptimize(lu.solve(f.v));
-  }
-}
-template <class S>
-void BM_lu_factor_compute(benchmark::State& st) {
-  Fixture<S> f;
-  PivotedLuJacobianFactor<S> lu;
-  for (auto _ : st) {
-    lu.compute(f.os.Ja);
-    benchmark::DoNotOptimize(lu.rcond);
-    benchmark::ClobberMemory();
-  }
-}
-template <class S>
-void BM_lu_factor_solve_only(benchmark::State& st) {
-  Fixture<S> f;
-  PivotedLuJacobianFactor<S> lu;
-  lu.compute(f.os.Ja);
-  for (auto _ : st) benchmark::DoNotOptimize(lu.solve(f.v));
-}
-template <class S>
-void BM_jacobian_factor_compute(benchmark::State& st) {
-  Fixture<S> f;
-  SphericalWristJacobianFactor<S> jf;
+  F<S> jf;
   for (auto _ : st) {
     jf.compute(f.os.Ja);
     benchmark::DoNotOptimize(jf.rcond);
     benchmark::ClobberMemory();
   }
 }
-template <class S>
-void BM_jacobian_factor_solve_only(benchmark::State& st) {
+template <class S, template <class> class F>
+void factor_solve_only(benchmark::State& st) {
   Fixture<S> f;
-  SphericalWristJacobianFactor<S> jf;
+  F<S> jf;
   jf.compute(f.os.Ja);
   for (auto _ : st) benchmark::DoNotOptimize(jf.solve(f.v));
+}
+template <class S>
+void BM_jacobian_factor_solve(benchmark::State& st) {
+  factor_solve<S, SphericalWristJacobianFactor>(st);
+}
+template <class S>
+void BM_jacobian_factor_compute(benchmark::State& st) {
+  factor_compute<S, SphericalWristJacobianFactor>(st);
+}
+template <class S>
+void BM_jacobian_factor_solve_only(benchmark::State& st) {
+  factor_solve_only<S, SphericalWristJacobianFactor>(st);
+}
+template <class S>
+void BM_lu_factor_solve(benchmark::State& st) {
+  factor_solve<S, PivotedLuJacobianFactor>(st);
+}
+template <class S>
+void BM_lu_factor_compute(benchmark::State& st) {
+  factor_compute<S, PivotedLuJacobianFactor>(st);
+}
+template <class S>
+void BM_lu_factor_solve_only(benchmark::State& st) {
+  factor_solve_only<S, PivotedLuJacobianFactor>(st);
 }
 template <class S>
 void BM_operational_inertia(benchmark::State& st) {

@@ -28,7 +28,9 @@ struct Worst {
   std::string name;
   double value = 0;
   void add(double err, double ref_norm, double floor) { value = std::max(value, err / std::max(ref_norm, floor)); }
-  void report(const char* prefix = "") const { std::printf("%smax relative error vs KDL, %-30s %.2e\n", prefix, name.c_str(), value); }
+  void report(const char* prefix = "") const {
+    std::printf("%smax relative error vs KDL, %-30s %.2e\n", prefix, name.c_str(), value);
+  }
 };
 
 class KdlComparison {
@@ -46,8 +48,12 @@ class KdlComparison {
         offset_(segment_offset),
         armature_in_chain_(armature_in_chain),
         floor_(floor),
-        w_{{prefix + "FK [R p]"}, {prefix + "geometric Jacobian"}, {prefix + "A(q) with armature"},
-           {prefix + "c(q, qd)"}, {prefix + "g(q)"}, {prefix + "Jdot qd (HYBRID)"}} {
+        w_{{prefix + "FK [R p]"},
+           {prefix + "geometric Jacobian"},
+           {prefix + "A(q) with armature"},
+           {prefix + "c(q, qd)"},
+           {prefix + "g(q)"},
+           {prefix + "Jdot qd (HYBRID)"}} {
     jacdot_.setRepresentation(KDL::ChainJntToJacDotSolver::HYBRID);  // ref point frame-6 origin, base axes
   }
 

@@ -19,9 +19,9 @@ inline double armature(int i) {
 
 /// A placement (osc/robots/arm.hpp) as a KDL frame.
 inline KDL::Frame kdl_frame(const Placement& P) {
-  return KDL::Frame(KDL::Rotation(P.R[0][0], P.R[0][1], P.R[0][2], P.R[1][0], P.R[1][1], P.R[1][2], P.R[2][0],
-                                  P.R[2][1], P.R[2][2]),
-                    KDL::Vector(P.p[0], P.p[1], P.p[2]));
+  return KDL::Frame(
+      KDL::Rotation(P.R[0][0], P.R[0][1], P.R[0][2], P.R[1][0], P.R[1][1], P.R[1][2], P.R[2][0], P.R[2][1], P.R[2][2]),
+      KDL::Vector(P.p[0], P.p[1], P.p[2]));
 }
 
 /// An arm's table as a KDL chain: a fixed segment to frame 0 (the base placement, where it is not the
@@ -38,7 +38,8 @@ inline KDL::Frame kdl_frame(const Placement& P) {
 inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true) {
   KDL::Chain chain;
   const KDL::Frame base = kdl_frame(arm.base);
-  if (!KDL::Equal(base, KDL::Frame::Identity(), 1e-15)) chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), base));
+  if (!KDL::Equal(base, KDL::Frame::Identity(), 1e-15))
+    chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), base));
   for (int i = 0; i < kDof; ++i) {
     const LinkParams& L = arm.links[i];
     const double jm = L.gear_ratio * L.gear_ratio * L.motor_inertia;

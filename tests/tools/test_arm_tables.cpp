@@ -272,10 +272,10 @@ TEST(ArmTables, PlacementsAndWristsAreAsTheKernelsExpect) {
 }
 
 TEST(ArmTables, DriveFactsOfTheNewFields) {
-  EXPECT_EQ(puma560::kDriveTrain.encoder_kind, EncoderKind::incremental);
+  EXPECT_EQ(puma560::kDriveTrain.encoder_kind, EncoderKind::kIncremental);
   EXPECT_TRUE(puma560::kDriveTrain.index_pulses);
   EXPECT_EQ(puma560::kDriveTrain.pot_bits, 12);
-  EXPECT_EQ(ur5e::kDriveTrain.encoder_kind, EncoderKind::absolute);
+  EXPECT_EQ(ur5e::kDriveTrain.encoder_kind, EncoderKind::kAbsolute);
   EXPECT_FALSE(ur5e::kDriveTrain.index_pulses);
   EXPECT_EQ(ur5e::kDriveTrain.pot_bits, 0);
   EXPECT_EQ(ur5e::kDriveTrain.encoders.coupling_terms, 0);

@@ -230,7 +230,7 @@ void emit_drives(std::ostream& o, const Sheet& s) {
   for (std::size_t k = 0; k < s.coupling.size(); ++k)
     o << (k ? ", " : "") << "{" << s.coupling[k].joint - 1 << ", " << s.coupling[k].motor - 1 << ", "
       << s.coupling[k].c.text << "}";
-  o << "}},\n    " << (s.absolute ? "EncoderKind::absolute" : "EncoderKind::incremental") << ",\n";
+  o << "}},\n    " << (s.absolute ? "EncoderKind::kAbsolute" : "EncoderKind::kIncremental") << ",\n";
   o << "    kMotorInertia" << camel(s.motor_sets[s.motor_alt].name) << ",\n";
   group(o, "    // ", "Torque constants K_m [N m/A].", s.torque_constant_text);
   o << "    " << six(s.torque_constant) << ",\n";

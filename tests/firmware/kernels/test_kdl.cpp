@@ -144,7 +144,7 @@ ArmDescription random_general_arm(std::mt19937_64& rng, bool quarter_turns) {
 TEST(Kdl, GeneralArmsKernelsAgreeOnRandomStates) {
   std::mt19937_64 rng(2026);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  test::Worst worst[6] = {{"general arms: FK [R p]"}, {"general arms: J"},      {"general arms: A(q)"},
+  test::Worst worst[6] = {{"general arms: FK [R p]"}, {"general arms: J"},    {"general arms: A(q)"},
                           {"general arms: c(q, qd)"}, {"general arms: g(q)"}, {"general arms: Jdot qd"}};
   for (int a = 0; a < 40; ++a) {
     const bool quarter_turns = a % 2 == 1;

@@ -34,9 +34,10 @@ void alpha_is_not_a_quarter_turn();
 constexpr void quarter_turn(double alpha, double& c, double& s) {
   constexpr double kTol = 1e-12;
   const double k = alpha / (kPi / 2);
-  const long n = k < 0 ? -static_cast<long>(-k + 0.5) : static_cast<long>(k + 0.5);
-  if (k - static_cast<double>(n) > kTol || static_cast<double>(n) - k > kTol) alpha_is_not_a_quarter_turn();
-  const int m = static_cast<int>(((n % 4) + 4) % 4);
+  int n = -8;  // the quarter turn k is, within +-2 turns
+  while (n <= 8 && (k - n > kTol || n - k > kTol)) ++n;
+  if (n > 8) alpha_is_not_a_quarter_turn();
+  const int m = ((n % 4) + 4) % 4;
   c = m == 0 ? 1.0 : (m == 2 ? -1.0 : 0.0);
   s = m == 1 ? 1.0 : (m == 3 ? -1.0 : 0.0);
 }
@@ -129,7 +130,7 @@ struct MotorInertias {
 
 /// What an encoder reports at power-up: an incremental encoder counts from wherever it started (the
 /// arm is homed: potentiometers, index pulses), an absolute one reads the angle itself.
-enum class EncoderKind { incremental, absolute };
+enum class EncoderKind { kIncremental, kAbsolute };
 
 /// The drive train of a real arm, as published (or estimated, where its description says so): the
 /// motors, the encoders, the amplifiers' limits, a potentiometer on every joint (if any), an index

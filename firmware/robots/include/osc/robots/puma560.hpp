@@ -126,7 +126,7 @@ constexpr DriveTrain kDriveTrain = {
      {1 / 0.00010035, 1 / 7.3156e-05, 1 / 0.000117, 1 / 8.2663e-05, 1 / 8.7376e-05, 1 / 8.1885e-05},
      3,
      {{4, 3, -0.0139037}, {5, 3, 0.0130401}, {5, 4, -0.180556}}},
-    EncoderKind::incremental,
+    EncoderKind::kIncremental,
     kMotorInertiaAkb86,
     // Torque constants K_m [N m/A].
     // Source: 0.228 N m/A on J2 (Corke, RVC3).

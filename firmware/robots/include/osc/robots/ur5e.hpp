@@ -123,7 +123,7 @@ constexpr DriveTrain kDriveTrain = {
      {1048576.0 / (2 * kPi), 1048576.0 / (2 * kPi), 1048576.0 / (2 * kPi), 1048576.0 / (2 * kPi), 1048576.0 / (2 * kPi), 1048576.0 / (2 * kPi)},
      0,
      {}},
-    EncoderKind::absolute,
+    EncoderKind::kAbsolute,
     kMotorInertiaHigh,
     // Torque constants K_m [N m/A].
     // Estimate: Not published. The motor torque limit below over an estimated peak phase current of 12 A (J1-J3) and
