@@ -11,11 +11,10 @@
 
 namespace osc::test {
 
-/// Armature G^2 Jm of joint i (link side), from the parameter table.
-inline double armature(int i) {
-  const LinkParams& L = robot::kArm.links[i];
-  return L.gear_ratio * L.gear_ratio * L.motor_inertia;
-}
+/// Armature G^2 Jm of a link's joint (link side).
+inline double armature(const LinkParams& L) { return L.gear_ratio * L.gear_ratio * L.motor_inertia; }
+/// The built robot's, of joint i.
+inline double armature(int i) { return armature(robot::kArm.links[i]); }
 
 /// A placement (osc/robots/arm.hpp) as a KDL frame.
 inline KDL::Frame kdl_frame(const Placement& P) {
@@ -42,8 +41,8 @@ inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true
     chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), base));
   for (int i = 0; i < kDof; ++i) {
     const LinkParams& L = arm.links[i];
-    const double jm = L.gear_ratio * L.gear_ratio * L.motor_inertia;
-    const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0, /*inertia=*/with_armature ? jm : 0.0);
+    const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0,
+                           /*inertia=*/with_armature ? armature(L) : 0.0);
     const double* I = L.inertia;
     const KDL::RigidBodyInertia inertia(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),
                                         KDL::RotationalInertia(I[0], I[1], I[2], I[3], I[4], I[5]));

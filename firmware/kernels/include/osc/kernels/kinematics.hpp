@@ -28,9 +28,9 @@ template <class S>
 /// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic; the
 /// joint axes' moments o_i x z_i into data.vO (the CRBA's and the RNEA passes' joint projections).
 /// F_{i+1} = F_i Rz(q_i) P_i (osc/robots/arm.hpp): Rz turns the first two columns of R_i by q_i
-/// (x, y below, z unchanged), and the placement's rotation mixes them (a permutation with signs
-/// for the DH twists 0 and +-pi/2 and a URDF's quarter turns: Model::Link::form). o_{i+1} = o_i +
-/// p_x x + p_y y + p_z z (a x + d z for a DH row).
+/// (x, y below, z unchanged), and the placement's rotation mixes them (columns moved with a sign
+/// for the DH twists 0 and +-pi/2, else a product: Model::Link::form). o_{i+1} = o_i + p_x x +
+/// p_y y + p_z z (a x + d z for a DH row).
 template <class S>
 void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q) {
   if (model.base_identity) {

@@ -73,7 +73,7 @@ struct PivotedLuJacobianFactor {
   /// J^{-1} b: L y = P b, then U x = y.
   Vec6<S> solve(const Vec6In<S>& b) const {
     Vec6<S> x;
-    for_each_index([&]<int I>(std::integral_constant<int, I>) {
+    for_each_index<kN>([&]<int I>(std::integral_constant<int, I>) {
       if constexpr (I == 0)
         x(0) = b(perm[0]);
       else
@@ -86,13 +86,13 @@ struct PivotedLuJacobianFactor {
   /// J^{-T} b: U^T z = b, then L^T w = z, x = P^T w.
   Vec6<S> solve_transpose(const Vec6In<S>& b) const {
     Vec6<S> z;
-    for_each_index([&]<int I>(std::integral_constant<int, I>) {
+    for_each_index<kN>([&]<int I>(std::integral_constant<int, I>) {
       if constexpr (I == 0)
         z(0) = b(0) * u_inv(0);
       else
         z(I) = (b(I) - lu.col(I).template head<I>().dot(z.template head<I>())) * u_inv(I);
     });
-    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+    for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
       constexpr int I = kN - 1 - K;  // rows 5 .. 0, each with the K entries of L below its diagonal
       if constexpr (K > 0) z(I) -= lu.col(I).template tail<K>().dot(z.template tail<K>());
     });
@@ -106,9 +106,9 @@ struct PivotedLuJacobianFactor {
   /// starts at K); each column is reduced to its 1-norm as it is computed, none is kept.
   S inverse_norm1() const {
     S largest = S(0);
-    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+    for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
       Vec6<S> x = Vec6<S>::Unit(K);
-      for_each_index([&]<int I>(std::integral_constant<int, I>) {
+      for_each_index<kN>([&]<int I>(std::integral_constant<int, I>) {
         if constexpr (I > K) x(I) = -lu.row(I).template segment<I - K>(K).dot(x.template segment<I - K>(K));
       });
       back_substitute(x);
@@ -135,7 +135,7 @@ struct PivotedLuJacobianFactor {
   bool factor() {
     bool regular = true;
     for (int i = 0; i < kN; ++i) perm[i] = static_cast<std::uint8_t>(i);
-    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+    for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
       // Column K of L U on and below the diagonal, each entry one dot product.
       if constexpr (K > 0)
         for (int i = K; i < kN; ++i) lu(i, K) -= lu.row(i).template head<K>().dot(lu.col(K).template head<K>());
@@ -163,7 +163,7 @@ struct PivotedLuJacobianFactor {
 
   /// U x = y in place (the solve's back substitution, by the pivots' reciprocals).
   void back_substitute(Vec6<S>& x) const {
-    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+    for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
       constexpr int I = kN - 1 - K;  // rows 5 .. 0, each with the K entries of U right of its diagonal
       if constexpr (K == 0)
         x(I) = x(I) * u_inv(I);
@@ -191,12 +191,6 @@ struct PivotedLuJacobianFactor {
   }
 
   static S norm1(const Vec6<S>& v) { return v.cwiseAbs().sum(); }
-  /// f(std::integral_constant<int, I>{}) for I = 0, 1, ..., 5 in order.
-  template <class Fn>
-  static void for_each_index(Fn&& f) {
-    [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }
-    (std::make_integer_sequence<int, kN>{});
-  }
 };
 
 }  // namespace osc

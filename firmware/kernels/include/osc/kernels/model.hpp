@@ -3,6 +3,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <type_traits>
+#include <utility>
 
 #include "osc/robots/arm.hpp"
 #include "osc/math/scalar.hpp"
@@ -35,6 +37,14 @@ Vec6<S> joint_vector(const double (&a)[kDof]) {
   Vec6<S> v;
   for (int i = 0; i < kDof; ++i) v(i) = lit<S>(a[i]);
   return v;
+}
+
+/// f(std::integral_constant<int, I>{}) for I = 0, 1, ..., N - 1 in order: a loop whose index is a
+/// compile-time constant, so that every partial row of a factorisation is a fixed-size segment.
+template <int N, class Fn>
+void for_each_index(Fn&& f) {
+  [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }
+  (std::make_integer_sequence<int, N>{});
 }
 
 /// a x b, each component a_i b_j - a_j b_i by math::dot2_minus (one rounding in fixed point).
@@ -79,8 +89,9 @@ template <class S>
 
 /// How a link's placement P = (R, p) places its frame, for forward_kinematics. The rotations of a
 /// DH table (Rx of 0 and +-pi/2: every PUMA 560 link) move two columns, one with a sign; any other
-/// signed permutation (a URDF's quarter turns) moves all three by its codes; only a general rotation
-/// takes a product. A translation (a, 0, d) in the turned frame (every DH row) is a two-term sum.
+/// rotation takes the product, exact for a signed permutation (a URDF's quarter turns: coefficients
+/// 0 and +-1), which kPermutation and its column codes name. A translation (a, 0, d) in the turned
+/// frame (every DH row) is a two-term sum.
 enum class Rotation : unsigned char { kIdentity, kRxPlusHalfPi, kRxMinusHalfPi, kPermutation, kGeneral };
 
 struct PlacementForm {

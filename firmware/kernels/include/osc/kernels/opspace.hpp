@@ -83,7 +83,7 @@ struct LdltFactor {
     positive = true;
     Eigen::Matrix<S, N, 1> t;  // t_k = L(j, k) d_k of the current row j
     // Row j at compile time, so that every partial row is a fixed-size segment (unrolled sums).
-    for_each_index([&]<int J>(std::integral_constant<int, J>) {
+    for_each_index<N>([&]<int J>(std::integral_constant<int, J>) {
       if constexpr (J == 0) {
         d(0) = A(0, 0);
       } else {
@@ -104,23 +104,15 @@ struct LdltFactor {
   Eigen::Matrix<S, N, 1> solve(const Eigen::Matrix<S, N, 1>& b) const {
     Eigen::Matrix<S, N, 1> x;
     x(0) = b(0);
-    for_each_index([&]<int I>(std::integral_constant<int, I>) {
+    for_each_index<N>([&]<int I>(std::integral_constant<int, I>) {
       if constexpr (I > 0) x(I) = b(I) - L.row(I).template head<I>().dot(x.template head<I>());
     });
     x(N - 1) *= d_inv(N - 1);
-    for_each_index([&]<int K>(std::integral_constant<int, K>) {
+    for_each_index<N>([&]<int K>(std::integral_constant<int, K>) {
       constexpr int I = N - 2 - K, M = N - 1 - I;  // rows N-2 .. 0, each with the M entries below it
       if constexpr (I >= 0) x(I) = x(I) * d_inv(I) - L.col(I).template tail<M>().dot(x.template tail<M>());
     });
     return x;
-  }
-
- private:
-  /// f(std::integral_constant<int, I>{}) for I = 0, 1, ..., N - 1 in order.
-  template <class Fn>
-  static void for_each_index(Fn&& f) {
-    [&]<int... I>(std::integer_sequence<int, I...>) { (f(std::integral_constant<int, I>{}), ...); }
-    (std::make_integer_sequence<int, N>{});
   }
 };
 

@@ -268,8 +268,8 @@ constexpr bool has_spherical_wrist(const ArmDescription& arm) {
 }
 
 /// True when the rotation of a placement is a permutation of the axes with signs (every entry 0 or
-/// +-1): the DH twists 0 and +-pi/2, and a URDF's quarter-turn rpy. The kernels then place a frame
-/// by moving columns, without a product.
+/// +-1): the DH twists 0 and +-pi/2, and a URDF's quarter-turn rpy. The kernels place the DH ones by
+/// moving columns, the others by a product that is exact for them (osc/kernels/model.hpp).
 constexpr bool is_signed_permutation(const Placement& P) {
   for (int r = 0; r < 3; ++r) {
     int nonzero = 0;
