@@ -751,7 +751,7 @@ bool validate_settings(const Settings& s, std::string& err) {
   // fault): a start pose there would fault at the first tick.
   const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> data;
-  osc::OpSpace<double> os;
+  osc::ArmOpSpace<double> os;
   osc::forward_kinematics(model, data, Vec6(s.base.q_start));
   const Mat3 R = data.R[osc::kDof];
   osc::opspace_update(model, data, os, Vec6(s.base.q_start), R);

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "cli_parse.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 #include "osc/robot.hpp"
 
 namespace {
@@ -53,21 +53,21 @@ int main(int argc, char** argv) {
 
   const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
-  OpSpace<double> os;
+  ArmOpSpace<double> os;
   forward_kinematics(model, data, q);
   const Mat3<double> R_ref = data.R[kDof];  // orientation coordinates relative to this pose
   opspace_update(model, data, os, q, R_ref);
-  std::printf("PUMA 560 at %s: q = [%g %g %g %g %g %g] rad\n", name.c_str(), q(0), q(1), q(2), q(3), q(4), q(5));
+  std::printf("The arm at %s: q = [%g %g %g %g %g %g] rad\n", name.c_str(), q(0), q(1), q(2), q(3), q(4), q(5));
   print("frame-6 origin p [m]", data.o[kDof].transpose());
   print("R06", data.R[kDof]);
   print("geometric Jacobian J0 [v; w]", data.J);
   print("A(q) incl. armature", data.A);
   print("g(q) [N m]", os.g.transpose());
   print("c(q, qd) [N m]", velocity_products(model, data, qd).c.transpose());
-  std::printf("Jacobian reciprocal condition (worse 3x3 block): %.3e%s\n", os.Jf.rcond,
-              os.Jf.rcond < 1e-3 ? "  (near-singular: Lambda not computed)" : "");
+  std::printf("Jacobian reciprocal condition (worse 3x3 block with a spherical wrist, else of J): %.3e%s\n",
+              os.Jf.rcond, os.Jf.rcond < 1e-3 ? "  (near-singular: Lambda not computed)" : "");
   if (os.Jf.rcond >= 1e-3) {
-    SphericalWristJacobianFactor<double> Jg;
+    ArmJacobianFactor<double> Jg;
     Jg.compute(data.J);
     print("Lambda with the geometric Jacobian", operational_inertia(data.A, Jg));
     print("Lambda with the analytic Jacobian (orientation relative to this pose)", operational_inertia(data, os));

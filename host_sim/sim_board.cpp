@@ -373,7 +373,7 @@ bool start_pose(const Options& o, sim::Vec6& q, std::string& err) {
   }
   const osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm);
   osc::Data<double> data;
-  osc::OpSpace<double> os;
+  osc::ArmOpSpace<double> os;
   osc::forward_kinematics(model, data, q);
   const sim::Mat3 R = data.R[osc::kDof];
   osc::opspace_update(model, data, os, q, R);

@@ -24,7 +24,7 @@ template <class S>
 struct Fixture {
   Model<S> model = Model<S>::of(robot::kArm);
   Data<S> data{};
-  OpSpace<S> os{};
+  ArmOpSpace<S> os{};
   Vec6<S> q, qd, v;
   Mat3<S> R_ref;
   Fixture() {

@@ -104,7 +104,7 @@ TEST(MotionSim, EnableAtRandomPosesHoldsTheArmWithinHalfAMillimetre) {
     // A reachable pose the controller can act at: away from the wrist and elbow singularities.
     Model<double> model = Model<double>::of(robot::kArm);
     Data<double> data;
-    OpSpace<double> os;
+    ArmOpSpace<double> os;
     opspace_update(model, data, os, q, Mat3<double>(Mat3<double>::Identity()));
     if (os.Jf.rcond < 10 * params::kPathMinRcond) continue;
     MotionSim<double> sim(q);

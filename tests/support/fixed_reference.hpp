@@ -27,7 +27,7 @@ constexpr int kSteps = 20;  // control steps from controller_init at the start p
 /// Calls emit(name, matrix) for every kernel output at case c (the kernels in S; the emitted
 /// matrices are of S). The workspaces are the caller's (static on the target).
 template <class S, class Emit>
-void kernel_outputs(const Case& c, const Model<S>& model, Data<S>& data, OpSpace<S>& os, Emit&& emit) {
+void kernel_outputs(const Case& c, const Model<S>& model, Data<S>& data, ArmOpSpace<S>& os, Emit&& emit) {
   const Vec6<S> q = joint_vector<S>(c.q), qd = joint_vector<S>(c.qd), v = joint_vector<S>(c.v);
   forward_kinematics(model, data, q);
   const Mat3<S> R_ref = data.R[kDof];  // phi = 0 at this state

@@ -70,7 +70,7 @@ struct Timer {
 // Kept out of the stack: Data, OpSpace and the controller state are a few kB each.
 Model<F> g_model;
 Data<F> g_data;
-OpSpace<F> g_os;
+ArmOpSpace<F> g_os;
 ControllerState<F> g_state;
 
 /// The joint-space kernels at qn, against the published gravity, inertia and Coriolis values.

@@ -20,7 +20,7 @@ struct Stages : ::testing::Test {
   Model<double> model = Model<double>::of(robot::kArm);
   Gains<double> G = Gains<double>::paper();
   Data<double> data{};
-  OpSpace<double> os{};
+  ArmOpSpace<double> os{};
   Vec6<double> q = q_start();
   void SetUp() override {
     forward_kinematics(model, data, q);

@@ -23,7 +23,7 @@
 
 #include "osc/control/gains.hpp"
 #include "osc/control/trajectory.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 #include "test_util.hpp"
 
 using namespace osc;
@@ -51,7 +51,7 @@ template <class S>
 Peaks chain(const Vec6<double>& q, const Mat3<double>& R_ref, const Vec6<double>& v, const Vec6<double>& a) {
   static const Model<S> model = Model<S>::of(robot::kArm);
   auto data = std::make_unique<Data<S>>();
-  auto os = std::make_unique<OpSpace<S>>();
+  auto os = std::make_unique<ArmOpSpace<S>>();
   opspace_update(model, *data, *os, Vec6<S>(q.cast<S>()), Mat3<S>(R_ref.cast<S>()));
   const Vec6<S> vs = v.cast<S>(), as = a.cast<S>();
   const Vec6<S> h = psi_quadratic(model, *data, *os, vs);
@@ -107,7 +107,7 @@ void print(const char* what, const Peaks& pk) {
 TEST(FixedHeadroom, AlongThePapersTaskEveryIntermediateFitsWithAtLeastFourBitsToSpare) {
   const Model<double> md = Model<double>::of(robot::kArm);
   auto dd = std::make_unique<Data<double>>();
-  auto od = std::make_unique<OpSpace<double>>();
+  auto od = std::make_unique<ArmOpSpace<double>>();
   Vec6<double> q = test::from_array(robot::kQStart);
   forward_kinematics(md, *dd, q);
   const Vec3<double> p0 = dd->o[kDof];
@@ -145,7 +145,7 @@ TEST(FixedHeadroom, AlongThePapersTaskEveryIntermediateFitsWithAtLeastFourBitsTo
 TEST(FixedHeadroom, AtTheJointLimitCornersEveryQuantityFitsOrSaturatesWithTheFlag) {
   const Model<double> md = Model<double>::of(robot::kArm);
   auto dd = std::make_unique<Data<double>>();
-  auto od = std::make_unique<OpSpace<double>>();
+  auto od = std::make_unique<ArmOpSpace<double>>();
   // Above the task's largest velocity (0.063 m/s) and acceleration (0.087 m/s^2), along every
   // position axis at once.
   const Vec6<double> v = (Vec6<double>() << 0.1, 0.1, 0.1, 0, 0, 0).finished();

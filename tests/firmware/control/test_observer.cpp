@@ -36,7 +36,7 @@ double spectral_radius(const Mat6<double>& Lambda, bool semi_implicit) {
 TEST(Observer, DiscretisationIsStableWithThePaperGainsAt1ms) {
   const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
-  OpSpace<double> os;
+  ArmOpSpace<double> os;
   forward_kinematics(model, data, q_start());
   const Mat3<double> R_ref = data.R[kDof];
   double worst_semi = 0, worst_explicit = 0;

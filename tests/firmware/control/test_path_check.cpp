@@ -330,13 +330,15 @@ TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
   forward_kinematics(model, *data, q0);
   geometric_jacobian(*data);
   const Mat3<double> R0 = data->R[kDof];
+  ArmJacobianFactor<double> Jg;
+  Jg.compute(data->J);
   for (double second : {100.0, 80.0}) {
     path_check::SingularityTrace<double> trace;
     PathCheck<double> r;
     EXPECT_FALSE(path_check::near_singular<double>(
-        *data, Mat3<double>(axis_rotation<double>(Vec3<double>::UnitY(), -80 * kPi / 180) * R0), trace, r));
+        *data, Jg, Mat3<double>(axis_rotation<double>(Vec3<double>::UnitY(), -80 * kPi / 180) * R0), trace, r));
     const Mat3<double> R_ref = axis_rotation<double>(Vec3<double>::UnitY(), -second * kPi / 180) * R0;
-    EXPECT_EQ(path_check::near_singular<double>(*data, R_ref, trace, r), second > 90) << second;
+    EXPECT_EQ(path_check::near_singular<double>(*data, Jg, R_ref, trace, r), second > 90) << second;
     EXPECT_GE(r.rcond, params::kPathMinRcond);
   }
 }

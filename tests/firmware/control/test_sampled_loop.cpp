@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "osc/control/arm_opspace.hpp"
 #include "osc/control/sampled_loop.hpp"
 #include "osc/robot.hpp"
 
@@ -133,7 +134,7 @@ TEST(SampledLoop, TheFloatFormJudgesAsTheDoubleReference) {
 Mat6<double> lambda_inverse_at(const Vec6<double>& q) {
   static const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
-  OpSpace<double> os;
+  ArmOpSpace<double> os;
   forward_kinematics(model, data, q);
   const Mat3<double> R_ref = data.R[kDof];
   opspace_update(model, data, os, q, R_ref);
@@ -176,7 +177,7 @@ TEST(SampledLoop, WhatTheCheckAcceptsTheCoupledLoopKeepsStable) {
     {
       static const Model<double> model = Model<double>::of(robot::kArm);
       Data<double> data;
-      OpSpace<double> os;
+      ArmOpSpace<double> os;
       forward_kinematics(model, data, q);
       opspace_update(model, data, os, q, Mat3<double>(data.R[kDof]));
       if (!(os.Jf.rcond > 0.05)) continue;  // near a singularity: the controller refuses to run there

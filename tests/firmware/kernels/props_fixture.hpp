@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 #include "test_util.hpp"
 
 namespace osc::test {
@@ -22,7 +22,7 @@ constexpr double kH = 1e-6;
 struct Props : ::testing::Test {
   Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data{};
-  OpSpace<double> os{};
+  ArmOpSpace<double> os{};
   test::RandomStates rs;
 
   /// x(q) = [p; phi] with orientation relative to R_ref.

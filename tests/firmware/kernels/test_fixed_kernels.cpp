@@ -86,8 +86,8 @@ TEST(FixedKernels, AgreeWithDoubleWithinTheirBudgets) {
   const Model<Fixed> mf = Model<Fixed>::of(robot::kArm);
   auto dd = std::make_unique<Data<double>>();
   auto df = std::make_unique<Data<Fixed>>();
-  auto od = std::make_unique<OpSpace<double>>();
-  auto of = std::make_unique<OpSpace<Fixed>>();
+  auto od = std::make_unique<ArmOpSpace<double>>();
+  auto of = std::make_unique<ArmOpSpace<Fixed>>();
   Worst wp, wR, wphi, wJ, wA, wg, wc, wL, wpg, wh, wW, outside_rel, wLr, whr, wpgr;
   double max_lambda = 0;
   int in_domain = 0, outside = 0, outside_flagged = 0;
@@ -335,7 +335,7 @@ TEST(FixedKernels, ControlStepTorqueAgreesWithDoubleWithinItsBudget) {
 TEST(FixedKernels, TheTargetImagesReferenceValuesAreWhatTheHostComputes) {
   const Model<Fixed> model = Model<Fixed>::of(robot::kArm);
   auto data = std::make_unique<Data<Fixed>>();
-  auto os = std::make_unique<OpSpace<Fixed>>();
+  auto os = std::make_unique<ArmOpSpace<Fixed>>();
   auto st = std::make_unique<ControllerState<Fixed>>();
   std::vector<std::int32_t> got;
   auto emit = [&got](const char*, const auto& m) {

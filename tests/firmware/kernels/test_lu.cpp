@@ -119,7 +119,8 @@ struct RandomMatrices {
 struct PumaJacobians {
   Model<double> model = Model<double>::of(robot::kArm);
   std::unique_ptr<Data<double>> data = std::make_unique<Data<double>>();
-  std::unique_ptr<OpSpace<double>> os = std::make_unique<OpSpace<double>>();
+  std::unique_ptr<OpSpace<double, SphericalWristJacobianFactor<double>>> os =
+      std::make_unique<OpSpace<double, SphericalWristJacobianFactor<double>>>();
   test::RandomStates rs;
   const M6& at_random() {
     V6 q;
@@ -169,6 +170,11 @@ TEST(PivotedLu, SolvesRandomMatricesLikeEigensLu) {
     for (int i = 0; i < kDof; ++i) same = same && PJ.row(i) == J.row(f.perm[i]);
     same_pivots += same;
     EXPECT_NEAR((f.u_inv.cwiseProduct(F.U.diagonal()) - V6::Ones()).cwiseAbs().maxCoeff(), 0.0, 1e-15);
+    // The side of the singularity (the path check's det_signs): the sign of Eigen's determinant.
+    EXPECT_EQ(f.det_positive(), ref.determinant() > 0) << k;
+    M6 swapped = J;  // two rows exchanged: the determinant's sign turns
+    swapped.row(0).swap(swapped.row(3));
+    EXPECT_EQ(factor_of(swapped).det_positive(), ref.determinant() < 0) << k;
   }
   std::printf(
       "%d random matrices (rcond >= %.1e): relative to PartialPivLU solve %.1e, solve_transpose %.1e; to FullPivLU "

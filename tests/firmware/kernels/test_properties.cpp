@@ -10,7 +10,7 @@
 
 #include "osc/control/params.hpp"
 #include "osc/kernels/friction.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 #include "props_fixture.hpp"
 
 using namespace osc;
@@ -28,7 +28,7 @@ TEST_F(Props, FloatKernelsAgreeWithDouble) {
   // >= 0.2): observed worst (printed) is 10-100x below these bounds.
   const Model<float> mf = Model<float>::of(robot::kArm);
   Data<float> df;
-  OpSpace<float> of;
+  ArmOpSpace<float> of;
   FrictionParams<double> pd;
   for (int i = 0; i < kDof; ++i) {
     pd.vis(i) = robot::kFrictionPaper.vis[i];

@@ -13,6 +13,7 @@
 
 #include "monitor_fixtures.hpp"
 #include "osc/runtime/residual_monitor.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 using namespace osc::test;
@@ -172,6 +173,36 @@ TEST(Residual, TheWristsVelocityNoiseCoversTheObserversMixing) {
   }
   EXPECT_GT(widest, 10) << "some pose near the wrist singularity, where the mixing dominates";
   std::printf("wrist noise bound / exact, |sin q5| < 0.3: at most %.2f\n", loosest);
+}
+
+// The general velocity-noise bound (ResidualMonitor::mixed_noise, the one an arm without a spherical wrist
+// takes; on the built arm here, with its own factor of J): at random poses clear of singularities and
+// reference orientations off the pose's, it is every joint's worst case sum_j |(Ja^-1 diag(k) Ja)_ij|
+// delta_j / 2, Ja the analytic Jacobian, that matrix formed by Eigen's LU.
+TEST(Residual, TheMixedVelocityNoiseCoversTheObserversMixing) {
+  ResidualRig<double> rig;
+  const Vec6<double> k = Gains<double>::paper().k;
+  const Mat6<double> Dk = k.asDiagonal();
+  test::RandomStates rs;
+  Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  ArmOpSpace<double> os;
+  double worst = 0;
+  for (int n = 0; n < 300; ++n) {
+    const Vec6<double> q = rs.q_nonsingular();
+    forward_kinematics(model, data, Vec6<double>(q + rs.vec(0.2)));
+    const Mat3<double> R_ref = data.R[kDof];
+    opspace_update(model, data, os, q, R_ref, false);
+    const Mat6<double> M = os.Ja.partialPivLu().solve(Dk * os.Ja);
+    rig.m.mixed_noise(os.Ja, os.Jf);
+    for (int i = 0; i < kDof; ++i) {
+      double exact = 0;
+      for (int j = 0; j < kDof; ++j) exact += std::abs(M(i, j)) * 0.5 / counts_per_rad(j);
+      worst = std::max(worst, std::abs(rig.m.velocity_noise(i) / exact - 1));
+    }
+  }
+  std::printf("mixed noise bound against the exact worst case: relative %.1e\n", worst);
+  EXPECT_LE(worst, 1e-9);
 }
 
 // A contact the task reacted to (ResidualMonitor::note_contact): the push stays in r while the arm

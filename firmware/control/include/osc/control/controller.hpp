@@ -25,7 +25,7 @@
 #include "osc/control/gains.hpp"
 #include "osc/control/observer.hpp"
 #include "osc/control/motion.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 
 namespace osc {
 
@@ -35,7 +35,7 @@ struct ControllerState {
   ObserverState<S> obs;      // x^, y (21)-(22)
   AdaptationState<S> adapt;  // theta^, the previous sample (67), the momentum law's filter
   Data<S> data;              // workspace
-  OpSpace<S> os;
+  ArmOpSpace<S> os;
   /// Psi's joint-space terms (force_command), held between the steps that compute them (ModelRate::kAlternate).
   PsiTerms<S> psi;
   /// The steps since the controller (re)started: whose turn it is (dynamics_turn).
@@ -129,7 +129,7 @@ struct ForceCommand {
 /// friction tau_f^ (30). Psi's terms are computed into `psi` on the steps whose turn it is (`velocity`,
 /// dynamics_turn), and those of the step before used otherwise.
 template <class S>
-ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Data<S>& data, const OpSpace<S>& os,
+ForceCommand<S> force_command(const Model<S>& model, const Gains<S>& G, const Data<S>& data, const ArmOpSpace<S>& os,
                               const Desired<S>& d, const ObserverOutput<S>& ob, const Vec6<S>& tau_f_hat,
                               PsiTerms<S>& psi, bool velocity) {
   ForceCommand<S> c;
@@ -173,7 +173,7 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
     out.rcond = S(0);
     return step_stopped(out, kFaultNonFinite);
   }
-  OpSpace<S>& os = st.os;
+  ArmOpSpace<S>& os = st.os;
   const DynamicsTurn turn = dynamics_turn(G.model_rate, st.steps++);
   opspace_update(model, st.data, os, q, st.R_ref, turn.model);
   out.rcond = os.Jf.rcond;

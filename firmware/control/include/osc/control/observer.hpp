@@ -14,7 +14,7 @@
 #pragma once
 
 #include "osc/control/gains.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 
 namespace osc {
 
@@ -27,7 +27,7 @@ struct ObserverOutput {
 
 /// The observer's output at the measured x (os.x): (23), (21), (28).
 template <class S>
-ObserverOutput<S> observer_output(const Gains<S>& G, const OpSpace<S>& os, const Vec6<S>& x_hat, const Vec6<S>& y) {
+ObserverOutput<S> observer_output(const Gains<S>& G, const ArmOpSpace<S>& os, const Vec6<S>& x_hat, const Vec6<S>& y) {
   ObserverOutput<S> o;
   o.x_tilde = os.x - x_hat;
   o.xd_hat = y + G.k.cwiseProduct(o.x_tilde);
@@ -56,7 +56,7 @@ struct BiasForce {
 /// operational acceleration J A^{-1}(J^T (F + k_i x~) - bias.tau) + bias.a: one product with J^T,
 /// one L D L^T solve with A and one product with J.
 template <class S>
-ObserverState<S> observer_update(const Gains<S>& G, const OpSpace<S>& os, const Vec6<S>& x_hat, const Vec6<S>& y,
+ObserverState<S> observer_update(const Gains<S>& G, const ArmOpSpace<S>& os, const Vec6<S>& x_hat, const Vec6<S>& y,
                                  const Vec6<S>& x_tilde, const Vec6<S>& F, const BiasForce<S>& bias) {
   const Vec6<S> tau = os.Ja.transpose() * (F + G.ki.cwiseProduct(x_tilde)) - bias.tau;
   const Vec6<S> y_dot = operational_acceleration(os, tau, bias.a);

@@ -10,11 +10,11 @@
 //   q <- q + J(q)^{-1} e                               (J the geometric Jacobian of the wrist centre)
 // For R_d = Rot(k, theta) R(q) the orientation error is sin(theta) k, the rotation that J's angular
 // rows map the joint rates to, so the step is Newton's for the pose (quadratic convergence, no
-// orientation coordinates). J^{-1} is SphericalWristJacobianFactor's (opspace.hpp): two 3x3 inverses,
-// no 6x6 one. Each step is scaled down, if need be, so that no joint moves more than kMaxStep: a
-// damped Newton where J is nearly singular. Starting every sample from the one before keeps the
-// solution on the seed's branch (elbow up or down, wrist flipped or not, the seed's turn of each
-// joint): there is no closed-form solution and no switch between branches, and the joint limits are
+// orientation coordinates). J^{-1} is the arm's factor's (ArmJacobianFactor, osc/control/arm_opspace.hpp):
+// two 3x3 inverses for an arm with a spherical wrist, a pivoted LU for any other; no 6x6 inverse. Each step is scaled
+// down, if need be, so that no joint moves more than kMaxStep: a damped Newton where J is nearly singular. Starting
+// every sample from the one before keeps the solution on the seed's branch (elbow up or down, wrist flipped or not, the
+// seed's turn of each joint): there is no closed-form solution and no switch between branches, and the joint limits are
 // those of the path the arm would actually follow.
 //
 // A sample fails, and the check stops there, in the order tested:
@@ -36,8 +36,9 @@
 // Between two samples the joints move continuously along the branch. A singularity the path
 // crosses there, with both samples' rcond above the threshold (joint 5 passing through 0 between
 // two samples), changes the sign of the determinant of one of the Jacobian's blocks, J11 (arm) or
-// J22 (wrist), or turns the roll and yaw coordinates by pi (pitch passing +-90 degrees relative to
-// R_ref): both are compared with the sample before. What a joint does between two samples the margin
+// J22 (wrist), or of det J for an arm without a spherical wrist, or turns the roll and yaw
+// coordinates by pi (pitch passing +-90 degrees relative to R_ref): both are compared with the
+// sample before. What a joint does between two samples the margin
 // kWorkspaceMargin covers, and kPathMinRcond is ten times the controller's threshold.
 //
 // Cost, bounded: the iteration counts are fixed (kFirstIterations at the first sample,
@@ -56,10 +57,11 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 
 #include "osc/control/cartesian_move.hpp"
 #include "osc/control/params.hpp"
-#include "osc/kernels/opspace.hpp"
+#include "osc/control/arm_opspace.hpp"
 #include "osc/robot.hpp"
 
 namespace osc {
@@ -132,7 +134,7 @@ bool saturated() {
 
 /// Forward kinematics and the geometric Jacobian at q, and the Jacobian's factors.
 template <class S>
-void evaluate(const Model<S>& model, Data<S>& data, SphericalWristJacobianFactor<S>& Jf, const Vec6<S>& q) {
+void evaluate(const Model<S>& model, Data<S>& data, ArmJacobianFactor<S>& Jf, const Vec6<S>& q) {
   forward_kinematics(model, data, q);
   geometric_jacobian(data);
   Jf.compute(data.J);
@@ -156,7 +158,7 @@ Vec6<S> pose_error(const Data<S>& data, const Pose<S>& target, bool& aligned) {
 
 /// q <- q + J^{-1} e, the step scaled down to kMaxStep in its largest joint.
 template <class S>
-void newton_step(const SphericalWristJacobianFactor<S>& Jf, const Vec6<S>& e, Vec6<S>& q) {
+void newton_step(const ArmJacobianFactor<S>& Jf, const Vec6<S>& e, Vec6<S>& q) {
   Vec6<S> dq = Jf.solve(e);
   const S longest = dq.cwiseAbs().maxCoeff();
   const S max_step = lit<S>(kMaxStep);
@@ -176,10 +178,10 @@ S joint_clearance(const Vec6<S>& q) {
   return c;
 }
 
-/// What the singularity test of a sample leaves for the next one's: the signs of the determinants of
-/// the geometric Jacobian's two blocks (each changes sign where the path crosses a singularity of the
-/// arm, J11, or of the wrist, J22) and the orientation coordinates (roll and yaw turn by pi where the
-/// path crosses their own singularity, pitch = +-90 degrees).
+/// What the singularity test of a sample leaves for the next one's: the signs of the geometric
+/// Jacobian's determinants (det_signs: each changes sign where the path crosses a singularity) and the
+/// orientation coordinates (roll and yaw turn by pi where the path crosses their own singularity,
+/// pitch = +-90 degrees).
 template <class S>
 struct SingularityTrace {
   bool valid = false;  // a sample came before
@@ -193,6 +195,19 @@ S det3(const Mat3<S>& M) {
   return M.col(0).dot(cross(M.col(1), M.col(2)));
 }
 
+/// The signs of the geometric Jacobian's determinants at the sample (data and its factor Jf evaluated
+/// there): with a spherical wrist, those of its two blocks, J11 (a singularity of the arm) and J22 (of
+/// the wrist), each of which a crossing turns; without one, that of det J (from its factors) and true.
+template <class S>
+std::pair<bool, bool> det_signs(const Data<S>& data, const ArmJacobianFactor<S>& Jf) {
+  if constexpr (kArmSphericalWrist) {
+    return {det3<S>(data.J.template topLeftCorner<3, 3>()) > S(0),
+            det3<S>(data.J.template bottomRightCorner<3, 3>()) > S(0)};
+  } else {
+    return {Jf.det_positive(), true};
+  }
+}
+
 /// a - b turned into [-pi, pi] (a, b in [-pi, pi]).
 template <class S>
 S angle_difference(S a, S b) {
@@ -200,18 +215,18 @@ S angle_difference(S a, S b) {
   return d > pi ? S(d - two_pi) : (d < -pi ? S(d + two_pi) : d);
 }
 
-/// The singularity test of a sample (data evaluated at its solution): the reciprocal condition that
-/// the controller tests, that of the analytic Jacobian in the orientation coordinates relative to
-/// R_ref (controller.hpp), and a singularity crossed since the sample before (trace); in fixed point
-/// also a saturated result in the sample's arithmetic. r.rcond updated.
+/// The singularity test of a sample (data and Jg, the geometric Jacobian's factor, evaluated at its solution): the
+/// reciprocal condition that the controller tests, that of the analytic Jacobian in the orientation coordinates
+/// relative to R_ref (controller.hpp), and a singularity crossed since the sample before (trace); in fixed point also a
+/// saturated result in the sample's arithmetic. r.rcond updated.
 template <class S>
-bool near_singular(const Data<S>& data, const Mat3<S>& R_ref, SingularityTrace<S>& trace, PathCheck<S>& r) {
+bool near_singular(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const Mat3<S>& R_ref,
+                   SingularityTrace<S>& trace, PathCheck<S>& r) {
   const Vec3<S> phi = orientation_coordinates<S>(data.R[kDof], R_ref);
-  SphericalWristJacobianFactor<S> Jf;
+  ArmJacobianFactor<S> Jf;
   Jf.compute(analytic_jacobian(data.J, phi));
   if (!(Jf.rcond >= r.rcond)) r.rcond = Jf.rcond;
-  const bool arm = det3<S>(data.J.template topLeftCorner<3, 3>()) > S(0);
-  const bool wrist = det3<S>(data.J.template bottomRightCorner<3, 3>()) > S(0);
+  const auto [arm, wrist] = det_signs(data, Jg);
   const S half_pi = lit<S>(kPi / 2);
   const bool crossed = trace.valid && (arm != trace.arm_positive || wrist != trace.wrist_positive ||
                                        math::abs(angle_difference(phi(0), trace.phi(0))) > half_pi ||
@@ -220,10 +235,10 @@ bool near_singular(const Data<S>& data, const Mat3<S>& R_ref, SingularityTrace<S
   return !(Jf.rcond >= lit<S>(params::kPathMinRcond)) || crossed || saturated<S>();
 }
 
-/// The tests of one sample at its solution q (data evaluated there), in order; r's extremes updated.
+/// The tests of one sample at its solution q (data and Jg evaluated there), in order; r's extremes updated.
 template <class S>
-PathStatus classify(const Data<S>& data, const Pose<S>& target, const Mat3<S>& R_ref, const Vec6<S>& q,
-                    SingularityTrace<S>& trace, PathCheck<S>& r) {
+PathStatus classify(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const Pose<S>& target, const Mat3<S>& R_ref,
+                    const Vec6<S>& q, SingularityTrace<S>& trace, PathCheck<S>& r) {
   bool aligned;
   const Vec6<S> e = pose_error(data, target, aligned);
   const S ep = e.template head<3>().cwiseAbs().maxCoeff(), eo = e.template tail<3>().cwiseAbs().maxCoeff();
@@ -234,7 +249,7 @@ PathStatus classify(const Data<S>& data, const Pose<S>& target, const Mat3<S>& R
   const S c = joint_clearance(q);
   if (c < r.clearance) r.clearance = c;
   if (!(c >= lit<S>(params::kWorkspaceMargin))) return PathStatus::kOutOfWorkspace;
-  if (near_singular(data, R_ref, trace, r)) return PathStatus::kNearSingular;
+  if (near_singular(data, Jg, R_ref, trace, r)) return PathStatus::kNearSingular;
   return PathStatus::kOk;
 }
 
@@ -251,7 +266,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
   const std::uint32_t before = math::take_arithmetic_flags<S>();  // the caller's, put back on return
   PathCheck<S> r;
   Vec6<S> q = q_seed;
-  SphericalWristJacobianFactor<S> Jf;
+  ArmJacobianFactor<S> Jf;
   SingularityTrace<S> trace;
   evaluate(model, data, Jf, q);
   for (int i = 0; i <= N; ++i) {
@@ -261,7 +276,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
       newton_step(Jf, pose_error(data, target, aligned), q);
       evaluate(model, data, Jf, q);
     }
-    const PathStatus s = classify(data, target, R_ref, q, trace, r);
+    const PathStatus s = classify(data, Jf, target, R_ref, q, trace, r);
     if (s != PathStatus::kOk) {
       r.status = s;
       r.sample = i;

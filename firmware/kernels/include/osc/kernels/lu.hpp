@@ -101,6 +101,26 @@ struct PivotedLuJacobianFactor {
     return x;
   }
 
+  /// Whether det J = sign(P) prod U(k, k) is positive (false when J is singular): the side of a
+  /// singularity J is on (a path that crosses one turns it).
+  bool det_positive() const {
+    bool positive = true;
+    for (int k = 0; k < kN; ++k) {
+      if (u_inv(k) == S(0)) return false;
+      if (u_inv(k) < S(0)) positive = !positive;
+    }
+    // The permutation's sign: each cycle of length m is m - 1 transpositions.
+    std::array<bool, kN> seen{};
+    for (int k = 0; k < kN; ++k) {
+      if (seen[k]) continue;
+      for (int i = k; !seen[i]; i = perm[i]) {
+        seen[i] = true;
+        if (i != k) positive = !positive;
+      }
+    }
+    return positive;
+  }
+
   /// ||J^{-1}||_1 from the factors, exactly: the largest 1-norm of a column of J^{-1} = U^{-1} L^{-1} P.
   /// Column perm[K] is U^{-1} y with L y = e_K, whose first K entries are 0 (the forward substitution
   /// starts at K); each column is reduced to its 1-norm as it is computed, none is kept.

@@ -1,11 +1,15 @@
 // Operational-space dynamics (4)-(5): Lambda(x), Psi(x,y) z, p(x), f, Gamma = J^T F.
 //
-// For an arm with a spherical wrist whose centre is the frame-6 origin (has_spherical_wrist(), in
-// osc/robots/arm.hpp; the PUMA 560 is one), the linear-velocity rows of J do not depend on joints
-// 4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian), and
-// J^{-1} = [J11^{-1} 0; -J22^{-1} J21 J11^{-1} J22^{-1}]. The factor keeps the inverses of the two
-// 3x3 blocks (by cofactors: one division each); every solve with J or J^T is then three 3x3 products
-// and no division, det J = det J11 det J22, and the reciprocal condition numbers are exact (1-norm).
+// Every solve with J or J^T goes through the arm's factor of J (OpSpace's JF, JacobianFactorFor):
+// - For an arm with a spherical wrist whose centre is the frame-6 origin (has_spherical_wrist(), in
+//   osc/robots/arm.hpp; the PUMA 560 is one), the linear-velocity rows of J do not depend on joints
+//   4-6: J = [J11 0; J21 J22] is block lower-triangular (also for the analytic Jacobian), and
+//   J^{-1} = [J11^{-1} 0; -J22^{-1} J21 J11^{-1} J22^{-1}]. SphericalWristJacobianFactor keeps the
+//   inverses of the two 3x3 blocks (by cofactors: one division each); every solve with J or J^T is
+//   then three 3x3 products and no division, det J = det J11 det J22, and the reciprocal condition
+//   numbers are exact (1-norm).
+// - Any other arm (a UR5e: its wrist axes are offset) takes PivotedLuJacobianFactor (lu.hpp): P J = L U,
+//   six divisions per factorisation, none per solve, its rcond exact too.
 // No 6x6 matrix is ever inverted.
 #pragma once
 
@@ -13,6 +17,7 @@
 #include <utility>
 
 #include "osc/kernels/dynamics.hpp"
+#include "osc/kernels/lu.hpp"
 
 namespace osc {
 
@@ -116,10 +121,17 @@ struct LdltFactor {
   }
 };
 
+/// The factor of J an arm takes: the block factor where it has a spherical wrist at its operational
+/// point (has_spherical_wrist(), osc/robots/arm.hpp), the pivoted LU (lu.hpp) where it has not.
+template <class S, bool kSphericalWrist>
+using JacobianFactorFor =
+    std::conditional_t<kSphericalWrist, SphericalWristJacobianFactor<S>, PivotedLuJacobianFactor<S>>;
+
 /// Lambda = J^{-T} A J^{-1} (5), by column solves; symmetrised. The control step never forms it: it
 /// needs only products Lambda u (operational_force) and solves Lambda^{-1} w (operational_acceleration).
-template <class S>
-Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor<S>& Jf) {
+/// JF: the factor of J (JacobianFactorFor).
+template <class S, class JF>
+Mat6<S> operational_inertia(const Mat6<S>& A, const JF& Jf) {
   Mat6<S> Y;  // Y = J^{-T} A
   for (int k = 0; k < kDof; ++k) Y.col(k) = Jf.solve_transpose(A.col(k));
   Mat6<S> L;  // L^T = J^{-T} Y^T
@@ -128,22 +140,24 @@ Mat6<S> operational_inertia(const Mat6<S>& A, const SphericalWristJacobianFactor
 }
 
 /// Operational-space state of the robot at q with task reference orientation R_ref: everything
-/// the observer and controller need that depends on q only.
-template <class S>
+/// the observer and controller need that depends on q only. JF: the arm's factor of J
+/// (JacobianFactorFor; ArmOpSpace, osc/control/controller.hpp, is the built arm's).
+template <class S, class JF>
 struct OpSpace {
-  Vec6<S> x;                           // [p; phi]
-  PhiRate<S> E;                        // E^{-1}(phi) and the trig of phi
-  Mat6<S> Ja;                          // analytic Jacobian
-  SphericalWristJacobianFactor<S> Jf;  // factorisation of Ja
-  LdltFactor<S, kDof> A_ldlt;          // A = L D L^T
-  Vec6<S> g;                           // joint gravity torques
+  using Factor = JF;
+  Vec6<S> x;                   // [p; phi]
+  PhiRate<S> E;                // E^{-1}(phi) and the trig of phi
+  Mat6<S> Ja;                  // analytic Jacobian
+  JF Jf;                       // factorisation of Ja
+  LdltFactor<S, kDof> A_ldlt;  // A = L D L^T
+  Vec6<S> g;                   // joint gravity torques
 };
 
 /// Computes kinematics, Ja and its factorisation at q and, with `dynamics` (the default), A(q), its L D L^T
 /// factors and g(q); without, data.A, os.A_ldlt and os.g keep the values of the last update that computed them
 /// (the control step's alternate model rate, osc/control/controller.hpp).
-template <class S>
-void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const Vec6In<S>& q, const Mat3<S>& R_ref,
+template <class S, class JF>
+void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S, JF>& os, const Vec6In<S>& q, const Mat3<S>& R_ref,
                     bool dynamics = true) {
   forward_kinematics(model, data, q);
   geometric_jacobian(data);
@@ -158,32 +172,32 @@ void opspace_update(const Model<S>& model, Data<S>& data, OpSpace<S>& os, const 
 }
 
 /// Lambda of the current state (opspace_update must have run).
-template <class S>
-Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S>& os) {
+template <class S, class JF>
+Mat6<S> operational_inertia(const Data<S>& data, const OpSpace<S, JF>& os) {
   return operational_inertia(data.A, os.Jf);
 }
 
 /// p(x) = J^{-T} g(q) (5).
-template <class S>
-Vec6<S> operational_gravity(const OpSpace<S>& os) {
+template <class S, class JF>
+Vec6<S> operational_gravity(const OpSpace<S, JF>& os) {
   return os.Jf.solve_transpose(os.g);
 }
 
 /// f = J^{-T} tau_f (5), (31).
-template <class S>
-Vec6<S> operational_friction(const OpSpace<S>& os, const Vec6In<S>& tau_f) {
+template <class S, class JF>
+Vec6<S> operational_friction(const OpSpace<S, JF>& os, const Vec6In<S>& tau_f) {
   return os.Jf.solve_transpose(tau_f);
 }
 
 /// Gamma = J^T F (5).
-template <class S>
-Vec6<S> joint_torques(const OpSpace<S>& os, const Vec6In<S>& F) {
+template <class S, class JF>
+Vec6<S> joint_torques(const OpSpace<S, JF>& os, const Vec6In<S>& F) {
   return os.Ja.transpose() * F;
 }
 
 /// Lambda^{-1} w = J A^{-1} J^T w, by the L D L^T factors of A.
-template <class S>
-Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
+template <class S, class JF>
+Vec6<S> lambda_solve(const OpSpace<S, JF>& os, const Vec6In<S>& w) {
   return os.Ja * os.A_ldlt.solve(Vec6<S>(os.Ja.transpose() * w));
 }
 
@@ -191,8 +205,8 @@ Vec6<S> lambda_solve(const OpSpace<S>& os, const Vec6In<S>& w) {
 /// and an operational acceleration a call for together, with one solve with J and one with J^T
 /// (Lambda = J^{-T} A J^{-1}). Every operational force of (35) is of this form: Lambda a, p = J^{-T} g,
 /// f = J^{-T} tau_f and Psi(x, y) z (psi_terms).
-template <class S>
-Vec6<S> operational_force(const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& a, const Vec6In<S>& tau) {
+template <class S, class JF>
+Vec6<S> operational_force(const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& a, const Vec6In<S>& tau) {
   return os.Jf.solve_transpose(Vec6<S>(data.A * os.Jf.solve(a) + tau));
 }
 
@@ -201,14 +215,14 @@ Vec6<S> operational_force(const Data<S>& data, const OpSpace<S>& os, const Vec6I
 /// operational_force: the acceleration a force F = Lambda a + J^{-T} tau gives is
 /// operational_acceleration(J^T F - tau, 0) = a. Lambda^{-1} w is operational_acceleration(J^T w, 0)
 /// (lambda_solve).
-template <class S>
-Vec6<S> operational_acceleration(const OpSpace<S>& os, const Vec6In<S>& tau, const Vec6In<S>& a) {
+template <class S, class JF>
+Vec6<S> operational_acceleration(const OpSpace<S, JF>& os, const Vec6In<S>& tau, const Vec6In<S>& a) {
   return os.Ja * os.A_ldlt.solve(tau) + a;
 }
 
 /// Analytic Jdot(q, qd) qd.
-template <class S>
-Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qd) {
+template <class S, class JF>
+Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& qd) {
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
   return analytic_jdot_qd(vp.jdot_qd, vp.w6, os.E);
 }
@@ -217,8 +231,8 @@ Vec6<S> analytic_jdot_qd(const Model<S>& model, const Data<S>& data, const OpSpa
 /// evaluated as J^{-T} [c - A J^{-1} Jdot qd_v] (operational_force): the bracket is a joint torque,
 /// whereas Lambda times the operational acceleration Jdot qd_v has entries many times h's
 /// own near the edges of the workspace (beyond the range of a fixed-point scalar first).
-template <class S>
-Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& v) {
+template <class S, class JF>
+Vec6<S> psi_quadratic(const Model<S>& model, const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& v) {
   const Vec6<S> qd = os.Jf.solve(v);
   const VelocityProducts<S> vp = velocity_products(model, data, qd);
   const Vec6<S> jdqd = analytic_jdot_qd(vp.jdot_qd, vp.w6, os.E);
@@ -237,8 +251,8 @@ struct PsiTerms {
 };
 
 /// The same from qy = J^{-1} y, which the caller may already have (the observer's q^dot).
-template <class S>
-PsiTerms<S> psi_terms(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& qy,
+template <class S, class JF>
+PsiTerms<S> psi_terms(const Model<S>& model, const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& qy,
                       const Vec6In<S>& z) {
   const Vec6<S> qz = os.Jf.solve(z);
   const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
@@ -261,8 +275,8 @@ struct PsiPair {
   Vec6<S> yz;  // Psi(x, y) z
 };
 
-template <class S>
-PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+template <class S, class JF>
+PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& y,
                     const Vec6In<S>& z) {
   const PsiTerms<S> t = psi_terms(model, data, os, Vec6<S>(os.Jf.solve(y)), z);
   PsiPair<S> out;
@@ -272,8 +286,8 @@ PsiPair<S> psi_pair(const Model<S>& model, const Data<S>& data, const OpSpace<S>
 }
 
 /// Psi(x, y) z, the symmetric bilinear form of (8).
-template <class S>
-Vec6<S> psi_bilinear(const Model<S>& model, const Data<S>& data, const OpSpace<S>& os, const Vec6In<S>& y,
+template <class S, class JF>
+Vec6<S> psi_bilinear(const Model<S>& model, const Data<S>& data, const OpSpace<S, JF>& os, const Vec6In<S>& y,
                      const Vec6In<S>& z) {
   return psi_pair(model, data, os, y, z).yz;
 }

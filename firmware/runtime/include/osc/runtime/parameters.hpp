@@ -210,7 +210,7 @@ ParamStatus param_value_status(int i, int e, double v) {
 /// the path check's workspace (outside the tick, as command preparation is).
 template <class S>
 Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
-  OpSpace<S> os;
+  ArmOpSpace<S> os;
   opspace_update(task.model, task.check_data, os, task.state.adapt.q_prev, task.state.R_ref);
   return lambda_inverse(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
 }

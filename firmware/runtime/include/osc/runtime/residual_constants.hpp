@@ -117,6 +117,10 @@ struct ResidualInput {
   /// the velocity estimate's noise on the wrist (ResidualMonitor::wrist_noise), or nullptr: none
   /// (a velocity that is not the observer's).
   const Mat6<S>* J = nullptr;
+  /// For an arm without a spherical wrist: the step's analytic Jacobian and its factor, the observer's,
+  /// whose mixing of the encoders' quanta the velocity estimate carries (ResidualMonitor::mixed_noise);
+  /// nullptr as J.
+  const ArmOpSpace<S>* os = nullptr;
 };
 
 }  // namespace osc

@@ -67,8 +67,10 @@ struct ResidualMonitor {
   Vec6<S> r_last, tau_last;              // r of the step before, the torque applied the period before tau_prev's
   Vec6<S> travel_error;                  // the travel check's bound on the model's error, from the last turn [N m]
   Vec6<S> velocity_noise;                // the velocity estimate's quantisation noise per joint [rad/s] (wrist_noise())
-  Vec6<S> noise_base;  // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
-  S wrist_mix;         // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
+  Vec6<S> noise_base;    // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
+  S wrist_mix;           // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
+  Vec6<S> half_quantum;  // set-up: the encoders' quanta / 2 [rad] (mixed_noise())
+  Vec6<S> gains;         // set-up: the observer's gains k [1/s] (mixed_noise())
   Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
   /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
   /// in contact, |r| as it was when the contact began (note_contact()) [N m].
@@ -128,7 +130,9 @@ struct ResidualMonitor {
     lag = S(1) / k.minCoeff();
     wrist_mix = lit<S>(0.5) * (k_max - k.minCoeff()) * (quantum(0) + quantum(1) + quantum(2));
     velocity_noise = noise_base = (lit<S>(0.5) * k_max) * quantum;
-    velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share of the arm's (wrist_noise())
+    if constexpr (kArmSphericalWrist) velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share (wrist_noise())
+    half_quantum = lit<S>(0.5) * quantum;
+    gains = k;
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       double cross = 0;
@@ -188,6 +192,16 @@ struct ResidualMonitor {
     const S turn = wrist_mix / (s2 > kFloorSquared ? math::sqrt(s2) : kFloor);
     velocity_noise(3) = noise_base(3) + turn;
     velocity_noise(5) = noise_base(5) + turn;
+  }
+  /// The velocity estimate's noise, this step, for an arm without a spherical wrist (wrist_noise() for one
+  /// with). The observer's q^dot = J^-1 (y + diag(k) x~) carries the encoders' quantisation e (x~'s share
+  /// J e, J the analytic Jacobian) as M e, M = J^-1 diag(k) J; with |e_j| at most half a quantum, joint
+  /// i's noise is at most sum_j |M_ij| quantum_j / 2, and e can reach it (the bound is exact). M by
+  /// columns, one solve with the factor of J each (no division): six solves on a turn.
+  void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf) {
+    velocity_noise.setZero();
+    for (int j = 0; j < kDof; ++j)
+      velocity_noise += half_quantum(j) * Jf.solve(Vec6<S>(gains.cwiseProduct(J.col(j)))).cwiseAbs();
   }
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
   S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }

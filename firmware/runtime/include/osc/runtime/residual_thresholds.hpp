@@ -17,7 +17,11 @@ template <class S>
 inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool moved[kDof], bool prime,
                                          std::uint64_t tick) {
   const ResidualConstants<S>& c = kResidualConstants<S>;
-  if (in.J) wrist_noise(*in.J);
+  if constexpr (kArmSphericalWrist) {
+    if (in.J) wrist_noise(*in.J);
+  } else {
+    if (in.os) mixed_noise(in.os->Ja, in.os->Jf);
+  }
   const Motion m = motion(in);
   const StrongestFriction strongest(in);
   int moved_too_far = -1;

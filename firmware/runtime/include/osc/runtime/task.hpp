@@ -19,10 +19,6 @@
 
 namespace osc {
 
-static_assert(has_spherical_wrist(robot::kArm),
-              "the kernels factor J block-triangularly (SphericalWristJacobianFactor): the robot needs a "
-              "spherical wrist centred at the frame-6 origin");
-
 /// How a task starts: running the paper's experiment from the first sample (moving along (68)
 /// about the start pose, the observer started at q_start; the firmware's default, and bit for bit
 /// the paper's run: its procedure places the arm at q_start, a declared pose), or disabled, waiting
