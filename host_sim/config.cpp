@@ -534,13 +534,16 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
        [](Settings& s) -> bool& { return s.base.plant.coupling; });
   name(
       t, "plant.motor_inertia",
-      "the plant's motor inertias: toolbox (the controller's model) or akb86 (+45/+105/+50 % on J1-J3)",
-      {"toolbox", "akb86"}, true,
+      "the plant's motor inertias: the sheet's first set (the controller's model; the PUMA's: toolbox) or its second "
+      "(the PUMA's: akb86, +45/+105/+50 % on J1-J3)",
+      {osc::robot::kMotorInertiaModel.name, osc::robot::kDriveTrain.motor_inertia_alt.name}, true,
       [](const Settings& s) {
-        return std::string(s.base.plant.motor_inertia ? s.base.plant.motor_inertia->name : "toolbox");
+        return std::string(s.base.plant.motor_inertia ? s.base.plant.motor_inertia->name
+                                                      : osc::robot::kMotorInertiaModel.name);
       },
       [](Settings& s, const std::string& v) {
-        s.base.plant.motor_inertia = v == "akb86" ? &osc::robot::kMotorInertiaAkb86 : nullptr;
+        s.base.plant.motor_inertia =
+            v == osc::robot::kDriveTrain.motor_inertia_alt.name ? &osc::robot::kDriveTrain.motor_inertia_alt : nullptr;
       });
   number(t, "plant.amp_lag",
          "the amplifiers' current loops, first-order time constant [s] (0: none; estimate: 0.2e-3..0.5e-3)", 0, 5e-3,

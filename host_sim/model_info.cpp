@@ -1,4 +1,4 @@
-// osc_model_info: prints the PUMA 560 model quantities at a named pose or given joint angles.
+// osc_model_info: prints the built arm's model quantities at a named pose or given joint angles.
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
@@ -26,12 +26,14 @@ int main(int argc, char** argv) {
   using namespace osc;
   CLI::App app(
       "Prints forward kinematics, Jacobians, A(q), g(q), c(q, qd), Lambda and the Jacobian condition "
-      "of the PUMA 560 model at a named pose or given joint angles.",
+      "of the built arm's model (OSC_ROBOT) at one of its named poses or given joint angles.",
       "osc_model_info");
-  std::string pose = "qn";
+  std::string pose = "start";
   std::vector<double> qv, qdv;
+  std::vector<std::string> names;
+  for (const NamedPose& p : robot::kNamedPoses) names.emplace_back(p.name);
   auto* pose_opt =
-      app.add_option("--pose", pose, "named pose (default qn)")->check(CLI::IsMember({"qn", "qz", "qr", "qs"}));
+      app.add_option("--pose", pose, "one of the arm's named poses (default start)")->check(CLI::IsMember(names));
   app.add_option("--q", qv, "joint angles q1,...,q6 [rad]")
       ->delimiter(',')
       ->expected(6)
@@ -42,10 +44,7 @@ int main(int argc, char** argv) {
       ->expected(6)
       ->check(CLI::Range(-100.0, 100.0));
   if (const int status = sim::parse_command_line(app, argc, argv, "osc_model_info"); status >= 0) return status;
-  const double* named = pose == "qz"   ? puma560::kQz
-                        : pose == "qr" ? puma560::kQr
-                        : pose == "qs" ? puma560::kQs
-                                       : puma560::kQn;
+  const double* named = robot::kNamedPoses[robot::named_pose_code(pose)].q;
   Vec6<double> q = Eigen::Map<const Vec6<double>>(named), qd = Vec6<double>::Zero();
   std::string name = pose;
   if (!qv.empty()) q = Eigen::Map<const Vec6<double>>(qv.data()), name = "given q";

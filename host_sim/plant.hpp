@@ -27,7 +27,7 @@ using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 
 struct PlantConfig {
-  osc::FrictionCoefficients friction = osc::robot::kFrictionPaper;
+  osc::FrictionCoefficients friction = *osc::robot::kFrictionPresets[0];  ///< the sheet's first preset (PUMA: paper)
   double tau_dec = osc::params::kTauDec;
   double substep = 1e-4;  ///< RK4 step [s] (10 kHz) wherever a joint's velocity changes sign
   /// Away from velocity reversals (every joint's velocity keeps its sign through the step, so the
@@ -41,7 +41,7 @@ struct PlantConfig {
   // and integrate() are the amplifier channels' torques, each referred to its joint (what the DACs
   // command): the joint torques themselves unless `coupling` is on.
   /// Motor inertias of the armature G^2 Jm: nullptr, the model's own (kArm.links[i].motor_inertia);
-  /// or e.g. &osc::robot::kMotorInertiaAkb86.
+  /// or e.g. &osc::robot::kDriveTrain.motor_inertia_alt (the PUMA's: AKB86's).
   const osc::MotorInertias* motor_inertia = nullptr;
   /// The wrist coupling (kDriveTrain.encoders: q = C e) in the dynamics: the motors turn at
   /// e_dot = C^-1 q_dot, the channels' torques reach the joints as C^-T tau_m, the motors' inertias

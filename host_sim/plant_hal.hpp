@@ -99,7 +99,10 @@ inline std::int32_t dac_quantise(std::int32_t code, int bits) {
 }
 
 /// The potentiometer's ADC: full scale 2^pot_bits - 1 codes.
-inline constexpr double kPotFullScale = static_cast<double>((1 << osc::robot::kDriveTrain.pot_bits) - 1);
+/// (An arm without potentiometers, pot_bits 0: 1, never read.)
+inline constexpr double kPotFullScale = osc::robot::kDriveTrain.pot_bits > 0
+                                            ? static_cast<double>((1 << osc::robot::kDriveTrain.pot_bits) - 1)
+                                            : 1.0;
 /// A joint angle's exact (unrounded, noise-free) potentiometer code.
 inline double pot_scale(int joint, double q) {
   const auto& d = osc::robot::kDriveTrain;

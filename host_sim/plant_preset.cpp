@@ -37,7 +37,7 @@ void realistic(ExperimentConfig& cfg) {
   ideal(cfg);
   cfg.published_encoders = true;
   cfg.plant.coupling = true;
-  cfg.plant.motor_inertia = &osc::robot::kMotorInertiaAkb86;
+  cfg.plant.motor_inertia = &osc::robot::kDriveTrain.motor_inertia_alt;
   cfg.plant.amp_lag = 0.35e-3;  // estimate: a current loop of 0.2-0.5 ms
   cfg.plant.amp_current_limit = true;
   // Estimates: gain errors within +-1 %, offsets of 0.1 % of each channel's full scale, signs mixed.

@@ -128,6 +128,8 @@ void emit_arm(std::ostream& o, const Sheet& s, const Chain& c) {
     o << "inline constexpr MotorInertias kMotorInertia" << camel(m.name) << " = {" << cstr(m.name) << ", " << six(m.jm)
       << "};\n";
   }
+  o << "/// The model's set (the first).\n";
+  o << "inline constexpr const MotorInertias& kMotorInertiaModel = " << jm << ";\n";
   if (!s.motor_text.source.empty() || !s.motor_text.estimate.empty()) group(o, "/// ", "Motor inertias:", s.motor_text);
   o << "\n";
   group(o, "/// ",

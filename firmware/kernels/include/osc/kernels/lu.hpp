@@ -143,8 +143,8 @@ struct PivotedLuJacobianFactor {
   /// (its reciprocal is finite), in fixed point the one whose reciprocal is half the range.
   static constexpr S min_pivot() {
     if constexpr (fixed::is_q_v<S>) {
-      constexpr int shift = 2 * S::kFractionBits - 30;  // 2^(1 - integer bits) in LSB
-      return S::from_raw(shift > 0 ? std::int32_t{1} << shift : 1);
+      constexpr int kShift = 2 * S::kFractionBits - 30;  // 2^(1 - integer bits) in LSB
+      return S::from_raw(kShift > 0 ? std::int32_t{1} << kShift : 1);
     } else {
       return std::numeric_limits<S>::min();
     }

@@ -30,6 +30,8 @@ inline constexpr MotorInertias kMotorInertiaToolbox = {"toolbox", {0.0002, 0.000
 /// Motor inertias [kg m^2], motor side: set "akb86".
 /// Source: AKB86's (RTB mdl_puma560akb): +45 / +105 / +50 % on J1-J3 (puma560.md C4).
 inline constexpr MotorInertias kMotorInertiaAkb86 = {"akb86", {0.000291, 0.000409, 0.000299, 3.5e-05, 3.5e-05, 3.5e-05}};
+/// The model's set (the first).
+inline constexpr const MotorInertias& kMotorInertiaModel = kMotorInertiaToolbox;
 
 /// The arm, from base_link (the base frame) to link6: kinematics and inertia.
 /// Source: Standard DH, links' masses, COMs and inertias about the COM (every product 0): the CAH94 consensus values

@@ -33,6 +33,8 @@ inline constexpr MotorInertias kMotorInertiaEstimate = {"estimate", {7e-05, 7e-0
 /// Estimate: The estimate + 50 %: the upper end of its uncertainty (the PUMA's two published sets differ by 45-105
 /// %), the residual monitor's second set.
 inline constexpr MotorInertias kMotorInertiaHigh = {"high", {0.000105, 0.000105, 0.000105, 1.5e-05, 1.5e-05, 1.5e-05}};
+/// The model's set (the first).
+inline constexpr const MotorInertias& kMotorInertiaModel = kMotorInertiaEstimate;
 
 /// The arm, from base_link (the base frame) to wrist_3_link: kinematics and inertia.
 /// Source: UR's DH table (article "DH Parameters for calculations of kinematics and dynamics", 2022) in the xyz/rpy

@@ -124,7 +124,9 @@ struct PositionCrossCheck {
   /// by up to half its resolution, 4 mrad over the 4095 codes.
   static S pot_angle(int i, std::uint16_t code) {
     static constexpr std::array<S, kDof> kMin = lit_array<S>(robot::kDriveTrain.pot_min);
-    static constexpr double kFull = static_cast<double>((1 << robot::kDriveTrain.pot_bits) - 1);
+    // An arm without potentiometers (pot_bits 0) never reads one; a full scale of 1 keeps this defined.
+    static constexpr double kFull =
+        robot::kDriveTrain.pot_bits > 0 ? static_cast<double>((1 << robot::kDriveTrain.pot_bits) - 1) : 1.0;
     if constexpr (fixed::is_q_v<S>) {
       static constexpr std::array<std::int64_t, kDof> kSpanRaw = [] {
         std::array<std::int64_t, kDof> a{};
