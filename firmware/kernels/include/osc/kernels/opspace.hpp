@@ -144,7 +144,6 @@ Mat6<S> operational_inertia(const Mat6<S>& A, const JF& Jf) {
 /// (JacobianFactorFor; ArmOpSpace, osc/control/controller.hpp, is the built arm's).
 template <class S, class JF>
 struct OpSpace {
-  using Factor = JF;
   Vec6<S> x;                   // [p; phi]
   PhiRate<S> E;                // E^{-1}(phi) and the trig of phi
   Mat6<S> Ja;                  // analytic Jacobian
