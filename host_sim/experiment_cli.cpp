@@ -57,9 +57,9 @@ struct Parsed {
 };
 
 void build(CLI::App& app, ExperimentOptions& o, Parsed& p, std::vector<std::vector<std::string>>& values) {
-  app.description(
-      "The paper's experiment (Section VI) on the simulated PUMA 560, with adaptive friction compensation and "
-      "without. The configuration's defaults are the paper's set-up; --print-config shows every key.");
+  app.description("The paper's experiment (Section VI) on the simulated " + std::string(osc::robot::kArm.name) +
+                  ", with adaptive friction compensation and without. The configuration's defaults are the paper's "
+                  "set-up; --print-config shows every key.");
   app.set_help_flag("-h,--help", "this text");
   app.option_defaults()->disable_flag_override()->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
   app.add_option("--config", o.config_file, "read the configuration from this YAML file (see --print-config)")

@@ -26,20 +26,22 @@ class MotionSim {
   /// inj: a simulated hardware fault or a contact (injection.hpp), none by default. sensors: the
   /// plant's (the task reads encoders of sensors.encoders). Without power_on the arm was placed at q0,
   /// a pose the task takes as declared (homed, as the paper's procedure); with power_on, the arm
-  /// powers on there (the encoders count from there) while the task assumes q0: not homed, motion is
-  /// refused until a home or a declare_pose.
+  /// powers on there (incremental encoders count from there) while the task assumes q0: not homed, motion is
+  /// refused until a home or a declare_pose. Absolute encoders (osc::has_absolute_encoders) read the
+  /// angle wherever it powers on: the task is homed from the start.
+  static constexpr bool kAbsolute = osc::has_absolute_encoders(osc::robot::kDriveTrain);
   explicit MotionSim(const Vec6& q0, const Injection& inj = {}, const PlantConfig& pc = {},
                      osc::FrictionMode mode = osc::FrictionMode::kAdaptive,
                      const osc::Gains<double>& gains = osc::Gains<double>::paper(), const SensorConfig& sensors = {},
                      const std::optional<Vec6>& power_on = std::nullopt)
-      : plant_(pc), hal_(plant_, power_on.value_or(q0), sensors, inj), task_(new osc::ControlTask<S>) {
+      : plant_(pc), hal_(plant_, kAbsolute ? q0 : power_on.value_or(q0), sensors, inj), task_(new osc::ControlTask<S>) {
     plant_.reset(power_on.value_or(q0));
     plant_.set_contact(Contact::of(inj));  // a collision or a wall acts in the plant, the rest in the HAL
     plant_.set_brakes(true);
     task_->init(osc::Model<S>::of(osc::robot::kArm), gains.template cast<S>(), mode, q0.cast<S>(), PlantHal::kPeriodNs,
                 osc::TaskStart::kDisabled);
     task_->set_encoders(sensors.encoders);
-    task_->homed = !power_on.has_value();
+    task_->homed = kAbsolute || !power_on.has_value();
   }
   /// A home, planned (the homing move, path-checked) from the measured angles, taken by the next tick.
   void home(std::uint32_t id) { task_->pending = osc::prepare_checked_home(*task_, id); }

@@ -47,8 +47,8 @@ void print_error_table(const std::vector<sim::ExperimentResult>& runs, bool pape
   // The paper's tables are compared with only when the set-up is the paper's.
   const char* t1 = paper ? "paper T.I" : "(T.I)";
   const char* t3 = paper ? "paper T.III" : "(T.III)";
-  std::printf("\nMaximum tracking errors (simulated PUMA 560, %.0f s, friction preset '%s')%s\n", runs[0].duration,
-              runs[0].friction_preset.c_str(),
+  std::printf("\nMaximum tracking errors (simulated %s, %.0f s, friction preset '%s')%s\n", osc::robot::kArm.name,
+              runs[0].duration, runs[0].friction_preset.c_str(),
               paper ? "" : "\n  (the set-up differs from the paper's: its tables, in brackets, are not comparable)");
   std::printf("%-12s", "axis");
   char last[32];

@@ -384,7 +384,8 @@ bool start_pose(const Options& o, sim::Vec6& q, std::string& err) {
 
 void build(CLI::App& app, Options& o) {
   app.description(
-      "The simulated PUMA 560 as a virtual board: the firmware's control task over the simulated arm, in real "
+      "The simulated " + std::string(osc::robot::kArm.name) +
+      " as a virtual board: the firmware's control task over the simulated arm, in real "
       "time, serving the command protocol (docs/protocol.md) on a pseudo-terminal whose path is the first line "
       "on standard output (\"pty: /dev/pts/N\"). The arm starts disabled. SIGINT or SIGTERM ends it (status 0). "
       "The controller runs in process, or with --qemu as the PIL firmware image in QEMU over the PIL link "

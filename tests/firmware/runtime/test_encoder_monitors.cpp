@@ -189,4 +189,34 @@ TYPED_TEST(Monitors, StuckEncoderDitherIsNoMovingJoint) {
   }
 }
 
+// The activity's window (the residual monitor's slide test on a fine encoder): each channel's |change| over
+// the last whole window of params::kResidualSlideInterval ticks, whichever way, and nothing from the
+// restart's reading on until a window has passed.
+TEST(EncoderActivity, TheWindowsTravelIsTheLastWholeWindowsChange) {
+  EncoderActivity a;
+  a.reset();
+  std::int32_t counts[kDof] = {};
+  bool moved[kDof] = {};
+  a.restart(counts, 0);
+  constexpr int kW = params::kResidualSlideInterval;
+  const std::int32_t pace[kDof] = {3, -2, 0, 1, 7, -1};  // counts a tick
+  for (int t = 1; t <= 3 * kW; ++t) {
+    for (int i = 0; i < kDof; ++i) {
+      moved[i] = pace[i] != 0;
+      counts[i] += pace[i];
+    }
+    a.track(counts, moved, static_cast<std::uint64_t>(t));
+    for (int i = 0; i < kDof; ++i) {
+      const std::uint32_t expect = t < kW ? 0u : static_cast<std::uint32_t>(std::abs(pace[i]) * kW);
+      EXPECT_EQ(a.window_travel[i], expect) << "tick " << t << " channel " << i;
+    }
+  }
+  // A joint that stops: its next whole window reads 0.
+  for (int t = 3 * kW + 1; t <= 5 * kW; ++t) {
+    for (int i = 0; i < kDof; ++i) moved[i] = false;
+    a.track(counts, moved, static_cast<std::uint64_t>(t));
+  }
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(a.window_travel[i], 0u) << i;
+}
+
 }  // namespace

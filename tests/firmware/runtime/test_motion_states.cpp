@@ -29,7 +29,7 @@ using R = MotionReason;
 constexpr int kStates = MotionNames<S>::kCount;
 constexpr int kCommands = MotionNames<C>::kCount;
 constexpr int kReasons = MotionNames<R>::kCount;
-static_assert(kStates == 7 && kCommands == 8 && kReasons == 24);
+static_assert(kStates == 7 && kCommands == 8 && kReasons == 25);
 static_assert(MotionNames<CommandOutcome>::kCount == 3 && MotionNames<StopCategory>::kCount == 3);
 static_assert(MotionNames<MotionCompletion>::kCount == 4);
 static_assert(sizeof(MotionNames<S>::kDocs) == sizeof(MotionNames<S>::kNames));
@@ -274,7 +274,7 @@ TEST(MotionStates, ExhaustiveAgainstTheTable) {
                   faulting += f != 0;
                   ++cases;
                 }
-  EXPECT_EQ(cases, 8L * 2 * 3 * 9 * 3 * 3 * 24 * 16);
+  EXPECT_EQ(cases, 8L * 2 * 3 * 9 * 3 * 3 * kReasons * 16);
   EXPECT_GT(refusals, 0);  // the loop reached every kind of row
   EXPECT_GT(aborts, 0);
   EXPECT_GT(faulting, 0);

@@ -243,4 +243,30 @@ TYPED_TEST(Monitors, AContactsPushIsNotedAndWhatChangesAfterItJudged) {
   EXPECT_EQ(kind, static_cast<std::uint32_t>(kFaultCollision)) << fault_name(kind);
 }
 
+// The slide test's counts (EncoderActivity::slide_counts): none where the encoder resolves the slide
+// speed at kResidualSlideInterval ticks a count (the PUMA's every joint); otherwise that speed's counts over
+// the window, kResidualSlideSpeed kResidualSlideInterval dt / quantum, whole (the UR5e's 3.8 urad: 13).
+TEST(Residual, AFineEncoderMustMakeTheSlideSpeedsCounts) {
+  const double identity[kDof][kDof] = {{1, 0, 0, 0, 0, 0}, {0, 1, 0, 0, 0, 0}, {0, 0, 1, 0, 0, 0},
+                                       {0, 0, 0, 1, 0, 0}, {0, 0, 0, 0, 1, 0}, {0, 0, 0, 0, 0, 1}};
+  ResidualMonitor<double> m;
+  m.reset();
+  Vec6<double> quantum;
+  for (int i = 0; i < kDof; ++i) quantum(i) = 1 / counts_per_rad(i);
+  m.set(quantum, Gains<double>::paper().k, identity);
+  for (int i = 0; i < kDof; ++i) {
+    const double speed = quantum(i) / (params::kResidualSlideInterval * params::kDt);  // a count per window
+    EXPECT_EQ(m.activity.slide_counts[i], speed >= params::kResidualSlideSpeed
+                                              ? 0u
+                                              : 1u * static_cast<unsigned>(params::kResidualSlideSpeed / speed))
+        << i;
+  }
+  const double ur5e = 2 * kPi / (16384 * 101.0);  // 3.8 urad
+  m.set(Vec6<double>::Constant(ur5e), Gains<double>::paper().k, identity);
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(m.activity.slide_counts[i], 13u) << i;
+  // Ten times coarser: 1.3 counts a window, one whole.
+  m.set(Vec6<double>::Constant(10 * ur5e), Gains<double>::paper().k, identity);
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(m.activity.slide_counts[i], 1u) << i;
+}
+
 }  // namespace

@@ -133,6 +133,14 @@ constexpr double kResidualMargin = 2;
 /// (Corke's friction, uncompensated) crept at 0.008 rad/s, a count every 10 ticks, for seconds;
 /// judged as sliding, it reached 1.03 of its change threshold (docs/safety.md).
 constexpr int kResidualSlideInterval = 5;
+/// The same as a speed [rad/s], for an encoder fine enough that kResidualSlideInterval ticks between counts is
+/// slower than this: a UR5e's count is 3.8 urad, so a joint creeping at 0.8 mrad/s counts every 5 ticks. Such a
+/// joint moves, for the residual monitor's friction bound, its stillness envelope and the identification's
+/// samples, only when its encoder made this speed's counts over the last kResidualSlideInterval ticks as well
+/// (EncoderActivity::slide_counts; a UR5e joint held by static friction crept at 0.2 mrad/s in the plant, its
+/// observed q^dot 10 mrad/s off by the friction the model lacked). The PUMA's encoders resolve it (0.012-0.023
+/// rad/s at 5 ticks): the count interval alone decides there, as before.
+constexpr double kResidualSlideSpeed = 0.01;
 /// The residual monitor raises its faults (encoder_stuck, drive_fault, collision) by default, and the
 /// stuck-encoder monitor's fitted criteria are off but while homing (the runtime parameter
 /// residual_monitor; docs/safety.md). Off,

@@ -147,6 +147,12 @@ struct DriveTrain {
   double index_angle[kDof];  ///< the motor shaft's angle at its index pulse [rad, 0..2 pi), from its angle at q = 0
 };
 
+/// Whether the arm has a potentiometer on every joint (pot_bits > 0): the position cross-check and homing
+/// need them.
+constexpr bool has_pots(const DriveTrain& d) { return d.pot_bits > 0; }
+/// Whether the arm's encoders read the angle itself (EncoderKind::kAbsolute): known from power-on, no homing.
+constexpr bool has_absolute_encoders(const DriveTrain& d) { return d.encoder_kind == EncoderKind::kAbsolute; }
+
 /// The maxima of the operational point's translation in a straight-line move (the arm's statement; the motion
 /// generator's limits are params::kMoveLinear today).
 struct CartesianMaxima {

@@ -115,11 +115,22 @@ struct EncoderActivity {
   std::int8_t direction[kDof];         // the sign of its last change
   bool steady[kDof];                   // its last two changes had the same sign
   bool reversed[kDof];                 // ... opposite signs
+  // Each channel's counts over the last whole window of params::kResidualSlideInterval ticks, either way
+  // (the residual monitor's slide test on a fine encoder: ResidualMonitor::slide_counts).
+  std::int32_t window_start[kDof];    // its reading at the current window's start
+  std::uint32_t window_travel[kDof];  // |its change| over the last whole window
+  std::uint8_t window_left;           // ticks until the current window ends
+  /// Set-up (set_slide): the counts channel c must make over a window for its joint to count as moving
+  /// (the residual monitor's friction_error): params::kResidualSlideSpeed's, where its encoder counts
+  /// kResidualSlideInterval ticks apart at a lower speed; else 0, no such test (the count interval
+  /// decides, as on the PUMA).
+  std::uint32_t slide_counts[kDof] = {};
 
   void reset() {
     for (int i = 0; i < kDof; ++i)
       last_move_tick[i] = 0, move_interval[i] = kStuckIntervalCap, last_counts[i] = 0, direction[i] = 0,
-      steady[i] = false, reversed[i] = false;
+      steady[i] = false, reversed[i] = false, window_start[i] = 0, window_travel[i] = 0;
+    window_left = 0;
   }
   /// Channel i changed (or is taken as changed) at `tick`.
   void mark(int i, std::uint64_t tick) {
@@ -137,6 +148,16 @@ struct EncoderActivity {
       last_counts[i] = counts[i];
       mark(i, tick);
     }
+    if (window_left > 0) {
+      --window_left;
+      return;
+    }
+    window_left = params::kResidualSlideInterval - 1;
+    for (int i = 0; i < kDof; ++i) {
+      const std::int32_t d = counts[i] - window_start[i];
+      window_travel[i] = static_cast<std::uint32_t>(d < 0 ? -d : d);
+      window_start[i] = counts[i];
+    }
   }
   /// The clock moved on by n ticks (a host test's jump of the uptime): the changes keep their age.
   void shift(std::uint64_t n) {
@@ -144,8 +165,19 @@ struct EncoderActivity {
   }
   /// Every channel taken as just changed at `tick`, from `counts`; none counts one way yet.
   void restart(const std::int32_t counts[kDof], std::uint64_t tick) {
-    for (int i = 0; i < kDof; ++i) last_counts[i] = counts[i], steady[i] = reversed[i] = false, mark(i, tick);
+    for (int i = 0; i < kDof; ++i)
+      last_counts[i] = window_start[i] = counts[i], window_travel[i] = 0, steady[i] = reversed[i] = false,
+      mark(i, tick);
+    window_left = params::kResidualSlideInterval - 1;
   }
+  /// Channel c's slide test for an encoder of `quantum` [rad at its joint] (0: none, a coupled channel).
+  void set_slide(int c, double quantum) {
+    constexpr double kSlideTravel = params::kResidualSlideSpeed * params::kResidualSlideInterval * params::kDt;
+    const double counts = quantum > 0 ? kSlideTravel / quantum : 0.0;
+    slide_counts[c] = counts > 1 ? static_cast<std::uint32_t>(counts) : 0u;
+  }
+  /// Channel c made its slide test's counts over the last whole window (always, without one).
+  bool fast_enough(int c) const { return window_travel[c] >= slide_counts[c]; }
   /// Channel c has been silent for more than params::kStuckIntervals of its recent intervals.
   bool silent(int c, std::uint64_t tick) const {
     const std::uint64_t quiet = tick - last_move_tick[c];

@@ -175,7 +175,8 @@ bool pots_settling(const ControlTask<S>& task) {
 /// Plans the homing move, outside the tick (like a move_to: path-checked by check_prepared_move):
 /// from the held pose, every motor (1 + kHomeMargin) revolutions toward the middle of its joint's
 /// travel, at the homing limits `lim`. q: the measured angles; data: the planning workspace.
-/// Refused busy unless the generator holds, over_limit when the plan fails.
+/// Refused not_needed on an arm with absolute encoders, busy unless the generator holds, over_limit when
+/// the plan fails.
 template <class S>
 TaskCommand<S> prepare_home(const MotionGenerator<S>& gen, const CartesianLimits<S>& lim, const Model<S>& model,
                             Data<S>& data, const IoMap<S>& io, const Vec6<S>& q, std::uint32_t id) {
@@ -191,6 +192,10 @@ TaskCommand<S> prepare_home(const MotionGenerator<S>& gen, const CartesianLimits
   }();
   TaskCommand<S> c = prepare_command<S>(MotionVerb::kHome, id);
   c.epoch = gen.epoch();
+  if (has_absolute_encoders(robot::kDriveTrain)) {
+    c.refusal = MotionReason::kNotNeeded;
+    return c;
+  }
   if (gen.source() != MotionSource::kHold) {
     c.refusal = MotionReason::kBusy;
     return c;

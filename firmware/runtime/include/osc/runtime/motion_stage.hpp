@@ -101,6 +101,9 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   MotionReason pre = cmd.refusal;
   const bool planned = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome;
   if (pre == MotionReason::kNone && planned && cmd.epoch != task.gen.epoch()) pre = MotionReason::kSuperseded;
+  if (pre == MotionReason::kNone && has_absolute_encoders(robot::kDriveTrain) &&
+      (cmd.verb == MotionVerb::kHome || cmd.verb == MotionVerb::kDeclarePose))
+    pre = MotionReason::kNotNeeded;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kHome && !homing_possible(task))
     pre = MotionReason::kNoPots;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kDeclarePose &&
@@ -158,7 +161,7 @@ template <class S>
 /// nothing runs nor is queued (the state frame's queued and running_id 0) until an enable holds.
 template <class S>
 [[gnu::noinline]] void fault_motion(ControlTask<S>& task, std::uint32_t faults) {
-  if ((faults & kFaultsUnhoming) != 0) task.homed = false;
+  if (!has_absolute_encoders(robot::kDriveTrain) && (faults & kFaultsUnhoming) != 0) task.homed = false;
   report_dropped(task);
   task.gen.halt();
 }

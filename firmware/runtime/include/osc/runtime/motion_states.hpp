@@ -78,7 +78,10 @@ namespace osc {
     "a declare_pose whose pose a potentiometer contradicts by more than params::kDeclareBand (2 degrees)")          \
   X(TorqueOn, "torque_on", "a declare_pose while the torque is on: disable first")                                  \
   X(UnknownPose, "unknown_pose", "a declare_pose of a pose code outside the robot's list of named poses")           \
-  X(Dropped, "dropped", "a queued move that never started: the motion ahead of it was stopped, re-targeted or faulted")
+  X(Dropped, "dropped",                                                                                             \
+    "a queued move that never started: the motion ahead of it was stopped, re-targeted or faulted")                 \
+  X(NotNeeded, "not_needed",                                                                                        \
+    "a home or a declare_pose on an arm with absolute encoders: its angles are known from power-on")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -129,7 +132,7 @@ OSC_MOTION_ENUM(CollisionReaction, OSC_COLLISION_REACTION_LIST);
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
 static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kHoming) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kDeclarePose) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kDropped) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kNotNeeded) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kHomed) + 1);

@@ -79,6 +79,8 @@ constexpr double kMoveAngularCap[3] = {params::kMoveAngular[0] * params::kMoveLi
                                        params::kMoveAngular[1] * params::kMoveLimitCap,
                                        params::kMoveAngular[2] * params::kMoveLimitCap};
 constexpr double kZeros[kDof] = {};
+/// The pots parameter's default and largest value: 1 where the arm is described with potentiometers.
+constexpr double kPotsWired = has_pots(robot::kDriveTrain) ? 1 : 0;
 /// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
 /// configured move maxima.
 constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
@@ -101,8 +103,9 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     true, "each joint's collision threshold; 0: the derived threshold alone")                                         \
   X(StreamTimeout, "stream_timeout", 1, "s", params::kStreamTimeoutLo, kStreamExtrapolation, kStreamTimeoutMin,       \
     Always, true, "a stream is stale after max(2 periods, this) without a setpoint; from the next stream on")         \
-  X(Pots, "pots", 1, "", 0, 1, 1, TorqueOff, true,                                                                    \
-    "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them")                  \
+  X(Pots, "pots", 1, "", 0, detail::kPotsWired, detail::kPotsWired, TorqueOff, true,                                  \
+    "1: the arm's potentiometers are wired (the position cross-check runs); 0: an arm without them (its only value "  \
+    "on an arm described without potentiometers)")                                                                    \
   X(HomeSpeed, "home_speed", 2, "m/s, rad/s", detail::kHomeSpeedLo, detail::kHomeSpeedHi, params::kHomeSpeed, Always, \
     true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")          \
   X(ResidualMonitor, "residual_monitor", 1, "", 0, 1, params::kResidualMonitorArmed ? 1 : 0, TorqueOff, true,         \

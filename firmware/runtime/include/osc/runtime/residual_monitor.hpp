@@ -111,8 +111,7 @@ struct ResidualMonitor {
   /// (the check's peak; against travel_limit, its headroom).
   Vec6<S> travel_limit, travel_peak;
   static constexpr S kNoDrive = lit<S>(1000);  // none yet this step [N m]
-  /// Set-up: each encoder's least and largest spacing of consecutive edges, its quantum less or
-  /// plus twice robot::kModelErrorBounds' encoder_edge [rad at the joint].
+  /// Set-up: each encoder's least and largest edge spacing, quantum -+ 2 encoder_edge quanta [rad at the joint].
   Vec6<S> spacing_lo, spacing_hi;
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
@@ -146,6 +145,7 @@ struct ResidualMonitor {
       travel_limit(i) = alone ? lit<S>(params::kResidualTravelCounts) * quantum(i) : S(0);
       spacing_lo(i) = lit<S>(1 - 2 * b.encoder_edge) * quantum(i);
       spacing_hi(i) = lit<S>(1 + 2 * b.encoder_edge) * quantum(i);
+      activity.set_slide(i, alone ? static_cast<double>(quantum(i)) : 0.0);
     }
   }
   /// Clears the filters and the record: the next check primes it (an enable, a restart).

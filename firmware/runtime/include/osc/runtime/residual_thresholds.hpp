@@ -111,8 +111,11 @@ inline auto ResidualMonitor<S>::friction_error(const ResidualInput<S>& in, const
   // the joint slides (its friction on the model's curve) when it counts fast enough besides. The
   // stillness envelope and the identification's samples go by the first (a joint that crawls
   // between counts resets neither).
+  // On an encoder finer than the slide speed's count interval, its counts over the last window as
+  // well (EncoderActivity::fast_enough): a joint held against static friction may creep and count, and
+  // q^dot, the observer's, carries the friction the model lacks (tens of mrad/s while it stands).
   const bool up = in.qd(i) > S(0);
-  e.moving = abs(in.qd(i)) > moving && activity.counting(i, up, tick);
+  e.moving = abs(in.qd(i)) > moving && activity.counting(i, up, tick) && activity.fast_enough(i);
   e.sliding = e.moving && activity.sliding(i);
   return e;
 }

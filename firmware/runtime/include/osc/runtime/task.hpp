@@ -116,8 +116,9 @@ struct ControlTask {
     contact = false;
     saturation.reset();
     position.reset();
-    pots = true;
-    homed = start == TaskStart::kPaper;  // the paper's procedure: the arm placed at q_start
+    pots = has_pots(robot::kDriveTrain);
+    // The paper's procedure places the arm at q_start; absolute encoders read it from power-on.
+    homed = start == TaskStart::kPaper || has_absolute_encoders(robot::kDriveTrain);
     homing = {};
     home_speed = lit_array<S>(params::kHomeSpeed);
     set_encoders(robot::kEncodersUniform);
