@@ -227,7 +227,7 @@ TaskCommand<S> prepare_command(MotionVerb verb, std::uint32_t id) {
 }
 
 /// Prepares a declare_pose of the pose of code `pose` (robot::kNamedPoses): unknown_pose for a code
-/// outside the list. The pots check and the state are the tick's.
+/// outside the list, not_needed on an arm with absolute encoders. The pots check and the state are the tick's.
 template <class S>
 TaskCommand<S> prepare_declare_pose(unsigned pose, std::uint32_t id) {
   TaskCommand<S> c = prepare_command<S>(MotionVerb::kDeclarePose, id);
@@ -236,6 +236,7 @@ TaskCommand<S> prepare_declare_pose(unsigned pose, std::uint32_t id) {
     return c;
   }
   c.pose = static_cast<std::uint8_t>(pose);
+  if (has_absolute_encoders(robot::kDriveTrain)) c.refusal = MotionReason::kNotNeeded;  // as prepare_home
   return c;
 }
 

@@ -101,9 +101,6 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   MotionReason pre = cmd.refusal;
   const bool planned = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome;
   if (pre == MotionReason::kNone && planned && cmd.epoch != task.gen.epoch()) pre = MotionReason::kSuperseded;
-  if (pre == MotionReason::kNone && has_absolute_encoders(robot::kDriveTrain) &&
-      (cmd.verb == MotionVerb::kHome || cmd.verb == MotionVerb::kDeclarePose))
-    pre = MotionReason::kNotNeeded;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kHome && !homing_possible(task))
     pre = MotionReason::kNoPots;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kDeclarePose &&
