@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Regenerates the tables of measured figures in docs/ from runs and test output.
 
-usage: docs_tables.py [--check] [--kind host|m4f|m3|long ...] [--only NAME ...] [--keep-going] [--list]
+usage: docs_tables.py [--check] [--kind host|m4f|m3|long|protocol|arms ...] [--only NAME ...] [--keep-going] [--list]
 
 A generated table sits between two markers in a docs/*.md file:
 
@@ -20,6 +20,8 @@ and is rewritten in place. Kinds:
         (hours of runs; wall-clock figures vary from run to run)
   protocol  the link protocol's tables in docs/protocol.md, from the host build's osc_protocol (the
         firmware's field lists, constants and encoder); checked exactly in CI (ctest docs_tables_protocol)
+  arms  every arm's images side by side (docs/arms.md): the default arm's m4f and m3 builds and another
+        arm's build/<arm>-m4f and build/<arm>-m3 (scripts/test_arm.sh ARM, which checks it)
 
 --check regenerates the selected tables in memory and compares them with the docs: the same text,
 or numbers within 2 % (the host build computes the same bits on every x86-64 machine; a build with
@@ -447,6 +449,63 @@ def timer_rows(output):
 def target_instructions():
     rows = kernel_instructions(image_output("kernels_image")) + timer_rows(image_output)
     return "\n".join(["| kernel (float) | instructions |", "|---|---|"] + [f"| {a} | {b} |" for a, b in rows])
+
+
+# ---------------------------------------------------------------- arms table (docs/arms.md)
+
+
+DEFAULT_ARM = "puma560"
+
+
+def arm_builds():
+    """[(arm, m4f build, m3 build)] for every arm of firmware/robots/: the default arm's are the m4f and m3
+    presets' builds, another arm's build/<arm>-m4f and build/<arm>-m3 (scripts/test_arm.sh)."""
+    arms = sorted(d for d in os.listdir(os.path.join(ROOT, "firmware", "robots"))
+                  if os.path.isfile(os.path.join(ROOT, "firmware", "robots", d, d + ".yaml")))
+    arms.sort(key=lambda arm: arm != DEFAULT_ARM)
+    return [(arm, M4F, M3) if arm == DEFAULT_ARM else
+            (arm, os.path.join(ROOT, "build", arm + "-m4f"), os.path.join(ROOT, "build", arm + "-m3")) for arm in arms]
+
+
+def arm_tick_rows(out, worst):
+    """The rows of one arm's image: its J factor, opspace_update, the control step, the worst-case tick and the
+    any-motion bound, as {row: count}."""
+    kernels = dict(kernel_instructions(out))
+    head = re.search(r"^kernels_image: (.+?) kernels in .*, J by (.+)$", out, re.M)
+    name, spherical = head.group(1), head.group(2).startswith("its blocks")
+    rows = {"J factor: the block solve (spherical wrist) or the pivoted LU": kernels[
+        "SphericalWristJacobianFactor::compute" if spherical else "PivotedLuJacobianFactor::compute (LU, exact rcond)"]}
+    rows["opspace_update (FK, J, A, g, Ja, J factor, LDLT of A)"] = kernels[
+        "opspace_update (FK, J, A, g, Ja, J factor, LDLT of A)"]
+    step = [v for k, v in kernels.items() if k.startswith("**control_step")]
+    rows["control_step, 20 steps: worst / mean"] = step[0].replace("**", "") if step else ""
+    tick = timer_step(worst, TIMER_WORST)
+    ended = "timer_firmware: pass" in worst  # else the image stopped early (a reset ends QEMU with status 0)
+    rows["**worst-case tick** (`timer_worst_firmware`): max / mean"] = (
+        tick[0][1] if tick and ended else "**did not run to its end**")
+    bound = any_motion_bound(out, worst)
+    rows["**worst case, any motion** (a bound)"] = bound[0][1] if bound and ended else ""
+    return name, rows
+
+
+@table("arm_instructions", "docs/arms.md", "arms")
+def arm_instructions():
+    """Every arm's images side by side (scripts/test_arm.sh builds another arm's)."""
+    columns, order = [], []
+    for arm, m4f, m3 in arm_builds():
+        for core, build, board, machine in (("M4F, float", m4f, "mps2_an386", "mps2-an386"),
+                                            ("M3, Q12.19", m3, "mps2_an385", "mps2-an385")):
+            if not os.path.isdir(build):
+                raise RuntimeError(f"{arm}: no build {build} (bash scripts/test_arm.sh {arm})")
+            out = image_output("kernels_image", board, machine, build)
+            worst = image_output("timer_worst_firmware", board, machine, build)
+            name, rows = arm_tick_rows(out, worst)
+            columns.append((f"{name}, {core}", rows))
+            order += [r for r in rows if r not in order]
+    lines = ["| instructions | " + " | ".join(c for c, _ in columns) + " |", "|---" * (len(columns) + 1) + "|"]
+    for r in order:
+        lines.append(f"| {r} | " + " | ".join(rows.get(r, "") for _, rows in columns) + " |")
+    return "\n".join(lines)
 
 
 # ---------------------------------------------------------------- m3 tables (docs/fixed_point.md)
@@ -1566,7 +1625,7 @@ def numbers_close(a, b):
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--check", action="store_true", help="compare, do not write; exit 1 when a table is stale")
-    ap.add_argument("--kind", action="append", choices=["host", "m4f", "m3", "long", "protocol"],
+    ap.add_argument("--kind", action="append", choices=["host", "m4f", "m3", "long", "protocol", "arms"],
                     help="the kinds of tables to do")
     ap.add_argument("--only", action="append", help="only these tables")
     ap.add_argument("--list", action="store_true", help="list the tables")

@@ -11,6 +11,7 @@
 
 #include "motion_sim.hpp"
 #include "osc/runtime/parameters.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 using sim::MotionSim;
@@ -75,9 +76,18 @@ void every_bound_holds(bool each_element) {
   EXPECT_GT(runs, 2 * kParamCount - 8);
 }
 
-TEST(GainExtremes, EveryElementsBoundsHoldTheArmDouble) { every_bound_holds<double>(true); }
-TEST(GainExtremes, EveryParametersBoundsHoldTheArmFloat) { every_bound_holds<float>(false); }
-TEST(GainExtremes, EveryParametersBoundsHoldTheArmFixed) { every_bound_holds<Fixed>(false); }
+TEST(GainExtremes, EveryElementsBoundsHoldTheArmDouble) {
+  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
+  every_bound_holds<double>(true);
+}
+TEST(GainExtremes, EveryParametersBoundsHoldTheArmFloat) {
+  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
+  every_bound_holds<float>(false);
+}
+TEST(GainExtremes, EveryParametersBoundsHoldTheArmFixed) {
+  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
+  every_bound_holds<Fixed>(false);
+}
 
 /// The defect's own value, now outside the range, and the old range's top through the controller:
 /// a loop the check would refuse latches a fault within a fraction of a second (the check is not

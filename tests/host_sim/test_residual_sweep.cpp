@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -155,15 +156,16 @@ SweepResult sweep(unsigned seed, int moves, int streams, const sim::PlantConfig&
 /// since (seed 25, 12 / 60 / 200 moves): at most 0.37 compensated in every scalar, 0.42 (J2) uncompensated.
 template <class S>
 void check_sweep(const char* label, const osc::FrictionCoefficients& friction, FrictionMode mode, int moves,
-                 bool streams = true) {
+                 bool streams = true, double link_scale = 1.0) {
   const unsigned seed = env_or("OSC_SWEEP_SEED", 25);
   sim::PlantConfig plant;
   plant.friction = friction;
+  plant.link_scale = link_scale;
   const SweepResult r = sweep<S>(seed, moves, streams ? moves / 3 : 0, plant, mode);
   std::printf(
-      "residual sweep %s, seed %u (OSC_SWEEP_SEED=%u replays it): %d moves (%d refused), %d noisy streams (%d "
-      "cut), worst ratio",
-      label, seed, seed, r.moves, r.refused, r.streams, r.streams_cut);
+      "residual sweep %s, %s, links x%.2f, seed %u (OSC_SWEEP_SEED=%u replays it): %d moves (%d refused), %d noisy "
+      "streams (%d cut), worst ratio",
+      robot::kArm.name, label, link_scale, seed, seed, r.moves, r.refused, r.streams, r.streams_cut);
   for (double w : r.worst) std::printf(" %.3f", w);
   std::printf(", travel check's worst share");
   for (double w : r.travel) std::printf(" %.3f", w);
@@ -181,20 +183,35 @@ void check_sweep(const char* label, const osc::FrictionCoefficients& friction, F
 
 const int kMoves = static_cast<int>(env_or("OSC_SWEEP_MOVES", 12));
 
+// The arm's friction presets (the sheet's): the first (the PUMA's paper values, the UR5e's estimate), and the
+// last of its band (the PUMA's Corke values, the UR5e's estimate again).
+const osc::FrictionCoefficients& first_preset() { return *robot::kFrictionPresets[0]; }
+const osc::FrictionCoefficients& band_preset() {
+  return *robot::kFrictionBandPresets[std::size(robot::kFrictionBandPresets) - 1];
+}
+
 TEST(ResidualSweep, RandomMovesPaperFrictionCompensated) {
-  check_sweep<double>("double, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+  check_sweep<double>("double, first preset, compensated", first_preset(), FrictionMode::kAdaptive, kMoves);
 }
 // No streams: without compensation, Corke's friction (26 N m of static friction on J1) holds the arm
 // 15 mm behind a fast stream, and the tracking bound faults (seed 25, measured): the controller's
 // limit, not the monitor's.
 TEST(ResidualSweep, RandomMovesCorkeFrictionUncompensated) {
-  check_sweep<double>("double, corke, none", robot::kFrictionCorke, FrictionMode::kNone, kMoves, false);
+  check_sweep<double>("double, band's last preset, none", band_preset(), FrictionMode::kNone, kMoves, false);
 }
 TEST(ResidualSweep, RandomMovesInFloat) {
-  check_sweep<float>("float, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+  check_sweep<float>("float, first preset, compensated", first_preset(), FrictionMode::kAdaptive, kMoves);
 }
 TEST(ResidualSweep, RandomMovesInFixedPoint) {
-  check_sweep<Fixed>("fixed, paper, compensated", robot::kFrictionPaper, FrictionMode::kAdaptive, kMoves);
+  check_sweep<Fixed>("fixed, first preset, compensated", first_preset(), FrictionMode::kAdaptive, kMoves);
+}
+// The model's error: every link's mass and inertia 10 % off the model's (within the sheet's link_inertia bound,
+// which the thresholds are derived from: the PUMA's +-10 %, the UR5e's +-20 %).
+TEST(ResidualSweep, RandomMovesWithLinksTenPercentHeavier) {
+  check_sweep<double>("double, first preset, compensated", first_preset(), FrictionMode::kAdaptive, kMoves, true, 1.1);
+}
+TEST(ResidualSweep, RandomMovesWithLinksTenPercentLighter) {
+  check_sweep<double>("double, first preset, compensated", first_preset(), FrictionMode::kAdaptive, kMoves, true, 0.9);
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ void kernel_outputs(const Case& c, const Model<S>& model, Data<S>& data, ArmOpSp
   emit("c", velocity_products(model, data, qd).c);
   emit("Psi h(v)", psi_quadratic(model, data, os, v));
   emit("lambda_solve", lambda_solve(os, v));
-  const FrictionParams<S> fp = FrictionParams<S>::from(robot::kFrictionPaper, params::kTauDec);
+  const FrictionParams<S> fp = FrictionParams<S>::from(*robot::kFrictionPresets[0], params::kTauDec);
   emit("friction_torque", friction_torque(fp, qd));
   emit("friction_regressor", friction_regressor(qd, fp.dec));
 }

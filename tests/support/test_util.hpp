@@ -3,11 +3,35 @@
 
 #include <Eigen/Core>
 #include <random>
+#include <string_view>
 
+#include "osc/control/params.hpp"
+#include "osc/kernels/kinematics.hpp"
+#include "osc/kernels/lu.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/robot.hpp"
+#include "osc/robots/puma560.hpp"
 
 namespace osc::test {
+
+/// The build's arm is the PUMA 560 (CMake OSC_ROBOT=puma560, the default).
+inline constexpr bool kPumaBuild = std::string_view(robot::kArm.name) == std::string_view(puma560::kArm.name);
+
+/// Skips the rest of a test in a build for another arm: a test of the PUMA 560's own figures (its
+/// published vectors, presets, coupled wrist, pots, index pulses, the docs' tables of it) inside an
+/// executable whose other tests run on any arm (a whole executable of them: osc_add_test's PUMA).
+#define OSC_PUMA_ONLY()                                                                             \
+  do {                                                                                              \
+    if (!::osc::test::kPumaBuild) GTEST_SKIP() << "the PUMA 560's own figures (OSC_ROBOT=puma560)"; \
+  } while (0)
+
+/// Skips the rest of a test in a build for another arm: a test whose fixture (poses, forces, gains,
+/// durations) was tuned on the PUMA 560 and has not been derived for any arm yet; `why` says what
+/// (docs/arms.md lists them).
+#define OSC_PUMA_TUNED(why)                                                                              \
+  do {                                                                                                   \
+    if (!::osc::test::kPumaBuild) GTEST_SKIP() << "tuned on the PUMA 560, not yet for any arm: " << why; \
+  } while (0)
 
 /// Arms Eigen's runtime no-malloc check for its lifetime (EIGEN_RUNTIME_NO_MALLOC is defined
 /// for every test target): any heap allocation inside Eigen aborts the test.
@@ -26,7 +50,12 @@ struct RandomStates {
     for (int i = 0; i < kDof; ++i) v(i) = scale * u(rng);
     return v;
   }
-  /// Joint angles within the WC91 limits, away from the wrist (q5 = 0) and elbow singularities.
+  /// Joint angles within the arm's limits, away from its singularities. A spherical wrist (the
+  /// PUMA's): away from the wrist (|sin q5| >= 0.2) and the elbow (stretched/folded,
+  /// |cos(q3 + 0.047)| >= 0.2); any other arm: J's reciprocal condition (PivotedLuJacobianFactor's
+  /// exact 1-norm rcond) at least kNonsingularRcond, twice the path check's kPathMinRcond (the UR5e: about half
+  /// of the poses within its limits; its median is 0.021, its 99th percentile 0.076).
+  static constexpr double kNonsingularRcond = 2 * params::kPathMinRcond;
   Vec6<double> q_nonsingular() {
     for (;;) {
       Vec6<double> q;
@@ -34,10 +63,24 @@ struct RandomStates {
         const double lo = robot::kArm.q_min[i], hi = robot::kArm.q_max[i];
         q(i) = lo + (hi - lo) * 0.5 * (u(rng) + 1.0);
       }
-      if (std::abs(std::sin(q(4))) < 0.2) continue;          // wrist
-      if (std::abs(std::cos(q(2) + 0.047)) < 0.2) continue;  // elbow (stretched/folded)
+      if constexpr (has_spherical_wrist(robot::kArm)) {
+        if (std::abs(std::sin(q(4))) < 0.2) continue;          // wrist
+        if (std::abs(std::cos(q(2) + 0.047)) < 0.2) continue;  // elbow (stretched/folded)
+      } else if (rcond(q) < kNonsingularRcond) {
+        continue;
+      }
       return q;
     }
+  }
+  /// J's reciprocal condition at q (the 1-norm, exact: PivotedLuJacobianFactor).
+  static double rcond(const Vec6<double>& q) {
+    static const Model<double> model = Model<double>::of(robot::kArm);
+    Data<double> data;
+    forward_kinematics(model, data, q);
+    geometric_jacobian(data);
+    PivotedLuJacobianFactor<double> f;
+    f.compute(data.J);
+    return f.rcond;
   }
 };
 

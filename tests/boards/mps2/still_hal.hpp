@@ -1,12 +1,14 @@
 // A HAL for the standalone MPS2 images that run the control task in the real 1 kHz TIMER0
 // interrupt without a plant: the encoders held at the start pose (joint 1 offset by `jump` counts,
-// to inject an encoder jump), the potentiometers reading the start pose (so that the tick measured
-// includes the position cross-check, as on a board with pots), no index pulse, the DAC codes kept in
-// memory, the overrun seen as the next timer interrupt already pending when a tick starts.
+// to inject an encoder jump), the potentiometers reading the start pose where the arm has pots (so
+// that the tick measured includes the position cross-check, as on a board with pots), no index
+// pulse, the DAC codes kept in memory, the overrun seen as the next timer interrupt already pending
+// when a tick starts. board::StillHal is the arm's: with pots (StillPotHal) or without (StillHalBase).
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 #include "board.hpp"
 #include "hal/hal.hpp"
@@ -15,7 +17,7 @@
 
 namespace board {
 
-struct StillHal {
+struct StillHalBase {
   std::int32_t codes[osc::kDof] = {};
   std::int32_t jump = 0;
   bool read_encoders(std::int32_t c[osc::kDof]) {
@@ -32,20 +34,6 @@ struct StillHal {
     // The next tick already pending when this one starts: the previous one overran.
     return board::control_timer_pending() ? static_cast<std::uint32_t>(osc::kFaultOverrun) : 0u;
   }
-  // hal::PositionHal: the start pose's codes, every tick.
-  bool read_pots(std::uint16_t c[osc::kDof]) {
-    static constexpr auto kCodes = [] {
-      const auto& d = osc::robot::kDriveTrain;
-      const double full = (1 << d.pot_bits) - 1;
-      std::array<std::uint16_t, osc::kDof> a{};
-      for (int i = 0; i < osc::kDof; ++i)
-        a[i] = static_cast<std::uint16_t>(
-            (osc::robot::kQStart[i] - d.pot_min[i]) / (d.pot_max[i] - d.pot_min[i]) * full + 0.5);
-      return a;
-    }();
-    for (int i = 0; i < osc::kDof; ++i) c[i] = kCodes[i];
-    return true;
-  }
   bool take_index(int, std::int32_t&) { return false; }
   bool codes_zero() const {
     for (int c : codes)
@@ -53,6 +41,27 @@ struct StillHal {
     return true;
   }
 };
-static_assert(hal::ControlHal<StillHal> && hal::PositionHal<StillHal>);
+
+/// The same with the pots (hal::PositionHal).
+struct StillPotHal : StillHalBase {
+  // hal::PositionHal: the start pose's codes, every tick.
+  bool read_pots(std::uint16_t c[osc::kDof]) {
+    static constexpr auto kCodes = [] {
+      const auto& d = osc::robot::kDriveTrain;
+      const double full = (1 << d.pot_bits) - 1;
+      std::array<std::uint16_t, osc::kDof> a{};
+      for (int i = 0; i < osc::kDof; ++i) {
+        const double span = d.pot_max[i] - d.pot_min[i];  // 0 on an arm without pots (not used there)
+        a[i] = span > 0 ? static_cast<std::uint16_t>((osc::robot::kQStart[i] - d.pot_min[i]) / span * full + 0.5) : 0;
+      }
+      return a;
+    }();
+    for (int i = 0; i < osc::kDof; ++i) c[i] = kCodes[i];
+    return true;
+  }
+};
+
+using StillHal = std::conditional_t<osc::has_pots(osc::robot::kDriveTrain), StillPotHal, StillHalBase>;
+static_assert(hal::ControlHal<StillHal> && hal::PositionHal<StillHal> == osc::has_pots(osc::robot::kDriveTrain));
 
 }  // namespace board

@@ -32,6 +32,7 @@
 #include "safety.hpp"
 #include "spi_bus.hpp"
 #include "usart.hpp"
+#include "test_util.hpp"
 
 using namespace stm32f4;
 
@@ -1409,6 +1410,7 @@ struct WatchedRig : BoardRig {
 };
 
 TEST(Stm32CommandLink, ASilentLinkStopsTheMotionCategoryTwoAfterTheTimeout) {
+  OSC_PUMA_TUNED("its rig's still encoders: the UR5e's fine encoders read encoder_stuck");
   auto r = std::make_unique<WatchedRig>();  // the paper's motion runs from the first tick
   constexpr int kTimeout = static_cast<int>(osc::CommandLinkWatch::kTimeoutTicks);
   static_assert(kTimeout == 500, "0.5 s at 1 kHz");
@@ -1425,6 +1427,7 @@ TEST(Stm32CommandLink, ASilentLinkStopsTheMotionCategoryTwoAfterTheTimeout) {
 }
 
 TEST(Stm32CommandLink, FramesKeepTheMotionGoingAndNoHostMeansNoStop) {
+  OSC_PUMA_TUNED("its rig's still encoders: the UR5e's fine encoders read encoder_stuck");
   auto r = std::make_unique<WatchedRig>();
   // (600 ticks at most: the encoders here stand still, and the paper's motion latches encoder_stuck
   // after about 620.)

@@ -8,6 +8,7 @@
 
 #include "osc/control/gains.hpp"
 #include "osc/control/identification.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 
@@ -170,6 +171,7 @@ TEST(FrictionIdentifier, RandomWalkGrowsToThePriorAndNoFurther) {
 // the excitation monitor opens the split, and the Coulomb and Stribeck levels are learned apart.
 template <class S>
 void converges_on_noisy_samples() {
+  OSC_PUMA_ONLY();  // the PUMA's J2 friction (paper preset) as the truth, within its band
   const Vec4 truth(3.7, 4.8, 4.3, -0.08);
   const double sd = 0.3;
   const Regression d = samples(truth, sd, 20000, 7, 1.5);
@@ -227,6 +229,7 @@ TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samp
 // deviation passes 2.5, 5, 10 and 20 % of it, and then is the band's top. Checked against the
 // standard deviation itself (sqrt of P, which prove() does not take) at every turn, for 20 minutes.
 TEST(FrictionIdentifier, ProvenBreakawayFollowsItsStandardDeviation) {
+  OSC_PUMA_ONLY();  // the PUMA's J2 friction as the truth, its band's top
   const Vec4 truth(3.7, 4.8, 4.3, -0.08);
   const Regression d = samples(truth, 0.3, 20000, 7, 1.5);
   FrictionIdentifier<double> id;

@@ -180,6 +180,7 @@ TEST(CartesianMove, PoseAtIsThePoseOfTheReference) {
 // The end angles reproduce the target (KDL's forward kinematics), equal the target's own angles
 // (the seed's branch) and KDL's inverse kinematics from the seed.
 TEST(PathCheck, EndAnglesReachTheTargetOnTheSeedsBranch) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   Pairs pairs;
   double worst_p = 0, worst_R = 0, worst_q = 0, worst_kdl = 0;
   for (int k = 0; k < kPairs; ++k) {
@@ -209,6 +210,7 @@ TEST(PathCheck, EndAnglesReachTheTargetOnTheSeedsBranch) {
 // A seed a tracking error away from the move's start (2 cm and 0.02 rad per joint): the first
 // sample's Newton steps bring it onto the path; the end is the same.
 TEST(PathCheck, ConvergesFromASeedOffTheStart) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   Pairs pairs;
   for (int k = 0; k < 10; ++k) {
     Vec6<double> qa, qb;
@@ -226,6 +228,7 @@ TEST(PathCheck, ConvergesFromASeedOffTheStart) {
 // (to -238 deg, KDL's solution) although both ends are well inside. The check stops at the sample
 // where KDL's solution first comes within the margin.
 TEST(PathCheck, ElbowFoldedPastItsLimitIsOutOfWorkspace) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   Vec6<double> qa, qb;
   qa << 0.2, -0.4, -kPi, 0.3, 0.5, 0.1;
   qb << 0.2, 2.0, -kPi, 0.3, 0.5, 0.1;
@@ -259,6 +262,7 @@ const Vec6<double> kWristBase = (Vec6<double>() << 0.2, 0.6, -2.8, 0.4, 0.0, -0.
 // Joint 5 turned towards its limit (100 deg) and past it: the first sample whose closed-form
 // solution lies within the margin.
 TEST(PathCheck, WristPastItsLimitIsOutOfWorkspace) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Vec6<double> qa = with_q5(kWristBase, 1.2);
   const MoveCheck<double> r = check_joint_move<double>(qa, with_q5(qa, 2.0));
   int expected = -1;
@@ -275,6 +279,7 @@ TEST(PathCheck, WristPastItsLimitIsOutOfWorkspace) {
 // threshold (the sign of det J22 changes); from 0.6 to 0.25 the path stays clear of it. Each at the
 // first sample where the closed-form solution is below the threshold or past q5 = 0.
 TEST(PathCheck, WristSingularityIsNearSingular) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   struct Case {
     double q5a, q5b;
     PathStatus status;
@@ -303,6 +308,7 @@ TEST(PathCheck, WristSingularityIsNearSingular) {
 // analytic Jacobian is singular: a rotation about the base y axis from a pitch of 60 deg by 40 deg
 // fails at the first sample whose rcond (from KDL's solution) is below the threshold.
 TEST(PathCheck, OrientationCoordinateSingularityIsNearSingular) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Vec6<double> q0 = test::from_array(robot::kQStart);
   const Pose<double> a = kdl_pose(q0);
   const Mat3<double> R_ref = axis_rotation<double>(Vec3<double>::UnitY(), -60 * kPi / 180) * a.R;
@@ -324,6 +330,7 @@ TEST(PathCheck, OrientationCoordinateSingularityIsNearSingular) {
 // Samples on either side of that singularity, whose rcond are both above the threshold (pitch 80 and
 // 100 deg): the crossing shows in roll and yaw, which turn by pi.
 TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Model<double> model = Model<double>::of(robot::kArm);
   const auto data = std::make_unique<Data<double>>();
   const Vec6<double> q0 = test::from_array(robot::kQStart);
@@ -347,6 +354,7 @@ TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
 // beyond the wrist centre's reach from the shoulder (at the base origin, d1 = 0),
 // sqrt((a2 + sqrt(a3^2 + d4^2))^2 + d3^2) = 0.877 m.
 TEST(PathCheck, TargetOutOfReachIsUnreachable) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const auto& L = robot::kArm.links;  // DH rows: a placement's translation is (a, 0, d)
   const double a2 = L[1].placement.p[0], a3 = L[2].placement.p[0], d3 = L[2].placement.p[2], d4 = L[3].placement.p[2];
   const double reach = std::hypot(a2 + std::hypot(a3, d4), d3);
@@ -404,12 +412,19 @@ void compare_scalar(double tol) {
   EXPECT_EQ(s.check.sample, d.check.sample);
 }
 
-TEST(PathCheck, FloatAgreesWithDouble) { compare_scalar<float>(1e-5); }
-TEST(PathCheck, FixedAgreesWithDouble) { compare_scalar<Fixed>(2e-4); }
+TEST(PathCheck, FloatAgreesWithDouble) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  compare_scalar<float>(1e-5);
+}
+TEST(PathCheck, FixedAgreesWithDouble) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  compare_scalar<Fixed>(2e-4);
+}
 
 // In fixed point the check's own saturations (near the wrist singularity a determinant's
 // reciprocal leaves the range) are discarded, the caller's kept.
 TEST(PathCheck, FixedPointKeepsTheCallersFlags) {
+  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Model<Fixed> model = Model<Fixed>::of(robot::kArm);
   const auto data = std::make_unique<Data<Fixed>>();
   // What the check meets next to q5 = 0: the kernels saturate.

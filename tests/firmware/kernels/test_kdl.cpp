@@ -79,6 +79,7 @@ TEST(KdlConvention, JointInertiaIsTheArmatureInMassMatrixIdAndFd) {
 }
 
 TEST(Kdl, KinematicsAndDynamicsKernelsAgreeOnRandomStates) {
+  OSC_PUMA_ONLY();
   // Every link frame: KDL's frame after segment i is our frame i (the PUMA's base placement is the
   // identity: no base segment, test::arm_chain).
   const KDL::Chain chain = test::puma560_chain();

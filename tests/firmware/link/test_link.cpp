@@ -13,6 +13,7 @@
 
 #include "osc/link/node.hpp"
 #include "osc/robot.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 
@@ -251,6 +252,8 @@ TEST_F(LinkNode, JunkAfterAnErrorBelongsToIt) {
 }
 
 TEST_F(LinkNode, ErrorsFurtherApartThanTheWindowDoNotLatch) {
+  OSC_PUMA_TUNED(
+      "its frames freeze the arm while the paper's motion runs: the UR5e's drives saturate within the window");
   healthy(2);
   auto error = [&] {
     const Answers a = lockstep(with(frame(), 10, 0x40));

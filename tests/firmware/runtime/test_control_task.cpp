@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "osc/runtime/control_task.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 
@@ -182,6 +183,7 @@ TEST_F(TaskFixture, FrozenEncodersFaultTheArmedResidualMonitor) {
 }
 
 TEST_F(TaskFixture, PersistentSaturationFaults) {
+  OSC_PUMA_TUNED("the torque that clips the PUMA's DAC does not clip the UR5e's");
   // Joint 1 creeps away from the reference by one count per tick (0.06 mm at the tip) and the other
   // encoders dither by a count (so that none stands still): the torque on joint 1 clips within a
   // millimetre of error, long before the 10 mm tracking bound, and after kSaturationTicks clipped

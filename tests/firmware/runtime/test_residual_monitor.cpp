@@ -194,7 +194,7 @@ TEST(Residual, TheMixedVelocityNoiseCoversTheObserversMixing) {
     const Mat3<double> R_ref = data.R[kDof];
     opspace_update(model, data, os, q, R_ref, false);
     const Mat6<double> M = os.Ja.partialPivLu().solve(Dk * os.Ja);
-    rig.m.mixed_noise(os.Ja, os.Jf);
+    rig.m.mixed_noise(os.Ja, os.Jf, 0, kDof);
     for (int i = 0; i < kDof; ++i) {
       double exact = 0;
       for (int j = 0; j < kDof; ++j) exact += std::abs(M(i, j)) * 0.5 / counts_per_rad(j);

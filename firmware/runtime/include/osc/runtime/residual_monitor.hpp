@@ -118,9 +118,8 @@ struct ResidualMonitor {
   bool contact = false;
   bool contact_noted = false;  // the contact error_floor holds (note_contact())
 
-  /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate
-  /// q^dot = J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its
-  /// mean) times the largest k.
+  /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate q^dot =
+  /// J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its mean) times the largest k.
   /// With a coupled drive train (inverse = C^-1, the identity without one), each motor's friction
   /// reaches joint i as C^-T f_m: the model's per-joint friction leaves out the other motors'
   /// shares, sum over c != i of |C^-1_ci| times their static band, which a reversal of motor c flips.
@@ -193,14 +192,15 @@ struct ResidualMonitor {
     velocity_noise(3) = noise_base(3) + turn;
     velocity_noise(5) = noise_base(5) + turn;
   }
-  /// The velocity estimate's noise, this step, for an arm without a spherical wrist (wrist_noise() for one
-  /// with). The observer's q^dot = J^-1 (y + diag(k) x~) carries the encoders' quantisation e (x~'s share
-  /// J e, J the analytic Jacobian) as M e, M = J^-1 diag(k) J; with |e_j| at most half a quantum, joint
-  /// i's noise is at most sum_j |M_ij| quantum_j / 2, and e can reach it (the bound is exact). M by
-  /// columns, one solve with the factor of J each (no division): six solves on a turn.
-  void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf) {
-    velocity_noise.setZero();
-    for (int j = 0; j < kDof; ++j)
+  /// The velocity estimate's noise without a spherical wrist (wrist_noise() with one). The observer's q^dot =
+  /// J^-1 (y + diag(k) x~) carries the encoders' quantisation e (x~'s share J e, J the analytic Jacobian) as M e,
+  /// M = J^-1 diag(k) J; with |e_j| at most half a quantum, joint i's noise is at most sum_j |M_ij| quantum_j / 2,
+  /// which e can reach (exact). M's columns [first, last), a solve with J's factor each (no division), added to
+  /// velocity_noise (reset when first is 0): the first three on the step before a turn, the last three on the
+  /// turn (as the alternate model rate's terms, at most one period old), so that no tick has all six solves.
+  void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last) {
+    if (first == 0) velocity_noise.setZero();
+    for (int j = first; j < last; ++j)
       velocity_noise += half_quantum(j) * Jf.solve(Vec6<S>(gains.cwiseProduct(J.col(j)))).cwiseAbs();
   }
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.

@@ -19,8 +19,9 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
   const ResidualConstants<S>& c = kResidualConstants<S>;
   if constexpr (kArmSphericalWrist) {
     if (in.J) wrist_noise(*in.J);
-  } else {
-    if (in.os) mixed_noise(in.os->Ja, in.os->Jf);
+  } else if (in.os) {
+    // The last three columns (the first three on the step before: between_turns()); all six when priming.
+    mixed_noise(in.os->Ja, in.os->Jf, prime ? 0 : kDof / 2, kDof);
   }
   const Motion m = motion(in);
   const StrongestFriction strongest(in);
@@ -48,9 +49,13 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
 
 /// A step between turns: the travel check's counts and drive, and the odd joints' step of its bounds (the even
 /// joints' is on the turn: each joint's every kResidualTurnEvery steps, half of them in each step), with the
-/// error bound of the last turn.
+/// error bound of the last turn; without a spherical wrist, half the velocity noise the next turn reads.
 template <class S>
 inline int ResidualMonitor<S>::between_turns(const ResidualInput<S>& in, const bool moved[kDof]) {
+  // Without a spherical wrist, the first three columns of the next turn's velocity noise (mixed_noise()).
+  if constexpr (!kArmSphericalWrist) {
+    if (in.os) mixed_noise(in.os->Ja, in.os->Jf, 0, kDof / 2);
+  }
   const StrongestFriction strongest(in);
   int moved_too_far = -1;
   for (int i = 0; i < kDof; ++i)
