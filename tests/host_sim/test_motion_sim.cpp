@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "motion_sim.hpp"
+#include "test_util.hpp"
 
 using namespace osc;
 using sim::MotionSim;
@@ -329,14 +330,11 @@ MoveRequest<double> quarter_turn_near_the_limit(std::unique_ptr<MotionSim<double
   return turn;
 }
 
-/// J's reciprocal condition at q (the arm's factor of the analytic Jacobian, as the controller's).
-double rcond_at(const V6& q) {
-  static const Model<double> model = Model<double>::of(robot::kArm);
-  Data<double> data;
-  ArmOpSpace<double> os;
-  forward_kinematics(model, data, q);
-  opspace_update(model, data, os, q, Mat3<double>(data.R[kDof]));
-  return os.Jf.rcond;
+/// Starts a move prepared without the path check (which would refuse it), as the tick's own checks must stop it;
+/// the tick that answers it runs.
+void start_unchecked(MotionSim<double>& sim, const MoveRequest<double>& req, std::uint32_t id) {
+  sim.task().pending = prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, req, id);
+  sim.tick();
 }
 
 /// The singular pose nearest the start pose along joint j's sweep (the other joints at the start pose): from
@@ -360,7 +358,7 @@ SweptSingularity least_rcond_on_sweep(int j) {
       if (q(j) < robot::kArm.q_min[j] + params::kWorkspaceMargin ||
           q(j) > robot::kArm.q_max[j] - params::kWorkspaceMargin)
         break;
-      const double r = rcond_at(q);
+      const double r = test::jacobian_rcond(q);
       if (r < found.rcond && (r < params::kPathMinRcond || found.steps > 0)) {
         found = {q, r, k};
       } else if (found.steps > 0) {
@@ -422,9 +420,7 @@ TEST(MotionSim, AMoveIntoTheWristSingularityStopsByName) {
   MotionSim<double> sim(start_pose());
   answer(sim, MotionVerb::kEnable, 1);
   run_ticks(sim, 100);
-  sim.task().pending =
-      prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, to_joint_pose(sing.q), 2);
-  sim.tick();
+  start_unchecked(sim, to_joint_pose(sing.q), 2);
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
   const Trace r = run_until(
       sim, [](const MotionSim<double>& m) { return m.task().report.abort != MotionReason::kNone; }, 60000);
@@ -464,8 +460,7 @@ TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
   std::unique_ptr<MotionSim<double>> owner;
   const MoveRequest<double> req = quarter_turn_near_the_limit(owner);
   MotionSim<double>& sim = *owner;
-  sim.task().pending = prepare_move(sim.task().gen, sim.task().limits, sim.task().tick, params::kControlHz, req, 2);
-  sim.tick();
+  start_unchecked(sim, req, 2);
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
   const Trace r = run_until(
       sim, [](const MotionSim<double>& s) { return s.task().report.abort != MotionReason::kNone; }, 20000);

@@ -4,6 +4,16 @@
 // to 4 decimals (6 significant digits for the inverse dynamics), as published.
 #pragma once
 
+#include <string_view>
+
+#include "osc/robot.hpp"
+#include "osc/robots/puma560.hpp"
+
+namespace osc::test {
+/// The build's arm is the PUMA 560 (CMake OSC_ROBOT=puma560, the default): the vectors below are its.
+inline constexpr bool kPumaBuild = std::string_view(robot::kArm.name) == std::string_view(puma560::kArm.name);
+}  // namespace osc::test
+
 namespace osc::test::published {
 
 /// gravload(qn): the gravity torques at the nominal pose qn [N m].

@@ -3,19 +3,15 @@
 
 #include <Eigen/Core>
 #include <random>
-#include <string_view>
 
+#include "osc/control/arm_opspace.hpp"
 #include "osc/control/params.hpp"
 #include "osc/kernels/kinematics.hpp"
-#include "osc/kernels/lu.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/robot.hpp"
-#include "osc/robots/puma560.hpp"
+#include "puma560_published.hpp"
 
 namespace osc::test {
-
-/// The build's arm is the PUMA 560 (CMake OSC_ROBOT=puma560, the default).
-inline constexpr bool kPumaBuild = std::string_view(robot::kArm.name) == std::string_view(puma560::kArm.name);
 
 /// Skips the rest of a test in a build for another arm: a test of the PUMA 560's own figures (its
 /// published vectors, presets, coupled wrist, pots, index pulses, the docs' tables of it) inside an
@@ -40,6 +36,19 @@ struct NoMalloc {
   ~NoMalloc() { Eigen::internal::set_is_malloc_allowed(true); }
 };
 
+/// J's reciprocal condition at q, by the arm's factor (ArmJacobianFactor: the block factor with a spherical wrist,
+/// else the pivoted LU's exact 1-norm rcond), as the controller and the path check see it (the analytic Jacobian
+/// is J where the orientation coordinates are 0).
+inline double jacobian_rcond(const Vec6<double>& q) {
+  static const Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  forward_kinematics(model, data, q);
+  geometric_jacobian(data);
+  ArmJacobianFactor<double> f;
+  f.compute(data.J);
+  return static_cast<double>(f.rcond);
+}
+
 /// Deterministic random states for property tests.
 struct RandomStates {
   std::mt19937_64 rng{12345};
@@ -53,8 +62,8 @@ struct RandomStates {
   /// Joint angles within the arm's limits, away from its singularities. A spherical wrist (the
   /// PUMA's): away from the wrist (|sin q5| >= 0.2) and the elbow (stretched/folded,
   /// |cos(q3 + 0.047)| >= 0.2); any other arm: J's reciprocal condition (PivotedLuJacobianFactor's
-  /// exact 1-norm rcond) at least kNonsingularRcond, twice the path check's kPathMinRcond (the UR5e: about half
-  /// of the poses within its limits; its median is 0.021, its 99th percentile 0.076).
+  /// exact 1-norm rcond, jacobian_rcond) at least kNonsingularRcond, twice the path check's kPathMinRcond (the UR5e:
+  /// about half of the poses within its limits; its median is 0.021, its 99th percentile 0.076).
   static constexpr double kNonsingularRcond = 2 * params::kPathMinRcond;
   Vec6<double> q_nonsingular() {
     for (;;) {
@@ -66,21 +75,11 @@ struct RandomStates {
       if constexpr (has_spherical_wrist(robot::kArm)) {
         if (std::abs(std::sin(q(4))) < 0.2) continue;          // wrist
         if (std::abs(std::cos(q(2) + 0.047)) < 0.2) continue;  // elbow (stretched/folded)
-      } else if (rcond(q) < kNonsingularRcond) {
+      } else if (jacobian_rcond(q) < kNonsingularRcond) {
         continue;
       }
       return q;
     }
-  }
-  /// J's reciprocal condition at q (the 1-norm, exact: PivotedLuJacobianFactor).
-  static double rcond(const Vec6<double>& q) {
-    static const Model<double> model = Model<double>::of(robot::kArm);
-    Data<double> data;
-    forward_kinematics(model, data, q);
-    geometric_jacobian(data);
-    PivotedLuJacobianFactor<double> f;
-    f.compute(data.J);
-    return f.rcond;
   }
 };
 

@@ -6,7 +6,6 @@
 // every kernel with the host's results bit for bit (tests/support/fixed_reference.hpp); in any build
 // it requires the arithmetic flag clear. Exit status 0 = pass.
 #include <cstdint>
-#include <string_view>
 
 #include "board.hpp"
 #include "osc/control/jerk_profile.hpp"
@@ -15,7 +14,6 @@
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
-#include "osc/robots/puma560.hpp"
 #include "puma560_published.hpp"
 #include "text.hpp"
 
@@ -25,8 +23,6 @@ using namespace osc;
 namespace published = osc::test::published;
 using F = board::Scalar;
 constexpr bool kFixed = fixed::is_q_v<F>;
-/// The build's arm is the PUMA 560, whose published vectors the checks below compare with.
-constexpr bool kPuma = std::string_view(robot::kArm.name) == std::string_view(puma560::kArm.name);
 
 int g_failures = 0;
 
@@ -116,7 +112,7 @@ void joint_space_kernels(const Vec6<F>& qn, const Vec6<F>& qd) {
     B = coriolis_matrix(g_model, g_data, qd);
     keep(B);
   }
-  if constexpr (kPuma) {
+  if constexpr (test::kPumaBuild) {
     const double tol = 2e-3;
     check("g2", d(g(1)), published::kGravityQn[1], tol * published::kGravityQn[1]);
     check("g3", d(g(2)), published::kGravityQn[2], tol * published::kGravityQn[2]);
@@ -210,7 +206,7 @@ void operational_inertia_kernels(const Vec6<F>& q0, const Vec6<F>& qn) {
       Lg = operational_inertia(g_data.A, Jlu);
     keep(Lg);
   }
-  if constexpr (kPuma) {
+  if constexpr (test::kPumaBuild) {
     check("Lambda(1,1)", d(Lg(0, 0)), published::kLambdaQn[0], 0.05);
     check("Lambda(3,3)", d(Lg(2, 2)), published::kLambdaQn[6 * 2 + 2], 0.05);
     check("Lambda(6,6)", d(Lg(5, 5)), published::kLambdaQn[6 * 5 + 5], 2e-3);
@@ -428,7 +424,7 @@ void motion_kernels(const Vec6<F>& q0) {
 /// (the committed values are the PUMA's; another arm's fixed point is compared with the host's in
 /// closed loop, motion_tour_qemu).
 void fixed_reference_check() {
-  if constexpr (kFixed && kPuma) {
+  if constexpr (kFixed && test::kPumaBuild) {
     // Every kernel against the host's Q12.19 results, bit for bit.
     int n = 0, mismatches = 0;
     const int count = static_cast<int>(sizeof(reference::kValues) / sizeof(reference::kValues[0]));
@@ -483,7 +479,8 @@ int main() {
       .emit();
   g_model = Model<F>::of(robot::kArm);
   // The published vectors' pose on the PUMA; the start pose on another arm.
-  const Vec6<F> qn = joint_vector<F>(kPuma ? puma560::kQn : robot::kQStart), q0 = joint_vector<F>(robot::kQStart);
+  const Vec6<F> qn = joint_vector<F>(test::kPumaBuild ? puma560::kQn : robot::kQStart),
+                q0 = joint_vector<F>(robot::kQStart);
   Vec6<F> qd;
   qd << 1, 2, 3, 1, 2, 3;
   joint_space_kernels(qn, qd);
