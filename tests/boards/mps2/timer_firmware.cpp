@@ -43,10 +43,17 @@ extern "C" void TIMER0_Handler() {
   g_ticks = k + 1;
 }
 
-// The watchdog's first expiry: fault line active, the cause noted, then the reset (under the
-// tests' -no-reboot QEMU ends without the pass line).
+// The watchdog's first expiry: fault line active, the cause noted and said (the tick it came after
+// and the latched faults, so that a failing run names its cause), then the reset (under the tests'
+// -no-reboot QEMU ends without the pass line).
 extern "C" void NMI_Handler() {
   board::watchdog_expired(g_task.sup.latched);
+  cortex_m::text::Line()
+      .str("timer_firmware: FAIL, the watchdog expired after tick ")
+      .i32(g_ticks)
+      .str(", faults ")
+      .u32(g_task.sup.latched)
+      .emit();
   board::await_reset();
 }
 

@@ -8,6 +8,7 @@
 
 #include "osc/control/gains.hpp"
 #include "osc/control/identification.hpp"
+#include "osc/math/fixed.hpp"
 #include "test_util.hpp"
 
 using namespace osc;
@@ -223,6 +224,25 @@ void converges_on_noisy_samples() {
 }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesDouble) { converges_on_noisy_samples<double>(); }
 TEST(FrictionIdentifier, ConvergesOnNoisySamplesFloat) { converges_on_noisy_samples<float>(); }
+
+// In fixed point the update's variance is floored (FrictionIdentifier::kFixedVarFloor): a joint whose
+// quantisation noise squared is below Q12.19's resolution (the UR5e's wrist: 0.5 mN m, its square
+// 2e-7 N^2 m^2, 0 in Q12.19) and a sample that explains nothing (phi = 0, as the worst-case timing image
+// counts at rest) divided 0 by 0 and latched `overflow`; with the floor the update is a gain of 0.
+TEST(FrictionIdentifier, FixedPointNoiseBelowItsResolutionDividesNothingByZero) {
+  FrictionIdentifier<Fixed> id;
+  id.reset();
+  const Vec18<Fixed> theta_max = Gains<Fixed>::paper().theta_max;
+  Vec18<Fixed> theta = Vec18<Fixed>::Zero();
+  const FrictionSample<Fixed> nothing{Fixed(0), Vec3<Fixed>::Zero(), Fixed(0), true};
+  (void)math::take_arithmetic_fault<Fixed>();
+  for (int k = 0; k < 8; ++k) {
+    const IdentifyOutcome o = id.update(4, nothing, true, Fixed(0), Fixed(1), theta, theta_max);
+    EXPECT_EQ(o, IdentifyOutcome::kUpdated) << k;
+  }
+  EXPECT_FALSE(math::take_arithmetic_fault<Fixed>());
+  EXPECT_EQ(theta, Vec18<Fixed>::Zero());
+}
 
 // The proven breakaway while the joint stands (no samples, P drifting back toward the prior): it
 // steps up through its tiers, 1.1, 1.2, 1.4 and 1.8 times the estimate, each as the standard

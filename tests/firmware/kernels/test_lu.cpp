@@ -33,7 +33,9 @@
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <memory>
@@ -257,6 +259,58 @@ TEST(PivotedLu, RcondIsTheExactOneNormValue) {
   graded.print("singular values log-uniform in [sigma_min, 2], kappa 10..1e9");
   puma.print("PUMA 560 analytic J in its joint limits, rcond >= 1e-9");
   for (const RcondQuality* q : {&uniform, &graded, &puma}) EXPECT_LE(q->worst_per_kappa, 24.0);
+}
+
+// The control step's rcond by halves (compute(J, half)): three of J^{-1}'s columns from this J, three
+// kept from the call before. The first call, and one after the pivots' order changed, are exact; two
+// calls with the same J are exact; between two Js the value is 1 / (||J||_1 max(the halves' norms))
+// from the columns each half saw. The columns kept are J^{-1}'s (inverse_column).
+TEST(PivotedLu, RcondByHalvesIsExactOnceBothHalvesSawTheJacobian) {
+  RandomMatrices rm;
+  for (int k = 0; k < 500; ++k) {
+    const M6 J = rm.uniform();
+    const Exact ex = exact_of(J);
+    if (ex.rcond < 1e-6) continue;
+    PivotedLuJacobianFactor<double> f;
+    f.compute(J, 1);  // nothing known yet: exact
+    EXPECT_NEAR(f.rcond, ex.rcond, 1e-9 * ex.rcond) << k;
+    for (int a = 0; a < kDof; ++a)
+      EXPECT_LE((f.inverse_column(a) - ex.inv.col(a)).cwiseAbs().maxCoeff(), 1e-9 * ex.inv.cwiseAbs().maxCoeff());
+    // A nearby J with the same pivots: half 0 from it, half 1 from J.
+    const M6 J2 = J + 1e-3 * rm.uniform();
+    const Exact ex2 = exact_of(J2);
+    const std::array<std::uint8_t, kDof> perm = f.perm;
+    f.compute(J2, 0);
+    if (f.perm != perm) {
+      EXPECT_NEAR(f.rcond, ex2.rcond, 1e-9 * ex2.rcond) << k;  // a new order: exact
+      continue;
+    }
+    double half[2] = {0, 0};
+    for (int K = 0; K < kDof; ++K) {
+      const int a = perm[K];
+      const double n = (K == 0 || K == 3 || K == 5 ? ex2.inv : ex.inv).col(a).cwiseAbs().sum();
+      half[K == 0 || K == 3 || K == 5 ? 0 : 1] = std::max(half[K == 0 || K == 3 || K == 5 ? 0 : 1], n);
+    }
+    const double expected = 1 / (J2.cwiseAbs().colwise().sum().maxCoeff() * std::max(half[0], half[1]));
+    EXPECT_NEAR(f.rcond, expected, 1e-9 * expected) << k;
+    f.compute(J2, 1);  // both halves from J2: exact
+    EXPECT_NEAR(f.rcond, ex2.rcond, 1e-9 * ex2.rcond) << k;
+  }
+  // A change of the pivots' order (another J, whose rcond is far from the first's): exact.
+  const M6 J = rm.uniform();
+  PivotedLuJacobianFactor<double> f;
+  f.compute(J);
+  const std::array<std::uint8_t, kDof> perm = f.perm;
+  M6 other = rm.with_singular_values(1e-4);
+  PivotedLuJacobianFactor<double> g;
+  for (g.compute(other); g.perm == perm; g.compute(other)) other = rm.with_singular_values(1e-4);
+  f.compute(other, 0);
+  EXPECT_NEAR(f.rcond, exact_of(other).rcond, 1e-9 * exact_of(other).rcond);
+  // A singular J forgets the halves: the next call is exact.
+  f.compute(M6::Zero(), 1);
+  EXPECT_EQ(f.rcond, 0.0);
+  f.compute(J, 1);
+  EXPECT_NEAR(f.rcond, exact_of(J).rcond, 1e-9 * exact_of(J).rcond);
 }
 
 /// Hager's estimate of ||A^{-1}||_1 as LAPACK's xLACN2 computes it (at most 5 iterations, then

@@ -3,9 +3,13 @@
 // fixed point rounded once, where rounding each term would lose the sum (values of a few LSB).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <random>
 #include <string_view>
 
+#include "osc/kernels/kinematics.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/math/fixed.hpp"
 #include "osc/robot.hpp"
@@ -71,6 +75,36 @@ TEST(Model, AMassInertiaErrorScalesTheLinksMassesAndInertiasOnly) {
     EXPECT_NEAR(m.armature(i), G * G * robot::kArm.links[i].motor_inertia, 1e-15) << i;
   }
   EXPECT_EQ(h.gravity, m.gravity);
+}
+
+// A link with products of inertia is rotated through its tensor's Cholesky factor (Model::cholesky_root,
+// rotated_full_inertia): L L^T is the tensor, and B B^T (B = R L) is R I R^T formed directly, for random
+// positive-definite tensors of the sizes an arm's links have and random rotations.
+TEST(Model, ARotatedFullInertiaIsRTimesTheTensorTimesRTransposed) {
+  std::mt19937 rng(55);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst = 0;
+  for (int n = 0; n < 500; ++n) {
+    Mat3<double> G;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) G(r, c) = u(rng);
+    const double size = std::pow(10.0, -4 + 3 * (u(rng) + 1) / 2);  // 1e-4 .. 0.03 kg m^2
+    const Mat3<double> I = size * (G * G.transpose() + 0.05 * Mat3<double>::Identity());
+    const double t[6] = {I(0, 0), I(1, 1), I(2, 2), I(0, 1), I(0, 2), I(1, 2)};
+    Vec3<double> d, l;
+    Model<double>::cholesky_root(t, 1.0, d, l);
+    Mat3<double> L;
+    L << d(0), 0, 0, l(0), d(1), 0, l(1), l(2), d(2);
+    EXPECT_LE((L * L.transpose() - I).cwiseAbs().maxCoeff(), 1e-15 * size * 100) << n;
+    const Mat3<double> R = Eigen::Quaterniond(u(rng), u(rng), u(rng), u(rng)).normalized().toRotationMatrix();
+    Mat3<double> Ic;
+    rotated_full_inertia(R, d, l, Ic);
+    const double err = (Ic - R * I * R.transpose()).cwiseAbs().maxCoeff() / size;
+    worst = std::max(worst, err);
+    EXPECT_EQ(Ic, Ic.transpose()) << n;
+  }
+  std::printf("rotated inertia through the Cholesky factor against R I R^T: relative %.1e\n", worst);
+  EXPECT_LE(worst, 1e-13);
 }
 
 // Terms of 0.4 LSB each: rounded one by one they vanish, their exact sum rounds to 1 LSB.

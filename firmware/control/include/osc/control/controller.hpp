@@ -97,6 +97,9 @@ void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<
   st.psi.c_yz.setZero();
   st.psi.jdot_yz.setZero();
   st.steps = 0;
+  // The pivoted LU's rcond by halves (its first step exact), a 1 ms lag on a singular stop whose margin is
+  // a factor 2 (motion_stage.hpp); the block factor's is cheap and exact.
+  if constexpr (requires { st.os.Jf.rcond_by_halves(); }) st.os.Jf.rcond_by_halves();
 }
 }  // namespace detail
 

@@ -148,6 +148,7 @@ struct FrictionIdentifier {
   /// explains of it, within [bound_var / 256, bound_var], bound_var the variance the residual
   /// monitor's quantisation bound implies [N^2 m^2]. The update counts it `correlation` times: the
   /// samples' correlation through the residual's filter, fewer independent samples than updates.
+  static constexpr S kFixedVarFloor = lit<S>(1.0 / 4096);
   IdentifyOutcome update(int i, const FrictionSample<S>& s, bool residual_low, S bound_var, S correlation,
                          Vec18<S>& theta, const Vec18<S>& theta_max) {
     drift(i);
@@ -181,7 +182,11 @@ struct FrictionIdentifier {
     }
     static constexpr S kAverage = lit<S>(1.0 / params::kIdentifyNoiseSamples);
     mean2 += kAverage * (e2 - mean2);
-    const S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
+    S var = explained + correlation * noise;  // the innovation's variance, as the update counts it
+    // In fixed point at least kFixedVarFloor (128 LSB: var's rounding within 0.4 %, as the noise's
+    // floor), so that the gain P phi / var stays in range where the arm's quantisation noise is
+    // below Q12.19's resolution in N^2 m^2 (the UR5e's wrist: 0.5 mN m); float and double as they are.
+    if constexpr (fixed::is_q_v<S>) var = var < kFixedVarFloor ? kFixedVarFloor : var;
     th += correct(i, Pphi, var, excite(i, phi)) * innovation;
     const Vec4 bounded = project(i, th, theta_max);
     for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * unscale(i);

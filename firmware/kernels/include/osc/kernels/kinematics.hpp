@@ -13,19 +13,17 @@
 
 namespace osc {
 
-/// Ic = Rn I Rn^T for a link with products of inertia: I the full tensor, diag(Ixx, Iyy, Izz) with the
-/// products (Ixy, Ixz, Iyz) off it, rotated at once (27 + 18 multiply-adds; the principal part and the
-/// products apart took 72). Apart, so that the arms without products (every DH table of principal
-/// moments) keep their frames' registers.
+/// Ic = Rn I Rn^T for a link with products of inertia, from I's Cholesky factor L (Model::root_diagonal,
+/// root_lower): Ic = B B^T with B = Rn L (18 + 18 multiply-adds; the full tensor rotated at once took 27 + 18).
+/// Apart, so that the arms without products (every DH table of principal moments) keep their frames' registers.
 template <class S>
-[[gnu::noinline]] void rotated_full_inertia(const Mat3<S>& Rn, const Vec3<S>& principal, const Vec3<S>& products,
-                                            Mat3<S>& Ic) {
-  Mat3<S> I;
-  I << principal(0), products(0), products(1), products(0), principal(1), products(2), products(1), products(2),
-      principal(2);
-  const Mat3<S> M = Rn * I;
+[[gnu::noinline]] void rotated_full_inertia(const Mat3<S>& Rn, const Vec3<S>& d, const Vec3<S>& l, Mat3<S>& Ic) {
+  Mat3<S> B;
+  B.col(0) = sum3(d(0), Vec3<S>(Rn.col(0)), l(0), Vec3<S>(Rn.col(1)), l(1), Vec3<S>(Rn.col(2)));
+  B.col(1) = combine(d(1), Vec3<S>(Rn.col(1)), l(2), Vec3<S>(Rn.col(2)));
+  B.col(2) = d(2) * Rn.col(2);
   for (int r = 0; r < 3; ++r)
-    for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));
+    for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = B.row(r).dot(B.row(k));
 }
 
 /// Frames 0..6 into data.R, data.o; COM positions and base-axis inertias into data.com, data.Ic; the
@@ -80,7 +78,7 @@ void forward_kinematics(const Model<S>& model, Data<S>& data, const Vec6In<S>& q
       for (int r = 0; r < 3; ++r)
         for (int k = r; k < 3; ++k) Ic(r, k) = Ic(k, r) = M.row(r).dot(Rn.row(k));
     } else {
-      rotated_full_inertia(Rn, l.inertia, l.products, Ic);
+      rotated_full_inertia(Rn, model.root_diagonal[i], model.root_lower[i], Ic);
     }
   }
   for (int i = 0; i < kDof; ++i) data.vO[i] = cross(data.o[i], data.R[i].col(2));

@@ -20,7 +20,9 @@
 //
 // rcond = 1 / (||J||_1 ||J^{-1}||_1), exact (like the block factor's), not estimated: ||J^{-1}||_1 is
 // the largest 1-norm of the six columns U^{-1} L^{-1} P e_j, each reduced to its norm as the factors'
-// substitutions produce it (no inverse is stored). At n = 6 that is six back substitutions and six
+// substitutions produce it, and kept (inverse, for the residual monitor's velocity noise, which needs
+// J^{-1}'s columns). The control step takes them by halves, three columns a step, the other three
+// one period old (compute(J, half); rcond_by_halves()), while the pivots' order holds. At n = 6 that is six back substitutions and six
 // sparse forward ones, 160 multiply-adds at a fixed cost: about what Hager's estimator (Higham's
 // form, LAPACK's xLACN2) spends, 4 to 11 solves of 36 (4.7 on average), and that estimate falls short
 // of ||J^{-1}||_1 by more than a factor 3 on about 0.2 % of random 6x6 matrices (by up to 10;
@@ -52,22 +54,46 @@ struct PivotedLuJacobianFactor {
   Mat6<S> lu;                           // strictly lower part: L (unit diagonal, not stored); the rest: U
   Vec6<S> u_inv;                        // 1 / U(k, k); 0 where the pivot is singular
   std::array<std::uint8_t, kN> perm{};  // row k of L U is row perm[k] of J
+  Mat6<S> inverse = Mat6<S>::Zero();    // J^{-1}, column by column as rcond's pass computes them
   /// Reciprocal condition number (1-norm, exact: see the file comment); 0 when J is singular or
   /// not finite. Callers refuse to act when it falls below their threshold.
   S rcond = S(0);
 
+  /// rcond exact, or by halves in turn once rcond_by_halves() set the control step's mode.
   void compute(const Mat6<S>& J) {
+    if (!by_halves) return compute(J, -1);
+    compute(J, next_half);
+    next_half ^= 1;
+  }
+  /// The control step's mode (the controller's observer start): compute(J) takes rcond by halves in turn,
+  /// from the next call on, which is exact (nothing known yet).
+  void rcond_by_halves() {
+    by_halves = true;
+    halves_known = false;
+    next_half = 0;
+  }
+
+  /// As compute(J), with ||J^{-1}||_1 by halves (the control step's: opspace_update): the largest
+  /// 1-norm of half `half` (0 or 1, kHalf) of J^{-1}'s columns from this J, of the other half the one
+  /// the call before found (so at most one period old, as the alternate model rate's terms; a control
+  /// step takes the halves in turn). half = -1, or the other half not known (the first call, or one
+  /// after a singular J): both, exactly. Each half is about 60 of the 160 multiply-adds.
+  void compute(const Mat6<S>& J, int half) {
     const Vec6<S> col_sums = J.cwiseAbs().colwise().sum().transpose();
     if (!math::isfinite(S(col_sums.sum()))) {  // a NaN or an infinity in J (float and double)
       set_singular();
       return;
     }
     lu = J;
+    const std::array<std::uint8_t, kN> perm_before = perm;
     if (!factor()) {
       rcond = S(0);
+      halves_known = false;
       return;
     }
-    rcond = reciprocal_condition(col_sums.maxCoeff());
+    // A half is its columns K of L U, that is J^{-1}'s columns perm[K]: the same ones only while the
+    // pivots' order holds.
+    rcond = reciprocal_condition(col_sums.maxCoeff(), halves_known && perm == perm_before ? half : -1);
   }
 
   /// J^{-1} b: L y = P b, then U x = y.
@@ -123,15 +149,27 @@ struct PivotedLuJacobianFactor {
 
   /// ||J^{-1}||_1 from the factors, exactly: the largest 1-norm of a column of J^{-1} = U^{-1} L^{-1} P.
   /// Column perm[K] is U^{-1} y with L y = e_K, whose first K entries are 0 (the forward substitution
-  /// starts at K); each column is reduced to its 1-norm as it is computed, none is kept.
-  S inverse_norm1() const {
+  /// starts at K); each column is reduced to its 1-norm as it is computed, none is kept. half (0 or
+  /// 1): the largest of the columns K of that half (kHalf) only; -1: of all.
+  S inverse_norm1(int half = -1) {
+    if (half == 0) return inverse_norm1_of<0>();
+    if (half == 1) return inverse_norm1_of<1>();
+    return inverse_norm1_of<-1>();
+  }
+  /// Column a of J^{-1}, as the last compute() found it (by halves: at most one period old).
+  Vec6<S> inverse_column(int a) const { return inverse.col(a); }
+
+  template <int Half>
+  S inverse_norm1_of() {
     S largest = S(0);
     for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
+      if constexpr (Half >= 0 && kHalf[K] != Half) return;
       Vec6<S> x = Vec6<S>::Unit(K);
       for_each_index<kN>([&]<int I>(std::integral_constant<int, I>) {
         if constexpr (I > K) x(I) = -lu.row(I).template segment<I - K>(K).dot(x.template segment<I - K>(K));
       });
       back_substitute(x);
+      inverse.col(perm[K]) = x;
       const S n = norm1(x);
       if (n > largest) largest = n;
     });
@@ -192,14 +230,21 @@ struct PivotedLuJacobianFactor {
     });
   }
 
-  /// 1 / (||J||_1 ||J^{-1}||_1); 0 when ||J^{-1}||_1 is not finite (float, double) or saturates (fixed
-  /// point, whose flags it leaves as it found them).
-  S reciprocal_condition(S norm_j) const {
+  /// 1 / (||J||_1 ||J^{-1}||_1), ||J^{-1}||_1 by half `half` (inverse_norm1; -1: both); 0 when
+  /// ||J^{-1}||_1 is not finite (float, double) or saturates (fixed point, whose flags it leaves as it
+  /// found them).
+  S reciprocal_condition(S norm_j, int half) {
     const std::uint32_t saved = math::take_arithmetic_flags<S>();
-    const S denom = norm_j * inverse_norm1();  // >= 1: ||J||_1 ||J^{-1}||_1 >= ||J J^{-1}||_1
+    if (half != 1) half_norm[0] = inverse_norm1_of<0>();
+    if (half != 0) half_norm[1] = inverse_norm1_of<1>();
+    halves_known = !math::take_arithmetic_fault<S>();
+    const S denom = norm_j * (half_norm[0] > half_norm[1] ? half_norm[0] : half_norm[1]);  // >= 1: ||J J^{-1}||_1
     const bool saturated = math::take_arithmetic_fault<S>();
     math::restore_arithmetic_flags<S>(saved);
-    if (saturated || !math::isfinite(denom) || !(denom >= lit<S>(0.5))) return S(0);
+    if (!halves_known || saturated || !math::isfinite(denom) || !(denom >= lit<S>(0.5))) {
+      halves_known = false;
+      return S(0);
+    }
     return S(1) / denom;
   }
 
@@ -208,7 +253,16 @@ struct PivotedLuJacobianFactor {
     u_inv.setZero();
     for (int i = 0; i < kN; ++i) perm[i] = static_cast<std::uint8_t>(i);
     rcond = S(0);
+    halves_known = false;
   }
+
+  /// The half of J^{-1}'s columns K is in: the forward substitutions' multiply-adds (15, 10, 6, 3, 1,
+  /// 0 for K = 0..5) split 18 and 17.
+  static constexpr std::array<std::uint8_t, kN> kHalf = {0, 1, 1, 0, 1, 0};
+  S half_norm[2] = {S(0), S(0)};  // the largest 1-norm of each half's columns, as last computed
+  bool halves_known = false;      // both half_norm from finite, regular factors
+  bool by_halves = false;         // compute(J) by halves (rcond_by_halves())
+  int next_half = 0;              // ... the half the next compute(J) takes
 
   static S norm1(const Vec6<S>& v) { return v.cwiseAbs().sum(); }
 };

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cmath>
 #include <Eigen/Geometry>
 #include <type_traits>
 #include <utility>
@@ -133,6 +134,23 @@ struct Model {
   Link link[kDof];
   Vec6<S> armature;  // G^2 * Jm, added to the diagonal of A(q)
   S gravity;         // along -z of the base frame
+  /// Of each link with products: its tensor's Cholesky factor L (I = L L^T, lower; the generator refuses a
+  /// tensor that is not positive definite), its diagonal and (L_yx, L_zx, L_zy) (rotated_full_inertia). Apart
+  /// from Link, whose size (the stride of link[i]) the arms without products keep.
+  Vec3<S> root_diagonal[kDof], root_lower[kDof];
+
+  /// The Cholesky factor of the tensor (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) scaled by s, in double (set-up
+  /// only); a pivot that is not positive (a tensor the generator would refuse) gives 0s.
+  static void cholesky_root(const double (&t)[6], double s, Vec3<S>& diagonal, Vec3<S>& lower) {
+    const auto root = [](double v) { return v > 0 ? std::sqrt(v) : 0.0; };
+    const double d0 = root(t[0] * s);
+    const double l10 = d0 > 0 ? t[3] * s / d0 : 0, l20 = d0 > 0 ? t[4] * s / d0 : 0;
+    const double d1 = root(t[1] * s - l10 * l10);
+    const double l21 = d1 > 0 ? (t[5] * s - l20 * l10) / d1 : 0;
+    const double d2 = root(t[2] * s - l20 * l20 - l21 * l21);
+    diagonal = Vec3<S>(lit<S>(d0), lit<S>(d1), lit<S>(d2));
+    lower = Vec3<S>(lit<S>(l10), lit<S>(l20), lit<S>(l21));
+  }
 
   /// The model of an arm from its description (osc/robots/arm.hpp), with every link mass and
   /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error).
@@ -152,6 +170,7 @@ struct Model {
       l.inertia = Vec3<S>(lit<S>(p.inertia[0] * s), lit<S>(p.inertia[1] * s), lit<S>(p.inertia[2] * s));
       l.products = Vec3<S>(lit<S>(p.inertia[3] * s), lit<S>(p.inertia[4] * s), lit<S>(p.inertia[5] * s));
       l.diagonal = p.inertia[3] == 0 && p.inertia[4] == 0 && p.inertia[5] == 0;
+      cholesky_root(p.inertia, s, m.root_diagonal[i], m.root_lower[i]);
       m.armature(i) = lit<S>(p.gear_ratio * p.gear_ratio * p.motor_inertia);
     }
     m.gravity = lit<S>(arm.gravity);

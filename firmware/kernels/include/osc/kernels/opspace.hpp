@@ -39,6 +39,8 @@ struct SphericalWristJacobianFactor {
     rcond = r1 < r2 ? r1 : r2;
     if (!math::isfinite(rcond)) rcond = S(0);
   }
+  /// Column a of J^{-1} (a solve; the pivoted LU keeps them).
+  Vec6<S> inverse_column(int a) const { return solve(Vec6<S>::Unit(a)); }
   /// J^{-1} b.
   Vec6<S> solve(const Vec6In<S>& b) const {
     Vec6<S> x;

@@ -70,12 +70,12 @@ struct ResidualMonitor {
   Vec6<S> noise_base;    // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
   S wrist_mix;           // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
   Vec6<S> half_quantum;  // set-up: the encoders' quanta / 2 [rad] (mixed_noise())
-  Vec6<S> gains;         // set-up: the observer's gains k [1/s] (mixed_noise())
+  Vec6<S> gain_excess;   // set-up: the observer's gains k less their least, k_min [1/s] (mixed_noise())
   Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
   /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
   /// in contact, |r| as it was when the contact began (note_contact()) [N m].
   Vec6<S> error_floor = Vec6<S>::Zero();
-  S k_max, lag;                    // set-up: the observer's largest gain, 1 / its smallest [1/s, s]
+  S k_max, k_min, lag;             // set-up: the observer's largest gain, its least, 1 / its least [1/s, s]
   Vec6<S> peak_ratio;              // the largest |r| / threshold seen per joint
   EncoderActivity activity;        // each encoder's changes
   std::uint8_t over[kDof];         // consecutive ticks beyond the threshold
@@ -125,12 +125,13 @@ struct ResidualMonitor {
   /// shares, sum over c != i of |C^-1_ci| times their static band, which a reversal of motor c flips.
   void set(const Vec6<S>& quantum, const Vec6<S>& k, const double (&inverse)[kDof][kDof]) {
     k_max = k.maxCoeff();
-    lag = S(1) / k.minCoeff();
-    wrist_mix = lit<S>(0.5) * (k_max - k.minCoeff()) * (quantum(0) + quantum(1) + quantum(2));
+    k_min = k.minCoeff();
+    lag = S(1) / k_min;
+    wrist_mix = lit<S>(0.5) * (k_max - k_min) * (quantum(0) + quantum(1) + quantum(2));
     velocity_noise = noise_base = (lit<S>(0.5) * k_max) * quantum;
     if constexpr (kArmSphericalWrist) velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share (wrist_noise())
     half_quantum = lit<S>(0.5) * quantum;
-    gains = k;
+    gain_excess = k - Vec6<S>::Constant(k_min);
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
       double cross = 0;
@@ -195,14 +196,13 @@ struct ResidualMonitor {
   /// The velocity estimate's noise without a spherical wrist (wrist_noise() with one). The observer's q^dot =
   /// J^-1 (y + diag(k) x~) carries the encoders' quantisation e (x~'s share J e, J the analytic Jacobian) as M e,
   /// M = J^-1 diag(k) J; with |e_j| at most half a quantum, joint i's noise is at most sum_j |M_ij| quantum_j / 2,
-  /// which e can reach (exact). M's columns [first, last), a solve with J's factor each (no division), added to
-  /// velocity_noise (reset when first is 0): the first three on the step before a turn, the last three on the
-  /// turn (as the alternate model rate's terms, at most one period old), so that no tick has all six solves.
-  void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last) {
-    if (first == 0) velocity_noise.setZero();
-    for (int j = first; j < last; ++j)
-      velocity_noise += half_quantum(j) * Jf.solve(Vec6<S>(gains.cwiseProduct(J.col(j)))).cwiseAbs();
-  }
+  /// which e can reach (exact). M = k_min I + J^-1 diag(k - k_min) J: column j is k_min e_j plus, over the axes a
+  /// whose gain exceeds the least (the paper's: the three of position), (k_a - k_min) J_aj times J^-1's column a,
+  /// which the factor keeps (Jf.inverse_column). Columns [first, last) added to velocity_noise (reset when first
+  /// is 0): kMixedNoiseBefore on the step before a turn, the others on the turn (at most one period old; the
+  /// turn's step computes A, the step before it the velocity products, the dearer of the two).
+  static constexpr int kMixedNoiseBefore = 2;
+  void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last);
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
   S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }
   /// The contact the task reports (contact) began or ended. Its push, which the model does not know,

@@ -20,8 +20,8 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
   if constexpr (kArmSphericalWrist) {
     if (in.J) wrist_noise(*in.J);
   } else if (in.os) {
-    // The last three columns (the first three on the step before: between_turns()); all six when priming.
-    mixed_noise(in.os->Ja, in.os->Jf, prime ? 0 : kDof / 2, kDof);
+    // The columns from kMixedNoiseBefore on (those before it on the step before: between_turns()); all when priming.
+    mixed_noise(in.os->Ja, in.os->Jf, prime ? 0 : kMixedNoiseBefore, kDof);
   }
   const Motion m = motion(in);
   const StrongestFriction strongest(in);
@@ -47,14 +47,25 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
   return moved_too_far;
 }
 
+template <class S>
+inline void ResidualMonitor<S>::mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last) {
+  if (first == 0) velocity_noise.setZero();
+  for (int j = first; j < last; ++j) {
+    Vec6<S> m = Vec6<S>::Unit(j) * k_min;
+    for (int a = 0; a < kDof; ++a)
+      if (gain_excess(a) != S(0)) m += (gain_excess(a) * J(a, j)) * Jf.inverse_column(a);
+    velocity_noise += half_quantum(j) * m.cwiseAbs();
+  }
+}
+
 /// A step between turns: the travel check's counts and drive, and the odd joints' step of its bounds (the even
 /// joints' is on the turn: each joint's every kResidualTurnEvery steps, half of them in each step), with the
 /// error bound of the last turn; without a spherical wrist, half the velocity noise the next turn reads.
 template <class S>
 inline int ResidualMonitor<S>::between_turns(const ResidualInput<S>& in, const bool moved[kDof]) {
-  // Without a spherical wrist, the first three columns of the next turn's velocity noise (mixed_noise()).
+  // Without a spherical wrist, the first columns of the next turn's velocity noise (mixed_noise()).
   if constexpr (!kArmSphericalWrist) {
-    if (in.os) mixed_noise(in.os->Ja, in.os->Jf, 0, kDof / 2);
+    if (in.os) mixed_noise(in.os->Ja, in.os->Jf, 0, kMixedNoiseBefore);
   }
   const StrongestFriction strongest(in);
   int moved_too_far = -1;
