@@ -22,9 +22,10 @@
 // the largest 1-norm of the six columns U^{-1} L^{-1} P e_j, each reduced to its norm as the factors'
 // substitutions produce it, and kept (inverse, for the residual monitor's velocity noise, which needs
 // J^{-1}'s columns). The control step takes them by halves, three columns a step, the other three
-// one period old (compute(J, half); rcond_by_halves()), while the pivots' order holds. At n = 6 that is six back substitutions and six
-// sparse forward ones, 160 multiply-adds at a fixed cost: about what Hager's estimator (Higham's
-// form, LAPACK's xLACN2) spends, 4 to 11 solves of 36 (4.7 on average), and that estimate falls short
+// one period old (compute(J, half); rcond_by_halves()), while the pivots' order holds. At n = 6
+// that is six back substitutions and six sparse forward ones, 160 multiply-adds at a fixed cost:
+// about what Hager's estimator (Higham's form, LAPACK's xLACN2) spends, 4 to 11 solves of 36 (4.7
+// on average), and that estimate falls short
 // of ||J^{-1}||_1 by more than a factor 3 on about 0.2 % of random 6x6 matrices (by up to 10;
 // test_lu.cpp measures it). In fixed point a norm beyond the range (rcond below about
 // 1 / (4096 ||J||_1)) gives rcond 0, and its saturations are not the caller's: the flags are taken
@@ -55,6 +56,11 @@ struct PivotedLuJacobianFactor {
   Vec6<S> u_inv;                        // 1 / U(k, k); 0 where the pivot is singular
   std::array<std::uint8_t, kN> perm{};  // row k of L U is row perm[k] of J
   Mat6<S> inverse = Mat6<S>::Zero();    // J^{-1}, column by column as rcond's pass computes them
+  // rcond by halves (compute(J, half)):
+  S half_norm[2] = {S(0), S(0)};  // the largest 1-norm of each half's columns, as last computed
+  bool halves_known = false;      // both half_norm from finite, regular factors
+  bool by_halves = false;         // compute(J) by halves (rcond_by_halves())
+  int next_half = 0;              // ... the half the next compute(J) takes
   /// Reciprocal condition number (1-norm, exact: see the file comment); 0 when J is singular or
   /// not finite. Callers refuse to act when it falls below their threshold.
   S rcond = S(0);
@@ -259,10 +265,6 @@ struct PivotedLuJacobianFactor {
   /// The half of J^{-1}'s columns K is in: the forward substitutions' multiply-adds (15, 10, 6, 3, 1,
   /// 0 for K = 0..5) split 18 and 17.
   static constexpr std::array<std::uint8_t, kN> kHalf = {0, 1, 1, 0, 1, 0};
-  S half_norm[2] = {S(0), S(0)};  // the largest 1-norm of each half's columns, as last computed
-  bool halves_known = false;      // both half_norm from finite, regular factors
-  bool by_halves = false;         // compute(J) by halves (rcond_by_halves())
-  int next_half = 0;              // ... the half the next compute(J) takes
 
   static S norm1(const Vec6<S>& v) { return v.cwiseAbs().sum(); }
 };
