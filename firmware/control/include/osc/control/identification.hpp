@@ -139,6 +139,9 @@ struct FrictionIdentifier {
     return i;
   }
 
+  /// The least innovation variance an update counts in fixed point (update()) [filter's units].
+  static constexpr S kFixedVarFloor = lit<S>(1.0 / 4096);
+
   /// Joint i's Kalman update from sample s: its estimate z moves by the gain times the innovation,
   /// and theta^'s coefficients (i, 6 + i, 12 + i) are z projected within [0, theta_max] (project).
   /// z itself is not bounded: a bound fed back into a linear estimator ratchets (on a frictionless
@@ -148,7 +151,6 @@ struct FrictionIdentifier {
   /// explains of it, within [bound_var / 256, bound_var], bound_var the variance the residual
   /// monitor's quantisation bound implies [N^2 m^2]. The update counts it `correlation` times: the
   /// samples' correlation through the residual's filter, fewer independent samples than updates.
-  static constexpr S kFixedVarFloor = lit<S>(1.0 / 4096);
   IdentifyOutcome update(int i, const FrictionSample<S>& s, bool residual_low, S bound_var, S correlation,
                          Vec18<S>& theta, const Vec18<S>& theta_max) {
     drift(i);

@@ -102,6 +102,9 @@ struct PivotedLuJacobianFactor {
     rcond = reciprocal_condition(col_sums.maxCoeff(), halves_known && perm == perm_before ? half : -1);
   }
 
+  /// Column a of J^{-1}, as the last compute() found it (by halves: at most one period old).
+  Vec6<S> inverse_column(int a) const { return inverse.col(a); }
+
   /// J^{-1} b: L y = P b, then U x = y.
   Vec6<S> solve(const Vec6In<S>& b) const {
     Vec6<S> x;
@@ -155,18 +158,10 @@ struct PivotedLuJacobianFactor {
 
   /// ||J^{-1}||_1 from the factors, exactly: the largest 1-norm of a column of J^{-1} = U^{-1} L^{-1} P.
   /// Column perm[K] is U^{-1} y with L y = e_K, whose first K entries are 0 (the forward substitution
-  /// starts at K); each column is reduced to its 1-norm as it is computed, none is kept. half (0 or
-  /// 1): the largest of the columns K of that half (kHalf) only; -1: of all.
-  S inverse_norm1(int half = -1) {
-    if (half == 0) return inverse_norm1_of<0>();
-    if (half == 1) return inverse_norm1_of<1>();
-    return inverse_norm1_of<-1>();
-  }
-  /// Column a of J^{-1}, as the last compute() found it (by halves: at most one period old).
-  Vec6<S> inverse_column(int a) const { return inverse.col(a); }
-
-  template <int Half>
-  S inverse_norm1_of() {
+  /// starts at K); each column is reduced to its 1-norm as it is computed and kept in `inverse`.
+  /// Half (0 or 1): the largest of the columns K of that half (kHalf) only; -1: of all.
+  template <int Half = -1>
+  S inverse_norm1() {
     S largest = S(0);
     for_each_index<kN>([&]<int K>(std::integral_constant<int, K>) {
       if constexpr (Half >= 0 && kHalf[K] != Half) return;
@@ -236,13 +231,13 @@ struct PivotedLuJacobianFactor {
     });
   }
 
-  /// 1 / (||J||_1 ||J^{-1}||_1), ||J^{-1}||_1 by half `half` (inverse_norm1; -1: both); 0 when
+  /// 1 / (||J||_1 ||J^{-1}||_1), ||J^{-1}||_1 by half `half` (inverse_norm1<half>; -1: both); 0 when
   /// ||J^{-1}||_1 is not finite (float, double) or saturates (fixed point, whose flags it leaves as it
   /// found them).
   S reciprocal_condition(S norm_j, int half) {
     const std::uint32_t saved = math::take_arithmetic_flags<S>();
-    if (half != 1) half_norm[0] = inverse_norm1_of<0>();
-    if (half != 0) half_norm[1] = inverse_norm1_of<1>();
+    if (half != 1) half_norm[0] = inverse_norm1<0>();
+    if (half != 0) half_norm[1] = inverse_norm1<1>();
     halves_known = !math::take_arithmetic_fault<S>();
     const S denom = norm_j * (half_norm[0] > half_norm[1] ? half_norm[0] : half_norm[1]);  // >= 1: ||J J^{-1}||_1
     const bool saturated = math::take_arithmetic_fault<S>();

@@ -2,8 +2,8 @@
 #pragma once
 
 #include <Eigen/Core>
-#include <cmath>
 #include <Eigen/Geometry>
+#include <cmath>
 #include <type_traits>
 #include <utility>
 
