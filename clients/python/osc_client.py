@@ -174,6 +174,7 @@ class Outcome:
     def __init__(self, status, cid=0, reason="none", cause=0, error="", answer=None, protocol=None):
         self.status, self.id, self.reason, self.cause, self.error = status, cid, reason, cause, error
         self.answer, self._p = answer, protocol
+        self.skipped = 0  # a stream's setpoints not sent: the client fell behind its schedule (Client.stream)
 
     def ok(self):
         return self.status in ("accepted", "done")
@@ -373,10 +374,17 @@ class Client:
             return o
         t0, T = time.monotonic(), 1.0 / rate_hz
         for n, point in enumerate(points):
-            if self._read_until(t0 + n * T, lambda: self._evaluate(cid, True).status in ("done", "aborted")):
-                return self._evaluate(cid, True)
-            pos, rpy = point[0], point[1]
             last = n + 1 == len(points)
+            # Behind the schedule (its successor is due already): skipped rather than sent in a burst,
+            # which the board would only overwrite (it keeps the newest setpoint not yet taken).
+            if not last and time.monotonic() >= t0 + (n + 1) * T:
+                o.skipped += 1
+                continue
+            if self._read_until(t0 + n * T, lambda: self._evaluate(cid, True).status in ("done", "aborted")):
+                e = self._evaluate(cid, True)
+                e.skipped = o.skipped
+                return e
+            pos, rpy = point[0], point[1]
             flags = (self.p.setpoint_flag["end"] if last else 0) | (self.p.setpoint_flag["has_rpy"] if has_rpy else 0)
             values = {"id": cid, "flags": flags, "position": list(pos), "rpy": list(rpy) if has_rpy else [0.0] * 3}
             if velocity:
@@ -599,6 +607,9 @@ def cmd_stream(c, a):
     o = c.stream(resample_path(rows, a.rate), has_rpy, a.rate, a.relative, c.limits(a.v, a.a, a.j), a.timeout,
                  a.velocity)
     print(f"{o.text()} (id {o.id})", flush=True)
+    if o.skipped:
+        print(f"osc_client: warning: {o.skipped} setpoints skipped: this client fell behind the stream's schedule",
+              file=sys.stderr)
     if o.status != "accepted":
         return 0 if o.ok() else 1
     return report(c.wait_done(o.id, a.timeout))

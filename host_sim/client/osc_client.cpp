@@ -425,14 +425,24 @@ Outcome Client::stream(const std::vector<StreamPoint>& points, bool has_rpy, dou
   if (o.status != Status::kAccepted) return o;
   const double t0 = now_s(), T = 1.0 / rate_hz;
   for (std::size_t n = 0; n < points.size(); ++n) {
+    const bool last = n + 1 == points.size();
+    // Behind the schedule (its successor is due already): skipped rather than sent in a burst.
+    if (!last && now_s() >= t0 + static_cast<double>(n + 1) * T) {
+      ++o.skipped;
+      continue;
+    }
     // Until this setpoint's time: the answers meanwhile (a stop, a stale stream end it).
     const bool ended = read_until(t0 + static_cast<double>(n) * T, [&] {
       const Outcome e = evaluate(id, true);
       return e.status == Status::kAborted || e.status == Status::kDone;
     });
     if (!error_.empty()) return o.status = Status::kError, o.error = error_, o;
-    if (ended) return evaluate(id, true);
-    const bool last = n + 1 == points.size();
+    if (ended) {
+      const std::uint32_t skipped = o.skipped;
+      o = evaluate(id, true);
+      o.skipped = skipped;
+      return o;
+    }
     const StreamPoint& p = points[n];
     std::uint8_t buf[pil::kMaxFrame];
     const int len =

@@ -84,6 +84,11 @@ struct Outcome {
   std::uint32_t cause = 0;
   std::string error;
   pil::AnswerFrame answer{};  ///< the answer that decided it (kAccepted, kDone, kRefused, kAborted)
+  /// A stream's setpoints not sent because the client fell behind its schedule (a busy machine): a
+  /// setpoint whose successor was due already. The board keeps only the newest setpoint it has not
+  /// taken (docs/protocol.md), so sent late together they would only be overwritten and counted in
+  /// the state frame's `dropped`; the last setpoint (the end) is always sent.
+  std::uint32_t skipped = 0;
   bool ok() const { return status == Status::kAccepted || status == Status::kDone; }
   /// "accepted", "done", "refused: not_enabled", "aborted: stop_command", "timeout", "error: ...".
   std::string text() const;

@@ -119,6 +119,9 @@ int stream(Client& c, const Args& a) {
   }
   std::printf("%s (id %u)\n", o.status == Status::kAccepted ? "accepted" : o.text().c_str(), o.id);
   std::fflush(stdout);
+  if (o.skipped > 0)
+    std::fprintf(stderr, "oscctl: warning: %u setpoints skipped: this client fell behind the stream's schedule\n",
+                 o.skipped);
   if (o.status != Status::kAccepted) return exit_of(o);
   return report(c.wait_done(o.id, a.timeout));
 }

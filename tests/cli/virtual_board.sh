@@ -24,7 +24,9 @@
 #                                      an unknown pose exit 2), home done
 #   python_queue                       the Python module: a slow move and two queued behind it, a stop:
 #                                      the running move aborted stop_command, each queued one aborted
-#                                      dropped (its own answer frame), the state frame's queue empty
+#                                      dropped (its own answer frame), the state frame's queue empty;
+#                                      two setpoints in one write both taken (none dropped), a client
+#                                      behind its stream's schedule skipping all but the last
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
@@ -280,6 +282,41 @@ assert c.wait_done(stop, 60).status == "done"
 s = c.state(10)
 assert (s["queued"], s["running_id"]) == (0, 0), s
 print("ok:", got)
+# Two setpoints in one write (a client that sent late): the board takes one a tick, none dropped.
+dropped = s["dropped"]
+sid = c.command("stream", relative=True, limits=None, period=100)
+assert c.wait_answer(sid, 60).status == "accepted"
+f = c.p.setpoint_flag
+c._write(c.p.encode("setpoint", {"id": sid, "flags": 0, "position": [0, 0.002, 0], "rpy": [0.0] * 3})
+         + c.p.encode("setpoint", {"id": sid, "flags": f["end"], "position": [0, 0.004, 0], "rpy": [0.0] * 3}))
+assert c.wait_done(sid, 60).status == "done"
+s = c.state(10)
+assert s["dropped"] == dropped, (s["dropped"], dropped)
+# A client behind its schedule (once the stream is accepted, a clock 0.3 s further on at each
+# reading: every setpoint's successor due already) skips all but the last, which ends the stream.
+real, answer = osc_client.time.monotonic, c.wait_answer
+late = [0.0, False]
+
+
+def clock():
+    late[0] += 0.3 if late[1] else 0.0
+    return real() + late[0]
+
+
+def answered(*args, **kwargs):
+    r = answer(*args, **kwargs)
+    late[1] = True
+    return r
+
+
+osc_client.time.monotonic, c.wait_answer = clock, answered
+o = c.stream([((0, 0.001 * k, 0), (0, 0, 0)) for k in range(6)], False, 10, relative=True)
+osc_client.time.monotonic, c.wait_answer = real, answer
+assert (o.status, o.skipped) == ("accepted", 5), (o.text(), o.skipped)
+assert c.wait_done(o.id, 60).status == "done"
+s = c.state(10)
+assert s["dropped"] == dropped, (s["dropped"], dropped)
+print("ok: a burst of two setpoints, none dropped; a late client skipped", o.skipped)
 PY
     cat "$tmp/queue.out"
     stop_sim

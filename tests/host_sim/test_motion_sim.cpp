@@ -165,10 +165,16 @@ TEST(MotionSim, MoveInFixedPoint) { move_and_finish<Fixed>(true, 1e-3); }
 // From a cold start (theta^ = 0: no friction learnt yet) the first move's break-away from static
 // friction costs more: 1.5 mm measured (issue 26 speeds up the identification; issue 27 keeps
 // theta^ across power cycles).
-/// From a cold start (theta^ = 0) the first break-away costs more than a millimetre: 2.29 mm with the
-/// momentum law, which learns only from settled samples (1.53 mm with the robust law, which learns
-/// from the tracking error at once; docs/motion.md).
-constexpr double kColdStartTolerance = 2.5e-3;
+/// From a cold start (theta^ = 0) the first break-away costs more than a millimetre: on the PUMA 560
+/// 2.29 mm with the momentum law, which learns only from settled samples (1.53 mm with the robust
+/// law, which learns from the tracking error at once; docs/motion.md). The UR5e's estimated friction
+/// (cou + sti 9 N m on J1-J3, a strain-wave gear's: docs/arms.md) against its lighter links costs
+/// more: 2.74 mm on this move, 3.14-3.24 mm on the streams' first (measured); another arm's bound is
+/// not yet derived from its sheet, so it takes the UR5e's.
+constexpr double kColdStartTolerance = test::kPumaBuild ? 2.5e-3 : 3.5e-3;
+/// The paper's motion from a cold start, its first seconds: on the PUMA 0.68 / 0.83 / 0.81 mm per
+/// axis (as in the paper's experiment) under 1.5 mm; the UR5e's break-away 2.56 mm (measured).
+constexpr double kColdStartPaperTolerance = test::kPumaBuild ? 1.5e-3 : 3e-3;
 TEST(MotionSim, ColdStartMoveIsTrackedWithinTwoAndAHalfMillimetres) {
   EXPECT_GT(move_and_finish<double>(false, kColdStartTolerance), 1e-3);
 }
@@ -293,8 +299,8 @@ TEST(MotionSim, PaperMotionByCommandThenAStopAlongItsPath) {
   const Trace moving = run_ticks(sim, 8000);
   EXPECT_EQ(moving.faults, 0u);
   EXPECT_GT(moving.tip_moved, 0.03);
-  // The first seconds from a cold start, as in the paper's experiment (0.68 / 0.83 / 0.81 mm per axis).
-  EXPECT_LE(moving.tracking, 1.5e-3);
+  // The first seconds from a cold start, as in the paper's experiment (kColdStartPaperTolerance).
+  EXPECT_LE(moving.tracking, kColdStartPaperTolerance);
   const MotionReport stop = answer(sim, MotionVerb::kStop, 3);
   EXPECT_EQ(stop.aborted_id, 2u);
   const Trace r = run_until(
@@ -656,7 +662,9 @@ TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
     const V3 held = sim.tip();
     const Trace hold = run_ticks(sim, 1000);
     EXPECT_EQ(faults | stop.faults | hold.faults, 0u) << rate;
-    EXPECT_LE((sim.tip() - held).norm(), 0.2e-3) << rate;
+    // Held: a second after a cold start's stop (theta^ still learning), the tip settles by at most
+    // 0.2 mm on the PUMA; 0.23 mm measured on the UR5e (its larger friction, kColdStartTolerance).
+    EXPECT_LE((sim.tip() - held).norm(), test::kPumaBuild ? 0.2e-3 : 0.3e-3) << rate;
     EXPECT_TRUE(state_is(sim, MotionState::kHolding));
   }
 }

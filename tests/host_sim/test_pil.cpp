@@ -751,6 +751,12 @@ settle: 0.2
   EXPECT_EQ(remote.duration_s, local.duration_s);
   EXPECT_EQ(remote.faults, 0u);
   // The figures: bit for bit where the arithmetic is the same; within the float's spread otherwise.
+  // On the PUMA 0.15 mm and 0.03 deg per command. The UR5e's friction (9 N m on J1-J3 against the
+  // PUMA's lighter break-aways for its links) turns a last-bit difference into a tick's difference in
+  // when a joint breaks away: 0.49 mm and 0.05 deg measured on the stream's first, while the run's
+  // maximum agrees within 0.001 mm and the host's scalar build gives the image's torques bit for bit
+  // (PilQemu above).
+  const double spread_mm = osc::test::kPumaBuild ? 0.15 : 0.6, spread_deg = osc::test::kPumaBuild ? 0.03 : 0.08;
   const bool same_arithmetic = !std::getenv("PIL_FIRMWARE_ELF") || peer_is_fixed();
   for (std::size_t i = 0; i < local.commands.size(); ++i) {
     const CommandRecord &l = local.commands[i], &r = remote.commands[i];
@@ -763,8 +769,8 @@ settle: 0.2
       EXPECT_EQ(r.w, l.w) << i;
       EXPECT_EQ(r.wd, l.wd) << i;
     } else {
-      EXPECT_NEAR(r.max_error_mm, l.max_error_mm, 0.15) << i;
-      EXPECT_NEAR(r.max_error_deg, l.max_error_deg, 0.03) << i;
+      EXPECT_NEAR(r.max_error_mm, l.max_error_mm, spread_mm) << i;
+      EXPECT_NEAR(r.max_error_deg, l.max_error_deg, spread_deg) << i;
       EXPECT_NEAR(r.v, l.v, 1e-4 * 0.1) << i;
       EXPECT_NEAR(r.a, l.a, 1e-4 * 0.25) << i;
       EXPECT_NEAR(r.j, l.j, 1e-2 * 2.5) << i;
