@@ -162,9 +162,6 @@ double move_and_finish(bool warm, double tol) {
 TEST(MotionSim, MoveIsTrackedWithinOneMillimetreAndEndsDone) { move_and_finish<double>(true, 1e-3); }
 TEST(MotionSim, MoveInFloat) { move_and_finish<float>(true, 1e-3); }
 TEST(MotionSim, MoveInFixedPoint) { move_and_finish<Fixed>(true, 1e-3); }
-// From a cold start (theta^ = 0: no friction learnt yet) the first move's break-away from static
-// friction costs more: 1.5 mm measured (issue 26 speeds up the identification; issue 27 keeps
-// theta^ across power cycles).
 /// From a cold start (theta^ = 0) the first break-away costs more than a millimetre: on the PUMA 560
 /// 2.29 mm with the momentum law, which learns only from settled samples (1.53 mm with the robust
 /// law, which learns from the tracking error at once; docs/motion.md). The UR5e's estimated friction
