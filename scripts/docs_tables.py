@@ -1422,8 +1422,9 @@ def t_protocol_command_checks():
             ("`rpy`", f"each angle within ±2π rad (±{c['max_angle']:.6f})", "`bad_command`"),
             ("`limits`, with `has_limits`", "each above 0", "`bad_command`"),
             ("`period`, with verb stream", f"1 to {c['stream_max_period']} ms", "`bad_command`"),
-            ("`limits`, with `has_limits`", f"each at most the configured maximum: linear {lin[0]:g} m/s, "
-             f"{lin[1]:g} m/s², {lin[2]:g} m/s³; angular {ang[0]:g} rad/s, {ang[1]:g} rad/s², {ang[2]:g} rad/s³",
+            ("`limits`, with `has_limits`", "each at most the configured maximum: linear, the arm's (its drive "
+             f"sheet's `cartesian_maxima`; the PUMA 560's here) {lin[0]:g} m/s, {lin[1]:g} m/s², {lin[2]:g} m/s³; "
+             f"angular {ang[0]:g} rad/s, {ang[1]:g} rad/s², {ang[2]:g} rad/s³",
              "`over_limit`"),
             ("move_to", f"room in the queue: the running move and {c['queue_length']} waiting (unless the move "
              "brakes the running motion first: `replace`, or after the paper's motion)", "`queue_full`"),

@@ -298,8 +298,8 @@ void emit_friction(std::ostream& o, const Sheet& s) {
     << s.drift.text << ");\n\n";
 
   group(o, "/// ",
-        "Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3] "
-        "(carried for the motion generator; params.hpp's kMoveLinear is what it uses today).",
+        "Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]: "
+        "a move's and a stream's configured maxima (params::kMoveLinear).",
         s.cart_text);
   o << "constexpr CartesianMaxima kCartesianMaxima = {" << s.cart_velocity.text << ", " << s.cart_acceleration.text
     << ", " << s.cart_jerk.text << "};\n\n";

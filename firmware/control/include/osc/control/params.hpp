@@ -3,7 +3,7 @@
 // friction presets, start pose) are its description (osc/robot.hpp).
 #pragma once
 
-#include "osc/robots/arm.hpp"
+#include "osc/robot.hpp"
 
 namespace osc::params {
 
@@ -53,10 +53,12 @@ constexpr double kEnvelope = 0.05;    ///< 1 - exp(-kEnvelope t^3)
 constexpr double kMinJacobianRcond = 1e-3;
 
 /// Motion generation (osc/control/cartesian_move.hpp, docs/motion.md): the configured maxima of a
-/// move's reference, translation of the wrist centre [m/s, m/s^2, m/s^3] and rotation about the
+/// move's reference, translation of the operational point [m/s, m/s^2, m/s^3] and rotation about the
 /// move's axis [rad/s, rad/s^2, rad/s^3]. A command may ask for less, never more (over_limit).
-/// Chosen so that the controller tracks a move at these limits within 1 mm (docs/motion.md).
-constexpr double kMoveLinear[3] = {0.10, 0.25, 2.5};
+/// The translation's are the arm's (its drive sheet's cartesian_maxima), each chosen so that the
+/// controller tracks a move at them within 1 mm (docs/arms.md); the rotation's are every arm's.
+constexpr double kMoveLinear[3] = {robot::kCartesianMaxima.velocity, robot::kCartesianMaxima.acceleration,
+                                   robot::kCartesianMaxima.jerk};
 constexpr double kMoveAngular[3] = {0.5, 1.0, 10.0};
 /// A planned path keeps every joint this far inside its limits [rad] (out_of_workspace).
 constexpr double kWorkspaceMargin = 0.05;
@@ -125,6 +127,11 @@ constexpr double kResidualSlowGain = 10;
 /// sweep of healthy runs checks exactly that (docs/safety.md); the rest is room for what the bounds
 /// leave out.
 constexpr double kResidualMargin = 2;
+/// The fixed-point pose x(q)'s rounding, per coordinate, in units of its resolution (the LSB of Q12.19:
+/// 1.9 um, 1.9 urad): the residual monitor's velocity noise takes it (ResidualConstants::pose_rounding).
+/// Measured against double over 1000 random states (tests/firmware/control/test_arm_opspace.cpp, which
+/// asserts it on the built arm): the UR5e's at most 2.9 LSB, the PUMA 560's 3.4.
+constexpr int kPoseRoundingLsb = 4;
 /// A joint whose friction the residual monitor takes on the model's sliding curve has counted within
 /// this many ticks of its last count (besides counting one way, beyond its velocity noise and lag):
 /// 0.017-0.02 rad/s at the joints' quanta. Slower, a joint held against its static friction may

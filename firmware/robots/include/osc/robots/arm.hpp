@@ -153,8 +153,8 @@ constexpr bool has_pots(const DriveTrain& d) { return d.pot_bits > 0; }
 /// Whether the arm's encoders read the angle itself (EncoderKind::kAbsolute): known from power-on, no homing.
 constexpr bool has_absolute_encoders(const DriveTrain& d) { return d.encoder_kind == EncoderKind::kAbsolute; }
 
-/// The maxima of the operational point's translation in a straight-line move (the arm's statement; the motion
-/// generator's limits are params::kMoveLinear today).
+/// The maxima of the operational point's translation in a straight-line move or a stream: the arm's statement,
+/// which the motion generator takes as its configured maxima (params::kMoveLinear).
 struct CartesianMaxima {
   double velocity;      ///< [m/s]
   double acceleration;  ///< [m/s^2]

@@ -190,10 +190,12 @@ constexpr ModelErrorBounds kModelErrorBounds = with_friction_band(
     {0.1, 0.02, 0.002, 0.03, 0.0005, 0.2, {"band_lo", {}, {}, {}}, {"band_hi", {}, {}, {}}},
     kFrictionBandPresets, 0.3);
 
-/// Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]
-/// (carried for the motion generator; params.hpp's kMoveLinear is what it uses today).
-/// Source: The configured maxima of a straight-line move (firmware/control/include/osc/control/params.hpp,
-/// kMoveLinear), the same for every arm today.
+/// Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]: a
+/// move's and a stream's configured maxima (params::kMoveLinear).
+/// Source: The first maxima, every arm's before the sheet held them. Measured with test_motion_sim's 50 seeded random
+/// moves (docs/arms.md, "Speed limits"), the largest tracking error: 0.53 mm at these; 0.89 mm at 0.20 m/s, 0.40
+/// m/s^2; 0.93 mm at 0.20 m/s, 0.50 m/s^2; 1.00 mm at 0.22 m/s; 1.02 mm at 0.25 m/s; 1.25 mm at 0.30 m/s. Not raised
+/// yet: at 0.20 m/s, 0.40 m/s^2 homing in float from a random pose (Homing.InFloat) faults tracking, not traced yet.
 constexpr CartesianMaxima kCartesianMaxima = {0.1, 0.25, 2.5};
 
 }  // namespace osc::puma560

@@ -5,8 +5,8 @@
 // generates).
 //
 // Universal Robots UR5e (e-Series): kinematics, masses, centres of mass, inertia tensors and limits as UR and its ROS
-// 2 description publish them; the drive train estimated. Not a spherical wrist (d5, d6 are not 0): the firmware's
-// runtime is not built for it yet (it static_asserts a spherical wrist).
+// 2 description publish them; the drive train estimated. Not a spherical wrist (d5, d6 are not 0): the firmware
+// factors its J by a pivoted LU (osc/control/arm_opspace.hpp).
 //
 // The numbers: each double of the URDF and of the conversion is printed with 15 significant digits (the descriptions'
 // numbers have fewer: the last-bit noise of the frame conversions goes); a rotation entry within 1e-12 of 0 or +-1 is
@@ -167,10 +167,12 @@ constexpr ModelErrorBounds kModelErrorBounds = with_friction_band(
     {0.2, 0.02, 0.002, 0.03, 0.0005, 0.2, {"band_lo", {}, {}, {}}, {"band_hi", {}, {}, {}}},
     kFrictionBandPresets, 0.5);
 
-/// Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]
-/// (carried for the motion generator; params.hpp's kMoveLinear is what it uses today).
-/// Source: The configured maxima of a straight-line move (firmware/control/include/osc/control/params.hpp,
-/// kMoveLinear), the same for every arm today.
+/// Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]: a
+/// move's and a stream's configured maxima (params::kMoveLinear).
+/// Source: The first arm's former maxima, kept until the UR5e's suite has run at faster ones. Measured with
+/// test_motion_sim's 50 seeded random moves (docs/arms.md, "Speed limits"), the largest tracking error: 0.54 mm at
+/// these; 0.61 mm at 0.20 m/s, 0.40 m/s^2; 0.75 mm at 0.30 m/s, 0.60 m/s^2, 5 m/s^3; 0.86 mm at 0.50 m/s, 1.0 m/s^2,
+/// 10 m/s^3 (0.42 m/s reached; J3 at 1.83 of its pi rad/s).
 constexpr CartesianMaxima kCartesianMaxima = {0.1, 0.25, 2.5};
 
 }  // namespace osc::ur5e

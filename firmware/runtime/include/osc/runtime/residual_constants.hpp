@@ -38,6 +38,9 @@ struct ResidualConstants {
   S link_inertia, gain_ripple, amp_gain, ripple;
   S slow_dt;  // params::kResidualSlowGain dt kResidualTurnEvery: the slow filter, a turn at a time
   S margin;   // params::kResidualMargin
+  // The pose x's own rounding in fixed point, per coordinate (kPoseRoundingLsb of Q<F>; 0 in float and double):
+  // the observer's x~ carries it as it carries the encoders' quanta (ResidualMonitor::mixed_noise) [m, rad].
+  S pose_rounding;
   constexpr ResidualConstants()
       : vis_mid{},
         vis_half{},
@@ -64,7 +67,8 @@ struct ResidualConstants {
         amp_gain{},
         ripple{},
         slow_dt{},
-        margin{} {
+        margin{},
+        pose_rounding{} {
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     constexpr double kTurnDt = params::kResidualTurnEvery * params::kDt;
     const FrictionCoefficients &lo = b.friction_lo, &hi = b.friction_hi;
@@ -93,6 +97,7 @@ struct ResidualConstants {
     gain_ripple = lit<S>(b.amp_gain + b.ripple);
     amp_gain = lit<S>(b.amp_gain);
     ripple = lit<S>(b.ripple);
+    if constexpr (fixed::is_q_v<S>) pose_rounding = S::from_raw(params::kPoseRoundingLsb);
     slow_dt = lit<S>(params::kResidualSlowGain * kTurnDt);
     margin = lit<S>(params::kResidualMargin);
   }

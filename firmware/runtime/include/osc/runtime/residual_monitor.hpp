@@ -198,8 +198,9 @@ struct ResidualMonitor {
   /// M = J^-1 diag(k) J; with |e_j| at most half a quantum, joint i's noise is at most sum_j |M_ij| quantum_j / 2,
   /// which e can reach (exact). M = k_min I + J^-1 diag(k - k_min) J: column j is k_min e_j plus, over the axes a
   /// whose gain exceeds the least (the paper's: the three of position), (k_a - k_min) J_aj times J^-1's column a,
-  /// which the factor keeps (Jf.inverse_column). Columns [first, last) added to velocity_noise (reset when first
-  /// is 0): kMixedNoiseBefore on the step before a turn, the others on the turn (at most one period old; the
+  /// which the factor keeps (Jf.inverse_column). In fixed point x~ carries x's rounding r too (pose_rounding), as
+  /// J^-1 diag(k) r: column j adds k_j r_j |J^-1 e_j|. Columns [first, last) added to velocity_noise (reset when
+  /// first is 0): kMixedNoiseBefore on the step before a turn, the others on the turn (at most one period old; the
   /// turn's step computes A, the step before it the velocity products, the dearer of the two).
   static constexpr int kMixedNoiseBefore = 2;
   void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last);
@@ -315,8 +316,7 @@ struct ResidualMonitor {
     return armed ? kind : 0u;
   }
 
-  /// Joint i's residual within `fraction` of its threshold on both channels (ratio_of(i) <= fraction,
-  /// without its divisions).
+  /// Joint i's residual within `fraction` of its thresholds on both channels (ratio_of(i) <= fraction, undivided).
   bool within(int i, S fraction) const {
     return math::abs(r(i)) <= fraction * threshold(i) && math::abs(d(i)) <= fraction * change_threshold(i);
   }
