@@ -70,10 +70,10 @@ struct ResidualMonitor {
   Vec6<S> noise_base;    // set-up: ... through its own row, its quantum times k_max / 2 (J5: and the arm's share)
   S wrist_mix;           // set-up: the gains' spread times the arm's quanta / 2 (wrist_noise()) [rad/s]
   Vec6<S> half_quantum;  // set-up: the encoders' quanta / 2 [rad] (mixed_noise())
+  Vec6<S> pose_noise;    // set-up: k times the pose's rounding, 0 but in fixed point [m/s, rad/s] (mixed_noise())
   Vec6<S> gain_excess;   // set-up: the observer's gains k less their least, k_min [1/s] (mixed_noise())
   Vec6<S> cross_friction = Vec6<S>::Zero();  // set-up: the other motors' static friction a coupling adds [N m]
-  /// Each joint's floor of the model's error: the amplifier's offset and cross_friction, plus, while
-  /// in contact, |r| as it was when the contact began (note_contact()) [N m].
+  /// Each joint's floor of the model's error: amplifier offset, cross_friction, in contact |r| at its start [N m].
   Vec6<S> error_floor = Vec6<S>::Zero();
   S k_max, k_min, lag;             // set-up: the observer's largest gain, its least, 1 / its least [1/s, s]
   Vec6<S> peak_ratio;              // the largest |r| / threshold seen per joint
@@ -131,6 +131,7 @@ struct ResidualMonitor {
     velocity_noise = noise_base = (lit<S>(0.5) * k_max) * quantum;
     if constexpr (kArmSphericalWrist) velocity_noise(4) = noise_base(4) += wrist_mix;  // J5's share (wrist_noise())
     half_quantum = lit<S>(0.5) * quantum;
+    pose_noise = kResidualConstants<S>.pose_rounding * k;
     gain_excess = k - Vec6<S>::Constant(k_min);
     const ModelErrorBounds& b = robot::kModelErrorBounds;
     for (int i = 0; i < kDof; ++i) {
@@ -389,8 +390,7 @@ struct ResidualMonitor {
   struct Friction {
     S vis, breakaway;
   };
-  /// Friction at its strongest, per joint: the band's tops, or what the identification proves
-  /// (in.proven), chosen once a step.
+  /// Friction at its strongest, per joint: the band's tops, or what the identification proves (in.proven), once a step.
   struct StrongestFriction {
     const S* vis;
     const S* breakaway;

@@ -56,10 +56,7 @@ inline void ResidualMonitor<S>::mixed_noise(const Mat6<S>& J, const ArmJacobianF
       if (gain_excess(a) != S(0)) m += (gain_excess(a) * J(a, j)) * Jf.inverse_column(a);
     velocity_noise += half_quantum(j) * m.cwiseAbs();
     // In fixed point x's own rounding too, which no J turns back: J^-1's column j times k_j and its bound.
-    if constexpr (fixed::is_q_v<S>) {
-      const S kr = (k_min + gain_excess(j)) * kResidualConstants<S>.pose_rounding;
-      velocity_noise += kr * Jf.inverse_column(j).cwiseAbs();
-    }
+    if constexpr (fixed::is_q_v<S>) velocity_noise += pose_noise(j) * Jf.inverse_column(j).cwiseAbs();
   }
 }
 
