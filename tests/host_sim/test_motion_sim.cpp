@@ -6,6 +6,7 @@
 // the move in float and fixed point.
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <memory>
@@ -13,6 +14,8 @@
 #include <vector>
 
 #include "motion_sim.hpp"
+#include "osc/control/sampled_loop.hpp"
+#include "sampled_loop_reference.hpp"
 #include "test_util.hpp"
 
 using namespace osc;
@@ -390,8 +393,13 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
     const SweptSingularity sing = least_rcond_on_sweep(s.joint);
     if (sing.rcond >= params::kPathMinRcond) continue;  // none on this joint's sweep (the PUMA's shoulder)
     ++found;
-    EXPECT_EQ(answer_move(sim, to_joint_pose(sing.q), 3).refusal, MotionReason::kNearSingular)
-        << s.name << " at q" << s.joint + 1 << " = " << sing.q(s.joint) << ", rcond " << sing.rcond;
+    // near_singular, or unstable_loop where the path meets a light axis first: on the PUMA the elbow's and the
+    // shoulder's (J4's axis along J1's), on the UR5e the wrist's too, where the loop is lost before J is near singular
+    // (APathThroughALightAxisIsRefusedUnstableLoop).
+    const MotionReason why = answer_move(sim, to_joint_pose(sing.q), 3).refusal;
+    EXPECT_TRUE(why == MotionReason::kNearSingular || why == MotionReason::kUnstableLoop)
+        << s.name << " at q" << s.joint + 1 << " = " << sing.q(s.joint) << ", rcond " << sing.rcond << ": "
+        << motion_name(why);
   }
   EXPECT_GE(found, 2) << "the wrist's and the elbow's sweeps reach their singularities";
   // Joint 1 turned 90 degrees from near its limit: past that limit.
@@ -414,8 +422,9 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
 /// to the controller's own threshold (kMinJacobianRcond), ends in the named fault `singular` (category 0: zero
 /// torque in that tick). Nothing else: no other fault, no non-finite value. The condition at the abort and the least
 /// while braking, measured, are printed (the PUMA: aborted at 1.99e-3, braking reached 1.0e-3: `singular`).
-/// The elbow's and the shoulder's poses on their sweeps are far from the start pose: a move there without the
-/// path check ended `collision` on the PUMA with J well conditioned (rcond 0.16), not traced yet (docs/arms.md).
+/// The elbow's and the shoulder's poses on their sweeps are far from the start pose: on the PUMA a move there without
+/// the path check passes a light axis first, where the sampled loop is lost
+/// (APathThroughALightAxisIsRefusedUnstableLoop).
 TEST(MotionSim, AMoveIntoTheWristSingularityStopsByName) {
   const auto& s = kSingularities[0];
   const SweptSingularity sing = least_rcond_on_sweep(s.joint);
@@ -455,6 +464,79 @@ TEST(MotionSim, AMoveIntoTheWristSingularityStopsByName) {
       "%.2e while braking (limit %.0e, fault %.0e): %s\n",
       robot::kArm.name, sing.q(s.joint), sing.rcond, at_abort, least, params::kLimitMinRcond, params::kMinJacobianRcond,
       held ? "held" : "fault singular");
+}
+
+/// Lambda^-1 at q in the controller's coordinates relative to R_ref.
+Mat6<double> lambda_inverse_at(const V6& q, const Mat3<double>& R_ref) {
+  static const Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  ArmOpSpace<double> os;
+  opspace_update(model, data, os, q, R_ref);
+  return lambda_inverse(data.A, os.Ja);
+}
+
+/// The first pose on the elbow's or the shoulder's sweep from the start pose (least_rcond_on_sweep's, J's reciprocal
+/// condition above kPathMinRcond all the way) where the coupled sampled loop at the gains g is unstable (the
+/// reference of tests/support/sampled_loop_reference.hpp, not the check's bound): an axis of Lambda^-1 so light there
+/// that the damping's step lambda (k_s + k_nd) dt passes about 2; its spectral radius above rho. None: steps 0.
+SweptSingularity first_unstable_on_sweep(const Mat3<double>& R_ref, const Gains<double>& g, double rho = 1) {
+  SweptSingularity best;
+  const V6 q0 = start_pose();
+  for (const int j : {2, 1})
+    for (const int dir : {-1, 1})
+      for (int k = 1; k <= 3142; k += 2) {
+        V6 q = q0;
+        q(j) += dir * 1e-3 * k;
+        if (q(j) < robot::kArm.q_min[j] + params::kWorkspaceMargin ||
+            q(j) > robot::kArm.q_max[j] - params::kWorkspaceMargin || test::jacobian_rcond(q) < params::kPathMinRcond)
+          break;
+        if (test::coupled_spectral_radius(g, lambda_inverse_at(q, R_ref)) > rho) {
+          if (best.steps == 0 || k < best.steps) best = {q, test::jacobian_rcond(q), k};
+          break;
+        }
+      }
+  return best;
+}
+
+/// The PUMA's false alarm of issue 55, traced: a move toward the elbow's singular pose, prepared without the path
+/// check, passed q2 + q3 near -pi/2 (J4's axis along J1's), where J is well conditioned (rcond 0.16) but Lambda^-1 has
+/// an eigenvalue of 34.5: the gains' sampled loop is unstable there, the torques alternated sign every tick and grew,
+/// and the residual monitor stopped the arm. The path check now judges the loop at each sample (kUnstableLoop): a move
+/// to the first pose where the coupled loop is unstable is refused `unstable_loop`, and so is one to where it grows
+/// 2 % a tick; started without the check, the latter does not stay in control (category 0: the PUMA's ends in
+/// `saturation`). An arm whose sweeps reach
+/// no such pose before a singularity skips, saying so.
+TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
+  MotionSim<double> sim(start_pose());
+  answer(sim, MotionVerb::kEnable, 1);
+  run_ticks(sim, 100);
+  const Mat3<double> R_ref = sim.task().gen.reference_orientation();
+  const Gains<double> g = sim.task().gains.template cast<double>();
+  EXPECT_GT(gain_margins(g, lambda_inverse_at(start_pose(), R_ref)).loop, 2) << "room at the start pose";
+  const SweptSingularity light = first_unstable_on_sweep(R_ref, g);
+  if (light.steps == 0)
+    GTEST_SKIP() << robot::kArm.name << ": no pose on the elbow's or shoulder's sweep loses the loop";
+  std::printf(
+      "%s: the coupled loop is lost at q = %.3f %.3f %.3f %.3f %.3f %.3f (rcond %.3f, Lambda^-1's largest "
+      "eigenvalue %.1f)\n",
+      robot::kArm.name, light.q(0), light.q(1), light.q(2), light.q(3), light.q(4), light.q(5), light.rcond,
+      Eigen::SelfAdjointEigenSolver<Mat6<double>>(lambda_inverse_at(light.q, R_ref)).eigenvalues().maxCoeff());
+  EXPECT_GT(light.rcond, 5 * params::kPathMinRcond) << "not near a singularity";
+  EXPECT_EQ(answer_move(sim, to_joint_pose(light.q), 2).refusal, MotionReason::kUnstableLoop);
+  // Where it grows 2 % a tick, the arm started there without the check does not stay in control (below that the
+  // joints' static friction can hold the oscillation: at 1 % the PUMA's arm held).
+  const SweptSingularity growing = first_unstable_on_sweep(R_ref, g, 1.02);
+  ASSERT_GT(growing.steps, 0);
+  EXPECT_EQ(answer_move(sim, to_joint_pose(growing.q), 2).refusal, MotionReason::kUnstableLoop);
+  start_unchecked(sim, to_joint_pose(growing.q), 3);
+  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+  const Trace r = run_until(
+      sim, [](const MotionSim<double>& m) { return state_is(m, MotionState::kFault); }, 30000);
+  EXPECT_NE(r.faults, 0u) << "the arm held the pose with the loop lost there for 30 s";
+  EXPECT_TRUE(state_is(sim, MotionState::kFault));
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(sim.task().codes[i], 0) << "zero torque after the fault";
+  std::printf("started without the path check: %s after %d ticks\n", std::string(fault_name(r.faults)).c_str(),
+              r.ticks);
 }
 
 TEST(MotionSim, AReachedJointLimitStopsTheMotion) {
@@ -715,7 +797,8 @@ TEST(MotionSim, StreamRefusalsAndAStopCommand) {
 
 /// 50 seeded random moves from where the arm is (up to 15 cm along each axis and 0.3 rad about z, at the
 /// configured maxima, params::kMoveLinear), after 10 s of the paper's motion (friction learnt): each is accepted
-/// or refused by name by the path check (out of the workspace, near a singular pose), and an accepted one runs to
+/// or refused by name by the path check (out of the workspace, near a singular pose, the loop lost on a light axis),
+/// and an accepted one runs to
 /// its end with no fault, its reference's speed and acceleration within the maxima and the tip within 1 mm of it.
 /// On every arm, at the arm's maxima (its sheet's cartesian_maxima, chosen by this test: docs/arms.md, "Speed
 /// limits").
@@ -738,7 +821,8 @@ TEST(MotionSim, FiftySeededRandomMovesAtTheMaximaTrackWithinOneMillimetre) {
     req.rpy = Vec3<double>(0, 0, a(rng));
     const MotionReport rep = answer_move(sim, req, id);
     if (rep.outcome != CommandOutcome::kAccepted) {
-      EXPECT_TRUE(rep.refusal == MotionReason::kOutOfWorkspace || rep.refusal == MotionReason::kNearSingular)
+      EXPECT_TRUE(rep.refusal == MotionReason::kOutOfWorkspace || rep.refusal == MotionReason::kNearSingular ||
+                  rep.refusal == MotionReason::kUnstableLoop)
           << MotionNames<MotionReason>::kNames[static_cast<int>(rep.refusal)];
       ASSERT_LT(++refused, 50) << "most random moves are accepted";
       continue;

@@ -308,7 +308,7 @@ void gain_check_kernels(const Vec6<F>& q0) {
   GainMargins m;
   {
     Timer t("lambda_inverse in double (a param set's pose)");
-    li = lambda_inverse(g_data.A.template cast<double>(), g_os.Ja.template cast<double>());
+    li = lambda_inverse<double>(g_data.A.template cast<double>(), g_os.Ja.template cast<double>());
     keep(li);
   }
   {
@@ -394,8 +394,9 @@ void motion_kernels(const Vec6<F>& q0) {
   }
   PathCheck<F> pc;
   {
-    Timer t("check_path (16 samples and the end)");
-    pc = check_path(g_model, g_data, g_move, from.R, q0);
+    Timer t("check_path (16 samples and the end, the sampled loop judged at each)");
+    const loop::PathLoop gains = loop::path_loop(Gains<double>::paper(), params::kPathLoopMargin);  // as command_prep
+    pc = check_path(g_model, g_data, g_move, from.R, q0, &gains);
   }
   check("the move's path is clear", static_cast<double>(pc.status), 0.0, 0.0);
   g_gen.hold(from, from.R);

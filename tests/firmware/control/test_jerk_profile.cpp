@@ -327,6 +327,54 @@ TEST(JerkProfile, InputsOutOfContractAreRefusedAndLeaveTheProfile) {
   EXPECT_EQ(pr.at(0).p, 0.25);
 }
 
+/// The defect behind Homing.InFloat at 0.40 m/s^2 (issue 55): a float profile evaluated at its cruise gave
+/// v = 0.0399960019 against its limit 0.0399959981 (0.04 less the float rounding margin), plan_stop refused it
+/// (kBadStart) and left the move's own profile, and CartesianMove::stop restarted its time at 0: the reference jumped
+/// back to the move's start (77 mm) and the arm faulted `tracking`. A stop is planned from any finite state: one a
+/// rounding or more beyond the speed limit only slows, an acceleration beyond the limit is taken at it; each ends
+/// at rest, keeps |a| <= amax and |j| <= j, and its speed only falls. A non-finite start still fails.
+TEST(JerkProfile, AStopIsPlannedFromAStateBeyondTheLimits) {
+  const Lim lim{0.04, 0.4, 2.5};
+  for (const double v0 : {0.04 * (1 + 1e-7), 0.06, -0.05}) {
+    for (const double a0 : {0.0, 0.3, -0.45}) {
+      JerkProfile<double> pr;
+      ASSERT_EQ(pr.plan_stop(0.1, v0, a0, lim), ProfileStatus::kOk) << v0 << " " << a0;
+      EXPECT_GT(pr.duration(), 0.0);
+      double v_prev = std::abs(v0);
+      for (double t = 0; t <= pr.duration() + 1e-3; t += 1e-3) {
+        const ProfileState<double> st = pr.at(t);
+        EXPECT_LE(std::abs(st.a), lim.a * (1 + 1e-12)) << t;
+        EXPECT_LE(std::abs(st.j), lim.j * (1 + 1e-12)) << t;
+        if (std::abs(a0) < lim.a && v0 * a0 <= 0) {  // already decelerating or coasting: the speed only falls
+          EXPECT_LE(std::abs(st.v), v_prev + 1e-12) << v0 << " " << a0 << " " << t;
+          v_prev = std::abs(st.v);
+        }
+      }
+      const ProfileState<double> end = pr.at(pr.duration());
+      EXPECT_EQ(end.v, 0.0);
+      EXPECT_EQ(end.a, 0.0);
+      EXPECT_NEAR(end.p, pr.target(), 1e-15);
+    }
+  }
+  // In float, from the state its own cruise gives.
+  JerkProfile<float> move, stop;
+  const JerkLimits<float> lf{0.04f * 0.9999f, 0.4f * 0.9999f, 2.5f * 0.998f};
+  ASSERT_EQ(move.plan(0, 0, 0, 0.2f, lf), ProfileStatus::kOk);
+  int refused_before = 0;
+  for (float t = 0; t < move.duration(); t += 1e-3f) {
+    const ProfileState<float> st = move.at(t);
+    refused_before += !(std::abs(st.v) <= lf.v);
+    ASSERT_EQ(stop.plan_stop(st.p, st.v, st.a, lf), ProfileStatus::kOk) << t;
+    EXPECT_EQ(stop.at(0).p, st.p);
+  }
+  std::printf("float cruise at 0.04 m/s: %d of %d ticks beyond the limit by rounding, each stop planned\n",
+              refused_before, static_cast<int>(move.duration() * 1000));
+  JerkProfile<double> pr;
+  EXPECT_EQ(pr.plan_stop(0, std::nan(""), 0, lim), ProfileStatus::kBadStart);
+  EXPECT_EQ(pr.plan_stop(0, 0, INFINITY, lim), ProfileStatus::kBadStart);
+  EXPECT_EQ(pr.plan_stop(0, 0, 0, Lim{0.04, 0, 2.5}), ProfileStatus::kBadLimits);
+}
+
 // ---------------------------------------------------------------- float and fixed point
 struct Move {
   double p0, v0, a0, target;

@@ -395,7 +395,9 @@ TEST(CommandFrames, ReasonsListKeepsItsCodesAndEndsWithTheCollisionReasons) {
   EXPECT_EQ(static_cast<int>(MotionReason::kUnknownPose), 22);
   EXPECT_EQ(static_cast<int>(MotionReason::kDropped), 23);    // issue 53's, after them
   EXPECT_EQ(static_cast<int>(MotionReason::kNotNeeded), 24);  // issue 55's, after it
-  EXPECT_EQ(static_cast<int>(MotionReason::kNotNeeded) + 1, MotionNames<MotionReason>::kCount);
+  EXPECT_EQ(static_cast<int>(MotionReason::kUnstableLoop), 25);
+  EXPECT_STREQ(motion_name(MotionReason::kUnstableLoop), "unstable_loop");
+  EXPECT_EQ(static_cast<int>(MotionReason::kUnstableLoop) + 1, MotionNames<MotionReason>::kCount);
   // The states too: yielding after fault.
   EXPECT_EQ(static_cast<int>(MotionState::kFault), 4);
   EXPECT_EQ(static_cast<int>(MotionState::kYielding), 5);

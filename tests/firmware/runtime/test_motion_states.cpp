@@ -29,7 +29,7 @@ using R = MotionReason;
 constexpr int kStates = MotionNames<S>::kCount;
 constexpr int kCommands = MotionNames<C>::kCount;
 constexpr int kReasons = MotionNames<R>::kCount;
-static_assert(kStates == 7 && kCommands == 8 && kReasons == 25);
+static_assert(kStates == 7 && kCommands == 8 && kReasons == 26);
 static_assert(MotionNames<CommandOutcome>::kCount == 3 && MotionNames<StopCategory>::kCount == 3);
 static_assert(MotionNames<MotionCompletion>::kCount == 4);
 static_assert(sizeof(MotionNames<S>::kDocs) == sizeof(MotionNames<S>::kNames));

@@ -149,7 +149,9 @@ class CartesianMove {
   }
 
   /// Replaces the move by its category-2 stop from the state at time t: each profile's hardest stop
-  /// (JerkProfile::plan_stop), along the same line and about the same axis. Time restarts at 0.
+  /// (JerkProfile::plan_stop, which plans one from any finite state: a state at the move's cruise
+  /// speed may lie beyond the limit by a rounding), along the same line and about the same axis. Time
+  /// restarts at 0.
   void stop(S t, const CartesianLimits<S>& lim) {
     const ProfileState<S> s = s_.at(t), a = psi_.at(t);
     s_.plan_stop(s.p, s.v, s.a, rounding_margin(lim.linear));

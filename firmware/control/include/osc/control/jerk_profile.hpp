@@ -312,10 +312,17 @@ class JerkProfile {
   }
 
   /// The hardest stop from (p0, v0, a0): the time-optimal change to v = a = 0 at full jerk, wherever
-  /// it comes to rest (a category-2 stop along the axis). The target is where it ends.
+  /// it comes to rest (a category-2 stop along the axis). The target is where it ends. A stop is
+  /// planned from any finite state: a speed beyond lim.v only slows (a profile evaluated at its cruise
+  /// lies beyond its own limit by a rounding: float's 4e-9 m/s at 0.04 m/s), and an acceleration
+  /// beyond lim.a is taken at lim.a. Only a non-finite start (kBadStart) or bad limits fail, leaving
+  /// the profile as it was.
   ProfileStatus plan_stop(S p0, S v0, S a0, const JerkLimits<S>& lim) {
-    const ProfileStatus st = check(p0, v0, a0, p0, lim);
+    const ProfileStatus st = check(p0, S(0), S(0), p0, lim);
     if (st != ProfileStatus::kOk) return st;
+    if (!math::isfinite(v0) || !math::isfinite(a0)) return ProfileStatus::kBadStart;
+    if (a0 > lim.a) a0 = lim.a;
+    if (a0 < -lim.a) a0 = -lim.a;
     const jerk_profile::Kin<S> start{p0, v0, a0};
     jerk_profile::Pieces<S> stop(lim.a);
     stop.add(jerk_profile::velocity_change(v0, a0, S(0), lim.a, lim.j), lim.j);

@@ -33,6 +33,16 @@
 //                    below params::kPathMinRcond, or a singularity crossed since the sample before
 //                    (below), or in fixed point a saturated result in the sample's arithmetic (a
 //                    division by a near-zero determinant).
+//   kUnstableLoop    (when the caller passes the gains' loop::PathLoop) the sampled closed loop of the
+//                    observer and the controller at the task's gains (sampled_loop.hpp) is not stable
+//                    at the sample's Lambda^-1 = J_a A^-1 J_a^T, its bounds times
+//                    params::kPathLoopMargin: an axis so light there (J4's axis along J1's on a
+//                    PUMA, q2 + q3 near -pi/2) that the damping's step, lambda (k_s + k_nd) dt,
+//                    passes about 2 and the arm would oscillate from tick to tick. The same test
+//                    that refuses a gain (param set: unstable_loop), at the path's poses. A path
+//                    that starts where an axis's loop is judged unstable already (the arm stands
+//                    there, held by its friction) may leave that region, not go deeper: that axis
+//                    fails only where its bounds exceed the first sample's.
 // Between two samples the joints move continuously along the branch. A singularity the path
 // crosses there, with both samples' rcond above the threshold (joint 5 passing through 0 between
 // two samples), changes the sign of the determinant of one of the Jacobian's blocks, J11 (arm) or
@@ -44,7 +54,8 @@
 // Cost, bounded: the iteration counts are fixed (kFirstIterations at the first sample,
 // kIterations at each other), one forward kinematics, geometric Jacobian and factorisation each:
 // kEvaluations = 1 + 6 + 16 x 4 = 71 of them per check, plus per sample (17) one pose on the path
-// (pose_at), the orientation coordinates and the analytic Jacobian's factorisation. It runs when a
+// (pose_at), the orientation coordinates and the analytic Jacobian's factorisation, and with the loop's
+// test one joint inertia, Lambda^-1 (an L D L^T of A and six solves) and loop::stable(). It runs when a
 // move is accepted, not every tick.
 //
 // Allocation-free, templated on the scalar (double, float, osc::Fixed); the kernels' workspace Data
@@ -60,8 +71,9 @@
 #include <utility>
 
 #include "osc/control/cartesian_move.hpp"
-#include "osc/control/params.hpp"
 #include "osc/control/arm_opspace.hpp"
+#include "osc/control/params.hpp"
+#include "osc/control/sampled_loop.hpp"
 #include "osc/robot.hpp"
 
 namespace osc {
@@ -71,7 +83,8 @@ enum class PathStatus : std::uint8_t {
   kOk = 0,
   kOutOfWorkspace,  ///< a joint within kWorkspaceMargin of a limit (or beyond)
   kNearSingular,    ///< the Jacobian's reciprocal condition below kPathMinRcond
-  kUnreachable      ///< Newton did not converge: no joint angles on the seed's branch reach the pose
+  kUnreachable,     ///< Newton did not converge: no joint angles on the seed's branch reach the pose
+  kUnstableLoop     ///< the gains would make the sampled closed loop unstable there (Lambda^-1's light axes)
 };
 
 namespace path_check {
@@ -215,6 +228,13 @@ S angle_difference(S a, S b) {
   return d > pi ? S(d - two_pi) : (d < -pi ? S(d + two_pi) : d);
 }
 
+/// The analytic Jacobian of a sample (data evaluated there), in the orientation coordinates relative to R_ref
+/// (controller.hpp).
+template <class S>
+Mat6<S> sample_analytic_jacobian(const Data<S>& data, const Mat3<S>& R_ref) {
+  return analytic_jacobian(data.J, orientation_coordinates<S>(data.R[kDof], R_ref));
+}
+
 /// The singularity test of a sample (data and Jg, the geometric Jacobian's factor, evaluated at its solution): the
 /// reciprocal condition that the controller tests, that of the analytic Jacobian in the orientation coordinates
 /// relative to R_ref (controller.hpp), and a singularity crossed since the sample before (trace); in fixed point also a
@@ -235,10 +255,44 @@ bool near_singular(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const Ma
   return !(Jf.rcond >= lit<S>(params::kPathMinRcond)) || crossed || saturated<S>();
 }
 
-/// The tests of one sample at its solution q (data and Jg evaluated there), in order; r's extremes updated.
+/// What the loop's test of the first sample leaves for the others': each axis's bounds there (loop::path_bounds) and
+/// whether its loop was judged stable there.
+struct LoopTrace {
+  bool valid = false;  // the first sample was judged
+  loop::LoopBounds start{};
+  bool stable[kDof] = {};
+};
+
+/// The sampled loop's test of a sample (data evaluated there; its joint inertia computed here): an axis whose loop is
+/// not stable at Lambda^-1's bounds there times the margin (loop::path_bounds, loop::axis_stable) fails it, unless
+/// the path began where that axis's loop was judged unstable already (the arm stands there, held by its friction:
+/// on the PUMA's power-on poses with q2 + q3 near -pi/2) and the axis is no lighter than it was there: a path may
+/// leave such a region, not go deeper into it. In fixed point a saturated Lambda^-1 fails it too.
 template <class S>
-PathStatus classify(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const Pose<S>& target, const Mat3<S>& R_ref,
-                    const Vec6<S>& q, SingularityTrace<S>& trace, PathCheck<S>& r) {
+bool unstable_loop(const Model<S>& model, Data<S>& data, const Mat3<S>& R_ref, const loop::PathLoop& loop,
+                   LoopTrace& trace) {
+  joint_inertia(model, data);
+  const loop::LoopBounds b = loop::path_bounds(loop, lambda_inverse<S>(data.A, sample_analytic_jacobian(data, R_ref)));
+  if (saturated<S>()) return true;
+  bool fails = false;
+  for (int i = 0; i < kDof; ++i) {
+    const bool ok = loop::axis_stable(b, i);
+    if (!trace.valid) {
+      trace.stable[i] = ok;
+      continue;
+    }
+    if (!ok && (trace.stable[i] || b.a[i] > trace.start.a[i] || b.b[i] > trace.start.b[i])) fails = true;
+  }
+  if (!trace.valid) trace.valid = true, trace.start = b;
+  return fails;
+}
+
+/// The tests of one sample at its solution q (data and Jg evaluated there), in order; r's extremes updated. loop:
+/// the sampled loop's test (none: not judged).
+template <class S>
+PathStatus classify(const Model<S>& model, Data<S>& data, const ArmJacobianFactor<S>& Jg, const Pose<S>& target,
+                    const Mat3<S>& R_ref, const Vec6<S>& q, SingularityTrace<S>& trace, PathCheck<S>& r,
+                    const loop::PathLoop* loop, LoopTrace& loop_trace) {
   bool aligned;
   const Vec6<S> e = pose_error(data, target, aligned);
   const S ep = e.template head<3>().cwiseAbs().maxCoeff(), eo = e.template tail<3>().cwiseAbs().maxCoeff();
@@ -250,6 +304,7 @@ PathStatus classify(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const P
   if (c < r.clearance) r.clearance = c;
   if (!(c >= lit<S>(params::kWorkspaceMargin))) return PathStatus::kOutOfWorkspace;
   if (near_singular(data, Jg, R_ref, trace, r)) return PathStatus::kNearSingular;
+  if (loop && unstable_loop(model, data, R_ref, *loop, loop_trace)) return PathStatus::kUnstableLoop;
   return PathStatus::kOk;
 }
 
@@ -257,10 +312,11 @@ PathStatus classify(const Data<S>& data, const ArmJacobianFactor<S>& Jg, const P
 
 /// Checks the path of `move` from the joint angles q_seed (the arm's, or the q_end of the check of
 /// the move queued before it); R_ref is the controller's reference orientation. data is the kernels'
-/// workspace (overwritten). See the file comment.
+/// workspace (overwritten). loop: the gains' sampled-loop test at every sample (loop::path_loop; none: not
+/// judged). See the file comment.
 template <class S>
 PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMove<S>& move, const Mat3<S>& R_ref,
-                        const Vec6<S>& q_seed) {
+                        const Vec6<S>& q_seed, const loop::PathLoop* loop = nullptr) {
   using namespace path_check;
   constexpr int N = params::kPathCheckPoints;
   const std::uint32_t before = math::take_arithmetic_flags<S>();  // the caller's, put back on return
@@ -268,6 +324,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
   Vec6<S> q = q_seed;
   ArmJacobianFactor<S> Jf;
   SingularityTrace<S> trace;
+  path_check::LoopTrace loop_trace;
   evaluate(model, data, Jf, q);
   for (int i = 0; i <= N; ++i) {
     const Pose<S> target = i == N ? move.end() : move.pose_at(move.duration() * math::ratio<S>(i, N));
@@ -276,7 +333,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
       newton_step(Jf, pose_error(data, target, aligned), q);
       evaluate(model, data, Jf, q);
     }
-    const PathStatus s = classify(data, Jf, target, R_ref, q, trace, r);
+    const PathStatus s = classify(model, data, Jf, target, R_ref, q, trace, r, loop, loop_trace);
     if (s != PathStatus::kOk) {
       r.status = s;
       r.sample = i;

@@ -205,6 +205,53 @@ inline LoopBounds loop_bounds(const Gains<double>& g, const RowBounds& r) {
   return l;
 }
 
+/// The loop's test at the samples of a path (osc/control/path_check.hpp): each axis at its row bounds
+/// of Lambda^-1 there (row_bounds, loop_bounds) times `scale`, the margin the path keeps on the inverse
+/// masses (not on the gains: a larger k can steady an axis that a lighter mass would not). The gains'
+/// terms once per check; per sample one row sum per axis and stable(). The square roots carry dt and
+/// the scale: a_i = w_i sum_j |Lambda^-1_ij| w_j with w = sqrt((k_s + k_nd) dt scale), b_i the same
+/// with v = sqrt(k_i scale) dt.
+struct PathLoop {
+  Real kappa[kDof], sigma[kDof], w[kDof], v[kDof];
+};
+inline PathLoop path_loop(const Gains<double>& g, double scale) {
+  PathLoop p;
+  for (int i = 0; i < kDof; ++i) {
+    p.kappa[i] = static_cast<Real>(g.k(i) * g.dt), p.sigma[i] = static_cast<Real>(g.ks(i) * g.dt);
+    p.w[i] = static_cast<Real>(std::sqrt((g.ks(i) + g.knd(i)) * g.dt * scale));
+    p.v[i] = static_cast<Real>(std::sqrt(g.ki(i) * scale) * g.dt);
+  }
+  return p;
+}
+/// Each axis's loop at Lambda^-1 (any scalar) times path_loop's scale: its terms at its row bounds.
+template <class S>
+LoopBounds path_bounds(const PathLoop& p, const Mat6<S>& lambda_inv) {
+  LoopBounds l;
+  for (int i = 0; i < kDof; ++i) {
+    Real a = 0, b = 0;
+    for (int j = 0; j < kDof; ++j) {
+      const Real m = std::fabs(static_cast<Real>(lambda_inv(i, j)));
+      a += m * p.w[j];
+      b += m * p.v[j];
+    }
+    l.kappa[i] = p.kappa[i], l.sigma[i] = p.sigma[i], l.a[i] = a * p.w[i], l.b[i] = b * p.v[i];
+  }
+  return l;
+}
+/// Whether axis i's loop is stable at its bound and every fraction of it (stable()'s test of one axis).
+inline bool axis_stable(const LoopBounds& l, int i) {
+  const AxisForm x = axis_form(l.kappa[i], l.sigma[i], l.a[i], l.b[i]);
+  Real f = 1;
+  for (int m = 0; m < kMassSteps; ++m, f *= Real(0.5))
+    if (!form_stable(x, f)) return false;
+  return true;
+}
+/// Whether the loop of every axis is stable at Lambda^-1 (any scalar) times path_loop's scale.
+template <class S>
+bool path_loop_stable(const PathLoop& p, const Mat6<S>& lambda_inv) {
+  return stable(path_bounds(p, lambda_inv));
+}
+
 /// The steps of the loop's gain margin: factors of sqrt 2, at most kMarginSteps of them each way.
 constexpr int kMarginSteps = 4;
 
@@ -253,13 +300,15 @@ struct GainMargins {
   bool loop_stable() const { return loop >= 1; }
 };
 
-/// Lambda^-1 = J A^-1 J^T at a pose, from the controller's A and analytic Jacobian (double), by the
-/// kernels' L D L^T solves column by column (Eigen's decompositions would link the heap in).
-inline Mat6<double> lambda_inverse(const Mat6<double>& A, const Mat6<double>& Ja) {
-  LdltFactor<double, kDof> ldlt;
+/// Lambda^-1 = J A^-1 J^T at a pose, from the controller's A and analytic Jacobian (a parameter set's
+/// check in double, the path check in its scalar), by the kernels' L D L^T solves column by column
+/// (Eigen's decompositions would link the heap in).
+template <class S>
+Mat6<S> lambda_inverse(const Mat6<S>& A, const Mat6<S>& Ja) {
+  LdltFactor<S, kDof> ldlt;
   ldlt.compute(A);
-  Mat6<double> X;  // A^-1 J^T
-  for (int k = 0; k < kDof; ++k) X.col(k) = ldlt.solve(Vec6<double>(Ja.row(k).transpose()));
+  Mat6<S> X;  // A^-1 J^T
+  for (int k = 0; k < kDof; ++k) X.col(k) = ldlt.solve(Vec6<S>(Ja.row(k).transpose()));
   return Ja.lazyProduct(X);
 }
 

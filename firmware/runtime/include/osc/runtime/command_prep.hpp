@@ -36,6 +36,8 @@ constexpr MotionReason path_refusal(PathStatus s) {
       return MotionReason::kNone;
     case PathStatus::kNearSingular:
       return MotionReason::kNearSingular;
+    case PathStatus::kUnstableLoop:
+      return MotionReason::kUnstableLoop;
     case PathStatus::kOutOfWorkspace:
     case PathStatus::kUnreachable:
       break;
@@ -43,12 +45,15 @@ constexpr MotionReason path_refusal(PathStatus s) {
   return MotionReason::kOutOfWorkspace;
 }
 
-/// The path check of a move_to prepare_move planned, or of a home's move (nothing if it refused it already).
+/// The path check of a move_to prepare_move planned, or of a home's move (nothing if it refused it already), with the
+/// sampled loop judged at the task's gains.
 template <class S>
 void check_prepared_move(ControlTask<S>& task, TaskCommand<S>& c) {
   if ((c.verb != MotionVerb::kMoveTo && c.verb != MotionVerb::kHome) || c.refusal != MotionReason::kNone) return;
   const Vec6<S> seed = c.brake ? task.state.adapt.q_prev : task.q_queue_end;
-  const PathCheck<S> pc = check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed);
+  const loop::PathLoop gains = loop::path_loop(task.gains.template cast<double>(), params::kPathLoopMargin);
+  const PathCheck<S> pc =
+      check_path(task.model, task.check_data, c.move, task.gen.reference_orientation(), seed, &gains);
   c.refusal = path_refusal(pc.status);
   c.q_end = pc.q_end;
 }

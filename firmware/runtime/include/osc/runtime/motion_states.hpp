@@ -81,7 +81,9 @@ namespace osc {
   X(Dropped, "dropped",                                                                                             \
     "a queued move that never started: the motion ahead of it was stopped, re-targeted or faulted")                 \
   X(NotNeeded, "not_needed",                                                                                        \
-    "a home or a declare_pose on an arm with absolute encoders: its angles are known from power-on")
+    "a home or a declare_pose on an arm with absolute encoders: its angles are known from power-on")                \
+  X(UnstableLoop, "unstable_loop",                                                                                  \
+    "the path passes a pose where the gains would make the sampled closed loop unstable (motion generator)")
 
 #define OSC_COMMAND_OUTCOME_LIST(X)                   \
   X(None, "none", "no command this tick")             \
@@ -132,7 +134,7 @@ OSC_MOTION_ENUM(CollisionReaction, OSC_COLLISION_REACTION_LIST);
 // A list that grows fails here: motion_next() and its table must say what the new entry does.
 static_assert(MotionNames<MotionState>::kCount == static_cast<int>(MotionState::kHoming) + 1);
 static_assert(MotionNames<MotionCommand>::kCount == static_cast<int>(MotionCommand::kDeclarePose) + 1);
-static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kNotNeeded) + 1);
+static_assert(MotionNames<MotionReason>::kCount == static_cast<int>(MotionReason::kUnstableLoop) + 1);
 static_assert(MotionNames<CommandOutcome>::kCount == static_cast<int>(CommandOutcome::kRefused) + 1);
 static_assert(MotionNames<StopCategory>::kCount == static_cast<int>(StopCategory::kCategory2) + 1);
 static_assert(MotionNames<MotionCompletion>::kCount == static_cast<int>(MotionCompletion::kHomed) + 1);

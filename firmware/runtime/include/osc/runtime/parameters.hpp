@@ -212,7 +212,7 @@ template <class S>
 Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
   ArmOpSpace<S> os;
   opspace_update(task.model, task.check_data, os, task.state.adapt.q_prev, task.state.R_ref);
-  return lambda_inverse(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
+  return lambda_inverse<double>(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
 }
 
 /// Whether gains of these margins may run (GainMargins' rules), and which check fails first.
