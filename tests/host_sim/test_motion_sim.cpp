@@ -466,15 +466,6 @@ TEST(MotionSim, AMoveIntoTheWristSingularityStopsByName) {
       held ? "held" : "fault singular");
 }
 
-/// Lambda^-1 at q in the controller's coordinates relative to R_ref.
-Mat6<double> lambda_inverse_at(const V6& q, const Mat3<double>& R_ref) {
-  static const Model<double> model = Model<double>::of(robot::kArm);
-  Data<double> data;
-  ArmOpSpace<double> os;
-  opspace_update(model, data, os, q, R_ref);
-  return lambda_inverse(data.A, os.Ja);
-}
-
 /// The first pose on the elbow's or the shoulder's sweep from the start pose (least_rcond_on_sweep's, J's reciprocal
 /// condition above kPathMinRcond all the way) where the coupled sampled loop at the gains g is unstable (the
 /// reference of tests/support/sampled_loop_reference.hpp, not the check's bound): an axis of Lambda^-1 so light there
@@ -490,7 +481,7 @@ SweptSingularity first_unstable_on_sweep(const Mat3<double>& R_ref, const Gains<
         if (q(j) < robot::kArm.q_min[j] + params::kWorkspaceMargin ||
             q(j) > robot::kArm.q_max[j] - params::kWorkspaceMargin || test::jacobian_rcond(q) < params::kPathMinRcond)
           break;
-        if (test::coupled_spectral_radius(g, lambda_inverse_at(q, R_ref)) > rho) {
+        if (test::coupled_spectral_radius(g, test::lambda_inverse_at(q, R_ref)) > rho) {
           if (best.steps == 0 || k < best.steps) best = {q, test::jacobian_rcond(q), k};
           break;
         }
@@ -512,7 +503,7 @@ TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
   run_ticks(sim, 100);
   const Mat3<double> R_ref = sim.task().gen.reference_orientation();
   const Gains<double> g = sim.task().gains.template cast<double>();
-  EXPECT_GT(gain_margins(g, lambda_inverse_at(start_pose(), R_ref)).loop, 2) << "room at the start pose";
+  EXPECT_GT(gain_margins(g, test::lambda_inverse_at(start_pose(), R_ref)).loop, 2) << "room at the start pose";
   const SweptSingularity light = first_unstable_on_sweep(R_ref, g);
   if (light.steps == 0)
     GTEST_SKIP() << robot::kArm.name << ": no pose on the elbow's or shoulder's sweep loses the loop";
@@ -520,7 +511,7 @@ TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
       "%s: the coupled loop is lost at q = %.3f %.3f %.3f %.3f %.3f %.3f (rcond %.3f, Lambda^-1's largest "
       "eigenvalue %.1f)\n",
       robot::kArm.name, light.q(0), light.q(1), light.q(2), light.q(3), light.q(4), light.q(5), light.rcond,
-      Eigen::SelfAdjointEigenSolver<Mat6<double>>(lambda_inverse_at(light.q, R_ref)).eigenvalues().maxCoeff());
+      Eigen::SelfAdjointEigenSolver<Mat6<double>>(test::lambda_inverse_at(light.q, R_ref)).eigenvalues().maxCoeff());
   EXPECT_GT(light.rcond, 5 * params::kPathMinRcond) << "not near a singularity";
   EXPECT_EQ(answer_move(sim, to_joint_pose(light.q), 2).refusal, MotionReason::kUnstableLoop);
   // Where it grows 2 % a tick, the arm started there without the check does not stay in control (below that the

@@ -6,8 +6,11 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "osc/control/arm_opspace.hpp"
 #include "osc/control/gains.hpp"
 #include "osc/control/params.hpp"
+#include "osc/control/sampled_loop.hpp"
+#include "osc/robot.hpp"
 
 namespace osc::test {
 
@@ -56,6 +59,15 @@ inline double loop_spectral_radius(const A&... a) {
 /// The coupled loop of the six axes through Lambda^-1 at the gains g: its spectral radius (below 1: stable).
 inline double coupled_spectral_radius(const Gains<double>& g, const Mat6<double>& lambda_inv, double phi = kLoopPhi) {
   return loop_spectral_radius<6>(lambda_inv, g.k, g.ks, g.knd, g.ki, g.dt, phi);
+}
+
+/// Lambda^-1 at q (the build's arm) in the controller's coordinates relative to R_ref: its A and analytic Jacobian.
+inline Mat6<double> lambda_inverse_at(const Vec6<double>& q, const Mat3<double>& R_ref) {
+  static const Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  ArmOpSpace<double> os;
+  opspace_update(model, data, os, q, R_ref);
+  return lambda_inverse(data.A, os.Ja);
 }
 
 }  // namespace osc::test

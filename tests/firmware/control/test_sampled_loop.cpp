@@ -100,11 +100,8 @@ TEST(SampledLoop, TheFloatFormJudgesAsTheDoubleReference) {
 Mat6<double> lambda_inverse_at(const Vec6<double>& q) {
   static const Model<double> model = Model<double>::of(robot::kArm);
   Data<double> data;
-  ArmOpSpace<double> os;
   forward_kinematics(model, data, q);
-  const Mat3<double> R_ref = data.R[kDof];
-  opspace_update(model, data, os, q, R_ref);
-  return lambda_inverse(data.A, os.Ja);
+  return test::lambda_inverse_at(q, Mat3<double>(data.R[kDof]));
 }
 
 /// Gains drawn log-uniformly within each element's range (params.hpp), the x y z alike, the

@@ -160,15 +160,19 @@ struct LoopBounds {
   Real kappa[kDof], sigma[kDof], a[kDof], b[kDof];
 };
 
+/// Whether an axis's loop is stable at its bound and every fraction of it.
+inline bool form_stable_below(const AxisForm& x) {
+  Real f = 1;
+  for (int m = 0; m < kMassSteps; ++m, f *= Real(0.5))
+    if (!form_stable(x, f)) return false;
+  return true;
+}
+
 /// Whether the loop of every axis is stable with the gains scaled by s, every inverse mass from
 /// each axis's bound down.
 inline bool stable(const LoopBounds& l, Real s = 1) {
-  for (int i = 0; i < kDof; ++i) {
-    const AxisForm x = axis_form(s * l.kappa[i], s * l.sigma[i], s * l.a[i], s * l.b[i]);
-    Real f = 1;
-    for (int m = 0; m < kMassSteps; ++m, f *= Real(0.5))
-      if (!form_stable(x, f)) return false;
-  }
+  for (int i = 0; i < kDof; ++i)
+    if (!form_stable_below(axis_form(s * l.kappa[i], s * l.sigma[i], s * l.a[i], s * l.b[i]))) return false;
   return true;
 }
 
@@ -240,11 +244,7 @@ LoopBounds path_bounds(const PathLoop& p, const Mat6<S>& lambda_inv) {
 }
 /// Whether axis i's loop is stable at its bound and every fraction of it (stable()'s test of one axis).
 inline bool axis_stable(const LoopBounds& l, int i) {
-  const AxisForm x = axis_form(l.kappa[i], l.sigma[i], l.a[i], l.b[i]);
-  Real f = 1;
-  for (int m = 0; m < kMassSteps; ++m, f *= Real(0.5))
-    if (!form_stable(x, f)) return false;
-  return true;
+  return form_stable_below(axis_form(l.kappa[i], l.sigma[i], l.a[i], l.b[i]));
 }
 /// Whether the loop of every axis is stable at Lambda^-1 (any scalar) times path_loop's scale.
 template <class S>
