@@ -65,6 +65,8 @@ class LocalController {
       const double ratio = th > 0 ? ri / th : 0;
       const double position = static_cast<double>(task_->position.ratio(i));
       if (position > residual_.position_peak_ratio[i]) residual_.position_peak_ratio[i] = position;
+      const double oscillation = task_->oscillation.ratio(i);
+      if (oscillation > residual_.oscillation_peak_ratio[i]) residual_.oscillation_peak_ratio[i] = oscillation;
       if (m.primed && th > 0 && ratio > residual_.residual_peak_ratio[i]) {
         residual_.residual_peak_ratio[i] = ratio;
         residual_.residual_peak_s[i] = static_cast<double>(task_->tick - 1) / osc::params::kControlHz;
@@ -95,6 +97,7 @@ class LocalController {
       res.residual_peak_Nm[i] = residual_.residual_peak_Nm[i];
       res.residual_threshold_Nm[i] = residual_.residual_threshold_Nm[i];
       res.position_peak_ratio[i] = residual_.position_peak_ratio[i];
+      res.oscillation_peak_ratio[i] = residual_.oscillation_peak_ratio[i];
     }
     const osc::ResidualMonitor<S>& m = task_->residual;
     for (int i = 0; i < 6; ++i) {

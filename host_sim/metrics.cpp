@@ -270,6 +270,7 @@ void StuckMonitorPeaks::to_json(Json& j) const {
   j["residual_monitor_peak_Nm"] = json_array(residual_peak_Nm, 6);
   j["residual_monitor_threshold_at_peak_Nm"] = json_array(residual_threshold_Nm, 6);
   j["position_check_peak_ratio"] = json_array(position_peak_ratio, 6);
+  j["oscillation_monitor_peak_ratio"] = json_array(oscillation_peak_ratio, 6);
   j["residual_monitor_travel_ratio"] = json_array(travel_peak_ratio, 6);
   j["residual_monitor_detection"] = residual_detection_json(residual_detected_s, residual_fault, residual_joint);
 }

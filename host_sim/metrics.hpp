@@ -172,6 +172,7 @@ struct StuckMonitorPeaks {
   std::uint32_t residual_fault = 0;       ///< ... its fault
   int residual_joint = -1;                ///< ... its joint (0-based)
   double position_peak_ratio[6] = {};     ///< the position cross-check's largest |d - d_ref| / band per joint
+  double oscillation_peak_ratio[6] = {};  ///< the oscillation monitor's largest half-rate amplitude / limit per joint
   double travel_peak_ratio[6] = {};       ///< the travel check's largest least travel / its limit per joint (0: off)
   void to_json(Json& j) const;
 };

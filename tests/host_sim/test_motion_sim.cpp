@@ -37,6 +37,7 @@ struct Trace {
   std::uint32_t faults = 0;
   double tracking = 0;                // largest |reference position - true tip| while torque was on [m]
   double tip_moved = 0;               // largest |tip - tip at the start of the run| [m]
+  double oscillation = 0;             // the oscillation monitor's largest ratio to its limit, any joint
   std::vector<MotionReport> reports;  // every tick's report with something in it
   bool ended = false;                 // the predicate became true
 };
@@ -55,6 +56,7 @@ Trace run_until(MotionSim<S>& sim, Pred done, int max_ticks) {
     if (motion_powered(sim.task().machine.state))
       r.tracking = std::max(r.tracking, (sim.reference().template head<3>() - sim.tip()).norm());
     r.tip_moved = std::max(r.tip_moved, (sim.tip() - tip0).norm());
+    for (int i = 0; i < kDof; ++i) r.oscillation = std::max(r.oscillation, sim.task().oscillation.ratio(i));
     if (done(sim)) {
       r.ended = true;
       break;
@@ -416,54 +418,79 @@ TEST(MotionSim, PathChecksRefuseLeavingTheWorkspaceAndPassingASingularity) {
   EXPECT_EQ(r.faults, 0u);
 }
 
-/// A move into the wrist singularity on joint 5's sweep (least_rcond_on_sweep), prepared without the path check
-/// (which refuses it, above): the tick's check aborts it, category 2 (limit_reached), when J's reciprocal
-/// condition falls below params::kLimitMinRcond; the stop then either holds, or, where braking carries the arm on
-/// to the controller's own threshold (kMinJacobianRcond), ends in the named fault `singular` (category 0: zero
-/// torque in that tick). Nothing else: no other fault, no non-finite value. The condition at the abort and the least
-/// while braking, measured, are printed (the PUMA: aborted at 1.99e-3, braking reached 1.0e-3: `singular`).
-/// The elbow's and the shoulder's poses on their sweeps are far from the start pose: on the PUMA a move there without
-/// the path check passes a light axis first, where the sampled loop is lost
-/// (APathThroughALightAxisIsRefusedUnstableLoop).
-TEST(MotionSim, AMoveIntoTheWristSingularityStopsByName) {
-  const auto& s = kSingularities[0];
-  const SweptSingularity sing = least_rcond_on_sweep(s.joint);
-  ASSERT_LT(sing.rcond, params::kPathMinRcond) << "joint 5's sweep reaches the wrist singularity";
-  MotionSim<double> sim(start_pose());
-  answer(sim, MotionVerb::kEnable, 1);
-  run_ticks(sim, 100);
-  start_unchecked(sim, to_joint_pose(sing.q), 2);
-  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
-  const Trace r = run_until(
-      sim, [](const MotionSim<double>& m) { return m.task().report.abort != MotionReason::kNone; }, 60000);
-  ASSERT_TRUE(r.ended);
-  EXPECT_EQ(sim.task().report.abort, MotionReason::kLimitReached);
-  EXPECT_EQ(r.faults, 0u) << fault_name(r.faults);
-  const double at_abort = static_cast<double>(sim.task().last.rcond);
-  EXPECT_LT(at_abort, params::kLimitMinRcond);
-  EXPECT_GE(at_abort, params::kMinJacobianRcond);
-  double least = at_abort;
-  const Trace rest = run_until(
-      sim,
-      [&](const MotionSim<double>& m) {
-        if (motion_powered(m.task().machine.state)) least = std::min(least, static_cast<double>(m.task().last.rcond));
-        return state_is(m, MotionState::kHolding) || state_is(m, MotionState::kFault);
-      },
-      10000);
-  ASSERT_TRUE(rest.ended);
-  const bool held = state_is(sim, MotionState::kHolding);
-  if (held) {
-    EXPECT_EQ(rest.faults, 0u) << fault_name(rest.faults);
-  } else {
-    EXPECT_EQ(rest.faults, static_cast<std::uint32_t>(kFaultSingular)) << fault_name(rest.faults);
-    for (int i = 0; i < kDof; ++i) EXPECT_EQ(sim.task().codes[i], 0) << "zero torque in the fault's tick";
+/// A move into each singularity on its joint's sweep (least_rcond_on_sweep: the wrist's, the elbow's, and the
+/// shoulder's where the sweep reaches one), prepared without the path check (which refuses it, above), stops by
+/// name and never reaches its end:
+/// - the tick's check aborts it, category 2 (limit_reached), when J's reciprocal condition falls below
+///   params::kLimitMinRcond (or a joint reaches its limit on the way); the stop then either holds, or, where
+///   braking carries the arm on to the controller's own threshold (kMinJacobianRcond), ends in the named fault
+///   `singular` (category 0: zero torque in that tick);
+/// - or, before J is near singular, the path passes a light axis of Lambda^-1 where the sampled loop is lost
+///   (APathThroughALightAxisIsRefusedUnstableLoop), and the oscillation monitor stops the arm: `unstable`
+///   (category 0).
+/// Nothing else: no other fault, no non-finite value. The condition at the abort or the fault and the least while
+/// braking, measured, are printed (the PUMA's wrist: aborted at 1.99e-3, braking reached 1.0e-3: `singular`).
+TEST(MotionSim, AMoveIntoEachSingularityStopsByName) {
+  int found = 0;
+  for (const auto& s : kSingularities) {
+    SCOPED_TRACE(s.name);
+    const SweptSingularity sing = least_rcond_on_sweep(s.joint);
+    if (sing.rcond >= params::kPathMinRcond) continue;  // none on this joint's sweep (the PUMA's shoulder)
+    ++found;
+    MotionSim<double> sim(start_pose());
+    answer(sim, MotionVerb::kEnable, 1);
+    run_ticks(sim, 100);
+    start_unchecked(sim, to_joint_pose(sing.q), 2);
+    ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+    double least = 1;
+    const Trace r = run_until(
+        sim,
+        [&](const MotionSim<double>& m) {
+          if (motion_powered(m.task().machine.state)) least = std::min(least, static_cast<double>(m.task().last.rcond));
+          return m.task().report.abort != MotionReason::kNone || state_is(m, MotionState::kFault) ||
+                 m.task().report.done_id == 2;
+        },
+        60000);
+    ASSERT_TRUE(r.ended);
+    ASSERT_NE(sim.task().report.done_id, 2u) << "the move reached the singular pose";
+    const double at_stop = static_cast<double>(sim.task().last.rcond);
+    const char* how = "";
+    if (state_is(sim, MotionState::kFault)) {
+      // The loop lost on the way, before J is near singular.
+      EXPECT_EQ(r.faults, static_cast<std::uint32_t>(kFaultUnstable)) << fault_name(r.faults);
+      EXPECT_GE(at_stop, params::kLimitMinRcond);
+      for (int i = 0; i < kDof; ++i) EXPECT_EQ(sim.task().codes[i], 0) << "zero torque in the fault's tick";
+      how = "fault unstable";
+    } else {
+      EXPECT_EQ(sim.task().report.abort, MotionReason::kLimitReached);
+      EXPECT_EQ(r.faults, 0u) << fault_name(r.faults);
+      EXPECT_GE(at_stop, params::kMinJacobianRcond);
+      const Trace rest = run_until(
+          sim,
+          [&](const MotionSim<double>& m) {
+            if (motion_powered(m.task().machine.state))
+              least = std::min(least, static_cast<double>(m.task().last.rcond));
+            return state_is(m, MotionState::kHolding) || state_is(m, MotionState::kFault);
+          },
+          10000);
+      ASSERT_TRUE(rest.ended);
+      if (state_is(sim, MotionState::kHolding)) {
+        EXPECT_EQ(rest.faults, 0u) << fault_name(rest.faults);
+        how = "aborted limit_reached, held";
+      } else {
+        EXPECT_EQ(rest.faults, static_cast<std::uint32_t>(kFaultSingular)) << fault_name(rest.faults);
+        for (int i = 0; i < kDof; ++i) EXPECT_EQ(sim.task().codes[i], 0) << "zero torque in the fault's tick";
+        how = "aborted limit_reached, then fault singular";
+      }
+    }
+    EXPECT_TRUE(std::isfinite(least) && least > 0);
+    std::printf(
+        "%s, %s singularity (q%d = %.3f rad, rcond %.2e there): %s; rcond %.2e at the stop, least %.2e while "
+        "powered (limit %.0e, fault %.0e), after %d ticks\n",
+        robot::kArm.name, s.name, s.joint + 1, sing.q(s.joint), sing.rcond, how, at_stop, least, params::kLimitMinRcond,
+        params::kMinJacobianRcond, r.ticks);
   }
-  EXPECT_TRUE(std::isfinite(least) && least > 0);
-  std::printf(
-      "%s, wrist singularity (q5 = %.3f rad, rcond %.2e there): aborted limit_reached at rcond %.2e, least "
-      "%.2e while braking (limit %.0e, fault %.0e): %s\n",
-      robot::kArm.name, sing.q(s.joint), sing.rcond, at_abort, least, params::kLimitMinRcond, params::kMinJacobianRcond,
-      held ? "held" : "fault singular");
+  EXPECT_GE(found, 2) << "the wrist's and the elbow's sweeps reach their singularities";
 }
 
 /// The first pose on the elbow's or the shoulder's sweep from the start pose (least_rcond_on_sweep's, J's reciprocal
@@ -494,8 +521,8 @@ SweptSingularity first_unstable_on_sweep(const Mat3<double>& R_ref, const Gains<
 /// an eigenvalue of 34.5: the gains' sampled loop is unstable there, the torques alternated sign every tick and grew,
 /// and the residual monitor stopped the arm. The path check now judges the loop at each sample (kUnstableLoop): a move
 /// to the first pose where the coupled loop is unstable is refused `unstable_loop`, and so is one to where it grows
-/// 2 % a tick; started without the check, the latter does not stay in control (category 0: the PUMA's ends in
-/// `saturation`). An arm whose sweeps reach
+/// 2 % a tick; started without the check, the latter does not stay in control, and the oscillation monitor stops it
+/// (category 0, `unstable`; before it, the PUMA's ended in `saturation` after 4 463 ticks). An arm whose sweeps reach
 /// no such pose before a singularity skips, saying so.
 TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
   MotionSim<double> sim(start_pose());
@@ -523,7 +550,8 @@ TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
   const Trace r = run_until(
       sim, [](const MotionSim<double>& m) { return state_is(m, MotionState::kFault); }, 30000);
-  EXPECT_NE(r.faults, 0u) << "the arm held the pose with the loop lost there for 30 s";
+  EXPECT_EQ(r.faults, static_cast<std::uint32_t>(kFaultUnstable))
+      << fault_name(r.faults) << ": the oscillation monitor names it (0: the arm held the pose for 30 s)";
   EXPECT_TRUE(state_is(sim, MotionState::kFault));
   for (int i = 0; i < kDof; ++i) EXPECT_EQ(sim.task().codes[i], 0) << "zero torque after the fault";
   std::printf("started without the path check: %s after %d ticks\n", std::string(fault_name(r.faults)).c_str(),
@@ -805,7 +833,7 @@ TEST(MotionSim, FiftySeededRandomMovesAtTheMaximaTrackWithinOneMillimetre) {
   run_until(
       sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
   int moves = 0, refused = 0;
-  double worst = 0, fastest = 0, hardest = 0;
+  double worst = 0, fastest = 0, hardest = 0, shaking = 0;
   for (std::uint32_t id = 10; moves < 50; ++id) {
     MoveRequest<double> req = relative<double>(d(rng), d(rng), d(rng));
     req.has_rpy = true;
@@ -831,15 +859,19 @@ TEST(MotionSim, FiftySeededRandomMovesAtTheMaximaTrackWithinOneMillimetre) {
     ASSERT_TRUE(r.ended) << "move " << id;
     ASSERT_EQ(r.faults, 0u) << fault_name(r.faults) << " in move " << id;
     EXPECT_LE(r.tracking, 1e-3) << "move " << id;
+    EXPECT_LE(r.oscillation, 0.5) << "the oscillation monitor's healthy margin, move " << id;
     EXPECT_LE(speed, params::kMoveLinear[0] * (1 + 1e-9)) << "move " << id;
     EXPECT_LE(accel, params::kMoveLinear[1] * (1 + 1e-9)) << "move " << id;
     worst = std::max(worst, r.tracking);
     fastest = std::max(fastest, speed);
     hardest = std::max(hardest, accel);
+    shaking = std::max(shaking, r.oscillation);
     run_ticks(sim, 100);
   }
   std::printf(
       "%s: 50 random moves (%d refused by the path check): tracking at most %.4f mm, reference speed at "
-      "most %.4f m/s (maximum %.2f), acceleration at most %.4f m/s^2 (maximum %.2f)\n",
-      robot::kArm.name, refused, worst * 1e3, fastest, params::kMoveLinear[0], hardest, params::kMoveLinear[1]);
+      "most %.4f m/s (maximum %.2f), acceleration at most %.4f m/s^2 (maximum %.2f); oscillation monitor at most "
+      "%.3f of its limit\n",
+      robot::kArm.name, refused, worst * 1e3, fastest, params::kMoveLinear[0], hardest, params::kMoveLinear[1],
+      shaking);
 }

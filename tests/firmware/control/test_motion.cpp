@@ -19,7 +19,12 @@ namespace {
 
 TEST(MotionGenerator, StopDeceleratesAlongThePathWithinTheLimits) {
   const Pose<double> a = pose(0.5, -0.2, 0.3, {0, 0, 0}), b = pose(0.5, 0.3, 0.2, {0, 0, 1.2});
-  for (int at : {50, 400, 1500, 3000}) {
+  // Stopped while speeding up, at the middle and at three quarters of the move (cruising at the arm's maxima,
+  // before its deceleration: a stop there must come to rest sooner than the move would have ended).
+  CartesianMove<double> planned;
+  ASSERT_EQ(planned.plan(a, b, kLim, a.R), ProfileStatus::kOk);
+  const int ticks = static_cast<int>(planned.duration() * kHz);
+  for (int at : {50, 400, ticks / 2, 3 * ticks / 4}) {
     MotionGenerator<double> g;
     g.hold(a, a.R);
     CartesianMove<double> m;

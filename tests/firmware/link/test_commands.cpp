@@ -298,7 +298,7 @@ TEST(CommandFrames, StreamPeriodBoundsAndOtherVerbsIgnoreIt) {
   f.period = 10;
   f.flags = pil::kFlagHasLimits | pil::kFlagRelative;
   const double lim[6] = {max.linear.v / 2, max.linear.a, max.linear.j, max.angular.v, max.angular.a, max.angular.j};
-  for (int i = 0; i < 6; ++i) f.limits[i] = static_cast<float>(lim[i]);
+  for (int i = 0; i < 6; ++i) f.limits[i] = detail::f32_at_most(lim[i]);  // as a client sends them: at most
   const MotionGenerator<double> g;
   TaskCommand<double> c = prepare_frame_command(g, max, 1, params::kControlHz, f);
   EXPECT_EQ(c.refusal, MotionReason::kNone);
@@ -642,11 +642,17 @@ TEST(CommandFrames, AnAnswerFrameReadsBackAsTheReport) {
 TEST(CommandFrames, LimitsAreSentAsTheF32AtMostThem) {
   MoveRequest<double> req;
   req.has_limits = true;
-  req.limits = CartesianLimits<double>::defaults();  // 0.1 m/s: above its nearest f32
+  req.limits = CartesianLimits<double>::defaults();  // the arm's maxima: 0.2 m/s lies below its nearest f32
   const pil::CommandFrame f = frame_from_command(1, MotionVerb::kMoveTo, req);
-  EXPECT_LE(static_cast<double>(f.limits[0]), 0.1);
-  EXPECT_EQ(f.limits[0], std::nextafter(0.1f, 0.0f));
-  EXPECT_EQ(f.limits[1], 0.25f);  // exact ones stay
+  const double lim[3] = {req.limits.linear.v, req.limits.linear.a, req.limits.linear.j};
+  int rounded_down = 0;
+  for (int i = 0; i < 3; ++i) {
+    // The largest f32 at most the limit: an exact one stays, any other is rounded down.
+    EXPECT_LE(static_cast<double>(f.limits[i]), lim[i]) << i;
+    EXPECT_GT(static_cast<double>(std::nextafter(f.limits[i], HUGE_VALF)), lim[i]) << i;
+    rounded_down += static_cast<double>(f.limits[i]) < lim[i];
+  }
+  EXPECT_GE(rounded_down, 1) << "one of the maxima is not an f32 (the case this test is for)";
   // A move at the configured maxima is within them in double too (not over_limit).
   auto task = std::make_unique<ControlTask<double>>();
   task->init(Model<double>::of(robot::kArm), Gains<double>::paper(), FrictionMode::kAdaptive,

@@ -1,6 +1,7 @@
 // The step's checks (osc/runtime/step_monitors.hpp), each alone against its rule written out from
-// docs/safety.md and params::, in double, float and fixed point: the saturation count, the tracking
-// limits, the friction estimates' band, and the position cross-check of the pots against the encoders.
+// docs/safety.md and params::, in double, float and fixed point: the saturation count, the oscillation
+// monitor's half-rate amplitude, the tracking limits, the friction estimates' band, and the position cross-check of the
+// pots against the encoders.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -24,6 +25,71 @@ TEST(Saturation, ConsecutiveClippedTicks) {
   for (int k = 1; k < params::kSaturationTicks; ++k) ASSERT_EQ(m.check(3, true), 0u) << k;
   EXPECT_EQ(m.check(3, true), kFaultSaturation);
   EXPECT_EQ(m.check(2, true), 0u);  // per joint
+}
+
+/// The oscillation monitor fed a joint's codes c(k) (every other joint 0); the first step that faults (-1: none).
+template <class Codes>
+int first_unstable(OscillationMonitor& m, int joint, int steps, Codes c) {
+  std::int32_t codes[kDof] = {};
+  for (int k = 0; k < steps; ++k) {
+    codes[joint] = static_cast<std::int32_t>(c(k));
+    const std::uint32_t f = m.check(codes);
+    if (f != 0) {
+      EXPECT_EQ(f, kFaultUnstable);
+      return k;
+    }
+  }
+  return -1;
+}
+
+/// Its rule, from step_monitors.hpp and params::: a half-rate oscillation of amplitude a is found when a exceeds
+/// kOscillationLimit of the DAC's full scale (its filter settled: the level after n steps is 1 - (1 - 2^-shift)^n of
+/// the amplitude's); smooth commands and white noise of that amplitude are not.
+TEST(Oscillation, AHalfRateAmplitudeBeyondItsLimit) {
+  const double limit = params::kOscillationLimit * kDacMaxCode;
+  const double step = 1.0 / (1 << params::kOscillationShift);
+  OscillationMonitor m;
+  // Held just under the limit for 10 000 steps: none; just over: found once the filter reaches the limit.
+  m.reset();
+  EXPECT_EQ(first_unstable(m, 2, 10000, [&](int k) { return 1000 + (k % 2 ? -0.97 : 0.97) * limit; }), -1);
+  EXPECT_NEAR(m.ratio(2), 0.97, 0.01);
+  m.reset();
+  const int found = first_unstable(m, 2, 10000, [&](int k) { return -500 + (k % 2 ? -1.5 : 1.5) * limit; });
+  // The level reaches 1/1.5 of its final value after n steps: (1 - step)^n = 1/3 (the first step only primes).
+  const double expected = std::log(1.0 / 3) / std::log(1 - step) + 1;
+  EXPECT_NEAR(found, expected, 1.5);
+  // Per joint: the others' zero codes are no oscillation; one tick without a step (reset) restarts it.
+  for (int j = 0; j < kDof; ++j) EXPECT_LT(m.ratio(j), j == 2 ? 2.0 : 1e-9) << j;
+  m.reset();
+  EXPECT_EQ(m.ratio(2), 0);
+  // A smooth command: a torque ramp over 50 ms to full scale, then a sine at 20 Hz of the full scale.
+  m.reset();
+  EXPECT_EQ(first_unstable(m, 0, 5000,
+                           [&](int k) {
+                             return k < 50 ? k / 50.0 * kDacMaxCode
+                                           : kDacMaxCode * std::cos(2 * M_PI * 20 * (k - 50) / 1000.0);
+                           }),
+            -1);
+  EXPECT_LT(m.ratio(0), 0.2);
+  // White noise over the limit's whole amplitude, for 100 000 steps: its half-rate share averages out.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-limit, limit);
+  m.reset();
+  double peak = 0;
+  std::int32_t codes[kDof] = {};
+  for (int k = 0; k < 100000; ++k) {
+    codes[5] = static_cast<std::int32_t>(std::lround(u(rng)));
+    ASSERT_EQ(m.check(codes), 0u) << k;
+    peak = std::max(peak, m.ratio(5));
+  }
+  EXPECT_LT(peak, 0.5);
+  // A loop lost: an oscillation from one code growing 2 % a step is found where its amplitude passes the limit
+  // (the filter lags a growing one by about 2^shift steps' growth).
+  m.reset();
+  const int grown = first_unstable(m, 4, 20000, [](int k) { return (k % 2 ? -1 : 1) * std::pow(1.02, k); });
+  const int at_limit = static_cast<int>(std::ceil(std::log(limit) / std::log(1.02)));
+  EXPECT_GE(grown, at_limit);
+  EXPECT_LE(grown, at_limit + 40);
 }
 
 TYPED_TEST(Monitors, TrackingLimits) {

@@ -88,6 +88,14 @@ constexpr double kEnableRamp = 0.05;
 constexpr double kJointLimitMargin = 0.1;
 /// Consecutive ticks a torque may stay clipped at the DAC range before the saturation fault.
 constexpr int kSaturationTicks = 50;
+/// Oscillation monitor (`unstable`): the largest amplitude of a joint torque's component at half the tick rate
+/// (every other tick up, then down; the torque less its friction compensation), averaged over about
+/// 2^kOscillationShift ticks, as a share of the joint's torque range (its DAC's full scale). Beyond it the sampled
+/// loop is lost: the gains are too high for the arm's inertia at the pose (docs/safety.md, "The oscillation
+/// monitor": twice the healthy runs' largest, 13.3 % at the gains' tops, with a little to spare).
+constexpr double kOscillationLimit = 0.30;
+/// The oscillation monitor's averaging: a first-order filter of 2^kOscillationShift ticks.
+constexpr int kOscillationShift = 4;
 /// Stuck-encoder monitor: the joint motion the reference commands while an encoder stands still,
 /// accumulated from the last count change, beyond which the encoder is stuck [counts]
 /// (docs/safety.md derives it and kStuckTorque from the fault-free peaks, 1.5 times the largest over

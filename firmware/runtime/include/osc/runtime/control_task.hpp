@@ -222,7 +222,7 @@ void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
 }
 
 /// codes: the step's torques (through the enable's ramp) to DAC codes, 0 without a step; the
-/// saturation monitor, a fixed-point overflow of the monitors or the conversion (the step reports
+/// saturation and oscillation monitors, a fixed-point overflow of the monitors or the conversion (the step reports
 /// its own), and the overrun: the tick so far, from its first mark (start), against the period (the
 /// next tick would have arrived).
 template <class S, hal::ControlHal Hal>
@@ -238,6 +238,13 @@ void stage_codes(ControlTask<S>& task, Hal& hal, TickData<S>& t, std::uint32_t s
       t.clipped = t.clipped || c;
       t.faults |= task.saturation.check(i, c);
     }
+    // The oscillation monitor's codes: the torques less the friction compensation, whose sign follows the
+    // velocity estimate's and flips tick by tick at rest (OscillationMonitor).
+    std::int32_t loop[kDof];
+    for (int i = 0; i < kDof; ++i) torque_to_code(i, S(task.last.tau(i) - task.last.tau_f_hat(i)), loop[i]);
+    t.faults |= task.oscillation.check(loop);
+  } else {
+    task.oscillation.reset();
   }
   if (math::take_arithmetic_fault<S>()) t.faults |= kFaultOverflow;
   const std::uint32_t elapsed = hal.cycles() - start;

@@ -221,6 +221,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.stuck.reset(true);  // from this tick's torques: a clear while holding is no torque change
     task.residual.reset();
     task.saturation.reset();
+    task.oscillation.reset();
     task.position.reset();  // learnt again from the next samples (an encoder fault also unhomed the arm)
   }
   if (!motion_powered(st.machine.state)) task.ramping = false;

@@ -5,6 +5,7 @@
 //   ThetaBandMonitor    the friction estimates within their band
 //   PositionCrossCheck  each joint's potentiometer against its encoders (a HAL with pots)
 //   SaturationMonitor   a DAC clipped for params::kSaturationTicks ticks in a row
+//   OscillationMonitor  a DAC code oscillating at half the tick rate (the sampled loop lost)
 #pragma once
 
 #include <array>
@@ -172,6 +173,54 @@ struct SaturationMonitor {
     ticks[joint] = clipped ? static_cast<std::uint16_t>(ticks[joint] + 1) : 0;
     return ticks[joint] >= params::kSaturationTicks ? static_cast<std::uint32_t>(kFaultSaturation) : 0u;
   }
+};
+
+/// unstable: a joint's torque oscillating at half the tick rate, every other tick up then down, with an amplitude
+/// beyond params::kOscillationLimit of its range (the DAC's full scale). That is how a sampled loop is lost: where
+/// an axis of Lambda^-1 is so light that the damping's step passes about 2, the torques alternate sign from tick to
+/// tick and grow (the path check refuses such paths, `unstable_loop`; a stream or an unchecked motion can still
+/// reach one). Without this check the arm shakes at 500 Hz until the residual monitor misreads it as a collision
+/// or a DAC clips for 50 ticks (`saturation`), hundreds of milliseconds later. The torque is the step's less its
+/// friction compensation, as DAC codes (control_task.hpp's stage_codes): the compensation's sign follows the
+/// velocity estimate's and flips from tick to tick about rest (a healthy half-rate share of up to 7.8 % of the
+/// range measured with it, 2.2 % without; the gains' tops 13.3 %: docs/safety.md, "The oscillation monitor"). The
+/// component: each code's difference from the step before, its sign flipped every other step (a half-rate oscillation
+/// of amplitude a gives 2a every tick; a smooth command's differences cancel), averaged by a first-order filter of
+/// 2^kOscillationShift steps. Integers: the same in every scalar. A tick without a step restarts it (its zero codes are
+/// no oscillation).
+struct OscillationMonitor {
+  static constexpr int kShift = params::kOscillationShift;
+  /// The filter's level at the limit: 2^kShift times the differences' 2a.
+  static constexpr std::int32_t kLevelLimit =
+      static_cast<std::int32_t>((1 << kShift) * 2.0 * params::kOscillationLimit * kDacMaxCode);
+  static_assert((std::int64_t{1} << kShift) * 4 * kDacMaxCode < (std::int64_t{1} << 31),
+                "the filter's level fits 32 bits");
+  std::int32_t last[kDof];   // the previous step's codes
+  std::int32_t level[kDof];  // 2^kShift times the filtered half-rate component of the differences
+  bool primed;               // last holds a step's codes
+  bool odd;                  // this step's differences are negated
+
+  void reset() {
+    for (auto& l : level) l = 0;
+    primed = false;
+    odd = false;
+  }
+  std::uint32_t check(const std::int32_t* codes) {
+    std::uint32_t faults = 0;
+    for (int i = 0; i < kDof; ++i) {
+      if (primed) {
+        const std::int32_t d = codes[i] - last[i];
+        level[i] += (odd ? -d : d) - (level[i] >> kShift);
+        if (level[i] > kLevelLimit || level[i] < -kLevelLimit) faults = kFaultUnstable;
+      }
+      last[i] = codes[i];
+    }
+    primed = true;
+    odd = !odd;
+    return faults;
+  }
+  /// Joint i's half-rate amplitude as a share of its limit (the healthy runs' margin).
+  double ratio(int i) const { return (level[i] < 0 ? -level[i] : level[i]) / static_cast<double>(kLevelLimit); }
 };
 
 }  // namespace osc

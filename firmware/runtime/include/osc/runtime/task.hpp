@@ -66,6 +66,7 @@ struct ControlTask {
   std::uint32_t stream_timeout_ticks;    // a stream is stale after max(2 periods, this) without a setpoint
   bool contact;                          // a collision was reacted to (category 2, yield) since the last motion
   SaturationMonitor saturation;
+  OscillationMonitor oscillation;
   PositionCrossCheck<S> position;  // a HAL with potentiometers (hal::PositionHal)
   bool pots;                       // the arm's potentiometers are wired (parameter pots): the cross-check runs
   Supervisor sup;
@@ -115,6 +116,7 @@ struct ControlTask {
     stream_timeout_ticks = stream::ticks(kStreamTimeoutMin);
     contact = false;
     saturation.reset();
+    oscillation.reset();
     position.reset();
     pots = has_pots(robot::kDriveTrain);
     // The paper's procedure places the arm at q_start; absolute encoders read it from power-on.
