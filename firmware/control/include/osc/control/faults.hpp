@@ -36,7 +36,7 @@ namespace osc {
     "a pot and its encoders disagree beyond their band: a stuck or slipping encoder; homing: a pot off its index") \
   X(IndexMissing, "index_missing", "homing: a motor turned a whole revolution and more without an index pulse")    \
   X(Unstable, "unstable",                                                                                          \
-    "a DAC code oscillated at half the tick rate beyond its bound: the sampled loop lost at this pose")
+    "a torque (less its friction compensation) oscillated at half the tick rate beyond its bound: the loop lost")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

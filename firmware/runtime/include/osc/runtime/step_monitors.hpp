@@ -5,7 +5,7 @@
 //   ThetaBandMonitor    the friction estimates within their band
 //   PositionCrossCheck  each joint's potentiometer against its encoders (a HAL with pots)
 //   SaturationMonitor   a DAC clipped for params::kSaturationTicks ticks in a row
-//   OscillationMonitor  a DAC code oscillating at half the tick rate (the sampled loop lost)
+//   OscillationMonitor  a torque (less its friction compensation) oscillating at half the tick rate
 #pragma once
 
 #include <array>
