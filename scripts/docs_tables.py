@@ -1147,13 +1147,17 @@ def plant_hour():
              "|---" * (len(runs) + 1) + "|"]
     rs = [run_of(experiment(*a), "adaptive") for _, a in runs]
 
-    def peaks(key, lim):
-        return " | ".join(", ".join(f"{v:.1f}" for v in r[key]) + f" ({max(v / t for v, t in zip(r[key], lim)):.2f} "
-                          "of a threshold)" for r in rs)
+    def peaks(key, lim, digits=1):
+        def one(r):
+            worst = max(v / t for v, t in zip(r[key], lim))
+            return ", ".join(f"{v:.{digits}f}" for v in r[key]) + f" ({worst:.2f} of a threshold)"
+        return " | ".join(one(r) for r in rs)
     lines.append("| residual monitor, \\|r\\| / threshold, J1..J6 (1) | "
                  + peaks("residual_monitor_peak_ratio", [1.0] * 6) + " |")
     lines.append("| travel check, least travel / limit, J1..J6 (1) | "
                  + peaks("residual_monitor_travel_ratio", [1.0] * 6) + " |")
+    lines.append("| oscillation monitor, half-rate amplitude / limit, J1..J6 (1) | "
+                 + peaks("oscillation_monitor_peak_ratio", [1.0] * 6, 3) + " |")
     return text + "\n" + "\n".join(lines)  # a blank line: the monitors' table is a table of its own
 
 
@@ -1178,7 +1182,9 @@ def monitor_margins():
                 TRIAL, criteria),
                ("the default: the residual monitor armed, the stuck-encoder monitor's fitted criteria off",
                 (), [("residual monitor, \\|r\\| / threshold", "residual_monitor_peak_ratio", [1.0] * 6, ""),
-                     ("travel check, least travel / limit", "residual_monitor_travel_ratio", [1.0] * 6, "")])]
+                     ("travel check, least travel / limit", "residual_monitor_travel_ratio", [1.0] * 6, ""),
+                     ("oscillation monitor, half-rate amplitude / limit", "oscillation_monitor_peak_ratio",
+                      [1.0] * 6, "")])]
     args = {(k, c[1]): ("--duration", "300", "--scalar", k[0], "--friction", k[1], *k[2], *c[1])
             for k in sets for c in configs}
     EXPECTED_FAULTS.update(args.values())  # a false alarm on a healthy arm is this table's finding

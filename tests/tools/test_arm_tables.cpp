@@ -283,11 +283,12 @@ TEST(ArmTables, DriveFactsOfTheNewFields) {
   // The sheet's expressions are the C++ the header carries: 150 / 101 in doubles, not integers.
   EXPECT_NEAR(ur5e::kDriveTrain.motor_torque_limit[0], 150.0 / 101, 1e-15);
   EXPECT_NEAR(ur5e::kDriveTrain.torque_constant[3], 28.0 / 101 / 4, 1e-15);
-  for (const auto* c : {&puma560::kCartesianMaxima, &ur5e::kCartesianMaxima}) {
-    EXPECT_EQ(c->velocity, 0.10);
-    EXPECT_EQ(c->acceleration, 0.25);
-    EXPECT_EQ(c->jerk, 2.5);
-  }
+  EXPECT_EQ(puma560::kCartesianMaxima.velocity, 0.20);
+  EXPECT_EQ(puma560::kCartesianMaxima.acceleration, 0.40);
+  EXPECT_EQ(puma560::kCartesianMaxima.jerk, 2.5);
+  EXPECT_EQ(ur5e::kCartesianMaxima.velocity, 0.10);
+  EXPECT_EQ(ur5e::kCartesianMaxima.acceleration, 0.25);
+  EXPECT_EQ(ur5e::kCartesianMaxima.jerk, 2.5);
   EXPECT_EQ(ur5e::named_pose_code("start"), 0);
   EXPECT_EQ(ur5e::named_pose_code("upright"), 2);
   EXPECT_EQ(ur5e::named_pose_code("nope"), -1);

@@ -642,7 +642,7 @@ TEST(CommandFrames, AnAnswerFrameReadsBackAsTheReport) {
 TEST(CommandFrames, LimitsAreSentAsTheF32AtMostThem) {
   MoveRequest<double> req;
   req.has_limits = true;
-  req.limits = CartesianLimits<double>::defaults();  // the arm's maxima: 0.1 m/s lies below its nearest f32
+  req.limits = CartesianLimits<double>::defaults();  // the arm's maxima (0.1 or 0.2 m/s lie below their nearest f32)
   const pil::CommandFrame f = frame_from_command(1, MotionVerb::kMoveTo, req);
   const double lim[3] = {req.limits.linear.v, req.limits.linear.a, req.limits.linear.j};
   int rounded_down = 0;

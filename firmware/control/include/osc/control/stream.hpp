@@ -166,6 +166,10 @@ class StreamFollower {
       const S k = i < 3 ? kl : kw;
       lim_[i] = {g.v * k, g.a * k, g.j * k};
     }
+    for (int g = 0; g < 2; ++g) {
+      const JerkLimits<S>& a = lim_[3 * g];
+      inv_a_[g] = S(1) / a.a, inv_j_[g] = S(1) / a.j, ramp_[g] = a.a / a.j;
+    }
   }
 
   /// Starts at x0 at rest (the held pose), the stream's period `period_ticks` (1 to 100 ticks: 1 kHz
@@ -276,6 +280,26 @@ class StreamFollower {
   }
   /// The per-axis limits in use.
   const JerkLimits<S>& limits(int axis) const { return lim_[axis]; }
+  /// How far a stop() from now would carry the reference, as a time at its present velocity: half
+  /// the stop's duration (its velocity profile is point-symmetric: a mean of half the start), the
+  /// longer of the two groups'. A group's fastest axis brakes at its full limits (the others at
+  /// theirs scaled in proportion, stopping together), from its coast velocity |v| + a^2 / (2 j)
+  /// (the speed it reaches while its acceleration is ramped to 0): (v_c / a + a / j) / 2. The
+  /// tick's joint-limit check (motion_limits_reached) multiplies the joint rates by it.
+  S stop_lead() const {
+    const S half = lit<S>(0.5);
+    S lead(0);
+    for (int g = 0; g < 6; g += 3) {
+      S vc(0);
+      for (int i = g; i < g + 3; ++i) {
+        const S c = math::abs(s_[i].v) + s_[i].a * s_[i].a * half * inv_j_[g / 3];
+        vc = c > vc ? c : vc;
+      }
+      const S t = half * (vc * inv_a_[g / 3] + ramp_[g / 3]);
+      lead = t > lead ? t : lead;
+    }
+    return lead;
+  }
   /// The target r at this tick and its velocity v_r.
   Vec6<S> target(Vec6<S>& vr) const {
     // The target moves until tau = T (after end()), else until the stream is stale, extrapolating
@@ -320,6 +344,7 @@ class StreamFollower {
   }
 
   JerkLimits<S> lim_[6]{}, stop_[6]{};
+  S inv_a_[2]{}, inv_j_[2]{}, ramp_[2]{};  ///< per group: 1 / a, 1 / j, a / j of its axes' limits (stop_lead)
   jerk_profile::Kin<S> s_[6]{};
   S lo_[6]{};  ///< the positions' residuals below their resolution (step_axis)
   Vec6<S> prev_ = Vec6<S>::Zero(), cur_ = Vec6<S>::Zero();

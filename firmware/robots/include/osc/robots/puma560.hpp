@@ -192,13 +192,12 @@ constexpr ModelErrorBounds kModelErrorBounds = with_friction_band(
 
 /// Cartesian maxima of the operational point's translation: velocity [m/s], acceleration [m/s^2], jerk [m/s^3]: a
 /// move's and a stream's configured maxima (params::kMoveLinear).
-/// Source: The first maxima, every arm's before the sheet held them. Measured with test_motion_sim's 50 seeded random
-/// moves (docs/arms.md, "Speed limits"), the largest tracking error: 0.53 mm at these; 0.885 mm at 0.20 m/s, 0.40
-/// m/s^2; 0.93 mm at 0.20 m/s, 0.50 m/s^2; 1.00 mm at 0.22 m/s; 1.02 mm at 0.25 m/s; 1.25 mm at 0.30 m/s. Not raised
-/// yet: at 0.20 m/s a joint stopped at its limit (a stream's, or a motion the path check did not judge) brakes 0.11
-/// rad past it, beyond the encoders' 0.1 rad plausibility margin (encoder_range, category 0, instead of the
-/// category-2 stop); the tick's limit check must first take the braking distance.
-constexpr CartesianMaxima kCartesianMaxima = {0.1, 0.25, 2.5};
+/// Source: Measured with test_motion_sim's 50 seeded random moves (docs/arms.md, "Speed limits"), the largest
+/// tracking error: 0.53 mm at 0.10 m/s, 0.25 m/s^2 (the first maxima, every arm's before the sheet held them); 0.885
+/// mm at these; 0.93 mm at 0.20 m/s, 0.50 m/s^2; 1.00 mm at 0.22 m/s; 1.02 mm at 0.25 m/s; 1.25 mm at 0.30 m/s. The
+/// largest speed whose moves track within 1 mm, with a margin. A stream into a joint limit stops at it (the tick's
+/// check takes the braking distance, MotionSim.AStreamIntoAJointLimitStopsAtIt).
+constexpr CartesianMaxima kCartesianMaxima = {0.2, 0.4, 2.5};
 
 }  // namespace osc::puma560
 // clang-format on

@@ -36,7 +36,13 @@ Desired<S> yield_reference(const ControlTask<S>& task) {
 }
 
 /// The limits checked every tick of a motion (a category-2 stop when one is reached): each joint
-/// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond.
+/// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond. A stream,
+/// whose path no check has judged, is stopped where its stop would end at the limit: each joint
+/// taken ahead by its rate estimate (one tick old) times the stream's stop lead (the distance its
+/// stop covers, as a time; StreamFollower::stop_lead), since a joint stopped only at its limit
+/// brakes past it (0.11 rad at 0.20 m/s on the PUMA: beyond the encoders' params::kJointLimitMargin).
+/// A move's path and the paper's keep params::kWorkspaceMargin from the limits (the path check);
+/// theirs is the joint itself, which a move passing near a limit and turning away does not reach.
 template <class S>
 MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q) {
   static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
@@ -45,6 +51,12 @@ MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q)
   if (!motion_running(task.machine.state)) return MotionReason::kNone;
   for (int i = 0; i < kDof; ++i)
     if (q(i) < kQMin[i] || q(i) > kQMax[i]) return MotionReason::kLimitReached;
+  const S lead = task.gen.stream_stop_lead();
+  if (lead > S(0))
+    for (int i = 0; i < kDof; ++i) {
+      const S ahead = q(i) + task.state.adapt.qd_hat_prev(i) * lead;
+      if (ahead < kQMin[i] || ahead > kQMax[i]) return MotionReason::kLimitReached;
+    }
   if (task.last.rcond < kMinRcond) return MotionReason::kLimitReached;
   return MotionReason::kNone;
 }
