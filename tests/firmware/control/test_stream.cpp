@@ -259,7 +259,7 @@ TEST(StreamFollower, ACutStreamGoesStaleAndStopsWithinTheLimits) {
     EXPECT_TRUE(f.stopped()) << rate;
     EXPECT_EQ(after.last.xd.norm(), 0.0);
     EXPECT_EQ(after.last.xdd.norm(), 0.0);
-    // Braking from about 0.09 m/s at 0.25 m/s^2 (less the jerk ramps): well within a second.
+    // Braking from the path's peak speed at the arm's acceleration limit (less the jerk ramps): within a second.
     EXPECT_LT(after.ticks, 1000) << rate;
     // Along the direction it was moving in (within 2 degrees).
     const Vec3<double> moved = after.last.x.head<3>() - p0;
@@ -267,6 +267,57 @@ TEST(StreamFollower, ACutStreamGoesStaleAndStopsWithinTheLimits) {
     std::printf("%4u Hz: stale after %d ticks, stop %d ticks over %.1f mm\n", rate, n - last, after.ticks,
                 1e3 * moved.norm());
   }
+}
+
+/// StreamFollower::stop_lead: the distance a stop() then covers, as a time at the velocity it starts from.
+/// Checked against the stop itself (the reference's own travel until it rests), on every axis that moves,
+/// at points of the path where it accelerates (0.6 s), cruises at its peak (1.5 s) and slows (2.4 s); and at
+/// the peak against the analytic (v / a + a / j) / 2 of each group. Measured (double and float alike):
+/// - cruising, the translation's axes 1.00 of their travel; the rotation's 1.36 (the lead is the longer
+///   group's, and the rotation's stop is shorter);
+/// - slowing, 1.64 (the coast velocity counts none of the deceleration under way);
+/// - accelerating, 0.81: **short** of the travel. The coast velocity |v| + a^2 / (2 j) leaves out the distance
+///   covered while the acceleration ramps to 0 and the higher speed after it; a stop there lands past where
+///   the check predicted by a fifth of its braking distance. To be fixed (issue 55, the next step): the
+///   lead from the whole stop, and this bound raised to 0.98 everywhere.
+/// Q12.19 is not in this test: its stop from 0.6 s does not come to exact rest within 5 000 ticks (one
+/// axis keeps 1 LSB of speed and -0.9e-3 m/s^2), a finding for the same step.
+template <class S>
+void check_stop_lead() {
+  for (double at : {0.6, 1.5, 2.4}) {
+    StreamFollower<S> f;
+    const int last = static_cast<int>(at * kHz);
+    stream_path(f, 1000, last + 1, at + 1e-9, true);
+    const Desired<double> d = to_double(f.tick());
+    const double lead = static_cast<double>(f.stop_lead());
+    f.stop();
+    Desired<double> e = d;
+    int ticks = 0;
+    while (!f.stopped() && ticks < 5000) e = to_double(f.tick()), ++ticks;
+    ASSERT_TRUE(f.stopped()) << at;
+    const double least = at < 1 ? 0.78 : 0.98;  // accelerating: short (above)
+    for (int i = 0; i < 6; ++i) {
+      const double v = d.xd(i), travel = e.x(i) - d.x(i);
+      if (std::abs(v) < 1e-3) continue;
+      EXPECT_GE(v * lead / travel, least) << "axis " << i << " at " << at << " s: lead " << lead;
+      EXPECT_LE(v * lead / travel, 1.7) << "axis " << i << " at " << at << " s: lead " << lead;
+    }
+    if (at == 1.5) {  // at the peak speed, the acceleration about 0: each group's (v / a + a / j) / 2
+      double analytic = 0;
+      for (int g = 0; g < 6; g += 3) {
+        const double a = static_cast<double>(f.limits(g).a), j = static_cast<double>(f.limits(g).j);
+        double vmax = 0;
+        for (int i = g; i < g + 3; ++i) vmax = std::max(vmax, std::abs(d.xd(i)));
+        analytic = std::max(analytic, 0.5 * (vmax / a + a / j));
+      }
+      EXPECT_NEAR(lead, analytic, 0.02 * analytic);
+    }
+  }
+}
+
+TEST(StreamFollower, AStopsLeadIsTheDistanceItsStopCovers) {
+  check_stop_lead<double>();
+  check_stop_lead<float>();
 }
 
 /// The same stream in S and double (double at the limits S uses, less its rounding margin), its
