@@ -581,14 +581,12 @@ TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
   const double radius = std::hypot(p0.x(), p0.y());
   const double rate = 0.9 * std::min(lim.linear.v * StreamFollower<double>::kInvSqrt3 / radius,
                                      lim.angular.v * StreamFollower<double>::kInvSqrt3 / kStreamEBound);
-  const double q_start = sim.plant().q()(0);
-  double q_peak = q_start, speed = 0;
+  double q_peak = sim.plant().q()(0), speed = 0;
   std::uint32_t faults = 0;
-  bool aborted = false;
-  MotionReason abort = MotionReason::kNone;
-  for (int k = 0; k < 60000 && !(aborted && state_is(sim, MotionState::kHolding)); ++k) {
+  MotionReason abort = MotionReason::kNone;  // the first abort's reason (the report's lasts a tick)
+  for (int k = 0; k < 60000 && !(abort != MotionReason::kNone && state_is(sim, MotionState::kHolding)); ++k) {
     const double theta = std::min(rate * k * 1e-3, 0.8);
-    if (!aborted && k % req.period == 0) {
+    if (abort == MotionReason::kNone && k % req.period == 0) {
       const Eigen::AngleAxisd turn(theta, V3::UnitZ());
       const V3 dp = turn * p0 - p0, rpy(0, 0, theta);
       V6 v = V6::Zero();
@@ -596,9 +594,11 @@ TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
       sim.setpoint(2, dp, &rpy, theta >= 0.8, &v);
     }
     faults |= sim.tick();
-    if (!aborted && sim.task().report.abort != MotionReason::kNone) abort = sim.task().report.abort, aborted = true;
+    if (abort == MotionReason::kNone) {
+      abort = sim.task().report.abort;
+      speed = std::max(speed, std::abs(sim.plant().qd()(0)));
+    }
     q_peak = std::max(q_peak, sim.plant().q()(0));
-    if (!aborted) speed = std::max(speed, std::abs(sim.plant().qd()(0)));
   }
   EXPECT_EQ(abort, MotionReason::kLimitReached);
   EXPECT_TRUE(state_is(sim, MotionState::kHolding));
