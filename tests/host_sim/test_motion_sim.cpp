@@ -559,6 +559,83 @@ TEST(MotionSim, APathThroughALightAxisIsRefusedUnstableLoop) {
               r.ticks);
 }
 
+/// What a stream turning the arm about the base's z axis did (stream_turn).
+struct Turn {
+  MotionReason abort = MotionReason::kNone;  // the first abort's reason (the report's lasts a tick)
+  double rate = 0;                           // the stream's turn rate [rad/s]
+  double speed = 0, q_peak = 0;              // joint 1's largest |rate| until the abort, its largest angle
+  std::uint32_t faults = 0;
+};
+
+/// Streams (id) a turn of the arm about the base's z axis (joint 1's) at `share` of the follower's per-axis limits,
+/// with velocities, to `to` rad (the stream ended there), until it is done or aborted and the arm holds.
+Turn stream_turn(MotionSim<double>& sim, double share, double to, std::uint32_t id) {
+  MoveRequest<double> req;
+  req.relative = true;
+  req.period = 10;
+  sim.stream(req, id);
+  sim.tick();
+  EXPECT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
+  const V3 p0 = sim.tip();
+  const CartesianLimits<double>& lim = sim.task().limits;
+  const double radius = std::hypot(p0.x(), p0.y());
+  Turn r;
+  r.rate = share * std::min(lim.linear.v * StreamFollower<double>::kInvSqrt3 / radius,
+                            lim.angular.v * StreamFollower<double>::kInvSqrt3 / kStreamEBound);
+  r.q_peak = sim.plant().q()(0);
+  bool done = false;
+  for (int k = 0; k < 60000 && !((done || r.abort != MotionReason::kNone) && state_is(sim, MotionState::kHolding));
+       ++k) {
+    const double theta = std::min(r.rate * k * 1e-3, to);
+    if (r.abort == MotionReason::kNone && !done && k % req.period == 0) {
+      const Eigen::AngleAxisd turn(theta, V3::UnitZ());
+      const V3 dp = turn * p0 - p0, rpy(0, 0, theta);
+      V6 v = V6::Zero();
+      if (theta < to) v << V3::UnitZ().cross(turn * p0) * r.rate, 0, 0, r.rate;
+      sim.setpoint(id, dp, &rpy, theta >= to, &v);
+    }
+    r.faults |= sim.tick();
+    done |= sim.task().report.done_id == id;
+    if (r.abort == MotionReason::kNone) {
+      r.abort = sim.task().report.abort;
+      r.speed = std::max(r.speed, std::abs(sim.plant().qd()(0)));
+    }
+    r.q_peak = std::max(r.q_peak, sim.plant().q()(0));
+  }
+  return r;
+}
+
+/// With joint 1 at rest at (or past) its upper limit: a move turning it further out is refused (out_of_workspace), a
+/// move that leaves it where it is and one turning it back in are accepted and done (the path check lets a path
+/// leave a limit, and the tick's limit check does not stop it: motion_limits_from). Ids id .. id + 2.
+void leave_limit_of_joint1(MotionSim<double>& sim, std::uint32_t id) {
+  const double q0 = sim.plant().q()(0);
+  const V3 p1 = sim.tip(), out = V3::UnitZ().cross(V3(p1.x(), p1.y(), 0)).normalized() * 0.03;  // joint 1's tangent
+  EXPECT_EQ(answer_move(sim, relative<double>(out.x(), out.y(), 0), id).refusal, MotionReason::kOutOfWorkspace)
+      << "a move further out";
+  std::uint32_t faults = 0;
+  for (const V3& d : {V3(0, 0, 0.02), V3(-out)}) {
+    ++id;
+    ASSERT_EQ(answer_move(sim, relative<double>(d.x(), d.y(), d.z()), id).outcome, CommandOutcome::kAccepted)
+        << d.transpose();
+    MotionReason abort = MotionReason::kNone;
+    const Trace r = run_until(
+        sim,
+        [&abort, id](const MotionSim<double>& m) {
+          if (m.task().report.abort != MotionReason::kNone) abort = m.task().report.abort;
+          return m.task().report.done_id == id;
+        },
+        10000);
+    EXPECT_TRUE(r.ended) << d.transpose() << ": done";
+    EXPECT_EQ(abort, MotionReason::kNone) << d.transpose();
+    faults |= r.faults;
+  }
+  EXPECT_EQ(faults, 0u) << fault_name(faults);
+  EXPECT_LT(sim.plant().q()(0), q0 - 0.02) << "joint 1 turned back in";
+  std::printf("from %.4f rad from its limit, joint 1 moved back in to %.4f rad from it\n", q0 - robot::kArm.q_max[0],
+              sim.plant().q()(0) - robot::kArm.q_max[0]);
+}
+
 TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
   // Joint 1 half a radian from its upper limit; a stream (which no path check judges) turns the arm about the
   // base's z axis (joint 1's) at 90 % of the follower's per-axis limits, on to 0.3 rad past the limit. The tick's
@@ -570,44 +647,36 @@ TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
   MotionSim<double> sim(q);
   ASSERT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
   run_ticks(sim, 200);
-  MoveRequest<double> req;
-  req.relative = true;
-  req.period = 10;
-  sim.stream(req, 2);
-  sim.tick();
-  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
-  const V3 p0 = sim.tip();
-  const CartesianLimits<double>& lim = sim.task().limits;
-  const double radius = std::hypot(p0.x(), p0.y());
-  const double rate = 0.9 * std::min(lim.linear.v * StreamFollower<double>::kInvSqrt3 / radius,
-                                     lim.angular.v * StreamFollower<double>::kInvSqrt3 / kStreamEBound);
-  double q_peak = sim.plant().q()(0), speed = 0;
-  std::uint32_t faults = 0;
-  MotionReason abort = MotionReason::kNone;  // the first abort's reason (the report's lasts a tick)
-  for (int k = 0; k < 60000 && !(abort != MotionReason::kNone && state_is(sim, MotionState::kHolding)); ++k) {
-    const double theta = std::min(rate * k * 1e-3, 0.8);
-    if (abort == MotionReason::kNone && k % req.period == 0) {
-      const Eigen::AngleAxisd turn(theta, V3::UnitZ());
-      const V3 dp = turn * p0 - p0, rpy(0, 0, theta);
-      V6 v = V6::Zero();
-      if (theta < 0.8) v << V3::UnitZ().cross(turn * p0) * rate, 0, 0, rate;
-      sim.setpoint(2, dp, &rpy, theta >= 0.8, &v);
-    }
-    faults |= sim.tick();
-    if (abort == MotionReason::kNone) {
-      abort = sim.task().report.abort;
-      speed = std::max(speed, std::abs(sim.plant().qd()(0)));
-    }
-    q_peak = std::max(q_peak, sim.plant().q()(0));
-  }
-  EXPECT_EQ(abort, MotionReason::kLimitReached);
+  const Turn t = stream_turn(sim, 0.9, 0.8, 2);
+  EXPECT_EQ(t.abort, MotionReason::kLimitReached);
   EXPECT_TRUE(state_is(sim, MotionState::kHolding));
-  EXPECT_EQ(faults, 0u) << fault_name(faults);
-  EXPECT_GT(speed, 0.5 * rate) << "the joint turned at the stream's rate";
-  EXPECT_LE(q_peak, robot::kArm.q_max[0] + 0.01) << "not past the limit (the brake taken into account)";
+  EXPECT_EQ(t.faults, 0u) << fault_name(t.faults);
+  EXPECT_GT(t.speed, 0.5 * t.rate) << "the joint turned at the stream's rate";
+  EXPECT_LE(t.q_peak, robot::kArm.q_max[0] + 0.01) << "not past the limit (the brake taken into account)";
   EXPECT_GE(sim.plant().q()(0), robot::kArm.q_max[0] - 0.05) << "and not far before it";
-  std::printf("joint 1 at %.3f rad/s (stream %.3f rad/s): at rest %.4f rad from its limit, peak %.4f\n", speed, rate,
-              sim.plant().q()(0) - robot::kArm.q_max[0], q_peak - robot::kArm.q_max[0]);
+  std::printf("joint 1 at %.3f rad/s (stream %.3f rad/s): at rest %.4f rad from its limit, peak %.4f\n", t.speed,
+              t.rate, sim.plant().q()(0) - robot::kArm.q_max[0], t.q_peak - robot::kArm.q_max[0]);
+  leave_limit_of_joint1(sim, 10);
+}
+
+TEST(MotionSim, AnArmPastAJointLimitCanBeMovedBackInOnly) {
+  // Joint 1 at rest 0.01 rad past its upper limit (within the encoders' margin: no fault), as a stop with any
+  // overshoot would leave it. A stream turning it further out is stopped within params::kLimitStartSlack of where it
+  // started; moves may take it back in, not further out (leave_limit_of_joint1).
+  V6 q = start_pose();
+  q(0) = robot::kArm.q_max[0] + 0.01;
+  MotionSim<double> sim(q);
+  ASSERT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  run_ticks(sim, 300);
+  const double q0 = sim.plant().q()(0);
+  const Turn t = stream_turn(sim, 0.9, 0.3, 2);
+  EXPECT_EQ(t.abort, MotionReason::kLimitReached);
+  EXPECT_EQ(t.faults, 0u) << fault_name(t.faults);
+  EXPECT_LE(t.q_peak, q0 + params::kLimitStartSlack + 0.003)
+      << "stopped near where it started (0.0016 beyond measured)";
+  std::printf("a stream out from %.4f rad past the limit: stopped, peak %.4f rad past\n", q0 - robot::kArm.q_max[0],
+              t.q_peak - robot::kArm.q_max[0]);
+  leave_limit_of_joint1(sim, 10);
 }
 
 }  // namespace
@@ -758,12 +827,16 @@ TEST(MotionSim, StreamWithVelocitiesAtTenHzLagsAFifthOrLess) {
   EXPECT_LE(with_v.lag, plain.lag / 5);
 }
 
-TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
+/// A stream cut mid-path (its last setpoint at 1 s): stale after max(2 T, 20 ms), the category-2 stop to
+/// rest, then held. In every scalar: in Q12.19 the stop once ended 1 unit of speed short of rest and the
+/// arm stayed `stopping` (kStopRestSpeed).
+template <class S>
+void cut_stream() {
   for (int rate : {10, 50, 1000}) {
-    MotionSim<double> sim(start_pose());
+    MotionSim<S> sim(start_pose());
     answer(sim, MotionVerb::kEnable, 1);
     run_ticks(sim, 200);
-    MoveRequest<double> req;
+    MoveRequest<S> req;
     req.relative = true;
     req.period = static_cast<std::uint32_t>(1000 / rate);
     sim.stream(req, 2);
@@ -788,8 +861,9 @@ TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
     EXPECT_EQ(sim.task().report.aborted_id, 2u);
     EXPECT_TRUE(state_is(sim, MotionState::kStopping));
     const Trace stop = run_until(
-        sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+        sim, [](const MotionSim<S>& s) { return state_is(s, MotionState::kHolding); }, 10000);
     EXPECT_TRUE(stop.ended) << rate;
+    EXPECT_LT(stop.ticks, 1500) << rate << ": the stop rests within 1.5 s";
     EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
     const V3 held = sim.tip();
     const Trace hold = run_ticks(sim, 1000);
@@ -799,6 +873,12 @@ TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
     EXPECT_LE((sim.tip() - held).norm(), test::kPumaBuild ? 0.2e-3 : 0.3e-3) << rate;
     EXPECT_TRUE(state_is(sim, MotionState::kHolding));
   }
+}
+
+TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
+  cut_stream<double>();
+  cut_stream<float>();
+  cut_stream<Fixed>();
 }
 
 TEST(MotionSim, StreamRefusalsAndAStopCommand) {

@@ -75,6 +75,12 @@ constexpr double kPathLoopMargin = 1.0;
 /// While moving, a Jacobian whose reciprocal condition falls below this stops the motion (category
 /// 2, limit_reached), before the controller's own threshold faults (category 0).
 constexpr double kLimitMinRcond = 2 * kMinJacobianRcond;
+/// A motion that starts with a joint this close to one of its limits, or past it, may take the joint
+/// this much further out than where it started before the tick's limit check stops it (limit_reached)
+/// [rad]: an arm at rest at a limit (where a stream's stop leaves it, up to its overshoot) can be moved
+/// away, its tracking's first wobble (0.003 rad/s measured) not taken for a motion out of it. A
+/// fraction of the encoders' kJointLimitMargin.
+constexpr double kLimitStartSlack = 0.005;
 /// Points checked along a planned path, besides its end (inverse kinematics at each).
 constexpr int kPathCheckPoints = 16;
 /// Moves a queue holds beyond the one running.

@@ -27,7 +27,9 @@
 //                    tell the two apart without a global solution; the caller reports both as
 //                    out_of_workspace.
 //   kOutOfWorkspace  a joint closer than params::kWorkspaceMargin to one of its limits
-//                    (robot::kArm.q_min, q_max);
+//                    (robot::kArm.q_min, q_max), or beyond it; where the path starts so (an arm a
+//                    stream's stop brought to rest at a limit), only where the joint comes closer to
+//                    the limit than at the start: a path may leave a limit, not go towards it;
 //   kNearSingular    the reciprocal condition that the controller tests (that of the analytic
 //                    Jacobian in the orientation coordinates relative to R_ref, controller.hpp)
 //                    below params::kPathMinRcond, or a singularity crossed since the sample before
@@ -129,6 +131,9 @@ constexpr double kMaxStep = 0.5;
 /// past it, at 16 samples a path).
 constexpr double kPositionTolerance = 1e-4;
 constexpr double kOrientationTolerance = 1e-3;
+/// How much closer to its limit than at the path's start a joint that starts within kWorkspaceMargin of it
+/// may come [rad]: the Newton steps' residual (far below it) on a path that does not move the joint.
+constexpr double kClearanceSlack = 1e-4;
 /// The joint limits in the scalar (converted at compile time).
 template <class S>
 constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
@@ -179,16 +184,32 @@ void newton_step(const ArmJacobianFactor<S>& Jf, const Vec6<S>& e, Vec6<S>& q) {
   q += dq;
 }
 
-/// The smallest distance of a joint of q to its nearer limit [rad].
+/// What the joint-limit test of the first sample leaves for the others': each joint's clearance there.
 template <class S>
-S joint_clearance(const Vec6<S>& q) {
-  S c = lit<S>(kNoClearance);
+struct ClearanceTrace {
+  bool valid = false;  // the first sample was judged
+  S start[kDof] = {};
+};
+
+/// The joint-limit test of a sample at its solution q: a joint closer than kWorkspaceMargin to one of its
+/// limits (or beyond it) fails it, unless the path began there already (an arm a stream's category-2 stop
+/// brought to rest at a limit, motion_limits_reached) and the joint is no closer than it was there, less
+/// kClearanceSlack: a path may leave a limit, not go towards it. r.clearance updated.
+template <class S>
+bool out_of_workspace(const Vec6<S>& q, ClearanceTrace<S>& trace, PathCheck<S>& r) {
+  const S margin = lit<S>(params::kWorkspaceMargin), slack = lit<S>(kClearanceSlack);
+  bool fails = false;
   for (int i = 0; i < kDof; ++i) {
-    const S lo = q(i) - kQMin<S>[i], hi = kQMax<S>[i] - q(i);
-    if (lo < c) c = lo;
-    if (hi < c) c = hi;
+    const S lo = q(i) - kQMin<S>[i], hi = kQMax<S>[i] - q(i), c = lo < hi ? lo : hi;
+    if (c < r.clearance) r.clearance = c;
+    if (!trace.valid) {
+      trace.start[i] = c;
+    } else if (!(c >= margin) && !(trace.start[i] < margin && c >= trace.start[i] - slack)) {
+      fails = true;
+    }
   }
-  return c;
+  trace.valid = true;
+  return fails;
 }
 
 /// What the singularity test of a sample leaves for the next one's: the signs of the geometric
@@ -291,8 +312,8 @@ bool unstable_loop(const Model<S>& model, Data<S>& data, const Mat3<S>& R_ref, c
 /// the sampled loop's test (none: not judged).
 template <class S>
 PathStatus classify(const Model<S>& model, Data<S>& data, const ArmJacobianFactor<S>& Jg, const Pose<S>& target,
-                    const Mat3<S>& R_ref, const Vec6<S>& q, SingularityTrace<S>& trace, PathCheck<S>& r,
-                    const loop::PathLoop* loop, LoopTrace& loop_trace) {
+                    const Mat3<S>& R_ref, const Vec6<S>& q, ClearanceTrace<S>& clearance, SingularityTrace<S>& trace,
+                    PathCheck<S>& r, const loop::PathLoop* loop, LoopTrace& loop_trace) {
   bool aligned;
   const Vec6<S> e = pose_error(data, target, aligned);
   const S ep = e.template head<3>().cwiseAbs().maxCoeff(), eo = e.template tail<3>().cwiseAbs().maxCoeff();
@@ -300,9 +321,7 @@ PathStatus classify(const Model<S>& model, Data<S>& data, const ArmJacobianFacto
   if (!(eo <= r.orientation_error)) r.orientation_error = eo;
   if (!(ep <= lit<S>(kPositionTolerance)) || !(eo <= lit<S>(kOrientationTolerance)) || !aligned)
     return PathStatus::kUnreachable;
-  const S c = joint_clearance(q);
-  if (c < r.clearance) r.clearance = c;
-  if (!(c >= lit<S>(params::kWorkspaceMargin))) return PathStatus::kOutOfWorkspace;
+  if (out_of_workspace(q, clearance, r)) return PathStatus::kOutOfWorkspace;
   if (near_singular(data, Jg, R_ref, trace, r)) return PathStatus::kNearSingular;
   if (loop && unstable_loop(model, data, R_ref, *loop, loop_trace)) return PathStatus::kUnstableLoop;
   return PathStatus::kOk;
@@ -323,6 +342,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
   PathCheck<S> r;
   Vec6<S> q = q_seed;
   ArmJacobianFactor<S> Jf;
+  ClearanceTrace<S> clearance;
   SingularityTrace<S> trace;
   path_check::LoopTrace loop_trace;
   evaluate(model, data, Jf, q);
@@ -333,7 +353,7 @@ PathCheck<S> check_path(const Model<S>& model, Data<S>& data, const CartesianMov
       newton_step(Jf, pose_error(data, target, aligned), q);
       evaluate(model, data, Jf, q);
     }
-    const PathStatus s = classify(model, data, Jf, target, R_ref, q, trace, r, loop, loop_trace);
+    const PathStatus s = classify(model, data, Jf, target, R_ref, q, clearance, trace, r, loop, loop_trace);
     if (s != PathStatus::kOk) {
       r.status = s;
       r.sample = i;

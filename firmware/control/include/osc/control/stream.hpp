@@ -53,7 +53,8 @@
 // least |a_i| (so |a_i| <= the stop's amax): axes whose accelerations are in the proportions of
 // their velocities follow proportional profiles and stop together, so the reference decelerates
 // approximately along its current direction (within 2 degrees in the tests). stopped(): stopped and
-// at rest (v = a = 0 exactly: the last change ends inside a tick at (0, 0)).
+// at rest (v = a = 0 exactly: the last change ends inside a tick at (0, 0); an axis within
+// kStopRestSpeed is set to rest, as Q12.19's last changes are below its resolution).
 //
 // Time in integer ticks. Header-only, allocation-free, templated on the scalar.
 #pragma once
@@ -79,6 +80,12 @@ constexpr double kStreamEBound = 1.42;
 constexpr double kStreamSettle = 1e-5;
 /// The least scale of an axis' limits in a stop (an axis at rest still brings a to 0).
 constexpr double kStopScaleFloor = 0.1;
+/// A stopping axis whose speed is at most this is at rest [m/s, rad/s]: its speed is set to 0 and
+/// its acceleration ramped to 0 at the stop's jerk limit (stop_axis). Two resolutions of Q12.19: in
+/// it a tick's change a dt of a small acceleration (below 1.9e-3 m/s^2) rounds to 0 or one unit, and
+/// a stop ended in a cycle of +-1 unit of speed, never at rest. In double and float the stop ends at
+/// (0, 0) exactly in the tick after it passes below this (a change of a few nanometres).
+constexpr double kStopRestSpeed = 4e-6;
 /// A sample's velocity is clamped to this per axis [m/s, rad/s] (the fixed-point range: the target
 /// is a sum of velocities times at most T = 0.1 s).
 constexpr double kStreamMaxSampleVelocity = 2.0;
@@ -241,7 +248,7 @@ class StreamFollower {
     Desired<S> d;
     for (int i = 0; i < 6; ++i) {
       if (stopping_) {
-        stream::step_axis(s_[i], lo_[i], S(0), stop_[i].a, stop_[i].j, dt);
+        stop_axis(i, dt);
       } else {
         const JerkLimits<S>& l = lim_[i];
         // kp e, bounded by the braking curve sqrt(2 a_b |e|) (a_b = amax / 2), which is the lower
@@ -280,23 +287,39 @@ class StreamFollower {
   }
   /// The per-axis limits in use.
   const JerkLimits<S>& limits(int axis) const { return lim_[axis]; }
-  /// How far a stop() from now would carry the reference, as a time at its present velocity: half
-  /// the stop's duration (its velocity profile is point-symmetric: a mean of half the start), the
-  /// longer of the two groups'. A group's fastest axis brakes at its full limits (the others at
-  /// theirs scaled in proportion, stopping together), from its coast velocity |v| + a^2 / (2 j)
-  /// (the speed it reaches while its acceleration is ramped to 0): (v_c / a + a / j) / 2. The
-  /// tick's joint-limit check (motion_limits_reached) multiplies the joint rates by it.
+  /// How far a stop() from now would carry the reference, as a time at its present velocity: the
+  /// longer of the two groups' (translation, rotation). A group's fastest axis (by its coast velocity
+  /// below) brakes at the group's full limits amax, j (the others at theirs scaled in proportion,
+  /// stopping together). Its stop from (v, a) (v >= 0 taken along the motion, a along it too) is the
+  /// stop from rest acceleration at the coast velocity v_c = v + a^2 / (2 j), which covers
+  ///   v_c (v_c / amax + amax / j) / 2       (half its duration at v_c: the profile is point-symmetric),
+  /// with, when the axis accelerates (a > 0), the ramp of a to 0 before it added, t (v + a t / 3) with
+  /// t = a / j; when it slows (a < 0), the ramp from 0 to a that the stop from v_c would have begun
+  /// with taken off, t (v_c - |a| t / 6). The distance D divided by v, v floored at a^2 / (2 j): no
+  /// jerk-limited motion from rest is slower at that acceleration (it ramped a from 0 at most at j),
+  /// so the floor only bounds the lead where a stream reverses through v = 0 (there the check is a few
+  /// ticks late: 4 mm of the reference at the PUMA's 0.4 m/s^2 from rest). For a trapezoidal stop the
+  /// distance is exact; for a triangular one (v_c < amax^2 / j) it is above. The tick's joint-limit
+  /// check (motion_limits_reached) multiplies the joint rates by it; two divisions a tick.
   S stop_lead() const {
-    const S half = lit<S>(0.5);
+    const S half = lit<S>(0.5), third = lit<S>(1.0 / 3.0), sixth = lit<S>(1.0 / 6.0);
     S lead(0);
-    for (int g = 0; g < 6; g += 3) {
+    for (int g = 0; g < 2; ++g) {
+      int f = 3 * g;
       S vc(0);
-      for (int i = g; i < g + 3; ++i) {
-        const S c = math::abs(s_[i].v) + s_[i].a * s_[i].a * half * inv_j_[g / 3];
-        vc = c > vc ? c : vc;
+      for (int i = 3 * g; i < 3 * g + 3; ++i) {
+        const S c = math::abs(s_[i].v) + s_[i].a * s_[i].a * half * inv_j_[g];
+        if (c > vc) vc = c, f = i;
       }
-      const S t = half * (vc * inv_a_[g / 3] + ramp_[g / 3]);
-      lead = t > lead ? t : lead;
+      const S v = math::abs(s_[f].v), a = s_[f].v < S(0) ? S(-s_[f].a) : s_[f].a;
+      const S t = math::abs(a) * inv_j_[g];
+      S d = half * vc * (vc * inv_a_[g] + ramp_[g]);
+      d += a > S(0) ? S(t * (v + third * a * t)) : S(-(t * (vc - sixth * math::abs(a) * t)));
+      const S floor = a * a * half * inv_j_[g], den = v > floor ? v : floor;
+      if (d > S(0) && den > S(0)) {
+        const S lg = d / den;
+        lead = lg > lead ? lg : lead;
+      }
     }
     return lead;
   }
@@ -341,6 +364,20 @@ class StreamFollower {
       vr(i) = moving ? d * (stream::clamp(D, lit<S>(2.0)) * rate_) + d0 * w0_(i) + d1 * v1_(i) : S(0);
     }
     return r;
+  }
+
+  /// One tick of a stop of axis i: the jerk-limited change to rest (step_axis), or, once its speed is
+  /// within kStopRestSpeed, the speed 0 and the acceleration ramped to 0 at the stop's jerk limit (the
+  /// position no longer moves).
+  void stop_axis(int i, S dt) {
+    jerk_profile::Kin<S>& s = s_[i];
+    if (math::abs(s.v) > lit<S>(kStopRestSpeed)) {
+      stream::step_axis(s, lo_[i], S(0), stop_[i].a, stop_[i].j, dt);
+      return;
+    }
+    const S step = stop_[i].j * dt;
+    s.v = S(0);
+    s.a = math::abs(s.a) <= step ? S(0) : (s.a > S(0) ? S(s.a - step) : S(s.a + step));
   }
 
   JerkLimits<S> lim_[6]{}, stop_[6]{};

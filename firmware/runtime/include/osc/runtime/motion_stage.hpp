@@ -43,19 +43,20 @@ Desired<S> yield_reference(const ControlTask<S>& task) {
 /// brakes past it (0.11 rad at 0.20 m/s on the PUMA: beyond the encoders' params::kJointLimitMargin).
 /// A move's path and the paper's keep params::kWorkspaceMargin from the limits (the path check);
 /// theirs is the joint itself, which a move passing near a limit and turning away does not reach.
+/// The limits are the motion's (ControlTask::q_lo, q_hi: motion_limits_from): the robot's, widened
+/// to params::kLimitStartSlack beyond where the motion found a joint near or past one, so that an
+/// arm a stop left at a limit can be moved away from it (as the path check lets a move leave it).
 template <class S>
 MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q) {
-  static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
-  static constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
   static constexpr S kMinRcond = lit<S>(params::kLimitMinRcond);
   if (!motion_running(task.machine.state)) return MotionReason::kNone;
   for (int i = 0; i < kDof; ++i)
-    if (q(i) < kQMin[i] || q(i) > kQMax[i]) return MotionReason::kLimitReached;
+    if (q(i) < task.q_lo(i) || q(i) > task.q_hi(i)) return MotionReason::kLimitReached;
   const S lead = task.gen.stream_stop_lead();
   if (lead > S(0))
-    for (int i = 0; i < kDof; ++i) {
+    for (int i = 0; i < kDof; ++i) {  // ahead by the stream's stop distance
       const S ahead = q(i) + task.state.adapt.qd_hat_prev(i) * lead;
-      if (ahead < kQMin[i] || ahead > kQMax[i]) return MotionReason::kLimitReached;
+      if (ahead < task.q_lo(i) || ahead > task.q_hi(i)) return MotionReason::kLimitReached;
     }
   if (task.last.rcond < kMinRcond) return MotionReason::kLimitReached;
   return MotionReason::kNone;
@@ -187,6 +188,20 @@ template <class S>
   task.gen.brake(next, params::kControlHz, task.limits);
 }
 
+/// The joint limits of a motion that starts at q (motion_limits_reached): each joint's, widened to
+/// params::kLimitStartSlack beyond q where q is that close to it or past it.
+template <class S>
+void motion_limits_from(ControlTask<S>& task, const Vec6<S>& q) {
+  static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
+  static constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
+  static constexpr S kSlack = lit<S>(params::kLimitStartSlack);
+  for (int i = 0; i < kDof; ++i) {
+    const S lo = q(i) - kSlack, hi = q(i) + kSlack;
+    task.q_lo(i) = lo < kQMin[i] ? lo : kQMin[i];
+    task.q_hi(i) = hi > kQMax[i] ? hi : kQMax[i];
+  }
+}
+
 /// What an accepted command and the machine's step ask of the generator and the controller, from
 /// the next tick on.
 template <class S>
@@ -197,6 +212,10 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (accepted && (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper ||
                    cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kClear))
     task.contact = false;
+  if (accepted && !motion_running(before) &&
+      (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream ||
+       cmd.verb == MotionVerb::kHome))
+    motion_limits_from(task, q);
   if (st.enabling) {
     const Vec6<S> q_now = task.homed ? q : coarse_from_pots(task, q);
     controller_restart(task.model, task.state, q_now);

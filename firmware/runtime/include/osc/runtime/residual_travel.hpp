@@ -100,9 +100,10 @@ inline void ResidualMonitor<S>::count_bounds(int i, S change) {
 
 /// One step of joint i's bounds one way: `force` is the least drive that way less the model's
 /// error; friction is at its strongest against the motion (none when the joint may be going the
-/// other way, where it pushes this way). Static friction holds a joint at rest against what cannot
-/// break it away (half the band's weakest static friction). Returns the least travel (within a
-/// count either way after it: the joint did not count).
+/// other way, where it pushes this way, until the bound reaches rest: from there on, against it).
+/// Static friction holds a joint at rest against what cannot break it away (half the band's weakest
+/// static friction). Returns the least travel (within a count either way after it: the joint did not
+/// count).
 template <class S>
 inline S ResidualMonitor<S>::advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max) {
   const ResidualConstants<S>& c = kResidualConstants<S>;
@@ -112,6 +113,10 @@ inline S ResidualMonitor<S>::advance(Way& w, int i, S force, const Friction& f, 
   const S net = force - (lo >= S(0) ? mul_add(f.vis, lo, f.breakaway) : S(0));
   S next = mul_add(kStep, net / (net < S(0) ? a_min : a_max), lo);
   if (lo >= S(0) && next < S(0) && force + c.static_lo[i] > S(0)) next = S(0);
+  // From below, it reached rest within the step (net = force > 0 at a constant rate, the step's last
+  // next / (next - lo) of it left). From there friction is against it: the breakaway holds it at rest
+  // unless the force exceeds it, and beyond it the rest of the step gains (force - breakaway) / a_max.
+  if (lo < S(0) && next > S(0)) next = force > f.breakaway ? next * (force - f.breakaway) / force : S(0);
   const S cap = c.speed_cap[i];
   next = next < -cap ? -cap : (next > cap ? cap : next);
   w.v(i) = next;

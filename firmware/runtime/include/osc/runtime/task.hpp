@@ -81,6 +81,7 @@ struct ControlTask {
   std::array<S, 2> home_speed;  // the homing move's speeds [m/s, rad/s] (parameter home_speed)
   // The ids of the moves the last tick dropped from the queue (report.dropped_moves of them).
   std::uint32_t dropped_move_ids[MotionGenerator<S>::kMaxWaiting];
+  Vec6<S> q_lo, q_hi;  // the running motion's joint limits (motion_limits_from, motion_limits_reached)
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -99,6 +100,7 @@ struct ControlTask {
     limits = CartesianLimits<S>::defaults();
     desired.x.setZero(), desired.xd.setZero(), desired.xdd.setZero();
     q_queue_end = q0;
+    motion_limits_from(*this, Vec6<S>(q0));
     pending = {};
     sample = {};
     dropped = 0;
