@@ -191,7 +191,7 @@ TYPED_TEST(Monitors, TravelCheckHoldsABoundThatRisesToRestUnderWhatTheBandHolds)
           << "J" << j + 1 << " pull " << pull << ": " << fault_name(kind);
       EXPECT_LT(static_cast<double>(rig.m.travel_peak(j)), 0.5 * static_cast<double>(rig.m.travel_limit(j)))
           << "J" << j + 1 << " pull " << pull;
-      worst = std::max(worst, static_cast<double>(rig.m.travel_peak(j) / rig.m.travel_limit(j)));
+      worst = std::max(worst, static_cast<double>(rig.m.travel_peak(j)) / static_cast<double>(rig.m.travel_limit(j)));
     }
     std::printf("J%d: the least travel's worst share of its limit %.3f\n", j + 1, worst);
   }
