@@ -4,7 +4,10 @@
 Pure Python 3 with pyserial (Debian's python3-serial). The frame layouts and the names of every code
 are not typed here: they come from osc_protocol.json beside this file, which the firmware's own
 declarations write (osc_protocol --client; scripts/client_protocol.py; ctest
-client_protocol_json_current fails when it is stale).
+client_protocol_json_current fails when it is stale). That file is the default arm's (the PUMA 560):
+the limits, named poses and parameter ranges are an arm's. For a board built for another arm, give
+its build's file (BUILD/clients/osc_protocol.json, which every host build writes) with --protocol
+FILE or the environment variable OSC_PROTOCOL.
 
 As a module:
 
@@ -40,6 +43,13 @@ import sys
 import time
 
 PROTOCOL_JSON = os.path.join(os.path.dirname(os.path.abspath(__file__)), "osc_protocol.json")
+
+
+def protocol_path():
+    """The protocol's description: $OSC_PROTOCOL when set (a build for another arm), else the default arm's."""
+    return os.environ.get("OSC_PROTOCOL") or PROTOCOL_JSON
+
+
 WIRE = {"u8": "B", "u32": "I", "i32": "i", "f32": "f"}
 
 
@@ -50,7 +60,8 @@ class ClientError(Exception):
 class Protocol:
     """The command protocol as osc_protocol.json declares it: frame types, layouts, flags, names."""
 
-    def __init__(self, path=PROTOCOL_JSON):
+    def __init__(self, path=None):
+        path = path or protocol_path()
         try:
             with open(path) as f:
                 p = json.load(f)
@@ -750,6 +761,9 @@ def parser():
                                  "or file.")
     ap.add_argument("--port", required=True, help="the serial device or pseudo-terminal (e.g. /dev/pts/7)")
     ap.add_argument("--baud", type=int, default=115200, help="baud rate of a serial device (default 115200)")
+    ap.add_argument("--protocol", metavar="FILE", help="the board's osc_protocol.json (default: $OSC_PROTOCOL, else "
+                    "the default arm's beside this file); a build for another arm writes BUILD/clients/"
+                    "osc_protocol.json")
     ap.add_argument("--timeout", type=positive, default=120.0, help="seconds to wait for an answer or an end")
     ap.add_argument("--keepalive", type=keepalive_seconds, default=Client.KEEPALIVE,
                     help="while waiting, a keep-alive frame after this many seconds without a frame sent (default "
@@ -808,9 +822,10 @@ def main(argv):
     try:
         if a.verb == "stream":
             read_stream_csv(a.file)  # a bad file before the port is touched
+        protocol = Protocol(a.protocol)
         if a.verb == "param":
-            check_param(ap, Protocol(), a)
-        c = Client(a.port, a.baud, keepalive=a.keepalive)
+            check_param(ap, protocol, a)
+        c = Client(a.port, a.baud, protocol=protocol, keepalive=a.keepalive)
         verbs = {"state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param,
                  "declare_pose": cmd_declare_pose}
         return verbs.get(a.verb, cmd_simple)(c, a)

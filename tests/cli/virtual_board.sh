@@ -30,7 +30,8 @@
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
-#   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients
+#   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients;
+#                                      the Python client's protocol file (--protocol, OSC_PROTOCOL) missing or bad
 #
 # usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_PY CASE [IMAGE [SCALAR]]
 # Nothing waits a fixed time for the simulator: each step waits for its answer (generous timeouts).
@@ -362,6 +363,14 @@ PY
       expect 2 '' -- $c --port /dev/null move 1 2
       expect 2 'fly' -- $c --port /dev/null fly
     done
+    # The Python client's protocol description (--protocol, else OSC_PROTOCOL): missing or not JSON,
+    # a named error before the port is opened.
+    expect 2 "$tmp/none.json: cannot read the protocol's description" -- \
+      "$py" "$client" --protocol "$tmp/none.json" --port /dev/null state
+    expect 2 "$tmp/bad.csv: cannot read the protocol's description" -- \
+      "$py" "$client" --protocol "$tmp/bad.csv" --port /dev/null state
+    expect 2 "$tmp/none.json: cannot read the protocol's description" -- \
+      env OSC_PROTOCOL="$tmp/none.json" "$py" "$client" --port /dev/null state
     ;;
   *)
     echo "virtual_board.sh: unknown case $case_"

@@ -569,19 +569,21 @@ struct Turn {
 
 /// Streams (id) a turn of the arm about the base's z axis (joint 1's) at `share` of the follower's per-axis limits,
 /// with velocities, to `to` rad (the stream ended there), until it is done or aborted and the arm holds.
-Turn stream_turn(MotionSim<double>& sim, double share, double to, std::uint32_t id) {
-  MoveRequest<double> req;
+template <class S>
+Turn stream_turn(MotionSim<S>& sim, double share, double to, std::uint32_t id) {
+  MoveRequest<S> req;
   req.relative = true;
   req.period = 10;
   sim.stream(req, id);
   sim.tick();
   EXPECT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted);
   const V3 p0 = sim.tip();
-  const CartesianLimits<double>& lim = sim.task().limits;
-  const double radius = std::hypot(p0.x(), p0.y());
+  const CartesianLimits<S>& lim = sim.task().limits;
+  const double radius = std::hypot(p0.x(), p0.y()), vmax = static_cast<double>(lim.linear.v),
+               wmax = static_cast<double>(lim.angular.v);
   Turn r;
-  r.rate = share * std::min(lim.linear.v * StreamFollower<double>::kInvSqrt3 / radius,
-                            lim.angular.v * StreamFollower<double>::kInvSqrt3 / kStreamEBound);
+  r.rate = share * std::min(vmax * StreamFollower<double>::kInvSqrt3 / radius,
+                            wmax * StreamFollower<double>::kInvSqrt3 / kStreamEBound);
   r.q_peak = sim.plant().q()(0);
   bool done = false;
   for (int k = 0; k < 60000 && !((done || r.abort != MotionReason::kNone) && state_is(sim, MotionState::kHolding));
@@ -608,20 +610,21 @@ Turn stream_turn(MotionSim<double>& sim, double share, double to, std::uint32_t 
 /// With joint 1 at rest at (or past) its upper limit: a move turning it further out is refused (out_of_workspace), a
 /// move that leaves it where it is and one turning it back in are accepted and done (the path check lets a path
 /// leave a limit, and the tick's limit check does not stop it: motion_limits_from). Ids id .. id + 2.
-void leave_limit_of_joint1(MotionSim<double>& sim, std::uint32_t id) {
+template <class S>
+void leave_limit_of_joint1(MotionSim<S>& sim, std::uint32_t id) {
   const double q0 = sim.plant().q()(0);
   const V3 p1 = sim.tip(), out = V3::UnitZ().cross(V3(p1.x(), p1.y(), 0)).normalized() * 0.03;  // joint 1's tangent
-  EXPECT_EQ(answer_move(sim, relative<double>(out.x(), out.y(), 0), id).refusal, MotionReason::kOutOfWorkspace)
+  EXPECT_EQ(answer_move(sim, relative<S>(out.x(), out.y(), 0), id).refusal, MotionReason::kOutOfWorkspace)
       << "a move further out";
   std::uint32_t faults = 0;
   for (const V3& d : {V3(0, 0, 0.02), V3(-out)}) {
     ++id;
-    ASSERT_EQ(answer_move(sim, relative<double>(d.x(), d.y(), d.z()), id).outcome, CommandOutcome::kAccepted)
+    ASSERT_EQ(answer_move(sim, relative<S>(d.x(), d.y(), d.z()), id).outcome, CommandOutcome::kAccepted)
         << d.transpose();
     MotionReason abort = MotionReason::kNone;
     const Trace r = run_until(
         sim,
-        [&abort, id](const MotionSim<double>& m) {
+        [&abort, id](const MotionSim<S>& m) {
           if (m.task().report.abort != MotionReason::kNone) abort = m.task().report.abort;
           return m.task().report.done_id == id;
         },
@@ -636,7 +639,10 @@ void leave_limit_of_joint1(MotionSim<double>& sim, std::uint32_t id) {
               sim.plant().q()(0) - robot::kArm.q_max[0]);
 }
 
-TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
+/// A stream into joint 1's upper limit, stopped at it (AStreamIntoAJointLimitStopsAtIt), in the scalar S: the
+/// tick's check multiplies through by the stop lead's velocity (no division), which Q12.19 rounds.
+template <class S>
+void stream_into_joint_limit(const char* scalar) {
   // Joint 1 half a radian from its upper limit; a stream (which no path check judges) turns the arm about the
   // base's z axis (joint 1's) at 90 % of the follower's per-axis limits, on to 0.3 rad past the limit. The tick's
   // check takes the stop's braking distance (motion_limits_reached): the arm comes to rest at the limit, not past
@@ -644,19 +650,25 @@ TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
   // encoder_range), and not far before it.
   V6 q = start_pose();
   q(0) = robot::kArm.q_max[0] - 0.5;
-  MotionSim<double> sim(q);
+  MotionSim<S> sim(q);
   ASSERT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
   run_ticks(sim, 200);
   const Turn t = stream_turn(sim, 0.9, 0.8, 2);
-  EXPECT_EQ(t.abort, MotionReason::kLimitReached);
-  EXPECT_TRUE(state_is(sim, MotionState::kHolding));
-  EXPECT_EQ(t.faults, 0u) << fault_name(t.faults);
-  EXPECT_GT(t.speed, 0.5 * t.rate) << "the joint turned at the stream's rate";
-  EXPECT_LE(t.q_peak, robot::kArm.q_max[0] + 0.01) << "not past the limit (the brake taken into account)";
-  EXPECT_GE(sim.plant().q()(0), robot::kArm.q_max[0] - 0.05) << "and not far before it";
-  std::printf("joint 1 at %.3f rad/s (stream %.3f rad/s): at rest %.4f rad from its limit, peak %.4f\n", t.speed,
-              t.rate, sim.plant().q()(0) - robot::kArm.q_max[0], t.q_peak - robot::kArm.q_max[0]);
+  EXPECT_EQ(t.abort, MotionReason::kLimitReached) << scalar;
+  EXPECT_TRUE(state_is(sim, MotionState::kHolding)) << scalar;
+  EXPECT_EQ(t.faults, 0u) << scalar << ": " << fault_name(t.faults);
+  EXPECT_GT(t.speed, 0.5 * t.rate) << scalar << ": the joint turned at the stream's rate";
+  EXPECT_LE(t.q_peak, robot::kArm.q_max[0] + 0.01) << scalar << ": not past the limit (the brake taken into account)";
+  EXPECT_GE(sim.plant().q()(0), robot::kArm.q_max[0] - 0.05) << scalar << ": and not far before it";
+  std::printf("%s: joint 1 at %.3f rad/s (stream %.3f rad/s): at rest %.4f rad from its limit, peak %.4f\n", scalar,
+              t.speed, t.rate, sim.plant().q()(0) - robot::kArm.q_max[0], t.q_peak - robot::kArm.q_max[0]);
   leave_limit_of_joint1(sim, 10);
+}
+
+TEST(MotionSim, AStreamIntoAJointLimitStopsAtIt) {
+  stream_into_joint_limit<double>("double");
+  stream_into_joint_limit<float>("float");
+  stream_into_joint_limit<Fixed>("Q12.19");
 }
 
 TEST(MotionSim, AnArmPastAJointLimitCanBeMovedBackInOnly) {
@@ -831,7 +843,7 @@ TEST(MotionSim, StreamWithVelocitiesAtTenHzLagsAFifthOrLess) {
 /// rest, then held. In every scalar: in Q12.19 the stop once ended 1 unit of speed short of rest and the
 /// arm stayed `stopping` (kStopRestSpeed).
 template <class S>
-void cut_stream() {
+void cut_stream(const char* scalar) {
   for (int rate : {10, 50, 1000}) {
     MotionSim<S> sim(start_pose());
     answer(sim, MotionVerb::kEnable, 1);
@@ -853,32 +865,32 @@ void cut_stream() {
       faults |= sim.tick();
       if (sim.task().report.abort == MotionReason::kStaleStream) stale_at = k;
     }
-    ASSERT_GE(stale_at, 0) << rate;
+    ASSERT_GE(stale_at, 0) << scalar << " at " << rate << " Hz";
     // Stale after max(2 T, 20 ms) without a setpoint: the tick after that.
     // Stale in the tick that completes max(2 T, 20 ms) without a setpoint after the last one's.
     const long timeout = std::max<long>(2 * req.period, 20);
-    EXPECT_EQ(stale_at - last, timeout) << rate;
-    EXPECT_EQ(sim.task().report.aborted_id, 2u);
+    EXPECT_EQ(stale_at - last, timeout) << scalar << " at " << rate << " Hz";
+    EXPECT_EQ(sim.task().report.aborted_id, 2u) << scalar;
     EXPECT_TRUE(state_is(sim, MotionState::kStopping));
     const Trace stop = run_until(
         sim, [](const MotionSim<S>& s) { return state_is(s, MotionState::kHolding); }, 10000);
-    EXPECT_TRUE(stop.ended) << rate;
-    EXPECT_LT(stop.ticks, 1500) << rate << ": the stop rests within 1.5 s";
+    EXPECT_TRUE(stop.ended) << scalar << " at " << rate << " Hz";
+    EXPECT_LT(stop.ticks, 1500) << scalar << " at " << rate << " Hz: the stop rests within 1.5 s";
     EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
     const V3 held = sim.tip();
     const Trace hold = run_ticks(sim, 1000);
-    EXPECT_EQ(faults | stop.faults | hold.faults, 0u) << rate;
+    EXPECT_EQ(faults | stop.faults | hold.faults, 0u) << scalar << " at " << rate << " Hz";
     // Held: a second after a cold start's stop (theta^ still learning), the tip settles by at most
     // 0.2 mm on the PUMA; 0.23 mm measured on the UR5e (its larger friction, kColdStartTolerance).
-    EXPECT_LE((sim.tip() - held).norm(), test::kPumaBuild ? 0.2e-3 : 0.3e-3) << rate;
+    EXPECT_LE((sim.tip() - held).norm(), test::kPumaBuild ? 0.2e-3 : 0.3e-3) << scalar << " at " << rate << " Hz";
     EXPECT_TRUE(state_is(sim, MotionState::kHolding));
   }
 }
 
 TEST(MotionSim, CuttingAStreamStopsItAndHolds) {
-  cut_stream<double>();
-  cut_stream<float>();
-  cut_stream<Fixed>();
+  cut_stream<double>("double");
+  cut_stream<float>("float");
+  cut_stream<Fixed>("Q12.19");
 }
 
 TEST(MotionSim, StreamRefusalsAndAStopCommand) {

@@ -269,7 +269,8 @@ TEST(StreamFollower, ACutStreamGoesStaleAndStopsWithinTheLimits) {
   }
 }
 
-/// StreamFollower::stop_lead: the distance a stop() then covers, as a time at the velocity it starts from.
+/// StreamFollower::stop_lead: the distance a stop() then covers, as a time at the velocity it starts from
+/// (the fraction d / v it returns, divided here in double).
 /// Checked against the stop itself (the reference's own travel until it rests), on every axis that moves,
 /// at points of the path where it accelerates (0.6 s), cruises at its peak (1.5 s) and slows (2.4 s), in
 /// every scalar; and at the peak against the analytic (v / a + a / j) / 2 of each group. Measured
@@ -286,7 +287,9 @@ void check_stop_lead(const char* scalar) {
     const int last = static_cast<int>(at * kHz);
     stream_path(f, 1000, last + 1, at + 1e-9, true);
     const Desired<double> d = to_double(f.tick());
-    const double lead = static_cast<double>(f.stop_lead());
+    const StopLead<S> fraction = f.stop_lead();
+    ASSERT_GT(static_cast<double>(fraction.v), 0.0) << at;
+    const double lead = static_cast<double>(fraction.d) / static_cast<double>(fraction.v);
     f.stop();
     Desired<double> e = d;
     int ticks = 0;

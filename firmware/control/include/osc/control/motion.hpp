@@ -114,9 +114,11 @@ class MotionGenerator {
   /// The running stream has gone stale (no setpoint for max(2 periods, 20 ms), not ended, not
   /// braking): the runtime stops it (category 2, stale_stream).
   bool stream_stale() const { return source_ == MotionSource::kStream && !braking_ && stream_.stale(); }
-  /// A running stream's stop lead (StreamFollower::stop_lead) [s]; 0 for any other motion (a move's
+  /// A running stream's stop lead (StreamFollower::stop_lead); none for any other motion (a move's
   /// and the paper's paths are checked before they start) and once braking.
-  S stream_stop_lead() const { return source_ == MotionSource::kStream && !braking_ ? stream_.stop_lead() : S(0); }
+  StopLead<S> stream_stop_lead() const {
+    return source_ == MotionSource::kStream && !braking_ ? stream_.stop_lead() : StopLead<S>{};
+  }
   /// The running stream's setpoints are offsets from the held pose.
   bool stream_relative() const { return stream_relative_; }
   /// Appends a move planned from queue_end() (CartesianMove::plan). false: the queue is full. While

@@ -153,6 +153,13 @@ S clamp(S x, S lim) {
 }
 }  // namespace stream
 
+/// A stream's stop lead (StreamFollower::stop_lead) as a fraction: the distance d its stop covers
+/// over the velocity v it starts from, lead = d / v [s]. None (v = 0) while no axis moves.
+template <class S>
+struct StopLead {
+  S d{0}, v{0};
+};
+
 template <class S>
 class StreamFollower {
  public:
@@ -299,11 +306,12 @@ class StreamFollower {
   /// jerk-limited motion from rest is slower at that acceleration (it ramped a from 0 at most at j),
   /// so the floor only bounds the lead where a stream reverses through v = 0 (there the check is a few
   /// ticks late: 4 mm of the reference at the PUMA's 0.4 m/s^2 from rest). For a trapezoidal stop the
-  /// distance is exact; for a triangular one (v_c < amax^2 / j) it is above. The tick's joint-limit
-  /// check (motion_limits_reached) multiplies the joint rates by it; two divisions a tick.
-  S stop_lead() const {
+  /// distance is exact; for a triangular one (v_c < amax^2 / j) it is above. Returned as the fraction
+  /// D / v (StopLead), the longer group's taken by cross-multiplying: the tick's joint-limit check
+  /// (motion_limits_reached) multiplies through by v, so that no division is taken (64-bit on the M3).
+  StopLead<S> stop_lead() const {
     const S half = lit<S>(0.5), third = lit<S>(1.0 / 3.0), sixth = lit<S>(1.0 / 6.0);
-    S lead(0);
+    StopLead<S> lead;
     for (int g = 0; g < 2; ++g) {
       int f = 3 * g;
       S vc(0);
@@ -316,10 +324,7 @@ class StreamFollower {
       S d = half * vc * (vc * inv_a_[g] + ramp_[g]);
       d += a > S(0) ? S(t * (v + third * a * t)) : S(-(t * (vc - sixth * math::abs(a) * t)));
       const S floor = a * a * half * inv_j_[g], den = v > floor ? v : floor;
-      if (d > S(0) && den > S(0)) {
-        const S lg = d / den;
-        lead = lg > lead ? lg : lead;
-      }
+      if (d > S(0) && den > S(0) && (lead.v == S(0) || d * lead.v > lead.d * den)) lead = {d, den};
     }
     return lead;
   }

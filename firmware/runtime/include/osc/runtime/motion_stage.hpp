@@ -9,6 +9,7 @@
 #include <cstdint>
 
 #include "osc/control/controller.hpp"
+#include "osc/control/path_check.hpp"
 #include "osc/runtime/homing.hpp"
 #include "osc/runtime/motion_commands.hpp"
 #include "osc/runtime/supervisor.hpp"
@@ -39,7 +40,8 @@ Desired<S> yield_reference(const ControlTask<S>& task) {
 /// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond. A stream,
 /// whose path no check has judged, is stopped where its stop would end at the limit: each joint
 /// taken ahead by its rate estimate (one tick old) times the stream's stop lead (the distance its
-/// stop covers, as a time; StreamFollower::stop_lead), since a joint stopped only at its limit
+/// stop covers, as a time d / v; StreamFollower::stop_lead, compared multiplied through by v, without
+/// a division), since a joint stopped only at its limit
 /// brakes past it (0.11 rad at 0.20 m/s on the PUMA: beyond the encoders' params::kJointLimitMargin).
 /// A move's path and the paper's keep params::kWorkspaceMargin from the limits (the path check);
 /// theirs is the joint itself, which a move passing near a limit and turning away does not reach.
@@ -52,11 +54,12 @@ MotionReason motion_limits_reached(const ControlTask<S>& task, const Vec6<S>& q)
   if (!motion_running(task.machine.state)) return MotionReason::kNone;
   for (int i = 0; i < kDof; ++i)
     if (q(i) < task.q_lo(i) || q(i) > task.q_hi(i)) return MotionReason::kLimitReached;
-  const S lead = task.gen.stream_stop_lead();
-  if (lead > S(0))
-    for (int i = 0; i < kDof; ++i) {  // ahead by the stream's stop distance
-      const S ahead = q(i) + task.state.adapt.qd_hat_prev(i) * lead;
-      if (ahead < task.q_lo(i) || ahead > task.q_hi(i)) return MotionReason::kLimitReached;
+  const StopLead<S> lead = task.gen.stream_stop_lead();
+  if (lead.v > S(0))
+    for (int i = 0; i < kDof; ++i) {  // ahead by the stream's stop distance, all times lead.v
+      const S ahead = task.state.adapt.qd_hat_prev(i) * lead.d;
+      if (ahead < (task.q_lo(i) - q(i)) * lead.v || ahead > (task.q_hi(i) - q(i)) * lead.v)
+        return MotionReason::kLimitReached;
     }
   if (task.last.rcond < kMinRcond) return MotionReason::kLimitReached;
   return MotionReason::kNone;
@@ -192,13 +195,11 @@ template <class S>
 /// params::kLimitStartSlack beyond q where q is that close to it or past it.
 template <class S>
 void motion_limits_from(ControlTask<S>& task, const Vec6<S>& q) {
-  static constexpr std::array<S, kDof> kQMin = lit_array<S>(robot::kArm.q_min);
-  static constexpr std::array<S, kDof> kQMax = lit_array<S>(robot::kArm.q_max);
   static constexpr S kSlack = lit<S>(params::kLimitStartSlack);
   for (int i = 0; i < kDof; ++i) {
     const S lo = q(i) - kSlack, hi = q(i) + kSlack;
-    task.q_lo(i) = lo < kQMin[i] ? lo : kQMin[i];
-    task.q_hi(i) = hi > kQMax[i] ? hi : kQMax[i];
+    task.q_lo(i) = lo < path_check::kQMin<S>[i] ? lo : path_check::kQMin<S>[i];
+    task.q_hi(i) = hi > path_check::kQMax<S>[i] ? hi : path_check::kQMax<S>[i];
   }
 }
 
