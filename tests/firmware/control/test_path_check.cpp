@@ -1,10 +1,12 @@
-// The path check (osc/control/path_check.hpp) against Orocos KDL 1.5.1 (tests/support/kdl_puma.hpp):
-// targets built by KDL's forward kinematics, the end joint angles put through KDL's forward
-// kinematics again and compared with the target's own joint angles and with KDL's inverse
-// kinematics (ChainIkSolverPos_LMA); each failure (a joint limit on the way, the wrist singularity
-// at a sample and between two, the orientation coordinates' singularity, a target out of reach) at
-// the sample where an independent solution of the same path shows it (KDL's, or the path's closed
-// form); float and Q12.19 against double; the fixed-point flags of the caller kept.
+// The path check (osc/control/path_check.hpp) against Orocos KDL 1.5.1 on the build's arm, its chain read
+// from the arm's own URDF and sheet (tests/support/kdl_arm.hpp: urdfdom and yaml-cpp, not the generator):
+// targets built by KDL's forward kinematics, the end joint angles put through KDL's forward kinematics
+// again and compared with the target's own joint angles and with KDL's inverse kinematics
+// (ChainIkSolverPos_LMA); the orientation coordinates' singularity at the sample where KDL's solution
+// shows it; float and Q12.19 against double. On the PUMA 560 also its own geometry (OSC_PUMA_ONLY): each
+// failure (a joint limit on the way, the wrist singularity at a sample and between two, a target out of
+// reach) at the sample where the path's closed form shows it, and the fixed-point flags of the caller
+// kept. The UR5e's singular poses are refused by test_motion_sim (AMoveIntoEachSingularity...).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +17,7 @@
 #include <memory>
 #include <random>
 
+#include "kdl_arm.hpp"
 #include "kdl_puma.hpp"
 #include "osc/control/path_check.hpp"
 #include "osc/math/fixed.hpp"
@@ -29,10 +32,15 @@ namespace {
 constexpr int N = params::kPathCheckPoints;
 const CartesianLimits<double> kLim = CartesianLimits<double>::defaults();
 
+/// The build's arm from its URDF and sheet (not the generated table): its last segment is frame 6.
+const KDL::Chain& urdf_chain() {
+  static const KDL::Chain chain = test::urdf_arm_chain(OSC_ARM_SHEET);
+  return chain;
+}
+
 /// The frame-6 pose of q by KDL's forward kinematics.
 Pose<double> kdl_pose(const Vec6<double>& q) {
-  static const KDL::Chain chain = test::puma560_chain();
-  KDL::ChainFkSolverPos_recursive fk(chain);
+  KDL::ChainFkSolverPos_recursive fk(urdf_chain());
   KDL::Frame F;
   EXPECT_GE(fk.JntToCart(to_kdl(q), F), 0);
   Pose<double> p;
@@ -54,8 +62,7 @@ double rotation_error(const Mat3<double>& R, const Mat3<double>& Rd) {
 /// its solution misses the pose by more than 1e-7 m or 1e-6 rad (its accuracy here: the solver
 /// stops on its joint increments before its error criterion, about 1e-7 rad in orientation).
 bool kdl_ik(const Pose<double>& target, const Vec6<double>& q_init, Vec6<double>& q) {
-  static const KDL::Chain chain = test::puma560_chain();
-  KDL::ChainIkSolverPos_LMA ik(chain, Vec6<double>::Ones(), 1e-24, 1000);
+  KDL::ChainIkSolverPos_LMA ik(urdf_chain(), Vec6<double>::Ones(), 1e-24, 1000);
   KDL::Frame F;
   for (int r = 0; r < 3; ++r) {
     F.p(r) = target.p(r);
@@ -126,7 +133,7 @@ double controller_rcond(const Vec6<double>& q, const Mat3<double>& R_ref) {
   static const std::unique_ptr<Data<double>> data = std::make_unique<Data<double>>();
   forward_kinematics(model, *data, q);
   geometric_jacobian(*data);
-  SphericalWristJacobianFactor<double> Jf;
+  ArmJacobianFactor<double> Jf;  // a fresh factor: its rcond exact (the pivoted LU's too)
   Jf.compute(analytic_jacobian(data->J, orientation_coordinates<double>(data->R[kDof], R_ref)));
   return Jf.rcond;
 }
@@ -177,10 +184,29 @@ TEST(CartesianMove, PoseAtIsThePoseOfTheReference) {
   EXPECT_LE(rotation_error(m.pose_at(m.duration()).R, b.R), 1e-9);
 }
 
+// The chain read from the URDF and the sheet ends at the firmware's frame 6 (the kernels' forward
+// kinematics on the generated table): what every comparison below rests on.
+TEST(PathCheck, TheUrdfChainEndsAtFrameSix) {
+  ASSERT_EQ(urdf_chain().getNrOfJoints(), static_cast<unsigned>(kDof));
+  const Model<double> model = Model<double>::of(robot::kArm);
+  const auto data = std::make_unique<Data<double>>();
+  Pairs pairs;
+  double worst_p = 0, worst_R = 0;
+  for (int k = 0; k < 20; ++k) {
+    Vec6<double> qa, qb;
+    pairs.next(qa, qb);
+    forward_kinematics(model, *data, qa);
+    const Pose<double> p = kdl_pose(qa);
+    worst_p = std::max(worst_p, (p.p - data->o[kDof]).norm());
+    worst_R = std::max(worst_R, rotation_error(p.R, data->R[kDof]));
+  }
+  EXPECT_LE(worst_p, 1e-12);
+  EXPECT_LE(worst_R, 1e-12);
+}
+
 // The end angles reproduce the target (KDL's forward kinematics), equal the target's own angles
 // (the seed's branch) and KDL's inverse kinematics from the seed.
 TEST(PathCheck, EndAnglesReachTheTargetOnTheSeedsBranch) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   Pairs pairs;
   double worst_p = 0, worst_R = 0, worst_q = 0, worst_kdl = 0;
   for (int k = 0; k < kPairs; ++k) {
@@ -210,7 +236,6 @@ TEST(PathCheck, EndAnglesReachTheTargetOnTheSeedsBranch) {
 // A seed a tracking error away from the move's start (2 cm and 0.02 rad per joint): the first
 // sample's Newton steps bring it onto the path; the end is the same.
 TEST(PathCheck, ConvergesFromASeedOffTheStart) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   Pairs pairs;
   for (int k = 0; k < 10; ++k) {
     Vec6<double> qa, qb;
@@ -228,7 +253,7 @@ TEST(PathCheck, ConvergesFromASeedOffTheStart) {
 // (to -238 deg, KDL's solution) although both ends are well inside. The check stops at the sample
 // where KDL's solution first comes within the margin.
 TEST(PathCheck, ElbowFoldedPastItsLimitIsOutOfWorkspace) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  OSC_PUMA_ONLY();  // its geometry: the elbow, the spherical wrist's closed form, the reach
   Vec6<double> qa, qb;
   qa << 0.2, -0.4, -kPi, 0.3, 0.5, 0.1;
   qb << 0.2, 2.0, -kPi, 0.3, 0.5, 0.1;
@@ -262,7 +287,7 @@ const Vec6<double> kWristBase = (Vec6<double>() << 0.2, 0.6, -2.8, 0.4, 0.0, -0.
 // Joint 5 turned towards its limit (100 deg) and past it: the first sample whose closed-form
 // solution lies within the margin.
 TEST(PathCheck, WristPastItsLimitIsOutOfWorkspace) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  OSC_PUMA_ONLY();  // its geometry: the elbow, the spherical wrist's closed form, the reach
   const Vec6<double> qa = with_q5(kWristBase, 1.2);
   const MoveCheck<double> r = check_joint_move<double>(qa, with_q5(qa, 2.0));
   int expected = -1;
@@ -279,7 +304,7 @@ TEST(PathCheck, WristPastItsLimitIsOutOfWorkspace) {
 // threshold (the sign of det J22 changes); from 0.6 to 0.25 the path stays clear of it. Each at the
 // first sample where the closed-form solution is below the threshold or past q5 = 0.
 TEST(PathCheck, WristSingularityIsNearSingular) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  OSC_PUMA_ONLY();  // its geometry: the elbow, the spherical wrist's closed form, the reach
   struct Case {
     double q5a, q5b;
     PathStatus status;
@@ -308,7 +333,6 @@ TEST(PathCheck, WristSingularityIsNearSingular) {
 // analytic Jacobian is singular: a rotation about the base y axis from a pitch of 60 deg by 40 deg
 // fails at the first sample whose rcond (from KDL's solution) is below the threshold.
 TEST(PathCheck, OrientationCoordinateSingularityIsNearSingular) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Vec6<double> q0 = test::from_array(robot::kQStart);
   const Pose<double> a = kdl_pose(q0);
   const Mat3<double> R_ref = axis_rotation<double>(Vec3<double>::UnitY(), -60 * kPi / 180) * a.R;
@@ -330,7 +354,6 @@ TEST(PathCheck, OrientationCoordinateSingularityIsNearSingular) {
 // Samples on either side of that singularity, whose rcond are both above the threshold (pitch 80 and
 // 100 deg): the crossing shows in roll and yaw, which turn by pi.
 TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
   const Model<double> model = Model<double>::of(robot::kArm);
   const auto data = std::make_unique<Data<double>>();
   const Vec6<double> q0 = test::from_array(robot::kQStart);
@@ -354,7 +377,7 @@ TEST(PathCheck, CoordinateSingularityBetweenSamplesIsNearSingular) {
 // beyond the wrist centre's reach from the shoulder (at the base origin, d1 = 0),
 // sqrt((a2 + sqrt(a3^2 + d4^2))^2 + d3^2) = 0.877 m.
 TEST(PathCheck, TargetOutOfReachIsUnreachable) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  OSC_PUMA_ONLY();                    // its geometry: the elbow, the spherical wrist's closed form, the reach
   const auto& L = robot::kArm.links;  // DH rows: a placement's translation is (a, 0, d)
   const double a2 = L[1].placement.p[0], a3 = L[2].placement.p[0], d3 = L[2].placement.p[2], d4 = L[3].placement.p[2];
   const double reach = std::hypot(a2 + std::hypot(a3, d4), d3);
@@ -390,6 +413,16 @@ void compare_scalar(double tol) {
   }
   std::printf("end angles vs double %.2e rad; largest residual %.2e m, %.2e rad\n", worst, worst_p, worst_o);
   EXPECT_LE(worst, tol);
+  {  // a target out of reach (3 m along x)
+    const Vec6<double> q0 = test::from_array(robot::kQStart);
+    const Pose<double> a = kdl_pose(q0);
+    const MoveCheck<double> d = check_move<double>(a, {a.p + Vec3<double>(3, 0, 0), a.R}, a.R, q0);
+    const MoveCheck<S> s = check_move<S>(a, {a.p + Vec3<double>(3, 0, 0), a.R}, a.R, q0);
+    EXPECT_EQ(d.check.status, PathStatus::kUnreachable);
+    EXPECT_EQ(s.check.status, d.check.status);
+    EXPECT_EQ(s.check.sample, d.check.sample);
+  }
+  if (!test::kPumaBuild) return;  // the pairs below are the PUMA's geometry (its elbow and wrist)
   Vec6<double> fold_a, fold_b;
   fold_a << 0.2, -0.4, -kPi, 0.3, 0.5, 0.1;
   fold_b << 0.2, 2.0, -kPi, 0.3, 0.5, 0.1;
@@ -404,27 +437,15 @@ void compare_scalar(double tol) {
     EXPECT_EQ(s.check.status, d.check.status) << p.a.transpose();
     EXPECT_EQ(s.check.sample, d.check.sample) << p.a.transpose();
   }
-  const Vec6<double> q0 = test::from_array(robot::kQStart);
-  const Pose<double> a = kdl_pose(q0);
-  const MoveCheck<double> d = check_move<double>(a, {a.p + Vec3<double>(3, 0, 0), a.R}, a.R, q0);
-  const MoveCheck<S> s = check_move<S>(a, {a.p + Vec3<double>(3, 0, 0), a.R}, a.R, q0);
-  EXPECT_EQ(s.check.status, d.check.status);
-  EXPECT_EQ(s.check.sample, d.check.sample);
 }
 
-TEST(PathCheck, FloatAgreesWithDouble) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
-  compare_scalar<float>(1e-5);
-}
-TEST(PathCheck, FixedAgreesWithDouble) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
-  compare_scalar<Fixed>(2e-4);
-}
+TEST(PathCheck, FloatAgreesWithDouble) { compare_scalar<float>(1e-5); }
+TEST(PathCheck, FixedAgreesWithDouble) { compare_scalar<Fixed>(2e-4); }
 
 // In fixed point the check's own saturations (near the wrist singularity a determinant's
 // reciprocal leaves the range) are discarded, the caller's kept.
 TEST(PathCheck, FixedPointKeepsTheCallersFlags) {
-  OSC_PUMA_TUNED("its targets and failures are the PUMA's: its KDL chain (kdl_puma.hpp), its wrist's closed form");
+  OSC_PUMA_ONLY();  // its geometry: the elbow, the spherical wrist's closed form, the reach
   const Model<Fixed> model = Model<Fixed>::of(robot::kArm);
   const auto data = std::make_unique<Data<Fixed>>();
   // What the check meets next to q5 = 0: the kernels saturate.
