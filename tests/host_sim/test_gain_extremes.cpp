@@ -2,7 +2,9 @@
 // each end of its range (the others at their defaults), then an enable of the simulated arm: the
 // set is accepted (or, in a scalar that cannot hold the value, refused out_of_range) and the arm
 // holds for 3 s without a fault, the oscillation monitor within half its limit. Before the fix, k_s = 1e5 (then inside
-// its range) was accepted and latched non_finite 21 ms after the enable.
+// its range) was accepted and latched non_finite 21 ms after the enable. The gains' ranges were set on the PUMA
+// (params.hpp): on another arm a bound that would lose its loop is refused by name (unstable_loop,
+// unstable_observer), counted and printed; on the PUMA none is.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -52,7 +54,7 @@ ParamStatus set_and_hold(int i, int e, bool top, Held& h) {
 /// Every bound of every parameter, element by element (each_element) or all elements at once.
 template <class S>
 void every_bound_holds(bool each_element) {
-  int runs = 0;
+  int runs = 0, refused = 0;
   double shaking = 0;
   for (int i = 0; i < kParamCount; ++i) {
     const ParamInfo& p = kParams[i];
@@ -69,6 +71,11 @@ void every_bound_holds(bool each_element) {
           EXPECT_GE(top ? p.hi_of(std::max(e, 0)) : -p.lo_of(std::max(e, 0)), param_scalar_max<S>() - 1) << what;
           continue;
         }
+        if (!test::kPumaBuild && (s == ParamStatus::kUnstableLoop || s == ParamStatus::kUnstableObserver)) {
+          std::printf("%s: refused %s on this arm\n", what, param_status_name(s));
+          ++refused;
+          continue;
+        }
         ASSERT_EQ(s, ParamStatus::kOk) << what;
         ++runs;
         EXPECT_EQ(h.faults, 0u) << what << ": " << fault_name(h.faults);
@@ -80,23 +87,15 @@ void every_bound_holds(bool each_element) {
         shaking = std::max(shaking, h.shaking);
       }
   }
-  EXPECT_GT(runs, 2 * kParamCount - 8);
-  std::printf("%s: the oscillation monitor at most %.3f of its limit\n",
-              each_element ? "each element" : "each parameter", shaking);
+  EXPECT_GT(runs + refused, 2 * kParamCount - 8);
+  EXPECT_LE(refused, runs / 4) << "most bounds are taken on any arm";
+  std::printf("%s: %d runs, %d refused by name; the oscillation monitor at most %.3f of its limit\n",
+              each_element ? "each element" : "each parameter", runs, refused, shaking);
 }
 
-TEST(GainExtremes, EveryElementsBoundsHoldTheArmDouble) {
-  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
-  every_bound_holds<double>(true);
-}
-TEST(GainExtremes, EveryParametersBoundsHoldTheArmFloat) {
-  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
-  every_bound_holds<float>(false);
-}
-TEST(GainExtremes, EveryParametersBoundsHoldTheArmFixed) {
-  OSC_PUMA_TUNED("the gains' declared bounds are the PUMA's: at some of them the UR5e's loop is refused unstable_loop");
-  every_bound_holds<Fixed>(false);
-}
+TEST(GainExtremes, EveryElementsBoundsHoldTheArmDouble) { every_bound_holds<double>(true); }
+TEST(GainExtremes, EveryParametersBoundsHoldTheArmFloat) { every_bound_holds<float>(false); }
+TEST(GainExtremes, EveryParametersBoundsHoldTheArmFixed) { every_bound_holds<Fixed>(false); }
 
 /// The defect's own value, now outside the range, and the old range's top through the controller:
 /// a loop the check would refuse latches a fault within a fraction of a second (the check is not
