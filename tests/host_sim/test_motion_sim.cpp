@@ -877,13 +877,24 @@ void cut_stream(const char* scalar) {
     EXPECT_TRUE(stop.ended) << scalar << " at " << rate << " Hz";
     EXPECT_LT(stop.ticks, 1500) << scalar << " at " << rate << " Hz: the stop rests within 1.5 s";
     EXPECT_EQ(sim.task().report.completion, MotionCompletion::kStopped);
+    // Held for 3 s after a cold start's stop: the tip's largest distance from where the stop ended. The
+    // Coulomb and Stribeck compensation, sgn(q^dot^) (cou^ + sti^), learnt from a cold start in the one-second
+    // stream, may exceed the plant's: then the joints hunt at rest (1e-2 rad/s at times, bounded), on both arms.
+    // On the PUMA that is its wrist's and the tip stays within 0.25 mm (0.193 measured, 2026-12-04); on the UR5e
+    // (J2's cou^ + sti^ 10.4 to 11.4 N m against the plant's 9.0) its shoulder's, and the tip within 1 mm (0.741
+    // measured, float at 50 Hz). A saved identification (issue 57) is what would start the hold from the plant's.
     const V3 held = sim.tip();
-    const Trace hold = run_ticks(sim, 1000);
-    EXPECT_EQ(faults | stop.faults | hold.faults, 0u) << scalar << " at " << rate << " Hz";
-    // Held: a second after a cold start's stop (theta^ still learning), the tip settles by at most
-    // 0.2 mm on the PUMA; 0.23 mm measured on the UR5e (its larger friction, kColdStartTolerance).
-    EXPECT_LE((sim.tip() - held).norm(), test::kPumaBuild ? 0.2e-3 : 0.3e-3) << scalar << " at " << rate << " Hz";
+    double settle = 0;
+    std::uint32_t hold_faults = 0;
+    for (int n = 0; n < 3000; ++n) {
+      hold_faults |= sim.tick();
+      settle = std::max(settle, (sim.tip() - held).norm());
+    }
+    EXPECT_EQ(faults | stop.faults | hold_faults, 0u) << scalar << " at " << rate << " Hz";
+    EXPECT_LE(settle, test::kPumaBuild ? 0.25e-3 : 1e-3) << scalar << " at " << rate << " Hz";
     EXPECT_TRUE(state_is(sim, MotionState::kHolding));
+    std::printf("%s, %d Hz: stale after %ld ticks, at rest after %d, then held 3 s within %.3f mm\n", scalar, rate,
+                stale_at - last, stop.ticks, 1e3 * settle);
   }
 }
 
