@@ -61,7 +61,9 @@ class Protocol:
     """The command protocol as osc_protocol.json declares it: frame types, layouts, flags, names."""
 
     def __init__(self, path=None):
-        path = path or protocol_path()
+        path = protocol_path() if path is None else path
+        if not path:
+            raise ClientError("the protocol's description: an empty path (--protocol FILE)")
         try:
             with open(path) as f:
                 p = json.load(f)

@@ -371,6 +371,7 @@ PY
       "$py" "$client" --protocol "$tmp/bad.csv" --port /dev/null state
     expect 2 "$tmp/none.json: cannot read the protocol's description" -- \
       env OSC_PROTOCOL="$tmp/none.json" "$py" "$client" --port /dev/null state
+    expect 2 "the protocol's description: an empty path" -- "$py" "$client" --protocol "" --port /dev/null state
     ;;
   *)
     echo "virtual_board.sh: unknown case $case_"
