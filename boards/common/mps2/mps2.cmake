@@ -97,17 +97,16 @@ function(osc_add_virtual_board_test scalar)
                    ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py qemu_sequence
                    $<TARGET_FILE:pil_firmware> ${scalar})
   # About 20 s simulated, in real time (slower on a busy machine: QEMU then falls behind). The Python
-  # client reads the protocol of the host build for the same arm (its limits, poses, parameter ranges).
-  set(protocol "OSC_PROTOCOL=${OSC_HOST_TOOLS_DIR}/clients/osc_protocol.json")
+  # client reads the protocol of the host build for the same arm (OSC_HOST_CLIENT_PROTOCOL_ENV).
   set_tests_properties(virtual_board_qemu_sequence PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600 ENVIRONMENT
-                                                              "${protocol}")
+                                                              "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
   # The command link's recovery over the image (tests/cli/link_recovery.py --qemu): the same outcomes
   # as in process.
   add_test(NAME virtual_board_qemu_link_recovery
            COMMAND ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/cli/link_recovery.py ${OSC_SIM_BOARD}
                    ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py --qemu $<TARGET_FILE:pil_firmware>)
   set_tests_properties(virtual_board_qemu_link_recovery PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 300
-                                                                   ENVIRONMENT "${protocol}")
+                                                                   ENVIRONMENT "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
 endfunction()
 
 # osc_add_motion_tests(SCALAR): scripted motions on this build's pil_firmware in QEMU (the host
