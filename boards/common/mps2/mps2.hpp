@@ -72,11 +72,25 @@ inline void uart_rx_irq_enable() {
 inline void uart_rx_irq_ack() { uart0().INTSTATUS = CmsdkUart::kRxIrq; }
 
 // ---------------------------------------------------------------- timing
-/// Starts the cycle counter (SysTick, free-running).
-inline void cycle_counter_init() { cortex_m::systick_free_run(); }
-/// Monotonic virtual nanoseconds (instructions under -icount shift=0).
-/// Must be called at least every 0.67 s to follow the 24-bit SysTick wrap.
-inline std::uint32_t cycles() { return cortex_m::systick_cycles() * kNsPerTick; }
+/// The CMSDK APB dual timer (0x40002000, Arm DDI 0479 "APB dual-input timers"): its first timer free-running
+/// in 32 bits at the 25 MHz clock (no prescale, no interrupt) is the cycle counter, counting down from
+/// 0xFFFFFFFF and wrapping there. The guest starts it, as it starts the control timer: the two keep one phase
+/// (the tick's marks read it at the same instructions run after run).
+struct CmsdkDualTimer {
+  volatile std::uint32_t LOAD, VALUE, CONTROL, INTCLR, RIS, MIS, BGLOAD;
+  static constexpr std::uint32_t kEnable = 1u << 7, kSize32 = 1u << 1;  // free-running (bit 6 clear), no prescale
+};
+inline CmsdkDualTimer& dual_timer1() { return *reinterpret_cast<CmsdkDualTimer*>(0x40002000u); }
+/// Starts the cycle counter (the dual timer's first timer, free-running).
+inline void cycle_counter_init() {
+  dual_timer1().CONTROL = 0;
+  dual_timer1().LOAD = 0xFFFFFFFFu;
+  dual_timer1().CONTROL = CmsdkDualTimer::kEnable | CmsdkDualTimer::kSize32;
+}
+/// Monotonic virtual nanoseconds (instructions under -icount shift=0), modulo 2^32: differences hold for
+/// spans under 4.29 s. One load (no wrap to extend): the tick reads it at each of its stages' marks
+/// (osc::control_tick).
+inline std::uint32_t cycles() { return ~dual_timer1().VALUE * kNsPerTick; }
 inline void busy_wait(std::uint32_t ns) {
   const std::uint32_t t0 = cycles();
   while (cycles() - t0 < ns) {

@@ -71,4 +71,33 @@ TEST(OrientationRates, EMapsRollPitchYawRatesToTheAngularVelocity) {
   }
 }
 
+// E^{-1} w with its zeros and one skipped (phi_rates_of, analytic_jacobian): the product E.Einv * w forms, bit for
+// bit, in double, float and fixed point (in fixed point both round each entry once).
+template <class S>
+void expect_phi_rates_are_the_product() {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.4, 1.4);
+  for (int k = 0; k < 200; ++k) {
+    const Vec3<S> phi(S(u(rng)), S(u(rng)), S(u(rng)));
+    const PhiRate<S> E = phi_rate(phi);
+    const Vec3<S> w(S(u(rng)), S(u(rng)), S(u(rng)));
+    const Vec3<S> product = E.Einv * w, skipped = phi_rates_of(E, w);
+    for (int r = 0; r < 3; ++r) EXPECT_TRUE(product(r) == skipped(r)) << k << " " << r;
+    Mat6<S> J;
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) J(r, c) = S(u(rng));
+    Mat6<S> Ja;
+    analytic_jacobian(J, E, Ja);
+    Mat6<S> expect = J;
+    expect.template bottomRows<3>() = E.Einv * J.template bottomRows<3>();
+    for (int r = 0; r < 6; ++r)
+      for (int c = 0; c < 6; ++c) EXPECT_TRUE(Ja(r, c) == expect(r, c)) << k << " " << r << " " << c;
+  }
+}
+TEST(OrientationRates, TheRatesWithoutEInversesZerosAreItsProductBitForBit) {
+  expect_phi_rates_are_the_product<double>();
+  expect_phi_rates_are_the_product<float>();
+  expect_phi_rates_are_the_product<Fixed>();
+}
+
 }  // namespace

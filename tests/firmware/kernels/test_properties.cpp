@@ -4,6 +4,8 @@
 // test_kinematics.cpp, test_opspace.cpp, test_friction.cpp.
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -115,6 +117,23 @@ TEST(FloatFunctions, SinCosAndExpWithinTheirStatedErrors) {
   EXPECT_EQ(math::exp(100.0f), HUGE_VALF);
   EXPECT_TRUE(std::isnan(math::exp(std::numeric_limits<float>::quiet_NaN())));
   EXPECT_EQ(math::exp(0.0f), 1.0f);
+  // exp_decay (v <= 0, without exp's checks above 0) is exp, bit for bit, down to where e^v is 0; and at the
+  // top of exp's range (v in [88.37, 88.5]), where 2^k takes two factors (k = 128), exp is finite and within its
+  // error.
+  int decay_differs = 0;
+  for (int i = -900000; i <= 0; ++i) {
+    const float v = static_cast<float>(i * 1e-4);
+    if (std::bit_cast<std::uint32_t>(math::exp_decay(v)) != std::bit_cast<std::uint32_t>(math::exp(v))) ++decay_differs;
+  }
+  EXPECT_EQ(decay_differs, 0);
+  EXPECT_TRUE(std::isnan(math::exp_decay(std::numeric_limits<float>::quiet_NaN())));
+  EXPECT_EQ(math::exp_decay(-100.0f), 0.0f);
+  EXPECT_EQ(math::exp_decay(-0.0f), 1.0f);
+  EXPECT_EQ(math::exp_decay(-1.0), std::exp(-1.0));
+  for (const float v : {88.38f, 88.45f, 88.5f}) {
+    const double exact = std::exp(static_cast<double>(v));
+    EXPECT_LE(std::abs(math::exp(v) - exact) / exact, 2.4e-7) << v;
+  }
 }
 
 TEST(FloatFunctions, Atan2AndAsinWithinTheirStatedErrors) {

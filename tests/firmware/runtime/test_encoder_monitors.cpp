@@ -219,4 +219,38 @@ TEST(EncoderActivity, TheWindowsTravelIsTheLastWholeWindowsChange) {
   for (int i = 0; i < kDof; ++i) EXPECT_EQ(a.window_travel[i], 0u) << i;
 }
 
+// Without windows (the stuck-encoder monitor's record, which no slide test reads): the same changes, intervals and
+// directions as with them, and the windows' counts left as they were.
+TEST(EncoderActivity, WithoutWindowsTheChangesAreTrackedAloneTheSame) {
+  EncoderActivity with, without;
+  with.reset();
+  without.reset();
+  std::int32_t counts[kDof] = {};
+  bool moved[kDof] = {};
+  with.restart(counts, 0);
+  without.restart(counts, 0);
+  const std::int32_t pace[kDof] = {3, -2, 0, 1, 7, -1};
+  for (int t = 1; t <= 4 * params::kResidualSlideInterval; ++t) {
+    for (int i = 0; i < kDof; ++i) {
+      moved[i] = pace[i] != 0 && t % (i + 1) == 0;
+      if (moved[i]) counts[i] += t % 3 == 0 ? -pace[i] : pace[i];
+    }
+    with.track(counts, moved, static_cast<std::uint64_t>(t));
+    without.track(counts, moved, static_cast<std::uint64_t>(t), false);
+    for (int i = 0; i < kDof; ++i) {
+      EXPECT_EQ(without.last_move_tick[i], with.last_move_tick[i]) << t << " " << i;
+      EXPECT_EQ(without.move_interval[i], with.move_interval[i]) << t << " " << i;
+      EXPECT_EQ(without.direction[i], with.direction[i]) << t << " " << i;
+      EXPECT_EQ(without.steady[i], with.steady[i]) << t << " " << i;
+      EXPECT_EQ(without.reversed[i], with.reversed[i]) << t << " " << i;
+      EXPECT_EQ(without.window_travel[i], 0u) << t << " " << i;
+    }
+  }
+  for (int i = 0; i < kDof; ++i) {
+    if (pace[i] != 0) {
+      EXPECT_GT(with.window_travel[i], 0u) << i;
+    }
+  }
+}
+
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "osc/runtime/monitors.hpp"
@@ -225,6 +226,43 @@ TEST(IoMap, CoupledChannelsRangeAndStepCoverTheJointsBox) {
   if (io.coupled()) {  // the coupling adds the wrist's other motors' share (an uncoupled arm: the joint's own)
     EXPECT_GT(jump.max_step[5],
               static_cast<std::int32_t>(robot::kDrives.max_joint_speed[5] * params::kDt * map.counts_per_rad[5]) + 1);
+  }
+}
+
+// A joint torque to its DAC code in each floating scalar (torque_to_code's one-comparison path): within half a
+// code of torque x scale below the limit (rounded half away from zero), the scalars' codes a code apart at most,
+// and saturated to the full code at and beyond the limit, a NaN to code 0, both flagged.
+TEST(TorqueToCode, FloatAndDoubleRoundBelowTheLimitAndSaturateAtIt) {
+  for (int i = 0; i < kDof; ++i) {
+    const double limit = robot::kDrives.torque_limit[i], scale = kDacMaxCode / limit;
+    for (int k = -12000; k <= 12000; ++k) {
+      const double t = limit * k / 10000.0;
+      std::int32_t cd = 7, cf = 7;
+      const bool sd = torque_to_code(i, t, cd), sf = torque_to_code(i, static_cast<float>(t), cf);
+      if (std::abs(t) < limit * (1 - 1e-6)) {
+        EXPECT_FALSE(sd) << i << " " << t;
+        EXPECT_FALSE(sf) << i << " " << t;
+        EXPECT_LE(std::abs(cd - t * scale), 0.5 + 1e-9) << i << " " << t;
+        EXPECT_LE(std::abs(cf - t * scale), 0.5 + 1e-2) << i << " " << t;
+        EXPECT_LE(std::abs(cf - cd), 1) << i << " " << t;
+        if (k != 0) {
+          EXPECT_EQ(cd > 0, t > 0) << i << " " << t;
+        }
+      } else if (std::abs(t) >= limit) {
+        EXPECT_TRUE(sd && sf) << i << " " << t;
+        EXPECT_EQ(cd, t > 0 ? kDacMaxCode : -kDacMaxCode) << i << " " << t;
+        EXPECT_EQ(cf, cd) << i << " " << t;
+      }
+    }
+    std::int32_t c = 7;
+    EXPECT_TRUE(torque_to_code(i, std::numeric_limits<float>::quiet_NaN(), c));
+    EXPECT_EQ(c, 0);
+    EXPECT_TRUE(torque_to_code(i, std::numeric_limits<float>::infinity(), c));
+    EXPECT_EQ(c, kDacMaxCode);
+    EXPECT_TRUE(torque_to_code(i, -std::numeric_limits<float>::infinity(), c));
+    EXPECT_EQ(c, -kDacMaxCode);
+    EXPECT_TRUE(torque_to_code(i, -std::numeric_limits<double>::infinity(), c));
+    EXPECT_EQ(c, -kDacMaxCode);
   }
 }
 

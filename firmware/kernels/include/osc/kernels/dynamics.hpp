@@ -63,7 +63,7 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
   const Vec3<S>* vO = data.vO;
   S m = S(0);
   Vec3<S> h = Vec3<S>::Zero();
-  Mat3<S> IO = Mat3<S>::Zero();  // symmetric
+  Mat3<S> IO;  // symmetric; the first body sets it
   for (int j = kDof; j >= 1; --j) {
     const S mj = model.link[j - 1].mass;
     const Vec3<S>& c = data.com[j];
@@ -73,12 +73,15 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
     // IO += Ic + mj (|c|^2 I - c c^T): the diagonal entry r is sum_{k != r} mc_k c_k, an off-diagonal
     // one -mc_r c_s; six entries, IO and Ic being symmetric.
     const Mat3<S>& Ic = data.Ic[j];
-    IO(0, 0) += Ic(0, 0) + math::sum_of_products(mc(1), c(1), mc(2), c(2));
-    IO(1, 1) += Ic(1, 1) + math::sum_of_products(mc(0), c(0), mc(2), c(2));
-    IO(2, 2) += Ic(2, 2) + math::sum_of_products(mc(0), c(0), mc(1), c(1));
-    IO(0, 1) += Ic(0, 1) - mc(0) * c(1);
-    IO(0, 2) += Ic(0, 2) - mc(0) * c(2);
-    IO(1, 2) += Ic(1, 2) - mc(1) * c(2);
+    const S d0 = Ic(0, 0) + math::sum_of_products(mc(1), c(1), mc(2), c(2));
+    const S d1 = Ic(1, 1) + math::sum_of_products(mc(0), c(0), mc(2), c(2));
+    const S d2 = Ic(2, 2) + math::sum_of_products(mc(0), c(0), mc(1), c(1));
+    const S o01 = Ic(0, 1) - mc(0) * c(1), o02 = Ic(0, 2) - mc(0) * c(2), o12 = Ic(1, 2) - mc(1) * c(2);
+    if (j == kDof) {  // the first body: IO is its own (adding it to zeros only rounds the sign of a zero)
+      IO(0, 0) = d0, IO(1, 1) = d1, IO(2, 2) = d2, IO(0, 1) = o01, IO(0, 2) = o02, IO(1, 2) = o12;
+    } else {
+      IO(0, 0) += d0, IO(1, 1) += d1, IO(2, 2) += d2, IO(0, 1) += o01, IO(0, 2) += o02, IO(1, 2) += o12;
+    }
     IO(1, 0) = IO(0, 1), IO(2, 0) = IO(0, 2), IO(2, 1) = IO(1, 2);
     const Vec3<S> z = data.R[j - 1].col(2);
     const Vec3<S> p = m * vO[j - 1] + cross(z, h);   // linear momentum
@@ -149,23 +152,37 @@ VelocityProductPair<S> velocity_product_pair(const Model<S>& model, const Data<S
   Vec3<S> wy = Vec3<S>::Zero(), wv = Vec3<S>::Zero();
   Vec3<S> wdq = Vec3<S>::Zero(), wdb = Vec3<S>::Zero(), aq = Vec3<S>::Zero(), ab = Vec3<S>::Zero();
   Vec3<S> fq[kDof + 1], nq[kDof + 1], fb[kDof + 1], nb[kDof + 1];
+  // Link 1: the base is at rest (w = wd = 0 before it), so the products with the base's wdq, wdb and w are exact
+  // zeros and left out (adding them changes no sum but, at most, the sign of a zero one).
   for (int i = 1; i <= kDof; ++i) {
+    const bool first = i == 1;
     const Vec3<S> z = data.R[i - 1].col(2);
     const Vec3<S> zy = z * y(i - 1), zv = z * v(i - 1);
-    wdq += cross(wy, zy);
-    wdb += cross(wy, zv) + cross(wv, zy);
+    if (!first) {
+      wdq += cross(wy, zy);
+      wdb += cross(wy, zv) + cross(wv, zy);
+    }
     wy += zy;
     wv += zv;
     const Vec3<S> r = data.o[i] - data.o[i - 1], rc = data.com[i] - data.o[i];
     const Vec3<S> wyr = cross(wy, r), wvr = cross(wv, r), wyrc = cross(wy, rc), wvrc = cross(wv, rc);
-    aq += cross(wdq, r) + cross(wy, wyr);
-    ab += cross(wdb, r) + cross(wy, wvr) + cross(wv, wyr);
     const S m = model.link[i - 1].mass;
-    fq[i] = m * (aq + cross(wdq, rc) + cross(wy, wyrc));
-    fb[i] = m * (ab + cross(wdb, rc) + cross(wy, wvrc) + cross(wv, wyrc));
     const Vec3<S> Iwy = data.Ic[i] * wy, Iwv = data.Ic[i] * wv;
-    nq[i] = data.Ic[i] * wdq + cross(wy, Iwy);
-    nb[i] = data.Ic[i] * wdb + cross(wy, Iwv) + cross(wv, Iwy);
+    if (first) {
+      aq += cross(wy, wyr);
+      ab += cross(wy, wvr) + cross(wv, wyr);
+      fq[i] = m * (aq + cross(wy, wyrc));
+      fb[i] = m * (ab + cross(wy, wvrc) + cross(wv, wyrc));
+      nq[i] = cross(wy, Iwy);
+      nb[i] = cross(wy, Iwv) + cross(wv, Iwy);
+    } else {
+      aq += cross(wdq, r) + cross(wy, wyr);
+      ab += cross(wdb, r) + cross(wy, wvr) + cross(wv, wyr);
+      fq[i] = m * (aq + cross(wdq, rc) + cross(wy, wyrc));
+      fb[i] = m * (ab + cross(wdb, rc) + cross(wy, wvrc) + cross(wv, wyrc));
+      nq[i] = data.Ic[i] * wdq + cross(wy, Iwy);
+      nb[i] = data.Ic[i] * wdb + cross(wy, Iwv) + cross(wv, Iwy);
+    }
   }
   const S h = lit<S>(0.5);
   VelocityProductPair<S> out;

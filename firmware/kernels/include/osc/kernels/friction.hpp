@@ -68,7 +68,7 @@ RegressorDiagonals<S> friction_regressor_diagonals(const Vec6<S>& qd, const Vec6
     const S s = math::sgn(qd(i));
     w.vis(i) = qd(i);
     w.cou(i) = s;
-    w.sti(i) = s * math::exp(-dec(i) * qd(i) * qd(i));
+    w.sti(i) = s * math::exp_decay(-dec(i) * qd(i) * qd(i));
   }
   return w;
 }

@@ -102,8 +102,8 @@ struct PivotedLuJacobianFactor {
     rcond = reciprocal_condition(col_sums.maxCoeff(), halves_known && perm == perm_before ? half : -1);
   }
 
-  /// Column a of J^{-1}, as the last compute() found it (by halves: at most one period old).
-  Vec6<S> inverse_column(int a) const { return inverse.col(a); }
+  /// Column a of J^{-1}, as the last compute() found it (by halves: at most one period old); a view of the factor's.
+  auto inverse_column(int a) const { return inverse.col(a); }
 
   /// J^{-1} b: L y = P b, then U x = y.
   Vec6<S> solve(const Vec6In<S>& b) const {

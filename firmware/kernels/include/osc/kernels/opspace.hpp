@@ -257,14 +257,14 @@ PsiTerms<S> psi_terms(const Model<S>& model, const Data<S>& data, const OpSpace<
                       const Vec6In<S>& z) {
   const Vec6<S> qz = os.Jf.solve(z);
   const VelocityProductPair<S> vp = velocity_product_pair(model, data, qy, qz);
-  const Vec3<S> pdy = os.E.Einv * vp.quad.w6, pdz = os.E.Einv * vp.bilinear.w6;  // orientation rates
+  const Vec3<S> pdy = phi_rates_of(os.E, vp.quad.w6), pdz = phi_rates_of(os.E, vp.bilinear.w6);  // orientation rates
   PsiTerms<S> t;
   t.c_yy = vp.quad.c;
   t.c_yz = vp.bilinear.c;
   t.jdot_yy << vp.quad.jdot_qd.template head<3>(),
-      os.E.Einv * (vp.quad.jdot_qd.template tail<3>() - edot_rates(os.E, pdy));
+      phi_rates_of(os.E, Vec3<S>(vp.quad.jdot_qd.template tail<3>() - edot_rates(os.E, pdy)));
   t.jdot_yz << vp.bilinear.jdot_qd.template head<3>(),
-      os.E.Einv * (vp.bilinear.jdot_qd.template tail<3>() - edot_rates(os.E, pdy, pdz));
+      phi_rates_of(os.E, Vec3<S>(vp.bilinear.jdot_qd.template tail<3>() - edot_rates(os.E, pdy, pdz)));
   return t;
 }
 

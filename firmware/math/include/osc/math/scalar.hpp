@@ -80,9 +80,11 @@ namespace detail {
 /// e^v in float: v = k ln 2 + r, |r| <= ln 2 / 2 (ln 2 in two floats, the first with 12 significant
 /// bits), Taylor polynomial to r^7 (truncation below 6e-9 relative), times 2^k from the exponent bits.
 /// Relative error <= 2.4e-7 (two float ulps) where e^v is a normal float; 0 below, +inf above.
+/// NonPositive: the caller's v is <= 0 or NaN (a decay), whose checks above 0 are left out; the same result.
+template <bool NonPositive = false>
 [[gnu::always_inline]] inline float exp_float(float v) {
   if (!(v >= -87.3f)) return v != v ? v : 0.0f;  // NaN stays NaN; e^v below the normal range: 0
-  if (v > 88.5f) return HUGE_VALF;
+  if (!NonPositive && v > 88.5f) return HUGE_VALF;
   const int k = round_to_int(v * 1.44269502f);
   const float fk = static_cast<float>(k);
   const float r = (v - fk * 0.693115234375f) - fk * 3.194618329871446e-05f;
@@ -91,7 +93,9 @@ namespace detail {
       r * (1.0f +
            r * (0.5f + r * (1.66666667e-1f +
                             r * (4.16666667e-2f + r * (8.33333333e-3f + r * (1.38888889e-3f + r * 1.98412698e-4f))))));
-  // 2^k as two factors: each is a normal float for k in [-126, 128] (k = 128 only just below 88.72).
+  // 2^k, k >= -126 (v >= -87.3): one factor below 128; p 2^k rounds once either way (to a subnormal at most).
+  // k = 128 (only just below 88.72) as two factors, each a normal float.
+  if (NonPositive || k < 128) return p * std::bit_cast<float>(static_cast<std::uint32_t>(k + 127) << 23);
   const int k1 = k / 2, k2 = k - k1;
   const float s1 = std::bit_cast<float>(static_cast<std::uint32_t>(k1 + 127) << 23);
   const float s2 = std::bit_cast<float>(static_cast<std::uint32_t>(k2 + 127) << 23);
@@ -150,6 +154,8 @@ inline float cos(float v) {
 }
 inline float sqrt(float v) { return std::sqrt(v); }
 inline float exp(float v) { return detail::exp_float(v); }
+/// e^v for v <= 0 (a decay): exp(v), in float without its checks for v > 0.
+inline float exp_decay(float v) { return detail::exp_float<true>(v); }
 inline float abs(float v) { return std::fabs(v); }
 inline float atan2(float y, float x) { return detail::atan2_float(y, x); }
 /// asin v = atan2(v, sqrt((1 - v)(1 + v))) (NaN outside [-1, 1]).
@@ -162,6 +168,7 @@ inline double sin(double v) { return std::sin(v); }
 inline double cos(double v) { return std::cos(v); }
 inline double sqrt(double v) { return std::sqrt(v); }
 inline double exp(double v) { return std::exp(v); }
+inline double exp_decay(double v) { return std::exp(v); }
 inline double abs(double v) { return std::fabs(v); }
 inline double atan2(double y, double x) { return std::atan2(y, x); }
 inline double asin(double v) { return std::asin(v); }
@@ -185,6 +192,10 @@ using fixed::atan2;
 using fixed::cos;
 using fixed::exp;
 using fixed::isfinite;
+/// e^v for v <= 0, fixed point: exp(v).
+template <class S>
+requires fixed::is_q_v<S>
+inline S exp_decay(S v) { return exp(v); }
 using fixed::sin;
 using fixed::sincos;
 using fixed::sqrt;

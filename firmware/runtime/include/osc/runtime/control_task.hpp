@@ -227,7 +227,6 @@ void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
 /// next tick would have arrived).
 template <class S, hal::ControlHal Hal>
 void stage_codes(ControlTask<S>& task, Hal& hal, TickData<S>& t, std::uint32_t start) {
-  for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
   if (t.stepped) {
     if (task.ramping) ramp_torque(task);
     // Each DAC drives a motor: C^T tau where the drive train couples the joints.
@@ -244,6 +243,7 @@ void stage_codes(ControlTask<S>& task, Hal& hal, TickData<S>& t, std::uint32_t s
     for (int i = 0; i < kDof; ++i) torque_to_code(i, S(task.last.tau(i) - task.last.tau_f_hat(i)), loop[i]);
     t.faults |= task.oscillation.check(loop);
   } else {
+    for (int i = 0; i < kDof; ++i) task.codes[i] = 0;
     task.oscillation.reset();
   }
   if (math::take_arithmetic_fault<S>()) t.faults |= kFaultOverflow;

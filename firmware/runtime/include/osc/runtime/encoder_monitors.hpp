@@ -138,7 +138,9 @@ struct EncoderActivity {
     move_interval[i] = gap < kStuckIntervalCap ? static_cast<std::uint32_t>(gap) : kStuckIntervalCap;
     last_move_tick[i] = tick;
   }
-  void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick) {
+  /// A sample: the channels that moved, and (windows) the windows' counts, which only the slide test reads
+  /// (fast_enough(): the residual monitor's record, not the stuck-encoder monitor's).
+  void track(const std::int32_t counts[kDof], const bool moved[kDof], std::uint64_t tick, bool windows = true) {
     for (int i = 0; i < kDof; ++i) {
       if (!moved[i]) continue;
       const std::int8_t way = counts[i] > last_counts[i] ? 1 : -1;
@@ -148,6 +150,7 @@ struct EncoderActivity {
       last_counts[i] = counts[i];
       mark(i, tick);
     }
+    if (!windows) return;
     if (window_left > 0) {
       --window_left;
       return;
@@ -253,7 +256,7 @@ struct StuckEncoderMonitor {
     if (fresh)
       activity.restart(counts, tick);
     else
-      activity.track(counts, moved, tick);
+      activity.track(counts, moved, tick, false);  // silent() and was_fast() only: no windows
     for (int i = 0; i < kDof; ++i) {
       S& m = motion(i);
       if (moved[i] || fresh) {

@@ -161,12 +161,23 @@ inline constexpr DacTable<W> kDacTable{};
 /// DAC code of a joint torque, saturated at the code range. Returns true when it saturated. The
 /// code is computed in the I/O scalar (it reaches 32767).
 template <class S>
-bool torque_to_code(int joint, S tau, std::int32_t& code) {
+[[gnu::always_inline]] inline bool torque_to_code(int joint, S tau, std::int32_t& code) {
   using W = math::io_scalar_t<S>;
   constexpr W kHalf = lit<W>(0.5);
   const W scale = kDacTable<W>.scale[joint];
   const W limit = kDacTable<W>.limit[joint];
   const W t = static_cast<W>(tau);
+  if constexpr (std::is_floating_point_v<W>) {
+    // One comparison for the common case: |t| below the limit (false for a NaN, an infinity and beyond).
+    if (!((t < W(0) ? -t : t) < limit)) {
+      code = t >= limit ? static_cast<std::int32_t>(kDacMaxCode)
+                        : (t <= -limit ? -static_cast<std::int32_t>(kDacMaxCode) : 0);
+      return true;
+    }
+    const W c = t * scale;
+    code = static_cast<std::int32_t>(c >= W(0) ? c + kHalf : c - kHalf);
+    return false;
+  }
   if (!math::isfinite(t)) {
     code = 0;
     return true;

@@ -50,11 +50,20 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
 template <class S>
 inline void ResidualMonitor<S>::mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last) {
   if (first == 0) velocity_noise.setZero();
+  // Scalar loops over the factor's own columns (no vector temporaries): the same operations, in the same order,
+  // as m = k_min e_j + sum_a (k_a - k_min) J_aj J^-1 e_a; velocity_noise += quantum_j / 2 |m|.
   for (int j = first; j < last; ++j) {
-    Vec6<S> m = Vec6<S>::Unit(j) * k_min;
-    for (int a = 0; a < kDof; ++a)
-      if (gain_excess(a) != S(0)) m += (gain_excess(a) * J(a, j)) * Jf.inverse_column(a);
-    velocity_noise += half_quantum(j) * m.cwiseAbs();
+    S m[kDof];
+    for (int i = 0; i < kDof; ++i) m[i] = S(0);
+    m[j] = k_min;
+    for (int a = 0; a < kDof; ++a) {
+      if (gain_excess(a) == S(0)) continue;
+      const S s = gain_excess(a) * J(a, j);
+      const auto col = Jf.inverse_column(a);
+      for (int i = 0; i < kDof; ++i) m[i] += s * col(i);
+    }
+    const S h = half_quantum(j);
+    for (int i = 0; i < kDof; ++i) velocity_noise(i) += h * math::abs(m[i]);
     // In fixed point x's own rounding too, which no J turns back: J^-1's column j times k_j and its bound.
     if constexpr (fixed::is_q_v<S>) velocity_noise += pose_noise(j) * Jf.inverse_column(j).cwiseAbs();
   }
