@@ -63,28 +63,30 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
   const Vec3<S>* vO = data.vO;
   S m = S(0);
   Vec3<S> h = Vec3<S>::Zero();
-  Mat3<S> IO;  // symmetric; the first body sets it
+  // I_O's six entries (symmetric), the first body's its own (adding it to zeros changes at most the sign of a zero).
+  S io00 = S(0), io11 = S(0), io22 = S(0), io01 = S(0), io02 = S(0), io12 = S(0);
   for (int j = kDof; j >= 1; --j) {
     const S mj = model.link[j - 1].mass;
     const Vec3<S>& c = data.com[j];
     const Vec3<S> mc = mj * c;
     m += mj;
     h += mc;
-    // IO += Ic + mj (|c|^2 I - c c^T): the diagonal entry r is sum_{k != r} mc_k c_k, an off-diagonal
-    // one -mc_r c_s; six entries, IO and Ic being symmetric.
+    // I_O += Ic + mj (|c|^2 I - c c^T): the diagonal entry r is sum_{k != r} mc_k c_k, an off-diagonal
+    // one -mc_r c_s.
     const Mat3<S>& Ic = data.Ic[j];
     const S d0 = Ic(0, 0) + math::sum_of_products(mc(1), c(1), mc(2), c(2));
     const S d1 = Ic(1, 1) + math::sum_of_products(mc(0), c(0), mc(2), c(2));
     const S d2 = Ic(2, 2) + math::sum_of_products(mc(0), c(0), mc(1), c(1));
     const S o01 = Ic(0, 1) - mc(0) * c(1), o02 = Ic(0, 2) - mc(0) * c(2), o12 = Ic(1, 2) - mc(1) * c(2);
-    if (j == kDof) {  // the first body: IO is its own (adding it to zeros only rounds the sign of a zero)
-      IO(0, 0) = d0, IO(1, 1) = d1, IO(2, 2) = d2, IO(0, 1) = o01, IO(0, 2) = o02, IO(1, 2) = o12;
+    if (j == kDof) {
+      io00 = d0, io11 = d1, io22 = d2, io01 = o01, io02 = o02, io12 = o12;
     } else {
-      IO(0, 0) += d0, IO(1, 1) += d1, IO(2, 2) += d2, IO(0, 1) += o01, IO(0, 2) += o02, IO(1, 2) += o12;
+      io00 += d0, io11 += d1, io22 += d2, io01 += o01, io02 += o02, io12 += o12;
     }
-    IO(1, 0) = IO(0, 1), IO(2, 0) = IO(0, 2), IO(2, 1) = IO(1, 2);
     const Vec3<S> z = data.R[j - 1].col(2);
-    const Vec3<S> p = m * vO[j - 1] + cross(z, h);   // linear momentum
+    const Vec3<S> p = m * vO[j - 1] + cross(z, h);  // linear momentum
+    Mat3<S> IO;
+    IO << io00, io01, io02, io01, io11, io12, io02, io12, io22;
     const Vec3<S> L = IO * z + cross(h, vO[j - 1]);  // angular momentum about the base origin
     for (int i = 1; i <= j; ++i) {
       data.A(i - 1, j - 1) = dot_sum(Vec3<S>(data.R[i - 1].col(2)), L, vO[i - 1], p);
