@@ -93,6 +93,7 @@ const Case kCasesList[] = {
     {"no_source.yaml", "sheet_no_source"},
     {"unknown_field.yaml", "sheet_unknown_field"},
     {"zero_gear.yaml", "sheet_value"},
+    {"narrow_current.yaml", "sheet_value"},
     {"nan.yaml", "not_finite"},
     {"pose_outside.yaml", "pose_outside_limits"},
     {"huge_gear.yaml", "fixed_point_range"},

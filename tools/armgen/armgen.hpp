@@ -127,6 +127,10 @@ struct Sheet {
   bool index = false;
   Six index_angle;
   Text index_text;
+  bool current = false;  ///< a current monitor on every amplifier
+  int current_bits = 0;
+  Value current_range, current_gain, current_offset, current_noise;
+  Text current_text;
   std::vector<FrictionPreset> friction;
   Value link_inertia, amp_gain, amp_offset, ripple, amp_lag, encoder_edge, drift;
   std::vector<std::string> band;  ///< the friction band's presets

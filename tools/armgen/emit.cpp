@@ -250,6 +250,16 @@ void emit_drives(std::ostream& o, const Sheet& s) {
   } else {
     o << "    // No index pulses.\n    false,\n    {0, 0, 0, 0, 0, 0},\n";
   }
+  if (s.current) {
+    group(o, "    // ",
+          "Current monitors: ADC bits, span (times the DAC's full-scale current), gain error, offset (of the full "
+          "scale) and noise (ADC codes, standard deviation) at most.",
+          s.current_text);
+    o << "    {" << s.current_bits << ", " << s.current_range.text << ", " << s.current_gain.text << ", "
+      << s.current_offset.text << ", " << s.current_noise.text << "},\n";
+  } else {
+    o << "    // No current readback.\n    {0, 1, 0, 0, 0},\n";
+  }
   o << "};\nstatic_assert(kDriveTrain.encoders.coupling_terms <= kMaxCouplingTerms);\n\n";
 }
 

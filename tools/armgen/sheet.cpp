@@ -223,6 +223,22 @@ void read_drives(const Reader& r, Sheet& s) {
     s.index_angle = p.at("angle").six();
     s.index_text = p.text();
   }
+  if (r.has("current_monitor")) {
+    const Reader p = r.at("current_monitor");
+    p.only({"bits", "range", "gain", "offset", "noise", "source", "estimate"});
+    s.current = true;
+    s.current_bits = p.at("bits").integer(2, 16);
+    s.current_range = p.at("range").value();
+    s.current_gain = p.at("gain").value();
+    s.current_offset = p.at("offset").value();
+    s.current_noise = p.at("noise").value();
+    if (s.current_range.v < 1)
+      throw Error("sheet_value", p.child_path("range") + ": below 1 (the ADC must span the DAC's full-scale current)");
+    for (const auto& [key, v] : {std::pair{"gain", s.current_gain}, std::pair{"offset", s.current_offset},
+                                 std::pair{"noise", s.current_noise}})
+      if (v.v < 0) throw Error("sheet_value", p.child_path(key) + ": negative");
+    s.current_text = p.text();
+  }
 }
 
 void read_friction(const Reader& r, Sheet& s) {
@@ -383,6 +399,7 @@ Sheet read_sheet(const std::string& path) {
           "plausible_joint_speed",
           "potentiometers",
           "index_pulses",
+          "current_monitor",
           "friction",
           "model_error_bounds",
           "poses",

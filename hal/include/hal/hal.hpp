@@ -50,6 +50,22 @@ concept PositionHal = requires(H& h, std::uint16_t* codes, int channel, std::int
   { h.take_index(channel, count) } -> std::same_as<bool>;
 };
 
+/// What the drive check (issue 56, docs/safety.md "The drive check") needs beyond ControlHal: each
+/// amplifier's current, read back from its current-monitor output through an ADC, and its fault line
+/// where one is wired. A HAL without them satisfies ControlHal alone: the task then cannot tell a
+/// drive fault from a contact on one joint, nor find a DAC frozen at its last value at rest.
+template <class H>
+concept CurrentHal = requires(H& h, std::int16_t* currents) {
+  /// Each amplifier channel's current (the channels of write_dacs), the latest complete conversion:
+  /// signed ADC codes, +-(2^(bits-1) - 1) at +-range times the DAC's full-scale current
+  /// (osc::robot::kDriveTrain.current); positive where a positive DAC code drives it. False when
+  /// there is none (no conversion yet, it failed, or the board has no readback wired).
+  { h.read_currents(currents) } -> std::same_as<bool>;
+  /// Bit c: amplifier c's fault line is active (over-current, over-temperature, a supply fault as the
+  /// amplifier reports it); 0 where no fault line is wired.
+  { h.amp_faults() } -> std::same_as<std::uint32_t>;
+};
+
 /// Extends a free-running N-bit hardware counter (e.g. a 16-bit timer in encoder mode) to a
 /// 32-bit position. Correct as long as fewer than 2^(N-1) counts pass between two reads.
 template <int Bits>

@@ -135,6 +135,18 @@ enum class EncoderKind { kIncremental, kAbsolute };
 /// The drive train of a real arm, as published (or estimated, where its description says so): the
 /// motors, the encoders, the amplifiers' limits, a potentiometer on every joint (if any), an index
 /// pulse once per motor revolution (if any).
+/// Each amplifier's current monitor (its current-monitor output through an ADC): what the drive check
+/// (osc/runtime/drive_monitor.hpp) compares with the DAC's command. Signed codes, +-(2^(bits-1) - 1) at
+/// +-range times the DAC's full-scale current; its errors at most: gain (relative), offset (relative
+/// to the DAC's full scale) and noise (standard deviation, ADC codes).
+struct CurrentMonitor {
+  int bits;       ///< the ADC's resolution; 0: no current readback
+  double range;   ///< the ADC's span over the DAC's full-scale current (at least 1)
+  double gain;    ///< gain error at most, relative
+  double offset;  ///< offset at most, relative to the DAC's full-scale current
+  double noise;   ///< noise, standard deviation [ADC codes]
+};
+
 struct DriveTrain {
   EncoderMap encoders;                  ///< the arm's own encoders and coupling
   EncoderKind encoder_kind;             ///< of `encoders`
@@ -145,11 +157,14 @@ struct DriveTrain {
   double pot_min[kDof], pot_max[kDof];  ///< joint angle at code 0 and at full scale [rad]
   bool index_pulses;                    ///< an index pulse per motor revolution; false: none (index_angle unused)
   double index_angle[kDof];  ///< the motor shaft's angle at its index pulse [rad, 0..2 pi), from its angle at q = 0
+  CurrentMonitor current;    ///< the amplifiers' current monitors (bits 0: none)
 };
 
 /// Whether the arm has a potentiometer on every joint (pot_bits > 0): the position cross-check and homing
 /// need them.
 constexpr bool has_pots(const DriveTrain& d) { return d.pot_bits > 0; }
+/// Whether every amplifier's current is read back (current.bits > 0): the drive check needs it.
+constexpr bool has_current_monitors(const DriveTrain& d) { return d.current.bits > 0; }
 /// Whether the arm's encoders read the angle itself (EncoderKind::kAbsolute): known from power-on, no homing.
 constexpr bool has_absolute_encoders(const DriveTrain& d) { return d.encoder_kind == EncoderKind::kAbsolute; }
 

@@ -152,6 +152,16 @@ constexpr DriveTrain kDriveTrain = {
     // relies on one place.
     true,
     {0.7, 2.1, 4, 1.3, 5.5, 3.1},
+    // Current monitors: ADC bits, span (times the DAC's full-scale current), gain error, offset (of the full scale)
+    // and noise (ADC codes, standard deviation) at most.
+    // Source: The PUMA's own Trident interface reads no amplifier current (ROBOT.H: DACs, encoders, one ADC for the
+    // pots); +-10 V analog amplifiers commonly give a current-monitor output (Copley 4122, PMA 90/180;
+    // ../shared/reference/drives-and-identification.md section 2).
+    // Estimate: A retrofit's readback: each amplifier's current-monitor output through a 12-bit ADC spanning 1.25
+    // times the DAC's full-scale current (headroom for a full-scale command's gain error), behind a 1-2 kHz
+    // anti-alias filter; the monitor's gain within +-2 %, its offset within 0.2 % of full scale (trimmed), 2 codes of
+    // noise (drives-and-identification.md section 2's error budget).
+    {12, 1.25, 0.02, 0.002, 2},
 };
 static_assert(kDriveTrain.encoders.coupling_terms <= kMaxCouplingTerms);
 
