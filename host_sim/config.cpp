@@ -554,6 +554,15 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
          [](Settings& s) { return s.base.plant.amp_gain_error; });
   array6(t, "plant.amp_offset", "the amplifiers' offsets per channel, joint-referred [N m]", -10, 10,
          [](Settings& s) { return s.base.plant.amp_offset; });
+  flag(t, "plant.current_monitor",
+       "the amplifiers' current monitors, read back (the drive check and its test dither run: docs/safety.md)",
+       [](Settings& s) -> bool& { return s.base.sensors.current_monitor; });
+  array6(t, "plant.current_gain", "the current monitors' gain errors per channel, relative", -0.2, 0.2,
+         [](Settings& s) { return s.base.sensors.current_gain; });
+  array6(t, "plant.current_offset", "the current monitors' offsets per channel, of the DAC's full scale", -0.05, 0.05,
+         [](Settings& s) { return s.base.sensors.current_offset; });
+  number(t, "plant.current_noise", "the current monitors' noise, standard deviation [ADC codes]", 0, 100, true,
+         [](Settings& s) -> double& { return s.base.sensors.current_noise; });
   add_plant_feature_tail(t);
   // The plant's preset and features model the paper's robot more or less closely: they do not change
   // the paper's set-up (the outputs name them apart: Provenance::plant).

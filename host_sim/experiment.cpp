@@ -109,6 +109,16 @@ class LocalController {
       res.residual_fault = m.detected;
       res.residual_joint = static_cast<unsigned char>(m.joint);  // set: 0..5
     }
+    const osc::DriveMonitor& d = task_->drive;
+    for (int c = 0; c < 6; ++c) {
+      res.drive_peak_ratio[c] = d.peak[c] / 1000.0;
+      res.dither_peak_fade[c] = d.dither_peak[c] / 1000.0;
+    }
+    if (d.detected != 0) {
+      res.drive_detected_s = static_cast<double>(d.detected_tick) / osc::params::kControlHz;
+      res.drive_fault = d.detected;
+      res.drive_channel = d.channel;
+    }
   }
 
  private:

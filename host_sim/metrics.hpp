@@ -174,6 +174,11 @@ struct StuckMonitorPeaks {
   double position_peak_ratio[6] = {};     ///< the position cross-check's largest |d - d_ref| / band per joint
   double oscillation_peak_ratio[6] = {};  ///< the oscillation monitor's largest half-rate amplitude / limit per joint
   double travel_peak_ratio[6] = {};       ///< the travel check's largest least travel / its limit per joint (0: off)
+  double drive_peak_ratio[6] = {};        ///< the drive check's largest |error| / threshold per channel
+  double dither_peak_fade[6] = {};        ///< ... its dither's largest fade, of the amplitude (0.5: the fault)
+  double drive_detected_s = -1;           ///< the drive check's first detection [s] (-1: none)
+  std::uint32_t drive_fault = 0;          ///< ... its fault
+  int drive_channel = -1;                 ///< ... its channel (0-based)
   void to_json(Json& j) const;
 };
 

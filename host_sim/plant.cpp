@@ -504,11 +504,21 @@ Vec6 Plant::amplifier(const Vec6& u, double s) const {
   return u + (amp_ - u) * std::exp(-s / cfg_.amp_lag);
 }
 
-Vec6 Plant::delivered(const Vec6& amp, const State& x) const {
+Vec6 Plant::currents(const Vec6& amp) const {
   if (!amplifiers_on_) return Vec6::Zero();  // disabled: no current at all, offsets included
   Vec6 t = amp;
   if (cfg_.amp_current_limit) t = t.cwiseMax(-limit_).cwiseMin(limit_);
   for (int i = 0; i < 6; ++i) t(i) = (1 + cfg_.amp_gain_error[i]) * t(i) + cfg_.amp_offset[i];
+  return t;
+}
+
+Vec6 Plant::amplifier_currents() const {
+  if (ideal_) return amplifiers_on_ ? cmd_ : Vec6::Zero();
+  return currents(cfg_.amp_lag > 0 ? amp_ : cmd_);
+}
+
+Vec6 Plant::delivered(const Vec6& amp, const State& x) const {
+  Vec6 t = currents(amp);
   if (cfg_.ripple != 0) {
     // The motor's pole frequency: ripple_cycles periods per shaft revolution, shaft angle G e.
     const Vec6 e = motor_angles_of(x);

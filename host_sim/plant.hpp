@@ -198,6 +198,9 @@ class Plant {
   /// The torques the motors produce now (joint-referred, per channel) for the last command: after
   /// the amplifiers' lag, current limit, gain error and offset, and the ripple.
   Vec6 motor_torques() const;
+  /// The amplifiers' currents now, each as the torque it gives (joint-referred, per channel): what a current
+  /// monitor measures (motor_torques() without the ripple, which is the motor's, not the current's).
+  Vec6 amplifier_currents() const;
   /// The elastic joints' spring torques K dz(theta - q) (zero on rigid joints).
   Vec6 spring_torques() const;
   /// The elastic joints' stiffness K [N m/rad] (zero on rigid joints).
@@ -244,6 +247,9 @@ class Plant {
   double spring(int i, double stretch) const;
   /// The amplifiers' output after s more seconds of command u, from their state now.
   Vec6 amplifier(const Vec6& u, double s) const;
+  /// The amplifiers' currents for their output amp (each as the torque it gives, joint-referred): their
+  /// current limit, gain error and offset; zero while disabled.
+  Vec6 currents(const Vec6& amp) const;
 
   PlantConfig cfg_;
   bool ideal_;

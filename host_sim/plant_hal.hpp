@@ -36,6 +36,13 @@ struct SensorConfig {
   double pot_noise = 0;        ///< potentiometer noise, standard deviation [ADC codes]
   double pot_offset[6] = {};   ///< potentiometer offset per joint [ADC codes]
   std::uint8_t index_off = 0;  ///< bit c: channel c's index pulse never fires (a broken index track)
+  /// The amplifiers' current monitors, read back (hal::CurrentHal: read_currents gives false without): each
+  /// reads its amplifier's current on osc::robot::kDriveTrain.current's ADC, with a gain error, an offset
+  /// (of the DAC's full scale) and Gaussian noise [ADC codes].
+  bool current_monitor = false;
+  double current_gain[6] = {};
+  double current_offset[6] = {};
+  double current_noise = 0;
   std::uint32_t seed = 12345;  ///< the noise generators' seed (runs are reproducible)
 };
 
@@ -176,7 +183,8 @@ class PlantHal {
         inj_(inj),
         rng_(sensors.seed),
         jitter_rng_(generator(sensors.seed, 1)),
-        pot_rng_(generator(sensors.seed, 2)) {
+        pot_rng_(generator(sensors.seed, 2)),
+        current_rng_(generator(sensors.seed, 3)) {
     for (int i = 0; i < hal::kJoints; ++i) {
       counts_per_rad_[i] = sensors.encoders.counts_per_rad[i];
       // The encoder change per tick at the joint's maximum speed (the firmware's bound, less one
@@ -277,7 +285,8 @@ class PlantHal {
     Vec6 t;
     if (fault_) return Vec6::Zero();
     for (int i = 0; i < hal::kJoints; ++i) {
-      const bool off = active_ && inj_.kind == InjectionKind::kAmpOff && inj_.hits(i);
+      const bool off =
+          active_ && (inj_.kind == InjectionKind::kAmpOff || inj_.kind == InjectionKind::kAmpFault) && inj_.hits(i);
       t(i) = off ? 0.0 : osc::code_to_torque(i, dac_quantise(codes_[i], sensors_.dac_bits));
     }
     return t;
@@ -294,6 +303,39 @@ class PlantHal {
       codes[i] = static_cast<std::uint16_t>(!(x > 0) ? 0.0 : (x >= kPotFullScale ? kPotFullScale : x));
     }
     return true;
+  }
+
+  /// The current monitors (SensorConfig::current_monitor; false without): each channel's amplifier current
+  /// (Plant::amplifier_currents, as a joint-referred torque) on the ADC's scale, +-adc_max at +-range times
+  /// the DAC's full scale: code = clamp(round((1 + gain) i / (range FS) adc_max + offset adc_max / range +
+  /// noise)); an injected monitor fault: frozen, zero or half the reading.
+  bool read_currents(std::int16_t adc[hal::kJoints]) {
+    if (!sensors_.current_monitor) return false;
+    const osc::CurrentMonitor& m = osc::robot::kDriveTrain.current;
+    const double top = static_cast<double>((1L << (m.bits - 1)) - 1);
+    const Vec6 current = plant_.amplifier_currents();
+    for (int i = 0; i < hal::kJoints; ++i) {
+      const double fs = osc::robot::kDrives.torque_limit[i];
+      double x = ((1 + sensors_.current_gain[i]) * current(i) / fs + sensors_.current_offset[i]) / m.range * top;
+      if (sensors_.current_noise > 0) x += sensors_.current_noise * gauss_(current_rng_);
+      const bool hit = active_ && inj_.hits(i);
+      if (hit && inj_.kind == InjectionKind::kCurrentZero) x = 0;
+      if (hit && inj_.kind == InjectionKind::kCurrentGain) x *= 0.5;
+      x = std::round(x);
+      auto code = static_cast<std::int16_t>(x > top ? top : (x < -top ? -top : x));
+      if (hit && inj_.kind == InjectionKind::kCurrentStuck) {
+        if (first_current_[i]) frozen_current_[i] = last_current_[i], first_current_[i] = false;
+        code = frozen_current_[i];
+      }
+      last_current_[i] = code;
+      adc[i] = code;
+    }
+    return true;
+  }
+  /// The amplifiers' fault lines: an injected amplifier trip (amp-fault).
+  std::uint32_t amp_faults() const {
+    if (!active_ || inj_.kind != InjectionKind::kAmpFault) return 0;
+    return inj_.joint < 0 ? (1u << hal::kJoints) - 1u : 1u << inj_.joint;
   }
 
   /// The index pulse latched on a channel since the last call: true once per latch, with the
@@ -329,12 +371,17 @@ class PlantHal {
   std::int32_t frozen_[hal::kJoints] = {};
   std::uint32_t clock_ = 0;
   int overrun_reads_ = 0;
-  std::mt19937 rng_;         // the injected encoder noise
-  std::mt19937 jitter_rng_;  // the encoders' edge jitter
-  std::mt19937 pot_rng_;     // the potentiometers' noise
+  std::mt19937 rng_;                                // the injected encoder noise
+  std::mt19937 jitter_rng_;                         // the encoders' edge jitter
+  std::mt19937 pot_rng_;                            // the potentiometers' noise
+  std::mt19937 current_rng_;                        // the current monitors' noise
+  std::int16_t last_current_[hal::kJoints] = {};    // each monitor's last reading
+  std::int16_t frozen_current_[hal::kJoints] = {};  // ... frozen (current-stuck)
+  bool first_current_[hal::kJoints] = {true, true, true, true, true, true};
   std::normal_distribution<double> gauss_{0.0, 1.0};
 };
 static_assert(hal::ControlHal<PlantHal>);
 static_assert(hal::PositionHal<PlantHal>, "the simulated arm has potentiometers and index pulses");
+static_assert(hal::CurrentHal<PlantHal>, "the simulated arm's amplifiers have current monitors (SensorConfig)");
 
 }  // namespace sim

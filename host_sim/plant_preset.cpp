@@ -28,6 +28,10 @@ void ideal(ExperimentConfig& cfg) {
   cfg.sensors.dac_bits = z.dac_bits;
   cfg.sensors.encoder_jitter = z.encoder_jitter;
   cfg.sensors.pot_noise = z.pot_noise;
+  cfg.sensors.current_monitor = z.current_monitor;
+  cfg.sensors.current_noise = z.current_noise;
+  for (int i = 0; i < 6; ++i)
+    cfg.sensors.current_gain[i] = z.current_gain[i], cfg.sensors.current_offset[i] = z.current_offset[i];
 }
 
 /// Every feature at its mid value. The published values where there are any (the encoders, the

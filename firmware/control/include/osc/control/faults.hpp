@@ -30,13 +30,16 @@ namespace osc {
   X(DacBus, "dac_bus",                                                                                             \
     "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")             \
   X(DriveFault, "drive_fault",                                                                                     \
-    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the residual monitor")      \
+    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the drive check, or the "   \
+    "residual monitor")                                                                                            \
   X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")            \
   X(PositionMismatch, "position_mismatch",                                                                         \
     "a pot and its encoders disagree beyond their band: a stuck or slipping encoder; homing: a pot off its index") \
   X(IndexMissing, "index_missing", "homing: a motor turned a whole revolution and more without an index pulse")    \
   X(Unstable, "unstable",                                                                                          \
-    "a torque (less its friction compensation) oscillated at half the tick rate beyond its bound: the loop lost")
+    "a torque (less its friction compensation) oscillated at half the tick rate beyond its bound: the loop lost")  \
+  X(CurrentSense, "current_sense",                                                                                 \
+    "an amplifier's current monitor read off its scale (beyond any current its amplifier gives): the drive check")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

@@ -180,6 +180,20 @@ constexpr bool kResidualMonitorArmed = true;
 /// exceeds this many counts must have counted: its encoder (or something holding the joint) is at
 /// fault. One count is the geometry (the next edge, or the last one back); the second is margin.
 constexpr double kResidualTravelCounts = 2;
+/// The drive check (osc/runtime/drive_monitor.hpp; docs/safety.md, "The drive check"), on a HAL with
+/// current readback:
+/// - its threshold is kDriveMargin times the stated bounds of the amplifiers' and the current monitors'
+///   errors (robot::kModelErrorBounds, robot::kDriveTrain.current): about 1.6 % of full scale plus 8 % of the
+///   command (drives-and-identification.md section 3 estimates 2 % and 6 %);
+/// - a reading beyond it for kDriveQualifyTicks in a row is a drive_fault (a glitch of one conversion is not);
+/// - the test dither: +-kDitherAmplitude of each channel's full scale on its DAC code, a square wave of
+///   kDitherHalfPeriod ticks a sign (125 Hz), the default of the runtime parameter dither; its demodulation
+///   filters over 2^kDitherWindowShift ticks (16 ms: a frozen DAC at half its level in 11 ticks).
+constexpr double kDriveMargin = 2;
+constexpr int kDriveQualifyTicks = 3;
+constexpr double kDitherAmplitude = 0.01;
+constexpr int kDitherHalfPeriod = 4;
+constexpr int kDitherWindowShift = 4;
 /// The residual monitor's turn: every this many control steps (the controller's even steps, on which the
 /// alternate model rate computes A and g, not Psi: osc/control/controller.hpp, even_step), it updates each joint's
 /// bound, change channel and thresholds and advances the travel check's bounds, on the inputs' means over the

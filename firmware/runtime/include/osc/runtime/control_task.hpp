@@ -142,6 +142,25 @@ std::uint32_t position_faults(ControlTask<S>& task, Hal& hal, const Vec6<S>& q) 
   }
 }
 
+/// The drive check of a tick (DriveMonitor), on a HAL with current readback whose monitors are wired
+/// (drive_check): each amplifier's current and fault line, whether the torque is on or not (off, the
+/// currents must be 0). It tells the residual monitor whether it ran and which channels it suspects.
+template <class S, class Hal>
+std::uint32_t drive_faults(ControlTask<S>& task, Hal& hal) {
+  if constexpr (hal::CurrentHal<Hal>) {
+    if (!task.drive_check) return 0;
+    std::int16_t adc[kDof];
+    const bool valid = hal.read_currents(adc);
+    const std::uint32_t faults = task.drive.check(adc, valid, hal.amp_faults(), task.tick);
+    task.residual.drives_checked = valid;
+    task.residual.drive_suspect = task.drive.suspect;
+    return faults;
+  } else {
+    (void)task, (void)hal;
+    return 0;
+  }
+}
+
 /// Homing's checks of a tick with a measured sample (homing_faults), while homing on a HAL with
 /// potentiometers and index pulses (homing cannot start without: no_pots).
 template <class S, class Hal>
@@ -167,8 +186,9 @@ struct TickData {
   MotionEvents ev;            // the motion source's events of this tick
   // The reaction to the residual monitor's collision (category 0: none, or the fault stays).
   CollisionReaction collision = CollisionReaction::kCategory0;
-  bool clipped = false;  // a DAC code was clipped at its range
-  bool torque = false;   // the supervisor and the motion state machine let torque reach the DACs
+  bool clipped = false;    // a DAC code was clipped at its range
+  bool torque = false;     // the supervisor and the motion state machine let torque reach the DACs
+  std::int8_t dither = 0;  // the test dither's sign in the step's codes (0: none)
 };
 
 /// read: the HAL's I/O faults (E-stop, drives) and the encoder sample.
@@ -211,11 +231,13 @@ void stage_step(ControlTask<S>& task, TickData<S>& t) {
   t.faults |= task.last.status;  // non_finite, singular
 }
 
-/// monitors: those of a completed step (step_monitor_faults: stuck encoder, residual, then the momentum
+/// monitors: the drive check (drive_faults: first, the residual monitor's isolation takes its suspects),
+/// those of a completed step (step_monitor_faults: stuck encoder, residual, then the momentum
 /// law's update on the residual's sample (adaptation_identify), tracking, friction-estimate band), the position
 /// cross-check of a measured sample; then a collision's reaction (take_collision).
 template <class S, hal::ControlHal Hal>
 void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
+  t.faults |= drive_faults(task, hal);
   if (t.stepped && task.last.status == kFaultNone) t.faults |= step_monitor_faults(task, t.counts, t.moved);
   if (t.measured) t.faults |= position_faults(task, hal, t.q);
   t.collision = take_collision(task, t.faults);
@@ -229,6 +251,11 @@ template <class S, hal::ControlHal Hal>
 void stage_codes(ControlTask<S>& task, Hal& hal, TickData<S>& t, std::uint32_t start) {
   if (t.stepped) {
     if (task.ramping) ramp_torque(task);
+    // The test dither, where the drive check runs on current readings (the residual monitor takes it as applied).
+    if (task.residual.drives_checked && task.drive.amplitude > 0) {
+      t.dither = task.dither_sign();
+      task.last.tau += t.dither > 0 ? task.dither_torque : Vec6<S>(-task.dither_torque);
+    }
     // Each DAC drives a motor: C^T tau where the drive train couples the joints.
     Vec6<S> tau_m;
     const Vec6<S>& tau = task.io.coupled() ? (tau_m = motor_torques(task.io, task.last.tau)) : task.last.tau;
@@ -274,6 +301,7 @@ void stage_output(ControlTask<S>& task, Hal& hal, const TickData<S>& t) {
     task.residual.applied(t.clipped ? applied_torque(task) : task.last.tau);
   hal.write_dacs(task.codes);
   hal.fault_output(task.sup.state == SupervisorState::kFault);
+  task.drive.written(task.codes, t.torque ? t.dither : std::int8_t{0});
 }
 
 /// One tick, the block diagram of its stages (TickStage, OSC_TICK_STAGE_LIST), each one call, timed:
@@ -318,6 +346,7 @@ void hold_tick(ControlTask<S>& task, Hal& hal) {
   task.report = {};
   task.jump.tick();
   hal.write_dacs(task.codes);
+  task.drive.written(task.codes, 0);
   ++task.tick;
 }
 

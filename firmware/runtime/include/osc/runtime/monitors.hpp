@@ -12,6 +12,9 @@
 //     after the step   ResidualMonitor       the torque the model does not explain, and the travel check
 //                                            (residual_constants.hpp, residual_thresholds.hpp and
 //                                            residual_travel.hpp: its constants, thresholds, travel check)
+//   osc/runtime/drive_monitor.hpp
+//     after the step   DriveMonitor          each amplifier's current against its DAC code, the test dither,
+//                                            the amplifiers' fault lines (a HAL with current readback)
 //   osc/runtime/step_monitors.hpp
 //     after the step   TrackingMonitor       the tracking error e (36) within params::kTrackingLimit*
 //                      ThetaBandMonitor      the friction estimates within their band
@@ -20,6 +23,7 @@
 // The thresholds are params:: constants (osc/control/params.hpp), converted to the scalar at compile time.
 #pragma once
 
+#include "osc/runtime/drive_monitor.hpp"
 #include "osc/runtime/encoder_monitors.hpp"
 #include "osc/runtime/residual_monitor.hpp"
 #include "osc/runtime/step_monitors.hpp"

@@ -33,8 +33,10 @@ namespace osc {
 /// and kind:
 ///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for
 ///    more than params::kStuckIntervals of its recent intervals between counts);
-///  - drive_fault: the residual is on this drive alone (every other joint below half its threshold);
-///  - collision: an external torque on several joints, as a contact gives.
+///  - with the drives checked (a HAL with current readback: DriveMonitor), drive_fault where the drive check
+///    suspects the joint's drive, else collision (isolation by order: docs/safety.md, "The drive check");
+///  - without: drive_fault when the residual is on this drive alone (every other joint below half its
+///    threshold); collision: an external torque on several joints, as a contact gives.
 /// Beside the residual, the travel check (travel()): a joint whose least motion since its encoder's
 /// last count, from the torque applied and the same bounds, passes params::kResidualTravelCounts
 /// counts must have counted; it is a fault at once (classify_travel() names it).
@@ -117,6 +119,11 @@ struct ResidualMonitor {
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
   bool contact_noted = false;  // the contact error_floor holds (note_contact())
+  /// Set by the task each tick on a HAL with current readback (DriveMonitor, osc/runtime/drive_monitor.hpp):
+  /// the drive check ran (drives_checked), and the channels it suspects (bit c). Then a residual on one joint
+  /// is no longer taken for a drive fault: only a suspect's joint's is (classify()).
+  bool drives_checked = false;
+  std::uint8_t drive_suspect = 0;
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate q^dot =
   /// J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its mean) times the largest k.
@@ -438,6 +445,15 @@ struct ResidualMonitor {
     for (int k = 0; k < io.terms; ++k)
       if (io.row[k] == i && silent_first(io.col[k], i, tick)) stuck = true;
     if (stuck) return kFaultEncoderStuck;
+    // With the drives checked (isolation by order): drive_fault where the check suspects a channel that drives
+    // joint i: its own, or one whose torque the coupling adds to it (C^-T: motor c reaches joint i where
+    // q_c = ... + C_ci e_i); what is left is a collision.
+    if (drives_checked) {
+      bool suspect = (drive_suspect >> i & 1u) != 0;
+      for (int k = 0; k < io.terms; ++k)
+        if (io.col[k] == i && (drive_suspect >> io.row[k] & 1u) != 0) suspect = true;
+      return suspect ? kFaultDriveFault : kFaultCollision;
+    }
     for (int j = 0; j < kDof; ++j)
       if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
     return kFaultDriveFault;

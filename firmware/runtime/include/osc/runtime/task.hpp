@@ -82,6 +82,11 @@ struct ControlTask {
   // The ids of the moves the last tick dropped from the queue (report.dropped_moves of them).
   std::uint32_t dropped_move_ids[MotionGenerator<S>::kMaxWaiting];
   Vec6<S> q_lo, q_hi;  // the running motion's joint limits (motion_limits_from, motion_limits_reached)
+  // The drive check (osc/runtime/drive_monitor.hpp), on a HAL with current readback (hal::CurrentHal).
+  DriveMonitor drive;
+  bool drive_check;        // the amplifiers' current monitors are wired: the drive check runs (has_current_monitors)
+  double dither_fraction;  // the test dither's amplitude, of each channel's full scale (0: off)
+  Vec6<S> dither_torque;   // its joint torques: each channel gets +-dither_fraction of its full scale (C^-T)
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -121,6 +126,9 @@ struct ControlTask {
     oscillation.reset();
     position.reset();
     pots = has_pots(robot::kDriveTrain);
+    drive.reset();
+    drive_check = has_current_monitors(robot::kDriveTrain);
+    dither_fraction = params::kDitherAmplitude;
     // The paper's procedure places the arm at q_start; absolute encoders read it from power-on.
     homed = start == TaskStart::kPaper || has_absolute_encoders(robot::kDriveTrain);
     homing = {};
@@ -148,6 +156,7 @@ struct ControlTask {
       quantum(j) = lit<S>(d);
     }
     residual.set(quantum, gains.k, io.inverse);
+    set_dither(dither_fraction);
     for (int i = 0; i < kDof; ++i) {
       const double c = map.counts_per_rad[i];
       if (io.coupled()) {
@@ -175,6 +184,17 @@ struct ControlTask {
     for (int i = 0; i < kDof; ++i) residual.collision_floor(i) = lit<S>(threshold_nm[i]);
     return true;
   }
+  /// The test dither's amplitude, a fraction of each channel's full scale (0: off; the drive check's dither
+  /// check runs with it): each channel's code gets +-fraction of its full scale, the joints C^-T of it.
+  [[gnu::cold]] void set_dither(double fraction) {
+    dither_fraction = fraction;
+    Vec6<S> d;
+    for (int c = 0; c < kDof; ++c) d(c) = lit<S>(fraction * robot::kDrives.torque_limit[c]);
+    dither_torque = io.coupled() ? joint_torques_of_motors(io, d) : d;
+    drive.start_dither(static_cast<std::int32_t>(fraction * static_cast<double>(kDacMaxCode) + 0.5));
+  }
+  /// The dither's sign in this tick's codes: a square wave of params::kDitherHalfPeriod ticks a sign.
+  std::int8_t dither_sign() const { return (tick / params::kDitherHalfPeriod) % 2 == 0 ? 1 : -1; }
   /// Encoder counts per radian of channel i (its motor angle referred to its joint).
   double counts_per_rad(int i) const { return static_cast<double>(io.counts_per_rad(i)); }
   /// Test hook (fault injection): poisons the observer state with a NaN.

@@ -1,0 +1,177 @@
+// The drive check (DriveMonitor; docs/safety.md, "The drive check"): each amplifier's current, read
+// back through its current monitor (hal::CurrentHal), against the DAC code it was given; a test dither
+// on the codes that a frozen DAC or amplifier cannot follow; the amplifiers' fault lines. Run by
+// control_tick() (osc/runtime/control_task.hpp) on a HAL with current readback, before the residual
+// monitor, which then names what is left a collision (ResidualMonitor::classify). In integers: the
+// codes' scale, whatever the scalar.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/control/faults.hpp"
+#include "osc/control/params.hpp"
+#include "osc/runtime/encoder_monitors.hpp"
+#include "osc/runtime/io.hpp"
+
+namespace osc {
+
+/// The check's constants in DAC codes (the amplifiers' command scale), from the arm's stated bounds
+/// (robot::kModelErrorBounds: the amplifiers; robot::kDriveTrain.current: the monitors).
+struct DriveCheckConstants {
+  std::int32_t adc_q8;       // one ADC code in DAC codes, times 256
+  std::int32_t adc_max;      // the ADC's largest code magnitude, 2^(bits-1) - 1 (a reading there is off its scale)
+  std::int32_t floor;        // the threshold's constant part [DAC codes]
+  std::int32_t share;        // its share of the command's size, times 2^16
+  std::int32_t limit[kDof];  // each amplifier's current limit (kDriveTrain.motor_torque_limit) [DAC codes]
+};
+
+/// floor = kDriveMargin (amplifier offset + monitor offset + 3 sigma of the monitor's noise + half its
+/// code); share = kDriveMargin (amplifier gain + monitor gain): 1.6 % of full scale and 8 % of the command
+/// with the PUMA's and the UR5e's bounds (2 % and 2 %; 0.2 % and 0.2 %; 2 codes of 12 bits over 1.25 full scale).
+constexpr DriveCheckConstants drive_check_constants() {
+  const CurrentMonitor& m = robot::kDriveTrain.current;
+  const ModelErrorBounds& b = robot::kModelErrorBounds;
+  DriveCheckConstants k{};
+  if (m.bits <= 0) return k;
+  const double adc_max = static_cast<double>((1L << (m.bits - 1)) - 1);
+  const double lsb = m.range / adc_max;  // one ADC code, relative to the DAC's full scale
+  const double floor = params::kDriveMargin * (b.amp_offset + m.offset + 3 * m.noise * lsb + 0.5 * lsb);
+  const double share = params::kDriveMargin * (b.amp_gain + m.gain);
+  const auto dac = static_cast<double>(kDacMaxCode);
+  k.adc_q8 = static_cast<std::int32_t>(lsb * dac * 256 + 0.5);
+  k.adc_max = static_cast<std::int32_t>(adc_max);
+  k.floor = static_cast<std::int32_t>(floor * dac + 0.5);
+  k.share = static_cast<std::int32_t>(share * 65536 + 0.5);
+  for (int c = 0; c < kDof; ++c) {
+    const double amp = robot::kDriveTrain.motor_torque_limit[c] * abs_of(robot::kArm.links[c].gear_ratio);
+    const double fs = robot::kDrives.torque_limit[c];
+    k.limit[c] = static_cast<std::int32_t>((amp < fs ? amp / fs : 1.0) * dac);
+  }
+  return k;
+}
+inline constexpr DriveCheckConstants kDriveCheck = drive_check_constants();
+
+/// drive_fault, current_sense: per amplifier channel, every tick with a current sample.
+///  - The tracking check: the current read at this tick's start, in DAC codes, lies between the last two
+///    codes written (the amplifier's current loop, at most robot::kModelErrorBounds.amp_lag, moves from the
+///    one before toward the last; it settles within a period) within floor + share |code|. Beyond, for
+///    params::kDriveQualifyTicks readings in a row: drive_fault (a DAC at zero or full scale, an amplifier
+///    off, a DAC frozen once the command has left its value).
+///  - The dither check: the codes carry a square wave of +-dither codes (params::kDitherAmplitude of full
+///    scale, params::kDitherHalfPeriod ticks a sign; ControlTask::dither_sign); the reading's difference from
+///    the last code, times that code's sign, filtered over 2^params::kDitherWindowShift readings (those not
+///    right after a change of sign), is about 0 on a drive that follows and -dither on one that does not.
+///    Below -dither / 2: drive_fault, at rest as in motion (a DAC or an amplifier frozen at any value).
+///  - The fault lines: an amplifier that reports a fault: drive_fault at once.
+///  - The monitor itself: a reading at the end of the ADC's span (beyond the largest current an amplifier
+///    can give, 1 / range of it): current_sense.
+/// A channel whose reading is off by more than half its threshold, or whose dither fades below three
+/// quarters, is a suspect: the residual monitor names a residual on its joint drive_fault, not collision.
+struct DriveMonitor {
+  std::int32_t last[kDof];    // the codes the last tick wrote (the amplifiers have had them since)
+  std::int32_t before[kDof];  // the codes the tick before wrote
+  std::int32_t dither[kDof];  // 2^kDitherShift times the filtered sign-weighted difference [DAC codes]
+  std::int8_t sign_last;      // the dither's sign in the last codes (0: none)
+  std::int8_t sign_before;    // ... in the codes before
+  std::uint8_t writes;        // ticks whose codes are on record (2: the check runs)
+  std::uint8_t over[kDof];    // consecutive readings beyond the threshold
+  std::uint8_t suspect;       // bit c: channel c is a suspect (see the type's comment)
+  std::uint32_t detected;     // the first fault's bit (0: none)
+  std::int8_t channel;        // its channel, -1 none
+  std::uint64_t detected_tick;
+  std::int32_t amplitude;           // the dither's amplitude in use [DAC codes] (0: off)
+  std::uint16_t peak[kDof];         // the largest |error| / threshold seen, times 1000 (the false-alarm margin)
+  std::uint16_t dither_peak[kDof];  // the largest fade of a dither in use, -filtered / amplitude, times 1000
+
+  static constexpr int kDitherShift = params::kDitherWindowShift;
+
+  void reset() {
+    for (int c = 0; c < kDof; ++c) last[c] = before[c] = dither[c] = 0, over[c] = 0, peak[c] = dither_peak[c] = 0;
+    sign_last = sign_before = 0;
+    writes = 0;
+    suspect = 0;
+    detected = 0;
+    channel = -1;
+    detected_tick = 0;
+    amplitude = 0;
+  }
+  /// The codes this tick wrote, and the dither's sign in them (0: none): after the DAC write.
+  void written(const std::int32_t codes[kDof], std::int8_t sign) {
+    for (int c = 0; c < kDof; ++c) before[c] = last[c], last[c] = codes[c];
+    sign_before = sign_last;
+    sign_last = sign;
+    if (writes < 2) ++writes;
+  }
+  /// This tick's reading (valid: the HAL gave one) and fault lines (bit c: amplifier c): the fault bits.
+  std::uint32_t check(const std::int16_t adc[kDof], bool valid, std::uint32_t lines, std::uint64_t tick) {
+    std::uint32_t faults = 0;
+    int at = -1;
+    for (int c = 0; c < kDof; ++c)
+      if (lines >> c & 1u) faults = kFaultDriveFault, at = c;
+    suspect = 0;
+    if (valid && writes >= 2)
+      for (int c = 0; c < kDof; ++c) {
+        const std::uint32_t f = check_channel(c, adc[c]);
+        if (f != 0 && faults == 0) faults = f, at = c;
+      }
+    if (faults != 0 && detected == 0) detected = faults, channel = static_cast<std::int8_t>(at), detected_tick = tick;
+    return faults;
+  }
+  /// Channel c's reading against its codes (check()).
+  std::uint32_t check_channel(int c, std::int32_t reading) {
+    const DriveCheckConstants& k = kDriveCheck;
+    if (reading >= k.adc_max || reading <= -k.adc_max) {
+      suspect |= static_cast<std::uint8_t>(1u << c);
+      return kFaultCurrentSense;
+    }
+    const std::int32_t m = (reading * k.adc_q8) >> 8;  // in DAC codes
+    // The last two codes, each within the amplifier's current limit.
+    const std::int32_t l = k.limit[c];
+    std::int32_t a = last[c], b = before[c];
+    a = a > l ? l : (a < -l ? -l : a);
+    b = b > l ? l : (b < -l ? -l : b);
+    const std::int32_t lo = a < b ? a : b, hi = a < b ? b : a;
+    const std::int32_t error = m > hi ? m - hi : (m < lo ? lo - m : 0);
+    const std::int32_t size = hi > -lo ? hi : -lo;
+    const std::int32_t threshold = k.floor + static_cast<std::int32_t>((std::int64_t{size} * k.share) >> 16);
+    track_peak(peak[c], error, threshold);
+    if (2 * error > threshold) suspect |= static_cast<std::uint8_t>(1u << c);
+    over[c] = qualify(over[c], error > threshold);
+    std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? kFaultDriveFault : 0u;
+    // The dither, where the amplifier passes it (both codes with their dither within its current limit), on the
+    // readings after a code of the same sign as the one before: the reading after a change of sign carries the
+    // current loop's lag behind its step of two amplitudes (up to 45 % of it: docs/safety.md), the others only a
+    // period's decay of that (e^-2 of it).
+    const std::int32_t room = l - amplitude;
+    if (sign_last != 0 && sign_last == sign_before && amplitude > 0 && last[c] < room && last[c] > -room &&
+        before[c] < room && before[c] > -room) {
+      // 2^s y += s (m - a) - y: the filter of the sign-weighted difference, its level 2^s times the mean; the
+      // difference within +-2 amplitudes (a larger one is the tracking check's: a glitch adds at most that).
+      const std::int32_t two = 2 * amplitude, d = m - a;
+      const std::int32_t dc = d > two ? two : (d < -two ? -two : d);
+      const std::int32_t x = sign_last > 0 ? dc : -dc;
+      dither[c] += x - (dither[c] >> kDitherShift);
+      const std::int32_t fade = -dither[c];  // 2^s times the missing share of the amplitude
+      track_peak(dither_peak[c], fade, amplitude << kDitherShift);
+      if (4 * fade > 3 * (amplitude << kDitherShift)) suspect |= static_cast<std::uint8_t>(1u << c);
+      if (2 * fade > (amplitude << kDitherShift)) f = kFaultDriveFault;
+    }
+    return f;
+  }
+  /// The dither runs: its filters start from a drive that follows (a torque-on, a change of amplitude).
+  void start_dither(std::int32_t codes) {
+    amplitude = codes;
+    for (int c = 0; c < kDof; ++c) dither[c] = 0;
+  }
+
+ private:
+  static void track_peak(std::uint16_t& peak, std::int32_t value, std::int32_t limit) {
+    // Divided only for a new peak (rare), compared in 64 bits (a multiply).
+    if (value <= 0 || limit <= 0 || std::int64_t{value} * 1000 <= std::int64_t{peak} * limit) return;
+    const std::int64_t r = std::int64_t{value} * 1000 / limit;
+    const std::uint16_t v = r > 65535 ? std::uint16_t{65535} : static_cast<std::uint16_t>(r);
+    if (v > peak) peak = v;
+  }
+};
+
+}  // namespace osc
