@@ -22,14 +22,14 @@
 namespace stm32f4 {
 
 /// The board's one scan: the current monitors (table 0), then the potentiometers (table 1).
-class AnalogInputs : public AdcScan<pins::kCurrentMonitors, pins::kPots> {
+using AnalogScan = AdcScan<pins::kCurrentMonitors, pins::kPots>;
+class AnalogInputs : public AnalogScan {
  public:
-  using Scan = AdcScan<pins::kCurrentMonitors, pins::kPots>;
   static constexpr int kCurrentTable = 0, kPotTable = 1;
 
   /// The potentiometers' codes of the scan update() took this tick (0 .. 4095), in joint order;
   /// false when it had none.
-  bool read(std::uint16_t pots[hal::kJoints]) const { return Scan::read<kPotTable>(pots); }
+  bool read(std::uint16_t pots[hal::kJoints]) const { return AnalogScan::read<kPotTable>(pots); }
   /// Each amplifier's current of that scan as a signed code (the code less kMidScale: -2048 .. 2047),
   /// in channel order; false when it had none.
   bool read_currents(std::int16_t currents[hal::kJoints]) const { return read_centred<kCurrentTable>(currents); }
