@@ -115,7 +115,7 @@ constexpr PinConfig kOthers[] = {kDacSck,    kDacMosi, kDacSync[0], kDacSync[1],
 /// each amplifier fault line's, then the others.
 constexpr int kPinCount = 6 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
 constexpr Pin pin_at(int i) {
-  constexpr int n = hal::kJoints;
+  const int n = hal::kJoints;
   if (i < 3 * n) {
     const EncoderChannel& e = kEncoders[i / 3];
     return i % 3 == 0 ? e.a.pin : i % 3 == 1 ? e.b.pin : e.index.pin;
