@@ -34,6 +34,9 @@ class AnalogInputs : public AnalogScan {
   /// in channel order; false when it had none.
   bool read_currents(std::int16_t currents[hal::kJoints]) const { return read_centred<kCurrentTable>(currents); }
 };
+static_assert(AnalogInputs::kSizes[AnalogInputs::kCurrentTable] == hal::kJoints &&
+                  AnalogInputs::kSizes[AnalogInputs::kPotTable] == hal::kJoints,
+              "a current monitor per amplifier and a potentiometer per joint");
 
 /// The arm's current monitors (osc::robot::kDriveTrain.current), read at the board's resolution.
 inline constexpr bool kHasCurrentMonitors = osc::has_current_monitors(osc::robot::kDriveTrain);
