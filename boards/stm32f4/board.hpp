@@ -13,8 +13,8 @@
 //     48 MHz timer clock;
 //   - the encoders are a still robot (every count 0, and no index pulse ever: take_index is always
 //     false): TIM2 is the tick, and QEMU would run TIM3..5 as free counters, not in encoder mode;
-//   - there are no potentiometers: the ADC and DMA2 are never touched, and read_pots is always
-//     false (no sample);
+//   - there are no analog inputs: the ADC and DMA2 are never touched, and read_pots and
+//     read_currents are always false (no sample);
 //   - the cycle counter's rate is QEMU's fixed 168 MHz CPU clock, whatever the RCC set-up reports.
 // Everything else is the board image's code: the bounded clock set-up (which falls back to HSI
 // there, the RCC reading zero), the DAC frames on SPI2, the safety I/O registers, the watchdog's
@@ -27,6 +27,7 @@
 
 #include "ad5754r.hpp"
 #include "adc.hpp"
+#include "analog_inputs.hpp"
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "control_timer.hpp"
@@ -134,20 +135,25 @@ struct StillEncoders {
 };
 using Encoders = std::conditional_t<kQemu, StillEncoders, stm32f4::EncoderBank<stm32f4::pins::kEncoders>>;
 
-/// The QEMU image's potentiometers: none (QEMU has no DMA2 and no scan): never a sample.
-struct NoPots {
+/// The QEMU image's analog inputs: none (QEMU has no DMA2 and no scan): never a potentiometer's or a
+/// current's sample.
+struct NoAnalogInputs {
   void init(const stm32f4::Chip&, std::uint32_t) {}
   bool update() { return false; }
   bool read(std::uint16_t*) const { return false; }
+  bool read_currents(std::int16_t*) const { return false; }
 };
-using Pots = std::conditional_t<kQemu, NoPots, stm32f4::AdcScan<stm32f4::pins::kPots>>;
-/// A scan fits a tick, on the PLL and on the HSI fallback alike: each tick takes the one before.
-constexpr std::uint32_t scan_ns_at(std::uint32_t pclk2) {
-  return stm32f4::AdcScan<stm32f4::pins::kPots>::scan_ns(pclk2 / stm32f4::adc_divider(pclk2));
+using Analog = std::conditional_t<kQemu, NoAnalogInputs, stm32f4::AnalogInputs>;
+/// The first `n` conversions of the scan (all by default) [ns] at a PCLK2.
+constexpr std::uint32_t scan_ns_at(std::uint32_t pclk2, int n = stm32f4::AnalogInputs::kCount) {
+  return stm32f4::AnalogInputs::scan_ns(pclk2 / stm32f4::adc_divider(pclk2), n);
 }
-static_assert(scan_ns_at(stm32f4::kPllClocks.pclk2) < 1000000000u / kControlHz &&
-                  scan_ns_at(stm32f4::kHsiClocks.pclk2) < 1000000000u / kControlHz,
-              "the potentiometers' scan within the tick");
+/// A scan fits a tick, on the PLL and on the HSI fallback alike (each tick takes the one before), with
+/// room to spare; the currents, converted first, within the tick's first 20 us on the PLL.
+static_assert(scan_ns_at(stm32f4::kPllClocks.pclk2) < 1000000000u / kControlHz / 4 &&
+                  scan_ns_at(stm32f4::kHsiClocks.pclk2) < 1000000000u / kControlHz / 2,
+              "the analog scan well within the tick");
+static_assert(scan_ns_at(stm32f4::kPllClocks.pclk2, hal::kJoints) < 20000u, "the currents at the tick's start");
 
 /// Step timing: the DWT cycle counter, or SysTick where the DWT does not count (start() finds out).
 struct CycleCounter {
@@ -171,8 +177,8 @@ inline const char* reset_cause_name(std::uint32_t csr) {
 }
 
 using Dac = ad5754r::DacPair<stm32f4::SpiDacBus>;
-using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter, Pots>;
-static_assert(hal::ControlHal<Hal> && hal::PositionHal<Hal>);
+using Hal = stm32f4::BoardHal<Encoders, Dac, CycleCounter, Analog>;
+static_assert(hal::ControlHal<Hal> && hal::PositionHal<Hal> && hal::CurrentHal<Hal>);
 /// The USART link: commands in, answer, state and telemetry frames out.
 using Uart = stm32f4::UsartLink<kTxFrames, pil::kMaxFrame, kRxBytes>;
 
@@ -183,16 +189,16 @@ struct Board {
   BootFault boot = BootFault::kNone;  ///< the first boot fault (docs/stm32f4.md, "Boot faults")
   std::uint32_t reset_flags = 0;
   Encoders encoders;
-  Pots pots;
+  Analog analog;
   stm32f4::SpiDacBus dac_bus;
   Dac dac{dac_bus};
   stm32f4::Safety safety;
   Uart uart;
-  Hal hal{encoders, dac, pots, safety, chip.timer(kControlTimer)};
+  Hal hal{encoders, dac, analog, safety, chip.timer(kControlTimer)};
 
   /// Boot, with interrupts still off: clocks (bounded, HSI fallback), the reset cause, the cycle
-  /// counter, the safety outputs first (amplifier disabled), the DACs at 0 V, the encoders and their
-  /// index captures, the potentiometers' ADC (the first tick starts its first scan), the USART link.
+  /// counter, the safety outputs first (amplifier disabled) and inputs, the DACs at 0 V, the encoders and
+  /// their index captures, the analog inputs' ADC (the first tick starts its first scan), the USART link.
   /// A boot fault keeps the torque off for good (Hal::permit_torque).
   void init() {
     clocks = stm32f4::clock_init(*chip.rcc, *chip.flash);
@@ -206,7 +212,7 @@ struct Board {
     dac_bus.init(chip, clocks.pclk1);
     if (!dac.init()) note(BootFault::kDacSetup);
     encoders.init(chip);
-    pots.init(chip, clocks.pclk2);
+    analog.init(chip, clocks.pclk2);
     uart.init(chip, clocks.pclk1, kTelemetryBaud, stm32f4::pins::kUartTx, stm32f4::pins::kUartRx);
   }
   /// The independent watchdog: from here on only healthy ticks keep the MCU out of reset.

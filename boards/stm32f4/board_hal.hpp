@@ -2,7 +2,8 @@
 // commands to the DAC pair, the E-stop and the control timer's overrun as I/O faults, and a tick
 // (BoardHal::tick) that drives the safety outputs and feeds the watchdog after the control step.
 // Also hal::PositionHal: the joints' potentiometers (the ADC scan each tick takes and restarts) and
-// the encoders' index latches.
+// the encoders' index latches; and hal::CurrentHal: the amplifiers' currents (the same scan) and their
+// fault lines.
 // Templates over the drivers (the board's, or fakes in tests/boards/stm32f4/test_stm32f4.cpp), each constrained by
 // the concept of what the binding needs from it: no virtual calls.
 #pragma once
@@ -26,11 +27,17 @@ concept EncoderInput = requires(E& e, std::int32_t* counts, int channel, std::in
   { e.take_index(channel, count) } -> std::same_as<bool>;
 };
 /// The potentiometers: a scan taken and the next started once a tick (update: whether the scan was
-/// good), and that tick's codes (read: false without a good scan). E.g. AdcScan, or none (QEMU).
+/// good), and that tick's codes (read: false without a good scan). E.g. AnalogInputs, or none (QEMU).
 template <class P>
 concept PotInput = requires(P& p, const P& cp, std::uint16_t* codes) {
   { p.update() } -> std::same_as<bool>;
   { cp.read(codes) } -> std::same_as<bool>;
+};
+/// The amplifiers' current monitors, converted in the potentiometers' scan: that tick's signed codes
+/// (read_currents: the code less mid-scale; false without a good scan). E.g. AnalogInputs, or none.
+template <class A>
+concept CurrentInput = requires(const A& ca, std::int16_t* currents) {
+  { ca.read_currents(currents) } -> std::same_as<bool>;
 };
 /// The torque outputs: one tick's codes (false: a bus fault), and every output to 0 V at once
 /// (e.g. ad5754r::DacPair).
@@ -45,11 +52,13 @@ concept CycleClock = requires {
   { C::cycles() } -> std::same_as<std::uint32_t>;
 };
 
-template <EncoderInput Encoders, DacOutput Dac, CycleClock Clock, PotInput Pots>
+/// Analog: one scan a tick of the potentiometers and the current monitors.
+template <EncoderInput Encoders, DacOutput Dac, CycleClock Clock, PotInput Analog>
+requires CurrentInput<Analog>
 class BoardHal {
  public:
-  BoardHal(Encoders& encoders, Dac& dac, Pots& pots, Safety& safety, TimRegs& control_timer)
-      : enc_(encoders), dac_(dac), pots_(pots), safety_(safety), timer_(control_timer) {}
+  BoardHal(Encoders& encoders, Dac& dac, Analog& analog, Safety& safety, TimRegs& control_timer)
+      : enc_(encoders), dac_(dac), analog_(analog), safety_(safety), timer_(control_timer) {}
 
   /// Whether torque may be commanded at all: false after a boot fault (docs/stm32f4.md, "Boot
   /// faults"): zero codes and the amplifier disabled, whatever the supervisor says.
@@ -81,17 +90,24 @@ class BoardHal {
 
   // hal::PositionHal
   /// The scan this tick took (the one the previous tick started); false when it failed or none ran.
-  bool read_pots(std::uint16_t codes[hal::kJoints]) { return pots_.read(codes); }
+  bool read_pots(std::uint16_t codes[hal::kJoints]) { return analog_.read(codes); }
   /// The index pulse latched on joint `channel`'s encoder, once, as the count read_encoders gives.
   bool take_index(int channel, std::int32_t& count) { return enc_.take_index(channel, count); }
 
-  /// One control tick: the potentiometers' scan taken and the next one started (no wait), the
+  // hal::CurrentHal
+  /// Each amplifier's current from the scan this tick took (signed codes, 0 at 0 A); false when it
+  /// failed or none ran.
+  bool read_currents(std::int16_t currents[hal::kJoints]) { return analog_.read_currents(currents); }
+  /// Bit c: amplifier c's fault line is high (its fault, or a broken wire), read now.
+  std::uint32_t amp_faults() { return safety_.amp_faults(); }
+
+  /// One control tick: the analog scan (currents, potentiometers) taken and the next one started (no wait), the
   /// control task, then the amplifier enable (on only in kRun with torque permitted and no E-stop)
   /// and the fault LED (a latched fault or a boot fault), then the watchdog, fed only when the
   /// supervisor is healthy (osc::supervisor_healthy). Returns the faults detected in the tick.
   template <class S>
   std::uint32_t tick(osc::ControlTask<S>& task) {
-    pots_.update();
+    analog_.update();
     const std::uint32_t faults = osc::control_tick(task, *this);
     safety_.set_outputs(permitted_ && osc::torque_enabled(task.sup),
                         task.sup.state == osc::SupervisorState::kFault || !permitted_);
@@ -109,7 +125,7 @@ class BoardHal {
  private:
   Encoders& enc_;
   Dac& dac_;
-  Pots& pots_;
+  Analog& analog_;
   Safety& safety_;
   TimRegs& timer_;
   bool permitted_ = true;

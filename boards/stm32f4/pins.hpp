@@ -1,9 +1,10 @@
 // The board's pin map: every pin the firmware uses, its alternate function (datasheet DS8626,
 // table 9 "alternate function mapping") and its role, in one place; the chip's drivers
 // (boards/common/stm32f4) take their pins from here. The encoder table also names each joint's
-// timer, its counter width and its clock-enable bit; the potentiometer table each joint's ADC
-// channel (data sheet DS8626, table 7). docs/stm32f4.md, "Wiring", is this file as a table; the pins
-// are chosen free on the STM32F4DISCOVERY (MB997) where they can be (the exceptions are noted there).
+// timer, its counter width and its clock-enable bit; the potentiometers' and the current monitors'
+// tables each input's ADC channel (data sheet DS8626, table 7) and sample time. docs/stm32f4.md,
+// "Wiring", is this file as a table; the pins are chosen free on the STM32F4DISCOVERY (MB997) where
+// they can be (the exceptions are noted there: the current monitors' six are its on-board parts').
 #pragma once
 
 #include <cstdint>
@@ -48,17 +49,34 @@ inline constexpr EncoderChannel kEncoders[hal::kJoints] = {
      4},  // joint 6: TIM8_CH1/2, index TIM8_CH4
 };
 
-// ---------------------------------------------------------------- potentiometers: ADC1
+// ---------------------------------------------------------------- analog inputs: ADC1
+// One scan a tick (stm32f4::AnalogInputs, analog_inputs.hpp): the current monitors, then the
+// potentiometers. The package's sixteen ADC1 pins (PA0-PA7, PB0-PB1, PC0-PC5; the 100-pin part has no
+// port F) are the encoders' and the link's (PA0-PA3), the potentiometers' and the current monitors'.
+
 /// Each joint's potentiometer (wiper to the pin, ends to VREF+ and VSSA), in joint order: channels
-/// that are free on the Discovery (PC0 drives its USB power switch, PC3 carries its microphone's
-/// output; PA4-PA7 its audio and accelerometer), scanned by stm32f4::AdcScan (adc.hpp).
+/// that are free on the Discovery. 480 sampling cycles: any potentiometer's impedance (adc.hpp).
 inline constexpr AnalogInput kPots[hal::kJoints] = {
-    {analog(PC(1)), 11},  // joint 1: ADC123_IN11
-    {analog(PC(2)), 12},  // joint 2: ADC123_IN12
-    {analog(PC(4)), 14},  // joint 3: ADC12_IN14
-    {analog(PC(5)), 15},  // joint 4: ADC12_IN15
-    {analog(PB(0)), 8},   // joint 5: ADC12_IN8
-    {analog(PB(1)), 9},   // joint 6: ADC12_IN9
+    {analog(PC(1)), 11, 480},  // joint 1: ADC123_IN11
+    {analog(PC(2)), 12, 480},  // joint 2: ADC123_IN12
+    {analog(PC(4)), 14, 480},  // joint 3: ADC12_IN14
+    {analog(PC(5)), 15, 480},  // joint 4: ADC12_IN15
+    {analog(PB(0)), 8, 480},   // joint 5: ADC12_IN8
+    {analog(PB(1)), 9, 480},   // joint 6: ADC12_IN9
+};
+/// Each amplifier's current monitor, in channel order (the DACs' channels): its bipolar output
+/// level-shifted to mid-scale (0 A at VREF+ / 2) behind an RC anti-alias filter of 1-2 kHz
+/// (docs/stm32f4.md, "Current monitors and amplifier fault lines"). The last six ADC1 pins, each an
+/// on-board part's on the Discovery (PA4 the audio codec's LRCK, PA5-PA7 the accelerometer's SPI, PC0
+/// the USB power switch's enable with its pull-up, PC3 the microphone's output): freed there first.
+/// 56 sampling cycles (the filter's capacitor charges the ADC's): converted first, 19 us from the start.
+inline constexpr AnalogInput kCurrentMonitors[hal::kJoints] = {
+    {analog(PA(4)), 4, 56},   // amplifier 1: ADC12_IN4
+    {analog(PA(5)), 5, 56},   // amplifier 2: ADC12_IN5
+    {analog(PA(6)), 6, 56},   // amplifier 3: ADC12_IN6
+    {analog(PA(7)), 7, 56},   // amplifier 4: ADC12_IN7
+    {analog(PC(0)), 10, 56},  // amplifier 5: ADC123_IN10
+    {analog(PC(3)), 13, 56},  // amplifier 6: ADC123_IN13
 };
 
 // ---------------------------------------------------------------- DAC: two AD5754R on SPI2
@@ -79,6 +97,12 @@ constexpr PinConfig kEstop = input(PD(1), Pull::kUp);
 constexpr int kEstopExtiLine = 1;
 /// Fault LED (the STM32F4DISCOVERY's red LD5), active high.
 constexpr PinConfig kFaultLed = output(PD(14), false);
+/// Each amplifier's fault output, in channel order, on port E (free on the Discovery): an open-drain
+/// output that holds its line low while the amplifier is healthy, internal pull-up. High is a fault:
+/// the amplifier's (it lets go), or a broken wire or an unplugged amplifier (the pull-up).
+constexpr PinConfig kAmpFaults[hal::kJoints] = {input(PE(7), Pull::kUp),  input(PE(8), Pull::kUp),
+                                                input(PE(10), Pull::kUp), input(PE(12), Pull::kUp),
+                                                input(PE(14), Pull::kUp), input(PE(15), Pull::kUp)};
 
 // ---------------------------------------------------------------- telemetry
 constexpr PinConfig kUartTx = alternate(PA(2), 7, Speed::kMedium);          // USART2_TX
@@ -87,15 +111,19 @@ constexpr PinConfig kUartRx = alternate(PD(6), 7, Speed::kLow, Pull::kUp);  // U
 // ---------------------------------------------------------------- every pin, once
 constexpr PinConfig kOthers[] = {kDacSck,    kDacMosi, kDacSync[0], kDacSync[1], kDacLdac, kDacClr,
                                  kAmpEnable, kEstop,   kFaultLed,   kUartTx,     kUartRx};
-/// Every pin of the map: each encoder's A, B and index, each potentiometer's, then the others.
-constexpr int kPinCount = 4 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
+/// Every pin of the map: each encoder's A, B and index, each potentiometer's, each current monitor's,
+/// each amplifier fault line's, then the others.
+constexpr int kPinCount = 6 * hal::kJoints + static_cast<int>(sizeof(kOthers) / sizeof(kOthers[0]));
 constexpr Pin pin_at(int i) {
-  if (i < 3 * hal::kJoints) {
+  const int n = hal::kJoints;
+  if (i < 3 * n) {
     const EncoderChannel& e = kEncoders[i / 3];
     return i % 3 == 0 ? e.a.pin : i % 3 == 1 ? e.b.pin : e.index.pin;
   }
-  if (i < 4 * hal::kJoints) return kPots[i - 3 * hal::kJoints].pin.pin;
-  return kOthers[i - 4 * hal::kJoints].pin;
+  if (i < 4 * n) return kPots[i - 3 * n].pin.pin;
+  if (i < 5 * n) return kCurrentMonitors[i - 4 * n].pin.pin;
+  if (i < 6 * n) return kAmpFaults[i - 5 * n].pin;
+  return kOthers[i - 6 * n].pin;
 }
 /// No pin twice among `pins`.
 constexpr bool distinct(const Pin* pins, int n) {

@@ -1,5 +1,5 @@
-// Safety I/O (pins.hpp): the amplifier-enable output, the E-stop input on EXTI, the fault LED, and
-// the independent watchdog (IWDG).
+// Safety I/O (pins.hpp): the amplifier-enable output, the E-stop input on EXTI, the fault LED, the
+// amplifiers' fault lines, and the independent watchdog (IWDG).
 //
 //   - Amplifier enable: low (disabled, also by its external pull-down while the MCU is in reset)
 //     from boot; high only while the supervisor runs healthy with torque allowed, the boot found no
@@ -10,6 +10,8 @@
 //     on_estop_interrupt(): amplifier off and LED on within the interrupt, and a latch the next tick
 //     reports as osc::kFaultEstop (io_faults()), so the supervisor latches `estop` within one tick.
 //     The input level is also read every tick: a stop pressed before boot has no edge.
+//   - Amplifier fault lines: one input with a pull-up per amplifier, low while it is healthy; read
+//     each tick as the HAL's amp_faults() bits (high: the amplifier's fault, or a broken wire).
 //   - IWDG (RM0090 21.3): clocked by the 32 kHz LSI (17 to 47 kHz, data sheet DS8626), /4, reload
 //     kWatchdogReload: expires 5 ms after the last feed (3.4 to 9.4 ms over the LSI's range). Started
 //     once, it cannot be stopped; the MCU resets when it expires, and the amplifier enable falls
@@ -50,6 +52,7 @@ class Safety {
     pin_configure(chip, pins::kAmpEnable);
     pin_configure(chip, pins::kFaultLed);
     pin_configure(chip, pins::kEstop);
+    for (const PinConfig& p : pins::kAmpFaults) pin_configure(chip, p);
     chip.rcc->APB2ENR = chip.rcc->APB2ENR | RccRegs::kSyscfgEn;
     read_back(chip.rcc->APB2ENR);
     constexpr int kEstopLine = pins::kEstopExtiLine;
@@ -75,6 +78,15 @@ class Safety {
   }
   /// The E-stop as the control task's fault bit.
   std::uint32_t io_faults() { return estop() ? static_cast<std::uint32_t>(osc::kFaultEstop) : 0u; }
+  /// Bit c: amplifier c's fault line reads high (the amplifier reports a fault, or its wire is open).
+  std::uint32_t amp_faults() const {
+    std::uint32_t bits = 0;
+    for (int c = 0; c < hal::kJoints; ++c) {
+      const Pin p = pins::kAmpFaults[c].pin;
+      if (pin_read(chip_.port(p.port), p.n)) bits |= 1u << c;
+    }
+    return bits;
+  }
 
   /// Amplifier off, fault LED on. Register writes only: callable from any interrupt or fault handler
   /// (before init() there is nothing to switch off: the pin is still an input, held low externally).

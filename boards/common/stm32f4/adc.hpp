@@ -1,29 +1,33 @@
-// Analog inputs on ADC1 (RM0090 section 13): one scan of the regular group over a board's table of
-// inputs (AnalogInput: the pin and its channel; the board's pins.hpp) per control tick, moved by
-// DMA2 into a buffer in RAM; the board reads its joints' potentiometers with it.
+// Analog inputs on ADC1 (RM0090 section 13): one scan of the regular group per control tick over a
+// board's tables of inputs (AnalogInput: the pin, its channel, its sample time; the board's pins.hpp),
+// the tables one after the other in one sequence, moved by DMA2 into a buffer in RAM. The STM32F4 board
+// reads its amplifiers' current monitors and its joints' potentiometers with it (one scan of twelve).
 //
 // When: the tick's update() takes the scan the previous tick started and starts the next one (the
 // software trigger, SWSTART); it never waits for a conversion. So the codes a tick gets were sampled
-// during the tick before (at most one period old). 12-bit, right-aligned; every channel sampled for
-// 480 ADC clock cycles. The ADC clock is PCLK2 / 4 = 21 MHz (84 MHz APB2; at most 36 MHz, DS8626
-// "ADC characteristics"), a conversion 480 + 12 = 492 cycles (23.4 us; RM0090 13.5), a scan of six
-// 141 us: well within the 1 ms tick. At the HSI fallback (PCLK2 16 MHz / 2 = 8 MHz) it is 369 us.
+// during the tick before (at most one period old), each at its place in the sequence. 12-bit,
+// right-aligned. The ADC clock is PCLK2 / 4 = 21 MHz (84 MHz APB2; at most 36 MHz, DS8626 "ADC
+// characteristics"); a conversion takes its input's sample time and 12 cycles (RM0090 13.5): 68 cycles
+// (3.2 us) at 56, 492 (23.4 us) at 480. The board's scan, six inputs at 56 cycles and six at 480, is
+// 3360 cycles: 160 us, and 420 us at the HSI fallback (PCLK2 16 MHz / 2 = 8 MHz): within the 1 ms tick.
 //
-// Why 480 cycles: the sample time must charge the ADC's sampling capacitor (C_ADC 4 pF behind
-// R_ADC 6 kOhm) through the source to within half an LSB. DS8626's equation 1 bounds the source's
-// impedance for k sampling cycles: R_AIN < (k - 0.5) / (f_ADC C_ADC ln(2^(N+2))) - R_ADC; at 21 MHz
-// and N = 12, 15 cycles allow 11.8 kOhm, 56 cycles the data sheet's own limit of 50 kOhm, 480 far
-// more. A potentiometer of R shows at most R / 4 at mid-travel (2.5 kOhm for 10 kOhm), plus the
-// series resistor of any filter before the pin: the longest sample time takes any of them, and costs
-// nothing here (the scan runs between ticks, the core does not wait for it).
+// The sample time must charge the ADC's sampling capacitor (C_ADC 4 pF behind R_ADC 6 kOhm) through the
+// source to within half an LSB. DS8626's equation 1 bounds the source's impedance for k sampling
+// cycles: R_AIN < (k - 0.5) / (f_ADC C_ADC ln(2^(N+2))) - R_ADC; at 21 MHz and N = 12, 15 cycles allow
+// 11.8 kOhm, 56 cycles the data sheet's own limit of 50 kOhm, 480 far more. A source with a capacitor
+// at the pin far larger than C_ADC (an anti-alias filter's) charges the sampling capacitor itself: the
+// error is C_ADC / C of a step between two channels (4e-5 with 100 nF, a sixth of an LSB).
 //
-// Why the regular group and DMA: six channels, and the injected group's JDR1-4 hold four (two
-// injected sequences a tick would need a second start: a wait or an interrupt). The regular group
-// converts all six in sequence (scan mode, RM0090 13.3.8) into its one data register, and DMA2 stream 0,
+// Why the regular group and DMA: more than four channels, and the injected group's JDR1-4 hold four
+// (two injected sequences a tick would need a second start: a wait or an interrupt). The regular group
+// converts the whole sequence (scan mode, RM0090 13.3.8) into its one data register, and DMA2 stream 0,
 // channel 0 (ADC1's request, RM0090 table 43) moves each result to the buffer before the next
-// conversion ends (23 us later); the tick checks that the stream completed. Normal mode (not
-// circular) with DDS = 0: each start re-arms the stream for one scan, so a scan that went wrong leaves
-// nothing behind for the next (RM0090 13.8.1, "Using the DMA").
+// conversion ends (3 us later at the shortest sample time here); the tick checks that the stream
+// completed. Normal mode (not circular) with DDS = 0: each start re-arms the stream for one scan, so a
+// scan that went wrong leaves nothing behind for the next (RM0090 13.8.1, "Using the DMA").
+//
+// A bipolar signal level-shifted to mid-scale (a current monitor's) is read as its code less the
+// mid-scale code, 2^(bits - 1) (read_centred): -2048 .. 2047 at 12 bits, 0 at mid-scale.
 //
 // No sample (update() and read() false) when, at the tick:
 //   - the ADC lost a result (OVR: a conversion ended before the DMA had taken the one before), or
@@ -35,6 +39,7 @@
 // tick starts a fresh scan, long after the ADC's stabilization time (t_STAB, 3 us, DS8626).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <iterator>
 #include <type_traits>
@@ -44,10 +49,12 @@
 
 namespace stm32f4 {
 
-/// One analog input: its pin (analog mode) and ADC1's channel on it.
+/// One analog input: its pin (analog mode), ADC1's channel on it and its sample time [ADC clock
+/// cycles: 3, 15, 28, 56, 84, 112, 144 or 480].
 struct AnalogInput {
   PinConfig pin;
   std::uint8_t channel;
+  std::uint16_t sample_cycles;
 };
 
 /// ADC1's channel on a pin, -1 where it has none (DS8626 table 7: ADC123_IN0-3 on PA0-PA3,
@@ -57,6 +64,14 @@ constexpr int adc1_channel_of(Pin p) {
   if (p.port == Port::A && p.n <= 7) return p.n;
   if (p.port == Port::B && p.n <= 1) return 8 + p.n;
   if (p.port == Port::C && p.n <= 5) return 10 + p.n;
+  return -1;
+}
+
+/// SMPx for a sample time in ADC clock cycles (RM0090 13.13.4, 13.13.5), -1 for one the ADC does not have.
+constexpr int adc_sample_code(std::uint32_t cycles) {
+  constexpr std::uint32_t kCycles[8] = {3, 15, 28, 56, 84, 112, 144, 480};
+  for (int code = 0; code < 8; ++code)
+    if (kCycles[code] == cycles) return code;
   return -1;
 }
 
@@ -70,46 +85,73 @@ constexpr std::uint32_t adc_divider(std::uint32_t pclk2) {
 }
 static_assert(adc_divider(84000000) == 4 && adc_divider(16000000) == 2, "21 MHz on the PLL, 8 MHz on HSI");
 
-/// The scan of a table of inputs (`Inputs`: a constexpr array of AnalogInput, in the order the codes
-/// are read: the joints' order for the potentiometers) on ADC1, through DMA2 stream 0.
-template <const auto& Inputs>
+/// The scan of tables of inputs (`Tables`: constexpr arrays of AnalogInput) on ADC1, through DMA2
+/// stream 0: one sequence, the tables one after the other, each in its own order (read<t>() gives
+/// table t's codes in it).
+template <const auto&... Tables>
 class AdcScan {
-  static_assert(std::is_same_v<std::remove_cvref_t<decltype(Inputs[0])>, AnalogInput>, "an array of AnalogInput");
+  static_assert(sizeof...(Tables) >= 1, "at least one table");
+  static_assert((std::is_same_v<std::remove_cvref_t<decltype(Tables[0])>, AnalogInput> && ...),
+                "arrays of AnalogInput");
 
  public:
-  static constexpr int kCount = static_cast<int>(std::size(Inputs));
-  static_assert(kCount >= 1 && kCount <= 16, "a regular sequence converts 1 to 16 channels");
-  static constexpr std::uint32_t kSampleCycles = 480;
-  /// A conversion at 12 bits: the sample time and 12 cycles (RM0090 13.5).
-  static constexpr std::uint32_t kConversionCycles = kSampleCycles + 12;
-  static constexpr std::uint32_t kCodeMask = 0xFFFu;
+  static constexpr int kTables = static_cast<int>(sizeof...(Tables));
+  /// Each table's length, and where it starts in the sequence.
+  static constexpr int kSizes[kTables] = {static_cast<int>(std::size(Tables))...};
+  static constexpr int first(int table) { return table == 0 ? 0 : first(table - 1) + kSizes[table - 1]; }
+  static constexpr int kCount = first(kTables - 1) + kSizes[kTables - 1];
+  static_assert(kCount <= 16, "a regular sequence converts 1 to 16 channels");
+  /// Every input in the sequence's order.
+  static constexpr std::array<AnalogInput, kCount> kInputs = [] {
+    std::array<AnalogInput, kCount> all{};
+    int i = 0;
+    const auto append = [&](const auto& table) {
+      for (const AnalogInput& in : table) all[i++] = in;
+    };
+    (append(Tables), ...);
+    return all;
+  }();
+
+  /// The resolution (RES 0), and the code at mid-scale: a level-shifted bipolar signal's zero.
+  static constexpr int kBits = 12;
+  static constexpr std::uint32_t kCodeMask = (1u << kBits) - 1u;
+  static constexpr std::int32_t kMidScale = 1 << (kBits - 1);
   /// Polls of the stream's EN bit after clearing it: it clears once the transfer in progress ends,
   /// a few bus cycles.
   static constexpr std::uint32_t kStreamPolls = 1000;
 
-  /// One scan's duration [ns] at an ADC clock [Hz].
-  static constexpr std::uint32_t scan_ns(std::uint32_t adc_hz) {
-    return static_cast<std::uint32_t>(static_cast<std::uint64_t>(kCount) * kConversionCycles * 1000000000u / adc_hz);
+  /// One input's conversion [ADC clock cycles] at 12 bits: its sample time and 12 cycles (RM0090 13.5).
+  static constexpr std::uint32_t conversion_cycles(const AnalogInput& in) { return in.sample_cycles + 12u; }
+  /// The first `n` conversions of the sequence [ADC clock cycles] (all of them by default: the scan).
+  static constexpr std::uint32_t sequence_cycles(int n = kCount) {
+    std::uint32_t cycles = 0;
+    for (int i = 0; i < n; ++i) cycles += conversion_cycles(kInputs[i]);
+    return cycles;
+  }
+  /// The first `n` conversions' duration [ns] at an ADC clock [Hz] (the whole scan by default).
+  static constexpr std::uint32_t scan_ns(std::uint32_t adc_hz, int n = kCount) {
+    return static_cast<std::uint32_t>(std::uint64_t{sequence_cycles(n)} * 1000000000u / adc_hz);
   }
 
-  /// SMPR1 and SMPR2: 480 cycles (SMP 7) for every channel of the table, 3 (SMP 0) for the others.
+  /// SMPR1 (channels 10-18) and SMPR2 (0-9): each input's sample time, 3 cycles (SMP 0) for the others.
   static constexpr std::uint32_t smpr1() {
     std::uint32_t v = 0;
-    for (const AnalogInput& in : Inputs)
-      if (in.channel >= 10) v |= AdcRegs::kSmp480 << (3u * (in.channel - 10u));
+    for (const AnalogInput& in : kInputs)
+      if (in.channel >= 10)
+        v |= static_cast<std::uint32_t>(adc_sample_code(in.sample_cycles)) << (3u * (in.channel - 10u));
     return v;
   }
   static constexpr std::uint32_t smpr2() {
     std::uint32_t v = 0;
-    for (const AnalogInput& in : Inputs)
-      if (in.channel < 10) v |= AdcRegs::kSmp480 << (3u * in.channel);
+    for (const AnalogInput& in : kInputs)
+      if (in.channel < 10) v |= static_cast<std::uint32_t>(adc_sample_code(in.sample_cycles)) << (3u * in.channel);
     return v;
   }
-  /// SQRn (n = 1, 2, 3): the channels in the table's order (SQ1 first, in SQR3), the length in SQR1.
+  /// SQRn (n = 1, 2, 3): the channels in the sequence's order (SQ1 first, in SQR3), the length in SQR1.
   static constexpr std::uint32_t sqr(int n) {
     std::uint32_t v = n == 1 ? AdcRegs::sqr1_length(kCount) : 0u;
     for (int i = 0; i < kCount; ++i)
-      if (3 - i / 6 == n) v |= static_cast<std::uint32_t>(Inputs[i].channel) << (5 * (i % 6));
+      if (3 - i / 6 == n) v |= static_cast<std::uint32_t>(kInputs[i].channel) << (5 * (i % 6));
     return v;
   }
   /// Scan mode, 12-bit (RES 0), no interrupt.
@@ -124,12 +166,15 @@ class AdcScan {
       DmaStream::chsel(0) | DmaStream::kPlHigh | DmaStream::kMsizeHalf | DmaStream::kPsizeHalf | DmaStream::kMinc;
   static constexpr std::uint32_t kStreamErrors = DmaRegs::kTeif0 | DmaRegs::kDmeif0;
 
-  static constexpr bool channels_match_pins() {
-    for (const AnalogInput& in : Inputs)
-      if (adc1_channel_of(in.pin.pin) != in.channel || in.pin.mode != Mode::kAnalog) return false;
+  static constexpr bool inputs_valid() {
+    for (const AnalogInput& in : kInputs)
+      if (adc1_channel_of(in.pin.pin) != in.channel || in.pin.mode != Mode::kAnalog ||
+          adc_sample_code(in.sample_cycles) < 0)
+        return false;
     return true;
   }
-  static_assert(channels_match_pins(), "each input an analog pin carrying its ADC1 channel (DS8626 table 7)");
+  static_assert(inputs_valid(),
+                "each input an analog pin carrying its ADC1 channel (DS8626 table 7), sampled for a time the ADC has");
 
   /// Clocks (ADC1, DMA2), pins, the ADC's sequence and the stream (GPIO port clocks already on). The
   /// ADC is left on and idle: the first update() starts the first scan.
@@ -142,7 +187,7 @@ class AdcScan {
     read_back(rcc.APB2ENR);
     rcc.AHB1ENR = rcc.AHB1ENR | RccRegs::kDma2En;
     read_back(rcc.AHB1ENR);
-    for (const AnalogInput& in : Inputs) pin_configure(chip, in.pin);
+    for (const AnalogInput& in : kInputs) pin_configure(chip, in.pin);
     chip.adc_common->CCR = AdcCommonRegs::adcpre(adc_divider(pclk2));  // independent ADCs, no multi-ADC DMA
     adc_->CR2 = 0;
     adc_->CR1 = kCr1;
@@ -190,10 +235,22 @@ class AdcScan {
     return valid_;
   }
 
-  /// The codes of the scan update() took this tick, in the table's order; false when it had none.
-  bool read(std::uint16_t codes[kCount]) const {
+  /// Table `T`'s codes (0 .. 4095) of the scan update() took this tick, in the table's order; false
+  /// when it had none.
+  template <int T>
+  bool read(std::uint16_t codes[]) const {
+    static_assert(T >= 0 && T < kTables, "a table of the scan");
     if (!valid_) return false;
-    for (int i = 0; i < kCount; ++i) codes[i] = latest_[i];
+    for (int i = 0; i < kSizes[T]; ++i) codes[i] = latest_[first(T) + i];
+    return true;
+  }
+  /// The same, each code less the mid-scale code (-2048 .. 2047): the inputs of a bipolar signal
+  /// level-shifted to mid-scale.
+  template <int T>
+  bool read_centred(std::int16_t codes[]) const {
+    static_assert(T >= 0 && T < kTables, "a table of the scan");
+    if (!valid_) return false;
+    for (int i = 0; i < kSizes[T]; ++i) codes[i] = static_cast<std::int16_t>(latest_[first(T) + i] - kMidScale);
     return true;
   }
 
@@ -201,7 +258,7 @@ class AdcScan {
   std::uint32_t overruns() const { return overruns_; }      ///< scans lost to OVR or a stream error
   std::uint32_t incomplete() const { return incomplete_; }  ///< scans not complete at the next tick
   std::uint32_t stuck() const { return stuck_; }            ///< starts refused: the stream never stopped
-  /// The DMA's destination (a host test plays the DMA into it).
+  /// The DMA's destination, in the sequence's order (a host test plays the DMA into it).
   volatile std::uint16_t* dma_buffer() { return buffer_; }
 
  private:

@@ -17,6 +17,7 @@
 
 #include "ad5754r.hpp"
 #include "adc.hpp"
+#include "analog_inputs.hpp"
 #include "board_hal.hpp"
 #include "clock.hpp"
 #include "control_timer.hpp"
@@ -40,8 +41,8 @@ namespace {
 
 /// The board's encoders: a timer per joint, as its pin map says.
 using Encoders = EncoderBank<pins::kEncoders>;
-/// The board's potentiometers: ADC1's scan of the pin map's inputs.
-using Pots = AdcScan<pins::kPots>;
+/// The board's analog inputs: ADC1's scan of the pin map's current monitors and potentiometers.
+using Analog = AnalogInputs;
 
 /// Every register block of the board, in RAM, zeroed.
 struct FakeChip {
@@ -417,23 +418,31 @@ TEST(Stm32Index, EveryChannelLatchesItsOwnIndexAndThirtyTwoBitCountersToo) {
   EXPECT_FALSE(enc.take_index(1, n)) << "relative to the counts before the restart: dropped";
 }
 
-// ------------------------------------------------------------------------------- potentiometers
+// ------------------------------------------------------------------- analog inputs: pots, currents
 
-/// The end of a scan as the DMA and the ADC leave it: the six codes in the buffer, the stream
-/// disabled with its transfers done (TCIF0, and HTIF0 half-way), the ADC's end of sequence.
-void scan_done(FakeChip& f, Pots& pots, const std::uint16_t (&codes)[hal::kJoints]) {
-  for (int i = 0; i < hal::kJoints; ++i) pots.dma_buffer()[i] = codes[i];
+/// The currents at 0 A: each code at mid-scale.
+constexpr std::uint16_t kZeroCurrents[hal::kJoints] = {2048, 2048, 2048, 2048, 2048, 2048};
+
+/// The end of a scan as the DMA and the ADC leave it: the twelve codes in the buffer in the sequence's
+/// order (the six currents, then the six potentiometers), the stream disabled with its transfers done
+/// (TCIF0, and HTIF0 half-way), the ADC's end of sequence.
+void scan_done(FakeChip& f, Analog& analog, const std::uint16_t (&pots)[hal::kJoints],
+               const std::uint16_t (&currents)[hal::kJoints] = kZeroCurrents) {
+  for (int i = 0; i < hal::kJoints; ++i) {
+    analog.dma_buffer()[i] = currents[i];
+    analog.dma_buffer()[hal::kJoints + i] = pots[i];
+  }
   f.dma2.S[0].CR = f.dma2.S[0].CR & ~DmaStream::kEn;
   f.dma2.S[0].NDTR = 0;
   f.dma2.LISR = DmaRegs::kTcif0 | DmaRegs::kHtif0;
   f.adc1.SR = AdcRegs::kEoc | AdcRegs::kStrt;
 }
-/// A scan was started since `forget` cleared the marks: the stream re-armed for six half-words with
-/// its flags cleared, the ADC's flags cleared, its DMA requests on and the software start set.
+/// A scan was started since `forget` cleared the marks: the stream re-armed for twelve half-words
+/// with its flags cleared, the ADC's flags cleared, its DMA requests on and the software start set.
 ::testing::AssertionResult started(FakeChip& f) {
   const DmaStream& s = f.dma2.S[0];
   if (f.dma2.LIFCR != 0x3Du) return ::testing::AssertionFailure() << "LIFCR 0x" << std::hex << f.dma2.LIFCR;
-  if (s.NDTR != 6u) return ::testing::AssertionFailure() << "NDTR " << s.NDTR;
+  if (s.NDTR != 12u) return ::testing::AssertionFailure() << "NDTR " << s.NDTR;
   if ((s.CR & DmaStream::kEn) == 0) return ::testing::AssertionFailure() << "stream not enabled";
   if (f.adc1.SR != 0u) return ::testing::AssertionFailure() << "ADC flags not cleared";
   if (f.adc1.CR2 != ((1u << 30) | (1u << 8) | 1u))
@@ -448,40 +457,41 @@ void forget(FakeChip& f) {
   f.adc1.CR2 = AdcRegs::kAdon;
 }
 
-TEST(Stm32Pots, InitSetsUpOneScanOfTheSixChannelsInJointOrderThroughDma) {
+TEST(Stm32Pots, InitSetsUpOneScanOfTheCurrentsThenThePotsThroughDma) {
   FakeChip f;
-  Pots pots;
-  pots.init(f.chip(), 84000000);
+  Analog analog;
+  analog.init(f.chip(), 84000000);
   EXPECT_NE(f.rcc.APB2ENR & (1u << 8), 0u) << "ADC1EN";
   EXPECT_NE(f.rcc.AHB1ENR & (1u << 22), 0u) << "DMA2EN";
   EXPECT_EQ(f.adc_common.CCR, 1u << 16) << "ADCPRE /4: 21 MHz from 84 MHz; independent ADCs";
   EXPECT_EQ(f.adc1.CR1, 1u << 8) << "SCAN; RES 0: 12-bit; no interrupt";
   EXPECT_EQ(f.adc1.CR2, 1u) << "on and idle (no CONT, no external trigger): the first tick starts it";
-  // 480 cycles (SMP 7) on channels 11, 12, 14, 15 (SMPR1) and 8, 9 (SMPR2), nothing else.
-  EXPECT_EQ(f.adc1.SMPR1, (7u << 3) | (7u << 6) | (7u << 12) | (7u << 15));
-  EXPECT_EQ(f.adc1.SMPR2, (7u << 24) | (7u << 27));
-  // Six conversions (L = 5), SQ1..SQ6 the joints' channels in joint order.
-  EXPECT_EQ(f.adc1.SQR1, 5u << 20);
-  EXPECT_EQ(f.adc1.SQR2, 0u);
-  EXPECT_EQ(f.adc1.SQR3, 11u | (12u << 5) | (14u << 10) | (15u << 15) | (8u << 20) | (9u << 25));
+  // 480 cycles (SMP 7) on the potentiometers' channels 11, 12, 14, 15 (SMPR1) and 8, 9 (SMPR2); 56
+  // (SMP 3) on the current monitors' 10, 13 (SMPR1) and 4-7 (SMPR2); 3 (SMP 0) on the others.
+  EXPECT_EQ(f.adc1.SMPR1, (3u << 0) | (7u << 3) | (7u << 6) | (3u << 9) | (7u << 12) | (7u << 15));
+  EXPECT_EQ(f.adc1.SMPR2, (3u << 12) | (3u << 15) | (3u << 18) | (3u << 21) | (7u << 24) | (7u << 27));
+  // Twelve conversions (L = 11): SQ1..SQ6 the amplifiers' channels in channel order, SQ7..SQ12 the
+  // potentiometers' in joint order, nothing in SQ13..SQ16.
+  EXPECT_EQ(f.adc1.SQR1, 11u << 20);
+  EXPECT_EQ(f.adc1.SQR3, 4u | (5u << 5) | (6u << 10) | (7u << 15) | (10u << 20) | (13u << 25));
+  EXPECT_EQ(f.adc1.SQR2, 11u | (12u << 5) | (14u << 10) | (15u << 15) | (8u << 20) | (9u << 25));
   for (int j = 0; j < hal::kJoints; ++j) {
-    const std::uint32_t ch = pins::kPots[j].channel;
-    const std::uint32_t smp = ch >= 10 ? (f.adc1.SMPR1 >> (3 * (ch - 10))) & 7u : (f.adc1.SMPR2 >> (3 * ch)) & 7u;
-    EXPECT_EQ(smp, 7u) << "joint " << j + 1;
-    EXPECT_EQ((f.adc1.SQR3 >> (5 * j)) & 0x1Fu, ch) << "joint " << j + 1;
+    EXPECT_EQ((f.adc1.SQR3 >> (5 * j)) & 0x1Fu, pins::kCurrentMonitors[j].channel) << "amplifier " << j + 1;
+    EXPECT_EQ((f.adc1.SQR2 >> (5 * j)) & 0x1Fu, pins::kPots[j].channel) << "joint " << j + 1;
   }
   const DmaStream& s = f.dma2.S[0];
   EXPECT_EQ(s.CR, (2u << 16) | (1u << 13) | (1u << 11) | (1u << 10))
       << "channel 0, peripheral to memory, half-words, memory increment, normal mode, high priority; off";
   EXPECT_EQ(s.PAR, static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(&f.adc1.DR)));
-  EXPECT_EQ(s.M0AR, static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(pots.dma_buffer())));
+  EXPECT_EQ(s.M0AR, static_cast<std::uint32_t>(reinterpret_cast<std::uintptr_t>(analog.dma_buffer())));
   EXPECT_EQ(s.FCR, 0u) << "direct mode";
-  for (const AnalogInput& in : pins::kPots) {
-    const GpioRegs& g = f.port(in.pin.pin.port);
-    EXPECT_EQ((g.MODER >> (2 * in.pin.pin.n)) & 3u, 3u) << "analog";
-    EXPECT_EQ((g.PUPDR >> (2 * in.pin.pin.n)) & 3u, 0u) << "no pull resistor";
-  }
-  Pots slow;
+  for (const auto* table : {&pins::kPots, &pins::kCurrentMonitors})
+    for (const AnalogInput& in : *table) {
+      const GpioRegs& g = f.port(in.pin.pin.port);
+      EXPECT_EQ((g.MODER >> (2 * in.pin.pin.n)) & 3u, 3u) << "analog";
+      EXPECT_EQ((g.PUPDR >> (2 * in.pin.pin.n)) & 3u, 0u) << "no pull resistor";
+    }
+  Analog slow;
   FakeChip g;
   slow.init(g.chip(), 16000000);
   EXPECT_EQ(g.adc_common.CCR, 0u) << "HSI fallback: /2, 8 MHz";
@@ -489,78 +499,119 @@ TEST(Stm32Pots, InitSetsUpOneScanOfTheSixChannelsInJointOrderThroughDma) {
 
 TEST(Stm32Pots, EachTickTakesTheScanThePreviousTickStartedAndStartsTheNext) {
   FakeChip f;
-  Pots pots;
-  pots.init(f.chip(), 84000000);
+  Analog analog;
+  analog.init(f.chip(), 84000000);
   std::uint16_t codes[hal::kJoints] = {};
-  EXPECT_FALSE(pots.update()) << "the first tick: no scan ran yet";
-  EXPECT_FALSE(pots.read(codes));
+  EXPECT_FALSE(analog.update()) << "the first tick: no scan ran yet";
+  EXPECT_FALSE(analog.read(codes));
   EXPECT_TRUE(started(f));
   const std::uint16_t first[hal::kJoints] = {100, 4095, 2048, 0, 1, 3000};
-  scan_done(f, pots, first);
+  scan_done(f, analog, first);
   forget(f);
-  ASSERT_TRUE(pots.update());
+  ASSERT_TRUE(analog.update());
   EXPECT_TRUE(started(f)) << "the next scan, right after the read";
-  ASSERT_TRUE(pots.read(codes));
+  ASSERT_TRUE(analog.read(codes));
   for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(codes[j], first[j]) << "joint " << j + 1;
-  EXPECT_TRUE(pots.read(codes)) << "the same tick's codes, again";
+  EXPECT_TRUE(analog.read(codes)) << "the same tick's codes, again";
   const std::uint16_t second[hal::kJoints] = {7, 6, 5, 4, 3, 2};
-  scan_done(f, pots, second);
+  scan_done(f, analog, second);
   forget(f);
-  ASSERT_TRUE(pots.update());
-  ASSERT_TRUE(pots.read(codes));
+  ASSERT_TRUE(analog.update());
+  ASSERT_TRUE(analog.read(codes));
   for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(codes[j], second[j]) << "joint " << j + 1;
-  EXPECT_EQ(pots.scans(), 2u);
+  EXPECT_EQ(analog.scans(), 2u);
 }
 
 TEST(Stm32Pots, AnOverrunAnIncompleteScanOrAStreamErrorIsNoSample) {
   FakeChip f;
-  Pots pots;
-  pots.init(f.chip(), 84000000);
+  Analog analog;
+  analog.init(f.chip(), 84000000);
   std::uint16_t codes[hal::kJoints] = {};
+  std::int16_t currents[hal::kJoints] = {};
   const std::uint16_t c[hal::kJoints] = {1, 2, 3, 4, 5, 6};
-  pots.update();
+  analog.update();
   // A result lost (OVR): the buffer may be shifted.
-  scan_done(f, pots, c);
+  scan_done(f, analog, c);
   f.adc1.SR = f.adc1.SR | AdcRegs::kOvr;
   forget(f);
-  EXPECT_FALSE(pots.update());
-  EXPECT_FALSE(pots.read(codes));
-  EXPECT_EQ(pots.overruns(), 1u);
+  EXPECT_FALSE(analog.update());
+  EXPECT_FALSE(analog.read(codes));
+  EXPECT_FALSE(analog.read_currents(currents)) << "the currents of that scan neither";
+  EXPECT_EQ(analog.overruns(), 1u);
   EXPECT_EQ(f.adc1.CR2, 1u) << "stopped, on again, no scan started this tick";
   EXPECT_EQ(f.dma2.S[0].CR & DmaStream::kEn, 0u) << "the stream disabled";
-  EXPECT_FALSE(pots.update()) << "the tick after: nothing ran";
+  EXPECT_FALSE(analog.update()) << "the tick after: nothing ran";
   EXPECT_TRUE(started(f)) << "a fresh scan";
-  scan_done(f, pots, c);
-  EXPECT_TRUE(pots.update()) << "and the one after has a sample again";
+  scan_done(f, analog, c);
+  EXPECT_TRUE(analog.update()) << "and the one after has a sample again";
+  EXPECT_TRUE(analog.read_currents(currents));
   // Not complete at the tick (only half the transfers done).
   f.dma2.LISR = DmaRegs::kHtif0;
   forget(f);
-  EXPECT_FALSE(pots.update());
-  EXPECT_FALSE(pots.read(codes));
-  EXPECT_EQ(pots.incomplete(), 1u);
+  EXPECT_FALSE(analog.update());
+  EXPECT_FALSE(analog.read(codes));
+  EXPECT_FALSE(analog.read_currents(currents));
+  EXPECT_EQ(analog.incomplete(), 1u);
   EXPECT_EQ(f.adc1.CR2, 1u) << "stopped: the rest of the late scan never reaches the next one's buffer";
-  EXPECT_FALSE(pots.update());
+  EXPECT_FALSE(analog.update());
   // A transfer error of the stream.
-  scan_done(f, pots, c);
+  scan_done(f, analog, c);
   f.dma2.LISR = f.dma2.LISR | DmaRegs::kTeif0;
-  EXPECT_FALSE(pots.update());
-  EXPECT_EQ(pots.overruns(), 2u);
-  EXPECT_EQ(pots.scans(), 1u);
+  EXPECT_FALSE(analog.update());
+  EXPECT_FALSE(analog.read_currents(currents));
+  EXPECT_EQ(analog.overruns(), 2u);
+  EXPECT_EQ(analog.scans(), 1u);
 }
 
-TEST(Stm32Pots, TheClockTheChannelsAndTheScanTime) {
+TEST(Stm32Pots, TheClockTheChannelsTheSampleTimesAndTheScanTime) {
   EXPECT_EQ(adc_divider(84000000), 4u);
   EXPECT_EQ(adc_divider(16000000), 2u);
   EXPECT_EQ(adc_divider(168000000), 6u) << "28 MHz: within 36 MHz";
-  EXPECT_EQ(Pots::scan_ns(21000000), 140571u) << "6 x (480 + 12) cycles at 21 MHz";
-  EXPECT_EQ(Pots::scan_ns(8000000), 369000u) << "at the HSI fallback";
-  EXPECT_LT(Pots::scan_ns(8000000), 1000000u) << "within the 1 ms tick";
+  EXPECT_EQ(Analog::kCount, 12);
+  EXPECT_EQ(Analog::scan_ns(21000000), 160000u) << "6 x (56 + 12) + 6 x (480 + 12) cycles at 21 MHz";
+  EXPECT_EQ(Analog::scan_ns(21000000, 6), 19428u) << "the six currents, first";
+  EXPECT_EQ(Analog::scan_ns(8000000), 420000u) << "at the HSI fallback";
+  EXPECT_LT(Analog::scan_ns(8000000), 500000u) << "within half the 1 ms tick";
   EXPECT_EQ(adc1_channel_of(pins::PA(0)), 0);
   EXPECT_EQ(adc1_channel_of(pins::PA(7)), 7);
   EXPECT_EQ(adc1_channel_of(pins::PB(1)), 9);
   EXPECT_EQ(adc1_channel_of(pins::PC(0)), 10);
   EXPECT_EQ(adc1_channel_of(pins::PC(5)), 15);
   for (Pin p : {pins::PA(8), pins::PB(2), pins::PC(6), pins::PD(0), pins::PE(13)}) EXPECT_EQ(adc1_channel_of(p), -1);
+  // RM0090 13.13.4: SMP 0..7 = 3, 15, 28, 56, 84, 112, 144, 480 cycles.
+  const std::uint32_t cycles[8] = {3, 15, 28, 56, 84, 112, 144, 480};
+  for (int code = 0; code < 8; ++code) EXPECT_EQ(adc_sample_code(cycles[code]), code);
+  for (std::uint32_t other : {0u, 4u, 57u, 479u, 481u}) EXPECT_EQ(adc_sample_code(other), -1);
+}
+
+TEST(Stm32Currents, EachCurrentIsItsCodeLessMidScale) {
+  FakeChip f;
+  Analog analog;
+  analog.init(f.chip(), 84000000);
+  std::int16_t currents[hal::kJoints] = {};
+  EXPECT_FALSE(analog.update());
+  EXPECT_FALSE(analog.read_currents(currents)) << "no current before the first scan completed";
+  const std::uint16_t pots[hal::kJoints] = {10, 20, 30, 40, 50, 60};
+  // 0 -> -2048, 2048 (0 A) -> 0, 4095 -> +2047, and their neighbours; bits above the twelfth dropped.
+  const std::uint16_t codes[hal::kJoints] = {0, 2048, 4095, 1, 2047, 0xF000u | 2049u};
+  const std::int16_t want[hal::kJoints] = {-2048, 0, 2047, -2047, -1, 1};
+  scan_done(f, analog, pots, codes);
+  ASSERT_TRUE(analog.update());
+  ASSERT_TRUE(analog.read_currents(currents));
+  for (int c = 0; c < hal::kJoints; ++c) EXPECT_EQ(currents[c], want[c]) << "amplifier " << c + 1;
+  std::uint16_t p[hal::kJoints] = {};
+  ASSERT_TRUE(analog.read(p));
+  for (int j = 0; j < hal::kJoints; ++j) EXPECT_EQ(p[j], pots[j]) << "the potentiometers after the currents";
+  EXPECT_EQ(Analog::kMidScale, 2048);
+}
+
+TEST(Stm32Currents, TheScaleIsTheDriveTrainsCurrentMonitors) {
+  const osc::CurrentMonitor& m = osc::robot::kDriveTrain.current;
+  ASSERT_TRUE(kHasCurrentMonitors) << "both arms' tables declare current monitors";
+  EXPECT_EQ(m.bits, 12);
+  EXPECT_EQ(kCurrentSpanCodes, 2047) << "+-(2^(bits-1) - 1) at +-range times the DAC's full scale";
+  EXPECT_NEAR(kCurrentCodesPerFullScale, 2047 / m.range, 1e-12);
+  EXPECT_NEAR(kCurrentCodesPerFullScale, 1637.6, 1e-9) << "the arms' range, 1.25";
 }
 
 // ------------------------------------------------------------------------------------------- pins
@@ -591,13 +642,43 @@ TEST(Stm32Pins, TheIndexAndPotentiometerPinsWithTheirFunctions) {
   EXPECT_EQ(kUartRx.af, 7);
   // Every pin once (the pin map's static_assert), and the check finds a pin used twice.
   EXPECT_TRUE(pins_distinct());
-  EXPECT_EQ(kPinCount, 4 * hal::kJoints + 11);
+  EXPECT_EQ(kPinCount, 6 * hal::kJoints + 11);
   const Pin twice[] = {PC(1), PE(13), PA(3), PC(1)};
   EXPECT_FALSE(distinct(twice, 4));
   EXPECT_TRUE(distinct(twice, 3));
   Pin all[kPinCount];
   for (int i = 0; i < kPinCount; ++i) all[i] = pin_at(i);
   all[3 * hal::kJoints + 4] = PA(3);  // joint 5's potentiometer on joint 5's index pin
+  EXPECT_FALSE(distinct(all, kPinCount));
+}
+
+TEST(Stm32Pins, TheCurrentMonitorAndFaultLinePinsAreInTheMap) {
+  using namespace pins;
+  // DS8626 table 7: ADC12_IN4-7 on PA4-PA7, ADC123_IN10 PC0, ADC123_IN13 PC3: the six ADC1 pins left.
+  const Pin monitor[hal::kJoints] = {PA(4), PA(5), PA(6), PA(7), PC(0), PC(3)};
+  const std::uint8_t adc[hal::kJoints] = {4, 5, 6, 7, 10, 13};
+  const Pin fault[hal::kJoints] = {PE(7), PE(8), PE(10), PE(12), PE(14), PE(15)};
+  for (int c = 0; c < hal::kJoints; ++c) {
+    SCOPED_TRACE(c + 1);
+    EXPECT_TRUE(kCurrentMonitors[c].pin.pin == monitor[c]);
+    EXPECT_EQ(kCurrentMonitors[c].pin.mode, Mode::kAnalog);
+    EXPECT_EQ(kCurrentMonitors[c].channel, adc[c]);
+    EXPECT_EQ(kCurrentMonitors[c].sample_cycles, 56u);
+    EXPECT_EQ(kPots[c].sample_cycles, 480u);
+    EXPECT_TRUE(kAmpFaults[c].pin == fault[c]);
+    EXPECT_EQ(kAmpFaults[c].mode, Mode::kInput);
+    EXPECT_EQ(kAmpFaults[c].pull, Pull::kUp) << "a broken wire reads high: a fault";
+  }
+  // The map's check covers them: a current monitor or a fault line on a pin already taken is found.
+  Pin all[kPinCount];
+  for (int i = 0; i < kPinCount; ++i) all[i] = pin_at(i);
+  ASSERT_TRUE(distinct(all, kPinCount));
+  EXPECT_TRUE(all[4 * hal::kJoints] == PA(4)) << "the current monitors follow the potentiometers";
+  EXPECT_TRUE(all[5 * hal::kJoints] == PE(7)) << "then the fault lines";
+  all[4 * hal::kJoints + 5] = PC(1);  // amplifier 6's monitor on joint 1's potentiometer
+  EXPECT_FALSE(distinct(all, kPinCount));
+  all[4 * hal::kJoints + 5] = PC(3);
+  all[5 * hal::kJoints + 1] = PE(9);  // amplifier 2's fault line on joint 1's encoder A
   EXPECT_FALSE(distinct(all, kPinCount));
 }
 
@@ -997,14 +1078,14 @@ struct BoardRig {
   FakeChip f;
   Encoders enc;
   RecordingDac dac;
-  Pots pots;
+  Analog analog;
   Safety safety;
-  BoardHal<Encoders, RecordingDac, FakeCycles, Pots> hal{enc, dac, pots, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RecordingDac, FakeCycles, Analog> hal{enc, dac, analog, safety, f.timer(Timer::kTim6)};
   osc::ControlTask<double> task;
   BoardRig() {
     const Chip c = f.chip();
     enc.init(c);
-    pots.init(c, 84000000);
+    analog.init(c, 84000000);
     safety.init(c);
     task.init(osc::Model<double>::of(osc::robot::kArm), osc::Gains<double>::paper(), osc::FrictionMode::kAdaptive,
               osc::joint_vector<double>(osc::robot::kQStart), 168000);
@@ -1015,11 +1096,12 @@ struct BoardRig {
     return hal.tick(task);
   }
 };
-static_assert(hal::ControlHal<BoardHal<Encoders, RecordingDac, FakeCycles, Pots>>);
-static_assert(hal::PositionHal<BoardHal<Encoders, RecordingDac, FakeCycles, Pots>>);
+static_assert(hal::ControlHal<BoardHal<Encoders, RecordingDac, FakeCycles, Analog>>);
+static_assert(hal::PositionHal<BoardHal<Encoders, RecordingDac, FakeCycles, Analog>>);
+static_assert(hal::CurrentHal<BoardHal<Encoders, RecordingDac, FakeCycles, Analog>>);
 // What BoardHal needs from its drivers: the board's and the fakes satisfy it...
 static_assert(EncoderInput<Encoders> && DacOutput<ad5754r::DacPair<SpiDacBus>> && DacOutput<RecordingDac> &&
-              CycleClock<FakeCycles> && PotInput<Pots>);
+              CycleClock<FakeCycles> && PotInput<Analog> && CurrentInput<Analog>);
 // ...and a driver that lacks a function, returns the wrong type or needs an instance does not: BoardHal
 // refuses it.
 struct DacWithoutClear {
@@ -1041,16 +1123,34 @@ struct CyclesOfAnInstance {
 };
 struct PotsWithoutUpdate {
   bool read(std::uint16_t*) const { return false; }
+  bool read_currents(std::int16_t*) const { return false; }
 };
 struct PotsWithVoidRead {
   bool update() { return false; }
   void read(std::uint16_t*) const {}  // cannot say there is no sample
+  bool read_currents(std::int16_t*) const { return false; }
+};
+struct PotsWithoutCurrents {  // the potentiometers' scan alone
+  bool update() { return false; }
+  bool read(std::uint16_t*) const { return false; }
+};
+struct CurrentsAsUnsignedCodes {
+  bool update() { return false; }
+  bool read(std::uint16_t*) const { return false; }
+  bool read_currents(std::uint16_t*) const { return false; }  // raw codes: no sign, no zero
+};
+struct CurrentsWithVoidRead {
+  bool update() { return false; }
+  bool read(std::uint16_t*) const { return false; }
+  void read_currents(std::int16_t*) const {}  // cannot say there is no sample
 };
 static_assert(!DacOutput<DacWithoutClear> && !DacOutput<DacWithVoidWrite>);
 static_assert(!EncoderInput<EncodersWithoutRead> && !EncoderInput<EncodersWithoutIndex>);
 static_assert(!CycleClock<CyclesOfAnInstance>);
 static_assert(!PotInput<PotsWithoutUpdate> && !PotInput<PotsWithVoidRead>);
-template <class E, class D, class C, class P = Pots>
+static_assert(PotInput<PotsWithoutCurrents> && !CurrentInput<PotsWithoutCurrents>);
+static_assert(!CurrentInput<CurrentsAsUnsignedCodes> && !CurrentInput<CurrentsWithVoidRead>);
+template <class E, class D, class C, class P = Analog>
 concept BoardHalOf = requires {
   typename BoardHal<E, D, C, P>;
 };
@@ -1060,6 +1160,8 @@ static_assert(!BoardHalOf<EncodersWithoutRead, RecordingDac, FakeCycles>);
 static_assert(!BoardHalOf<EncodersWithoutIndex, RecordingDac, FakeCycles>);
 static_assert(!BoardHalOf<Encoders, RecordingDac, CyclesOfAnInstance>);
 static_assert(!BoardHalOf<Encoders, RecordingDac, FakeCycles, PotsWithVoidRead>);
+static_assert(!BoardHalOf<Encoders, RecordingDac, FakeCycles, PotsWithoutCurrents>);
+static_assert(!BoardHalOf<Encoders, RecordingDac, FakeCycles, CurrentsAsUnsignedCodes>);
 
 TEST(Stm32Board, AmplifierOffUntilTheSupervisorRunsHealthy) {
   BoardRig r;
@@ -1136,12 +1238,12 @@ TEST(Stm32Board, AnEstopDuringTheBurstClearsTheOutputs) {
   FakeChip f;
   Encoders enc;
   RacingDac dac;
-  Pots pots;
+  Analog analog;
   Safety safety;
   enc.init(f.chip());
   safety.init(f.chip());
   dac.s = &safety;
-  BoardHal<Encoders, RacingDac, FakeCycles, Pots> hal{enc, dac, pots, safety, f.timer(Timer::kTim6)};
+  BoardHal<Encoders, RacingDac, FakeCycles, Analog> hal{enc, dac, analog, safety, f.timer(Timer::kTim6)};
   const std::int32_t codes[hal::kJoints] = {1, 2, 3, 4, 5, 6};
   hal.write_dacs(codes);
   EXPECT_EQ(dac.clears, 1) << "CLR pulsed: the codes of that burst never reach the joints";
@@ -1212,7 +1314,7 @@ TEST(Stm32Board, TheTickScansThePotsAndTheHalGivesThemAndTheIndex) {
   EXPECT_FALSE(r.hal.read_pots(codes)) << "the first tick started the first scan";
   EXPECT_TRUE(started(r.f));
   const std::uint16_t c[hal::kJoints] = {2048, 100, 4000, 1234, 3333, 17};
-  scan_done(r.f, r.pots, c);
+  scan_done(r.f, r.analog, c);
   index_edge(r.f, 2, 65535);  // joint 3's index one count below the start
   ASSERT_EQ(r.tick(), 0u);
   ccr_read(r.f, 2);
@@ -1226,6 +1328,53 @@ TEST(Stm32Board, TheTickScansThePotsAndTheHalGivesThemAndTheIndex) {
   lifcr_cleared(r.f);
   ASSERT_EQ(r.tick(), 0u);  // the scan the last tick started has not completed
   EXPECT_FALSE(r.hal.read_pots(codes));
+}
+
+TEST(Stm32Board, TheTickScansTheCurrentsAndTheHalGivesThemSigned) {
+  BoardRig r;
+  std::int16_t currents[hal::kJoints] = {};
+  ASSERT_EQ(r.tick(), 0u);
+  EXPECT_FALSE(r.hal.read_currents(currents)) << "the first tick started the first scan";
+  const std::uint16_t pots[hal::kJoints] = {2048, 100, 4000, 1234, 3333, 17};
+  const std::uint16_t codes[hal::kJoints] = {4095, 0, 2048, 2100, 1000, 2047};
+  scan_done(r.f, r.analog, pots, codes);
+  ASSERT_EQ(r.tick(), 0u);
+  ASSERT_TRUE(r.hal.read_currents(currents));
+  const std::int16_t want[hal::kJoints] = {2047, -2048, 0, 52, -1048, -1};
+  for (int c = 0; c < hal::kJoints; ++c) EXPECT_EQ(currents[c], want[c]) << "amplifier " << c + 1;
+  // The next scan lost a result: no current that tick, as no potentiometer.
+  scan_done(r.f, r.analog, pots, codes);
+  r.f.adc1.SR = r.f.adc1.SR | AdcRegs::kOvr;
+  ASSERT_EQ(r.tick(), 0u);
+  EXPECT_FALSE(r.hal.read_currents(currents));
+  std::uint16_t p[hal::kJoints] = {};
+  EXPECT_FALSE(r.hal.read_pots(p));
+}
+
+/// Amplifier fault line c at a level, the other lines as they were.
+void fault_line(FakeChip& f, int c, bool high) {
+  const Pin p = pins::kAmpFaults[c].pin;
+  GpioRegs& g = f.port(p.port);
+  g.IDR = high ? g.IDR | (1u << p.n) : g.IDR & ~(1u << p.n);
+}
+
+TEST(Stm32Board, EachAmplifiersFaultLineIsItsBit) {
+  BoardRig r;
+  for (const PinConfig& p : pins::kAmpFaults) {
+    const GpioRegs& g = r.f.port(p.pin.port);
+    EXPECT_EQ((g.MODER >> (2 * p.pin.n)) & 3u, 0u) << "an input";
+    EXPECT_EQ((g.PUPDR >> (2 * p.pin.n)) & 3u, 1u) << "with its pull-up";
+  }
+  EXPECT_EQ(r.hal.amp_faults(), 0u) << "every line held low: every amplifier healthy";
+  for (int c = 0; c < hal::kJoints; ++c) {
+    fault_line(r.f, c, true);
+    EXPECT_EQ(r.hal.amp_faults(), 1u << c) << "amplifier " << c + 1 << "'s line high (its fault, or an open wire)";
+    fault_line(r.f, c, false);
+  }
+  for (int c = 0; c < hal::kJoints; ++c) fault_line(r.f, c, true);
+  EXPECT_EQ(r.hal.amp_faults(), 0x3Fu) << "every line open: an unplugged cable";
+  r.f.port(Port::E).IDR = ~0u & ~((1u << 7) | (1u << 8) | (1u << 10) | (1u << 12) | (1u << 14) | (1u << 15));
+  EXPECT_EQ(r.hal.amp_faults(), 0u) << "the port's other pins (joint 1's encoder) are no fault";
 }
 
 // ---------------------------------------------------------------------- control timer, telemetry
