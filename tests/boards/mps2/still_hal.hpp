@@ -3,7 +3,8 @@
 // to inject an encoder jump), the potentiometers reading the start pose where the arm has pots (so
 // that the tick measured includes the position cross-check, as on a board with pots), no index
 // pulse, the DAC codes kept in memory, the overrun seen as the next timer interrupt already pending
-// when a tick starts. board::StillHal is the arm's: with pots (StillPotHal) or without (StillHalBase).
+// when a tick starts; current monitors reading the codes written (WithCurrents), where the arm has them.
+// board::StillHal is the arm's: with pots (StillPotHal) or without (StillHalBase), with current monitors or not.
 #pragma once
 
 #include <array>
@@ -61,7 +62,26 @@ struct StillPotHal : StillHalBase {
   }
 };
 
-using StillHal = std::conditional_t<osc::has_pots(osc::robot::kDriveTrain), StillPotHal, StillHalBase>;
+/// The same with current monitors (hal::CurrentHal) of healthy drives: each reads the code written last, on the
+/// ADC's scale (so that the tick measured includes the drive check and its dither, as on a board with them).
+template <class Base>
+struct WithCurrents : Base {
+  bool read_currents(std::int16_t a[osc::kDof]) {
+    static constexpr std::int32_t kAdcPerCodeQ16 = [] {
+      const osc::CurrentMonitor& m = osc::robot::kDriveTrain.current;
+      const double top = m.bits > 0 ? static_cast<double>((1L << (m.bits - 1)) - 1) : 0.0;
+      return static_cast<std::int32_t>(top / (m.range * static_cast<double>(osc::kDacMaxCode)) * 65536 + 0.5);
+    }();
+    for (int i = 0; i < osc::kDof; ++i) a[i] = static_cast<std::int16_t>((this->codes[i] * kAdcPerCodeQ16) >> 16);
+    return true;
+  }
+  std::uint32_t amp_faults() { return 0; }
+};
+
+using StillPositionHal = std::conditional_t<osc::has_pots(osc::robot::kDriveTrain), StillPotHal, StillHalBase>;
+using StillHal = std::conditional_t<osc::has_current_monitors(osc::robot::kDriveTrain), WithCurrents<StillPositionHal>,
+                                    StillPositionHal>;
 static_assert(hal::ControlHal<StillHal> && hal::PositionHal<StillHal> == osc::has_pots(osc::robot::kDriveTrain));
+static_assert(hal::CurrentHal<StillHal> == osc::has_current_monitors(osc::robot::kDriveTrain));
 
 }  // namespace board

@@ -137,7 +137,7 @@ struct DriveMonitor {
     track_peak(peak[c], error, threshold);
     if (2 * error > threshold) suspect |= static_cast<std::uint8_t>(1u << c);
     over[c] = qualify(over[c], error > threshold);
-    std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? kFaultDriveFault : 0u;
+    std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? static_cast<std::uint32_t>(kFaultDriveFault) : 0u;
     // The dither, where the amplifier passes it (both codes with their dither within its current limit), on the
     // readings after a code of the same sign as the one before: the reading after a change of sign carries the
     // current loop's lag behind its step of two amplitudes (up to 45 % of it: docs/safety.md), the others only a
