@@ -929,6 +929,46 @@ def residual_contact():
     return "\n".join(lines)
 
 
+DRIVE_KINDS = ["dac-zero", "dac-full", "amp-off", "amp-fault", "dac-stuck", "current-zero", "current-stuck",
+               "current-gain"]
+DRIVE_TIMES = [20.0, 22.5]
+CURRENT_ON = ("--set", "plant.current_monitor=on")
+
+
+def drive_cell(r):
+    """The first fault named, ms after the injection, and by whom (the drive check, else the monitor that did)."""
+    inj = r["injection"]
+    if inj.get("detected_s") is None:
+        return "not detected"
+    ms = (inj["detected_s"] - inj["at_s"]) * 1e3
+    d = r["drive_check_detection"]
+    by = "" if d is not None and abs(d["t_s"] - inj["detected_s"]) < 1e-9 else " (other monitor)"
+    return f"{inj['fault']}{by} {ms:.0f} ms"
+
+
+@table("drive_injection", "docs/safety.md", "long")
+def drive_injection():
+    """The drive check (the simulated arm's current monitors on, plant.current_monitor): each drive and
+    current-monitor fault on each joint at two phases of the paper's motion, and a 50 N step at the tip in
+    each direction at three. Cell: the first fault, ms after the injection (the monitor that named it when
+    not the drive check)."""
+    specs = [(f"{k}:{j}@{t:g}", t) for k in DRIVE_KINDS for j in range(1, 7) for t in DRIVE_TIMES]
+    specs += [(f"collision:{d}:50@{t:g}", t) for d in DIRECTIONS for t in RESIDUAL_TIMES[:3]]
+    prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s, *CURRENT_ON) for s, t in specs])
+    lines = ["| kind | joint | " + " | ".join(f"at {t:g} s" for t in DRIVE_TIMES) + " |",
+             "|---|---|" + "---|" * len(DRIVE_TIMES)]
+    for k in DRIVE_KINDS:
+        for j in range(1, 7):
+            cells = [drive_cell(armed_injection(f"{k}:{j}@{t:g}", t, CURRENT_ON)) for t in DRIVE_TIMES]
+            lines.append(f"| `{k}` | J{j} | " + " | ".join(cells) + " |")
+    lines += ["", "| 50 N step at the tip | " + " | ".join(f"at {t:g} s" for t in RESIDUAL_TIMES[:3]) + " |",
+              "|---|" + "---|" * 3]
+    for d in DIRECTIONS:
+        cells = [drive_cell(armed_injection(f"collision:{d}:50@{t:g}", t, CURRENT_ON)) for t in RESIDUAL_TIMES[:3]]
+        lines.append(f"| `collision:{d}:50` | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 def motion_run(script):
     """Plays a motion script (YAML text) on the simulated arm (puma_experiment --motion); its JSON."""
     with tempfile.TemporaryDirectory() as d:

@@ -142,7 +142,8 @@ TEST(GainKeys, EveryRuntimeParameterIsAHostKeyWithTheTablesRanges) {
     def += p.count > 1 ? "]" : "";
     EXPECT_NE(yaml.find("\n  " + key.substr(4) + ": " + def), std::string::npos) << key << " default " << def;
   }
-  EXPECT_EQ(generated, 5);  // move_linear, move_angular, stream_timeout, pots, home_speed
+  // move_linear, move_angular, stream_timeout, pots, home_speed, drive_check, dither_amplitude, dither_half_period
+  EXPECT_EQ(generated, 8);
 }
 
 }  // namespace

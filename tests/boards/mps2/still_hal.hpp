@@ -15,6 +15,7 @@
 #include "hal/hal.hpp"
 #include "osc/control/faults.hpp"
 #include "osc/robot.hpp"
+#include "osc/runtime/io.hpp"
 
 namespace board {
 

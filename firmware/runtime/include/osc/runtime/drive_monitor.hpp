@@ -68,16 +68,18 @@ inline constexpr DriveCheckConstants kDriveCheck = drive_check_constants();
 /// A channel whose reading is off by more than half its threshold, or whose dither fades below three
 /// quarters, is a suspect: the residual monitor names a residual on its joint drive_fault, not collision.
 struct DriveMonitor {
-  std::int32_t last[kDof];    // the codes the last tick wrote (the amplifiers have had them since)
-  std::int32_t before[kDof];  // the codes the tick before wrote
-  std::int32_t dither[kDof];  // 2^kDitherShift times the filtered sign-weighted difference [DAC codes]
-  std::int8_t sign_last;      // the dither's sign in the last codes (0: none)
-  std::int8_t sign_before;    // ... in the codes before
-  std::uint8_t writes;        // ticks whose codes are on record (2: the check runs)
-  std::uint8_t over[kDof];    // consecutive readings beyond the threshold
-  std::uint8_t suspect;       // bit c: channel c is a suspect (see the type's comment)
-  std::uint32_t detected;     // the first fault's bit (0: none)
-  std::int8_t channel;        // its channel, -1 none
+  // Per channel, from the codes the last two ticks wrote (written()), each within its amplifier's current limit:
+  std::int32_t last[kDof];          // the last code (the amplifier has had it since)
+  std::int32_t lo[kDof], hi[kDof];  // the two codes' range, where the current must lie
+  std::int32_t threshold[kDof];     // floor + share max(|lo|, |hi|)
+  std::int32_t dither[kDof];        // 2^kDitherShift times the filtered sign-weighted difference [DAC codes]
+  std::int8_t sign_last;            // the dither's sign in the last codes (0: none)
+  std::uint8_t dithered;            // bit c: the next reading of channel c takes part in the dither check
+  std::uint8_t writes;              // ticks whose codes are on record (2: the check runs)
+  std::uint8_t over[kDof];          // consecutive readings beyond the threshold
+  std::uint8_t suspect;             // bit c: channel c is a suspect (see the type's comment)
+  std::uint32_t detected;           // the first fault's bit (0: none)
+  std::int8_t channel;              // its channel, -1 none
   std::uint64_t detected_tick;
   std::int32_t amplitude;           // the dither's amplitude in use [DAC codes] (0: off)
   std::uint16_t peak[kDof];         // the largest |error| / threshold seen, times 1000 (the false-alarm margin)
@@ -86,8 +88,13 @@ struct DriveMonitor {
   static constexpr int kDitherShift = params::kDitherWindowShift;
 
   void reset() {
-    for (int c = 0; c < kDof; ++c) last[c] = before[c] = dither[c] = 0, over[c] = 0, peak[c] = dither_peak[c] = 0;
-    sign_last = sign_before = 0;
+    for (int c = 0; c < kDof; ++c) {
+      last[c] = lo[c] = hi[c] = dither[c] = 0;
+      threshold[c] = kDriveCheck.floor;
+      over[c] = 0, peak[c] = dither_peak[c] = 0;
+    }
+    sign_last = 0;
+    dithered = 0;
     writes = 0;
     suspect = 0;
     detected = 0;
@@ -95,10 +102,25 @@ struct DriveMonitor {
     detected_tick = 0;
     amplitude = 0;
   }
-  /// The codes this tick wrote, and the dither's sign in them (0: none): after the DAC write.
+  /// The codes this tick wrote, and the dither's sign in them (0: none): after the DAC write. The next reading
+  /// lies between them and the last ones (the amplifier's current loop moves from one toward the other and
+  /// settles within a period); it takes part in the dither check where both had the same sign and both codes
+  /// with their dither lie within the amplifier's current limit (the reading after a change of sign carries
+  /// the loop's lag behind its step of two amplitudes, up to 45 % of it: docs/safety.md; the others only a
+  /// period's decay of that, e^-2 of it).
   void written(const std::int32_t codes[kDof], std::int8_t sign) {
-    for (int c = 0; c < kDof; ++c) before[c] = last[c], last[c] = codes[c];
-    sign_before = sign_last;
+    const DriveCheckConstants& k = kDriveCheck;
+    const bool same = sign != 0 && sign == sign_last && amplitude > 0;
+    dithered = 0;
+    for (int c = 0; c < kDof; ++c) {
+      const std::int32_t l = k.limit[c], u = codes[c], b = last[c];
+      const std::int32_t a = u > l ? l : (u < -l ? -l : u);
+      const std::int32_t x = a < b ? a : b, y = a < b ? b : a;
+      lo[c] = x, hi[c] = y, last[c] = a;
+      threshold[c] = k.floor + static_cast<std::int32_t>((static_cast<std::uint32_t>(y > -x ? y : -x) * k.share) >> 16);
+      const std::int32_t room = l - amplitude;
+      if (same && y < room && x > -room) dithered |= static_cast<std::uint8_t>(1u << c);
+    }
     sign_last = sign;
     if (writes < 2) ++writes;
   }
@@ -106,8 +128,9 @@ struct DriveMonitor {
   std::uint32_t check(const std::int16_t adc[kDof], bool valid, std::uint32_t lines, std::uint64_t tick) {
     std::uint32_t faults = 0;
     int at = -1;
-    for (int c = 0; c < kDof; ++c)
-      if (lines >> c & 1u) faults = kFaultDriveFault, at = c;
+    if (lines != 0)
+      for (int c = kDof - 1; c >= 0; --c)
+        if (lines >> c & 1u) faults = kFaultDriveFault, at = c;
     suspect = 0;
     if (valid && writes >= 2)
       for (int c = 0; c < kDof; ++c) {
@@ -125,36 +148,24 @@ struct DriveMonitor {
       return kFaultCurrentSense;
     }
     const std::int32_t m = (reading * k.adc_q8) >> 8;  // in DAC codes
-    // The last two codes, each within the amplifier's current limit.
-    const std::int32_t l = k.limit[c];
-    std::int32_t a = last[c], b = before[c];
-    a = a > l ? l : (a < -l ? -l : a);
-    b = b > l ? l : (b < -l ? -l : b);
-    const std::int32_t lo = a < b ? a : b, hi = a < b ? b : a;
-    const std::int32_t error = m > hi ? m - hi : (m < lo ? lo - m : 0);
-    const std::int32_t size = hi > -lo ? hi : -lo;
-    const std::int32_t threshold = k.floor + static_cast<std::int32_t>((std::int64_t{size} * k.share) >> 16);
-    track_peak(peak[c], error, threshold);
-    if (2 * error > threshold) suspect |= static_cast<std::uint8_t>(1u << c);
-    over[c] = qualify(over[c], error > threshold);
+    const std::int32_t above = m - hi[c], below = lo[c] - m;
+    const std::int32_t error = above > 0 ? above : (below > 0 ? below : 0);
+    const std::int32_t th = threshold[c];
+    track_peak(peak[c], error, th);
+    if (2 * error > th) suspect |= static_cast<std::uint8_t>(1u << c);
+    over[c] = qualify(over[c], error > th);
     std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? static_cast<std::uint32_t>(kFaultDriveFault) : 0u;
-    // The dither, where the amplifier passes it (both codes with their dither within its current limit), on the
-    // readings after a code of the same sign as the one before: the reading after a change of sign carries the
-    // current loop's lag behind its step of two amplitudes (up to 45 % of it: docs/safety.md), the others only a
-    // period's decay of that (e^-2 of it).
-    const std::int32_t room = l - amplitude;
-    if (sign_last != 0 && sign_last == sign_before && amplitude > 0 && last[c] < room && last[c] > -room &&
-        before[c] < room && before[c] > -room) {
+    if (dithered >> c & 1u) {
       // 2^s y += s (m - a) - y: the filter of the sign-weighted difference, its level 2^s times the mean; the
       // difference within +-2 amplitudes (a larger one is the tracking check's: a glitch adds at most that).
-      const std::int32_t two = 2 * amplitude, d = m - a;
+      const std::int32_t two = 2 * amplitude, d = m - last[c];
       const std::int32_t dc = d > two ? two : (d < -two ? -two : d);
-      const std::int32_t x = sign_last > 0 ? dc : -dc;
-      dither[c] += x - (dither[c] >> kDitherShift);
-      const std::int32_t fade = -dither[c];  // 2^s times the missing share of the amplitude
-      track_peak(dither_peak[c], fade, amplitude << kDitherShift);
-      if (4 * fade > 3 * (amplitude << kDitherShift)) suspect |= static_cast<std::uint8_t>(1u << c);
-      if (2 * fade > (amplitude << kDitherShift)) f = kFaultDriveFault;
+      std::int32_t& y = dither[c];
+      y += (sign_last > 0 ? dc : -dc) - (y >> kDitherShift);
+      const std::int32_t fade = -y, level = amplitude << kDitherShift;  // 2^s times the missing share
+      track_peak(dither_peak[c], fade, level);
+      if (4 * fade > 3 * level) suspect |= static_cast<std::uint8_t>(1u << c);
+      if (2 * fade > level) f = kFaultDriveFault;
     }
     return f;
   }
@@ -165,12 +176,14 @@ struct DriveMonitor {
   }
 
  private:
+  /// peak = max(peak, 1000 value / limit): compared in 32 bits (value < 2^16, limit < 2^15), divided only for a
+  /// new peak.
   static void track_peak(std::uint16_t& peak, std::int32_t value, std::int32_t limit) {
-    // Divided only for a new peak (rare), compared in 64 bits (a multiply).
-    if (value <= 0 || limit <= 0 || std::int64_t{value} * 1000 <= std::int64_t{peak} * limit) return;
-    const std::int64_t r = std::int64_t{value} * 1000 / limit;
-    const std::uint16_t v = r > 65535 ? std::uint16_t{65535} : static_cast<std::uint16_t>(r);
-    if (v > peak) peak = v;
+    if (value <= 0 ||
+        static_cast<std::uint32_t>(value) * 1000u <= std::uint32_t{peak} * static_cast<std::uint32_t>(limit))
+      return;
+    const std::uint32_t r = static_cast<std::uint32_t>(value) * 1000u / static_cast<std::uint32_t>(limit);
+    peak = r > 65535u ? std::uint16_t{65535} : static_cast<std::uint16_t>(r);
   }
 };
 

@@ -81,6 +81,8 @@ constexpr double kMoveAngularCap[3] = {params::kMoveAngular[0] * params::kMoveLi
 constexpr double kZeros[kDof] = {};
 /// The pots parameter's default and largest value: 1 where the arm is described with potentiometers.
 constexpr double kPotsWired = has_pots(robot::kDriveTrain) ? 1 : 0;
+/// The drive_check parameter's default and largest value: 1 where the arm is described with current monitors.
+constexpr double kCurrentWired = has_current_monitors(robot::kDriveTrain) ? 1 : 0;
 /// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
 /// configured move maxima.
 constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
@@ -110,7 +112,15 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     true, "the homing move's speeds: the wrist centre's, the rotation's (accelerations, jerks: the move's)")          \
   X(ResidualMonitor, "residual_monitor", 1, "", 0, 1, params::kResidualMonitorArmed ? 1 : 0, TorqueOff, true,         \
     "1: the residual monitor armed: it raises encoder_stuck, drive_fault, collision (the stuck-encoder "              \
-    "monitor off but homing); 0: a trial (recorded; the stuck-encoder monitor raises encoder_stuck)")
+    "monitor off but homing); 0: a trial (recorded; the stuck-encoder monitor raises encoder_stuck)")                 \
+  X(DriveCheck, "drive_check", 1, "", 0, detail::kCurrentWired, detail::kCurrentWired, TorqueOff, true,               \
+    "1: the amplifiers' current monitors are wired (the drive check runs: drive_fault, current_sense; a residual "    \
+    "on a healthy drive is a collision); 0: none (its only value on an arm described without them)")                  \
+  X(DitherAmplitude, "dither_amplitude", 1, "of full scale", 0, 0.05, params::kDitherAmplitude, TorqueOff, true,      \
+    "the drive check's test dither on each DAC code, a fraction of its full scale (0: off: a DAC frozen at rest "     \
+    "is not found)")                                                                                                  \
+  X(DitherHalfPeriod, "dither_half_period", 1, "ticks", 2, 8, params::kDitherHalfPeriod, TorqueOff, true,             \
+    "the test dither's half period: a square wave of 1000 / (2 n) Hz (n = 4: 125 Hz)")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),

@@ -117,6 +117,12 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return static_cast<double>(task.home_speed[e]);
     case RuntimeParam::kParamResidualMonitor:
       return task.residual.armed ? 1.0 : 0.0;
+    case RuntimeParam::kParamDriveCheck:
+      return task.drive_check ? 1.0 : 0.0;
+    case RuntimeParam::kParamDitherAmplitude:
+      return task.dither_fraction;
+    case RuntimeParam::kParamDitherHalfPeriod:
+      return task.dither_half;
     case RuntimeParam::kCount:
       break;
   }
@@ -160,6 +166,17 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamResidualMonitor:
       task.residual.armed = v != 0;
       break;
+    case RuntimeParam::kParamDriveCheck:
+      if ((v != 0) != task.drive_check) task.drive.reset(), task.set_dither(task.dither_fraction);
+      task.drive_check = v != 0;
+      if (!task.drive_check) task.residual.drives_checked = false;
+      break;
+    case RuntimeParam::kParamDitherAmplitude:
+      task.set_dither(v);
+      break;
+    case RuntimeParam::kParamDitherHalfPeriod:
+      task.dither_half = static_cast<std::uint8_t>(v);
+      break;
     case RuntimeParam::kCount:
       break;
   }
@@ -191,7 +208,8 @@ constexpr ParamStatus param_address_status(int i, int e) {
 constexpr bool param_is_code(const ParamInfo& p) {
   return p.gain < 0 &&
          (p.runtime == RuntimeParam::kParamAdaptation || p.runtime == RuntimeParam::kParamCollisionReaction ||
-          p.runtime == RuntimeParam::kParamPots || p.runtime == RuntimeParam::kParamResidualMonitor);
+          p.runtime == RuntimeParam::kParamPots || p.runtime == RuntimeParam::kParamResidualMonitor ||
+          p.runtime == RuntimeParam::kParamDriveCheck || p.runtime == RuntimeParam::kParamDitherHalfPeriod);
 }
 
 /// Whether v is a valid value of element e of parameter i (finite, in range and within the scalar

@@ -84,9 +84,12 @@ struct ControlTask {
   Vec6<S> q_lo, q_hi;  // the running motion's joint limits (motion_limits_from, motion_limits_reached)
   // The drive check (osc/runtime/drive_monitor.hpp), on a HAL with current readback (hal::CurrentHal).
   DriveMonitor drive;
-  bool drive_check;        // the amplifiers' current monitors are wired: the drive check runs (has_current_monitors)
-  double dither_fraction;  // the test dither's amplitude, of each channel's full scale (0: off)
-  Vec6<S> dither_torque;   // its joint torques: each channel gets +-dither_fraction of its full scale (C^-T)
+  bool drive_check;           // the amplifiers' current monitors are wired: the drive check runs (has_current_monitors)
+  double dither_fraction;     // the test dither's amplitude, of each channel's full scale (0: off)
+  Vec6<S> dither_torque;      // its joint torques: each channel gets +-dither_fraction of its full scale (C^-T)
+  std::uint8_t dither_half;   // its half period [ticks] (parameter dither_half_period)
+  std::uint8_t dither_phase;  // the ticks of the current sign so far
+  std::int8_t dither_now;     // the current sign
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -129,6 +132,9 @@ struct ControlTask {
     drive.reset();
     drive_check = has_current_monitors(robot::kDriveTrain);
     dither_fraction = params::kDitherAmplitude;
+    dither_half = params::kDitherHalfPeriod;
+    dither_phase = 0;
+    dither_now = 1;
     // The paper's procedure places the arm at q_start; absolute encoders read it from power-on.
     homed = start == TaskStart::kPaper || has_absolute_encoders(robot::kDriveTrain);
     homing = {};
@@ -193,8 +199,11 @@ struct ControlTask {
     dither_torque = io.coupled() ? joint_torques_of_motors(io, d) : d;
     drive.start_dither(static_cast<std::int32_t>(fraction * static_cast<double>(kDacMaxCode) + 0.5));
   }
-  /// The dither's sign in this tick's codes: a square wave of params::kDitherHalfPeriod ticks a sign.
-  std::int8_t dither_sign() const { return (tick / params::kDitherHalfPeriod) % 2 == 0 ? 1 : -1; }
+  /// The dither's sign in this tick's codes: a square wave of dither_half ticks a sign (a tick that dithers).
+  std::int8_t dither_sign() {
+    if (++dither_phase > dither_half) dither_phase = 1, dither_now = static_cast<std::int8_t>(-dither_now);
+    return dither_now;
+  }
   /// Encoder counts per radian of channel i (its motor angle referred to its joint).
   double counts_per_rad(int i) const { return static_cast<double>(io.counts_per_rad(i)); }
   /// Test hook (fault injection): poisons the observer state with a NaN.
