@@ -936,13 +936,17 @@ CURRENT_ON = ("--set", "plant.current_monitor=on")
 
 
 def drive_cell(r):
-    """The first fault named, ms after the injection, and by whom (the drive check, else the monitor that did)."""
+    """The first fault named, ms after the injection, and by whom: the drive check, the residual monitor (its
+    residual or its travel check), or another monitor."""
     inj = r["injection"]
     if inj.get("detected_s") is None:
         return "not detected"
     ms = (inj["detected_s"] - inj["at_s"]) * 1e3
-    d = r["drive_check_detection"]
-    by = "" if d is not None and abs(d["t_s"] - inj["detected_s"]) < 1e-9 else " (other monitor)"
+
+    def named(det):
+        return det is not None and abs(det["t_s"] - inj["detected_s"]) < 1e-9
+    by = ("" if named(r["drive_check_detection"])
+          else " (residual)" if named(r["residual_monitor_detection"]) else " (other monitor)")
     return f"{inj['fault']}{by} {ms:.0f} ms"
 
 
@@ -950,8 +954,8 @@ def drive_cell(r):
 def drive_injection():
     """The drive check (the simulated arm's current monitors on, plant.current_monitor): each drive and
     current-monitor fault on each joint at two phases of the paper's motion, and a 50 N step at the tip in
-    each direction at three. Cell: the first fault, ms after the injection (the monitor that named it when
-    not the drive check)."""
+    each direction at three. Cell: the first fault, ms after the injection, and the monitor that named it when
+    not the drive check."""
     specs = [(f"{k}:{j}@{t:g}", t) for k in DRIVE_KINDS for j in range(1, 7) for t in DRIVE_TIMES]
     specs += [(f"collision:{d}:50@{t:g}", t) for d in DIRECTIONS for t in RESIDUAL_TIMES[:3]]
     prefetch([("--duration", f"{t + 1.5:g}", "--mode", "adaptive", "--inject", s, *CURRENT_ON) for s, t in specs])
