@@ -117,7 +117,7 @@ class LocalController {
     if (d.detected != 0) {
       res.drive_detected_s = static_cast<double>(d.detected_tick) / osc::params::kControlHz;
       res.drive_fault = d.detected;
-      res.drive_channel = d.channel;
+      res.drive_channel = static_cast<unsigned char>(d.channel);  // set: 0..5
     }
   }
 

@@ -30,8 +30,7 @@ namespace osc {
   X(DacBus, "dac_bus",                                                                                             \
     "a board's DAC frame did not complete on its bus (the codes may not have reached the amplifiers)")             \
   X(DriveFault, "drive_fault",                                                                                     \
-    "a drive did not deliver the torque commanded (zero, full scale or a stuck value): the drive check, or the "   \
-    "residual monitor")                                                                                            \
+    "a drive did not deliver the torque commanded (zero, full scale, stuck): the drive check or the residual")     \
   X(Collision, "collision", "an external torque beyond the model's error bounds: the residual monitor")            \
   X(PositionMismatch, "position_mismatch",                                                                         \
     "a pot and its encoders disagree beyond their band: a stuck or slipping encoder; homing: a pot off its index") \

@@ -25,6 +25,12 @@ struct DriveCheckConstants {
   std::int32_t limit[kDof];  // each amplifier's current limit (kDriveTrain.motor_torque_limit) [DAC codes]
 };
 
+/// x >= 0 to the nearest whole number (set-up arithmetic, compile time).
+constexpr std::int32_t nearest(double x) {
+  const auto n = static_cast<std::int32_t>(x);
+  return x - n >= 0.5 ? n + 1 : n;
+}
+
 /// floor = kDriveMargin (amplifier offset + monitor offset + 3 sigma of the monitor's noise + half its
 /// code); share = kDriveMargin (amplifier gain + monitor gain): 1.6 % of full scale and 8 % of the command
 /// with the PUMA's and the UR5e's bounds (2 % and 2 %; 0.2 % and 0.2 %; 2 codes of 12 bits over 1.25 full scale).
@@ -38,10 +44,10 @@ constexpr DriveCheckConstants drive_check_constants() {
   const double floor = params::kDriveMargin * (b.amp_offset + m.offset + 3 * m.noise * lsb + 0.5 * lsb);
   const double share = params::kDriveMargin * (b.amp_gain + m.gain);
   const auto dac = static_cast<double>(kDacMaxCode);
-  k.adc_q8 = static_cast<std::int32_t>(lsb * dac * 256 + 0.5);
+  k.adc_q8 = nearest(lsb * dac * 256);
   k.adc_max = static_cast<std::int32_t>(adc_max);
-  k.floor = static_cast<std::int32_t>(floor * dac + 0.5);
-  k.share = static_cast<std::int32_t>(share * 65536 + 0.5);
+  k.floor = nearest(floor * dac);
+  k.share = nearest(share * 65536);
   for (int c = 0; c < kDof; ++c) {
     const double amp = robot::kDriveTrain.motor_torque_limit[c] * abs_of(robot::kArm.links[c].gear_ratio);
     const double fs = robot::kDrives.torque_limit[c];
@@ -186,5 +192,16 @@ struct DriveMonitor {
     peak = r > 65535u ? std::uint16_t{65535} : static_cast<std::uint16_t>(r);
   }
 };
+
+/// Whether a suspect channel (bit c of `suspect`) drives joint i: its own, or one whose torque the wrist
+/// coupling adds to it (C^-T: motor c reaches joint i where q_c = ... + C_ci e_i). The residual monitor's
+/// isolation by order (ResidualMonitor::classify): a residual on a suspect's joint is a drive_fault.
+template <class IoMapT>
+bool drive_suspected(std::uint8_t suspect, int i, const IoMapT& io) {
+  bool s = (suspect >> i & 1u) != 0;
+  for (int k = 0; k < io.terms; ++k)
+    if (io.col[k] == i && (suspect >> io.row[k] & 1u) != 0) s = true;
+  return s;
+}
 
 }  // namespace osc

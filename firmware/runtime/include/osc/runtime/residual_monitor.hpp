@@ -11,35 +11,35 @@
 
 #include "osc/control/controller.hpp"
 #include "osc/control/identification.hpp"
+#include "osc/runtime/drive_monitor.hpp"
 #include "osc/runtime/encoder_monitors.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/residual_constants.hpp"
 
 namespace osc {
 
-/// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone;
-/// Haddadin, De Luca and Albu-Schaeffer 2017) in its sampled, acceleration-free form. Per joint,
-/// the torque the model does not explain, A(q) q^dot' + c + g + tau_f^ - tau, through a first-order
-/// filter of bandwidth K = params::kResidualGain:
+/// encoder_stuck, drive_fault, collision: a generalised-momentum residual (De Luca and Mattone; Haddadin, De Luca
+/// and Albu-Schaeffer 2017) in its sampled, acceleration-free form. Per joint, the torque the model does not
+/// explain, A(q) q^dot' + c + g + tau_f^ - tau, through a first-order filter of bandwidth K =
+/// params::kResidualGain:
 ///   r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})],
-/// n = c + g + tau_f^, tau_{k-1} the torque applied over the last period, q^dot the observer's (no
-/// numerical differentiation: the velocity difference is integrated). On a healthy arm r is the
-/// model's error, and each joint's threshold bounds it from the arm's stated error bounds
-/// (robot::kModelErrorBounds): friction (a still joint: anywhere in its static band; a moving one:
-/// the band's distance from theta^), link inertia, motor inertia, the amplifiers, and the encoder
-/// quantum through the velocity estimate (docs/safety.md derives each term). r is updated every tick, the
-/// thresholds on the monitor's turns (every params::kResidualTurnEvery ticks: turn_pass()) and held between. A
-/// residual beyond its threshold for params::kResidualQualifyTicks ticks in a row is a fault, isolated by joint
-/// and kind:
-///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for
-///    more than params::kStuckIntervals of its recent intervals between counts);
+/// n = c + g + tau_f^, tau_{k-1} the torque applied over the last period, q^dot the observer's (no numerical
+/// differentiation: the velocity difference is integrated). On a healthy arm r is the model's error, and each
+/// joint's threshold bounds it from the arm's stated error bounds (robot::kModelErrorBounds): friction (a still
+/// joint: anywhere in its static band; a moving one: the band's distance from theta^), link inertia, motor inertia,
+/// the amplifiers, and the encoder quantum through the velocity estimate (docs/safety.md derives each term). r is
+/// updated every tick, the thresholds on the monitor's turns (every params::kResidualTurnEvery ticks: turn_pass())
+/// and held between. A residual beyond its threshold for params::kResidualQualifyTicks ticks in a row is a fault,
+/// isolated by joint and kind:
+///  - encoder_stuck: an encoder of the joint fell silent at once while its joint was counting (for more than
+///    params::kStuckIntervals of its recent intervals between counts);
 ///  - with the drives checked (a HAL with current readback: DriveMonitor), drive_fault where the drive check
 ///    suspects the joint's drive, else collision (isolation by order: docs/safety.md, "The drive check");
-///  - without: drive_fault when the residual is on this drive alone (every other joint below half its
-///    threshold); collision: an external torque on several joints, as a contact gives.
-/// Beside the residual, the travel check (travel()): a joint whose least motion since its encoder's
-/// last count, from the torque applied and the same bounds, passes params::kResidualTravelCounts
-/// counts must have counted; it is a fault at once (classify_travel() names it).
+///  - without: drive_fault when the residual is on this drive alone (every other joint below half its threshold);
+///    collision: an external torque on several joints, as a contact gives.
+/// Beside the residual, the travel check (travel()): a joint whose least motion since its encoder's last count,
+/// from the torque applied and the same bounds, passes params::kResidualTravelCounts counts must have counted; it
+/// is a fault at once (classify_travel() names it).
 template <class S>
 struct ResidualMonitor {
   /// The model error's regressors, each filtered as r, then slowly (the change channel): the
@@ -119,9 +119,7 @@ struct ResidualMonitor {
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
   bool contact_noted = false;  // the contact error_floor holds (note_contact())
-  /// Set by the task each tick on a HAL with current readback (DriveMonitor, osc/runtime/drive_monitor.hpp):
-  /// the drive check ran (drives_checked), and the channels it suspects (bit c). Then a residual on one joint
-  /// is no longer taken for a drive fault: only a suspect's joint's is (classify()).
+  /// Set by the task on a HAL with current readback (DriveMonitor): the drive check ran, the channels it suspects.
   bool drives_checked = false;
   std::uint8_t drive_suspect = 0;
 
@@ -431,33 +429,10 @@ struct ResidualMonitor {
   void count_bounds(int i, S change);
   S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
   std::uint32_t classify_travel(int i) const;
-  /// Channel c fell silent before joint i's residual rose, and not long before (what a frozen
-  /// reading does); a joint that came to rest after, under a contact that lasts, is no stuck encoder.
-  bool silent_first(int c, int i, std::uint64_t tick) const {
-    constexpr std::uint64_t kWindow = params::kControlHz / 4;  // a residual rises within 250 ms of it
-    const std::uint64_t last = activity.last_move_tick[c];
-    return activity.silent(c, tick) && last <= over_since[i] && over_since[i] - last <= kWindow;
-  }
-  /// The kind of a qualified residual on joint i (the worst).
-  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
-    // A stuck encoder: joint i's own encoder or one the coupling adds to it.
-    bool stuck = silent_first(i, i, tick);
-    for (int k = 0; k < io.terms; ++k)
-      if (io.row[k] == i && silent_first(io.col[k], i, tick)) stuck = true;
-    if (stuck) return kFaultEncoderStuck;
-    // With the drives checked (isolation by order): drive_fault where the check suspects a channel that drives
-    // joint i: its own, or one whose torque the coupling adds to it (C^-T: motor c reaches joint i where
-    // q_c = ... + C_ci e_i); what is left is a collision.
-    if (drives_checked) {
-      bool suspect = (drive_suspect >> i & 1u) != 0;
-      for (int k = 0; k < io.terms; ++k)
-        if (io.col[k] == i && (drive_suspect >> io.row[k] & 1u) != 0) suspect = true;
-      return suspect ? kFaultDriveFault : kFaultCollision;
-    }
-    for (int j = 0; j < kDof; ++j)
-      if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
-    return kFaultDriveFault;
-  }
+  /// Channel c fell silent before joint i's residual rose, and not long before (residual_travel.hpp).
+  bool silent_first(int c, int i, std::uint64_t tick) const;
+  /// The kind of a qualified residual on joint i, the worst (residual_travel.hpp).
+  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const;
 };
 
 }  // namespace osc

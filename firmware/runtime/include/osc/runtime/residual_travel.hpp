@@ -1,7 +1,7 @@
 // The residual monitor's travel check (ResidualMonitor::travel(), osc/runtime/residual_monitor.hpp, which
 // includes this header at its end; docs/safety.md): a joint whose least motion since its encoder's last
 // count, from the torque applied and the model's error bounds, passes params::kResidualTravelCounts counts
-// must have counted; classify_travel() names the finding.
+// must have counted; classify_travel() names the finding, and classify() a qualified residual.
 #pragma once
 
 #include <cstdint>
@@ -124,6 +124,31 @@ inline S ResidualMonitor<S>::advance(Way& w, int i, S force, const Friction& f, 
   const S p = mul_add(kStep, lo < next ? lo : next, w.p(i));
   w.p(i) = p < -limit ? -limit : (p > limit ? limit : p);
   return p;
+}
+
+/// Channel c fell silent before joint i's residual rose, and not long before (what a frozen reading does); a
+/// joint that came to rest after, under a contact that lasts, is no stuck encoder.
+template <class S>
+inline bool ResidualMonitor<S>::silent_first(int c, int i, std::uint64_t tick) const {
+  constexpr std::uint64_t kWindow = params::kControlHz / 4;  // a residual rises within 250 ms of it
+  const std::uint64_t last = activity.last_move_tick[c];
+  return activity.silent(c, tick) && last <= over_since[i] && over_since[i] - last <= kWindow;
+}
+
+/// The kind of a qualified residual on joint i (the worst): encoder_stuck where its encoder (or one the coupling
+/// adds to it) fell silent first; with the drives checked (isolation by order: docs/safety.md, "The drive
+/// check"), drive_fault on a suspect drive's joint, else collision; without, drive_fault on one joint alone,
+/// collision on several.
+template <class S>
+inline std::uint32_t ResidualMonitor<S>::classify(int i, const IoMap<S>& io, std::uint64_t tick) const {
+  bool stuck = silent_first(i, i, tick);
+  for (int k = 0; k < io.terms; ++k)
+    if (io.row[k] == i && silent_first(io.col[k], i, tick)) stuck = true;
+  if (stuck) return kFaultEncoderStuck;
+  if (drives_checked) return drive_suspected(drive_suspect, i, io) ? kFaultDriveFault : kFaultCollision;
+  for (int j = 0; j < kDof; ++j)
+    if (j != i && ratio_of(j) > lit<S>(0.5)) return kFaultCollision;
+  return kFaultDriveFault;
 }
 
 /// The kind of a travel check's finding on joint i: a joint that must have counted and did not.

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "hal/hal.hpp"
@@ -197,7 +198,7 @@ struct ControlTask {
     Vec6<S> d;
     for (int c = 0; c < kDof; ++c) d(c) = lit<S>(fraction * robot::kDrives.torque_limit[c]);
     dither_torque = io.coupled() ? joint_torques_of_motors(io, d) : d;
-    drive.start_dither(static_cast<std::int32_t>(fraction * static_cast<double>(kDacMaxCode) + 0.5));
+    drive.start_dither(static_cast<std::int32_t>(std::lround(fraction * static_cast<double>(kDacMaxCode))));
   }
   /// The dither's sign in this tick's codes: a square wave of dither_half ticks a sign (a tick that dithers).
   std::int8_t dither_sign() {
