@@ -64,9 +64,9 @@ inline constexpr DriveCheckConstants kDriveCheck = drive_check_constants();
 ///    params::kDriveQualifyTicks readings in a row: drive_fault (a DAC at zero or full scale, an amplifier
 ///    off, a DAC frozen once the command has left its value).
 ///  - The dither check: the codes carry a square wave of +-dither codes (params::kDitherAmplitude of full
-///    scale, params::kDitherHalfPeriod ticks a sign; ControlTask::dither_sign); the reading's difference from
-///    the last code, times that code's sign, filtered over 2^params::kDitherWindowShift readings (those not
-///    right after a change of sign), is about 0 on a drive that follows and -dither on one that does not.
+///    scale, params::kDitherHalfPeriod ticks a sign; ControlTask::dither_sign); the reading's distance outside
+///    its codes' range, times their sign, filtered over 2^params::kDitherWindowShift readings (those not right
+///    after a change of sign), is about 0 on a drive that follows and -dither on one that does not.
 ///    Below -dither / 2: drive_fault, at rest as in motion (a DAC or an amplifier frozen at any value).
 ///  - The fault lines: an amplifier that reports a fault: drive_fault at once.
 ///  - The monitor itself: a reading at the end of the ADC's span (beyond the largest current an amplifier
@@ -162,9 +162,11 @@ struct DriveMonitor {
     over[c] = qualify(over[c], error > th);
     std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? static_cast<std::uint32_t>(kFaultDriveFault) : 0u;
     if (dithered >> c & 1u) {
-      // 2^s y += s (m - a) - y: the filter of the sign-weighted difference, its level 2^s times the mean; the
-      // difference within +-2 amplitudes (a larger one is the tracking check's: a glitch adds at most that).
-      const std::int32_t two = 2 * amplitude, d = m - last[c];
+      // 2^s y += s e - y: the filter of the sign-weighted error (the reading's distance outside its codes' range,
+      // signed), its level 2^s times the mean; the error within +-2 amplitudes (a larger one is the tracking
+      // check's: a glitch adds at most that). Outside the range, not from the last code: a drive's lag behind
+      // the controller's own steps, which answer the dither on a light joint, stays inside it.
+      const std::int32_t two = 2 * amplitude, d = above > 0 ? above : (below > 0 ? -below : 0);
       const std::int32_t dc = d > two ? two : (d < -two ? -two : d);
       std::int32_t& y = dither[c];
       y += (sign_last > 0 ? dc : -dc) - (y >> kDitherShift);
