@@ -312,7 +312,7 @@ class PlantHal {
   bool read_currents(std::int16_t adc[hal::kJoints]) {
     if (!sensors_.current_monitor) return false;
     const osc::CurrentMonitor& m = osc::robot::kDriveTrain.current;
-    const double top = static_cast<double>((1L << (m.bits - 1)) - 1);
+    const auto top = static_cast<double>(osc::current_max_code(m));
     const Vec6 current = plant_.amplifier_currents();
     for (int i = 0; i < hal::kJoints; ++i) {
       const double fs = osc::robot::kDrives.torque_limit[i];

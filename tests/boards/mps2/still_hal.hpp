@@ -70,7 +70,7 @@ struct WithCurrents : Base {
   bool read_currents(std::int16_t a[osc::kDof]) {
     static constexpr std::int32_t kAdcPerCodeQ16 = [] {
       const osc::CurrentMonitor& m = osc::robot::kDriveTrain.current;
-      const double top = m.bits > 0 ? static_cast<double>((1L << (m.bits - 1)) - 1) : 0.0;
+      const auto top = static_cast<double>(osc::current_max_code(m));
       return static_cast<std::int32_t>(top / (m.range * static_cast<double>(osc::kDacMaxCode)) * 65536 + 0.5);
     }();
     for (int i = 0; i < osc::kDof; ++i) a[i] = static_cast<std::int16_t>((this->codes[i] * kAdcPerCodeQ16) >> 16);

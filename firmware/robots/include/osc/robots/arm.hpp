@@ -275,6 +275,8 @@ constexpr ModelErrorBounds with_friction_band(ModelErrorBounds b, const Friction
 
 /// Largest DAC code magnitude.
 constexpr long dac_max_code(const DriveParams& drives) { return (1L << (drives.dac_bits - 1)) - 1; }
+/// Largest current-monitor code magnitude, 2^(bits-1) - 1 at range times the DAC's full-scale current (0: none).
+constexpr long current_max_code(const CurrentMonitor& m) { return m.bits > 0 ? (1L << (m.bits - 1)) - 1 : 0; }
 
 /// True when the last three joint axes meet at the frame-6 origin (a spherical wrist with the
 /// operational point at its centre): link 4's origin lies on joint 4's axis (P_4's translation along

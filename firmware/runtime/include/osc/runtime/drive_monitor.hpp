@@ -39,7 +39,7 @@ constexpr DriveCheckConstants drive_check_constants() {
   const ModelErrorBounds& b = robot::kModelErrorBounds;
   DriveCheckConstants k{};
   if (m.bits <= 0) return k;
-  const double adc_max = static_cast<double>((1L << (m.bits - 1)) - 1);
+  const auto adc_max = static_cast<double>(current_max_code(m));
   const double lsb = m.range / adc_max;  // one ADC code, relative to the DAC's full scale
   const double floor = params::kDriveMargin * (b.amp_offset + m.offset + 3 * m.noise * lsb + 0.5 * lsb);
   const double share = params::kDriveMargin * (b.amp_gain + m.gain);
