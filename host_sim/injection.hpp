@@ -18,8 +18,9 @@ enum class InjectionForm : std::uint8_t {
 };
 
 // X(Name, "name", form, qemu, what the hardware does from the injection time on). qemu: it acts on
-// what a PIL run shares with the in-process one (the plant, the encoders, the amplifiers), so
-// --qemu takes it; overrun and estop act on the host-built task's clock and E-stop input.
+// what a PIL run shares with the in-process one (the plant, the encoders, the amplifiers, their current
+// monitors and fault lines: the sensor frame carries them), so --qemu takes it; overrun and estop act
+// on the host-built task's clock and E-stop input.
 #define SIM_INJECTION_LIST(X)                                                                                      \
   X(EncoderStuck, "encoder-stuck", kJoint, true, "the encoder reading freezes at its value at the injection time") \
   X(EncoderJump, "encoder-jump", kJoint, true,                                                                     \
@@ -31,11 +32,11 @@ enum class InjectionForm : std::uint8_t {
   X(DacZero, "dac-zero", kJoint, true, "the amplifier receives DAC code 0 whatever the controller writes")         \
   X(DacFull, "dac-full", kJoint, true, "the amplifier receives the positive full-scale DAC code")                  \
   X(AmpOff, "amp-off", kJoint, true, "the amplifier produces zero torque whatever code it receives")               \
-  X(AmpFault, "amp-fault", kJoint, false, "the amplifier trips: zero torque, and its fault line reports it")       \
-  X(CurrentStuck, "current-stuck", kJoint, false,                                                                  \
+  X(AmpFault, "amp-fault", kJoint, true, "the amplifier trips: zero torque, and its fault line reports it")        \
+  X(CurrentStuck, "current-stuck", kJoint, true,                                                                   \
     "the current monitor's reading freezes at its value at the injection time")                                    \
-  X(CurrentZero, "current-zero", kJoint, false, "the current monitor reads zero current whatever flows")           \
-  X(CurrentGain, "current-gain", kJoint, false, "the current monitor reads half the current (its gain halved)")    \
+  X(CurrentZero, "current-zero", kJoint, true, "the current monitor reads zero current whatever flows")            \
+  X(CurrentGain, "current-gain", kJoint, true, "the current monitor reads half the current (its gain halved)")     \
   X(Overrun, "overrun", kNone, false, "the control tick at the injection time takes three periods")                \
   X(Estop, "estop", kNone, false, "the emergency-stop input becomes active and stays active")                      \
   X(Collision, "collision", kForce, true,                                                                          \

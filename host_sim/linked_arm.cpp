@@ -9,7 +9,13 @@ namespace sim {
 bool PilSession::exchange(PlantHal& hal, std::string& err) {
   pil::SensorFrame s;
   s.seq = seq_++;
+  // The sample as the in-process tick reads it (control_tick: the encoders, then the drive check's
+  // currents and fault lines, before the DAC write): once each, at this sample's time.
   hal.read_encoders(s.counts);
+  const bool currents = hal.read_currents(s.currents);
+  if (!currents)
+    for (std::int16_t& c : s.currents) c = 0;
+  s.drive = pil::drive_byte(hal.amp_faults(), currents);
   if (s.seq == 0) s.inject = config_;
   pil::ActuatorFrame a = last_;
   std::string why;
@@ -27,7 +33,7 @@ bool PilSession::exchange(PlantHal& hal, std::string& err) {
 LinkedArm::LinkedArm(const Vec6& q0, const ExperimentConfig& cfg, std::uint8_t config)
     : q0_(q0),
       plant_(cfg.plant),
-      hal_(plant_, q0_, SensorConfig{}, cfg.injection),
+      hal_(plant_, q0_, cfg.sensor_config(), cfg.injection),
       session_(cfg.pil_timeout,
                static_cast<std::uint8_t>(config | pil::kConfigStartDisabled | pil::kConfigTrace |
                                          (cfg.mode == osc::FrictionMode::kNone ? pil::kConfigNoCompensation : 0) |

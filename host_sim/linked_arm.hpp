@@ -34,10 +34,10 @@ struct TickView {
 };
 
 /// The host's end of a lockstep PIL session over the simulated hardware (the paper's experiment's
-/// remote controller, experiment.cpp, and LinkedArm): each tick a sensor frame of the encoders (the
-/// session's first with the configuration bits), the answer's codes to the amplifiers; zero codes
-/// on a link error (counted, the first kept), and a lost link (no answer in time, the peer gone)
-/// ends it.
+/// remote controller, experiment.cpp, and LinkedArm): each tick a sensor frame of the encoders, the
+/// amplifiers' currents and their fault lines (hal::CurrentHal; the session's first frame with the
+/// configuration bits), the answer's codes to the amplifiers; zero codes on a link error (counted, the
+/// first kept), and a lost link (no answer in time, the peer gone) ends it.
 class PilSession {
  public:
   PilSession(double timeout_s, std::uint8_t config) : timeout_(timeout_s), config_(config) {}
@@ -67,8 +67,9 @@ class PilSession {
 class LinkedArm {
  public:
   /// Starts cfg.pil_command (waits for its hello frame: ok() says whether it came), the arm at rest at
-  /// q0 with its brakes on. config: configuration bits for the first sensor frame besides
-  /// start_disabled, trace and cfg's friction mode and adaptation law (e.g. pil::kConfigStateFrames).
+  /// q0 with its brakes on, its sensors cfg's (cfg.sensor_config(): e.g. plant.current_monitor). config: configuration
+  /// bits for the first sensor frame besides start_disabled, trace and cfg's friction mode and adaptation law (e.g.
+  /// pil::kConfigStateFrames).
   LinkedArm(const Vec6& q0, const ExperimentConfig& cfg, std::uint8_t config = 0);
   LinkedArm(const LinkedArm&) = delete;
   LinkedArm& operator=(const LinkedArm&) = delete;

@@ -52,7 +52,8 @@ json bytes_of(const std::uint8_t* p, int n) {
 }
 
 /// The examples of the document: the first sensor frame of a run (at the start pose, asking for the
-/// paper's adaptation law), a later one, and an actuator frame that answers it.
+/// paper's adaptation law), a later one (with the amplifiers' currents and a fault line), and an actuator
+/// frame that answers it.
 json examples() {
   json out = json::array();
   std::uint8_t buf[pil::kMaxFrame];
@@ -67,8 +68,12 @@ json examples() {
   pil::SensorFrame later;
   later.seq = 1234;
   const std::int32_t counts[pil::kJoints] = {1500, -2750, 40, -3, 0, 12};
-  for (int i = 0; i < pil::kJoints; ++i) later.counts[i] = counts[i];
-  out.push_back({{"what", "sensor frame 1234: counts 1500, -2750, 40, -3, 0, 12"},
+  const std::int16_t currents[pil::kJoints] = {310, -1200, 45, 0, -7, 2};
+  for (int i = 0; i < pil::kJoints; ++i) later.counts[i] = counts[i], later.currents[i] = currents[i];
+  later.drive = pil::drive_byte(1u << 2, true);
+  out.push_back({{"what",
+                  "sensor frame 1234: counts 1500, -2750, 40, -3, 0, 12; currents 310, -1200, 45, 0, -7, 2, a "
+                  "reading (currents_valid), amplifier 3's fault line active"},
                  {"frame", "sensor"},
                  {"bytes", bytes_of(buf, pil::encode(later, buf))}});
   pil::ActuatorFrame a;
@@ -307,6 +312,11 @@ int main(int argc, char** argv) {
                  {"adaptation_shift", pil::kConfigAdaptationShift},
                  {"adaptation_mask", pil::kConfigAdaptationMask},
                  {"no_compensation", pil::kConfigNoCompensation}};
+  const osc::CurrentMonitor& monitor = osc::robot::kDriveTrain.current;
+  j["drive"] = {{"fault_lines", pil::kDriveFaultLines},
+                {"currents_valid", pil::kDriveCurrentsValid},
+                {"adc_bits", monitor.bits},
+                {"range", monitor.range}};
   j["adaptation_laws"] = json::array();
   for (int i = 0; i < osc::kAdaptationLawCount; ++i) j["adaptation_laws"].push_back(osc::kAdaptationLawNames[i]);
   j["default_adaptation"] = osc::adaptation_law_name(osc::Gains<double>::paper().adaptation);

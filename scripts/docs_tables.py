@@ -1392,6 +1392,24 @@ def t_protocol_flags():
     return "\n".join(rows)
 
 
+@table("protocol_drive", "docs/protocol.md", "protocol")
+def t_protocol_drive():
+    d = protocol()["drive"]
+    lines, valid = d["fault_lines"], d["currents_valid"]
+    top = bin(lines).count("1") - 1
+    bit = valid.bit_length() - 1
+    coding = (f"a {d['adc_bits']}-bit ADC's signed codes, ±{2 ** (d['adc_bits'] - 1) - 1} at ±{d['range']:g} times the "
+              "DAC's full-scale current" if d["adc_bits"] > 0 else "the arm states no current monitors")
+    rows = ["| bits | mask | name | meaning |", "|---|---|---|---|",
+            f"| 0-{top} | `{hexs(lines)}` | fault_lines | bit c: amplifier c + 1 reports a fault on its fault line "
+            "(over-current, over-temperature, a supply fault): the drive check's drive_fault in this tick |",
+            f"| {bit} | `{hexs(valid)}` | currents_valid | `currents` holds this tick's current-monitor readings "
+            f"({coding}); 0: there are none (a plant without current monitors: `currents` all 0, the drive check "
+            "sees the fault lines alone) |",
+            "| other | | | 0 |"]
+    return "\n".join(rows)
+
+
 @table("protocol_link_errors", "docs/protocol.md", "protocol")
 def t_protocol_link_errors():
     p = protocol()

@@ -50,7 +50,7 @@ def protocol_path():
     return os.environ.get("OSC_PROTOCOL") or PROTOCOL_JSON
 
 
-WIRE = {"u8": "B", "u32": "I", "i32": "i", "f32": "f"}
+WIRE = {"u8": "B", "i16": "h", "u32": "I", "i32": "i", "f32": "f"}
 
 
 class ClientError(Exception):

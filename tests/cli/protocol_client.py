@@ -10,7 +10,9 @@ firmware's link node and control task built for the host). The check:
   2. the document's worked examples decode to what their captions say, and their CRCs check;
   3. a live session with PEER: the hello frame, 50 frames in lockstep with torque, a frame with a
      bad CRC answered at once with zero codes and counted, torque again, then an encoder jump that
-     latches its fault with zero torque, and the fault stays.
+     latches its fault with zero torque, and the fault stays;
+  4. a second session: an amplifier's fault line in the drive byte (the document's mask) latches
+     drive_fault with zero torque in the same tick.
 Prints one line per check; exit 0 when all pass, 1 otherwise.
 """
 import os
@@ -23,13 +25,14 @@ import time
 # The frame, as docs/protocol.md gives it.
 SYNC = b"\xA5\x5A"
 SENSOR, ACTUATOR = 1, 2
-SENSOR_LAYOUT = [("seq", "u32", 1), ("counts", "i32", 6), ("inject", "u8", 1)]
+SENSOR_LAYOUT = [("seq", "u32", 1), ("counts", "i32", 6), ("currents", "i16", 6), ("drive", "u8", 1),
+                 ("inject", "u8", 1)]
 ACTUATOR_LAYOUT = [("seq", "u32", 1), ("codes", "i32", 6), ("faults", "u32", 1), ("state", "u8", 1),
                    ("step_cycles", "u32", 1), ("max_cycles", "u32", 1), ("mean_cycles", "u32", 1),
                    ("tick_max_cycles", "u32", 1), ("stage_cycles", "u32", 8), ("stack_used", "u32", 1),
                    ("theta_hat", "f32", 18), ("tau_f_hat", "f32", 6), ("link", "u32", 7), ("rx_gap_max", "u32", 1),
                    ("rx_long_gaps", "u32", 1)]
-CODE = {"u8": "B", "u32": "I", "i32": "i", "f32": "f"}
+CODE = {"u8": "B", "i16": "h", "u32": "I", "i32": "i", "f32": "f"}
 
 
 def fmt_of(layout):
@@ -56,8 +59,8 @@ def frame(ftype, payload):
     return SYNC + body + struct.pack("<H", crc16(body))
 
 
-def sensor(seq, counts, inject=0):
-    return frame(SENSOR, struct.pack(SENSOR_FMT, seq, *counts, inject))
+def sensor(seq, counts, inject=0, currents=(0,) * 6, drive=0):
+    return frame(SENSOR, struct.pack(SENSOR_FMT, seq, *counts, *currents, drive, inject))
 
 
 def decode(layout, payload):
@@ -121,13 +124,20 @@ def doc_tables(text):
         sec = text[text.index("## " + heading):]
         rows = []
         for line in sec.split("\n"):
-            m = re.match(r"\| (\d+) \| (u8|u32|i32|f32)(?: × (\d+))? \| \d+ \| `(\w+)` \|", line)
+            m = re.match(r"\| (\d+) \| (u8|i16|u32|i32|f32)(?: × (\d+))? \| \d+ \| `(\w+)` \|", line)
             if m:
                 rows.append((int(m.group(1)), m.group(2), int(m.group(3) or 1), m.group(4)))
             elif rows and not line.startswith("|"):
                 break
         out[heading] = rows
     return out
+
+
+def drive_bits(text):
+    """The drive byte's masks as the document's table gives them: {name: mask}."""
+    sec = text[text.index("### The drive byte"):]
+    sec = sec[:sec.find("\n#", 1)]  # to the next heading
+    return {m.group(2): int(m.group(1), 16) for m in re.finditer(r"\| [\d-]+ \| `0x([0-9A-F]{2})` \| (\w+) \|", sec)}
 
 
 def layout_rows(layout):
@@ -162,6 +172,15 @@ def check_document(text, f):
             ok = ok and (counts == tuple(words[:6]) if words else counts == (0,) * 6)
             if "paper" in caption:  # the adaptation law + 1 in bits 5-6: paper is law 0
                 ok = ok and inject == (0 + 1) << 5
+            drive = drive_bits(text)
+            if "currents " in caption:  # the readings, the valid bit, the fault line named
+                words = [int(x) for x in re.findall(r"-?\d+", caption.split("currents ")[1])]
+                line = re.search(r"amplifier (\d+)'s fault line", caption)
+                ok = ok and tuple(s_["currents"]) == tuple(words[:6])
+                lines = 1 << (int(line.group(1)) - 1) if line else 0
+                ok = ok and s_["drive"] == drive["currents_valid"] | lines
+            else:
+                ok = ok and tuple(s_["currents"]) == (0,) * 6 and s_["drive"] == 0
             f.check(ok, f"example sensor frame {seq} decodes to its caption")
         else:
             a = decode_actuator(payload)
@@ -233,6 +252,26 @@ def check_session(argv, fault_bits, f):
         peer.close()
 
 
+def check_fault_line(argv, text, fault_bits, f):
+    """An amplifier's fault line (the document's drive byte) is a drive fault in the tick it comes."""
+    lines = drive_bits(text).get("fault_lines", 0)
+    f.check(lines == 0x3F, f"the document's drive byte: six fault lines in bits 0-5 (mask {lines:#x})")
+    peer = Peer(argv)
+    try:
+        peer.receive()  # hello
+        for n in range(5):
+            peer.send(sensor(n, [0] * 6))
+            a = peer.receive()
+        f.check(a["faults"] == 0 and any(a["codes"]), "no fault line, no current reading: torque, no fault")
+        peer.send(sensor(5, [0] * 6, drive=lines & (1 << 1)))  # amplifier 2 trips
+        a = peer.receive()
+        drive = fault_bits["drive_fault"]
+        f.check(a["seq"] == 5 and a["faults"] & drive and a["state"] == 2 and a["codes"] == [0] * 6,
+                "amplifier 2's fault line: the document's drive_fault bit, state fault, zero codes in the same tick")
+    finally:
+        peer.close()
+
+
 def main(argv):
     if len(argv) != 3:
         print(__doc__, file=sys.stderr)
@@ -244,6 +283,8 @@ def main(argv):
     faults = {m.group(2): int(m.group(1), 16) for m in re.finditer(r"\| \d+ \| `0x([0-9A-F]{8})` \| `(\w+)` \|", text)}
     f.check("encoder_jump" in faults, "the document names the encoder_jump bit")
     check_session([argv[1]], faults, f)
+    f.check("drive_fault" in faults, "the document names the drive_fault bit")
+    check_fault_line([argv[1]], text, faults, f)
     print(f"{f.n} failed" if f.n else "all checks passed")
     return 1 if f.n else 0
 

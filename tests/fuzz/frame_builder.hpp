@@ -10,6 +10,7 @@
 namespace fuzz {
 
 inline void fill(Input& in, std::uint8_t& v) { v = in.u8(); }
+inline void fill(Input& in, std::int16_t& v) { v = static_cast<std::int16_t>(in.u16()); }
 inline void fill(Input& in, std::uint32_t& v) { v = in.u32(); }
 inline void fill(Input& in, std::int32_t& v) { v = in.i32(); }
 inline void fill(Input& in, float& v) {  // raw bits: NaNs and infinities included

@@ -1,6 +1,7 @@
 // Fuzz target: the firmware's PIL node (osc/link/node.hpp), osc::PilNode<double, FakeBoard>, driven
-// by fuzzed link traffic: raw bytes, well-formed sensor frames with fuzzed encoder counts, sequence
-// numbers and fault-injection bits, and link timeouts. FakeBoard captures what the node writes.
+// by fuzzed link traffic: raw bytes, well-formed sensor frames with fuzzed encoder counts, amplifier
+// currents and drive bytes (fault lines: a drive_fault; readings: the drive check), sequence numbers and
+// fault-injection bits, and link timeouts. FakeBoard captures what the node writes.
 //
 // Invariants:
 //  - hello() writes one actuator frame: sequence kHelloSeq, zero codes, state kInit;
@@ -220,12 +221,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       }
       case 1:
-      case 2: {  // a well-formed sensor frame: small encoder steps, or (op & 4) any counts
+      case 2: {  // a well-formed sensor frame: small encoder steps, or (op & 4) any counts; (op & 32) currents
         pil::SensorFrame f;
         f.seq = (op & 8) ? in.u32() : d.expected_seq;
         for (int i = 0; i < osc::kDof; ++i)
           counts[i] = (op & 4) ? in.i32() : fuzz::wrap_add(counts[i], static_cast<std::int8_t>(in.u8()) / 4);
         for (int i = 0; i < osc::kDof; ++i) f.counts[i] = counts[i];
+        if (op & 32) {  // the amplifiers' currents and drive byte (fault lines, valid bit) from the input
+          for (std::int16_t& c : f.currents) c = static_cast<std::int16_t>(in.u16());
+          f.drive = in.u8();
+        }
         f.inject = (op & 16) ? in.u8() : 0;
         std::uint8_t buf[pil::kMaxFrame];
         const int n = pil::encode(f, buf);

@@ -88,8 +88,8 @@ void frames() {
   append(b, sensor(3, 9));
   put("fuzz_frames", "raw_garbage_between", b);
   // Structured mode (first byte odd): op, garbage, fields.
-  b = {1, 0x02, 0xA5, 0x5A};
-  for (int i = 0; i < 29; ++i) b.push_back(static_cast<std::uint8_t>(i));
+  b = {1, 0x02, 0xA5, 0x5A};  // a sensor frame after two garbage bytes, its fields
+  for (int i = 0; i < pil::kSensorPayload; ++i) b.push_back(static_cast<std::uint8_t>(i));
   b.push_back(0x18);  // actuator frame, one bit flipped
   for (int i = 0; i < 137; ++i) b.push_back(static_cast<std::uint8_t>(3 * i));
   put("fuzz_frames", "structured", b);
@@ -131,6 +131,27 @@ void node() {
   append(first, cfg);
   append(first, b);
   put("fuzz_node", "configured_run", first);
+  // op bit 5: the amplifiers' currents and drive byte from the input. Readings that follow the codes
+  // loosely (the drive check's tracking and dither), then a reading off the ADC's scale; a fault line.
+  Bytes d;
+  for (int t = 0; t < 20; ++t) {
+    d.push_back(1 | 32);
+    for (int i = 0; i < 6; ++i) d.push_back(static_cast<std::uint8_t>(t % 2 ? 4 : 0xFC));
+    for (int i = 0; i < 6; ++i) {
+      const int reading = t == 19 && i == 2 ? 2047 : (t % 3) * (i - 2);
+      d.push_back(static_cast<std::uint8_t>(reading & 0xFF));
+      d.push_back(static_cast<std::uint8_t>((reading >> 8) & 0xFF));
+    }
+    d.push_back(pil::drive_byte(0, true));
+  }
+  put("fuzz_node", "drive_readings", d);
+  Bytes lines = b;
+  lines.resize(7 * 10);
+  lines.push_back(1 | 32);
+  for (int i = 0; i < 6; ++i) lines.push_back(0);
+  for (int i = 0; i < 12; ++i) lines.push_back(0);
+  lines.push_back(pil::drive_byte(1u << 3, false));
+  put("fuzz_node", "amp_fault_line", lines);
 }
 
 void encoder() {
@@ -194,8 +215,8 @@ void pil_client() {
   // Byte 0 odd: frames built from the input (op, garbage, fields).
   Bytes d{1, 255, 255, 255, 255, 255, 255, 255, 255, 0x01, 0x5A};
   for (int i = 0; i < 137; ++i) d.push_back(static_cast<std::uint8_t>(i));
-  d.push_back(0x08);
-  for (int i = 0; i < 29; ++i) d.push_back(static_cast<std::uint8_t>(7 * i));
+  d.push_back(0x08);  // a sensor frame, its fields
+  for (int i = 0; i < pil::kSensorPayload; ++i) d.push_back(static_cast<std::uint8_t>(7 * i));
   put("fuzz_pil_client", "structured", d);
 }
 

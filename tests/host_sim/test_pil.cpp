@@ -16,6 +16,7 @@
 
 #include "experiment.hpp"
 #include "frame_json.hpp"
+#include "injection.hpp"
 #include "motion_script.hpp"
 #include "osc/control/params.hpp"
 #include "osc/link/commands.hpp"
@@ -57,6 +58,22 @@ std::vector<std::string> peer_command() {
 }
 
 // ---------------------------------------------------------------- protocol
+/// The single-bit flips of an encoded frame that still parse as a frame (each must be detected: 0).
+int undetected_flips(const std::uint8_t* buf, int n) {
+  int undetected = 0;
+  for (int byte = 0; byte < n; ++byte)
+    for (int bit = 0; bit < 8; ++bit) {
+      std::uint8_t c[pil::kMaxFrame];
+      std::copy(buf, buf + n, c);
+      c[byte] ^= static_cast<std::uint8_t>(1u << bit);
+      pil::Parser q;
+      bool frame = false;
+      for (int i = 0; i < n; ++i) frame |= q.feed(c[i]) == pil::Parser::kFrame;
+      undetected += frame;
+    }
+  return undetected;
+}
+
 TEST(PilProtocol, RoundTripAndEverySingleBitFlipIsDetected) {
   pil::ActuatorFrame a;
   a.seq = 123456;
@@ -81,20 +98,37 @@ TEST(PilProtocol, RoundTripAndEverySingleBitFlipIsDetected) {
   EXPECT_EQ(b.tau_f_hat[3], -0.5f);
   pil::SensorFrame s;
   EXPECT_FALSE(p.decode(s));  // wrong type
+  EXPECT_EQ(undetected_flips(buf, n), 0);
 
-  int detected = 0, total = 0;
-  for (int byte = 0; byte < n; ++byte)
-    for (int bit = 0; bit < 8; ++bit) {
-      std::uint8_t c[pil::kMaxFrame];
-      std::copy(buf, buf + n, c);
-      c[byte] ^= static_cast<std::uint8_t>(1u << bit);
-      pil::Parser q;
-      bool frame = false;
-      for (int i = 0; i < n; ++i) frame |= q.feed(c[i]) == pil::Parser::kFrame;
-      ++total;
-      detected += !frame;
-    }
-  EXPECT_EQ(detected, total);
+  // A sensor frame, every field set: the amplifiers' currents at the ends of an i16 and the drive byte
+  // with fault lines and the valid bit.
+  s.seq = 0xFFFFFFFEu;
+  for (int i = 0; i < 6; ++i) s.counts[i] = 70000 * (i - 2) - 1;
+  const std::int16_t currents[6] = {32767, -32768, -2047, 2047, 0, -1};
+  for (int i = 0; i < 6; ++i) s.currents[i] = currents[i];
+  s.drive = pil::drive_byte(0x21, true);
+  s.inject = pil::kInjectOverrun;
+  const int m = pil::encode(s, buf);
+  ASSERT_EQ(m, pil::kSensorPayload + pil::kOverhead);
+  pil::Parser q;
+  for (int i = 0; i < m - 1; ++i) ASSERT_EQ(q.feed(buf[i]), pil::Parser::kPending);
+  ASSERT_EQ(q.feed(buf[m - 1]), pil::Parser::kFrame);
+  pil::SensorFrame t;
+  ASSERT_TRUE(q.decode(t));
+  EXPECT_FALSE(q.decode(b));  // wrong type
+  EXPECT_EQ(t.seq, s.seq);
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(t.counts[i], s.counts[i]) << i;
+  for (int i = 0; i < 6; ++i) EXPECT_EQ(t.currents[i], currents[i]) << i;
+  EXPECT_EQ(t.drive, 0xA1);
+  EXPECT_EQ(t.inject, pil::kInjectOverrun);
+  // Little-endian, in the field list's order: the currents after the counts, then drive, then inject.
+  EXPECT_EQ(buf[4 + 28], 0xFF);
+  EXPECT_EQ(buf[4 + 29], 0x7F);
+  EXPECT_EQ(buf[4 + 30], 0x00);
+  EXPECT_EQ(buf[4 + 31], 0x80);
+  EXPECT_EQ(buf[4 + 40], 0xA1);
+  EXPECT_EQ(buf[4 + 41], pil::kInjectOverrun);
+  EXPECT_EQ(undetected_flips(buf, m), 0);
 }
 
 // A frame's JSON keys are its field list's names in wire order, with the values decoded from the wire.
@@ -624,6 +658,45 @@ TEST(PilClosedLoop, TracksLikeTheInProcessController) {
         differ += remote.log[k].tau[i] != local.log[k].tau[i] || remote.log[k].e[i] != local.log[k].e[i];
     EXPECT_EQ(differ, 0u) << "of " << local.log.size() << " logged samples";
     std::printf("bit for bit: %zu logged samples of torques and errors, %zu differ\n", local.log.size(), differ);
+  }
+}
+
+// The amplifiers over the link (the sensor frame's currents and drive byte, filled from the plant's
+// hal::CurrentHal): with the current monitors on, a monitor that reads zero and an amplifier that trips
+// are found by the firmware's drive check as by the in-process one: the same fault bits, in the same tick.
+// The host peer (float, the same code and compiler) and the M3 image (fixed point) are bit for bit; the
+// M4F image's float may move a threshold's crossing by a tick.
+TEST(PilClosedLoop, TheDriveCheckSeesTheAmplifiersAsInProcess) {
+  const PatientPeer patient;
+  const bool same_arithmetic = !std::getenv("PIL_FIRMWARE_ELF") || peer_is_fixed();
+  for (const char* inject : {"current-zero:2@1", "amp-fault:5@1"}) {
+    ExperimentConfig c;
+    c.duration = 1.5;
+    c.final_window = 0.5;
+    c.scalar = peer_scalar();
+    c.sensors.current_monitor = true;
+    std::string err;
+    ASSERT_TRUE(parse_injection(inject, c.injection, err)) << err;
+    ASSERT_TRUE(info(c.injection.kind).qemu) << inject << ": --qemu takes it";
+    const ExperimentResult local = run_experiment(c);
+    c.pil_command = peer_command();
+    const ExperimentResult remote = run_experiment(c);
+    ASSERT_TRUE(remote.error.empty()) << inject << ": " << remote.error;
+    EXPECT_TRUE(remote.link.clean()) << inject;
+    std::printf("%s: in process %s at %.3f s, over the link %s at %.3f s\n", inject, osc::fault_name(local.status),
+                local.fault_time, osc::fault_name(remote.status), remote.fault_time);
+    EXPECT_EQ(local.status, static_cast<std::uint32_t>(osc::kFaultDriveFault)) << inject;
+    EXPECT_GE(local.fault_time, 1.0) << inject;
+    EXPECT_LT(local.fault_time, 1.01) << inject;
+    EXPECT_EQ(remote.status, local.status) << inject;
+    EXPECT_EQ(remote.injection.faults, local.injection.faults) << inject;
+    if (same_arithmetic) {
+      EXPECT_EQ(remote.fault_time, local.fault_time) << inject;
+      EXPECT_EQ(remote.injection.detected, local.injection.detected) << inject;
+    } else {
+      EXPECT_NEAR(remote.fault_time, local.fault_time, 0.0015) << inject;
+      EXPECT_NEAR(remote.injection.detected, local.injection.detected, 0.0015) << inject;
+    }
   }
 }
 

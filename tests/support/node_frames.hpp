@@ -74,14 +74,17 @@ struct NodeFrames : ::testing::Test {
     for (std::uint8_t b : bytes_of(f)) node->on_byte(b, [&] { ++ticks, node->tick(); });
     return ticks;
   }
-  /// One tick: the next sensor frame (the arm at the start pose, its encoders dithering by a count).
-  void tick(std::uint8_t inject = 0) {
+  /// The next sensor frame (the arm at the start pose, its encoders dithering by a count; no current
+  /// readings, no fault line).
+  pil::SensorFrame sensor(std::uint8_t inject = 0) {
     pil::SensorFrame s;
     for (int i = 0; i < kDof; ++i) s.counts[i] = counts[i] + static_cast<std::int32_t>(seq & 1u);
     s.seq = seq++;
     s.inject = inject;
-    ASSERT_EQ(arrive(s), 1);
+    return s;
   }
+  /// One tick: the next sensor frame.
+  void tick(std::uint8_t inject = 0) { ASSERT_EQ(arrive(sensor(inject)), 1); }
   static pil::CommandFrame command(std::uint32_t id, MotionVerb v) {
     pil::CommandFrame f;
     f.id = id;

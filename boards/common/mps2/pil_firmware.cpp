@@ -69,6 +69,7 @@ struct Mps2Board {
 };
 static_assert(osc::PilBoard<Mps2Board>);
 static_assert(hal::ControlHal<osc::PilNode<board::Scalar, Mps2Board>>);
+static_assert(hal::CurrentHal<osc::PilNode<board::Scalar, Mps2Board>>, "the host's amplifiers over the link");
 
 osc::PilNode<board::Scalar, Mps2Board> g_node;  // a few kB: static, never on the stack
 

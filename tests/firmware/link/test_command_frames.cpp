@@ -18,8 +18,9 @@ namespace {
 
 TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   // The sensor and actuator frames (the QEMU PIL tests and the boards depend on them): the actuator
-  // frame grew by 12 bytes when the tick's stages went from 5 to 8 (issue 54: stage_cycles).
-  EXPECT_EQ(pil::kSensorPayload, 29);
+  // frame grew by 12 bytes when the tick's stages went from 5 to 8 (issue 54: stage_cycles), the sensor
+  // frame by 13 with the amplifiers' currents and fault lines (issue 56: currents, drive).
+  EXPECT_EQ(pil::kSensorPayload, 4 + 24 + 12 + 1 + 1);
   EXPECT_EQ(pil::kActuatorPayload, 217);
   EXPECT_EQ(pil::kMaxFrame, 223);
   EXPECT_EQ(pil::kSensorFrame, 1);

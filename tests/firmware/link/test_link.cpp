@@ -48,6 +48,7 @@ struct FakeBoard {
 };
 static_assert(PilBoard<FakeBoard>);
 static_assert(hal::ControlHal<PilNode<double, FakeBoard>>);
+static_assert(hal::CurrentHal<PilNode<double, FakeBoard>>);
 
 using Bytes = std::vector<std::uint8_t>;
 using Answers = std::vector<pil::ActuatorFrame>;

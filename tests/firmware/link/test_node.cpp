@@ -1,7 +1,8 @@
 // The PIL node's side of the command protocol (osc/link/node.hpp; NodeFrames, node_frames.hpp): a command
 // frame is neither a tick nor a link error and is answered after the tick's actuator frame; the first
 // sensor frame's configuration bits (start disabled, state frames, a trace frame ending every tick). The
-// node's link supervision: test_link.cpp.
+// node as the task's hal::CurrentHal: the sensor frame's currents when its drive byte says they are a
+// reading, its fault lines, each what the drive check sees. The node's link supervision: test_link.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -105,6 +106,68 @@ TEST_F(NodeFrames, ATraceFrameEndsEveryTickWhenTheFirstFrameAsks) {
   tick();
   EXPECT_EQ(RecordingBoard::traces.back().faults, 0u);
   EXPECT_EQ(RecordingBoard::actuators.back().faults, static_cast<std::uint32_t>(kFaultNonFinite));
+}
+
+// ---------------------------------------------------------------- the amplifiers (hal::CurrentHal)
+
+static_assert(pil::drive_byte(0x3F, true) == 0xBF && pil::drive_byte(1u << 6, false) == 0,
+              "six fault lines in bits 0-5, the valid bit 7");
+
+TEST_F(NodeFrames, TheSensorFramesCurrentsAreTheNodesReadingsWhenItsDriveByteSaysSo) {
+  std::int16_t got[kDof] = {1, 1, 1, 1, 1, 1};
+  EXPECT_FALSE(node->read_currents(got));  // no frame yet
+  EXPECT_EQ(node->amp_faults(), 0u);
+  tick(pil::kConfigStartDisabled | pil::kConfigTrace);
+  tick();
+  EXPECT_FALSE(node->read_currents(got));  // frames without readings (drive 0)
+  // Currents that are not a reading (the valid bit clear): none, whatever they hold; the drive check
+  // sees none (a reading at the end of the ADC's span would be current_sense).
+  const std::int16_t reading[kDof] = {3, -5, static_cast<std::int16_t>(kDriveCheck.adc_max), 0, 7, -1};
+  pil::SensorFrame s = sensor();
+  for (int i = 0; i < kDof; ++i) s.currents[i] = reading[i];
+  ASSERT_EQ(arrive(s), 1);
+  EXPECT_FALSE(node->read_currents(got));
+  EXPECT_EQ(RecordingBoard::traces.back().faults, 0u);
+  // The same currents with the valid bit: the node's reading, which the drive check takes.
+  s = sensor();
+  for (int i = 0; i < kDof; ++i) s.currents[i] = reading[i];
+  s.drive = pil::drive_byte(0, true);
+  ASSERT_EQ(arrive(s), 1);
+  ASSERT_TRUE(node->read_currents(got));
+  for (int i = 0; i < kDof; ++i) EXPECT_EQ(got[i], reading[i]) << i;
+  EXPECT_EQ(node->amp_faults(), 0u);
+  if (node->task.drive_check) {  // the arm states current monitors (robot::kDriveTrain.current)
+    EXPECT_EQ(RecordingBoard::traces.back().faults, static_cast<std::uint32_t>(kFaultCurrentSense));
+    EXPECT_EQ(node->task.drive.channel, 2);
+  }
+  // A tick without a sample (the next frame's CRC broken): no reading, though the last valid frame had one.
+  Bytes bad = bytes_of(sensor());
+  bad[10] ^= 0x40;
+  int ticks = 0;
+  for (std::uint8_t b : bad) node->on_byte(b, [&] { ++ticks, node->tick(); });
+  ASSERT_EQ(ticks, 1);
+  EXPECT_EQ(RecordingBoard::actuators.back().link[pil::kErrCrc], 1u);
+  EXPECT_FALSE(node->read_currents(got));
+}
+
+TEST_F(NodeFrames, TheDriveBytesFaultLinesAreTheAmplifiersFaults) {
+  tick(pil::kConfigStartDisabled | pil::kConfigTrace);
+  tick();
+  pil::SensorFrame s = sensor();
+  s.drive = pil::drive_byte((1u << 4) | (1u << 9), false);  // amplifier 5's line; bit 9 is no amplifier's
+  EXPECT_EQ(s.drive, 0x10);
+  ASSERT_EQ(arrive(s), 1);
+  EXPECT_EQ(node->amp_faults(), 0x10u);
+  std::int16_t got[kDof];
+  EXPECT_FALSE(node->read_currents(got));  // the fault lines without readings
+  if (node->task.drive_check) {
+    EXPECT_EQ(RecordingBoard::traces.back().faults, static_cast<std::uint32_t>(kFaultDriveFault));
+    EXPECT_EQ(node->task.drive.channel, 4);
+  }
+  // The lines are the latest valid frame's: the next frame's, none.
+  tick();
+  EXPECT_EQ(node->amp_faults(), 0u);
+  EXPECT_EQ(RecordingBoard::traces.back().faults, 0u);
 }
 
 }  // namespace

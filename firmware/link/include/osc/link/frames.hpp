@@ -47,6 +47,21 @@ enum Inject : std::uint8_t {
 };
 static_assert(osc::kAdaptationLawCount <= 3, "the adaptation law fits the configuration field");
 
+/// The drive byte of a sensor frame: the amplifiers' fault lines and whether its currents are a reading
+/// (hal::CurrentHal, read by the host from its amplifiers: the PIL node's read_currents and amp_faults).
+enum Drive : std::uint8_t {
+  kDriveFaultLines = (1u << kJoints) - 1u,  ///< bit c: amplifier c's fault line is active (amp_faults)
+  kDriveCurrentsValid = 1u << 7,            ///< currents holds a reading (read_currents gave one); 0: none
+};
+static_assert(kJoints <= 7, "a fault line per amplifier below the valid bit");
+
+/// The drive byte of a reading: the fault lines (bit c: amplifier c; those of other bits dropped) and
+/// whether the currents are one.
+constexpr std::uint8_t drive_byte(std::uint32_t fault_lines, bool currents_valid) {
+  const unsigned valid = currents_valid ? static_cast<unsigned>(kDriveCurrentsValid) : 0u;
+  return static_cast<std::uint8_t>((fault_lines & kDriveFaultLines) | valid);
+}
+
 /// The configuration bits that select an adaptation law.
 constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
   return static_cast<std::uint8_t>((static_cast<unsigned>(law) + 1u) << kConfigAdaptationShift);
@@ -54,11 +69,15 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
 
 // X(type, name, extent, unit, meaning): one payload field, in wire order. `extent` is empty for one
 // value or [N] for N of them; the wire type follows the C++ type (detail::Wire): std::uint8_t u8,
-// std::uint32_t u32, std::int32_t i32, float f32 (IEEE 754 binary32), all little-endian.
+// std::int16_t i16, std::uint32_t u32, std::int32_t i32, float f32 (IEEE 754 binary32), all little-endian.
 #define OSC_SENSOR_FIELDS(X)                                                                                        \
   X(std::uint32_t, seq, , "", "sequence number: 0 in the first frame, one more in each next frame (wraps at 2^32)") \
   X(std::int32_t, counts, [kJoints], "count",                                                                       \
     "encoder counts of joints 1 to 6, 0 at the start pose (Encoders, DACs, the plant)")                             \
+  X(std::int16_t, currents, [kJoints], "code",                                                                      \
+    "each amplifier's current-monitor reading, as hal::CurrentHal::read_currents gives it: +-(2^(bits-1) - 1) at "  \
+    "+-range times the DAC's full-scale current; 0 when drive says there is none (The drive byte)")                 \
+  X(std::uint8_t, drive, , "", "the amplifiers' fault lines and whether currents is a reading (The drive byte)")    \
   X(std::uint8_t, inject, , "", "fault-injection requests; configuration bits in the first frame (The inject byte)")
 
 #define OSC_ACTUATOR_FIELDS(X)                                                                                       \
@@ -88,7 +107,8 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
 // (its fields as the document lists them), kNamePayload (its payload length), encode(),
 // Parser::decode() and for_each_field().
 #define OSC_FRAME_LIST(X)                                                                                             \
-  X(Sensor, 1, "sensor", "host", "one per control tick: the tick's encoder counts", OSC_SENSOR_FIELDS)                \
+  X(Sensor, 1, "sensor", "host",                                                                                      \
+    "one per control tick: the tick's encoder counts, amplifier currents and fault lines", OSC_SENSOR_FIELDS)         \
   X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",              \
     OSC_ACTUATOR_FIELDS)                                                                                              \
   X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS)   \
@@ -123,7 +143,7 @@ OSC_FRAME_LIST(OSC_FRAME_STRUCT)
 /// One field of a payload as the protocol document lists it.
 struct FieldInfo {
   const char* name;
-  const char* type;  ///< u8, u32, i32, f32
+  const char* type;  ///< u8, i16, u32, i32, f32
   int count;         ///< values of that type
   int bytes;         ///< count x the type's size
   const char* unit;

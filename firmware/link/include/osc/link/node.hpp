@@ -1,7 +1,8 @@
-// The firmware side of the processor-in-the-loop link: a HAL binding (hal::ControlHal) of the
-// control task whose encoders and DACs are the frames of osc/link/frames.hpp. Board-independent; a
-// board supplies the static functions of the concept PilBoard below, calls on_byte() for every
-// received byte, and runs tick() from the control interrupt, paced in one of two ways:
+// The firmware side of the processor-in-the-loop link: a HAL binding (hal::ControlHal, hal::CurrentHal)
+// of the control task whose encoders, amplifier currents and fault lines, and DACs are the frames of
+// osc/link/frames.hpp. Board-independent; a board supplies the static functions of the concept PilBoard
+// below, calls on_byte() for every received byte, and runs tick() from the control interrupt, paced in
+// one of two ways:
 //
 //   lockstep (the host paces the ticks; pil_firmware under QEMU, pil_peer): a tick whenever
 //     on_byte() calls its `due` (a frame ended, valid or not: each sensor frame is answered by exactly
@@ -157,6 +158,14 @@ class PilNode {
     if (sample_ && (frame_.inject & pil::kInjectOverrun)) Board::burn(2 * task.period_cycles + 1);
     return sample_;
   }
+  /// hal::CurrentHal: the amplifiers' currents of this tick's sensor frame, when it carries a reading
+  /// (pil::kDriveCurrentsValid); false in a tick without a valid frame (a link error: no sample).
+  bool read_currents(std::int16_t currents[kDof]) {
+    for (int i = 0; i < kDof; ++i) currents[i] = frame_.currents[i];
+    return sample_ && (frame_.drive & pil::kDriveCurrentsValid) != 0;
+  }
+  /// The amplifiers' fault lines of the latest valid sensor frame (pil::kDriveFaultLines).
+  std::uint32_t amp_faults() const { return frame_.drive & pil::kDriveFaultLines; }
   void write_dacs(const std::int32_t codes[kDof]) {
     pil::ActuatorFrame a = telemetry_frame(task, codes, answer_seq_, Board::stack_used());
     a.link = counters_;

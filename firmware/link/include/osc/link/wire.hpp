@@ -56,6 +56,11 @@ struct Wire<std::uint32_t> {
   static constexpr int size = 4, count = 1;
 };
 template <>
+struct Wire<std::int16_t> {
+  static constexpr const char* type_name = "i16";
+  static constexpr int size = 2, count = 1;
+};
+template <>
 struct Wire<std::int32_t> {
   static constexpr const char* type_name = "i32";
   static constexpr int size = 4, count = 1;
@@ -119,6 +124,11 @@ struct Writer {
     for (int i = 0; i < 4; ++i) *p++ = static_cast<std::uint8_t>(v >> (8 * i));
   }
   void put(std::int32_t v) { put(static_cast<std::uint32_t>(v)); }
+  void put(std::int16_t v) {
+    const auto u = static_cast<std::uint16_t>(v);
+    *p++ = static_cast<std::uint8_t>(u & 0xFF);
+    *p++ = static_cast<std::uint8_t>(u >> 8);
+  }
   void put(float v) {
     std::uint32_t u;
     std::memcpy(&u, &v, 4);
@@ -142,6 +152,11 @@ struct Reader {
     std::uint32_t u;
     get(u);
     v = static_cast<std::int32_t>(u);
+  }
+  void get(std::int16_t& v) {
+    const auto u = static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+    p += 2;
+    v = static_cast<std::int16_t>(u);
   }
   void get(float& v) {
     std::uint32_t u;
