@@ -1,11 +1,12 @@
 #!/usr/bin/env python3
-"""Writes clients/python/osc_protocol.json from the firmware's declarations (osc_protocol --client).
+"""Writes the Python client's osc_protocol.json from the firmware's declarations (osc_protocol --client).
 
 usage: client_protocol.py [--check] [--host-build DIR]
 
-The Python client (clients/python/osc_client.py) builds its frame layouts and names from that file,
-so that nothing of the protocol is typed twice. --check compares instead of writing and exits 1 when
-the file differs from what the code declares (ctest client_protocol_json_current).
+The Python client (the package osc_client, clients/python/src/osc_client/) builds its frame layouts
+and names from that file, its package data, so that nothing of the protocol is typed twice. --check
+compares instead of writing and exits 1 when the file differs from what the code declares (ctest
+client_protocol_json_current).
 """
 import argparse
 import os
@@ -13,7 +14,7 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-OUT = os.path.join(ROOT, "clients", "python", "osc_protocol.json")
+OUT = os.path.join(ROOT, "clients", "python", "src", "osc_client", "osc_protocol.json")
 
 
 def main(argv):

@@ -1,0 +1,42 @@
+"""A client of the controller's command protocol (docs/protocol.md; docs/motion.md, "Clients").
+
+Pure Python 3 with pyserial (Debian's ``python3-serial``). The frame layouts and the names of every
+code are not typed here: they come from ``osc_protocol.json``, which the firmware's own declarations
+write (``osc_protocol --client``; ``scripts/client_protocol.py``). The package's copy is the default
+arm's (the PUMA 560); for a board built for another arm give its build's file
+(``BUILD/clients/osc_protocol.json``) as ``Protocol(path)``, ``--protocol FILE`` or ``$OSC_PROTOCOL``.
+
+As a module::
+
+    from osc_client import Client
+    c = Client("/dev/pts/7")
+    c.wait_answer(c.enable())
+    print(c.wait_done(c.move_to((0, 0.02, 0), relative=True)).text())   # done, aborted: stop_command, ...
+
+As a program (``osc-client``, or ``python3 -m osc_client``), oscctl's verbs: see ``osc_client.cli``.
+
+The parts, in the order a frame meets them:
+
+- ``protocol``: the declaration (``Protocol``): frame types, layouts, flags, names; encode, decode, CRC
+- ``frames``: each frame type as a dataclass (``Command``, ``Answer``, ``State`` ...)
+- ``parser``: frames out of a byte stream, resynchronising after a bad one (``Parser``)
+- ``transport``: the byte stream (``Transport``; ``SerialTransport``, a serial device or pseudo-terminal)
+- ``client``: commands and their outcomes (``Client``, ``Outcome``, ``Status``)
+- ``paths``: a stream's CSV path and its setpoints (``read_stream_csv``, ``resample_path``)
+- ``text``, ``cli``: oscctl's output and verbs
+"""
+from .client import Client, Outcome, Status
+from .errors import ClientError
+from .frames import (Actuator, Answer, Command, Frame, FrameType, Param, ParamAnswer, Sensor, Setpoint,
+                     SetpointVelocity, State, Trace)
+from .parser import Parser, RawFrame
+from .paths import PathPoint, angular_velocity, read_stream_csv, resample_path
+from .protocol import PROTOCOL_JSON, NameList, Parameter, Protocol, crc16, protocol_path
+from .transport import SerialTransport, Transport
+
+__all__ = [
+    "Actuator", "Answer", "Client", "ClientError", "Command", "Frame", "FrameType", "NameList", "Outcome",
+    "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser", "PathPoint", "Protocol", "RawFrame", "Sensor",
+    "SerialTransport", "Setpoint", "SetpointVelocity", "State", "Status", "Trace", "Transport", "angular_velocity",
+    "crc16", "protocol_path", "read_stream_csv", "resample_path",
+]

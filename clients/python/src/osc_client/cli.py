@@ -1,0 +1,281 @@
+"""osc-client: oscctl's verbs over the command protocol, the same lines printed, the same exit status.
+
+    osc-client --port /dev/pts/7 state | enable | disable | clear | paper | stop | home
+    osc-client --port /dev/pts/7 declare_pose start | zero | ready | stretch
+    osc-client --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
+    osc-client --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
+    osc-client --port /dev/pts/7 watch [--seconds S]
+    osc-client --port /dev/pts/7 param list | get NAME | set NAME VALUE... | save | load | reset | check
+
+Exit status 0: accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port or
+file (``osc_client: MESSAGE`` on standard error). Also ``python3 -m osc_client``.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from typing import Callable, Sequence
+
+from .client import Client, Outcome, Status
+from .errors import ClientError
+from .frames import ParamAnswer, State
+from .paths import read_stream_csv, resample_path
+from .protocol import NameList, Protocol
+from .text import answer_text, margins_text, param_line, state_change_text, state_text
+
+Connect = Callable[[str, int, Protocol, float], Client]
+"""Opens the client of a port: (port, baud, protocol, keepalive)."""
+
+SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
+PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
+
+
+def report(o: Outcome) -> int:
+    """Prints the outcome; its exit status."""
+    print(o.text(), flush=True)
+    return 0 if o.ok() else 1
+
+
+def cmd_simple(c: Client, a: argparse.Namespace) -> int:
+    """enable, disable, clear, paper, stop, home: the answer; for stop, disable and home the end too."""
+    cid = c.command(a.verb)
+    o = c.wait_answer(cid, a.timeout)
+    rc = report(o)
+    if o.status != Status.ACCEPTED or o.answer is None:
+        return rc
+    abort = c.protocol.name_of(NameList.REASONS, o.answer.abort)
+    if abort != "none":  # the motion this command ended (stop, disable)
+        print(f"aborted {o.answer.aborted_id}: {abort}", flush=True)
+    if a.verb not in ("stop", "disable", "home"):
+        return rc
+    return report(c.wait_done(cid, a.timeout))
+
+
+def cmd_declare_pose(c: Client, a: argparse.Namespace) -> int:
+    return report(c.wait_answer(c.declare_pose(a.pose), a.timeout))
+
+
+def cmd_move(c: Client, a: argparse.Namespace) -> int:
+    rpy = [math.radians(x) for x in a.rpy] if a.rpy else None
+    cid = c.move_to(a.xyz, rpy, a.relative, a.replace, c.limits(a.v, a.a, a.j))
+    o = c.wait_answer(cid, a.timeout)
+    print(f"{o.text()} (id {cid})", flush=True)
+    if o.status != Status.ACCEPTED or a.no_wait:
+        return 0 if o.ok() else 1
+    return report(c.wait_done(cid, a.timeout))
+
+
+def cmd_stream(c: Client, a: argparse.Namespace) -> int:
+    rows, has_rpy = read_stream_csv(a.file)
+    o = c.stream(resample_path(rows, a.rate), has_rpy, a.rate, a.relative, c.limits(a.v, a.a, a.j), a.timeout,
+                 a.velocity)
+    print(f"{o.text()} (id {o.id})", flush=True)
+    if o.skipped:
+        print(f"osc_client: warning: {o.skipped} setpoints skipped: this client fell behind the stream's schedule",
+              file=sys.stderr)
+    if o.status != Status.ACCEPTED:
+        return 0 if o.ok() else 1
+    return report(c.wait_done(o.id, a.timeout))
+
+
+def cmd_state(c: Client, a: argparse.Namespace) -> int:
+    s = c.state(min(a.timeout, 10.0))
+    if s is None:
+        print("osc_client: no state frame within the time (is a controller on the port?)", file=sys.stderr)
+        return 1
+    print(state_text(c.protocol, s), end="")
+    return 0
+
+
+def cmd_watch(c: Client, a: argparse.Namespace) -> int:
+    """Every answer, and each state frame that changes the state, stop, faults, queue or running id."""
+    last: list[tuple[int, ...]] = []
+
+    def on_state(s: State) -> None:
+        key = (s.state, s.stop, s.faults, s.queued, s.running_id)
+        if last and last[0] == key:
+            return
+        print(state_change_text(c.protocol, s), flush=True)
+        last[:] = [key]
+
+    c.on_answer = lambda f: print(answer_text(c.protocol, f), flush=True)
+    c.on_state = on_state
+    try:
+        c.pump(a.seconds if a.seconds else float("inf"))
+    except KeyboardInterrupt:
+        pass
+    return 0
+
+
+def param_refused(c: Client, r: ParamAnswer) -> int:
+    """0 when ok, else 1 with the reason printed."""
+    if r.status == 0:
+        return 0
+    print(f"refused: {c.protocol.name_of(NameList.PARAM_STATUSES, r.status)}")
+    return 1
+
+
+def check_param(ap: argparse.ArgumentParser, p: Protocol, a: argparse.Namespace) -> None:
+    """The param command line's own checks, as oscctl's: a known name, as many values as elements."""
+    if a.op not in ("get", "set"):
+        if a.name is not None or a.values:
+            ap.error(f"param {a.op} takes no name")
+        return
+    q = p.parameter(a.name)
+    if q is None:
+        ap.error(f"param {a.name}: no such parameter ({', '.join(x.name for x in p.parameters)})")
+    n = q.count
+    if a.element is not None and not 0 <= a.element < n:
+        ap.error(f"param {a.name} --element {a.element}: it has {n} element" + ("s" if n > 1 else ""))
+    if a.op == "get":
+        if a.values:
+            ap.error("param get takes no value")
+        return
+    want = 1 if a.element is not None else n
+    if len(a.values) != want:
+        ap.error(f"param set {a.name}: {want} value" + ("s" if want > 1 else "") + (
+            " (one element)" if a.element is not None else " (one per element; --element E sets one)") +
+            f", got {len(a.values)}")
+
+
+def cmd_param(c: Client, a: argparse.Namespace) -> int:
+    p = c.protocol
+    if a.op in ("list", "get"):
+        table = p.parameters if a.op == "list" else [q for q in p.parameters if q.name == a.name]
+        only = a.element if a.op == "get" else None  # get --element E: that element alone
+        for q in table:
+            for e in range(q.count):
+                if only is None or e == only:
+                    r = c.param("get", q.index, e, timeout=a.timeout)
+                    if param_refused(c, r):
+                        return 1
+                    print(param_line(p, q, r))
+        return 0
+    if a.op == "set":
+        q = next(q for q in p.parameters if q.name == a.name)
+        for k, v in enumerate(a.values):
+            e = a.element if a.element is not None else k
+            r = c.param("set", q.index, e, v, timeout=a.timeout)
+            if param_refused(c, r):
+                if r.margins[1] > 0:
+                    print(margins_text(p, r))
+                return 1
+            print(param_line(p, q, r))
+            if r.flags & p.param_flags["warn_37"]:
+                print(margins_text(p, r))
+        return 0
+    r = c.param(a.op, timeout=a.timeout)
+    if param_refused(c, r):
+        return 1
+    print(margins_text(p, r) if a.op == "check" else f"{a.op}: ok")
+    return 0
+
+
+VERBS: dict[str, Callable[[Client, argparse.Namespace], int]] = {
+    "state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param,
+    "declare_pose": cmd_declare_pose}
+
+
+def positive(text: str) -> float:
+    v = float(text)
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"{text}: must be above 0")
+    return v
+
+
+def keepalive_seconds(text: str) -> float:
+    v = float(text)
+    if not 0 <= v <= 0.4:
+        raise argparse.ArgumentTypeError(f"{text}: must be from 0 (none) to 0.4 (below the board's 0.5 s timeout)")
+    return v
+
+
+def parser() -> argparse.ArgumentParser:
+    """The command line."""
+    ap = argparse.ArgumentParser(
+        prog="osc-client", description="A client of the controller's command protocol (docs/protocol.md). Exit "
+        "status 0: accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port or file.")
+    ap.add_argument("--port", required=True, help="the serial device or pseudo-terminal (e.g. /dev/pts/7)")
+    ap.add_argument("--baud", type=int, default=115200, help="baud rate of a serial device (default 115200)")
+    ap.add_argument("--protocol", metavar="FILE", help="the board's osc_protocol.json (default: $OSC_PROTOCOL, else "
+                    "the default arm's, installed with the package); a build for another arm writes BUILD/clients/"
+                    "osc_protocol.json")
+    ap.add_argument("--timeout", type=positive, default=120.0, help="seconds to wait for an answer or an end")
+    ap.add_argument("--keepalive", type=keepalive_seconds, default=Client.KEEPALIVE,
+                    help="while waiting, a keep-alive frame after this many seconds without a frame sent (default "
+                         "0.1; 0: none): a board with local encoders stops a motion after 0.5 s of link silence")
+    sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
+    for v in SIMPLE_VERBS:
+        sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")
+    dp = sub.add_parser("declare_pose", help="the arm stands at a named pose (torque off; the pots must agree)")
+    dp.add_argument("pose", help="the pose's name (osc_protocol.json's poses: start, zero, ready, stretch)")
+
+    def limits(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--v", type=positive, help="linear speed limit [m/s]")
+        p.add_argument("--a", type=positive, help="linear acceleration limit [m/s^2]")
+        p.add_argument("--j", type=positive, help="linear jerk limit [m/s^3]")
+        p.add_argument("--relative", action="store_true", help="offsets from where the queue ends (or the stream "
+                       "starts)")
+    m = sub.add_parser("move", help="a jerk-limited move_to of the wrist centre; waits until done")
+    m.add_argument("xyz", type=float, nargs=3, metavar="X/Y/Z", help="X Y Z [m], base frame")
+    m.add_argument("--rpy", type=float, nargs=3, metavar=("R", "P", "Y"), help="roll pitch yaw [deg]")
+    m.add_argument("--replace", action="store_true", help="re-target the running motion instead of queueing")
+    m.add_argument("--no-wait", action="store_true", help="return once accepted")
+    limits(m)
+    s = sub.add_parser("stream", help="stream a CSV path (t, x, y, z[, roll, pitch, yaw] in s, m, deg)")
+    s.add_argument("file")
+    s.add_argument("--rate", type=positive, required=True, help="setpoints per second: 1000 / N, N from 1 to 100")
+    s.add_argument("--velocity", action="store_true",
+                   help="send each setpoint with the path's velocity (its slope between rows): no delay of one period")
+    limits(s)
+    w = sub.add_parser("watch", help="print state changes and every answer")
+    w.add_argument("--seconds", type=positive, help="for this long (default: until interrupted)")
+    pm = sub.add_parser("param", help="the controller's parameters: list, get, set, save, load, reset, check")
+    pm.add_argument("op", choices=PARAM_OPS)
+    pm.add_argument("name", nargs="?", help="the parameter (get, set)")
+    pm.add_argument("values", type=float, nargs="*", help="set: one value per element, or one with --element")
+    pm.add_argument("--element", type=int, help="get, set: only this element of a vector parameter")
+    return ap
+
+
+def open_client(port: str, baud: int, protocol: Protocol, keepalive: float) -> Client:
+    """The client of a serial device or pseudo-terminal."""
+    return Client(port, baud, protocol=protocol, keepalive=keepalive)
+
+
+def main(argv: Sequence[str] | None = None, connect: Connect = open_client) -> int:
+    """Runs one verb; its exit status. A bad command line exits (SystemExit 2) from argparse.
+
+    ``connect`` opens the client (the tests give one over a recorded byte stream).
+    """
+    ap = parser()
+    # param's values may follow its options (set k --element 0 2500): numbers left over after a param
+    # are its values.
+    a, extra = ap.parse_known_args(sys.argv[1:] if argv is None else list(argv))
+    if extra and a.verb == "param":
+        try:
+            a.values += [float(x) for x in extra]
+            extra = []
+        except ValueError:
+            pass
+    if extra:
+        ap.error("unrecognized arguments: " + " ".join(extra))
+    if a.verb == "move" and not all(math.isfinite(x) for x in a.xyz + (a.rpy or [])):
+        ap.error("move: X Y Z and --rpy must be finite numbers")
+    if not 50 <= a.baud <= 4000000:
+        ap.error(f"--baud {a.baud}: 50 to 4000000")
+    try:
+        if a.verb == "stream":
+            read_stream_csv(a.file)  # a bad file before the port is touched
+        protocol = Protocol(a.protocol)
+        if a.verb == "param":
+            check_param(ap, protocol, a)
+        c = connect(a.port, a.baud, protocol, a.keepalive)
+        try:
+            return VERBS.get(a.verb, cmd_simple)(c, a)
+        finally:
+            c.close()
+    except ClientError as e:
+        print(f"osc_client: {e}", file=sys.stderr)
+        return 2

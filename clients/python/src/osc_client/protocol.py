@@ -1,0 +1,252 @@
+"""The command protocol as the firmware declares it, read from ``osc_protocol.json``.
+
+Nothing of the wire format is typed here. ``osc_protocol --client`` writes the JSON from the
+firmware's own declarations (``scripts/client_protocol.py``; ctest ``client_protocol_json_current``
+fails when the copy in this package is stale): the sync pair, the CRC, each frame type's code,
+payload length and fields (name, wire type, count), the flags, the names of every code, the arm's
+limits and named poses, and the parameter table. The package's copy is the default arm's (the PUMA
+560); a board built for another arm takes its own build's file (``BUILD/clients/osc_protocol.json``),
+given as the path here or in the environment variable ``OSC_PROTOCOL``.
+
+A frame on the wire (docs/protocol.md, "Framing and resynchronisation")::
+
+    sync[0] sync[1] | type  length | payload (length bytes, little-endian) | CRC-16 (little-endian)
+                      \\___________ CRC over these ____________________/
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import struct
+from dataclasses import dataclass
+from enum import Enum
+from pathlib import Path
+from typing import Any, Union
+
+from .errors import ClientError
+from .frames import FRAME_CLASSES, Floats, Frame, FrameType
+
+PROTOCOL_JSON = str(Path(__file__).with_name("osc_protocol.json"))
+"""The default arm's protocol description, installed with the package."""
+
+WIRE_FORMAT = {"u8": "B", "i16": "h", "u32": "I", "i32": "i", "f32": "f"}
+"""The ``struct`` format character of each wire type of the declaration."""
+
+FieldValue = Union[int, float, tuple[int, ...], tuple[float, ...]]
+
+
+def protocol_path() -> str:
+    """The protocol description to read: ``$OSC_PROTOCOL`` when set, else the package's (the default arm's)."""
+    return os.environ.get("OSC_PROTOCOL") or PROTOCOL_JSON
+
+
+def crc16(data: bytes, poly: int, init: int) -> int:
+    """The frame's CRC-16 (MSB first, no final XOR: CCITT-FALSE with the declaration's poly and init)."""
+    crc = init
+    for byte in data:
+        crc ^= byte << 8
+        for _ in range(8):
+            crc = ((crc << 1) ^ poly) if crc & 0x8000 else (crc << 1)
+            crc &= 0xFFFF
+    return crc
+
+
+class NameList(str, Enum):
+    """The lists of names the declaration gives, a code being the index of its name."""
+
+    VERBS = "verbs"
+    MOTION_STATES = "motion_states"
+    REASONS = "reasons"
+    OUTCOMES = "outcomes"
+    STOP_CATEGORIES = "stop_categories"
+    COMPLETIONS = "completions"
+    POSES = "poses"
+    FAULTS = "faults"  # bit numbers, not codes: Protocol.fault_names
+    PARAM_OPS = "param_ops"
+    PARAM_STATUSES = "param_statuses"
+
+
+@dataclass(frozen=True)
+class Field:
+    """One field of a frame: its name, wire type (u8, i16, u32, i32, f32) and element count."""
+
+    name: str
+    type: str
+    count: int
+
+
+@dataclass(frozen=True)
+class FrameSpec:
+    """A frame type as declared: its code, payload length and fields, and their ``struct`` layout."""
+
+    type: FrameType
+    code: int
+    payload: int
+    fields: tuple[Field, ...]
+    layout: struct.Struct
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A runtime parameter of the firmware's table (docs/protocol.md, "Parameters")."""
+
+    name: str
+    index: int
+    count: int  # elements
+    unit: str
+    lo: Floats
+    hi: Floats
+    default: Floats
+    access: str  # always, or torque_off: written only with the torque off
+    persists: bool  # kept by save
+
+
+@dataclass(frozen=True)
+class MotionLimits:
+    """The arm's configured maxima of a move: speed, acceleration, jerk."""
+
+    linear: Floats  # m/s, m/s^2, m/s^3
+    angular: Floats  # rad/s, rad/s^2, rad/s^3
+
+
+class Protocol:
+    """The command protocol of one firmware build: frames, flags, names, limits, parameters.
+
+    ``Protocol()`` reads ``protocol_path()``; ``Protocol(path)`` a given description. A missing or
+    malformed file, or one declaring a frame this package's classes do not match, is a ClientError.
+    """
+
+    def __init__(self, path: str | None = None) -> None:
+        path = protocol_path() if path is None else path
+        if not path:
+            raise ClientError("the protocol's description: an empty path (--protocol FILE)")
+        try:
+            with open(path) as f:
+                declaration = json.load(f)
+        except (OSError, ValueError) as e:
+            raise ClientError(f"{path}: cannot read the protocol's description: {e}") from e
+        try:
+            self._load(declaration)
+        except (KeyError, TypeError, ValueError, struct.error) as e:
+            raise ClientError(f"{path}: not a protocol description this client reads: {e!r}") from e
+
+    def _load(self, p: dict[str, Any]) -> None:
+        self.sync = bytes(p["sync"])
+        self.crc_poly, self.crc_init = int(p["crc"]["poly"]), int(p["crc"]["init"])
+        self.control_hz = int(p["control_hz"])
+        self.frames: dict[FrameType, FrameSpec] = {}
+        for t in p["types"]:
+            kind = FrameType(t["name"])
+            fields = tuple(Field(str(f["name"]), str(f["type"]), int(f["count"])) for f in p["fields"][kind.value])
+            layout = struct.Struct("<" + "".join(f"{f.count}{WIRE_FORMAT[f.type]}" for f in fields))
+            if layout.size != t["payload"]:
+                raise ValueError(f"the {kind.value} frame's fields do not add up to its payload")
+            _check_class(kind, fields)
+            self.frames[kind] = FrameSpec(kind, int(t["code"]), int(t["payload"]), fields, layout)
+        self.by_code = {spec.code: spec for spec in self.frames.values()}
+        self.command_flags = _flags(p["command_flags"])
+        self.setpoint_flags = _flags(p["setpoint_flags"])
+        self.stream_max_period = int(p["stream_max_period"])
+        self.limits = MotionLimits(tuple(map(float, p["limits"]["linear"])), tuple(map(float, p["limits"]["angular"])))
+        params = p["parameters"]
+        self.param_layout = int(params["layout"])
+        self.param_flags = _flags(params["flags"])
+        self.parameters = tuple(
+            Parameter(str(q["name"]), int(q["index"]), int(q["count"]), str(q["unit"]), tuple(map(float, q["lo"])),
+                      tuple(map(float, q["hi"])), tuple(map(float, q["default"])), str(q["access"]),
+                      bool(q["persists"]))
+            for q in params["table"])
+        lists = {kind: p[kind.value] for kind in NameList if not kind.value.startswith("param_")}
+        lists[NameList.PARAM_OPS], lists[NameList.PARAM_STATUSES] = params["ops"], params["statuses"]
+        self._names = {kind: [str(n) for n in names] for kind, names in lists.items()}
+
+    # ------------------------------------------------------------------ names and flags
+    def names(self, kind: NameList) -> list[str]:
+        """The names of a list, in code order."""
+        return list(self._names[kind])
+
+    def name_of(self, kind: NameList, code: int) -> str:
+        """A code's name; ``?`` for a code outside the list."""
+        names = self._names[kind]
+        return names[code] if 0 <= code < len(names) else "?"
+
+    def code_of(self, kind: NameList, name: str) -> int:
+        """A name's code (ValueError for a name not in the list)."""
+        return self._names[kind].index(name)
+
+    @property
+    def poses(self) -> list[str]:
+        """The arm's named poses (declare_pose)."""
+        return self.names(NameList.POSES)
+
+    def fault_names(self, bits: int) -> str:
+        """Fault bits as oscctl prints them: ``none``, or the names joined by commas."""
+        if bits == 0:
+            return "none"
+        faults = self._names[NameList.FAULTS]
+        return ",".join(faults[i] if i < len(faults) else f"bit{i}" for i in range(32) if bits >> i & 1)
+
+    def parameter(self, name: str) -> Parameter | None:
+        """The parameter of that name, or None."""
+        return next((q for q in self.parameters if q.name == name), None)
+
+    # ------------------------------------------------------------------ frames
+    def crc16(self, data: bytes) -> int:
+        """The CRC of a frame's type, length and payload."""
+        return crc16(data, self.crc_poly, self.crc_init)
+
+    def payload_length(self, code: int) -> int | None:
+        """The payload length of a type code, None for a code the protocol does not declare."""
+        spec = self.by_code.get(code)
+        return spec.payload if spec else None
+
+    def encode(self, frame: Frame) -> bytes:
+        """A frame's bytes on the wire: sync pair, type, length, payload, CRC."""
+        spec = self.frames[frame.TYPE]
+        flat: list[int | float] = []
+        for f in spec.fields:
+            value = getattr(frame, f.name)
+            if isinstance(value, tuple):
+                if not value:
+                    value = (0,) * f.count
+                if len(value) != f.count:
+                    raise ClientError(f"{spec.type.value}.{f.name}: {f.count} values, not {len(value)}")
+                flat += value
+            else:
+                flat.append(value)
+        try:
+            payload = spec.layout.pack(*flat)
+        except struct.error as e:
+            raise ClientError(f"{spec.type.value}: {e}") from e
+        body = bytes([spec.code, len(payload)]) + payload
+        return self.sync + body + struct.pack("<H", self.crc16(body))
+
+    def decode(self, kind: FrameType, payload: bytes) -> Frame:
+        """A frame of the given type from its payload (the parser's frames have a valid length)."""
+        spec = self.frames[kind]
+        values = spec.layout.unpack(payload)
+        fields: dict[str, FieldValue] = {}
+        for f in spec.fields:
+            fields[f.name] = values[0] if f.count == 1 else tuple(values[:f.count])
+            values = values[f.count:]
+        return FRAME_CLASSES[kind](**fields)
+
+
+def _flags(names: list[str]) -> dict[str, int]:
+    """Each flag's bit: the declaration lists them from bit 0."""
+    return {str(n): 1 << i for i, n in enumerate(names)}
+
+
+def _check_class(kind: FrameType, fields: tuple[Field, ...]) -> None:
+    """The frame's class names exactly the declared fields, a tuple for several elements, a float for f32."""
+    members = {f.name: f for f in dataclasses.fields(FRAME_CLASSES[kind])}
+    if set(members) != {f.name for f in fields}:
+        raise ValueError(f"the {kind.value} frame declares fields {[f.name for f in fields]}, this client's "
+                         f"{kind.value} class has {list(members)}: update osc_client/frames.py")
+    for f in fields:
+        default = members[f.name].default
+        several, real = isinstance(default, tuple), isinstance(default, float)
+        if several != (f.count > 1) or (not several and real != (f.type == "f32")):
+            raise ValueError(f"{kind.value}.{f.name}: declared {f.count} x {f.type}, this client's class "
+                             f"holds {default!r}")

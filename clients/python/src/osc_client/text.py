@@ -1,0 +1,72 @@
+"""Frames as oscctl prints them (the command line's output, which scripts and tests read)."""
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+from .frames import Answer, ParamAnswer, State
+from .protocol import NameList, Parameter, Protocol
+
+
+def pose_text(x: Sequence[float]) -> str:
+    """``0.4318 0.1500 0.4000 m, rpy 0.00 90.00 0.00 deg``: a pose of x, y, z [m], roll, pitch, yaw [rad]."""
+    d = [math.degrees(v) for v in x[3:]]
+    return f"{x[0]:.4f} {x[1]:.4f} {x[2]:.4f} m, rpy {d[0]:.2f} {d[1]:.2f} {d[2]:.2f} deg"
+
+
+def state_text(p: Protocol, s: State) -> str:
+    """The state frame, a line a field (the verb state)."""
+    return (f"state: {p.name_of(NameList.MOTION_STATES, s.state)}\n"
+            f"stop: {p.name_of(NameList.STOP_CATEGORIES, s.stop)}\n"
+            f"faults: {p.fault_names(s.faults)}\n"
+            f"queued: {s.queued}\n"
+            f"running_id: {s.running_id}\n"
+            f"reference: {pose_text(s.x_d)}\n"
+            f"measured: {pose_text(s.x)}\n"
+            f"dropped: {s.dropped}\n"
+            f"tick: {s.tick}\n")
+
+
+def state_change_text(p: Protocol, s: State) -> str:
+    """A state frame in one line (the verb watch)."""
+    return (f"tick {s.tick}: state {p.name_of(NameList.MOTION_STATES, s.state)}, "
+            f"stop {p.name_of(NameList.STOP_CATEGORIES, s.stop)}, faults {p.fault_names(s.faults)}, "
+            f"queued {s.queued}, running_id {s.running_id}")
+
+
+def answer_text(p: Protocol, a: Answer) -> str:
+    """An answer frame in one line (the verb watch): ``tick 812: move_to 17 accepted; state moving, queued 0``."""
+    n = p.name_of
+    text = f"tick {a.tick}:"
+    if n(NameList.OUTCOMES, a.outcome) != "none":
+        text += f" {n(NameList.VERBS, a.verb)} {a.id} {n(NameList.OUTCOMES, a.outcome)}"
+        if n(NameList.OUTCOMES, a.outcome) == "refused":
+            text += f": {n(NameList.REASONS, a.refusal)}"
+        if a.cause:
+            text += f" ({p.fault_names(a.cause)})"
+        text += ";"
+    if a.done_id:
+        text += f" done {a.done_id};"
+    if n(NameList.REASONS, a.abort) != "none":
+        text += f" aborted {a.aborted_id}: {n(NameList.REASONS, a.abort)};"
+    if n(NameList.COMPLETIONS, a.completion) != "none":
+        text += f" completion {n(NameList.COMPLETIONS, a.completion)};"
+    return text + f" state {n(NameList.MOTION_STATES, a.state)}, queued {a.queued}"
+
+
+def param_line(p: Protocol, q: Parameter, a: ParamAnswer) -> str:
+    """One element's line: ``ks[2] = 97 (0.001 to 1000; torque_off)``."""
+    index = f"[{a.element}]" if q.count > 1 else ""
+    unit = f" {q.unit}" if q.unit else ""
+    off = "; torque_off" if a.flags & p.param_flags["torque_off"] else ""
+    return f"{q.name}{index} = {a.value:.7g}{unit} ({a.lo:.7g} to {a.hi:.7g}{off})"
+
+
+def margins_text(p: Protocol, a: ParamAnswer) -> str:
+    """The gains' margins of a check (or of a gain refused as unstable), three lines."""
+    warn = ": warning, the paper's sufficient condition cannot hold" if a.flags & p.param_flags["warn_37"] else ""
+    m = a.margins
+    return (f"observer margin {m[0]:.3g} (stable above 1: (4 - 2 k dt) / (b dt^2), b <= "
+            f"{m[1]:.4g} 1/s^2 at the last pose)\n"
+            f"loop margin {m[3]:.3g} (stable at 1 or above: the factor the gains may grow by at the last pose)\n"
+            f"condition (37) {m[2]:.3g} (k_s k_nd / 2: above 1 it can hold){warn}")

@@ -1,0 +1,52 @@
+"""A scripted board: a transport whose controller answers each command as a test says."""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+from osc_client import Answer, Command, Frame, NameList, Parser, Protocol
+
+Reply = Callable[[Command], list[Frame]]
+
+
+@dataclass
+class FakeBoard:
+    """Answers each command frame the client writes through ``reply`` (the client reads the frames
+    it returns next) and keeps every frame the client sent."""
+
+    protocol: Protocol
+    reply: Reply
+    sent: list[Frame] = field(default_factory=list)
+    pending: bytes = b""
+
+    def __post_init__(self) -> None:
+        self.parser = Parser(self.protocol)
+
+    def read(self, timeout: float) -> bytes:
+        data, self.pending = self.pending, b""
+        if not data:
+            time.sleep(min(timeout, 0.002))
+        return data
+
+    def write(self, data: bytes) -> None:
+        for raw in self.parser.feed(data):
+            frame = self.protocol.decode(raw.type, raw.payload)
+            self.sent.append(frame)
+            if isinstance(frame, Command):
+                self.pending += b"".join(self.protocol.encode(f) for f in self.reply(frame))
+
+    def close(self) -> None:
+        pass
+
+    def commands(self) -> list[Command]:
+        """The command frames the client sent, resends included."""
+        return [f for f in self.sent if isinstance(f, Command)]
+
+
+def answer(p: Protocol, command: Command, outcome: str = "accepted", refusal: str = "none",
+           state: str = "holding", **fields: int) -> Answer:
+    """The answer to a command (its id and verb) with the named outcome, refusal and motion state."""
+    return Answer(id=command.id, verb=command.verb, outcome=p.code_of(NameList.OUTCOMES, outcome),
+                  refusal=p.code_of(NameList.REASONS, refusal), state=p.code_of(NameList.MOTION_STATES, state),
+                  **fields)
