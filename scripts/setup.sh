@@ -4,7 +4,9 @@ set -euo pipefail
 pkgs=(cmake ninja-build g++ libeigen3-dev libgtest-dev libbenchmark-dev liborocos-kdl-dev
       gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib binutils-arm-none-eabi
       qemu-system-arm python3 python3-matplotlib
-      python3-serial                        # the Python client of the command protocol (clients/python/)
+      python3-serial                        # the Python client of the command protocol (clients/python/),
+      python3-venv python3-pip python3-setuptools python3-wheel   # its offline install (README.md),
+      python3-pytest mypy                   # its unit tests and types (ctest python_client_*)
       gdb-multiarch openocd                 # debugging the images (debug_<image>, the QEMU debug test),
                                             # flashing the STM32F4 board (the flash target)
       clang libclang-rt-14-dev llvm-14      # the fuzz preset: clang 14 (Debian 12), its sanitizer and

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """The command link's recovery on the virtual board (osc_sim --pty), issue 53's defects 3, 5 and 6.
 
-usage: link_recovery.py OSC_SIM CLIENT_PY [--qemu IMAGE]
+usage: link_recovery.py OSC_SIM CLIENT_SRC [--qemu IMAGE]
 
-Raw bytes on the terminal (the frames encoded by the Python client's Protocol, from the firmware's
-declarations), one check per line, exit 0 when all pass:
+CLIENT_SRC: the Python client's package source (clients/python/src). Raw bytes on the terminal (the
+frames encoded by the package's Protocol, from the firmware's declarations), one check per line, exit
+0 when all pass:
   cut_frame_GAP   half a command frame, then GAP s of silence (10 ms, 80 ms, 0.5 s, 2 s), then a
                   clear: the clear is answered (a frame cut short never swallows the next); the cut
                   command is never answered; the state frames count the cut frame (link field)
@@ -27,14 +28,14 @@ import termios
 import time
 import tty
 
-sim, client_py = sys.argv[1], sys.argv[2]
+sim, client_src = sys.argv[1], sys.argv[2]
 qemu = sys.argv[3:5] == ["--qemu", sys.argv[4]] if len(sys.argv) >= 5 else False
 image = sys.argv[4] if qemu else None
-sys.path.insert(0, os.path.dirname(os.path.abspath(client_py)))
-import osc_client  # noqa: E402 (the client's module, beside its protocol data)
+sys.path.insert(0, os.path.abspath(client_src))
+from osc_client import Answer, Command, NameList, Parser, Protocol, State  # noqa: E402 (the package's source)
 
-P = osc_client.Protocol()
-KEEPALIVE = P.encode("state", {f["name"]: [0] * f["count"] if f["count"] > 1 else 0 for f in P.fields["state"]})
+P = Protocol()
+KEEPALIVE = P.encode(State())
 failures, passes = [], []
 
 
@@ -55,7 +56,7 @@ class Board:
         self.fd = os.open(line[5:].strip(), os.O_RDWR | os.O_NOCTTY)
         tty.setraw(self.fd)
         termios.tcflush(self.fd, termios.TCIOFLUSH)
-        self.parser = osc_client.Parser(P)
+        self.parser = Parser(P)
         self.answers, self.states, self.last_write = [], [], 0.0
         self.next_id = 1000
 
@@ -74,10 +75,9 @@ class Board:
         if cid is None:
             self.next_id += 1
             cid = self.next_id
-        flags = (P.command_flag["relative"] if relative else 0) | (P.command_flag["has_limits"] if limits else 0)
-        return cid, P.encode("command", {"id": cid, "verb": P.code_of("verbs", verb), "flags": flags,
-                                         "position": list(position), "rpy": [0.0] * 3,
-                                         "limits": list(limits or [0.0] * 6), "period": 0})
+        flags = (P.command_flags["relative"] if relative else 0) | (P.command_flags["has_limits"] if limits else 0)
+        return cid, P.encode(Command(id=cid, verb=P.code_of(NameList.VERBS, verb), flags=flags,
+                                     position=tuple(position), limits=tuple(limits or ())))
 
     def pump(self, seconds, keepalive=True, until=None):
         """Reads frames for `seconds` (or until until() holds), a keep-alive every 0.1 s if asked."""
@@ -86,15 +86,16 @@ class Board:
             if keepalive and time.monotonic() - self.last_write >= 0.1:
                 self.write(KEEPALIVE)
             if select.select([self.fd], [], [], 0.02)[0]:
-                for name, payload in self.parser.feed(os.read(self.fd, 4096)):
-                    if name == "answer":
-                        self.answers.append(P.decode("answer", payload))
-                    elif name == "state":
-                        self.states.append(P.decode("state", payload))
+                for raw in self.parser.feed(os.read(self.fd, 4096)):
+                    frame = P.decode(raw.type, raw.payload)
+                    if isinstance(frame, Answer):
+                        self.answers.append(frame)
+                    elif isinstance(frame, State):
+                        self.states.append(frame)
         return until() if until else True
 
     def answered(self, cid):
-        return [a for a in self.answers if a["id"] == cid and a["outcome"] != 0]
+        return [a for a in self.answers if a.id == cid and a.outcome != 0]
 
     def state_after(self, seconds=0.2):
         n = len(self.states)
@@ -103,7 +104,7 @@ class Board:
 
     def link(self, kind):
         """A link error counter of the latest state frame."""
-        return self.state_after()["link"][LINK_KINDS[kind]]
+        return self.state_after().link[LINK_KINDS[kind]]
 
 
 # The link error kinds in their counter order (OSC_LINK_ERROR_LIST).
@@ -134,15 +135,15 @@ def resend(b):
     eid, enable = b.command("enable")
     b.write(enable)
     b.pump(3, until=lambda: b.answered(eid))
-    z0 = b.state_after()["x_d"][2]
+    z0 = b.state_after().x_d[2]
     mid, move = b.command("move_to", (0.0, 0.0, 0.01), relative=True)
     b.write(move + move)
-    b.pump(20, until=lambda: any(a["done_id"] == mid for a in b.answers))
+    b.pump(20, until=lambda: any(a.done_id == mid for a in b.answers))
     b.write(move)
     b.pump(1.0)
-    z1 = b.state_after()["x_d"][2]
+    z1 = b.state_after().x_d[2]
     accepted = b.answered(mid)
-    done = [a for a in b.answers if a["done_id"] == mid]
+    done = [a for a in b.answers if a.done_id == mid]
     same = all(a == accepted[0] for a in accepted)
     check("resend", len(done) == 1 and len(accepted) >= 2 and same and abs((z1 - z0) - 0.01) < 5e-4,
           f"moved {1000 * (z1 - z0):.2f} mm, {len(done)} done, {len(accepted)} identical answers: {same}")
@@ -166,18 +167,18 @@ def link_silent(watch):
     mid, move = b.command("move_to", (0.0, 0.0, 0.05), relative=True, limits=[0.025, 0.25, 2.5, 0.5, 1, 10])
     b.write(move)
     b.pump(3, until=lambda: b.answered(mid))
-    t0 = b.answers[-1]["tick"]
-    b.pump(6, keepalive=False, until=lambda: any(a["aborted_id"] == mid or a["done_id"] == mid for a in b.answers))
-    end = [a for a in b.answers if a["aborted_id"] == mid or a["done_id"] == mid]
+    t0 = b.answers[-1].tick
+    b.pump(6, keepalive=False, until=lambda: any(a.aborted_id == mid or a.done_id == mid for a in b.answers))
+    end = [a for a in b.answers if a.aborted_id == mid or a.done_id == mid]
     b.close()
     if not end:
         return check(f"link_silent{'' if watch else '_off'}", False, "the move neither aborted nor done")
     a = end[0]
-    why = P.name_of("reasons", a["abort"]) if a["aborted_id"] == mid else "done"
+    why = P.name_of(NameList.REASONS, a.abort) if a.aborted_id == mid else "done"
     if watch:
         # 0.5 s of the client's (wall) time: 1000 ticks at --speed 2, and not before 500.
-        check("link_silent", why == "link_silent" and 1000 <= a["tick"] - t0 <= 1020,
-              f"{why} {a['tick'] - t0} ticks after the move's answer")
+        check("link_silent", why == "link_silent" and 1000 <= a.tick - t0 <= 1020,
+              f"{why} {a.tick - t0} ticks after the move's answer")
     else:
         check("link_silent_off", why == "done", f"{why} with --no-link-watch")
 
@@ -187,12 +188,12 @@ def inject():
     eid, enable = b.command("enable")
     b.write(enable)
     b.pump(3, until=lambda: b.answered(eid))
-    b.pump(3, until=lambda: b.states and P.name_of("motion_states", b.states[-1]["state"]) == "fault")
+    b.pump(3, until=lambda: b.states and P.name_of(NameList.MOTION_STATES, b.states[-1].state) == "fault")
     s = b.states[-1]
     b.close()
-    faults = P.fault_names(s["faults"])
-    check("inject", P.name_of("motion_states", s["state"]) == "fault" and "encoder" in faults,
-          f"state {P.name_of('motion_states', s['state'])}, faults {faults}, tick {s['tick']}")
+    faults = P.fault_names(s.faults)
+    state = P.name_of(NameList.MOTION_STATES, s.state)
+    check("inject", state == "fault" and "encoder" in faults, f"state {state}, faults {faults}, tick {s.tick}")
 
 
 board = Board()

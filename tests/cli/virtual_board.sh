@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The simulator as a virtual board (osc_sim --pty) and the command protocol's clients: oscctl and the
-# Python client (clients/python/osc_client.py). One check per CASE (tests/cli/CMakeLists.txt):
+# Python client (the package osc_client, clients/python/src: PYTHON -m osc_client). One check per CASE
+# (tests/cli/CMakeLists.txt):
 #
 #   oscctl_sequence, python_sequence   state (disabled); a move refused not_enabled (exit 1); enable
 #                                      (holding); a relative move of 20 mm done (the reference moved by
@@ -22,7 +23,7 @@
 #                                      refused torque_on while enabled
 #   oscctl_homing, python_homing       declare_pose (refused pots_disagree, accepted, refused torque_on;
 #                                      an unknown pose exit 2), home done
-#   python_queue                       the Python module: a slow move and two queued behind it, a stop:
+#   python_queue                       the Python package: a slow move and two queued behind it, a stop:
 #                                      the running move aborted stop_command, each queued one aborted
 #                                      dropped (its own answer frame), the state frame's queue empty;
 #                                      two setpoints in one write both taken (none dropped), a client
@@ -33,10 +34,13 @@
 #   bad_port_and_file                  a bad port or CSV file: a named error and exit 2, in both clients;
 #                                      the Python client's protocol file (--protocol, OSC_PROTOCOL) missing or bad
 #
-# usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_PY CASE [IMAGE [SCALAR]]
+# usage: virtual_board.sh OSC_SIM OSCCTL PYTHON CLIENT_SRC CASE [IMAGE [SCALAR]]
+# (CLIENT_SRC: the Python package's source folder, clients/python/src, put on PYTHONPATH.)
 # Nothing waits a fixed time for the simulator: each step waits for its answer (generous timeouts).
 set -uo pipefail
-sim=$1 ctl=$2 py=$3 client=$4 case_=$5 image=${6:-} image_scalar=${7:-float}
+sim=$1 ctl=$2 py=$3 client_src=$4 case_=$5 image=${6:-} image_scalar=${7:-float}
+export PYTHONPATH="$client_src${PYTHONPATH:+:$PYTHONPATH}"
+pyc=("$py" -m osc_client)  # the Python client's command line
 tmp=$(mktemp -d)
 sim_pid=
 port=
@@ -213,7 +217,7 @@ case "$case_" in
     ;;
   python_sequence)
     start_sim --speed 4 --scalar float --no-link-watch
-    sequence "$py" "$client" --port "$port" --timeout 60
+    sequence "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
     ;;
   oscctl_stream)
@@ -223,7 +227,7 @@ case "$case_" in
     ;;
   python_stream)
     start_sim
-    stream "$py" "$client" --port "$port" --timeout 60
+    stream "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
     ;;
   qemu_sequence)
@@ -235,7 +239,7 @@ case "$case_" in
     start_sim --qemu --elf "$image" --scalar "$image_scalar"
     watch_s=10  # the watched move takes 3.3 s simulated; QEMU keeps real time within 0.11 s (docs/motion.md)
     sequence "$ctl" --port "$port" --timeout 120
-    sequence "$py" "$client" --port "$port" --timeout 120
+    sequence "${pyc[@]}" --port "$port" --timeout 120
     param_sequence "$ctl" --port "$port" --timeout 120  # the image's parameters, its RAM store
     stop_sim
     # The clients' keep-alives (state frames) reached osc_sim and stayed off the PIL link: it is clean.
@@ -249,7 +253,7 @@ case "$case_" in
     ;;
   python_param)
     start_sim --speed 4 --scalar float
-    param_sequence "$py" "$client" --port "$port" --timeout 60
+    param_sequence "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
     ;;
   oscctl_homing)
@@ -259,43 +263,42 @@ case "$case_" in
     ;;
   python_homing)
     start_sim --speed 4 --scalar float
-    homing_sequence "$py" "$client" --port "$port" --timeout 60
+    homing_sequence "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
     ;;
   python_queue)
     start_sim --speed 4 --scalar float
-    "$py" - "$client" "$port" >"$tmp/queue.out" 2>&1 <<'PY' || fail "$(cat "$tmp/queue.out")"
-import os, sys
-sys.path.insert(0, os.path.dirname(os.path.abspath(sys.argv[1])))
-import osc_client
-c = osc_client.Client(sys.argv[2])
-assert c.wait_answer(c.enable(), 60).status == "accepted"
+    "$py" - "$port" >"$tmp/queue.out" 2>&1 <<'PY' || fail "$(cat "$tmp/queue.out")"
+import sys
+import time
+from osc_client import Client, PathPoint, Setpoint, Status
+c = Client(sys.argv[1])
+assert c.wait_answer(c.enable(), 60).status == Status.ACCEPTED
 ids = [c.move_to((0, 0.02, 0), relative=True, limits=c.limits(v=0.01))]
 for dy in (-0.02, 0.02):
     ids.append(c.move_to((0, dy, 0), relative=True))
 for i in ids:
-    assert c.wait_answer(i, 60).status == "accepted", i
+    assert c.wait_answer(i, 60).status == Status.ACCEPTED, i
 stop = c.stop()
-assert c.wait_answer(stop, 60).status == "accepted"
+assert c.wait_answer(stop, 60).status == Status.ACCEPTED
 got = [c.wait_done(i, 60).text() for i in ids]
 assert got == ["aborted: stop_command", "aborted: dropped", "aborted: dropped"], got
-assert c.wait_done(stop, 60).status == "done"
+assert c.wait_done(stop, 60).status == Status.DONE
 s = c.state(10)
-assert (s["queued"], s["running_id"]) == (0, 0), s
+assert s is not None and (s.queued, s.running_id) == (0, 0), s
 print("ok:", got)
 # Two setpoints in one write (a client that sent late): the board takes one a tick, none dropped.
-dropped = s["dropped"]
+dropped = s.dropped
 sid = c.command("stream", relative=True, limits=None, period=100)
-assert c.wait_answer(sid, 60).status == "accepted"
-f = c.p.setpoint_flag
-c._write(c.p.encode("setpoint", {"id": sid, "flags": 0, "position": [0, 0.002, 0], "rpy": [0.0] * 3})
-         + c.p.encode("setpoint", {"id": sid, "flags": f["end"], "position": [0, 0.004, 0], "rpy": [0.0] * 3}))
-assert c.wait_done(sid, 60).status == "done"
+assert c.wait_answer(sid, 60).status == Status.ACCEPTED
+end = c.protocol.setpoint_flags["end"]
+c.send(Setpoint(sid, 0, (0, 0.002, 0), (0.0,) * 3), Setpoint(sid, end, (0, 0.004, 0), (0.0,) * 3))
+assert c.wait_done(sid, 60).status == Status.DONE
 s = c.state(10)
-assert s["dropped"] == dropped, (s["dropped"], dropped)
+assert s is not None and s.dropped == dropped, (s, dropped)
 # A client behind its schedule (once the stream is accepted, a clock 0.3 s further on at each
 # reading: every setpoint's successor due already) skips all but the last, which ends the stream.
-real, answer = osc_client.time.monotonic, c.wait_answer
+real, answer = time.monotonic, c.wait_answer
 late = [0.0, False]
 
 
@@ -310,13 +313,13 @@ def answered(*args, **kwargs):
     return r
 
 
-osc_client.time.monotonic, c.wait_answer = clock, answered
-o = c.stream([((0, 0.001 * k, 0), (0, 0, 0)) for k in range(6)], False, 10, relative=True)
-osc_client.time.monotonic, c.wait_answer = real, answer
-assert (o.status, o.skipped) == ("accepted", 5), (o.text(), o.skipped)
-assert c.wait_done(o.id, 60).status == "done"
+time.monotonic, c.wait_answer = clock, answered
+o = c.stream([PathPoint((0, 0.001 * k, 0), (0, 0, 0)) for k in range(6)], False, 10, relative=True)
+time.monotonic, c.wait_answer = real, answer
+assert (o.status, o.skipped) == (Status.ACCEPTED, 5), (o.text(), o.skipped)
+assert c.wait_done(o.id, 60).status == Status.DONE
 s = c.state(10)
-assert s["dropped"] == dropped, (s["dropped"], dropped)
+assert s is not None and s.dropped == dropped, (s.dropped, dropped)
 print("ok: a burst of two setpoints, none dropped; a late client skipped", o.skipped)
 PY
     cat "$tmp/queue.out"
@@ -354,8 +357,8 @@ PY
     ;;
   bad_port_and_file)
     printf 't,x,y,z\n0,0,0,0\n1,0,x,0\n' >"$tmp/bad.csv"
-    for c in "$ctl" "$py $client"; do
-      # shellcheck disable=SC2086  # the Python client is two words
+    for c in "$ctl" "${pyc[*]}"; do
+      # shellcheck disable=SC2086  # the Python client is three words
       expect 2 "--port $tmp/none: No such file or directory|$tmp/none: No such file or directory" -- \
         $c --port "$tmp/none" state
       expect 2 "$tmp/bad.csv: not a serial device or terminal" -- $c --port "$tmp/bad.csv" state
@@ -366,12 +369,12 @@ PY
     # The Python client's protocol description (--protocol, else OSC_PROTOCOL): missing or not JSON,
     # a named error before the port is opened.
     expect 2 "$tmp/none.json: cannot read the protocol's description" -- \
-      "$py" "$client" --protocol "$tmp/none.json" --port /dev/null state
+      "${pyc[@]}" --protocol "$tmp/none.json" --port /dev/null state
     expect 2 "$tmp/bad.csv: cannot read the protocol's description" -- \
-      "$py" "$client" --protocol "$tmp/bad.csv" --port /dev/null state
+      "${pyc[@]}" --protocol "$tmp/bad.csv" --port /dev/null state
     expect 2 "$tmp/none.json: cannot read the protocol's description" -- \
-      env OSC_PROTOCOL="$tmp/none.json" "$py" "$client" --port /dev/null state
-    expect 2 "the protocol's description: an empty path" -- "$py" "$client" --protocol "" --port /dev/null state
+      env OSC_PROTOCOL="$tmp/none.json" "${pyc[@]}" --port /dev/null state
+    expect 2 "the protocol's description: an empty path" -- "${pyc[@]}" --protocol "" --port /dev/null state
     ;;
   *)
     echo "virtual_board.sh: unknown case $case_"

@@ -94,7 +94,7 @@ function(osc_add_virtual_board_test scalar)
   endif()
   add_test(NAME virtual_board_qemu_sequence
            COMMAND bash ${PROJECT_SOURCE_DIR}/tests/cli/virtual_board.sh ${OSC_SIM_BOARD} ${OSC_OSCCTL}
-                   ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py qemu_sequence
+                   ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/src qemu_sequence
                    $<TARGET_FILE:pil_firmware> ${scalar})
   # About 20 s simulated, in real time (slower on a busy machine: QEMU then falls behind). The Python
   # client reads the protocol of the host build for the same arm (OSC_HOST_CLIENT_PROTOCOL_ENV).
@@ -104,7 +104,7 @@ function(osc_add_virtual_board_test scalar)
   # as in process.
   add_test(NAME virtual_board_qemu_link_recovery
            COMMAND ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/tests/cli/link_recovery.py ${OSC_SIM_BOARD}
-                   ${PROJECT_SOURCE_DIR}/clients/python/osc_client.py --qemu $<TARGET_FILE:pil_firmware>)
+                   ${PROJECT_SOURCE_DIR}/clients/python/src --qemu $<TARGET_FILE:pil_firmware>)
   set_tests_properties(virtual_board_qemu_link_recovery PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 300
                                                                    ENVIRONMENT "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
 endfunction()

@@ -10,3 +10,9 @@ from osc_client import PROTOCOL_JSON, Protocol
 def protocol() -> Protocol:
     """The package's description (not $OSC_PROTOCOL: the tests are the default arm's)."""
     return Protocol(PROTOCOL_JSON)
+
+
+@pytest.fixture(autouse=True)
+def default_arm(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No $OSC_PROTOCOL of the caller's: the command line reads the package's description too."""
+    monkeypatch.delenv("OSC_PROTOCOL", raising=False)

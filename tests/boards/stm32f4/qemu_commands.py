@@ -1,12 +1,12 @@
 #!/usr/bin/env python3
 """The STM32F4 board's command link end to end (ctest stm32f4_qemu_commands).
 
-usage: qemu_commands.py CLIENT_DIR QEMU_COMMAND...
+usage: qemu_commands.py CLIENT_SRC QEMU_COMMAND...
 
 Starts QEMU_COMMAND (qemu-system-arm -M netduinoplus2 ... -kernel stm32f4_qemu_link.elf) with the
 board's USART2 on a pseudo-terminal (-serial pty: QEMU names it on its standard output, "char device
-redirected to /dev/pts/N"), and drives it with the project's Python client (CLIENT_DIR/osc_client.py), as a user
-would drive the board over a serial adapter:
+redirected to /dev/pts/N"), and drives it with the project's Python client (the package osc_client,
+from CLIENT_SRC: clients/python/src), as a user would drive the board over a serial adapter:
   1. a state frame says disabled (the board starts disabled);
   2. enable is accepted, and the state becomes holding;
   3. a move_to far outside the workspace (2 m along x from where the arm holds) is refused
@@ -44,15 +44,17 @@ def find_pty(proc, deadline):
 
 def wait_state(c, name, timeout=TIMEOUT):
     """The first state frame whose motion state is `name` (None after the timeout)."""
+    from osc_client import NameList  # from CLIENT_SRC (main)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         s = c.state(timeout=deadline - time.monotonic())
-        if s is not None and c.p.name_of("motion_states", s["state"]) == name:
+        if s is not None and c.protocol.name_of(NameList.MOTION_STATES, s.state) == name:
             return s
     return None
 
 
 def run(c):
+    from osc_client import NameList, Status  # from CLIENT_SRC (main)
     ok = True
 
     def check(what, good, detail=""):
@@ -60,40 +62,42 @@ def run(c):
         ok &= bool(good)
         print(f"{'ok  ' if good else 'FAIL'} {what}{': ' + detail if detail else ''}", flush=True)
 
+    def motion_state(s):
+        return c.protocol.name_of(NameList.MOTION_STATES, s.state) if s else "no state frame"
+
     s = c.state(timeout=TIMEOUT)
-    check("boots disabled", s is not None and c.p.name_of("motion_states", s["state"]) == "disabled",
-          c.p.name_of("motion_states", s["state"]) if s else "no state frame")
+    check("boots disabled", motion_state(s) == "disabled", motion_state(s))
     o = c.wait_answer(c.enable(), TIMEOUT)
-    check("enable accepted", o.status == "accepted", o.text())
+    check("enable accepted", o.status == Status.ACCEPTED, o.text())
     check("holding after enable", wait_state(c, "holding") is not None)
     o = c.wait_answer(c.move_to((2.0, 0.0, 0.0), relative=True), TIMEOUT)
     check("a move_to outside the workspace refused out_of_workspace",
-          o.status == "refused" and o.reason == "out_of_workspace", o.text())
+          o.status == Status.REFUSED and o.reason == "out_of_workspace", o.text())
     o = c.wait_done(c.stop(), TIMEOUT)
-    check("stop accepted and done (holding)", o.status == "done", o.text())
+    check("stop accepted and done (holding)", o.status == Status.DONE, o.text())
     o = c.wait_answer(c.disable(), TIMEOUT)
-    check("disable accepted", o.status == "accepted", o.text())
+    check("disable accepted", o.status == Status.ACCEPTED, o.text())
     s = wait_state(c, "disabled")
     check("disabled after disable", s is not None)
     if s is not None:
-        check("no fault", s["faults"] == 0, c.p.fault_names(s["faults"]))
-        check("no setpoint dropped (keep-alive frames are no setpoints)", s["dropped"] == 0, str(s["dropped"]))
-    ks = c.p.param_index["ks"]
+        check("no fault", s.faults == 0, c.protocol.fault_names(s.faults))
+        check("no setpoint dropped (keep-alive frames are no setpoints)", s.dropped == 0, str(s.dropped))
+    ks = c.protocol.parameter("ks").index
     a = c.param("set", ks, 1, 80.0, timeout=TIMEOUT)
-    check("param set ks[1] = 80 accepted", a["status"] == 0 and a["value"] == 80.0, str(a))
-    names = [c.param(op, timeout=TIMEOUT)["status"] for op in ("save", "reset")]
+    check("param set ks[1] = 80 accepted", a.status == 0 and a.value == 80.0, str(a))
+    names = [c.param(op, timeout=TIMEOUT).status for op in ("save", "reset")]
     check("save and reset ok", names == [0, 0], str(names))
-    check("reset: ks[1] back to 97", c.param("get", ks, 1, timeout=TIMEOUT)["value"] == 97.0)
-    check("load ok", c.param("load", timeout=TIMEOUT)["status"] == 0)
-    check("load: ks[1] is 80 again", c.param("get", ks, 1, timeout=TIMEOUT)["value"] == 80.0)
+    check("reset: ks[1] back to 97", c.param("get", ks, 1, timeout=TIMEOUT).value == 97.0)
+    check("load ok", c.param("load", timeout=TIMEOUT).status == 0)
+    check("load: ks[1] is 80 again", c.param("get", ks, 1, timeout=TIMEOUT).value == 80.0)
     o = c.wait_answer(c.enable(), TIMEOUT)
-    check("enable accepted", o.status == "accepted", o.text())
+    check("enable accepted", o.status == Status.ACCEPTED, o.text())
     wait_state(c, "holding")
     a = c.param("set", ks, 1, 90.0, timeout=TIMEOUT)
     check("param set while enabled refused torque_on",
-          c.p.name_of("param_statuses", a["status"]) == "torque_on" and a["value"] == 80.0, str(a))
+          c.protocol.name_of(NameList.PARAM_STATUSES, a.status) == "torque_on" and a.value == 80.0, str(a))
     o = c.wait_answer(c.disable(), TIMEOUT)
-    check("disable accepted", o.status == "accepted", o.text())
+    check("disable accepted", o.status == Status.ACCEPTED, o.text())
     return ok
 
 
