@@ -63,6 +63,13 @@ void realistic(ExperimentConfig& cfg) {
   // Estimates: offsets up to 20 codes, about the +-1.7 degrees a PUMA's pot is good for.
   const double pot[6] = {12, -8, 15, -20, 6, -10};
   for (int i = 0; i < 6; ++i) cfg.sensors.pot_offset[i] = pot[i];
+  // The amplifiers' current monitors (the drive sheet's current_monitor group: gain within +-2 %, offset within
+  // 0.2 % of full scale, 2 codes of noise): half of each, signs mixed.
+  cfg.sensors.current_monitor = true;
+  cfg.sensors.current_noise = 1;
+  const double current_gain[6] = {0.01, -0.008, 0.006, -0.01, 0.007, -0.005};
+  for (int i = 0; i < 6; ++i)
+    cfg.sensors.current_gain[i] = current_gain[i], cfg.sensors.current_offset[i] = sign[i] * 1e-3;
 }
 
 struct Preset {

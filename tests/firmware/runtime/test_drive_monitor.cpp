@@ -179,6 +179,26 @@ TEST(DriveCheck, ADacFrozenAtRestIsFoundByTheDitherWithin30Ms) {
             -1);
 }
 
+TEST(DriveCheck, ADacFrozenUnderAMovingCommandIsFoundWithin30Ms) {
+  // The command leaves the frozen code slowly: a few dither amplitudes off within the window, below the tracking
+  // check's threshold (floor + share of a large code) for tens of ms. The dither check alone must find it: its
+  // demodulation does not depend on how far the reading has drifted from the codes. Rates from 0.5 to 2 % of
+  // full scale per 10 ms, either way, from a code of 35 % (the threshold there 4.4 amplitudes).
+  for (const double rate : {-0.002, -0.001, -0.0005, 0.0005, 0.001, 0.002})
+    for (int phase = 0; phase < 2 * params::kDitherHalfPeriod; phase += 3) {
+      const int at = 500 + phase;
+      const auto ramp = [rate, at](int c, std::uint64_t k) {
+        const double moved = k > static_cast<std::uint64_t>(at) ? rate * static_cast<double>(k - at) : 0.0;
+        return c == 1 ? (0.35 + moved) * kFullScale : 0.0;
+      };
+      Loop l;
+      const int k = ticks_to_fault(
+          l, at, 100, [](Loop& x) { x.drive.frozen[1] = true; }, ramp);
+      EXPECT_GE(k, 0) << rate << " " << phase;
+      EXPECT_LE(k, 30) << rate << " " << phase;
+    }
+}
+
 TEST(DriveCheck, AFaultLineIsADriveFaultAtOnce) {
   Loop l;
   for (int k = 0; k < 100; ++k) ASSERT_EQ(l.step(smooth), 0u);

@@ -188,12 +188,12 @@ constexpr double kResidualTravelCounts = 2;
 /// - a reading beyond it for kDriveQualifyTicks in a row is a drive_fault (a glitch of one conversion is not);
 /// - the test dither: +-kDitherAmplitude of each channel's full scale on its DAC code, a square wave of
 ///   kDitherHalfPeriod ticks a sign (125 Hz), the default of the runtime parameter dither; its demodulation
-///   filters over 2^kDitherWindowShift ticks (16 ms: a frozen DAC at half its level in 11 ticks).
+///   filters over 2^kDitherWindowShift readings (8: a frozen DAC at half its level in 6 readings, 8 ticks).
 constexpr double kDriveMargin = 2;
 constexpr int kDriveQualifyTicks = 3;
 constexpr double kDitherAmplitude = 0.01;
 constexpr int kDitherHalfPeriod = 4;
-constexpr int kDitherWindowShift = 4;
+constexpr int kDitherWindowShift = 3;
 /// The residual monitor's turn: every this many control steps (the controller's even steps, on which the
 /// alternate model rate computes A and g, not Psi: osc/control/controller.hpp, even_step), it updates each joint's
 /// bound, change channel and thresholds and advances the travel check's bounds, on the inputs' means over the

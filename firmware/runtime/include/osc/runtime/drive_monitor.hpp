@@ -65,8 +65,9 @@ inline constexpr DriveCheckConstants kDriveCheck = drive_check_constants();
 ///    off, a DAC frozen once the command has left its value).
 ///  - The dither check: the codes carry a square wave of +-dither codes (params::kDitherAmplitude of full
 ///    scale, params::kDitherHalfPeriod ticks a sign; ControlTask::dither_sign); the reading's distance outside
-///    its codes' range, times their sign, filtered over 2^params::kDitherWindowShift readings (those not right
-///    after a change of sign), is about 0 on a drive that follows and -dither on one that does not.
+///    its codes' range less its mean, times their sign, filtered over 2^params::kDitherWindowShift readings
+///    (those not right after a change of sign), is about 0 on a drive that follows and -dither on one that does
+///    not, whether its command stands or drifts away from a frozen code.
 ///    Below -dither / 2: drive_fault, at rest as in motion (a DAC or an amplifier frozen at any value).
 ///  - The fault lines: an amplifier that reports a fault: drive_fault at once.
 ///  - The monitor itself: a reading at the end of the ADC's span (beyond the largest current an amplifier
@@ -79,6 +80,7 @@ struct DriveMonitor {
   std::int32_t lo[kDof], hi[kDof];  // the two codes' range, where the current must lie
   std::int32_t threshold[kDof];     // floor + share max(|lo|, |hi|)
   std::int32_t dither[kDof];        // 2^kDitherShift times the filtered sign-weighted difference [DAC codes]
+  std::int32_t base[kDof];          // 2^kDitherShift times the filtered distance outside the range [DAC codes]
   std::int8_t sign_last;            // the dither's sign in the last codes (0: none)
   std::uint8_t dithered;            // bit c: the next reading of channel c takes part in the dither check
   std::uint8_t writes;              // ticks whose codes are on record (2: the check runs)
@@ -95,7 +97,7 @@ struct DriveMonitor {
 
   void reset() {
     for (int c = 0; c < kDof; ++c) {
-      last[c] = lo[c] = hi[c] = dither[c] = 0;
+      last[c] = lo[c] = hi[c] = dither[c] = base[c] = 0;
       threshold[c] = kDriveCheck.floor;
       over[c] = 0, peak[c] = dither_peak[c] = 0;
     }
@@ -162,14 +164,20 @@ struct DriveMonitor {
     over[c] = qualify(over[c], error > th);
     std::uint32_t f = over[c] >= params::kDriveQualifyTicks ? static_cast<std::uint32_t>(kFaultDriveFault) : 0u;
     if (dithered >> c & 1u) {
-      // 2^s y += s e - y: the filter of the sign-weighted error (the reading's distance outside its codes' range,
-      // signed), its level 2^s times the mean; the error within +-2 amplitudes (a larger one is the tracking
-      // check's: a glitch adds at most that). Outside the range, not from the last code: a drive's lag behind
-      // the controller's own steps, which answer the dither on a light joint, stays inside it.
-      const std::int32_t two = 2 * amplitude, d = above > 0 ? above : (below > 0 ? -below : 0);
-      const std::int32_t dc = d > two ? two : (d < -two ? -two : d);
+      // The reading's distance outside its codes' range, signed (outside the range, not from the last code: a
+      // drive's lag behind the controller's own steps, which answer the dither on a light joint, stays inside
+      // it), less its mean over the window (base: 2^s times it, of the distance within the tracking threshold,
+      // beyond which the tracking check has it): a DAC frozen while the command drifts away from its code reads
+      // a distance that grows, and what the dither adds to it alternates about that growth.
+      const std::int32_t d = above > 0 ? above : (below > 0 ? -below : 0);
+      std::int32_t& b = base[c];
+      b += (d > th ? th : (d < -th ? -th : d)) - (b >> kDitherShift);
+      // 2^s y += s e - y: the filter of the sign-weighted difference e, its level 2^s times the mean; e within +-2
+      // amplitudes (a glitch adds at most that).
+      const std::int32_t two = 2 * amplitude, e = d - (b >> kDitherShift);
+      const std::int32_t ec = e > two ? two : (e < -two ? -two : e);
       std::int32_t& y = dither[c];
-      y += (sign_last > 0 ? dc : -dc) - (y >> kDitherShift);
+      y += (sign_last > 0 ? ec : -ec) - (y >> kDitherShift);
       const std::int32_t fade = -y, level = amplitude << kDitherShift;  // 2^s times the missing share
       track_peak(dither_peak[c], fade, level);
       if (4 * fade > 3 * level) suspect |= static_cast<std::uint8_t>(1u << c);
@@ -180,7 +188,7 @@ struct DriveMonitor {
   /// The dither runs: its filters start from a drive that follows (a torque-on, a change of amplitude).
   void start_dither(std::int32_t codes) {
     amplitude = codes;
-    for (int c = 0; c < kDof; ++c) dither[c] = 0;
+    for (int c = 0; c < kDof; ++c) dither[c] = base[c] = 0;
   }
 
  private:
