@@ -251,6 +251,7 @@ void run(const ExperimentConfig& cfg, const Vec6& q0, Controller& ctrl, Experime
   res.plant_evaluations = plant.evaluations();
   res.injection.peak_contact_force = plant.peak_contact_force();
   res.injection.first_contact = plant.first_contact_time();
+  res.injection.breakaway = hal.breakaway_before(res.injection.detected >= 0 ? res.injection.detected : cfg.duration);
   res.each([](auto& m) {
     if constexpr (requires { m.end(); }) m.end();
   });

@@ -359,7 +359,8 @@ void InjectionTracking::to_json(Json& j) const {
                     {"excursion_mm", ir.excursion_mm},
                     {"max_torque_after_detection_Nm", ir.max_torque_after},
                     {"peak_contact_force_N", ir.peak_contact_force},
-                    {"first_contact_s", json_time(ir.first_contact)}};
+                    {"first_contact_s", json_time(ir.first_contact)},
+                    {"breakaway_s", json_time(ir.breakaway)}};
 }
 
 void InjectionTracking::print(const ExperimentResult& run) const {
@@ -376,6 +377,8 @@ void InjectionTracking::print(const ExperimentResult& run) const {
     std::printf(", zero torque after %.1f ms", (ir.zero_torque - ir.injection.at) * 1e3);
   std::printf(", tip excursion %.2f mm, largest torque after detection %.2f N m", ir.excursion_mm, ir.max_torque_after);
   if (ir.injection.contact()) std::printf(", peak contact force %.1f N", ir.peak_contact_force);
+  if (ir.breakaway >= 0)
+    std::printf(", the joint's last breakaway before it after %.1f ms", (ir.breakaway - ir.injection.at) * 1e3);
   std::printf("\n");
 }
 

@@ -221,6 +221,7 @@ struct InjectionResult {
   int max_torque_joint = -1;      ///< its joint (0-based)
   double peak_contact_force = 0;  ///< largest |F| of an injected contact (collision, wall) [N]; 0: none
   double first_contact = -1;      ///< [s] when it first pushed (-1: never)
+  double breakaway = -1;          ///< [s] a stuck encoder's joint's last breakaway before detection (-1: none)
 };
 
 /// The injected fault's detection, torque cut-off and tip excursion.

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include "hal/hal.hpp"
 #include "injection.hpp"
@@ -204,6 +205,16 @@ class PlantHal {
     t_ = t;
   }
   bool injection_active() const { return active_; }
+  /// A stuck encoder's joint's last breakaway at or before t [s]: the first count the frozen encoder missed (the
+  /// first sample whose true count differs from the frozen one), or a later first count after the joint had stood
+  /// kStood without one; -1: none (no encoder-stuck injection, or the joint has not moved).
+  double breakaway_before(double t) const {
+    double last = -1;
+    for (const double b : breakaways_)
+      if (b <= t + 1e-12) last = b;
+    return last;
+  }
+  static constexpr double kStood = 0.02;  ///< [s] without a true count: the joint stood (static friction held it)
 
   /// Incremental encoders on the motors, zeroed at q_start: channel i counts
   /// floor((e_i - e_start_i) * counts_per_rad_i + u), e the plant's motor angles (referred to their
@@ -220,7 +231,8 @@ class PlantHal {
       if (!active_ || !inj_.hits(i)) continue;
       switch (inj_.kind) {
         case InjectionKind::kEncoderStuck:
-          if (first_) frozen_[i] = counts[i];
+          if (first_) frozen_[i] = last_true_[i] = counts[i];
+          note_true_count(i, counts[i]);
           counts[i] = frozen_[i];
           break;
         case InjectionKind::kEncoderJump:
@@ -350,6 +362,12 @@ class PlantHal {
   const Vec6& motor_start() const { return e_start_; }
 
  private:
+  /// A stuck channel's true count this sample (breakaway_before()).
+  void note_true_count(int i, std::int32_t count) {
+    if (count == last_true_[i]) return;
+    if (breakaways_.empty() || t_ - last_true_change_ > kStood + 1e-12) breakaways_.push_back(t_);
+    last_true_change_ = t_, last_true_[i] = count;
+  }
   static constexpr double kNoiseBurst = 0.05;  // [s]
   /// A generator of its own per noise source (the encoders' jitter does not move the pots' noise).
   static std::mt19937 generator(std::uint32_t seed, std::uint32_t stream) {
@@ -368,6 +386,9 @@ class PlantHal {
   Injection inj_;
   bool active_ = false, first_ = false;
   double t_ = 0, t_inj_ = 0;
+  std::vector<double> breakaways_;             // breakaway_before()
+  double last_true_change_ = -1;               // the last change of a stuck channel's true count [s]
+  std::int32_t last_true_[hal::kJoints] = {};  // each stuck channel's true count then
   std::int32_t frozen_[hal::kJoints] = {};
   std::uint32_t clock_ = 0;
   int overrun_reads_ = 0;
