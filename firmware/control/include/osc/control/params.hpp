@@ -88,6 +88,49 @@ constexpr int kMoveQueueLength = 16;
 /// Enable: the torque beyond the gravity the model predicts is ramped in over this time [s].
 constexpr double kEnableRamp = 0.05;
 
+/// The excitation motion of an identification run (osc/control/excitation.hpp, docs/adaptation.md section 6;
+/// Swevers et al. 1997, Gaz et al. 2019): a Fourier series per joint of kExcitationHarmonics harmonics of
+/// 1 / kExcitationPeriod, repeated kExcitationPeriods times, at rest at its start pose at the start of
+/// every period. The reference stays kExcitationPositionMargin inside each joint's limits, below the
+/// speed bound (kExcitationMaxSpeed or the drive's plausible speed, whichever is lower) by
+/// kExcitationSpeedMargin, and needs at most kExcitationTorqueFraction of each joint's torque limit
+/// (its rigid-body torque plus the model-error band's strongest friction). 1.5 rad/s: the speed at which
+/// the Stribeck term has decayed by 90 % (tau_dec = 1), so that its split from the Coulomb level is
+/// observed (shared/reference/drives-and-identification.md section 7.1); the margins are Gaz's (5 deg,
+/// 10 deg/s), the period his order (13.3 s), the duration within issue 57's 90 s.
+constexpr int kExcitationHarmonics = 5;
+constexpr double kExcitationPeriod = 10;  ///< [s], a whole number of control ticks
+constexpr int kExcitationPeriods = 8;
+constexpr double kExcitationMaxDuration = 90;                ///< [s]
+constexpr double kExcitationMaxSpeed = 1.5;                  ///< [rad/s]
+constexpr double kExcitationSpeedMargin = 10 * kPi / 180;    ///< [rad/s]
+constexpr double kExcitationPositionMargin = 5 * kPi / 180;  ///< [rad]
+constexpr double kExcitationTorqueFraction = 0.8;            ///< of robot::kDrives.torque_limit
+/// How far the design's speed may be cut where it does not fit (excitation.hpp, "Fitting the design"):
+/// a joint's travel at the start pose may cut its speed to kExcitationMinScale of its design speed, and
+/// a check that fails is tried again with every joint's amplitude times kExcitationScaleStep, while the
+/// factor stays at least kExcitationMinScale (1, 0.8, 0.64, 0.512); beyond, the motion is refused.
+constexpr double kExcitationMinScale = 0.5;
+constexpr double kExcitationScaleStep = 0.8;
+/// The plan aims this fraction of each bound (speed, travel), so that the scalar's rounding never puts
+/// a sample of the reference over it.
+constexpr double kExcitationPlanFill = 0.99;
+/// The design: each joint's velocity coefficients, a_k on cos(k w t) and b_k on sin(k w t), k = 1..5, in
+/// units the plan scales (excitation.hpp, "The design"). Joints 1, 3, 5 move with cosines, 2, 4, 6 with
+/// sines; each row solves sum a_k = sum k^2 a_k = 0, or sum b_k / k = sum k b_k = 0.
+constexpr double kExcitationCos[kDof][kExcitationHarmonics] = {{2, 3, -12, 9, -2},    // J1
+                                                               {0, 0, 0, 0, 0},       // J2
+                                                               {0, 3, 0, -7, 4},      // J3
+                                                               {0, 0, 0, 0, 0},       // J4
+                                                               {7, -6, 3, -10, 6},    // J5
+                                                               {0, 0, 0, 0, 0}};      // J6
+constexpr double kExcitationSin[kDof][kExcitationHarmonics] = {{0, 0, 0, 0, 0},       // J1
+                                                               {4, -2, -9, -12, 15},  // J2
+                                                               {0, 0, 0, 0, 0},       // J3
+                                                               {6, -18, 0, 20, -10},  // J4
+                                                               {0, 0, 0, 0, 0},       // J5
+                                                               {0, 2, -9, 12, -5}};   // J6
+
 /// Supervision limits.
 /// How far an encoder reading may lie outside the joint limits (overtravel to the hard stops)
 /// before it is implausible, from the first sample on [rad].
