@@ -37,6 +37,8 @@ def run(exe, mode, kind, form, arg, at, out):
     path = os.path.join(out, spec.replace(":", "_").replace("@", "_at_") + f"_{mode}.json")
     cmd = [exe, "--duration", f"{at + AFTER.get(form, 1.0):g}", "--mode", mode, "--inject", spec, "--no-csv",
            "--no-progress", "--json", path]
+    if kind.startswith("current-"):  # a current monitor's own fault: the monitors on (the ideal plant has none)
+        cmd += ["--set", "plant.current_monitor=on"]
     p = subprocess.run(cmd, capture_output=True, text=True)
     if p.returncode != 0:
         sys.exit(f"{' '.join(cmd)} failed ({p.returncode}):\n{p.stdout}{p.stderr}")
