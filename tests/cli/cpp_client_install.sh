@@ -10,20 +10,8 @@
 # usage: cpp_client_install.sh CMAKE BUILD_DIR SOURCE_DIR CXX GENERATOR ROBOT OSC_SIM
 set -euo pipefail
 cmake=$1 build=$2 src=$3 cxx=$4 generator=$5 robot=$6 sim=$7
-tmp=$(mktemp -d)
-sim_pid=
-cleanup() {
-  if [ -n "$sim_pid" ]; then
-    kill -TERM "$sim_pid" 2>/dev/null || true
-    wait "$sim_pid" 2>/dev/null || true
-  fi
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+# $tmp, its cleanup on exit (stopping $sim_pid), fail.
+. "${BASH_SOURCE[0]%/*}/scratch.sh"
 prefix=$tmp/prefix
 
 # (a) Installed: the component alone.

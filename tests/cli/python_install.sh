@@ -9,20 +9,8 @@
 # usage: python_install.sh PYTHON CLIENT_DIR [OSC_SIM]   (CLIENT_DIR: clients/python)
 set -euo pipefail
 py=$1 client=$2 sim=${3:-}
-tmp=$(mktemp -d)
-sim_pid=
-cleanup() {
-  if [ -n "$sim_pid" ]; then
-    kill -TERM "$sim_pid" 2>/dev/null || true
-    wait "$sim_pid" 2>/dev/null || true
-  fi
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*"
-  exit 1
-}
+# $tmp, its cleanup on exit (stopping $sim_pid), fail.
+. "${BASH_SOURCE[0]%/*}/scratch.sh"
 # A copy: pip builds in the tree it is given (build/, *.egg-info), and the source tree stays clean.
 cp -r "$client" "$tmp/client"
 rm -rf "$tmp/client/build" "$tmp/client"/src/*.egg-info
