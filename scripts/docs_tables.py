@@ -930,7 +930,7 @@ def stuck_encoder_bound():
                 cells.append("**not detected**")
                 continue
             moved = inj.get("breakaway_s")
-            after = (inj["detected_s"] - max(inj["at_s"], moved if moved is not None else inj["at_s"])) * 1e3
+            after = (inj["detected_s"] - (inj["at_s"] if moved is None else moved)) * 1e3  # at or after at_s
             mm = inj["excursion_mm"]
             bound = after <= STUCK_MS and mm <= STUCK_MM
             stated = not bound and j == 1 and mm <= STUCK_J1_MM  # J1 at a reversal: the stated exception

@@ -122,7 +122,7 @@ struct DriveMonitor {
     dithered = 0;
     for (int c = 0; c < kDof; ++c) {
       const std::int32_t l = k.limit[c], u = codes[c], b = last[c];
-      const std::int32_t a = u > l ? l : (u < -l ? -l : u);
+      const std::int32_t a = within(u, l);
       const std::int32_t x = a < b ? a : b, y = a < b ? b : a;
       lo[c] = x, hi[c] = y, last[c] = a;
       threshold[c] = k.floor + static_cast<std::int32_t>((static_cast<std::uint32_t>(y > -x ? y : -x) * k.share) >> 16);
@@ -171,11 +171,10 @@ struct DriveMonitor {
       // a distance that grows, and what the dither adds to it alternates about that growth.
       const std::int32_t d = above > 0 ? above : (below > 0 ? -below : 0);
       std::int32_t& b = base[c];
-      b += (d > th ? th : (d < -th ? -th : d)) - (b >> kDitherShift);
+      b += within(d, th) - (b >> kDitherShift);
       // 2^s y += s e - y: the filter of the sign-weighted difference e, its level 2^s times the mean; e within +-2
       // amplitudes (a glitch adds at most that).
-      const std::int32_t two = 2 * amplitude, e = d - (b >> kDitherShift);
-      const std::int32_t ec = e > two ? two : (e < -two ? -two : e);
+      const std::int32_t ec = within(d - (b >> kDitherShift), 2 * amplitude);
       std::int32_t& y = dither[c];
       y += (sign_last > 0 ? ec : -ec) - (y >> kDitherShift);
       const std::int32_t fade = -y, level = amplitude << kDitherShift;  // 2^s times the missing share
@@ -192,6 +191,8 @@ struct DriveMonitor {
   }
 
  private:
+  /// x limited to [-t, t] (t >= 0).
+  static constexpr std::int32_t within(std::int32_t x, std::int32_t t) { return x > t ? t : (x < -t ? -t : x); }
   /// peak = max(peak, 1000 value / limit): compared in 32 bits (value < 2^16, limit < 2^15), divided only for a
   /// new peak.
   static void track_peak(std::uint16_t& peak, std::int32_t value, std::int32_t limit) {
