@@ -152,8 +152,12 @@ void add_runtime_param_entries(std::vector<Entry>& t) {
       for (int k = 0; k < n; ++k) a.push_back(s.base.params[slot + k]);
       return a;
     };
-    e.put = [slot, n](Settings& s, const json& v) {
-      for (int k = 0; k < n; ++k) s.base.params[slot + k] = n == 1 ? v.get<double>() : v[k].get<double>();
+    e.put = [i, slot, n](Settings& s, const json& v) {
+      double in[6] = {};
+      for (int k = 0; k < n; ++k) in[k] = n == 1 ? v.get<double>() : v[k].get<double>();
+      if (i == osc::kPayloadInertiaParam && !osc::inertia_semidefinite(in))
+        return std::string("not positive semi-definite: ") + osc::param_status_name(osc::ParamStatus::kNotPhysical);
+      for (int k = 0; k < n; ++k) s.base.params[slot + k] = in[k];
       return std::string();
     };
     e.element_range = [i](const Settings&, double& lo, double& hi, int k) {
@@ -570,8 +574,48 @@ void add_plant_feature_entries(std::vector<Entry>& t) {
   for (std::size_t i = first; i < t.size(); ++i) t[i].feature = true, t[i].paper = false;
 }
 
+/// The payload the simulated arm carries at its flange (the truth; the controller's model knows it
+/// through run.payload_*, the firmware's parameters). Up to twice the arm's rating, so that a run can
+/// carry more than the model may be told.
+void add_plant_payload_entries(std::vector<Entry>& t) {
+  const osc::PayloadRating& r = osc::robot::kPayloadRating;
+  number(t, "plant.payload_mass", "the payload the simulated arm carries at its flange [kg]", 0, 2 * r.mass, true,
+         [](Settings& s) -> double& { return s.base.plant.payload.mass; });
+  Entry c{"plant.payload_com",
+          "its centre of mass in frame 6 [m]",
+          Kind::kList,
+          -2 * r.com_reach,
+          2 * r.com_reach,
+          {},
+          true};
+  c.count = 3;
+  c.get = [](const Settings& s) { return vec_json(s.base.plant.payload.com, 3); };
+  c.put = [](Settings& s, const json& v) {
+    for (int i = 0; i < 3; ++i) s.base.plant.payload.com[i] = v[i].get<double>();
+    return std::string();
+  };
+  t.push_back(c);
+  Entry i{"plant.payload_inertia",
+          "its inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2]",
+          Kind::kList,
+          -2 * r.inertia,
+          2 * r.inertia,
+          {},
+          true};
+  i.put = [](Settings& s, const json& v) {
+    double in[6];
+    for (int k = 0; k < 6; ++k) in[k] = v[k].get<double>();
+    if (!osc::inertia_semidefinite(in)) return std::string("not positive semi-definite (no rigid body has it)");
+    for (int k = 0; k < 6; ++k) s.base.plant.payload.inertia[k] = in[k];
+    return std::string();
+  };
+  i.get = [](const Settings& s) { return vec_json(s.base.plant.payload.inertia, 6); };
+  t.push_back(i);
+}
+
 void add_plant_entries(std::vector<Entry>& t) {
   add_plant_feature_entries(t);
+  add_plant_payload_entries(t);
   add_plant_friction_entries(t);
   number(t, "plant.tau_dec", "the simulated robot's Stribeck decay tau_dec [s^2/rad^2]", 0.01, 100, true,
          [](Settings& s) -> double& { return s.base.plant.tau_dec; });

@@ -59,10 +59,10 @@ double motor_armature(const PlantConfig& cfg, int i) {
 /// uncoupled joint (an elastic joint's motor is a state of its own; with the coupling the armature is a
 /// full matrix, solved by the composite-rigid-body path instead).
 ArticulatedBody make_body(const PlantConfig& cfg) {
-  if (cfg.ideal_drives()) return ArticulatedBody(cfg.link_scale);
+  if (cfg.ideal_drives()) return ArticulatedBody(cfg.link_scale, cfg.payload);
   double a[6];
   for (int i = 0; i < 6; ++i) a[i] = cfg.coupling || is_elastic(cfg, i) ? 0.0 : motor_armature(cfg, i);
-  return ArticulatedBody(cfg.link_scale, a);
+  return ArticulatedBody(cfg.link_scale, a, cfg.payload);
 }
 
 int sign_of(double v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
@@ -110,17 +110,21 @@ Mat3 rotation_of(const osc::Placement& P) {
 Vec3 translation_of(const osc::Placement& P) { return Vec3(P.p[0], P.p[1], P.p[2]); }
 }  // namespace
 
-ArticulatedBody::ArticulatedBody(double link_scale) {
+ArticulatedBody::ArticulatedBody(double link_scale, const osc::Payload& payload) {
   const osc::ArmDescription& arm = osc::robot::kArm;
   for (int i = 0; i < 6; ++i) {
-    const auto& L = arm.links[i];
+    // The link scaled (model-error studies), then link 6 with the payload it carries (not scaled).
+    osc::LinkParams L = arm.links[i];
+    L.mass *= link_scale;
+    for (double& v : L.inertia) v *= link_scale;
+    if (i == 5) L = osc::with_payload(L, payload);
     // Link i in its joint frame B_i = F_{i-1} Rz(q_i): F_i = B_i P_i, P_i = (R, p) its placement.
     const Mat3 R = rotation_of(L.placement);
     const Vec3 c = translation_of(L.placement) + R * Vec3(L.com[0], L.com[1], L.com[2]);
     Mat3 I;  // about the COM, axes of F_i
     I << L.inertia[0], L.inertia[3], L.inertia[4], L.inertia[3], L.inertia[1], L.inertia[5], L.inertia[4], L.inertia[5],
         L.inertia[2];
-    body_[i] = Body{L.mass * link_scale, c, R * I * R.transpose() * link_scale};
+    body_[i] = Body{L.mass, c, R * I * R.transpose()};
     armature_[i] = L.gear_ratio * L.gear_ratio * L.motor_inertia;
     // F_{i-1} in B_{i-1} (F_0 in the base frame for the first joint).
     const osc::Placement& P = i == 0 ? arm.base : arm.links[i - 1].placement;
@@ -183,7 +187,8 @@ Vec6 ArticulatedBody::forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6
   return qdd;
 }
 
-ArticulatedBody::ArticulatedBody(double link_scale, const double armature[6]) : ArticulatedBody(link_scale) {
+ArticulatedBody::ArticulatedBody(double link_scale, const double armature[6], const osc::Payload& payload)
+    : ArticulatedBody(link_scale, payload) {
   for (int i = 0; i < 6; ++i) armature_[i] = armature[i];
 }
 
@@ -306,7 +311,7 @@ Plant::Plant(const PlantConfig& cfg)
     : cfg_(cfg),
       ideal_(cfg.ideal_drives()),
       body_(make_body(cfg)),
-      links_(cfg.link_scale, kNoArmature),
+      links_(cfg.link_scale, kNoArmature, cfg.payload),
       friction_(osc::FrictionParams<double>::from(cfg.friction, cfg.tau_dec)) {
   if (ideal_) return;
   coupled_ = cfg.coupling;
@@ -711,7 +716,7 @@ void Plant::advance_sample(const Vec6& tau_old, const Vec6& tau_new, double dt) 
 
 double Plant::energy() const {
   // Uses the kernels' CRBA only as an energy probe; the dynamics above never call it.
-  osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm, cfg_.link_scale - 1.0);
+  osc::Model<double> model = osc::Model<double>::of(osc::robot::kArm, cfg_.link_scale - 1.0, cfg_.payload);
   if (!ideal_) model.armature.setZero();  // the links alone; the drive train's armature below
   osc::Data<double> data;
   osc::forward_kinematics(model, data, q_);

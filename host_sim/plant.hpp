@@ -35,6 +35,7 @@ struct PlantConfig {
   int smooth_steps = 8;
   double compute_delay = osc::params::kActuationDelay;  ///< from the encoder sample to the DAC update [s]
   double link_scale = 1.0;                              ///< scales every link mass and inertia (model-error studies)
+  osc::Payload payload;  ///< the payload the arm carries at its flange (link 6): plant.payload_*, unscaled
 
   // The drive train's dynamics (issue 24), each off by default; all off, the plant computes exactly
   // what it did without them (the articulated-body path, bit for bit). The inputs of advance_sample()
@@ -106,9 +107,9 @@ constexpr double kBacklashStiffHz = 60.0;
 /// so that no transform is needed between links.
 class ArticulatedBody {
  public:
-  explicit ArticulatedBody(double link_scale = 1.0);
+  explicit ArticulatedBody(double link_scale = 1.0, const osc::Payload& payload = {});
   /// With a given armature (joint-referred, on each joint's scalar inertia) instead of the model's G^2 Jm.
-  ArticulatedBody(double link_scale, const double armature[6]);
+  ArticulatedBody(double link_scale, const double armature[6], const osc::Payload& payload = {});
   /// q_dd for joint torques tau (friction already subtracted), gravity along -z0.
   Vec6 forward_dynamics(const Vec6& q, const Vec6& qd, const Vec6& tau) const;
   /// The composite-rigid-body inertia M(q) (this body's scalar armature on its diagonal) and the bias

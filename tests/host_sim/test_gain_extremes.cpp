@@ -34,9 +34,17 @@ template <class S>
 ParamStatus set_and_hold(int i, int e, bool top, Held& h) {
   MotionSim<S> sim(start_pose());
   const ParamInfo& p = kParams[i];
+  // A payload's products are bounded by its moments (positive semi-definite): the moments at their top
+  // first, where a product is set (not_physical otherwise).
+  const bool inertia = p.runtime == RuntimeParam::kParamPayloadInertia;
+  if (inertia && (e < 0 || e >= 3))
+    for (int k = 0; k < 3; ++k)
+      if (const ParamStatus s = param_set(sim.task(), i, k, p.hi_of(k)); s != ParamStatus::kOk) return s;
   for (int k = 0; k < p.count; ++k) {
-    if (e >= 0 && k != e) continue;
-    const double v = top ? p.hi_of(k) : p.lo_of(k);
+    if ((e >= 0 && k != e) || (inertia && e < 0 && k < 3)) continue;
+    // Every product at its bound together is no body's (three of them at their bottom, or one after
+    // another at their top): a quarter of it, with the moments at their top.
+    const double v = (top ? p.hi_of(k) : p.lo_of(k)) * (inertia && e < 0 ? 0.25 : 1.0);
     const ParamStatus s = param_set(sim.task(), i, k, v);
     if (s != ParamStatus::kOk) return s;
   }

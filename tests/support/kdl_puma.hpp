@@ -34,7 +34,9 @@ inline KDL::Frame kdl_frame(const Placement& P) {
 /// ChainDynParam::JntToMass, as armature * qdd_i in ChainIdSolver_RNE, and (through both) in
 /// ChainFdSolver_RNE; test_kdl.cpp (KdlConvention) checks this against a chain built with
 /// with_armature = false.
-inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true) {
+/// With `payload`, link 6's segment carries it too: KDL's own sum of the two rigid-body inertias in frame 6
+/// (RigidBodyInertia's operator+), not the firmware's combine_bodies.
+inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true, const Payload* payload = nullptr) {
   KDL::Chain chain;
   const KDL::Frame base = kdl_frame(arm.base);
   if (!KDL::Equal(base, KDL::Frame::Identity(), 1e-15))
@@ -44,8 +46,14 @@ inline KDL::Chain arm_chain(const ArmDescription& arm, bool with_armature = true
     const KDL::Joint joint(KDL::Joint::RotZ, /*scale=*/1.0, /*offset=*/0.0,
                            /*inertia=*/with_armature ? armature(L) : 0.0);
     const double* I = L.inertia;
-    const KDL::RigidBodyInertia inertia(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),
-                                        KDL::RotationalInertia(I[0], I[1], I[2], I[3], I[4], I[5]));
+    KDL::RigidBodyInertia inertia(L.mass, KDL::Vector(L.com[0], L.com[1], L.com[2]),
+                                  KDL::RotationalInertia(I[0], I[1], I[2], I[3], I[4], I[5]));
+    if (payload && i == kDof - 1) {
+      const double* P = payload->inertia;
+      inertia =
+          inertia + KDL::RigidBodyInertia(payload->mass, KDL::Vector(payload->com[0], payload->com[1], payload->com[2]),
+                                          KDL::RotationalInertia(P[0], P[1], P[2], P[3], P[4], P[5]));
+    }
     chain.addSegment(KDL::Segment(joint, kdl_frame(L.placement), inertia));
   }
   return chain;

@@ -146,6 +146,8 @@ struct Sheet {
   Text op_text;
   Value cart_velocity, cart_acceleration, cart_jerk;
   Text cart_text;
+  Value payload_mass, payload_com_reach, payload_inertia;  ///< the rated payload and its envelope
+  Text payload_text;
 };
 
 /// Reads and checks the sheet (errors sheet_*, not_finite, sheet_no_source).

@@ -313,6 +313,14 @@ void emit_friction(std::ostream& o, const Sheet& s) {
         s.cart_text);
   o << "constexpr CartesianMaxima kCartesianMaxima = {" << s.cart_velocity.text << ", " << s.cart_acceleration.text
     << ", " << s.cart_jerk.text << "};\n\n";
+
+  group(o, "/// ",
+        "The rated payload at the flange (frame 6) [kg], the reach of its centre of mass in frame 6 (each "
+        "coordinate) [m], and the largest principal moment of its inertia [kg m^2]: the runtime parameters "
+        "payload_*'s ranges.",
+        s.payload_text);
+  o << "constexpr PayloadRating kPayloadRating = {" << s.payload_mass.text << ", " << s.payload_com_reach.text << ", "
+    << s.payload_inertia.text << "};\n\n";
 }
 
 }  // namespace

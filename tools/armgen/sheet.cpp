@@ -370,6 +370,16 @@ void read_rest(const Reader& r, Sheet& s) {
                                std::pair{"jerk", s.cart_jerk}})
     require_positive(v, c.child_path(key));
   s.cart_text = c.text();
+
+  const Reader pl = r.at("payload");
+  pl.only({"mass", "com_reach", "inertia", "source", "estimate"});
+  s.payload_mass = pl.at("mass").value();
+  s.payload_com_reach = pl.at("com_reach").value();
+  s.payload_inertia = pl.at("inertia").value();
+  for (const auto& [key, v] : {std::pair{"mass", s.payload_mass}, std::pair{"com_reach", s.payload_com_reach},
+                               std::pair{"inertia", s.payload_inertia}})
+    require_positive(v, pl.child_path(key));
+  s.payload_text = pl.text();
 }
 
 }  // namespace
@@ -404,7 +414,8 @@ Sheet read_sheet(const std::string& path) {
           "model_error_bounds",
           "poses",
           "operational_point",
-          "cartesian_maxima"});
+          "cartesian_maxima",
+          "payload"});
   Sheet s;
   s.path = path;
   s.arm = r.at("arm").str();

@@ -197,4 +197,78 @@ TEST(Kdl, PlantForwardDynamicsAgreesWithChainFdSolverRne) {
   EXPECT_LE(w_fd.value, kTol);
 }
 
+/// Payloads at the flange as issue 57 tests them (0.5, 1.5, 2.5 kg up to 0.1 m off the flange), the last
+/// with an inertia that has products (a box turned about two axes).
+std::vector<Payload> test_payloads() {
+  Payload a, b, c;
+  a.mass = 0.5, a.com[2] = 0.1;
+  b.mass = 1.5, b.com[0] = 0.1, b.com[2] = 0.05;
+  const double in_b[6] = {2e-3, 3e-3, 4e-3, 0, 0, 0};
+  std::copy(in_b, in_b + 6, b.inertia);
+  c.mass = 2.5, c.com[0] = 0.05, c.com[1] = -0.07, c.com[2] = 0.1;
+  const double in_c[6] = {0.012, 0.010, 0.008, 1.5e-3, -1e-3, 0.5e-3};
+  std::copy(in_c, in_c + 6, c.inertia);
+  return {a, b, c};
+}
+
+// A payload in the model (Model::of's link 6 with combine_bodies) against KDL's chain whose last segment
+// carries it by KDL's own rigid-body sum: FK, J, A, c, g and J-dot qd on random states.
+TEST(Kdl, APayloadOnLinkSixAgreesWithKdl) {
+  OSC_PUMA_ONLY();
+  for (const Payload& p : test_payloads()) {
+    const KDL::Chain chain = test::arm_chain(robot::kArm, true, &p);
+    test::KdlComparison cmp(chain, robot::kArm.gravity, 1, 0, true, kFloor);
+    const Model<double> model = Model<double>::of(robot::kArm, 0.0, p);
+    Data<double> data;
+    test::RandomStates rs;
+    for (int k = 0; k < 200; ++k) cmp.add(model, data, rs.q_nonsingular(), rs.vec(2.0));
+    cmp.expect_within(kTol);
+  }
+}
+
+// The same payloads without the model: the gravity torque they add is what they weigh (a check that the
+// comparison above could fail: a 0.5 kg payload changes g by newton-metres).
+TEST(Kdl, APayloadChangesTheGravityTorqueByItsWeight) {
+  OSC_PUMA_ONLY();
+  const Model<double> bare = Model<double>::of(robot::kArm);
+  for (const Payload& p : test_payloads()) {
+    const Model<double> loaded = Model<double>::of(robot::kArm, 0.0, p);
+    Data<double> d0, d1;
+    const Vec6<double> q = joint_vector<double>(robot::kQStart);
+    forward_kinematics(bare, d0, q);
+    forward_kinematics(loaded, d1, q);
+    // Static: the payload's weight at its centre of mass, -J_c^T m g_vec, g_vec along -z.
+    const Vec3<double> c = d1.o[kDof] + d1.R[kDof] * Vec3<double>(p.com[0], p.com[1], p.com[2]);
+    Vec6<double> expect;
+    for (int j = 0; j < kDof; ++j) {
+      const Vec3<double> z = d1.R[j].col(2);
+      expect(j) = z.cross(c - d1.o[j]).z() * p.mass * robot::kArm.gravity;
+    }
+    const Vec6<double> delta = gravity_torques(loaded, d1) - gravity_torques(bare, d0);
+    EXPECT_LT((delta - expect).norm(), 1e-9 * std::max(1.0, expect.norm())) << p.mass << " kg";
+    EXPECT_GT(expect.norm(), 0.4 * p.mass) << "the pose must load the payload's weight";
+  }
+}
+
+TEST(Kdl, PlantWithAPayloadAgreesWithChainFdSolverRne) {
+  OSC_PUMA_ONLY();
+  for (const Payload& p : test_payloads()) {
+    const KDL::Chain chain = test::arm_chain(robot::kArm, true, &p);
+    KDL::ChainFdSolver_RNE fd(chain, kGravityVec);
+    const sim::ArticulatedBody body(1.0, p);
+    test::RandomStates rs;
+    rs.rng.seed(778);
+    const KDL::Wrenches f_ext(chain.getNrOfSegments(), KDL::Wrench::Zero());
+    KDL::JntArray kqdd(kDof);
+    Worst w{"plant forward dynamics q_dd with a payload"};
+    for (int k = 0; k < 200; ++k) {
+      const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(2.0), tau = rs.vec(40.0);
+      ASSERT_GE(fd.CartToJnt(to_kdl(q), to_kdl(qd), to_kdl(tau), f_ext, kqdd), 0);
+      w.add((kqdd.data - body.forward_dynamics(q, qd, tau)).norm(), kqdd.data.norm(), kFloor);
+    }
+    w.report();
+    EXPECT_LE(w.value, kTol);
+  }
+}
+
 }  // namespace

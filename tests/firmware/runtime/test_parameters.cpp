@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
+#include <type_traits>
 
 #include "osc/math/fixed.hpp"
 #include "osc/robot.hpp"
@@ -81,9 +83,13 @@ void every_element_sets_and_reads_back() {
     for (int e = 0; e < kParams[i].count; ++e) {
       const ParamInfo& p = kParams[i];
       const bool code = param_is_code(p);
-      // A value between the default and the top of the range, that keeps the observer stable.
-      const double v =
-          code ? p.hi_of(e) : param_default(i, e) * 0.75 + 0.25 * std::fmin(p.hi_of(e), 4 * param_default(i, e) + 1);
+      // A value between the default and the top of the range, that keeps the observer stable (a
+      // payload's products a tenth of their bound, so that the tensor stays positive semi-definite).
+      const bool product = p.runtime == RuntimeParam::kParamPayloadInertia && e >= 3;
+      const double v = code ? p.hi_of(e)
+                       : product
+                           ? 0.1 * p.hi_of(e)
+                           : param_default(i, e) * 0.75 + 0.25 * std::fmin(p.hi_of(e), 4 * param_default(i, e) + 1);
       if (std::fabs(v) >= param_scalar_max<S>()) {  // beyond a fixed-point scalar: refused, unchanged
         EXPECT_EQ(param_set(*t, i, e, v), ParamStatus::kOutOfRange) << p.name;
         EXPECT_NEAR(param_get(*t, i, e), param_default(i, e), 1e-3) << p.name;
@@ -159,6 +165,81 @@ TEST(Parameters, EachBadSetIsRefusedByNameAndChangesNothing) {
   EXPECT_EQ(param_set(*t, thr, 0, 30.0), ParamStatus::kOk);
   t->machine.state = MotionState::kFault;  // in fault the torque is off
   EXPECT_EQ(param_set(*t, knd, 0, 100.0), ParamStatus::kOk);
+}
+
+// A payload set through the parameters is the model's link 6 with it (Model::of with the payload, bit for
+// bit in double), reaches the dynamics, and setting it back to nothing restores link 6 bit for bit.
+template <class S>
+void payload_sets_link_six() {
+  auto t = disabled_task<S>();
+  const typename Model<S>::Link bare = t->model.link[kDof - 1];
+  Payload p;
+  p.mass = 1.5, p.com[0] = 0.1, p.com[2] = 0.05;
+  const double in[6] = {2e-3, 3e-3, 4e-3, 5e-4, 0, -2e-4};
+  std::copy(in, in + 6, p.inertia);
+  ASSERT_EQ(param_set(*t, param_index("payload_mass"), 0, p.mass), ParamStatus::kOk);
+  for (int e = 0; e < 3; ++e) ASSERT_EQ(param_set(*t, param_index("payload_com"), e, p.com[e]), ParamStatus::kOk);
+  for (int e = 0; e < 6; ++e) ASSERT_EQ(param_set(*t, param_index("payload_inertia"), e, in[e]), ParamStatus::kOk);
+  const Model<S> want = Model<S>::of(robot::kArm, 0.0, p);
+  const auto& got = t->model.link[kDof - 1];
+  const auto& ref = want.link[kDof - 1];
+  const double tol = std::is_same_v<S, double> ? 0 : 1e-5;  // float and Q round the combination's inputs
+  EXPECT_NEAR(static_cast<double>(got.mass), static_cast<double>(ref.mass), tol);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(static_cast<double>(got.com(k)), static_cast<double>(ref.com(k)), tol);
+    EXPECT_NEAR(static_cast<double>(got.inertia(k)), static_cast<double>(ref.inertia(k)), tol);
+    EXPECT_NEAR(static_cast<double>(got.products(k)), static_cast<double>(ref.products(k)), tol);
+  }
+  EXPECT_FALSE(got.diagonal);
+  EXPECT_NEAR(static_cast<double>(got.mass), robot::kArm.links[kDof - 1].mass + 1.5, 1e-5);
+  // The gravity torque carries the payload: J2 holds its weight.
+  Data<S> d0, d1;
+  const Vec6<S> q = joint_vector<S>(robot::kQStart);
+  const Model<S> bare_model = Model<S>::of(robot::kArm);
+  forward_kinematics(bare_model, d0, q);
+  forward_kinematics(t->model, d1, q);
+  EXPECT_GT(std::fabs(static_cast<double>(gravity_torques(t->model, d1)(1) - gravity_torques(bare_model, d0)(1))), 1.0);
+  // Nothing again: link 6 as it was, bit for bit.
+  ASSERT_EQ(param_set(*t, param_index("payload_mass"), 0, 0.0), ParamStatus::kOk);
+  for (int e = 0; e < 6; ++e) ASSERT_EQ(param_set(*t, param_index("payload_inertia"), 5 - e, 0.0), ParamStatus::kOk);
+  const auto& back = t->model.link[kDof - 1];
+  EXPECT_TRUE(back.mass == bare.mass && back.com == bare.com && back.inertia == bare.inertia &&
+              back.products == bare.products && back.diagonal == bare.diagonal);
+}
+TEST(Parameters, APayloadIsTheModelsLinkSixDouble) { payload_sets_link_six<double>(); }
+TEST(Parameters, APayloadIsTheModelsLinkSixFloat) { payload_sets_link_six<float>(); }
+TEST(Parameters, APayloadIsTheModelsLinkSixFixed) { payload_sets_link_six<Fixed>(); }
+
+// Issue 57's bad payloads, each refused by name with nothing changed: a mass below 0 or beyond the arm's
+// rating, a centre of mass outside the stated envelope, NaN, an inertia no body has, and any of them
+// under torque.
+TEST(Parameters, ABadPayloadIsRefusedByName) {
+  auto t = disabled_task<double>();
+  const int mass = param_index("payload_mass"), com = param_index("payload_com"), in = param_index("payload_inertia");
+  const double rating = robot::kPayloadRating.mass, reach = robot::kPayloadRating.com_reach;
+  EXPECT_EQ(param_set(*t, mass, 0, -0.1), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, mass, 0, rating * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, mass, 0, std::numeric_limits<double>::quiet_NaN()), ParamStatus::kNotFinite);
+  EXPECT_EQ(param_set(*t, com, 2, reach * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, com, 0, -reach * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, com, 3, 0.0), ParamStatus::kBadElement);
+  EXPECT_EQ(param_set(*t, in, 0, -1e-4), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, in, 3, 1e-3), ParamStatus::kNotPhysical);  // a product before its moments
+  ASSERT_EQ(param_set(*t, in, 0, 2e-3), ParamStatus::kOk);
+  ASSERT_EQ(param_set(*t, in, 1, 2e-3), ParamStatus::kOk);
+  EXPECT_EQ(param_set(*t, in, 3, 2.5e-3), ParamStatus::kNotPhysical);  // |Ixy| > sqrt(Ixx Iyy)
+  EXPECT_EQ(param_set(*t, in, 3, 1.5e-3), ParamStatus::kOk);
+  EXPECT_EQ(param_set(*t, mass, 0, rating), ParamStatus::kOk);  // the rating itself
+  EXPECT_DOUBLE_EQ(t->payload.mass, rating);
+  t->machine.state = MotionState::kHolding;
+  EXPECT_EQ(param_set(*t, mass, 0, 1.0), ParamStatus::kTorqueOn);
+  EXPECT_DOUBLE_EQ(t->payload.mass, rating);
+  // A record whose inertia no body has is refused whole.
+  t->machine.state = MotionState::kDisabled;
+  ParamRecord r = param_capture(*t);
+  r.value[param_slot(in) + 4] = 0.004f;  // within its range, but Ixx Izz < Ixz^2
+  EXPECT_EQ(param_apply(*t, r), ParamStatus::kBadRecord);
+  EXPECT_DOUBLE_EQ(t->payload.inertia[4], 0.0);
 }
 
 // The torque-on states are one list (motion_powered): a torque_off parameter is written in exactly the

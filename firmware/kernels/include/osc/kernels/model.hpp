@@ -153,28 +153,50 @@ struct Model {
   }
 
   /// The model of an arm from its description (osc/robots/arm.hpp), with every link mass and
-  /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error).
-  static Model of(const ArmDescription& arm, double mass_inertia_error = 0.0) {
+  /// inertia scaled by (1 + mass_inertia_error) (used to test robustness to model error), and link 6
+  /// carrying `payload` (none by default: the arm's own link, bit for bit).
+  static Model of(const ArmDescription& arm, double mass_inertia_error = 0.0, const Payload& payload = {}) {
     Model m{};
     const double s = 1.0 + mass_inertia_error;
     placement(arm.base, m.base_R, m.base_o);
     m.base_identity = placement_form(arm.base).rotation == Rotation::kIdentity && arm.base.p[0] == 0 &&
                       arm.base.p[1] == 0 && arm.base.p[2] == 0;
     for (int i = 0; i < kDof; ++i) {
-      const LinkParams& p = arm.links[i];
+      LinkParams p = arm.links[i];
+      p.mass *= s;
+      for (double& v : p.inertia) v *= s;
+      if (i == kDof - 1) p = with_payload(p, payload);
       Link& l = m.link[i];
       placement(p.placement, l.R, l.p);
       l.form = placement_form(p.placement);
-      l.mass = lit<S>(p.mass * s);
-      l.com = Vec3<S>(lit<S>(p.com[0]), lit<S>(p.com[1]), lit<S>(p.com[2]));
-      l.inertia = Vec3<S>(lit<S>(p.inertia[0] * s), lit<S>(p.inertia[1] * s), lit<S>(p.inertia[2] * s));
-      l.products = Vec3<S>(lit<S>(p.inertia[3] * s), lit<S>(p.inertia[4] * s), lit<S>(p.inertia[5] * s));
-      l.diagonal = p.inertia[3] == 0 && p.inertia[4] == 0 && p.inertia[5] == 0;
-      cholesky_root(p.inertia, s, m.root_diagonal[i], m.root_lower[i]);
+      m.set_inertial(i, {p.mass,
+                         {p.com[0], p.com[1], p.com[2]},
+                         {p.inertia[0], p.inertia[1], p.inertia[2], p.inertia[3], p.inertia[4], p.inertia[5]}});
       m.armature(i) = lit<S>(p.gear_ratio * p.gear_ratio * p.motor_inertia);
     }
     m.gravity = lit<S>(arm.gravity);
     return m;
+  }
+
+  /// Link i's mass, centre of mass and inertia (and its tensor's Cholesky factor) from a body in its
+  /// frame, in double (set-up, and a payload set at run time: outside the tick).
+  void set_inertial(int i, const RigidBody& b) {
+    Link& l = link[i];
+    l.mass = lit<S>(b.mass);
+    l.com = Vec3<S>(lit<S>(b.com[0]), lit<S>(b.com[1]), lit<S>(b.com[2]));
+    l.inertia = Vec3<S>(lit<S>(b.inertia[0]), lit<S>(b.inertia[1]), lit<S>(b.inertia[2]));
+    l.products = Vec3<S>(lit<S>(b.inertia[3]), lit<S>(b.inertia[4]), lit<S>(b.inertia[5]));
+    l.diagonal = b.inertia[3] == 0 && b.inertia[4] == 0 && b.inertia[5] == 0;
+    cholesky_root(b.inertia, 1.0, root_diagonal[i], root_lower[i]);
+  }
+
+  /// Link i's body as the model has it, in double.
+  RigidBody inertial(int i) const {
+    const Link& l = link[i];
+    const auto d = [](S v) { return static_cast<double>(v); };
+    return {d(l.mass),
+            {d(l.com(0)), d(l.com(1)), d(l.com(2))},
+            {d(l.inertia(0)), d(l.inertia(1)), d(l.inertia(2)), d(l.products(0)), d(l.products(1)), d(l.products(2))}};
   }
 
  private:

@@ -176,6 +176,90 @@ struct CartesianMaxima {
   double jerk;          ///< [m/s^3]
 };
 
+/// What the arm may carry at its flange (frame 6): the rated payload and the envelope its centre of mass
+/// and inertia must lie within. The runtime parameters payload_mass, payload_com and payload_inertia
+/// (osc/runtime/param_table.hpp) are checked against it.
+struct PayloadRating {
+  double mass;       ///< the rated payload [kg]
+  double com_reach;  ///< each coordinate of the payload's centre of mass in frame 6 within +-this [m]
+  double inertia;    ///< each principal moment about its centre of mass at most this [kg m^2]
+};
+
+/// A rigid payload fixed to frame 6 (a tool, a part in the gripper): the model's last link carries it.
+struct Payload {
+  double mass = 0;         ///< [kg]
+  double com[3] = {};      ///< its centre of mass in frame 6 [m]
+  double inertia[6] = {};  ///< about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2]
+};
+
+/// Whether a payload is nothing at all (the model's link 6 is the arm's own, bit for bit).
+constexpr bool payload_empty(const Payload& p) {
+  if (p.mass != 0) return false;
+  for (double v : p.inertia)
+    if (v != 0) return false;
+  return true;
+}
+
+/// One rigid body: a mass, its centre of mass [m] and its inertia about it (Ixx, Iyy, Izz, Ixy, Ixz, Iyz
+/// [kg m^2], tensor entries), all in one frame.
+struct RigidBody {
+  double mass;
+  double com[3];
+  double inertia[6];
+};
+
+/// Two rigid bodies fixed together, in their common frame: the masses add, the centre of mass is the
+/// mass-weighted mean, and each inertia moves to it by the parallel-axis theorem,
+/// I += m (|d|^2 E - d d^T), d the body's offset from the common centre of mass. Both massless: the
+/// centre of mass is the first's.
+constexpr RigidBody combine_bodies(const RigidBody& a, const RigidBody& b) {
+  RigidBody r{a.mass + b.mass, {a.com[0], a.com[1], a.com[2]}, {}};
+  if (r.mass > 0)
+    for (int k = 0; k < 3; ++k) r.com[k] = (a.mass * a.com[k] + b.mass * b.com[k]) / r.mass;
+  for (int k = 0; k < 6; ++k) r.inertia[k] = a.inertia[k] + b.inertia[k];
+  for (const RigidBody* body : {&a, &b}) {
+    const double d[3] = {body->com[0] - r.com[0], body->com[1] - r.com[1], body->com[2] - r.com[2]};
+    const double m = body->mass, dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+    r.inertia[0] += m * (dd - d[0] * d[0]);
+    r.inertia[1] += m * (dd - d[1] * d[1]);
+    r.inertia[2] += m * (dd - d[2] * d[2]);
+    r.inertia[3] -= m * d[0] * d[1];
+    r.inertia[4] -= m * d[0] * d[2];
+    r.inertia[5] -= m * d[1] * d[2];
+  }
+  return r;
+}
+
+/// A link carrying a payload in its own frame (link 6 and frame 6: the payload's frame): its mass,
+/// centre of mass and inertia those of the two bodies together; the placement and drive unchanged.
+/// An empty payload leaves the link as it is, bit for bit.
+constexpr LinkParams with_payload(const LinkParams& link, const Payload& p) {
+  if (payload_empty(p)) return link;
+  const RigidBody a{
+      link.mass,
+      {link.com[0], link.com[1], link.com[2]},
+      {link.inertia[0], link.inertia[1], link.inertia[2], link.inertia[3], link.inertia[4], link.inertia[5]}};
+  const RigidBody b{p.mass,
+                    {p.com[0], p.com[1], p.com[2]},
+                    {p.inertia[0], p.inertia[1], p.inertia[2], p.inertia[3], p.inertia[4], p.inertia[5]}};
+  const RigidBody r = combine_bodies(a, b);
+  LinkParams l = link;
+  l.mass = r.mass;
+  for (int k = 0; k < 3; ++k) l.com[k] = r.com[k];
+  for (int k = 0; k < 6; ++k) l.inertia[k] = r.inertia[k];
+  return l;
+}
+
+/// Whether an inertia tensor (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) is positive semi-definite: its diagonal and
+/// its 2x2 and 3x3 principal minors at least 0 (the model's Cholesky factor needs it; a rigid body's also
+/// meets the triangle inequality, which is not asked, so that its elements can be set one at a time).
+constexpr bool inertia_semidefinite(const double (&t)[6]) {
+  const double xx = t[0], yy = t[1], zz = t[2], xy = t[3], xz = t[4], yz = t[5];
+  if (xx < 0 || yy < 0 || zz < 0) return false;
+  if (xx * yy - xy * xy < 0 || xx * zz - xz * xz < 0 || yy * zz - yz * yz < 0) return false;
+  return xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz) >= 0;
+}
+
 /// A pose an operator can declare the arm to stand at (declare_pose): its name, its joint angles.
 struct NamedPose {
   const char* name;

@@ -209,5 +209,13 @@ constexpr ModelErrorBounds kModelErrorBounds = with_friction_band(
 /// check takes the braking distance, MotionSim.AStreamIntoAJointLimitStopsAtIt).
 constexpr CartesianMaxima kCartesianMaxima = {0.2, 0.4, 2.5};
 
+/// The rated payload at the flange (frame 6) [kg], the reach of its centre of mass in frame 6 (each coordinate) [m],
+/// and the largest principal moment of its inertia [kg m^2]: the runtime parameters payload_*'s ranges.
+/// Estimate: Rated payload: the PUMA 560's commonly quoted 2.5 kg (recalled; not in ../shared/reference/puma560.md),
+/// the largest of issue 57's test payloads. The centre of mass within 0.2 m of the flange in each coordinate (twice
+/// the test payloads' 0.1 m offsets); each principal moment at most 0.05 kg m^2 (2.5 kg at a radius of gyration of
+/// 0.14 m).
+constexpr PayloadRating kPayloadRating = {2.5, 0.2, 0.05};
+
 }  // namespace osc::puma560
 // clang-format on

@@ -181,5 +181,13 @@ constexpr ModelErrorBounds kModelErrorBounds = with_friction_band(
 /// 10 m/s^3 (0.42 m/s reached; J3 at 1.83 of its pi rad/s).
 constexpr CartesianMaxima kCartesianMaxima = {0.1, 0.25, 2.5};
 
+/// The rated payload at the flange (frame 6) [kg], the reach of its centre of mass in frame 6 (each coordinate) [m],
+/// and the largest principal moment of its inertia [kg m^2]: the runtime parameters payload_*'s ranges.
+/// Source: Rated payload 5 kg (Universal Robots, UR5e technical specifications).
+/// Estimate: The centre of mass within 0.2 m of the flange in each coordinate and each principal moment at most 0.1
+/// kg m^2 (5 kg at a radius of gyration of 0.14 m): UR's payload chart derates beyond about 0.1 m, which the firmware
+/// does not model; the envelope only bounds what may be set.
+constexpr PayloadRating kPayloadRating = {5, 0.2, 0.1};
+
 }  // namespace osc::ur5e
 // clang-format on

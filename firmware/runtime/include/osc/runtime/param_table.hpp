@@ -45,6 +45,8 @@ namespace osc {
     "the gains would make the discrete observer unstable at the last computed pose (param check: margin)")        \
   X(UnstableLoop, "unstable_loop",                                                                                \
     "the gains would make the sampled closed loop unstable at the last computed pose (param check: loop margin)") \
+  X(NotPhysical, "not_physical",                                                                                  \
+    "the payload's inertia would not be positive semi-definite (set the moments before the products)")            \
   X(StoreFailed, "store_failed", "the parameter store could not write the record")                                \
   X(NoRecord, "no_record", "load: the store holds no valid record (the values are unchanged)")                    \
   X(LayoutMismatch, "layout_mismatch", "load: the stored record is of another table layout (values unchanged)")   \
@@ -83,6 +85,14 @@ constexpr double kZeros[kDof] = {};
 constexpr double kPotsWired = has_pots(robot::kDriveTrain) ? 1 : 0;
 /// The drive_check parameter's default and largest value: 1 where the arm is described with current monitors.
 constexpr double kCurrentWired = has_current_monitors(robot::kDriveTrain) ? 1 : 0;
+/// The payload's envelope (robot::kPayloadRating): its centre of mass within +-com_reach in each
+/// coordinate of frame 6; its moments within [0, inertia], its products within +-inertia.
+constexpr double kPayloadComLo = -robot::kPayloadRating.com_reach;
+constexpr double kPayloadInertiaLo[6] = {
+    0, 0, 0, -robot::kPayloadRating.inertia, -robot::kPayloadRating.inertia, -robot::kPayloadRating.inertia};
+constexpr double kPayloadInertiaHi[6] = {robot::kPayloadRating.inertia, robot::kPayloadRating.inertia,
+                                         robot::kPayloadRating.inertia, robot::kPayloadRating.inertia,
+                                         robot::kPayloadRating.inertia, robot::kPayloadRating.inertia};
 /// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
 /// configured move maxima.
 constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
@@ -120,7 +130,16 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     "the drive check's test dither on each DAC code, a fraction of its full scale (0: off: a DAC frozen at rest "     \
     "is not found)")                                                                                                  \
   X(DitherHalfPeriod, "dither_half_period", 1, "ticks", 2, 8, params::kDitherHalfPeriod, TorqueOff, true,             \
-    "the test dither's half period: a square wave of 1000 / (2 n) Hz (n = 4: 125 Hz)")
+    "the test dither's half period: a square wave of 1000 / (2 n) Hz (n = 4: 125 Hz)")                                \
+  X(PayloadMass, "payload_mass", 1, "kg", 0, robot::kPayloadRating.mass, 0, TorqueOff, true,                          \
+    "the payload's mass at the flange (a tool, a part in the gripper): the model's link 6 carries it, up to the "     \
+    "arm's rating")                                                                                                   \
+  X(PayloadCom, "payload_com", 3, "m", detail::kPayloadComLo, robot::kPayloadRating.com_reach, 0, TorqueOff, true,    \
+    "the payload's centre of mass in frame 6 (the flange), each coordinate within the arm's stated reach")            \
+  X(PayloadInertia, "payload_inertia", 6, "kg m^2", detail::kPayloadInertiaLo, detail::kPayloadInertiaHi, 0,          \
+    TorqueOff, true,                                                                                                  \
+    "the payload's inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz; positive "           \
+    "semi-definite (else not_physical): set the moments before the products")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),

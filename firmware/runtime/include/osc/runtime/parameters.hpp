@@ -76,6 +76,13 @@ template <class S>
 void limit_set(JerkLimits<S>& l, int e, double v) {
   (e == 0 ? l.v : e == 1 ? l.a : l.j) = static_cast<S>(v);
 }
+/// The payload p with element e of parameter `which` (payload_mass, _com or _inertia) set to v.
+inline Payload payload_with(Payload p, RuntimeParam which, int e, double v) {
+  if (which == RuntimeParam::kParamPayloadMass) p.mass = v;
+  if (which == RuntimeParam::kParamPayloadCom) p.com[e] = v;
+  if (which == RuntimeParam::kParamPayloadInertia) p.inertia[e] = v;
+  return p;
+}
 }  // namespace detail
 
 /// Element e of parameter i's default: a gain's paper value (Gains::paper), a runtime parameter's
@@ -123,6 +130,12 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return task.dither_fraction;
     case RuntimeParam::kParamDitherHalfPeriod:
       return task.dither_half;
+    case RuntimeParam::kParamPayloadMass:
+      return task.payload.mass;
+    case RuntimeParam::kParamPayloadCom:
+      return task.payload.com[e];
+    case RuntimeParam::kParamPayloadInertia:
+      return task.payload.inertia[e];
     case RuntimeParam::kCount:
       break;
   }
@@ -176,6 +189,11 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
       break;
     case RuntimeParam::kParamDitherHalfPeriod:
       task.dither_half = static_cast<std::uint8_t>(v);
+      break;
+    case RuntimeParam::kParamPayloadMass:
+    case RuntimeParam::kParamPayloadCom:
+    case RuntimeParam::kParamPayloadInertia:
+      task.set_payload(detail::payload_with(task.payload, p.runtime, e, v));
       break;
     case RuntimeParam::kCount:
       break;
@@ -257,6 +275,9 @@ ParamStatus param_set(ControlTask<S>& task, int i, int e, double v, GainMargins*
   if (s != ParamStatus::kOk) return s;
   const ParamInfo& p = kParams[i];
   if (p.access == ParamAccess::kTorqueOff && !param_torque_off(task)) return ParamStatus::kTorqueOn;
+  if (p.runtime == RuntimeParam::kParamPayloadInertia &&
+      !inertia_semidefinite(detail::payload_with(task.payload, p.runtime, e, v).inertia))
+    return ParamStatus::kNotPhysical;
   if (p.gain >= 0) {
     const GainMargins m = param_margins(task, i, e, v);
     if (margins) *margins = m;
@@ -287,6 +308,9 @@ inline ParamRecord param_defaults() {
   return r;
 }
 
+/// The payload inertia's index in kParams.
+constexpr int kPayloadInertiaParam = param_index("payload_inertia");
+
 /// Applies a record when every value is valid and the gains keep the observer stable (else nothing
 /// changes: bad_record, unstable_observer). Needs the torque off.
 template <class S>
@@ -295,6 +319,9 @@ ParamStatus param_apply(ControlTask<S>& task, const ParamRecord& r) {
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e)
       if (param_value_status<S>(i, e, r.value[param_slot(i) + e]) != ParamStatus::kOk) return ParamStatus::kBadRecord;
+  double inertia[6];
+  for (int e = 0; e < 6; ++e) inertia[e] = r.value[param_slot(kPayloadInertiaParam) + e];
+  if (!inertia_semidefinite(inertia)) return ParamStatus::kBadRecord;
   Gains<double> g = task.gains.template cast<double>();
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count && kParams[i].gain >= 0; ++e)

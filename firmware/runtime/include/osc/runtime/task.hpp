@@ -91,6 +91,11 @@ struct ControlTask {
   std::uint8_t dither_half;   // its half period [ticks] (parameter dither_half_period)
   std::uint8_t dither_phase;  // the ticks of the current sign so far
   std::int8_t dither_now;     // the current sign
+  // The payload link 6 carries (parameters payload_*: set_payload), and link 6 without it (with its
+  // tensor's Cholesky factor), from which set_payload builds the model's link 6 again.
+  Payload payload;
+  typename Model<S>::Link link6;
+  Vec3<S> link6_root[2];
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -146,6 +151,26 @@ struct ControlTask {
     timing = {};
     step_timing = {};
     stages = {};
+    payload = {};
+    link6 = model.link[kDof - 1];
+    link6_root[0] = model.root_diagonal[kDof - 1];
+    link6_root[1] = model.root_lower[kDof - 1];
+  }
+  /// The payload at the flange (osc/robots/arm.hpp, Payload): the model's link 6 becomes link 6 and
+  /// the payload together (combine_bodies), which the model's every use then sees: the controller's
+  /// inertia and gravity, the observer, the residual monitor and its thresholds, the path checks. No
+  /// payload: link 6 as init had it, bit for bit. Outside the tick, with the torque off (the
+  /// parameters' access), in double: compiled for size.
+  [[gnu::cold]] void set_payload(const Payload& p) {
+    payload = p;
+    model.link[kDof - 1] = link6;
+    model.root_diagonal[kDof - 1] = link6_root[0];
+    model.root_lower[kDof - 1] = link6_root[1];
+    if (payload_empty(p)) return;
+    const RigidBody load{p.mass,
+                         {p.com[0], p.com[1], p.com[2]},
+                         {p.inertia[0], p.inertia[1], p.inertia[2], p.inertia[3], p.inertia[4], p.inertia[5]}};
+    model.set_inertial(kDof - 1, combine_bodies(model.inertial(kDof - 1), load));
   }
   /// The encoders and coupling of the arm (osc/robots/arm.hpp, EncoderMap): the angles, the
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
