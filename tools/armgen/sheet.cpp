@@ -30,12 +30,13 @@ class Reader {
       throw Error("sheet_missing_field", "no " + child_path(key) + " in " + (path_.empty() ? "the sheet" : path_));
     return {n, child_path(key)};
   }
-  /// The keys of a map, each one of `allowed` (sheet_unknown_field).
-  void only(std::initializer_list<const char*> allowed) const {
+  /// The keys of a map, each one of `allowed` (sheet_unknown_field): a braced list of names, or a container.
+  template <class C = std::initializer_list<const char*>>
+  void only(const C& allowed) const {
     if (!node_.IsMap()) throw Error("sheet_value", where() + " is not a map");
     for (const auto& kv : node_) {
       const std::string k = kv.first.as<std::string>();
-      if (std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return k == a; }))
+      if (std::none_of(allowed.begin(), allowed.end(), [&](const auto& a) { return k == a; }))
         throw Error("sheet_unknown_field", child_path(k) + " is not a field of the sheet (docs/arms.md)");
     }
   }
@@ -347,6 +348,19 @@ void read_poses(const Reader& r, Sheet& s) {
         throw Error("sheet_value", "poses: the symbol " + p.symbol + " is used twice");
 }
 
+/// A group of positive numbers with its source: each key's value into its field; its text.
+Text positive_group(const Reader& r, const char* group, std::initializer_list<std::pair<const char*, Value*>> fields) {
+  const Reader g = r.at(group);
+  std::vector<const char*> keys{"source", "estimate"};
+  for (const auto& [key, v] : fields) keys.push_back(key);
+  g.only(keys);
+  for (const auto& [key, v] : fields) {
+    *v = g.at(key).value();
+    require_positive(*v, g.child_path(key));
+  }
+  return g.text();
+}
+
 void read_rest(const Reader& r, Sheet& s) {
   const Reader op = r.at("operational_point");
   op.only({"frame", "xyz", "rpy", "source", "estimate"});
@@ -361,25 +375,11 @@ void read_rest(const Reader& r, Sheet& s) {
   }
   s.op_text = op.text();
 
-  const Reader c = r.at("cartesian_maxima");
-  c.only({"velocity", "acceleration", "jerk", "source", "estimate"});
-  s.cart_velocity = c.at("velocity").value();
-  s.cart_acceleration = c.at("acceleration").value();
-  s.cart_jerk = c.at("jerk").value();
-  for (const auto& [key, v] : {std::pair{"velocity", s.cart_velocity}, std::pair{"acceleration", s.cart_acceleration},
-                               std::pair{"jerk", s.cart_jerk}})
-    require_positive(v, c.child_path(key));
-  s.cart_text = c.text();
-
-  const Reader pl = r.at("payload");
-  pl.only({"mass", "com_reach", "inertia", "source", "estimate"});
-  s.payload_mass = pl.at("mass").value();
-  s.payload_com_reach = pl.at("com_reach").value();
-  s.payload_inertia = pl.at("inertia").value();
-  for (const auto& [key, v] : {std::pair{"mass", s.payload_mass}, std::pair{"com_reach", s.payload_com_reach},
-                               std::pair{"inertia", s.payload_inertia}})
-    require_positive(v, pl.child_path(key));
-  s.payload_text = pl.text();
+  s.cart_text =
+      positive_group(r, "cartesian_maxima",
+                     {{"velocity", &s.cart_velocity}, {"acceleration", &s.cart_acceleration}, {"jerk", &s.cart_jerk}});
+  s.payload_text = positive_group(
+      r, "payload", {{"mass", &s.payload_mass}, {"com_reach", &s.payload_com_reach}, {"inertia", &s.payload_inertia}});
 }
 
 }  // namespace
