@@ -139,6 +139,18 @@ constexpr double kExcitationSin[kDof][kExcitationHarmonics] = {{0, 0, 0, 0, 0}, 
 /// torque-prediction error 1.1, 4.3, 9.4 and 16 %, the mass 0.34, 0.09, 0.16 and 0.54 % off, the centre of mass
 /// 0.20, 0.16, 1.1 and 3.4 mm. w^2 = 3948 fits Q12.19.
 constexpr double kIdentifyFilterOmega = 2 * kPi * 10;
+/// The identification run's estimate (osc/control/identify_estimate.hpp). At least kIdentifyMinSamples samples: a
+/// joint's residual variance from 200 degrees of freedom is within sqrt(2 / 200) = 10 % of itself, so that a
+/// coefficient's reported 2 sigma is a normal one. The column-normalised information matrix's condition at most
+/// kIdentifyMaxCondition (the regressor's 316): the excitation gives 4 600-5 500 at the PUMA's start pose, 14 000 at
+/// the smallest scale its plan accepts (0.512), most of it each joint's Coulomb / Stribeck split (2 700-4 600 at
+/// 1.3 rad/s: test_identify_estimate.cpp); a joint that does not move or two columns alike are far beyond. Every
+/// joint's torque-prediction error (the rms residual over the rms of the torque the model leaves) at most
+/// kIdentifyMaxPredictionError: Servotronix softMC's RelTeMax default, 20 %
+/// (shared/reference/drives-and-identification.md section 7.4).
+constexpr unsigned kIdentifyMinSamples = 200;
+constexpr double kIdentifyMaxCondition = 1e5;
+constexpr double kIdentifyMaxPredictionError = 0.2;
 
 /// Supervision limits.
 /// How far an encoder reading may lie outside the joint limits (overtravel to the hard stops)

@@ -1,0 +1,337 @@
+// The identification run's estimate (issue 57): the 18 friction coefficients of model (2) and optionally a payload's
+// inertial parameters (osc/kernels/payload.hpp) by weighted least squares over the run's samples, each with an honest
+// standard deviation, and the run's verdict by name.
+//
+// The regression. At a sample, for each joint i (the signals through the run's filter, identify_filter.hpp),
+//   y_i = F tau_i - tau_rb,i(q_f, qd_f, qdd_f) = w_i^T theta_i + Y_i pi + e_i,
+// y_i the torque the model leaves (the caller forms it), w_i the joint's filtered friction columns (vis, cou, sti),
+// theta_i = (vis_i, cou_i, sti_i), Y_i the payload regressor's row and pi the payload's parameters, all ten or the
+// subset a mask selects. A run that moves estimates all ten: about the flange a payload's inertia is mostly
+// m |c|^2 (1.5 kg at 87 mm: 0.012 of its 0.014 kg m^2), and left out it goes into the friction and the centre of
+// mass (on the excitation 2.3 mm, 0.16 %, a friction coefficient 9 %: test_identify_estimate.cpp); the mass and
+// first moments alone (payload_mask::kMassAndMoment) are for poses held still. Friction is per joint (Property 4),
+// the payload common to all: the information matrix is block-arrowed, the friction blocks coupled only through pi.
+//
+// The sums. Per joint, of phi = (w_i, Y_i) (13 columns): the symmetric block sum phi phi^T, its right-hand side
+// sum phi y, sum y^2 and the count. In double on every target: a run's 10^4 samples of products of regressors
+// spanning 10^3 in size need more than float's 24 bits or Q12.19's resolution, and an accumulator that rounds a
+// sample's share away biases the estimate; the samples arrive at 100 Hz at most, outside the control tick. Any
+// parameter vector's residual sum of squares per joint follows from them: RSS_i = sum y^2 - 2 x^T b_i + x^T M_i x.
+//
+// The solve (solve()). The unknowns x = [theta; pi's selected entries] (theta in FrictionParams::theta's order: vis,
+// cou, sti, each per joint), the normal equations sum_i M_i / s_i^2 x = sum_i b_i / s_i^2 assembled from the blocks,
+// weighted per joint by its residual variance s_i^2 = RSS_i / (n - p_i), p_i = 3 + n_pi / 6 (its own
+// coefficients and an equal share of the payload's, so that the p_i sum to the unknowns): unweighted first (s_i =
+// 1), then weighted with the variances of its residuals, then once more with the weighted solution's (Gautier's
+// weighted least squares). Each solve factors the column-normalised matrix H = D A D (D = diag(A)^-1/2, unit
+// diagonal) as L D' L^T (LdltFactor, no pivoting: H is positive definite when the motion excites every column; it
+// is not when a column is zero or a combination of others). Payload entries the mask leaves out are rows of the
+// identity: their eigenvalue 1 lies between H's extremes, so they change neither the solution nor the condition.
+//
+// What it reports (IdentifyReport). Each coefficient with its standard deviation sqrt(kappa (A^-1)_jj), A the
+// weighted information matrix and its inverse's diagonal by solves (A^-1 = D H^-1 D, column j of H^-1 solved
+// for e_j). kappa >= 1 is the caller's factor for correlated samples: noise alike in neighbouring samples carries
+// less information than as many independent ones, and A counts them as independent. For noise white before the
+// run's filter and samples every d ticks it is identify::noise_correlation_factor(d) (12.7 at 5 ms: the coverage
+// of 2 sigma is 95 % with it and 45 % without, test_identify_estimate.cpp); 1 for independent samples; for noise
+// coloured at the motion's own frequencies (a model error) more, which no factor from the filter knows. The
+// condition number of H, estimated by power iterations on H and on H^-1 (through the factor), each until its
+// Rayleigh quotient moves by less than 1e-6: a lower bound (within 1e-5 of the eigenvalues' ratio in the test),
+// reported with the upper bound ||H||_inf trace(H^-1). Per joint the residual rms sqrt(RSS_i / n) and the
+// torque-prediction error, the rms residual over the rms of y_i. Each coefficient's verdict by the excitation monitor's
+// rule (friction_identified, osc/control/identification.hpp: identified when its standard deviation is at most
+// params::kIdentifiedFraction of its value), the payload's entries too (an entry near 0, a first moment along an
+// axis the centre of mass is on, is never identified by a relative rule, however well it is known). The status, the
+// first of: kNotFinite (a sample or the solution not finite; such a sample is not summed), kTooFewSamples (fewer than
+// params::kIdentifyMinSamples), kIllConditioned (H not positive definite or its condition above
+// params::kIdentifyMaxCondition), kPredictionError (a joint's prediction error above
+// params::kIdentifyMaxPredictionError), else kOk.
+//
+// Size and cost: the sums 8.6 kB, the solve's workspace (H and its factor, members so that the board's stack
+// does not hold them) 13 kB; a sample 6 x 91 multiply-adds with the payload's ten (6 x 6 without); a solve three
+// factorisations of 28 x 28, 28 solves and at most 2 x 200 power iterations, once per run. No heap.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+#include "osc/control/identification.hpp"
+#include "osc/control/params.hpp"
+#include "osc/kernels/friction.hpp"
+#include "osc/kernels/opspace.hpp"
+#include "osc/kernels/payload.hpp"
+
+namespace osc {
+
+/// Which of pi's entries a run estimates: bit k for pi(k) (payload.hpp's order: m, hx, hy, hz, Ixx, Ixy, Ixz, Iyy,
+/// Iyz, Izz).
+namespace payload_mask {
+constexpr std::uint16_t kNone = 0;
+constexpr std::uint16_t kMass = 0x001;
+constexpr std::uint16_t kMassAndMoment = 0x00F;  ///< m and h = m c: the mass and the centre of mass
+constexpr std::uint16_t kAll = 0x3FF;
+}  // namespace payload_mask
+
+/// A run's verdict (IdentifyReport::status), the first that applies.
+enum class IdentifyStatus : std::uint8_t {
+  kOk = 0,
+  kTooFewSamples,    ///< fewer than params::kIdentifyMinSamples
+  kIllConditioned,   ///< the columns (nearly) dependent: condition above params::kIdentifyMaxCondition
+  kPredictionError,  ///< a joint's torque-prediction error above params::kIdentifyMaxPredictionError
+  kNotFinite         ///< a sample or the solution not finite
+};
+
+/// A coefficient's verdict.
+enum class CoefficientVerdict : std::uint8_t {
+  kIdentified,   ///< its standard deviation within params::kIdentifiedFraction of its value
+  kNotExcited,   ///< estimated, but the motion did not pin it down that far
+  kNotEstimated  ///< a payload entry the mask left out (reported as 0)
+};
+
+/// What solve() found. Coefficients in SI units, their standard deviations likewise (+inf where none could be had).
+struct IdentifyReport {
+  IdentifyStatus status = IdentifyStatus::kNotFinite;
+  Vec18<double> friction = Vec18<double>::Zero();  ///< theta = [vis; cou; sti], FrictionParams::theta's order
+  Vec18<double> friction_sd = Vec18<double>::Zero();
+  PayloadVector<double> payload = PayloadVector<double>::Zero();  ///< pi (0 where not estimated)
+  PayloadVector<double> payload_sd = PayloadVector<double>::Zero();
+  std::array<CoefficientVerdict, 3 * kDof> friction_verdict{};
+  std::array<CoefficientVerdict, 10> payload_verdict{};
+  /// The column-normalised information matrix's condition by power iterations (from below), and ||H||_inf
+  /// trace(H^-1) (from above); +inf where H is singular, 0 where no solve ran (too few samples, not finite).
+  double condition = 0;
+  double condition_bound = 0;
+  Vec6<double> noise_sd = Vec6<double>::Zero();          ///< the s_i the solution was weighted with [N m]
+  Vec6<double> residual_rms = Vec6<double>::Zero();      ///< sqrt(RSS_i / n) [N m]
+  Vec6<double> prediction_error = Vec6<double>::Zero();  ///< rms residual / rms y_i
+  double worst_prediction_error = 0;
+  int worst_joint = -1;
+  std::uint32_t samples = 0;
+};
+
+namespace identify {
+constexpr int kJointColumns = 13;                 // a joint's phi: its 3 friction columns and the payload's 10
+constexpr int kUnknowns = 3 * kDof + 10;          // theta and pi
+constexpr int kPowerIterations = 200;             // the condition's estimate: at most, each way
+constexpr double kPowerTolerance = 1e-6;          // ... or until the Rayleigh quotient moves less than this (relative)
+constexpr double kVarianceFloor = 1e-24;          // [N^2 m^2]: a joint whose model fits exactly still gets a weight
+constexpr double kRelativeVarianceFloor = 1e-12;  // ... and at least this of its mean square
+
+/// Where a joint's local column l (0-2 friction, 3-12 pi) sits among the unknowns.
+constexpr int unknown_index(int joint, int l) { return l < 3 ? l * kDof + joint : 3 * kDof + l - 3; }
+}  // namespace identify
+
+/// The batch weighted least-squares estimate of a run (the file comment).
+class IdentifyEstimate {
+ public:
+  using JointMatrix = Eigen::Matrix<double, identify::kJointColumns, identify::kJointColumns>;
+  using JointVector = Eigen::Matrix<double, identify::kJointColumns, 1>;
+  using Matrix = Eigen::Matrix<double, identify::kUnknowns, identify::kUnknowns>;
+  using Vector = Eigen::Matrix<double, identify::kUnknowns, 1>;
+
+  explicit IdentifyEstimate(std::uint16_t payload = payload_mask::kNone) { reset(payload); }
+
+  /// Clears the sums; `payload` selects pi's entries (payload_mask).
+  void reset(std::uint16_t payload) {
+    mask_ = static_cast<std::uint16_t>(payload & payload_mask::kAll);
+    columns_ = 0;
+    for (int l = 0; l < identify::kJointColumns; ++l)
+      if (l < 3 || (mask_ >> (l - 3) & 1u)) column_[columns_++] = l;
+    for (int i = 0; i < kDof; ++i) M_[i].setZero(), b_[i].setZero();
+    yy_.setZero();
+    n_ = 0;
+    not_finite_ = false;
+  }
+
+  /// One sample: y_i (the torque the model leaves, per joint), the filtered friction columns, and the payload
+  /// regressor (its rows Y_i; ignored where the mask selects nothing). A sample with a value that is not finite
+  /// is not summed, and the run's status is kNotFinite.
+  template <class S>
+  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, const PayloadRegressor<S>& Y) {
+    double phi[kDof][identify::kJointColumns], yd[kDof];
+    bool finite = true;
+    for (int i = 0; i < kDof; ++i) {
+      yd[i] = static_cast<double>(y(i));
+      phi[i][0] = static_cast<double>(w.vis(i)), phi[i][1] = static_cast<double>(w.cou(i));
+      phi[i][2] = static_cast<double>(w.sti(i));
+      for (int k = 0; k < 10; ++k) phi[i][3 + k] = static_cast<double>(Y(i, k));
+      for (int c = 0; c < columns_; ++c) finite = finite && std::isfinite(phi[i][column_[c]]);
+      finite = finite && std::isfinite(yd[i]);
+    }
+    if (!finite) {
+      not_finite_ = true;
+      return;
+    }
+    for (int i = 0; i < kDof; ++i) accumulate(i, phi[i], yd[i]);
+    ++n_;
+  }
+  /// A sample without a payload regressor (friction only: the mask selects nothing).
+  template <class S>
+  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w) {
+    add(y, w, PayloadRegressor<S>(PayloadRegressor<S>::Zero()));
+  }
+
+  std::uint32_t samples() const { return n_; }
+  std::uint16_t mask() const { return mask_; }
+
+  /// The estimate, its uncertainty and the run's verdict (the file comment). correlation_factor: kappa >= 1, the
+  /// variance factor of correlated samples (identify::noise_correlation_factor of the decimation).
+  IdentifyReport solve(double correlation_factor = 1) {
+    IdentifyReport r;
+    r.samples = n_;
+    if (not_finite_) return failed(r, IdentifyStatus::kNotFinite);
+    if (n_ < params::kIdentifyMinSamples) return failed(r, IdentifyStatus::kTooFewSamples);
+    Vec6<double> variance = Vec6<double>::Ones(), weights = variance;
+    Vector x = Vector::Zero();
+    for (int pass = 0; pass < 3; ++pass) {  // unweighted, then weighted twice
+      if (!factor(variance)) {              // singular: a column never excited, or a combination of others
+        r.condition = r.condition_bound = std::numeric_limits<double>::infinity();
+        return failed(r, IdentifyStatus::kIllConditioned);
+      }
+      x = D_.cwiseProduct(ldlt_.solve(D_.cwiseProduct(rhs_)));
+      weights = variance;
+      for (int i = 0; i < kDof; ++i) variance(i) = residual_variance(i, x);
+    }
+    r.noise_sd = weights.cwiseSqrt();
+    report(r, x, correlation_factor);
+    return r;
+  }
+
+ private:
+  void accumulate(int i, const double* phi, double y) {
+    for (int a = 0; a < columns_; ++a) {
+      const int la = column_[a];
+      for (int c = a; c < columns_; ++c) M_[i](la, column_[c]) += phi[la] * phi[column_[c]];
+      b_[i](la) += phi[la] * y;
+    }
+    yy_(i) += y * y;
+  }
+
+  /// Joint i's local parameters (its theta_i and pi) out of the unknowns.
+  JointVector local(int i, const Vector& x) const {
+    JointVector v = JointVector::Zero();
+    for (int c = 0; c < columns_; ++c) v(column_[c]) = x(identify::unknown_index(i, column_[c]));
+    return v;
+  }
+  /// Joint i's residual sum of squares at x, from the sums (never below 0: the sums' rounding).
+  double rss(int i, const Vector& x) const {
+    const JointVector v = local(i, x);
+    const double s = yy_(i) - 2 * v.dot(b_[i]) + v.dot(M_[i].selfadjointView<Eigen::Upper>() * v);
+    return s > 0 ? s : 0;
+  }
+  double degrees_of_freedom() const { return static_cast<double>(n_) - 3 - (columns_ - 3) / static_cast<double>(kDof); }
+  /// s_i^2 = RSS_i / (n - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
+  double residual_variance(int i, const Vector& x) const {
+    const double v = rss(i, x) / degrees_of_freedom(), floor = identify::kRelativeVarianceFloor * yy_(i) / n_;
+    return std::max(v, std::max(floor, identify::kVarianceFloor));
+  }
+
+  /// The weighted normal equations A x = rhs_, assembled in H_ and column-normalised there (H = D A D, D_ the
+  /// scaling), and H_'s factor.
+  bool factor(const Vec6<double>& variance) {
+    H_.setZero();
+    rhs_.setZero();
+    for (int i = 0; i < kDof; ++i)
+      for (int a = 0; a < columns_; ++a) {
+        const int la = column_[a], ga = identify::unknown_index(i, la);
+        for (int c = 0; c < columns_; ++c) {
+          const int lc = column_[c];
+          H_(ga, identify::unknown_index(i, lc)) += (a <= c ? M_[i](la, lc) : M_[i](lc, la)) / variance(i);
+        }
+        rhs_(ga) += b_[i](la) / variance(i);
+      }
+    for (int k = 0; k < identify::kUnknowns; ++k) {
+      if (!(H_(k, k) > 0)) H_(k, k) = estimated(k) ? 0 : 1;  // a column never excited stays 0: H is singular
+      D_(k) = H_(k, k) > 0 ? 1 / std::sqrt(H_(k, k)) : 1;
+    }
+    for (int c = 0; c < identify::kUnknowns; ++c)
+      for (int r = 0; r < identify::kUnknowns; ++r) H_(r, c) *= D_(r) * D_(c);
+    ldlt_.compute(H_);
+    return ldlt_.positive;
+  }
+
+  bool estimated(int k) const { return k < 3 * kDof || (mask_ >> (k - 3 * kDof) & 1u); }
+
+  /// The report of the solution x, H_'s factor that of its weights (the file comment's "What it reports").
+  void report(IdentifyReport& r, const Vector& x, double kappa) const {
+    Vector sd = Vector::Zero();
+    double trace = 0;  // of H^-1
+    for (int k = 0; k < identify::kUnknowns; ++k)
+      if (estimated(k)) {
+        const double h = ldlt_.solve(Vector::Unit(k))(k);  // (H^-1)_kk
+        trace += h;
+        sd(k) = D_(k) * std::sqrt(kappa * h);
+      }
+    r.friction = x.head<3 * kDof>(), r.friction_sd = sd.head<3 * kDof>();
+    r.payload = x.tail<10>(), r.payload_sd = sd.tail<10>();
+    for (int k = 0; k < identify::kUnknowns; ++k) {
+      const CoefficientVerdict v = !estimated(k)                      ? CoefficientVerdict::kNotEstimated
+                                   : friction_identified(x(k), sd(k)) ? CoefficientVerdict::kIdentified
+                                                                      : CoefficientVerdict::kNotExcited;
+      (k < 3 * kDof ? r.friction_verdict[k] : r.payload_verdict[k - 3 * kDof]) = v;
+    }
+    for (int i = 0; i < kDof; ++i) {
+      const double e = rss(i, x);
+      r.residual_rms(i) = std::sqrt(e / n_);
+      const double inf = std::numeric_limits<double>::infinity();
+      r.prediction_error(i) = yy_(i) > 0 ? std::sqrt(e / yy_(i)) : (e > 0 ? inf : 0);
+      if (r.worst_joint < 0 || !(r.prediction_error(i) <= r.worst_prediction_error))
+        r.worst_joint = i, r.worst_prediction_error = r.prediction_error(i);
+    }
+    r.condition = extreme_eigenvalue(false) * extreme_eigenvalue(true);  // lambda_max / lambda_min
+    r.condition_bound = H_.cwiseAbs().rowwise().sum().maxCoeff() * trace;
+    const bool finite = math::all_finite(x) && math::all_finite(sd) && std::isfinite(r.condition);
+    r.status = !finite                                                              ? IdentifyStatus::kNotFinite
+               : !(r.condition <= params::kIdentifyMaxCondition)                    ? IdentifyStatus::kIllConditioned
+               : !(r.worst_prediction_error <= params::kIdentifyMaxPredictionError) ? IdentifyStatus::kPredictionError
+                                                                                    : IdentifyStatus::kOk;
+  }
+
+  /// H_'s largest eigenvalue by power iterations, or (inverse) H^-1's, through the factor: the Rayleigh quotient,
+  /// which rises towards it, until it moves by less than kPowerTolerance of itself.
+  double extreme_eigenvalue(bool inverse) const {
+    Vector v;
+    for (int k = 0; k < identify::kUnknowns; ++k) v(k) = 1 + static_cast<double>(k) / identify::kUnknowns;
+    v.normalize();
+    double lambda = 0;
+    for (int it = 0; it < identify::kPowerIterations; ++it) {
+      const Vector w = inverse ? ldlt_.solve(v) : Vector(H_ * v);
+      const double next = v.dot(w);
+      v = w / w.norm();
+      const bool settled = std::abs(next - lambda) <= identify::kPowerTolerance * next;
+      lambda = next;
+      if (settled) break;
+    }
+    return lambda;
+  }
+
+  /// A report without a solution: no standard deviations, nothing identified.
+  IdentifyReport& failed(IdentifyReport& r, IdentifyStatus s) const {
+    r.status = s;
+    r.friction_sd.setConstant(std::numeric_limits<double>::infinity());
+    r.friction_verdict.fill(CoefficientVerdict::kNotExcited);
+    for (int k = 0; k < 10; ++k) {
+      const bool on = estimated(3 * kDof + k);
+      r.payload_sd(k) = on ? std::numeric_limits<double>::infinity() : 0;
+      r.payload_verdict[k] = on ? CoefficientVerdict::kNotExcited : CoefficientVerdict::kNotEstimated;
+    }
+    return r;
+  }
+
+  JointMatrix M_[kDof];  // upper triangles of the selected columns
+  JointVector b_[kDof];
+  Vec6<double> yy_;
+  std::uint32_t n_ = 0;
+  bool not_finite_ = false;
+  std::uint16_t mask_ = 0;
+  int column_[identify::kJointColumns] = {};  // the selected local columns, in order
+  int columns_ = 0;
+  Matrix H_;  // the solve's workspace
+  Vector D_, rhs_;
+  LdltFactor<double, identify::kUnknowns> ldlt_;
+};
+
+}  // namespace osc
