@@ -24,9 +24,9 @@
 // coefficients and an equal share of the payload's, so that the p_i sum to the unknowns): unweighted first (s_i =
 // 1), then weighted with the variances of its residuals, then once more with the weighted solution's (Gautier's
 // weighted least squares). Each solve factors the column-normalised matrix H = D A D (D = diag(A)^-1/2, unit
-// diagonal) as L D' L^T (LdltFactor, no pivoting: H is positive definite when the motion excites every column; it
-// is not when a column is zero or a combination of others). Payload entries the mask leaves out are rows of the
-// identity: their eigenvalue 1 lies between H's extremes, so they change neither the solution nor the condition.
+// diagonal) as L D' L^T (identify::PackedLdlt, no pivoting: H is positive definite when the motion excites every
+// column; it is not when a column is zero or a combination of others). Payload entries the mask leaves out are rows of
+// the identity: their eigenvalue 1 lies between H's extremes, so they change neither the solution nor the condition.
 //
 // What it reports (IdentifyReport). Each coefficient with its standard deviation sqrt(kappa (A^-1)_jj), A the
 // weighted information matrix and its inverse's diagonal by solves (A^-1 = D H^-1 D, column j of H^-1 solved
@@ -47,9 +47,9 @@
 // params::kIdentifyMaxCondition), kPredictionError (a joint's prediction error above
 // params::kIdentifyMaxPredictionError), else kOk.
 //
-// Size and cost: the sums 8.6 kB, the solve's workspace (H and its factor, members so that the board's stack
-// does not hold them) 13 kB; a sample 6 x 91 multiply-adds with the payload's ten (6 x 6 without); a solve three
-// factorisations of 28 x 28, 28 solves and at most 2 x 200 power iterations, once per run. No heap.
+// Size and cost: the sums 8.8 kB, the solve's workspace (H and its factor packed in one matrix, a member so that the
+// board's stack does not hold it) 6.5 kB; a sample 6 x 91 multiply-adds with the payload's ten (6 x 6 without); a solve
+// three factorisations of 28 x 28, 28 solves and at most 2 x 200 power iterations, once per run. No heap.
 #pragma once
 
 #include <algorithm>
@@ -61,7 +61,6 @@
 #include "osc/control/identification.hpp"
 #include "osc/control/params.hpp"
 #include "osc/kernels/friction.hpp"
-#include "osc/kernels/opspace.hpp"
 #include "osc/kernels/payload.hpp"
 
 namespace osc {
@@ -122,6 +121,57 @@ constexpr double kRelativeVarianceFloor = 1e-12;  // ... and at least this of it
 
 /// Where a joint's local column l (0-2 friction, 3-12 pi) sits among the unknowns.
 constexpr int unknown_index(int joint, int l) { return l < 3 ? l * kDof + joint : 3 * kDof + l - 3; }
+
+using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+using Vector = Eigen::Matrix<double, kUnknowns, 1>;
+
+/// H = L D L^T of a symmetric matrix H, packed in one matrix: H in its upper triangle and diagonal, L's strict
+/// lower part below (its unit diagonal implied), D apart. No pivoting (H positive definite); a pivot at most
+/// kUnknowns epsilon, H's diagonal being 1 (column-normalised), is singular to working precision. Loops, not
+/// LdltFactor (osc/kernels/opspace.hpp), which unrolls each row for the tick's 6 x 6: at 28 x 28 the estimate's code
+/// took 72 kB of an M4F build with it and takes 12 kB with this, for a factorisation that runs three times a run;
+/// and H and its factor share the 6.3 kB.
+struct PackedLdlt {
+  Matrix m;
+  Vector d;
+
+  bool factor() {
+    for (int j = 0; j < kUnknowns; ++j) {
+      double dj = m(j, j);
+      for (int k = 0; k < j; ++k) dj -= m(j, k) * m(j, k) * d(k);
+      if (!(dj > kUnknowns * std::numeric_limits<double>::epsilon())) return false;
+      d(j) = dj;
+      for (int i = j + 1; i < kUnknowns; ++i) {
+        double v = m(j, i);  // H(i, j), from the upper triangle
+        for (int k = 0; k < j; ++k) v -= m(i, k) * m(j, k) * d(k);
+        m(i, j) = v / dj;
+      }
+    }
+    return true;
+  }
+  /// H^-1 b: L y = b, then L^T x = D^-1 y.
+  Vector solve(const Vector& b) const {
+    Vector x = b;
+    for (int i = 1; i < kUnknowns; ++i)
+      for (int k = 0; k < i; ++k) x(i) -= m(i, k) * x(k);
+    x = x.cwiseQuotient(d);
+    for (int i = kUnknowns - 2; i >= 0; --i)
+      for (int k = i + 1; k < kUnknowns; ++k) x(i) -= m(k, i) * x(k);
+    return x;
+  }
+  /// H v, from the upper triangle.
+  Vector times(const Vector& v) const { return m.selfadjointView<Eigen::Upper>() * v; }
+  /// ||H||_inf, its largest row sum of magnitudes.
+  double norm_inf() const {
+    double largest = 0;
+    for (int r = 0; r < kUnknowns; ++r) {
+      double sum = 0;
+      for (int c = 0; c < kUnknowns; ++c) sum += std::abs(r <= c ? m(r, c) : m(c, r));
+      largest = std::max(largest, sum);
+    }
+    return largest;
+  }
+};
 }  // namespace identify
 
 /// The batch weighted least-squares estimate of a run (the file comment).
@@ -129,8 +179,7 @@ class IdentifyEstimate {
  public:
   using JointMatrix = Eigen::Matrix<double, identify::kJointColumns, identify::kJointColumns>;
   using JointVector = Eigen::Matrix<double, identify::kJointColumns, 1>;
-  using Matrix = Eigen::Matrix<double, identify::kUnknowns, identify::kUnknowns>;
-  using Vector = Eigen::Matrix<double, identify::kUnknowns, 1>;
+  using Vector = identify::Vector;
 
   explicit IdentifyEstimate(std::uint16_t payload = payload_mask::kNone) { reset(payload); }
 
@@ -191,7 +240,7 @@ class IdentifyEstimate {
         r.condition = r.condition_bound = std::numeric_limits<double>::infinity();
         return failed(r, IdentifyStatus::kIllConditioned);
       }
-      x = D_.cwiseProduct(ldlt_.solve(D_.cwiseProduct(rhs_)));
+      x = D_.cwiseProduct(f_.solve(D_.cwiseProduct(rhs_)));
       weights = variance;
       for (int i = 0; i < kDof; ++i) variance(i) = residual_variance(i, x);
     }
@@ -229,39 +278,39 @@ class IdentifyEstimate {
     return std::max(v, std::max(floor, identify::kVarianceFloor));
   }
 
-  /// The weighted normal equations A x = rhs_, assembled in H_ and column-normalised there (H = D A D, D_ the
-  /// scaling), and H_'s factor.
+  /// The weighted normal equations A x = rhs_, assembled in f_'s upper triangle and column-normalised there (H = D
+  /// A D, D_ the scaling), and H's factor.
   bool factor(const Vec6<double>& variance) {
-    H_.setZero();
+    identify::Matrix& H = f_.m;
+    H.setZero();
     rhs_.setZero();
     for (int i = 0; i < kDof; ++i)
       for (int a = 0; a < columns_; ++a) {
         const int la = column_[a], ga = identify::unknown_index(i, la);
-        for (int c = 0; c < columns_; ++c) {
+        for (int c = a; c < columns_; ++c) {  // la <= lc, and ga <= gc: the upper triangle
           const int lc = column_[c];
-          H_(ga, identify::unknown_index(i, lc)) += (a <= c ? M_[i](la, lc) : M_[i](lc, la)) / variance(i);
+          H(ga, identify::unknown_index(i, lc)) += M_[i](la, lc) / variance(i);
         }
         rhs_(ga) += b_[i](la) / variance(i);
       }
     for (int k = 0; k < identify::kUnknowns; ++k) {
-      if (!(H_(k, k) > 0)) H_(k, k) = estimated(k) ? 0 : 1;  // a column never excited stays 0: H is singular
-      D_(k) = H_(k, k) > 0 ? 1 / std::sqrt(H_(k, k)) : 1;
+      if (!(H(k, k) > 0)) H(k, k) = estimated(k) ? 0 : 1;  // a column never excited stays 0: H is singular
+      D_(k) = H(k, k) > 0 ? 1 / std::sqrt(H(k, k)) : 1;
     }
     for (int c = 0; c < identify::kUnknowns; ++c)
-      for (int r = 0; r < identify::kUnknowns; ++r) H_(r, c) *= D_(r) * D_(c);
-    ldlt_.compute(H_);
-    return ldlt_.positive;
+      for (int r = 0; r <= c; ++r) H(r, c) *= D_(r) * D_(c);
+    return f_.factor();
   }
 
   bool estimated(int k) const { return k < 3 * kDof || (mask_ >> (k - 3 * kDof) & 1u); }
 
-  /// The report of the solution x, H_'s factor that of its weights (the file comment's "What it reports").
+  /// The report of the solution x, f_ the factor of its weights (the file comment's "What it reports").
   void report(IdentifyReport& r, const Vector& x, double kappa) const {
     Vector sd = Vector::Zero();
     double trace = 0;  // of H^-1
     for (int k = 0; k < identify::kUnknowns; ++k)
       if (estimated(k)) {
-        const double h = ldlt_.solve(Vector::Unit(k))(k);  // (H^-1)_kk
+        const double h = f_.solve(Vector::Unit(k))(k);  // (H^-1)_kk
         trace += h;
         sd(k) = D_(k) * std::sqrt(kappa * h);
       }
@@ -282,7 +331,7 @@ class IdentifyEstimate {
         r.worst_joint = i, r.worst_prediction_error = r.prediction_error(i);
     }
     r.condition = extreme_eigenvalue(false) * extreme_eigenvalue(true);  // lambda_max / lambda_min
-    r.condition_bound = H_.cwiseAbs().rowwise().sum().maxCoeff() * trace;
+    r.condition_bound = f_.norm_inf() * trace;
     const bool finite = math::all_finite(x) && math::all_finite(sd) && std::isfinite(r.condition);
     r.status = !finite                                                              ? IdentifyStatus::kNotFinite
                : !(r.condition <= params::kIdentifyMaxCondition)                    ? IdentifyStatus::kIllConditioned
@@ -290,7 +339,7 @@ class IdentifyEstimate {
                                                                                     : IdentifyStatus::kOk;
   }
 
-  /// H_'s largest eigenvalue by power iterations, or (inverse) H^-1's, through the factor: the Rayleigh quotient,
+  /// H's largest eigenvalue by power iterations, or (inverse) H^-1's, through the factor: the Rayleigh quotient,
   /// which rises towards it, until it moves by less than kPowerTolerance of itself.
   double extreme_eigenvalue(bool inverse) const {
     Vector v;
@@ -298,7 +347,7 @@ class IdentifyEstimate {
     v.normalize();
     double lambda = 0;
     for (int it = 0; it < identify::kPowerIterations; ++it) {
-      const Vector w = inverse ? ldlt_.solve(v) : Vector(H_ * v);
+      const Vector w = inverse ? f_.solve(v) : f_.times(v);
       const double next = v.dot(w);
       v = w / w.norm();
       const bool settled = std::abs(next - lambda) <= identify::kPowerTolerance * next;
@@ -329,9 +378,8 @@ class IdentifyEstimate {
   std::uint16_t mask_ = 0;
   int column_[identify::kJointColumns] = {};  // the selected local columns, in order
   int columns_ = 0;
-  Matrix H_;  // the solve's workspace
+  identify::PackedLdlt f_;  // the solve's workspace: H and its factor
   Vector D_, rhs_;
-  LdltFactor<double, identify::kUnknowns> ldlt_;
 };
 
 }  // namespace osc
