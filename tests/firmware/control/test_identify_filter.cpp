@@ -205,14 +205,14 @@ TEST(IdentifyFilter, ItIsTheContinuousFilterDrivenByTheSamplesJoinedByStraightLi
 namespace {
 /// F's response to a step of U taken between ticks 0 and 1 (the hold's line from 0 to U over the first tick), at t
 /// since tick 0: the step response s(t) = U (1 - e^-wt (1 + wt)) averaged over [t - dt, t], its integral
-/// S(t) = U (t - (2 - e^-wt (2 + wt)) / w), so y = (S(t) - S(t - dt)) / dt, yd = (s(t) - s(t - dt)) / dt and ydd
-/// = (s'(t) - s'(t - dt)) / dt with s'(t) = U w^2 t e^-wt.
+/// integral(t) = U (t - (2 - e^-wt (2 + wt)) / w), so y = (integral(t) - integral(t - dt)) / dt, yd = (s(t) - s(t -
+/// dt)) / dt and ydd = (s'(t) - s'(t - dt)) / dt with s'(t) = U w^2 t e^-wt.
 struct StepReference {
   double U;
-  double S(double t) const { return t <= 0 ? 0 : U * (t - (2 - std::exp(-kW * t) * (2 + kW * t)) / kW); }
+  double integral(double t) const { return t <= 0 ? 0 : U * (t - (2 - std::exp(-kW * t) * (2 + kW * t)) / kW); }
   double s(double t) const { return t <= 0 ? 0 : U * (1 - std::exp(-kW * t) * (1 + kW * t)); }
   double sd(double t) const { return t <= 0 ? 0 : U * kW * kW * t * std::exp(-kW * t); }
-  double y(double t) const { return (S(t) - S(t - kT)) / kT; }
+  double y(double t) const { return (integral(t) - integral(t - kT)) / kT; }
   double yd(double t) const { return (s(t) - s(t - kT)) / kT; }
   double ydd(double t) const { return (sd(t) - sd(t - kT)) / kT; }
 };
@@ -243,8 +243,8 @@ void step_response(double U, double tolerance[3]) {
 
 TEST(IdentifyFilter, AStepIsItsClosedForm) {
   // A step of 0.5 rad in an angle's channel over 1 s (its qdd_f starts at w^2 U = 1974 rad/s^2, within Q12.19).
-  // double: the closed form's own rounding (S(t) - S(t - dt) of values up to 0.5 over dt). float: the states may
-  // stop up to 8 ulps (0.5e-6 rad at 0.5 rad) short of the held input, times w and w^2 for the derivatives;
+  // double: the closed form's own rounding (integral(t) - integral(t - dt) of values up to 0.5 over dt). float: the
+  // states may stop up to 8 ulps (0.5e-6 rad at 0.5 rad) short of the held input, times w and w^2 for the derivatives;
   // Q12.19: the output's rounding (1e-6), Q5.26's 8 LSB (1.2e-7) times w and w^2. Budgets about twice the
   // measured.
   double d[3] = {1e-11, 1e-10, 1e-8}, f[3] = {2e-6, 1e-4, 1e-2}, x[3] = {2e-6, 2e-5, 2e-3};

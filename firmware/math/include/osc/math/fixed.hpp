@@ -15,7 +15,9 @@
 //             (angles, positions, velocities, forces, torques, inertias, gains, time).
 //   FixedIo = Q<12> (Q19.12, range +-524288, resolution 2.4e-4): hardware units at the I/O boundary
 //             (encoder counts, counts per radian, DAC codes): math::io_scalar_t<Fixed>.
-//   Q1.30 in 32 bits and Q30 / Q61 in 64 bits: inside the elementary functions only.
+//   Q1.30 in 32 bits and Q30 / Q61 in 64 bits: inside the elementary functions (and Q1.30 for
+//   the coefficients, Q5.26, Q6.25 and Q9.22 for the states of the identification filter:
+//   osc/control/identify_filter.hpp).
 // The elementary functions (sin, cos, exp, atan2, asin, sqrt) take and return Q<F>; their maximum
 // errors against double over the whole input range are stated at each and tested in
 // tests/firmware/math/test_q_functions.cpp.
