@@ -122,9 +122,10 @@ std::vector<Vec6<double>> noisy(std::uint16_t mask, std::uint64_t seed, const Ve
 IdentifyReport estimate(std::uint16_t mask, const std::vector<Vec6<double>>& y, double kappa = 1) {
   static_assert(sizeof(IdentifyEstimate) < 16 * 1024, "identify_estimate.hpp's stated size: 8.8 + 6.5 kB");
   static IdentifyEstimate e;
+  const std::vector<Sample>& d = design();
+  test::NoMalloc guard;  // the sums and the solve: no heap
   e.reset(mask);
-  for (std::size_t k = 0; k < y.size(); ++k) e.add(y[k], design()[k].w, design()[k].Y);
-  test::NoMalloc guard;
+  for (std::size_t k = 0; k < y.size(); ++k) e.add(y[k], d[k].w, d[k].Y);
   return e.solve(kappa);
 }
 
