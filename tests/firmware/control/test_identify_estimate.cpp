@@ -45,7 +45,7 @@ const Model<double>& model() {
 const FrictionParams<double> kFriction = FrictionParams<double>::from(*robot::kFrictionPresets[0], params::kTauDec);
 constexpr double kBoxI[3] = {1.5 / 12 * (0.08 * 0.08 + 0.05 * 0.05), 1.5 / 12 * (0.12 * 0.12 + 0.05 * 0.05),
                              1.5 / 12 * (0.12 * 0.12 + 0.08 * 0.08)};
-const PayloadBody kPayload = {1.5, {0.03, -0.02, 0.08}, {kBoxI[0], kBoxI[1], kBoxI[2], 0, 0, 0}};
+const Payload kPayload = {1.5, {0.03, -0.02, 0.08}, {kBoxI[0], kBoxI[1], kBoxI[2], 0, 0, 0}};
 const PayloadVector<double> kTruePi = PayloadParams<double>::from(kPayload).vector();
 
 /// pi with only the entries of `mask` (what data whose payload has only those make of it).
@@ -515,7 +515,7 @@ struct PayloadErrors {
   double mass, com;
 };
 PayloadErrors payload_errors(const IdentifyReport& r) {
-  const PayloadBody b = PayloadParams<double>::of(r.payload).body();
+  const Payload b = PayloadParams<double>::of(r.payload).body();
   const Eigen::Vector3d c(b.com[0], b.com[1], b.com[2]), truth(kPayload.com[0], kPayload.com[1], kPayload.com[2]);
   return {std::abs(b.mass / kPayload.mass - 1), (c - truth).norm()};
 }

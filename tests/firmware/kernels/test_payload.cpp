@@ -45,8 +45,8 @@ struct RandomPayloads {
   std::mt19937_64 rng{57};
   std::uniform_real_distribution<double> u{0.0, 1.0};
 
-  PayloadBody next() {
-    PayloadBody b{};
+  Payload next() {
+    Payload b{};
     b.mass = 0.1 + 4.9 * u(rng);
     Eigen::Vector3d c;
     do c = Eigen::Vector3d(2 * u(rng) - 1, 2 * u(rng) - 1, 2 * u(rng) - 1);
@@ -64,14 +64,14 @@ struct RandomPayloads {
   }
 };
 
-KDL::RigidBodyInertia kdl_inertia(const PayloadBody& b) {
+KDL::RigidBodyInertia kdl_inertia(const Payload& b) {
   const double* I = b.inertia;
   return KDL::RigidBodyInertia(b.mass, KDL::Vector(b.com[0], b.com[1], b.com[2]),
                                KDL::RotationalInertia(I[0], I[1], I[2], I[3], I[4], I[5]));
 }
 
 /// The arm's chain with the payload as one more rigid segment, its frame frame 6's (identity placement).
-KDL::Chain with_payload(const PayloadBody& b) {
+KDL::Chain with_payload(const Payload& b) {
   KDL::Chain chain = test::puma560_chain();
   chain.addSegment(KDL::Segment(KDL::Joint(KDL::Joint::None), KDL::Frame::Identity(), kdl_inertia(b)));
   return chain;
@@ -98,7 +98,7 @@ TEST(PayloadKdl, RegressorTimesParametersIsKdlsInverseDynamicsWithLessWithoutThe
   double worst = 0, smallest = 1e9, largest = 0;
   for (int k = 0; k < kStates; ++k) {
     const Vec6<double> q = rs.q_nonsingular(), qd = rs.vec(2.0), qdd = rs.vec(5.0);
-    const PayloadBody b = payloads.next();
+    const Payload b = payloads.next();
     const KDL::Chain chain = with_payload(b);
     KDL::ChainIdSolver_RNE id(chain, kGravityVec);
     KDL::JntArray t_with(kDof), t_without(kDof);
@@ -131,7 +131,7 @@ TEST(PayloadKdl, AtRestItIsTheWeightThroughKdlsJacobianTransposeAndTheInertiaDoe
   double worst = 0;
   for (int k = 0; k < 200; ++k) {
     const Vec6<double> q = rs.q_nonsingular();
-    const PayloadBody b = payloads.next();
+    const Payload b = payloads.next();
     KDL::Frame F;
     KDL::Jacobian J(kDof);
     ASSERT_GE(fk.JntToCart(to_kdl(q), F), 0);
@@ -182,7 +182,7 @@ TEST(PayloadKdl, TheFlangeMotionIsTheNewtonEulerPassAndTheRegressorIsLinearInThe
 TEST(PayloadParams, FromADatasheetIsKdlsRigidBodyInertiaAboutTheFlangeAndBackIsTheDatasheet) {
   RandomPayloads payloads;
   for (int k = 0; k < 1000; ++k) {
-    const PayloadBody b = payloads.next();
+    const Payload b = payloads.next();
     const PayloadParams<double> p = PayloadParams<double>::from(b);
     // KDL keeps a rigid body's inertia about its reference point (the segment's frame, here frame 6).
     const KDL::RigidBodyInertia ref = kdl_inertia(b);
@@ -192,7 +192,7 @@ TEST(PayloadParams, FromADatasheetIsKdlsRigidBodyInertiaAboutTheFlangeAndBackIsT
     const double io[6] = {Io.data[0], Io.data[1], Io.data[2], Io.data[4], Io.data[5], Io.data[8]};  // pi's order
     for (int e = 0; e < 6; ++e) EXPECT_NEAR(p.inertia(e), io[e], 1e-14) << k << " " << e;
     // ... and back.
-    const PayloadBody back = p.body();
+    const Payload back = p.body();
     EXPECT_NEAR(back.mass, b.mass, 1e-15);
     for (int r = 0; r < 3; ++r) EXPECT_NEAR(back.com[r], b.com[r], 1e-15) << k;
     for (int e = 0; e < 6; ++e) EXPECT_NEAR(back.inertia[e], b.inertia[e], 1e-14) << k << " " << e;
@@ -201,7 +201,7 @@ TEST(PayloadParams, FromADatasheetIsKdlsRigidBodyInertiaAboutTheFlangeAndBackIsT
   // No mass, no centre of mass: the inertia stays as it is.
   PayloadParams<double> none;
   none.inertia << 1, 0, 0, 2, 0, 3;
-  const PayloadBody b = none.body();
+  const Payload b = none.body();
   EXPECT_EQ(b.mass, 0);
   EXPECT_EQ(b.com[0], 0);
   EXPECT_EQ(b.inertia[1], 2);

@@ -6,8 +6,9 @@
 // h = m c the first moment (c the payload's centre of mass in frame 6) and I the inertia tensor about the
 // frame-6 origin in frame-6 axes (its entries, not the products of inertia with their minus sign: the
 // convention of LinkParams::inertia and of KDL). Parameters about the origin, not the COM, make the torque
-// linear in them; PayloadParams converts to and from the datasheet's form (mass, COM, inertia about the
-// COM) by the parallel-axis theorem.
+// linear in them; PayloadParams converts to and from the datasheet's form (osc::Payload of
+// osc/robots/arm.hpp: mass, COM, inertia about the COM, the runtime parameters payload_*) by the
+// parallel-axis theorem.
 //
 // Y in three steps, each the textbook's equation:
 //  1. The motion of frame 6 by the forward recursion of the Newton-Euler pass (rnea's, the base accelerating
@@ -35,14 +36,6 @@ using PayloadRegressor = Eigen::Matrix<S, kDof, 10>;  // joint torques = Y pi
 template <class S>
 using WrenchRegressor = Eigen::Matrix<S, 6, 10>;  // [f; n] at the frame-6 origin, frame-6 axes = A pi
 
-/// A payload as a datasheet states it, in LinkParams' form: mass [kg], centre of mass in frame 6 [m], and the
-/// inertia about the centre of mass in frame-6 axes, Ixx, Iyy, Izz, Ixy, Ixz, Iyz [kg m^2]. Set-up only.
-struct PayloadBody {
-  double mass;
-  double com[3];
-  double inertia[6];
-};
-
 /// The payload's inertial parameters pi in the scalar.
 template <class S>
 struct PayloadParams {
@@ -60,7 +53,7 @@ struct PayloadParams {
   }
 
   /// From a datasheet's payload, in double: I_O = I_C + m (|c|^2 E - c c^T) (parallel axes).
-  static PayloadParams from(const PayloadBody& b) {
+  static PayloadParams from(const Payload& b) {
     const double m = b.mass, *c = b.com, *I = b.inertia, c2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
     PayloadParams p;
     p.mass = lit<S>(m);
@@ -73,7 +66,7 @@ struct PayloadParams {
 
   /// Back to a datasheet's form, in double: c = h / m and I_C = I_O - (|h|^2 E - h h^T) / m. A payload
   /// without mass (m <= 0: none, or an estimate below zero) has no centre of mass: c = 0, I_C = I_O.
-  PayloadBody body() const {
+  Payload body() const {
     const double m = static_cast<double>(mass);
     const double h[3] = {static_cast<double>(moment(0)), static_cast<double>(moment(1)),
                          static_cast<double>(moment(2))};
