@@ -508,7 +508,7 @@ void Player<Arm>::observe(double t, const osc::MotionReport& rep) {
     r->accepted = rep.outcome == osc::CommandOutcome::kAccepted;
     if (!r->accepted) r->refused = osc::motion_name(rep.refusal), r->cause = rep.cause;
     const bool motion = rep.verb == osc::MotionVerb::kMoveTo || rep.verb == osc::MotionVerb::kPaper ||
-                        rep.verb == osc::MotionVerb::kStream;
+                        rep.verb == osc::MotionVerb::kStream || rep.verb == osc::MotionVerb::kIdentify;
     r->running = r->accepted && motion;
     // Done at once unless it started a motion or a stop (a stop or disable from holding has nothing to stop).
     if (r->accepted && !motion && state_ != osc::MotionState::kStopping) r->done_s = t;

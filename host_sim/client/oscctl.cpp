@@ -1,7 +1,7 @@
 // oscctl: commands a controller over the command protocol (docs/motion.md, "Clients"), on a serial
 // device or the simulator's pseudo-terminal (osc_sim --pty):
 //
-//   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop
+//   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop | identify
 //   oscctl --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
 //   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative] [--v V --a A --j J]
 //   oscctl --port /dev/pts/7 watch [--seconds S]
@@ -79,7 +79,9 @@ int simple(Client& c, const Args& a, osc::MotionVerb verb) {
   if (o.answer.abort != 0)
     std::printf("aborted %u: %s\n", o.answer.aborted_id,
                 osc::motion_name(static_cast<osc::MotionReason>(o.answer.abort)));
-  if (verb != osc::MotionVerb::kStop && verb != osc::MotionVerb::kDisable && verb != osc::MotionVerb::kHome) return rc;
+  if (verb != osc::MotionVerb::kStop && verb != osc::MotionVerb::kDisable && verb != osc::MotionVerb::kHome &&
+      verb != osc::MotionVerb::kIdentify)
+    return rc;
   return report(c.wait_done(id, a.timeout));
 }
 
@@ -313,8 +315,9 @@ void build(CLI::App& app, Args& a) {
       ->check(CLI::Range(0.0, 0.4));
   app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
   // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
-  for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
-                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop, osc::MotionVerb::kHome})
+  for (osc::MotionVerb v :
+       {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear, osc::MotionVerb::kPaper,
+        osc::MotionVerb::kStop, osc::MotionVerb::kHome, osc::MotionVerb::kIdentify})
     app.add_subcommand(osc::motion_name(v), osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(v)]);
   std::string poses;
   for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
@@ -363,12 +366,13 @@ int run(Client& c, const Args& a) {
   if (a.verb == "watch") return watch(c, a);
   if (a.verb == "param") return param(c, a);
   if (a.verb == "declare_pose") return declare_pose(c, a);
-  const osc::MotionVerb verb = a.verb == "enable"    ? osc::MotionVerb::kEnable
-                               : a.verb == "disable" ? osc::MotionVerb::kDisable
-                               : a.verb == "clear"   ? osc::MotionVerb::kClear
-                               : a.verb == "paper"   ? osc::MotionVerb::kPaper
-                               : a.verb == "home"    ? osc::MotionVerb::kHome
-                                                     : osc::MotionVerb::kStop;
+  const osc::MotionVerb verb = a.verb == "enable"     ? osc::MotionVerb::kEnable
+                               : a.verb == "disable"  ? osc::MotionVerb::kDisable
+                               : a.verb == "clear"    ? osc::MotionVerb::kClear
+                               : a.verb == "paper"    ? osc::MotionVerb::kPaper
+                               : a.verb == "home"     ? osc::MotionVerb::kHome
+                               : a.verb == "identify" ? osc::MotionVerb::kIdentify
+                                                      : osc::MotionVerb::kStop;
   return simple(c, a, verb);
 }
 
@@ -383,7 +387,8 @@ int main(int argc, char** argv) {
     const std::vector<std::string> extra = app.remaining();
     return app.get_subcommands().empty() && !extra.empty()
                ? extra.front() +
-                     ": not a command (state, enable, disable, clear, paper, stop, home, declare_pose, move, stream, "
+                     ": not a command (state, enable, disable, clear, paper, stop, home, identify, declare_pose, move, "
+                     "stream, "
                      "watch, "
                      "param)"
                : std::string(e.what());

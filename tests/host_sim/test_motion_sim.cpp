@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "motion_sim.hpp"
+#include "motion_sim_util.hpp"
 #include "osc/control/sampled_loop.hpp"
 #include "sampled_loop_reference.hpp"
 #include "test_util.hpp"
@@ -22,81 +23,16 @@ using namespace osc;
 using sim::MotionSim;
 using V3 = sim::Vec3;
 using V6 = sim::Vec6;
+using test::answer;
+using test::answer_move;
+using test::relative;
+using test::run_ticks;
+using test::run_until;
+using test::start_pose;
+using test::state_is;
+using test::Trace;
 
 namespace {
-
-V6 start_pose() {
-  V6 q;
-  for (int i = 0; i < 6; ++i) q(i) = robot::kQStart[i];
-  return q;
-}
-
-/// What a run of ticks saw.
-struct Trace {
-  int ticks = 0;
-  std::uint32_t faults = 0;
-  double tracking = 0;                // largest |reference position - true tip| while torque was on [m]
-  double tip_moved = 0;               // largest |tip - tip at the start of the run| [m]
-  double oscillation = 0;             // the oscillation monitor's largest ratio to its limit, any joint
-  std::vector<MotionReport> reports;  // every tick's report with something in it
-  bool ended = false;                 // the predicate became true
-};
-
-template <class S, class Pred>
-Trace run_until(MotionSim<S>& sim, Pred done, int max_ticks) {
-  Trace r;
-  const V3 tip0 = sim.tip();
-  for (int k = 0; k < max_ticks; ++k) {
-    r.faults |= sim.tick();
-    ++r.ticks;
-    const MotionReport& rep = sim.task().report;
-    if (rep.outcome != CommandOutcome::kNone || rep.completion != MotionCompletion::kNone ||
-        rep.abort != MotionReason::kNone || rep.done_id != 0)
-      r.reports.push_back(rep);
-    if (motion_powered(sim.task().machine.state))
-      r.tracking = std::max(r.tracking, (sim.reference().template head<3>() - sim.tip()).norm());
-    r.tip_moved = std::max(r.tip_moved, (sim.tip() - tip0).norm());
-    for (int i = 0; i < kDof; ++i) r.oscillation = std::max(r.oscillation, sim.task().oscillation.ratio(i));
-    if (done(sim)) {
-      r.ended = true;
-      break;
-    }
-  }
-  return r;
-}
-
-template <class S>
-Trace run_ticks(MotionSim<S>& sim, int n) {
-  return run_until(
-      sim, [](const MotionSim<S>&) { return false; }, n);
-}
-
-/// Sends a command and runs the tick that answers it; returns that tick's report.
-template <class S>
-MotionReport answer(MotionSim<S>& sim, MotionVerb verb, std::uint32_t id) {
-  sim.command(verb, id);
-  sim.tick();
-  return sim.task().report;
-}
-template <class S>
-MotionReport answer_move(MotionSim<S>& sim, const MoveRequest<S>& req, std::uint32_t id) {
-  sim.move_to(req, id);
-  sim.tick();
-  return sim.task().report;
-}
-
-template <class S>
-MoveRequest<S> relative(double dx, double dy, double dz) {
-  MoveRequest<S> r;
-  r.relative = true;
-  r.position = Vec3<S>(static_cast<S>(dx), static_cast<S>(dy), static_cast<S>(dz));
-  return r;
-}
-
-template <class S>
-bool state_is(const MotionSim<S>& sim, MotionState s) {
-  return sim.task().machine.state == s;
-}
 
 TEST(MotionSim, EnableAtRandomPosesHoldsTheArmWithinHalfAMillimetre) {
   std::mt19937 rng(2026);

@@ -25,10 +25,14 @@ TEST(MotionCommands, EachVerbIsItsMachinesCommand) {
                                    {V::kDisable, C::kDisable}, {V::kMoveTo, C::kMove},
                                    {V::kPaper, C::kMove},      {V::kStop, C::kStop},
                                    {V::kClear, C::kClear},     {V::kStream, C::kMove},
-                                   {V::kHome, C::kHome},       {V::kDeclarePose, C::kDeclarePose}};
+                                   {V::kHome, C::kHome},       {V::kDeclarePose, C::kDeclarePose},
+                                   {V::kIdentify, C::kMove}};
   ASSERT_EQ(static_cast<int>(std::size(table)), MotionNames<V>::kCount);
   for (const auto& [v, c] : table) EXPECT_EQ(verb_command(v), c) << motion_name(v);
   EXPECT_EQ(verb_command(static_cast<V>(200)), C::kNone);  // a code outside the list
+  // An identify only as prepare_identify planned it: a bare one is refused.
+  EXPECT_EQ(prepare_command<double>(V::kIdentify, 4).refusal, MotionReason::kBadCommand);
+  EXPECT_EQ(prepare_command<double>(V::kPaper, 4).refusal, MotionReason::kNone);
 }
 
 TEST(MotionCommands, AMoveTargetIsRelativeToWhereItStartsOrAbsolute) {

@@ -1,6 +1,6 @@
 """osc-client: oscctl's verbs over the command protocol, the same lines printed, the same exit status.
 
-    osc-client --port /dev/pts/7 state | enable | disable | clear | paper | stop | home
+    osc-client --port /dev/pts/7 state | enable | disable | clear | paper | stop | home | identify
     osc-client --port /dev/pts/7 declare_pose start | zero | ready | stretch
     osc-client --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
     osc-client --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
@@ -27,7 +27,7 @@ from .text import answer_text, margins_text, param_line, state_change_text, stat
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
 
-SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
+SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home", "identify")
 PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
 
 
@@ -38,7 +38,8 @@ def report(o: Outcome) -> int:
 
 
 def cmd_simple(c: Client, a: argparse.Namespace) -> int:
-    """enable, disable, clear, paper, stop, home: the answer; for stop, disable and home the end too."""
+    """enable, disable, clear, paper, stop, home, identify: the answer; for stop, disable, home and identify the end
+    too."""
     cid = c.command(a.verb)
     o = c.wait_answer(cid, a.timeout)
     rc = report(o)
@@ -47,7 +48,7 @@ def cmd_simple(c: Client, a: argparse.Namespace) -> int:
     abort = c.protocol.name_of(NameList.REASONS, o.answer.abort)
     if abort != "none":  # the motion this command ended (stop, disable)
         print(f"aborted {o.answer.aborted_id}: {abort}", flush=True)
-    if a.verb not in ("stop", "disable", "home"):
+    if a.verb not in ("stop", "disable", "home", "identify"):
         return rc
     return report(c.wait_done(cid, a.timeout))
 

@@ -21,7 +21,7 @@ from .paths import PathPoint
 from .protocol import NameList, Protocol
 from .transport import SerialTransport, Transport
 
-MOTION_VERBS = ("move_to", "paper", "stream", "home")
+MOTION_VERBS = ("move_to", "paper", "stream", "home", "identify")
 """The verbs whose acceptance starts a motion, which ends later (done or aborted)."""
 
 
@@ -143,6 +143,12 @@ class Client:
     def paper(self) -> int:
         """The paper's motion (trajectory (68))."""
         return self.command("paper")
+
+    def identify(self) -> int:
+        """An identification run: the excitation motion about the held joint angles (80 s), planned and checked
+        on the board first (refused by name: out_of_workspace, near_singular, over_limit, unstable_loop);
+        wait_done for its end."""
+        return self.command("identify")
 
     def home(self) -> int:
         """Homing: each motor to its index pulse from the pots' coarse angles; wait_done for its end."""

@@ -17,9 +17,7 @@
 // make the motion start at rest at q0 and, after a whole number of periods, end there at rest
 // (q = q0, qd = qdd = 0), without a step in the jerk either, so that the torque rises smoothly from
 // the holding torque. No offset term and no window: q0 is the series' mean, and every period is the
-// same motion, the first and the last included, so that an identification may average the periods
-// (Swevers' reason for a periodic excitation). (C) leaves three of each joint's five cosine
-// coefficients and three of its five sine coefficients free.
+// same motion (Swevers' reason for a periodic excitation). (C) leaves three of five coefficients free.
 //
 // The design (params::kExcitationCos, kExcitationSin; declared once, checked against (C) below).
 // Joints 1, 3, 5 move with cosines only (their velocities even in t), joints 2, 4, 6 with sines only
@@ -29,8 +27,7 @@
 // 1.31 rad/s) and little correlation between them: the six velocities' correlations are at most 0.60,
 // their Gram matrix's eigenvalues 0.36 to 2.1 (test_excitation.cpp). The two aims pull apart: the
 // least travel per speed puts the power on the 4th and 5th harmonics, where joints become alike. Each
-// joint has its own spectrum, on 3 to 5 harmonics, so no two move in phase. The rows are shapes: the
-// plan scales each to the arm.
+// joint has its own spectrum, so no two move in phase. The rows are shapes: the plan scales each.
 //
 // Fitting the design (ExcitationMotion::plan). Joint i's row is scaled by the largest gain g_i that
 // keeps its peak speed within kExcitationPlanFill of its speed bound and its swing each way within that
@@ -49,20 +46,16 @@
 //                    is lower, less kExcitationSpeedMargin);
 //   kNearSingular    path_check's test (near_singular): the analytic Jacobian's reciprocal condition in
 //                    the controller's orientation coordinates relative to R_ref below kPathMinRcond, or a
-//                    singularity crossed since the sample before. The controller acts in operational
-//                    space, through J^-1, whatever the motion's coordinates, and faults below
-//                    kMinJacobianRcond: a joint-space motion needs the test as much as a move does;
+//                    singularity crossed since the sample before (the controller acts through J^-1
+//                    whatever the motion's coordinates: a joint-space motion needs it as a move does);
+//   kUnstableLoop    with the task's gains given, path_check's sampled-loop test (unstable_loop);
 //   kOverLimit       a joint's |tau| + |tau_f| above kExcitationTorqueFraction of its torque limit:
-//                    tau = A(q) qdd + c(q, qd) + g(q) by the Newton-Euler pass (rnea, armature included),
-//                    tau_f the friction (2) at the model-error band's top without Stribeck decay, the
-//                    strongest the arm may have; the remaining 20 % is the controller's.
-// The refusals are a move's (osc/runtime/motion_states.hpp): a joint limit is out_of_workspace, as in
-// the path check; a speed or a torque over_limit; a singularity near_singular.
-//
-// Cost: planning, a period of the design's samples (a sincos, two 6x10 products each); the check, per
-// tick (P + 1 = 10 001), a forward kinematics, geometric Jacobian and factor, the analytic Jacobian's
-// factor and a Newton-Euler pass; at most four checks. It runs when the command is prepared, outside
-// the tick. In fixed point the flags raised before it are kept and its own discarded (as check_path).
+//                    tau = A qdd + c + g (rnea, armature included), tau_f the friction (2) at the band's
+//                    top without decay, the strongest the arm may have; the other 20 % is the controller's.
+// The refusals are a move's (osc/runtime/motion_states.hpp: out_of_workspace, over_limit, near_singular,
+// unstable_loop). Cost: per tick of the check (P + 1 = 10 001) a forward kinematics, the Jacobians'
+// factors and a Newton-Euler pass (and the loop's test), at most four checks; when the command is
+// prepared, outside the tick. In fixed point the flags raised before it are kept, its own discarded.
 #pragma once
 
 #include <array>
@@ -81,7 +74,8 @@ enum class ExcitationStatus : std::uint8_t {
   kOk = 0,
   kOutOfWorkspace,  ///< a joint within kExcitationPositionMargin of a limit, or too close to one to swing
   kNearSingular,    ///< the Jacobian's reciprocal condition below kPathMinRcond, or a singularity crossed
-  kOverLimit        ///< a joint's speed or torque over its bound
+  kOverLimit,       ///< a joint's speed or torque over its bound
+  kUnstableLoop     ///< the sampled closed loop at the task's gains not stable at a sample (path_check's test)
 };
 
 namespace excitation {
@@ -395,15 +389,20 @@ ExcitationStatus torque_limits(const Model<S>& model, const Data<S>& data, const
 
 /// Checks every tick of `motion` (the file comment's "The check"); R_ref is the controller's reference
 /// orientation, data the kernels' workspace (overwritten). The first failure stops it.
+/// loop: the gains' sampled-loop test at every tick (loop::path_loop, as a move's path check; none: not
+/// judged): an axis whose loop is unstable there fails it (kUnstableLoop), unless it was so at q0 already
+/// and is no lighter (path_check::unstable_loop).
 template <class S>
 ExcitationCheck<S> check_excitation(const Model<S>& model, Data<S>& data, const ExcitationMotion<S>& motion,
-                                    const Mat3<S>& R_ref, const ExcitationLimits<S>& lim) {
+                                    const Mat3<S>& R_ref, const ExcitationLimits<S>& lim,
+                                    const loop::PathLoop* loop = nullptr) {
   const std::uint32_t before = math::take_arithmetic_flags<S>();  // the caller's, put back on return
   ExcitationCheck<S> r;
   r.scale = motion.scale();
   path_check::SingularityTrace<S> trace;
   PathCheck<S> singular;  // near_singular's smallest rcond
   ArmJacobianFactor<S> Jf;
+  path_check::LoopTrace loop_trace;
   for (std::uint32_t n = 0; n <= excitation::kPeriodTicks; ++n) {
     const JointSample<S> d = motion.at_tick(n);
     ExcitationStatus s = excitation::kinematic_limits(d, lim, r);
@@ -411,6 +410,8 @@ ExcitationCheck<S> check_excitation(const Model<S>& model, Data<S>& data, const 
       path_check::evaluate(model, data, Jf, d.q);
       if (path_check::near_singular(data, Jf, R_ref, trace, singular)) s = ExcitationStatus::kNearSingular;
     }
+    if (s == ExcitationStatus::kOk && loop && path_check::unstable_loop(model, data, R_ref, *loop, loop_trace))
+      s = ExcitationStatus::kUnstableLoop;
     if (s == ExcitationStatus::kOk) s = excitation::torque_limits(model, data, d, lim, r);
     if (s != ExcitationStatus::kOk) {
       r.status = s;
@@ -428,7 +429,8 @@ ExcitationCheck<S> check_excitation(const Model<S>& model, Data<S>& data, const 
 /// the motion to run, or the plan's refusal, or the last check's.
 template <class S>
 ExcitationCheck<S> prepare_excitation(const Model<S>& model, Data<S>& data, const Vec6<S>& q0, const Mat3<S>& R_ref,
-                                      const ExcitationLimits<S>& lim, ExcitationMotion<S>& motion) {
+                                      const ExcitationLimits<S>& lim, ExcitationMotion<S>& motion,
+                                      const loop::PathLoop* loop = nullptr) {
   ExcitationCheck<S> r;
   r.status = motion.plan(q0, lim);
   if (r.status != ExcitationStatus::kOk) {
@@ -438,7 +440,7 @@ ExcitationCheck<S> prepare_excitation(const Model<S>& model, Data<S>& data, cons
   S scale(1);
   for (int attempt = 0; attempt < excitation::kAttempts; ++attempt) {
     motion.set_scale(scale);
-    r = check_excitation(model, data, motion, R_ref, lim);
+    r = check_excitation(model, data, motion, R_ref, lim, loop);
     if (r.status == ExcitationStatus::kOk) break;
     scale *= lit<S>(params::kExcitationScaleStep);
   }

@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "osc/control/cartesian_move.hpp"
+#include "osc/control/excitation.hpp"
 #include "osc/control/stream.hpp"
 #include "osc/control/trajectory.hpp"
 
@@ -61,7 +62,15 @@ struct MotionEvents {
   std::uint32_t done_id = 0;
 };
 
-enum class MotionSource : std::uint8_t { kHold, kMove, kPaper, kStream };
+enum class MotionSource : std::uint8_t { kHold, kMove, kPaper, kStream, kExcitation };
+
+/// A tick of an identification run's excitation motion: its joint reference, and whether the motion is
+/// at rest for good (its last period ended, or a brake reached rest).
+template <class S>
+struct ExcitationStep {
+  JointSample<S> ref;
+  bool at_rest_end = false;
+};
 
 template <class S>
 class MotionGenerator {
@@ -100,6 +109,44 @@ class MotionGenerator {
     source_ = MotionSource::kStream;
     stopping_ = braking_ = false;
     count_ = 0;
+  }
+  /// Starts an identification run's excitation motion (osc/control/excitation.hpp: planned and checked about
+  /// the joint angles where the arm holds) at sample `tick`. Its reference is in joint space
+  /// (excitation_at); the runtime maps it to the controller's coordinates (excitation_reference,
+  /// osc/runtime/motion_stage.hpp) and ends it there (excitation_end).
+  void start_excitation(const ExcitationMotion<S>& m, std::uint64_t tick, std::uint32_t id) {
+    excitation_ = m;
+    excitation_id_ = id;
+    excitation_start_ = tick;
+    ++epoch_;
+    source_ = MotionSource::kExcitation;
+    stopping_ = braking_ = false;
+    count_ = 0;
+  }
+  /// The excitation's joint reference at sample `tick`: its own, or, braking, its time slowed to rest
+  /// along its path (as the paper's motion: q(tau), qd tau_dot, qdd tau_dot^2 + qd tau_ddot), which
+  /// keeps to the positions and speeds the check passed (the path is one period's, repeated).
+  ExcitationStep<S> excitation_at(std::uint64_t tick, std::uint32_t rate_hz) const {
+    ExcitationStep<S> e;
+    if (!braking_) {
+      e.ref = excitation_.at_tick(tick - excitation_start_);
+      e.at_rest_end = tick - excitation_start_ >= excitation_.ticks();
+      return e;
+    }
+    const S t = math::ratio<S>(tick - start_tick_, rate_hz);
+    const ProfileState<S> tau = stop_tau_.at(t);
+    e.ref = excitation_.at(tau.p);
+    e.ref.qdd = e.ref.qdd * (tau.v * tau.v) + e.ref.qd * tau.a;
+    e.ref.qd = e.ref.qd * tau.v;
+    e.at_rest_end = !(t < stop_tau_.duration());
+    return e;
+  }
+  /// The excitation at rest for good at `d` (the controller's coordinates of its last reference): done
+  /// (its last period; MotionEvents::done_id) or stopped (a brake), holding there.
+  Desired<S> excitation_end(const Desired<S>& d, MotionEvents& ev) {
+    if (!braking_) ev.done_id = excitation_id_;
+    return end_at_rest({d.x.template head<3>(), Mat3<S>(rpy_rotation<S>(d.x.template tail<3>()) * R_ref_)},
+                       d.x.template tail<3>(), ev);
   }
   /// A setpoint of the running stream (the follower's target x, in the controller's coordinates,
   /// with its rates v or none), for this tick; `end`: its last.
@@ -178,6 +225,8 @@ class MotionGenerator {
       stream_.stop();
     else if (source_ == MotionSource::kMove)
       queue_[head_].stop(t, lim);
+    else if (source_ == MotionSource::kExcitation)
+      stop_tau_ = slow_down(math::ratio<S>(tick - excitation_start_, rate_hz));
     else
       stop_tau_ = paper_slow_down(tick, rate_hz);
     start_tick_ = tick;
@@ -213,6 +262,7 @@ class MotionGenerator {
     if (source_ == MotionSource::kPaper) return paper_at(tick, rate_hz, ev);
     if (source_ == MotionSource::kHold) return hold_d_;
     if (source_ == MotionSource::kStream) return stream_at(ev);
+    if (source_ == MotionSource::kExcitation) return hold_d_;  // in joint space: excitation_at
     S t = math::ratio<S>(tick - start_tick_, rate_hz);
     while (!(t < queue_[head_].duration())) {
       // The running move ended at rest: the next one starts from there in this tick.
@@ -236,6 +286,7 @@ class MotionGenerator {
   std::uint32_t running_id() const {
     if (source_ == MotionSource::kMove) return ids_[head_];
     if (source_ == MotionSource::kStream) return stream_id_;
+    if (source_ == MotionSource::kExcitation) return excitation_id_;
     return source_ == MotionSource::kPaper ? paper_id_ : 0;
   }
   const Pose<S>& hold_pose() const { return hold_pose_; }
@@ -268,12 +319,15 @@ class MotionGenerator {
     return hold_d_;
   }
 
+  /// A motion's time slowed from rate 1 at its time t to rest (the paper's motion, an excitation).
+  static JerkProfile<S> slow_down(S t) {
+    JerkProfile<S> tau;
+    tau.plan_stop(t, S(1), S(0), {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
+    return tau;
+  }
   /// The slow-down of the paper's motion from sample `tick`: its time from rate 1 to rest.
   JerkProfile<S> paper_slow_down(std::uint64_t tick, std::uint32_t rate_hz) const {
-    JerkProfile<S> tau;
-    tau.plan_stop(paper_.time_at_tick(tick, rate_hz), S(1), S(0),
-                  {S(1), lit<S>(kPaperStopRate), lit<S>(kPaperStopJerk)});
-    return tau;
+    return slow_down(paper_.time_at_tick(tick, rate_hz));
   }
   /// The pose of the paper's motion at its time tau: (68) keeps the orientation it started with.
   Pose<S> paper_pose(S tau) const { return {paper_.at_time(tau).x.template head<3>(), hold_pose_.R}; }
@@ -317,6 +371,9 @@ class MotionGenerator {
   CartesianMove<S> queue_[kQueueSlots];
   std::uint32_t ids_[kQueueSlots] = {};
   std::uint32_t paper_id_ = 0;
+  ExcitationMotion<S> excitation_{};
+  std::uint32_t excitation_id_ = 0;
+  std::uint64_t excitation_start_ = 0;
   StreamFollower<S> stream_;
   std::uint32_t stream_id_ = 0;
   bool stream_relative_ = false;

@@ -153,6 +153,7 @@ class CommandPort {
         continue;
       }
       if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone) c = prepare_checked_home(task, f.id);
+      if (c.verb == MotionVerb::kIdentify) c = prepare_identify(task, f.id);
       if (c.verb == MotionVerb::kMoveTo) check_prepared_move(task, c);
       task.pending = c;
       pending_print_ = fingerprint(f);
@@ -192,6 +193,9 @@ class CommandPort {
       }
       if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone)
         c = prepare_home(in.gen, in.home_limits, task.model, task.check_data, task.io, in.q_measured, in.frame.id);
+      if (c.verb == MotionVerb::kIdentify)
+        c = prepare_identify_at(task.model, task.gains, task.check_data, in.q_measured, in.gen.reference_orientation(),
+                                in.frame.id, static_cast<ExcitationCheck<S>*>(nullptr));
       const bool has_path = c.verb == MotionVerb::kMoveTo || c.verb == MotionVerb::kHome;
       if (has_path && c.refusal == MotionReason::kNone) {
         const Vec6<S>& seed = c.brake ? in.q_measured : in.q_queue_end;

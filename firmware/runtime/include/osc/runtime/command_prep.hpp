@@ -7,6 +7,7 @@
 
 #include <cstdint>
 
+#include "osc/control/excitation.hpp"
 #include "osc/control/path_check.hpp"
 #include "osc/runtime/homing.hpp"
 #include "osc/runtime/motion_commands.hpp"
@@ -77,6 +78,51 @@ TaskCommand<S> prepare_checked_home(ControlTask<S>& task, std::uint32_t id) {
       prepare_home(task.gen, home_limits(task), task.model, task.check_data, task.io, task.state.adapt.q_prev, id);
   check_prepared_move(task, c);
   return c;
+}
+
+/// An excitation's check as a refusal (none: it fits): the names a move's path check uses.
+constexpr MotionReason excitation_refusal(ExcitationStatus s) {
+  switch (s) {
+    case ExcitationStatus::kOk:
+      return MotionReason::kNone;
+    case ExcitationStatus::kNearSingular:
+      return MotionReason::kNearSingular;
+    case ExcitationStatus::kOverLimit:
+      return MotionReason::kOverLimit;
+    case ExcitationStatus::kUnstableLoop:
+      return MotionReason::kUnstableLoop;
+    case ExcitationStatus::kOutOfWorkspace:
+      break;
+  }
+  return MotionReason::kOutOfWorkspace;
+}
+
+/// The same about the joint angles q (a paced board's copy of the last measured ones), with the
+/// controller's reference orientation R_ref and its gains (the sampled loop's test, as a move's path
+/// check: unstable_loop), in the workspace `data`.
+template <class S>
+TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains, Data<S>& data, const Vec6<S>& q,
+                                   const Mat3<S>& R_ref, std::uint32_t id, ExcitationCheck<S>* check) {
+  TaskCommand<S> c;
+  c.verb = MotionVerb::kIdentify;
+  c.id = id;
+  const loop::PathLoop loop = loop::path_loop(gains.template cast<double>(), params::kPathLoopMargin);
+  const ExcitationCheck<S> r =
+      prepare_excitation(model, data, q, R_ref, ExcitationLimits<S>::defaults(), c.excitation, &loop);
+  c.refusal = excitation_refusal(r.status);
+  if (check) *check = r;
+  return c;
+}
+
+/// Prepares an identification run outside the tick (like prepare_checked_move): its excitation motion
+/// planned about the last measured joint angles and checked in full (prepare_excitation: limits, speeds,
+/// torques with the model as it is, the payload included, and the Jacobian's condition), refused by
+/// name rather than stopped halfway. Whether the arm holds there (else not_enabled, busy) is the tick's to
+/// decide. `check`, when given, receives the check's report (which joint, which tick, the peaks).
+template <class S>
+TaskCommand<S> prepare_identify(ControlTask<S>& task, std::uint32_t id, ExcitationCheck<S>* check = nullptr) {
+  return prepare_identify_at(task.model, task.gains, task.check_data, task.state.adapt.q_prev, task.state.R_ref, id,
+                             check);
 }
 
 /// Puts a setpoint of stream `id` (with its velocity, or none) into the task's mailbox for the next

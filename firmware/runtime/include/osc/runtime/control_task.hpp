@@ -219,8 +219,12 @@ void stage_reference(ControlTask<S>& task, TickData<S>& t) {
     task.sample.valid = false;
   }
   if (!t.stepped) return;
-  const bool yielding = task.machine.state == MotionState::kYielding;
-  task.desired = yielding ? yield_reference(task) : task.gen.at_tick(task.tick, params::kControlHz, t.ev);
+  if (task.machine.state == MotionState::kYielding)
+    task.desired = yield_reference(task);
+  else if (task.gen.source() == MotionSource::kExcitation)
+    task.desired = excitation_reference(task, t.ev);
+  else
+    task.desired = task.gen.at_tick(task.tick, params::kControlHz, t.ev);
 }
 
 /// step: the control step (observer, controller, adaptation); its stage's time is the step's (step_timing).
@@ -229,6 +233,9 @@ void stage_step(ControlTask<S>& task, TickData<S>& t) {
   if (!t.stepped) return;
   control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired, task.last);
   t.faults |= task.last.status;  // non_finite, singular
+  // An identification run's samples: its own motion only (not its stop's, whose time is slowed).
+  if (task.gen.source() == MotionSource::kExcitation && !task.gen.braking() && task.last.status == kFaultNone)
+    task.identify.tick(task.gen.running_id(), t.q, task.last.tau, task.state.adapt.qd_hat_prev, task.gains.tau_dec);
 }
 
 /// monitors: the drive check (drive_faults: first, the residual monitor's isolation takes its suspects),

@@ -31,7 +31,8 @@ namespace osc {
   X(Clear, "clear", "leave fault for disabled, once no fault cause is present")                               \
   X(Stream, "stream", "follow the setpoint frames that follow, jerk-limited; stale: category-2 stop")         \
   X(Home, "home", "homing: each motor up to one revolution to its index pulse, from the pots' coarse angles") \
-  X(DeclarePose, "declare_pose", "the arm stands at the named pose `pose` (torque off; the pots must agree)")
+  X(DeclarePose, "declare_pose", "the arm stands at the named pose `pose` (torque off; the pots must agree)") \
+  X(Identify, "identify", "an identification run: the excitation about the held angles, checked first")
 
 #define OSC_X_PREFIX k
 OSC_MOTION_ENUM(MotionVerb, OSC_MOTION_VERB_LIST);
@@ -47,6 +48,7 @@ constexpr MotionCommand verb_command(MotionVerb v) {
     case MotionVerb::kMoveTo:
     case MotionVerb::kPaper:
     case MotionVerb::kStream:
+    case MotionVerb::kIdentify:
       return MotionCommand::kMove;
     case MotionVerb::kStop:
       return MotionCommand::kStop;
@@ -92,6 +94,7 @@ struct TaskCommand {
   std::uint32_t period = 1;                    ///< stream: the setpoints' period [ticks]
   bool relative = false;                       ///< stream: setpoints relative to where it starts
   CartesianLimits<S> limits{};                 ///< stream: its limits
+  ExcitationMotion<S> excitation{};            ///< identify: the motion, planned and checked
 };
 
 /// One setpoint of a stream, ready for the next tick (prepare_setpoint): the follower's target in
@@ -150,8 +153,9 @@ TaskCommand<S> prepare_move(const MotionGenerator<S>& gen, const CartesianLimits
     c.refusal = MotionReason::kOverLimit;
     return c;
   }
-  // A move while a stream runs: its end is not known until the stream ends (stop it, or wait).
-  if (gen.source() == MotionSource::kStream) {
+  // A move while a stream or an identification run runs: its end is not known until it ends (stop it,
+  // or wait).
+  if (gen.source() == MotionSource::kStream || gen.source() == MotionSource::kExcitation) {
     c.refusal = MotionReason::kBusy;
     return c;
   }
@@ -223,6 +227,8 @@ TaskCommand<S> prepare_command(MotionVerb verb, std::uint32_t id) {
   TaskCommand<S> c;
   c.verb = verb;
   c.id = id;
+  // An identification run moves only as prepare_identify planned and checked it (osc/runtime/command_prep.hpp).
+  if (verb == MotionVerb::kIdentify) c.refusal = MotionReason::kBadCommand;
   return c;
 }
 

@@ -36,6 +36,25 @@ Desired<S> yield_reference(const ControlTask<S>& task) {
   return d;
 }
 
+/// An identification run's reference (its joint reference, MotionGenerator::excitation_at) in the
+/// controller's coordinates, to first order about the pose of the last step (q its angles, x its
+/// coordinates, J_a its analytic Jacobian, the task's state.os):
+///   x_d = x + J_a (q_r - q),   x_d' = J_a q_r',   x_d'' = J_a q_r'' + Jdot_a(q^')q^',
+/// the last with the last step's velocity product at the observed joint rates (state.psi.jdot_yy). The
+/// neglected terms are second order in q_r - q, one tick's motion and the tracking error (about 2e-3
+/// rad: micrometres), and the controller's (36) error is then J_a (q_r - q), its joint error mapped. The
+/// run's end at rest (its last period, or a stop's) holds there (excitation_end).
+template <class S>
+Desired<S> excitation_reference(ControlTask<S>& task, MotionEvents& ev) {
+  const ExcitationStep<S> e = task.gen.excitation_at(task.tick, params::kControlHz);
+  const Mat6<S>& Ja = task.state.os.Ja;
+  Desired<S> d;
+  d.x = task.state.os.x + Ja * Vec6<S>(e.ref.q - task.state.adapt.q_prev);
+  d.xd = Ja * e.ref.qd;
+  d.xdd = Ja * e.ref.qdd + task.state.psi.jdot_yy;
+  return e.at_rest_end ? task.gen.excitation_end(d, ev) : d;
+}
+
 /// The limits checked every tick of a motion (a category-2 stop when one is reached): each joint
 /// within its limits, the Jacobian's reciprocal condition at least params::kLimitMinRcond. A stream,
 /// whose path no check has judged, is stopped where its stop would end at the limit: each joint
@@ -114,7 +133,11 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   if (coarse && task.pots && pots_settling(task)) return MotionCommand::kNone;
   rep.id = cmd.id;
   rep.verb = cmd.verb;
-  MotionReason pre = cmd.refusal;
+  // An identification run's own refusal (its check's) only where the arm holds: elsewhere the state's
+  // (not_enabled, busy, ...), which say what to do first.
+  MotionReason pre = cmd.verb == MotionVerb::kIdentify && task.machine.state != MotionState::kHolding
+                         ? MotionReason::kNone
+                         : cmd.refusal;
   const bool planned = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome;
   if (pre == MotionReason::kNone && planned && cmd.epoch != task.gen.epoch()) pre = MotionReason::kSuperseded;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kHome && !homing_possible(task))
@@ -122,7 +145,8 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kDeclarePose &&
       task.machine.state == MotionState::kDisabled && pots_disagree(task, q, cmd.pose))
     pre = MotionReason::kPotsDisagree;
-  if (pre == MotionReason::kNone && (cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream) &&
+  if (pre == MotionReason::kNone &&
+      (cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kIdentify) &&
       task.gen.source() != MotionSource::kHold)
     pre = MotionReason::kBusy;
   if (pre == MotionReason::kNone) return verb_command(cmd.verb);
@@ -210,13 +234,10 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   const std::uint64_t next = task.tick + 1;
   const bool accepted = st.outcome == CommandOutcome::kAccepted;
   const TaskCommand<S>& cmd = task.pending;
-  if (accepted && (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper ||
-                   cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kClear))
-    task.contact = false;
-  if (accepted && !motion_running(before) &&
-      (cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper || cmd.verb == MotionVerb::kStream ||
-       cmd.verb == MotionVerb::kHome))
-    motion_limits_from(task, q);
+  const bool motion = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kPaper ||
+                      cmd.verb == MotionVerb::kStream || cmd.verb == MotionVerb::kIdentify;
+  if (accepted && (motion || cmd.verb == MotionVerb::kClear)) task.contact = false;
+  if (accepted && !motion_running(before) && (motion || cmd.verb == MotionVerb::kHome)) motion_limits_from(task, q);
   if (st.enabling) {
     const Vec6<S> q_now = task.homed ? q : coarse_from_pots(task, q);
     controller_restart(task.model, task.state, q_now);
@@ -241,6 +262,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream)
     task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
+  if (accepted && cmd.verb == MotionVerb::kIdentify) task.gen.start_excitation(cmd.excitation, next, cmd.id);
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {

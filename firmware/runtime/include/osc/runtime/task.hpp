@@ -11,6 +11,7 @@
 #include "osc/control/controller.hpp"
 #include "osc/runtime/command_prep.hpp"
 #include "osc/runtime/homing.hpp"
+#include "osc/runtime/identify_run.hpp"
 #include "osc/runtime/io.hpp"
 #include "osc/runtime/monitors.hpp"
 #include "osc/runtime/motion_commands.hpp"
@@ -96,6 +97,8 @@ struct ControlTask {
   Payload payload;
   typename Model<S>::Link link6;
   Vec3<S> link6_root[2];
+  // An identification run's filter and its samples for the main loop (osc/runtime/identify_run.hpp).
+  IdentifySampler<S> identify;
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
@@ -152,6 +155,7 @@ struct ControlTask {
     step_timing = {};
     stages = {};
     payload = {};
+    identify.reset();
     link6 = model.link[kDof - 1];
     link6_root[0] = model.root_diagonal[kDof - 1];
     link6_root[1] = model.root_lower[kDof - 1];

@@ -1,0 +1,99 @@
+// The closed-loop tests' loop over host_sim/motion_sim.hpp (the control task over the simulated arm):
+// run ticks until a predicate holds, collecting what the ticks reported, the tracking and the tip's
+// motion; a command and the tick that answers it. Shared by test_motion_sim.cpp and test_identify_command.cpp.
+#pragma once
+
+#include <algorithm>
+#include <vector>
+
+#include "motion_sim.hpp"
+#include "test_util.hpp"
+
+namespace osc::test {
+
+using sim::MotionSim;
+
+inline sim::Vec6 start_pose() {
+  sim::Vec6 q;
+  for (int i = 0; i < 6; ++i) q(i) = robot::kQStart[i];
+  return q;
+}
+
+/// Where an identification run starts in the tests: the start pose with the wrist bent further on the PUMA
+/// (q5 = 1.3 rad), where the run passes its check at 0.64 of its design. At the start pose itself (q5 = pi/4)
+/// the sampled loop at the paper's gains is unstable on the roll axis somewhere along the run at every scale
+/// the check tries (test_identify_command.cpp): the wrist's swing makes that axis light.
+inline sim::Vec6 identify_pose() {
+  sim::Vec6 q = start_pose();
+  if (kPumaBuild) q(4) = 1.3;
+  return q;
+}
+
+/// What a run of ticks saw.
+struct Trace {
+  int ticks = 0;
+  std::uint32_t faults = 0;
+  double tracking = 0;                // largest |reference position - true tip| while torque was on [m]
+  double tip_moved = 0;               // largest |tip - tip at the start of the run| [m]
+  double oscillation = 0;             // the oscillation monitor's largest ratio to its limit, any joint
+  std::vector<MotionReport> reports;  // every tick's report with something in it
+  bool ended = false;                 // the predicate became true
+};
+
+template <class S, class Pred>
+Trace run_until(MotionSim<S>& sim, Pred done, int max_ticks) {
+  Trace r;
+  const sim::Vec3 tip0 = sim.tip();
+  for (int k = 0; k < max_ticks; ++k) {
+    r.faults |= sim.tick();
+    ++r.ticks;
+    const MotionReport& rep = sim.task().report;
+    if (rep.outcome != CommandOutcome::kNone || rep.completion != MotionCompletion::kNone ||
+        rep.abort != MotionReason::kNone || rep.done_id != 0)
+      r.reports.push_back(rep);
+    if (motion_powered(sim.task().machine.state))
+      r.tracking = std::max(r.tracking, (sim.reference().template head<3>() - sim.tip()).norm());
+    r.tip_moved = std::max(r.tip_moved, (sim.tip() - tip0).norm());
+    for (int i = 0; i < kDof; ++i) r.oscillation = std::max(r.oscillation, sim.task().oscillation.ratio(i));
+    if (done(sim)) {
+      r.ended = true;
+      break;
+    }
+  }
+  return r;
+}
+
+template <class S>
+Trace run_ticks(MotionSim<S>& sim, int n) {
+  return run_until(
+      sim, [](const MotionSim<S>&) { return false; }, n);
+}
+
+/// Sends a command and runs the tick that answers it; returns that tick's report.
+template <class S>
+MotionReport answer(MotionSim<S>& sim, MotionVerb verb, std::uint32_t id) {
+  sim.command(verb, id);
+  sim.tick();
+  return sim.task().report;
+}
+template <class S>
+MotionReport answer_move(MotionSim<S>& sim, const MoveRequest<S>& req, std::uint32_t id) {
+  sim.move_to(req, id);
+  sim.tick();
+  return sim.task().report;
+}
+
+template <class S>
+MoveRequest<S> relative(double dx, double dy, double dz) {
+  MoveRequest<S> r;
+  r.relative = true;
+  r.position = Vec3<S>(static_cast<S>(dx), static_cast<S>(dy), static_cast<S>(dz));
+  return r;
+}
+
+template <class S>
+bool state_is(const MotionSim<S>& sim, MotionState s) {
+  return sim.task().machine.state == s;
+}
+
+}  // namespace osc::test
