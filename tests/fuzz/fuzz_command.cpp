@@ -47,7 +47,7 @@ const osc::CartesianLimits<double> kMax = osc::CartesianLimits<double>::defaults
 
 /// The command checks of docs/protocol.md, written from the document (not from the code).
 bool valid_by_the_document(const pil::CommandFrame& f) {
-  if (f.verb > 9 || (f.flags & 0xF0) != 0) return false;              // verbs 0 to 9: none ... home, declare_pose
+  if (f.verb > 10 || (f.flags & 0xF0) != 0) return false;             // verbs 0 to 10: none ... declare_pose, identify
   if (f.verb == 7 && (f.period < 1 || f.period > 100)) return false;  // stream: 1 to 100 ms
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(f.position[i]) || std::isinf(f.position[i]) || f.position[i] < -10.0f || f.position[i] > 10.0f)
@@ -130,7 +130,11 @@ struct Checker {
     FUZZ_CHECK(c.verb == verb);
     FUZZ_CHECK(static_cast<int>(c.refusal) < osc::MotionNames<MotionReason>::kCount);
     FUZZ_CHECK(std::strcmp(osc::motion_name(c.refusal), "?") != 0);
-    FUZZ_CHECK((c.refusal == MotionReason::kBadCommand) == (why == MotionReason::kBadCommand));
+    // An identify is planned and checked by prepare_identify, which the port calls in its place (its frame
+    // has no fields); prepare_frame_command's own answer for it is bad_command, so that an identify that
+    // skipped that step never moves.
+    const bool unplanned = why == MotionReason::kNone && verb == MotionVerb::kIdentify;
+    FUZZ_CHECK((c.refusal == MotionReason::kBadCommand) == (why == MotionReason::kBadCommand || unplanned));
     // declare_pose: a pose code beyond the document's Poses table (4 poses) is unknown_pose, and only it.
     const bool unknown_pose = why == MotionReason::kNone && verb == MotionVerb::kDeclarePose && f.period >= 4;
     FUZZ_CHECK((c.refusal == MotionReason::kUnknownPose) == unknown_pose);
