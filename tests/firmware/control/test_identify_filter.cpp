@@ -88,12 +88,19 @@ void inputs_at(double t, Vec6<S>& q, Vec6<S>& tau, Vec6<S>& qd) {
   }
 }
 
+/// The filter primed with the inputs at t = 0 (into q, tau, qd), as a run starts at rest.
 template <class S>
-Errors sinusoids_through_the_filter() {
+IdentifyFilter<S> primed_at_start(Vec6<S>& q, Vec6<S>& tau, Vec6<S>& qd) {
   IdentifyFilter<S> f;
-  Vec6<S> q, tau, qd;
   inputs_at<S>(0, q, tau, qd);
   f.prime(q, tau, qd, Vec6<S>::Constant(lit<S>(params::kTauDec)));
+  return f;
+}
+
+template <class S>
+Errors sinusoids_through_the_filter() {
+  Vec6<S> q, tau, qd;
+  IdentifyFilter<S> f = primed_at_start(q, tau, qd);
   Errors e;
   const auto worst = [](double& w, S ours, double ref) { w = std::max(w, std::abs(static_cast<double>(ours) - ref)); };
   for (int n = 1; n <= 10000; ++n) {
@@ -280,10 +287,8 @@ TEST(IdentifyFilter, APrimedFilterHoldsAnArmAtRestWithoutDriftInEveryScalar) {
 /// A joint that moves for 3 s and stops: 2 s after, how far q_f is from where it stopped and what derivatives remain.
 template <class S>
 Errors settles_after_a_stop() {
-  IdentifyFilter<S> f;
   Vec6<S> q, tau, qd;
-  inputs_at<S>(0, q, tau, qd);
-  f.prime(q, tau, qd, Vec6<S>::Constant(lit<S>(params::kTauDec)));
+  IdentifyFilter<S> f = primed_at_start(q, tau, qd);
   for (int n = 1; n <= 3000; ++n) inputs_at<S>(n * kT, q, tau, qd), f.update(q, tau, qd);
   for (int n = 0; n < 2000; ++n) f.update(q, tau, qd);
   const IdentifySignals<S> s = f.signals();
