@@ -130,11 +130,10 @@ struct Checker {
     FUZZ_CHECK(c.verb == verb);
     FUZZ_CHECK(static_cast<int>(c.refusal) < osc::MotionNames<MotionReason>::kCount);
     FUZZ_CHECK(std::strcmp(osc::motion_name(c.refusal), "?") != 0);
-    // An identify is planned and checked by prepare_identify, which the port calls in its place (its frame
-    // has no fields); prepare_frame_command's own answer for it is bad_command, so that an identify that
-    // skipped that step never moves.
-    const bool unplanned = why == MotionReason::kNone && verb == MotionVerb::kIdentify;
-    FUZZ_CHECK((c.refusal == MotionReason::kBadCommand) == (why == MotionReason::kBadCommand || unplanned));
+    FUZZ_CHECK((c.refusal == MotionReason::kBadCommand) == (why == MotionReason::kBadCommand));
+    // An identify moves only as prepare_identify planned and checked it (the port calls it in this one's
+    // place): a frame's own command is never marked checked, so a tick that were given it refuses it.
+    FUZZ_CHECK(!c.checked);
     // declare_pose: a pose code beyond the document's Poses table (4 poses) is unknown_pose, and only it.
     const bool unknown_pose = why == MotionReason::kNone && verb == MotionVerb::kDeclarePose && f.period >= 4;
     FUZZ_CHECK((c.refusal == MotionReason::kUnknownPose) == unknown_pose);

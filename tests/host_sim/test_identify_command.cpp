@@ -188,8 +188,9 @@ TEST(IdentifyCommand, WhatCannotRunIsRefusedByName) {
     EXPECT_EQ(sim.task().report.refusal, MotionReason::kBusy);
     EXPECT_EQ(sim.task().gen.source(), MotionSource::kExcitation);
   }
-  {  // an identify that was not prepared (a bare command): bad_command
+  {  // an identify that was not prepared (a bare command): bad_command, in any state (the tick's flag)
     MotionSim<double> sim(start_pose());
+    EXPECT_EQ(answer(sim, MotionVerb::kIdentify, 4).refusal, MotionReason::kBadCommand);
     enable_and_settle(sim);
     EXPECT_EQ(answer(sim, MotionVerb::kIdentify, 5).refusal, MotionReason::kBadCommand);
     EXPECT_TRUE(state_is(sim, MotionState::kHolding));

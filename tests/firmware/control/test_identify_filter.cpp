@@ -116,8 +116,8 @@ Errors sinusoids_through_the_filter() {
     for (int i = 0; i < kDof; ++i) {
       const double ti = t - 0.1 * i;
       worst(e.q, s.q(i), response(kAngle, kAngleOffset, ti, 0));
-      worst(e.qd, s.qd(i), response(kAngle, 0, ti, 1));
-      worst(e.qdd, s.qdd(i), response(kAngle, 0, ti, 2));
+      worst(e.qd, s.qd(i), response(kSpeed, 0, ti, 0));  // the velocity estimate's, not the angles'
+      worst(e.qdd, s.qdd(i), response(kSpeed, 0, ti, 1));
       worst(e.tau, s.tau(i), response(kTorque, 0, ti, 0));
       worst(e.vis, s.w.vis(i), response(kSpeed, 0, ti, 0));  // the viscous column is qd itself
     }
@@ -128,18 +128,18 @@ Errors sinusoids_through_the_filter() {
 
 void print(const char* what, const Errors& e) {
   std::printf(
-      "%-7s |q_f - Fq| %.2e rad, |qd_f - sFq| %.2e rad/s, |qdd_f - s^2Fq| %.2e rad/s^2, |tau_f - Ftau| %.2e N m, "
+      "%-7s |q_f - Fq| %.2e rad, |qd_f - Fqd| %.2e rad/s, |qdd_f - sFqd| %.2e rad/s^2, |tau_f - Ftau| %.2e N m, "
       "|vis_f - Fqd| %.2e rad/s\n",
       what, e.q, e.qd, e.qdd, e.tau, e.vis);
 }
 
 }  // namespace
 
-TEST(IdentifyFilter, SinusoidsComeOutWithFsAmplitudeAndPhaseAndTheirFirstAndSecondDerivatives) {
+TEST(IdentifyFilter, SinusoidsComeOutWithFsAmplitudeAndPhaseAndTheRatesAsTheVelocityEstimatesAndItsDerivative) {
   const Errors d = sinusoids_through_the_filter<double>();
   const Errors f = sinusoids_through_the_filter<float>();
   const Errors x = sinusoids_through_the_filter<Fixed>();
-  const Errors hold{hold_bound(kAngle, 0), hold_bound(kAngle, 1), hold_bound(kAngle, 2), hold_bound(kTorque, 0),
+  const Errors hold{hold_bound(kAngle, 0), hold_bound(kSpeed, 0), hold_bound(kSpeed, 1), hold_bound(kTorque, 0),
                     hold_bound(kSpeed, 0)};
   print("hold", hold);
   print("double", d);
@@ -151,20 +151,20 @@ TEST(IdentifyFilter, SinusoidsComeOutWithFsAmplitudeAndPhaseAndTheirFirstAndSeco
   EXPECT_LE(d.qdd, hold.qdd);
   EXPECT_LE(d.tau, hold.tau);
   EXPECT_LE(d.vis, hold.vis);
-  // float: the hold plus the inputs' rounding (1.2e-7 at 1-2 rad, which s^2 F passes at up to w^2 = 3948) and the
-  // states', about an ulp in motion, times w for qd_f and w^2 for qdd_f: measured 0.5e-6 rad, 2.1e-5 rad/s, 1.1e-3
-  // rad/s^2, 1.8e-5 N m above double's. Budgets about twice that.
+  // float: the hold plus the inputs' rounding and the states', about an ulp in motion (the rates' channel at speeds
+  // below 1.5 rad/s: 1e-7), times w for qdd_f: measured 0.5e-6 rad, 0 rad/s, 1.4e-5 rad/s^2, 1.8e-5 N m above
+  // double's. Budgets about twice that.
   EXPECT_LE(f.q, hold.q + 1e-6);
-  EXPECT_LE(f.qd, hold.qd + 4e-5);
-  EXPECT_LE(f.qdd, hold.qdd + 2.5e-3);
+  EXPECT_LE(f.qd, hold.qd + 1e-6);
+  EXPECT_LE(f.qdd, hold.qdd + 3e-5);
   EXPECT_LE(f.tau, hold.tau + 4e-5);
   EXPECT_LE(f.vis, hold.vis + 1e-6);
   // Q12.19: the hold plus the inputs' and outputs' rounding to 2^-19 (half an LSB each, 1e-6; the inputs' through
-  // s^2 F at up to w^2: 3.8e-3 rad/s^2) and the states' to Q5.26 / Q9.22 (1.5e-8 / 2.4e-7): measured 0.9e-6 rad,
-  // 0.9e-5 rad/s, 3.6e-3 rad/s^2, 0 N m above double's. Budgets about twice that.
+  // s F at up to w: 6e-5 rad/s^2) and the states' to Q5.26 / Q6.25 / Q9.22 (1.5e-8 / 3e-8 / 2.4e-7): measured 0.9e-6
+  // rad, 0.9e-6 rad/s, 1.1e-5 rad/s^2, 0 N m above double's. Budgets about twice that.
   EXPECT_LE(x.q, hold.q + 2e-6);
-  EXPECT_LE(x.qd, hold.qd + 2e-5);
-  EXPECT_LE(x.qdd, hold.qdd + 8e-3);
+  EXPECT_LE(x.qd, hold.qd + 2e-6);
+  EXPECT_LE(x.qdd, hold.qdd + 2.5e-5);
   EXPECT_LE(x.tau, hold.tau + 4e-6);
   EXPECT_LE(x.vis, hold.vis + 2e-6);
 }
@@ -293,14 +293,14 @@ Errors settles_after_a_stop() {
   for (int n = 0; n < 2000; ++n) f.update(q, tau, qd);
   const IdentifySignals<S> s = f.signals();
   const auto worst = [](const Vec6<S>& a) { return a.template cast<double>().cwiseAbs().maxCoeff(); };
-  return {worst(s.q - q), worst(s.qd), worst(s.qdd), worst(s.tau - tau), worst(s.w.vis - qd)};
+  return {worst(s.q - q), worst(s.qd - qd), worst(s.qdd), worst(s.tau - tau), worst(s.w.vis - qd)};
 }
 
 TEST(IdentifyFilter, AfterAStopTheStatesSettleWithinTheirRounding) {
   // A state moves while its update exceeds half its LSB: it may stay 1 / (2k) = 8 LSB short of a held input
-  // (identify_filter.hpp), each of the two, then qd_f and qdd_f are w and w^2 times those lags. Q5.26: 1.2e-7 rad,
-  // so qdd_f within 3948 x 16 x 1.5e-8 = 1e-3 rad/s^2; float at 1-2 rad: 8 ulps of 1.2e-7-2.4e-7, qdd_f up to
-  // 1.5e-2 rad/s^2.
+  // (identify_filter.hpp), each of the two; qd_f is the rates' channel's value and qdd_f w times its lag. Q5.26:
+  // 1.2e-7 rad; Q6.25: 2.4e-7 rad/s, qdd_f within 63 x 16 x 3e-8 = 3e-5 rad/s^2; float at 1-2 rad: 8 ulps of
+  // 1.2e-7-2.4e-7, at the speeds below 1 rad/s 8 ulps of 6e-8, qdd_f within 63 x 1e-6 = 6e-5 rad/s^2.
   const Errors d = settles_after_a_stop<double>(), f = settles_after_a_stop<float>(), x = settles_after_a_stop<Fixed>();
   print("double", d);
   print("float", f);
@@ -308,11 +308,11 @@ TEST(IdentifyFilter, AfterAStopTheStatesSettleWithinTheirRounding) {
   EXPECT_LT(d.q, 1e-12);
   EXPECT_LT(d.qdd, 1e-9);
   EXPECT_LT(f.q, 4e-6);
-  EXPECT_LT(f.qd, 1e-4);
-  EXPECT_LT(f.qdd, 1.2e-2);
+  EXPECT_LT(f.qd, 1e-6);
+  EXPECT_LT(f.qdd, 6e-5);
   EXPECT_LT(x.q, 1.5e-6);
-  EXPECT_LT(x.qd, 1e-5);
-  EXPECT_LT(x.qdd, 1e-3);
+  EXPECT_LT(x.qd, 5e-7);
+  EXPECT_LT(x.qdd, 3e-5);
   EXPECT_LT(x.tau, 8e-6);  // Q9.22: 2 x 8 LSB of 2.4e-7
 }
 

@@ -30,8 +30,9 @@ TEST(MotionCommands, EachVerbIsItsMachinesCommand) {
   ASSERT_EQ(static_cast<int>(std::size(table)), MotionNames<V>::kCount);
   for (const auto& [v, c] : table) EXPECT_EQ(verb_command(v), c) << motion_name(v);
   EXPECT_EQ(verb_command(static_cast<V>(200)), C::kNone);  // a code outside the list
-  // An identify only as prepare_identify planned it: a bare one is refused.
-  EXPECT_EQ(prepare_command<double>(V::kIdentify, 4).refusal, MotionReason::kBadCommand);
+  // An identify moves only as prepare_identify planned and checked it: a bare one is not marked checked (the tick
+  // refuses it bad_command: test_identify_command.cpp).
+  EXPECT_FALSE(prepare_command<double>(V::kIdentify, 4).checked);
   EXPECT_EQ(prepare_command<double>(V::kPaper, 4).refusal, MotionReason::kNone);
 }
 

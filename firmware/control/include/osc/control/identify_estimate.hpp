@@ -20,9 +20,9 @@
 //
 // The solve (solve()). The unknowns x = [theta; pi's selected entries] (theta in FrictionParams::theta's order: vis,
 // cou, sti, each per joint), the normal equations sum_i M_i / s_i^2 x = sum_i b_i / s_i^2 assembled from the blocks,
-// weighted per joint by its residual variance s_i^2 = RSS_i / (n - p_i), p_i = 3 + n_pi / 6 (its own
-// coefficients and an equal share of the payload's, so that the p_i sum to the unknowns): unweighted first (s_i =
-// 1), then weighted with the variances of its residuals, then once more with the weighted solution's (Gautier's
+// weighted per joint by its residual variance s_i^2 = RSS_i / (n_i - p_i) (n_i its rows summed), p_i = 3 + n_pi / 6
+// (its own coefficients and an equal share of the payload's, so that the p_i sum to the unknowns): unweighted first
+// (s_i = 1), then weighted with the variances of its residuals, then once more with the weighted solution's (Gautier's
 // weighted least squares). Each solve factors the column-normalised matrix H = D A D (D = diag(A)^-1/2, unit
 // diagonal) as L D' L^T (identify::PackedLdlt, no pivoting: H is positive definite when the motion excites every
 // column; it is not when a column is zero or a combination of others). Payload entries the mask leaves out are rows of
@@ -42,8 +42,8 @@
 // rule (friction_identified, osc/control/identification.hpp: identified when its standard deviation is at most
 // params::kIdentifiedFraction of its value), the payload's entries too (an entry near 0, a first moment along an
 // axis the centre of mass is on, is never identified by a relative rule, however well it is known). The status, the
-// first of: kNotFinite (a sample or the solution not finite; such a sample is not summed), kTooFewSamples (fewer than
-// params::kIdentifyMinSamples), kIllConditioned (H not positive definite or its condition above
+// first of: kNotFinite (a sample or the solution not finite; such a sample is not summed), kTooFewSamples (a joint with
+// fewer rows than params::kIdentifyMinSamples), kIllConditioned (H not positive definite or its condition above
 // params::kIdentifyMaxCondition), kPredictionError (a joint's prediction error above
 // params::kIdentifyMaxPredictionError), else kOk.
 //
@@ -77,7 +77,7 @@ constexpr std::uint16_t kAll = 0x3FF;
 /// A run's verdict (IdentifyReport::status), the first that applies.
 enum class IdentifyStatus : std::uint8_t {
   kOk = 0,
-  kTooFewSamples,    ///< fewer than params::kIdentifyMinSamples
+  kTooFewSamples,    ///< a joint with fewer rows than params::kIdentifyMinSamples
   kIllConditioned,   ///< the columns (nearly) dependent: condition above params::kIdentifyMaxCondition
   kPredictionError,  ///< a joint's torque-prediction error above params::kIdentifyMaxPredictionError
   kNotFinite         ///< a sample or the solution not finite
@@ -112,9 +112,10 @@ struct IdentifyReport {
 };
 
 namespace identify {
-constexpr int kJointColumns = 13;                 // a joint's phi: its 3 friction columns and the payload's 10
-constexpr int kUnknowns = 3 * kDof + 10;          // theta and pi
-constexpr int kPowerIterations = 200;             // the condition's estimate: at most, each way
+constexpr std::uint8_t kAllRows = (1u << kDof) - 1;  // every joint's row of a sample
+constexpr int kJointColumns = 13;                    // a joint's phi: its 3 friction columns and the payload's 10
+constexpr int kUnknowns = 3 * kDof + 10;             // theta and pi
+constexpr int kPowerIterations = 200;                // the condition's estimate: at most, each way
 constexpr double kPowerTolerance = 1e-6;          // ... or until the Rayleigh quotient moves less than this (relative)
 constexpr double kVarianceFloor = 1e-24;          // [N^2 m^2]: a joint whose model fits exactly still gets a weight
 constexpr double kRelativeVarianceFloor = 1e-12;  // ... and at least this of its mean square
@@ -192,14 +193,17 @@ class IdentifyEstimate {
     for (int i = 0; i < kDof; ++i) M_[i].setZero(), b_[i].setZero();
     yy_.setZero();
     n_ = 0;
+    rows_.fill(0);
     not_finite_ = false;
   }
 
   /// One sample: y_i (the torque the model leaves, per joint), the filtered friction columns, and the payload
-  /// regressor (its rows Y_i; ignored where the mask selects nothing). A sample with a value that is not finite
-  /// is not summed, and the run's status is kNotFinite.
+  /// regressor (its rows Y_i; ignored where the mask selects nothing); `rows`: bit i for joint i's row, the rows
+  /// summed (the caller leaves out a joint about its reversals: identify::moving_rows). A sample with a value
+  /// that is not finite is not summed, and the run's status is kNotFinite.
   template <class S>
-  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, const PayloadRegressor<S>& Y) {
+  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, const PayloadRegressor<S>& Y,
+           std::uint8_t rows = identify::kAllRows) {
     double phi[kDof][identify::kJointColumns], yd[kDof];
     bool finite = true;
     for (int i = 0; i < kDof; ++i) {
@@ -214,13 +218,14 @@ class IdentifyEstimate {
       not_finite_ = true;
       return;
     }
-    for (int i = 0; i < kDof; ++i) accumulate(i, phi[i], yd[i]);
+    for (int i = 0; i < kDof; ++i)
+      if (rows >> i & 1u) accumulate(i, phi[i], yd[i]), ++rows_[i];
     ++n_;
   }
   /// A sample without a payload regressor (friction only: the mask selects nothing).
   template <class S>
-  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w) {
-    add(y, w, PayloadRegressor<S>(PayloadRegressor<S>::Zero()));
+  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, std::uint8_t rows = identify::kAllRows) {
+    add(y, w, PayloadRegressor<S>(PayloadRegressor<S>::Zero()), rows);
   }
 
   std::uint32_t samples() const { return n_; }
@@ -232,7 +237,8 @@ class IdentifyEstimate {
     IdentifyReport r;
     r.samples = n_;
     if (not_finite_) return failed(r, IdentifyStatus::kNotFinite);
-    if (n_ < params::kIdentifyMinSamples) return failed(r, IdentifyStatus::kTooFewSamples);
+    if (*std::min_element(rows_.begin(), rows_.end()) < params::kIdentifyMinSamples)
+      return failed(r, IdentifyStatus::kTooFewSamples);
     Vec6<double> variance = Vec6<double>::Ones(), weights = variance;
     Vector x = Vector::Zero();
     for (int pass = 0; pass < 3; ++pass) {  // unweighted, then weighted twice
@@ -271,10 +277,12 @@ class IdentifyEstimate {
     const double s = yy_(i) - 2 * v.dot(b_[i]) + v.dot(M_[i].selfadjointView<Eigen::Upper>() * v);
     return s > 0 ? s : 0;
   }
-  double degrees_of_freedom() const { return static_cast<double>(n_) - 3 - (columns_ - 3) / static_cast<double>(kDof); }
-  /// s_i^2 = RSS_i / (n - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
+  double degrees_of_freedom(int i) const {
+    return static_cast<double>(rows_[i]) - 3 - (columns_ - 3) / static_cast<double>(kDof);
+  }
+  /// s_i^2 = RSS_i / (n_i - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
   double residual_variance(int i, const Vector& x) const {
-    const double v = rss(i, x) / degrees_of_freedom(), floor = identify::kRelativeVarianceFloor * yy_(i) / n_;
+    const double v = rss(i, x) / degrees_of_freedom(i), floor = identify::kRelativeVarianceFloor * yy_(i) / rows_[i];
     return std::max(v, std::max(floor, identify::kVarianceFloor));
   }
 
@@ -324,7 +332,7 @@ class IdentifyEstimate {
     }
     for (int i = 0; i < kDof; ++i) {
       const double e = rss(i, x);
-      r.residual_rms(i) = std::sqrt(e / n_);
+      r.residual_rms(i) = std::sqrt(e / rows_[i]);
       const double inf = std::numeric_limits<double>::infinity();
       r.prediction_error(i) = yy_(i) > 0 ? std::sqrt(e / yy_(i)) : (e > 0 ? inf : 0);
       if (r.worst_joint < 0 || !(r.prediction_error(i) <= r.worst_prediction_error))
@@ -373,7 +381,8 @@ class IdentifyEstimate {
   JointMatrix M_[kDof];  // upper triangles of the selected columns
   JointVector b_[kDof];
   Vec6<double> yy_;
-  std::uint32_t n_ = 0;
+  std::uint32_t n_ = 0;                     // samples
+  std::array<std::uint32_t, kDof> rows_{};  // rows summed per joint
   bool not_finite_ = false;
   std::uint16_t mask_ = 0;
   int column_[identify::kJointColumns] = {};  // the selected local columns, in order

@@ -92,10 +92,7 @@ class MotionGenerator {
                    const Vec3<S>& phi0 = Vec3<S>::Zero()) {
     paper_ = {spec, hold_pose_.p, tick, phi0};
     paper_id_ = id;
-    ++epoch_;
-    source_ = MotionSource::kPaper;
-    stopping_ = braking_ = false;
-    count_ = 0;
+    begin(MotionSource::kPaper);
   }
   /// Starts following a stream from the held pose at rest (its setpoints every `period` ticks; with
   /// `relative`, offsets from the held pose: prepare_setpoint), keeping `lim`.
@@ -105,10 +102,7 @@ class MotionGenerator {
     stream_.start(hold_d_.x, period, timeout_min);
     stream_relative_ = relative;
     stream_id_ = id;
-    ++epoch_;
-    source_ = MotionSource::kStream;
-    stopping_ = braking_ = false;
-    count_ = 0;
+    begin(MotionSource::kStream);
   }
   /// Starts an identification run's excitation motion (osc/control/excitation.hpp: planned and checked about
   /// the joint angles where the arm holds) at sample `tick`. Its reference is in joint space
@@ -118,10 +112,7 @@ class MotionGenerator {
     excitation_ = m;
     excitation_id_ = id;
     excitation_start_ = tick;
-    ++epoch_;
-    source_ = MotionSource::kExcitation;
-    stopping_ = braking_ = false;
-    count_ = 0;
+    begin(MotionSource::kExcitation);
   }
   /// The excitation's joint reference at sample `tick`: its own, or, braking, its time slowed to rest
   /// along its path (as the paper's motion: q(tau), qd tau_dot, qdd tau_dot^2 + qd tau_ddot), which
@@ -295,6 +286,13 @@ class MotionGenerator {
   const Mat3<S>& reference_orientation() const { return R_ref_; }
 
  private:
+  /// A new source takes over the reference: no stop or brake pending, its own tick count.
+  void begin(MotionSource source) {
+    ++epoch_;
+    source_ = source;
+    stopping_ = braking_ = false;
+    count_ = 0;
+  }
   static constexpr int kQueueSlots = kQueueLength + 1;  // the running move and those waiting
 
   void set_hold(const Pose<S>& pose) { set_hold(pose, orientation_coordinates<S>(pose.R, R_ref_)); }

@@ -133,12 +133,20 @@ constexpr double kExcitationSin[kDof][kExcitationHarmonics] = {{0, 0, 0, 0, 0}, 
 /// The identification run's state-variable filter (osc/control/identify_filter.hpp): F(s) = w^2 / (s + w)^2 at
 /// w = kIdentifyFilterOmega [rad/s], 10 Hz, twenty times the excitation's highest harmonic (kExcitationHarmonics /
 /// kExcitationPeriod = 0.5 Hz). The rigid-body model evaluated at the filtered states differs from the filtered
-/// torque by the model's nonlinearity through F, as (its harmonics / w)^2; the encoder's quantum reaches qdd_f as
-/// w^2. On the PUMA's excitation with a 1.5 kg payload (test_identify_estimate.cpp, IdentifyRun), at 5, 10, 15 and
-/// 20 Hz: noise-free, the worst friction coefficient 20, 4.7, 2.1 and 2.4 % off; with the encoders' quantum, J1's
-/// torque-prediction error 1.1, 4.3, 9.4 and 16 %, the mass 0.34, 0.09, 0.16 and 0.54 % off, the centre of mass
-/// 0.20, 0.16, 1.1 and 3.4 mm. w^2 = 3948 fits Q12.19.
+/// torque by the model's nonlinearity through F, as (its harmonics / w)^2; the noise of qdd_f (s F of the velocity
+/// estimate: identify_filter.hpp, "The rates") grows as w. On the PUMA's excitation with a 1.5 kg payload
+/// (test_identify_estimate.cpp, IdentifyRun, with qdd_f = s^2 F q then), at 5, 10, 15 and 20 Hz: noise-free, the
+/// worst friction coefficient 20, 4.7, 2.1 and 2.4 % off; with the encoders' quantum, J1's torque-prediction error
+/// 1.1, 4.3, 9.4 and 16 %, the mass 0.34, 0.09, 0.16 and 0.54 % off, the centre of mass 0.20, 0.16, 1.1 and 3.4 mm.
+/// w^2 = 3948 fits Q12.19.
 constexpr double kIdentifyFilterOmega = 2 * kPi * 10;
+/// A joint's row of a run's sample enters the estimate only while its filtered rate |s F q_i| is at least
+/// kIdentifyMinRowSpeed [rad/s]. About a reversal the sign of the velocity estimate the friction columns are formed
+/// at differs from the joint's for a few ticks, and F spreads that error over its window; the sign and Stribeck
+/// columns, nearly alike below 1 rad/s, turn it into a large error in the Coulomb / Stribeck split. On the ideal
+/// plant at 0.64 of the excitation's design (test_identify_sim.cpp), every row: J1's Coulomb 1.6 against 4.9, its
+/// viscous 7.9 against 5.8; rows from 0.05 rad/s: 4.7 and 5.9, every coefficient within 6 %.
+constexpr double kIdentifyMinRowSpeed = 0.05;
 /// The identification run's estimate (osc/control/identify_estimate.hpp). At least kIdentifyMinSamples samples: a
 /// joint's residual variance from 200 degrees of freedom is within sqrt(2 / 200) = 10 % of itself, so that a
 /// coefficient's reported 2 sigma is a normal one. The column-normalised information matrix's condition at most

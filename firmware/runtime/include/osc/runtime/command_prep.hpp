@@ -110,6 +110,7 @@ TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains,
   const ExcitationCheck<S> r =
       prepare_excitation(model, data, q, R_ref, ExcitationLimits<S>::defaults(), c.excitation, &loop);
   c.refusal = excitation_refusal(r.status);
+  c.checked = true;
   if (check) *check = r;
   return c;
 }

@@ -9,7 +9,8 @@
 // the filtered angles and their derivatives, w_i the filtered friction columns, Y the payload regressor
 // (osc/kernels/payload.hpp) there. With the payload estimated the model is the arm's own, link 6 without
 // the payload parameters set (so that pi is the whole payload, not a correction to the one set); without,
-// the model as it is, the payload set included, and the friction alone is estimated.
+// the model as it is, the payload set included, and the friction alone is estimated. A joint's row is left out
+// about its reversals (identify::moving_rows, params::kIdentifyMinRowSpeed says why).
 //
 // Pairing. The torque commanded in tick n acts from the DAC's update (params::kActuationDelay after the
 // sample) to the next one; the angle of tick n is sampled at its start. Fed with the angle of tick n, the
@@ -107,9 +108,10 @@ class IdentifyRun {
   void add(const IdentifySignals<S>& s) {
     forward_kinematics(model_, data_, s.q);
     const Vec6<S> y = s.tau - rnea(model_, data_, s.qd, s.qdd, true).tau;
-    if (!with_payload_) return estimate_.add(y, s.w);
+    const std::uint8_t rows = identify::moving_rows(s.qd);  // each joint away from its reversals
+    if (!with_payload_) return estimate_.add(y, s.w, rows);
     geometric_jacobian(data_);
-    estimate_.add(y, s.w, payload_regressor(model_, data_, s.qd, s.qdd));
+    estimate_.add(y, s.w, payload_regressor(model_, data_, s.qd, s.qdd), rows);
   }
 
   IdentifyEstimate estimate_;

@@ -95,6 +95,7 @@ struct TaskCommand {
   bool relative = false;                       ///< stream: setpoints relative to where it starts
   CartesianLimits<S> limits{};                 ///< stream: its limits
   ExcitationMotion<S> excitation{};            ///< identify: the motion, planned and checked
+  bool checked = false;  ///< identify: planned and checked by prepare_identify (else the tick refuses it)
 };
 
 /// One setpoint of a stream, ready for the next tick (prepare_setpoint): the follower's target in
@@ -227,8 +228,6 @@ TaskCommand<S> prepare_command(MotionVerb verb, std::uint32_t id) {
   TaskCommand<S> c;
   c.verb = verb;
   c.id = id;
-  // An identification run moves only as prepare_identify planned and checked it (osc/runtime/command_prep.hpp).
-  if (verb == MotionVerb::kIdentify) c.refusal = MotionReason::kBadCommand;
   return c;
 }
 

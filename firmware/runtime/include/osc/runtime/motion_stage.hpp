@@ -134,10 +134,10 @@ MotionCommand motion_command_of_tick(ControlTask<S>& task, bool measured, const 
   rep.id = cmd.id;
   rep.verb = cmd.verb;
   // An identification run's own refusal (its check's) only where the arm holds: elsewhere the state's
-  // (not_enabled, busy, ...), which say what to do first.
-  MotionReason pre = cmd.verb == MotionVerb::kIdentify && task.machine.state != MotionState::kHolding
-                         ? MotionReason::kNone
-                         : cmd.refusal;
+  // (not_enabled, busy, ...), which say what to do first. One that skipped prepare_identify never moves.
+  const bool identify = cmd.verb == MotionVerb::kIdentify;
+  MotionReason pre = identify && task.machine.state != MotionState::kHolding ? MotionReason::kNone : cmd.refusal;
+  if (identify && !cmd.checked) pre = MotionReason::kBadCommand;
   const bool planned = cmd.verb == MotionVerb::kMoveTo || cmd.verb == MotionVerb::kHome;
   if (pre == MotionReason::kNone && planned && cmd.epoch != task.gen.epoch()) pre = MotionReason::kSuperseded;
   if (pre == MotionReason::kNone && cmd.verb == MotionVerb::kHome && !homing_possible(task))
