@@ -8,6 +8,7 @@
 
 #include "motion_sim.hpp"
 #include "motion_sim_util.hpp"
+#include "experiment.hpp"
 #include "osc/runtime/identify_run.hpp"
 #include "test_util.hpp"
 
@@ -29,7 +30,7 @@ IdentifyReport identify(MotionSim<S>& sim, std::uint16_t payload, std::uint32_t&
   const auto tr = run_ticks(sim, 500);
   EXPECT_EQ(tr.faults, 0u) << fault_name(tr.faults);
   IdentifyRun<S> run;
-  run.start(5, payload, sim.task().model, Model<S>::of(robot::kArm));
+  run.start(5, payload, sim.task().model, Model<S>::of(robot::kArm), &sim.task().io);
   sim.identify(5);
   sim.tick();
   EXPECT_EQ(sim.task().report.outcome, CommandOutcome::kAccepted) << motion_name(sim.task().report.refusal);
@@ -77,6 +78,22 @@ FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficien
   return e;
 }
 
+/// A run on the ideal plant with the realistic plant's drive train: the published encoders and the wrist's coupling,
+/// each motor with its own friction at its own rate (the plant's C^-T f(C^-1 q')). The estimate is the drives' (the
+/// regression in the drives' space: osc/runtime/identify_run.hpp); each coefficient printed against the plant's.
+IdentifyReport coupled_run(FrictionErrors& e) {
+  sim::ExperimentConfig cfg;
+  cfg.published_encoders = true;
+  cfg.plant.coupling = true;
+  MotionSim<double> sim(test::identify_pose(), {}, cfg.plant, FrictionMode::kAdaptive, Gains<double>::paper(),
+                        cfg.sensor_config());
+  EXPECT_TRUE(sim.task().io.coupled());
+  std::uint32_t taken = 0, lost = 0;
+  const IdentifyReport r = identify(sim, payload_mask::kNone, taken, lost);
+  e = report_friction(r, *robot::kFrictionPresets[0], "the wrist coupled");
+  return r;
+}
+
 /// One run on the ideal plant from the runs' pose (0.64 of the design) in scalar S: every sample taken, the run's
 /// estimate ok, every coefficient within issue 57's bar (10 %, or 0.05 where that is more) and within 3 of its
 /// reported sigma, and each joint's Coulomb + Stribeck sum, the friction at the onset of motion, within 1 %.
@@ -103,4 +120,22 @@ TEST(IdentifySim, TheFrictionOfTheIdealPlantFromOneRunInEveryScalar) {
   ideal_plant_run<double>("double");
   ideal_plant_run<float>("float");
   ideal_plant_run<fixed::Q<19>>("Q12.19");
+}
+
+// The wrist's coupling (the PUMA's q6 = e6 + 0.013 e4 - 0.18 e5) and the published encoders: in the joints' space J5's
+// torque-prediction error was 23 % and the run failed (prediction_error); in the drives' space it is ok (measured
+// 4.6 %, J6). J1 and J2 are within the bar. Not yet (measured, docs/adaptation.md): J3's Stribeck term 2.6 times the
+// bar (0.45 against 0.6) and J5, J6 up to 5.7 times (4.3 sigma): the rotors' inertia coupled through C, C^-T J_m C^-1,
+// which the model's diagonal armature lacks, biases the observer's rates there.
+TEST(IdentifySim, TheWristsCoupledDrivesAreIdentifiedInTheDrivesSpace) {
+  if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's coupled wrist";
+  FrictionErrors e;
+  const IdentifyReport r = coupled_run(e);
+  EXPECT_EQ(r.status, IdentifyStatus::kOk);
+  EXPECT_LE(r.worst_prediction_error, 0.1);
+  const FrictionCoefficients& truth = *robot::kFrictionPresets[0];
+  const double* t[3] = {truth.vis, truth.cou, truth.sti};
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < 2; ++i)
+      EXPECT_LE(std::fabs(r.friction(c * kDof + i) - t[c][i]), std::max(0.1 * t[c][i], 0.05)) << c << " J" << i + 1;
 }

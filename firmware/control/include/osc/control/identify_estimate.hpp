@@ -6,11 +6,14 @@
 //   y_i = F tau_i - tau_rb,i(q_f, qd_f, qdd_f) = w_i^T theta_i + Y_i pi + e_i,
 // y_i the torque the model leaves (the caller forms it), w_i the joint's filtered friction columns (vis, cou, sti),
 // theta_i = (vis_i, cou_i, sti_i), Y_i the payload regressor's row and pi the payload's parameters, all ten or the
-// subset a mask selects. A run that moves estimates all ten: about the flange a payload's inertia is mostly
-// m |c|^2 (1.5 kg at 87 mm: 0.012 of its 0.014 kg m^2), and left out it goes into the friction and the centre of
-// mass (on the excitation 2.3 mm, 0.16 %, a friction coefficient 9 %: test_identify_estimate.cpp); the mass and
-// first moments alone (payload_mask::kMassAndMoment) are for poses held still. Friction is per joint (Property 4),
-// the payload common to all: the information matrix is block-arrowed, the friction blocks coupled only through pi.
+// subset a mask selects. Optionally a joint's row also carries dI_i qdd_i, dI_i the correction to the model's
+// armature (the rotor's inertia referred to the joint, G^2 J_m: the PUMA's two published sets differ by 2.4 kg m^2
+// on J2, which left out goes into the friction and fails the run on its prediction error). A run that moves estimates
+// all ten: about the flange a payload's inertia is mostly m |c|^2 (1.5 kg at 87 mm: 0.012 of its 0.014 kg m^2), and
+// left out it goes into the friction and the centre of mass (on the excitation 2.3 mm, 0.16 %, a friction coefficient 9
+// %: test_identify_estimate.cpp); the mass and first moments alone (payload_mask::kMassAndMoment) are for poses held
+// still. Friction is per joint (Property 4), the payload common to all: the information matrix is block-arrowed, the
+// friction blocks coupled only through pi.
 //
 // The sums. Per joint, of phi = (w_i, Y_i) (13 columns): the symmetric block sum phi phi^T, its right-hand side
 // sum phi y, sum y^2 and the count. In double on every target: a run's 10^4 samples of products of regressors
@@ -47,9 +50,10 @@
 // params::kIdentifyMaxCondition), kPredictionError (a joint's prediction error above
 // params::kIdentifyMaxPredictionError), else kOk.
 //
-// Size and cost: the sums 8.8 kB, the solve's workspace (H and its factor packed in one matrix, a member so that the
-// board's stack does not hold it) 6.5 kB; a sample 6 x 91 multiply-adds with the payload's ten (6 x 6 without); a solve
-// three factorisations of 28 x 28, 28 solves and at most 2 x 200 power iterations, once per run. No heap.
+// Size and cost: the sums 10.1 kB, the solve's workspace (H and its factor packed in one matrix, a member so that the
+// board's stack does not hold it) 10 kB; a sample 6 x 105 multiply-adds with the armatures and the payload's ten (6 x
+// 10 without the payload); a solve three factorisations of 34 x 34, 34 solves and at most 2 x 200 power iterations,
+// once per run. No heap.
 #pragma once
 
 #include <algorithm>
@@ -95,6 +99,9 @@ struct IdentifyReport {
   IdentifyStatus status = IdentifyStatus::kNotFinite;
   Vec18<double> friction = Vec18<double>::Zero();  ///< theta = [vis; cou; sti], FrictionParams::theta's order
   Vec18<double> friction_sd = Vec18<double>::Zero();
+  /// The joints' armature corrections (what the model's armature lacks, N m s^2/rad: 0 where not estimated).
+  Vec6<double> armature = Vec6<double>::Zero();
+  Vec6<double> armature_sd = Vec6<double>::Zero();
   PayloadVector<double> payload = PayloadVector<double>::Zero();  ///< pi (0 where not estimated)
   PayloadVector<double> payload_sd = PayloadVector<double>::Zero();
   std::array<CoefficientVerdict, 3 * kDof> friction_verdict{};
@@ -113,15 +120,19 @@ struct IdentifyReport {
 
 namespace identify {
 constexpr std::uint8_t kAllRows = (1u << kDof) - 1;  // every joint's row of a sample
-constexpr int kJointColumns = 13;                    // a joint's phi: its 3 friction columns and the payload's 10
-constexpr int kUnknowns = 3 * kDof + 10;             // theta and pi
-constexpr int kPowerIterations = 200;                // the condition's estimate: at most, each way
+constexpr int kJointColumns = 14;   // a joint's phi: its 3 friction columns, its armature's, and the payload's 10
+constexpr int kArmatureColumn = 3;  // the armature's local column; the payload's follow it
+constexpr int kPayloadColumn = 4;
+constexpr int kUnknowns = 4 * kDof + 10;          // theta, the armatures' corrections and pi
+constexpr int kPowerIterations = 200;             // the condition's estimate: at most, each way
 constexpr double kPowerTolerance = 1e-6;          // ... or until the Rayleigh quotient moves less than this (relative)
 constexpr double kVarianceFloor = 1e-24;          // [N^2 m^2]: a joint whose model fits exactly still gets a weight
 constexpr double kRelativeVarianceFloor = 1e-12;  // ... and at least this of its mean square
 
-/// Where a joint's local column l (0-2 friction, 3-12 pi) sits among the unknowns.
-constexpr int unknown_index(int joint, int l) { return l < 3 ? l * kDof + joint : 3 * kDof + l - 3; }
+/// Where a joint's local column l (0-2 friction, 3 armature, 4-13 pi) sits among the unknowns.
+constexpr int unknown_index(int joint, int l) {
+  return l <= kArmatureColumn ? l * kDof + joint : 4 * kDof + l - kPayloadColumn;
+}
 
 using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
 using Vector = Eigen::Matrix<double, kUnknowns, 1>;
@@ -131,7 +142,7 @@ using Vector = Eigen::Matrix<double, kUnknowns, 1>;
 /// kUnknowns epsilon, H's diagonal being 1 (column-normalised), is singular to working precision. Loops, not
 /// LdltFactor (osc/kernels/opspace.hpp), which unrolls each row for the tick's 6 x 6: at 28 x 28 the estimate's code
 /// took 72 kB of an M4F build with it and takes 12 kB with this, for a factorisation that runs three times a run;
-/// and H and its factor share the 6.3 kB.
+/// and H and its factor share one matrix (9.2 kB at 34 x 34).
 struct PackedLdlt {
   Matrix m;
   Vector d;
@@ -184,12 +195,16 @@ class IdentifyEstimate {
 
   explicit IdentifyEstimate(std::uint16_t payload = payload_mask::kNone) { reset(payload); }
 
-  /// Clears the sums; `payload` selects pi's entries (payload_mask).
-  void reset(std::uint16_t payload) {
+  /// Clears the sums; `payload` selects pi's entries (payload_mask), `armature` the joints whose armature correction
+  /// is estimated (bit i for joint i; none by default).
+  void reset(std::uint16_t payload, std::uint8_t armature = 0) {
     mask_ = static_cast<std::uint16_t>(payload & payload_mask::kAll);
-    columns_ = 0;
-    for (int l = 0; l < identify::kJointColumns; ++l)
-      if (l < 3 || (mask_ >> (l - 3) & 1u)) column_[columns_++] = l;
+    armature_ = static_cast<std::uint8_t>(armature & identify::kAllRows);
+    for (int i = 0; i < kDof; ++i) {
+      columns_[i] = 0;
+      for (int l = 0; l < identify::kJointColumns; ++l)
+        if (estimated(identify::unknown_index(i, l))) column_[i][columns_[i]++] = l;
+    }
     for (int i = 0; i < kDof; ++i) M_[i].setZero(), b_[i].setZero();
     yy_.setZero();
     n_ = 0;
@@ -201,17 +216,19 @@ class IdentifyEstimate {
   /// regressor (its rows Y_i; ignored where the mask selects nothing); `rows`: bit i for joint i's row, the rows
   /// summed (the caller leaves out a joint about its reversals: identify::moving_rows). A sample with a value
   /// that is not finite is not summed, and the run's status is kNotFinite.
+  /// qdd: the joints' accelerations (the armature's columns; read only for the joints reset() selected).
   template <class S>
   void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, const PayloadRegressor<S>& Y,
-           std::uint8_t rows = identify::kAllRows) {
+           std::uint8_t rows = identify::kAllRows, const Vec6<S>& qdd = Vec6<S>::Zero()) {
     double phi[kDof][identify::kJointColumns], yd[kDof];
     bool finite = true;
     for (int i = 0; i < kDof; ++i) {
       yd[i] = static_cast<double>(y(i));
       phi[i][0] = static_cast<double>(w.vis(i)), phi[i][1] = static_cast<double>(w.cou(i));
       phi[i][2] = static_cast<double>(w.sti(i));
-      for (int k = 0; k < 10; ++k) phi[i][3 + k] = static_cast<double>(Y(i, k));
-      for (int c = 0; c < columns_; ++c) finite = finite && std::isfinite(phi[i][column_[c]]);
+      phi[i][identify::kArmatureColumn] = static_cast<double>(qdd(i));
+      for (int k = 0; k < 10; ++k) phi[i][identify::kPayloadColumn + k] = static_cast<double>(Y(i, k));
+      for (int c = 0; c < columns_[i]; ++c) finite = finite && std::isfinite(phi[i][column_[i][c]]);
       finite = finite && std::isfinite(yd[i]);
     }
     if (!finite) {
@@ -224,8 +241,9 @@ class IdentifyEstimate {
   }
   /// A sample without a payload regressor (friction only: the mask selects nothing).
   template <class S>
-  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, std::uint8_t rows = identify::kAllRows) {
-    add(y, w, PayloadRegressor<S>(PayloadRegressor<S>::Zero()), rows);
+  void add(const Vec6<S>& y, const RegressorDiagonals<S>& w, std::uint8_t rows = identify::kAllRows,
+           const Vec6<S>& qdd = Vec6<S>::Zero()) {
+    add(y, w, PayloadRegressor<S>(PayloadRegressor<S>::Zero()), rows, qdd);
   }
 
   std::uint32_t samples() const { return n_; }
@@ -257,9 +275,9 @@ class IdentifyEstimate {
 
  private:
   void accumulate(int i, const double* phi, double y) {
-    for (int a = 0; a < columns_; ++a) {
-      const int la = column_[a];
-      for (int c = a; c < columns_; ++c) M_[i](la, column_[c]) += phi[la] * phi[column_[c]];
+    for (int a = 0; a < columns_[i]; ++a) {
+      const int la = column_[i][a];
+      for (int c = a; c < columns_[i]; ++c) M_[i](la, column_[i][c]) += phi[la] * phi[column_[i][c]];
       b_[i](la) += phi[la] * y;
     }
     yy_(i) += y * y;
@@ -268,7 +286,7 @@ class IdentifyEstimate {
   /// Joint i's local parameters (its theta_i and pi) out of the unknowns.
   JointVector local(int i, const Vector& x) const {
     JointVector v = JointVector::Zero();
-    for (int c = 0; c < columns_; ++c) v(column_[c]) = x(identify::unknown_index(i, column_[c]));
+    for (int c = 0; c < columns_[i]; ++c) v(column_[i][c]) = x(identify::unknown_index(i, column_[i][c]));
     return v;
   }
   /// Joint i's residual sum of squares at x, from the sums (never below 0: the sums' rounding).
@@ -278,7 +296,8 @@ class IdentifyEstimate {
     return s > 0 ? s : 0;
   }
   double degrees_of_freedom(int i) const {
-    return static_cast<double>(rows_[i]) - 3 - (columns_ - 3) / static_cast<double>(kDof);
+    const int own = (armature_ >> i & 1u) ? 4 : 3;  // its friction and armature; a sixth of the payload's
+    return static_cast<double>(rows_[i]) - own - (columns_[i] - own) / static_cast<double>(kDof);
   }
   /// s_i^2 = RSS_i / (n_i - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
   double residual_variance(int i, const Vector& x) const {
@@ -293,10 +312,10 @@ class IdentifyEstimate {
     H.setZero();
     rhs_.setZero();
     for (int i = 0; i < kDof; ++i)
-      for (int a = 0; a < columns_; ++a) {
-        const int la = column_[a], ga = identify::unknown_index(i, la);
-        for (int c = a; c < columns_; ++c) {  // la <= lc, and ga <= gc: the upper triangle
-          const int lc = column_[c];
+      for (int a = 0; a < columns_[i]; ++a) {
+        const int la = column_[i][a], ga = identify::unknown_index(i, la);
+        for (int c = a; c < columns_[i]; ++c) {  // la <= lc, and ga <= gc: the upper triangle
+          const int lc = column_[i][c];
           H(ga, identify::unknown_index(i, lc)) += M_[i](la, lc) / variance(i);
         }
         rhs_(ga) += b_[i](la) / variance(i);
@@ -310,7 +329,9 @@ class IdentifyEstimate {
     return f_.factor();
   }
 
-  bool estimated(int k) const { return k < 3 * kDof || (mask_ >> (k - 3 * kDof) & 1u); }
+  bool estimated(int k) const {
+    return k < 3 * kDof || (k < 4 * kDof ? (armature_ >> (k - 3 * kDof) & 1u) : (mask_ >> (k - 4 * kDof) & 1u));
+  }
 
   /// The report of the solution x, f_ the factor of its weights (the file comment's "What it reports").
   void report(IdentifyReport& r, const Vector& x, double kappa) const {
@@ -323,12 +344,14 @@ class IdentifyEstimate {
         sd(k) = D_(k) * std::sqrt(kappa * h);
       }
     r.friction = x.head<3 * kDof>(), r.friction_sd = sd.head<3 * kDof>();
+    r.armature = x.segment<kDof>(3 * kDof), r.armature_sd = sd.segment<kDof>(3 * kDof);
     r.payload = x.tail<10>(), r.payload_sd = sd.tail<10>();
     for (int k = 0; k < identify::kUnknowns; ++k) {
+      if (k >= 3 * kDof && k < 4 * kDof) continue;  // an armature's correction: judged against the arm's (the caller)
       const CoefficientVerdict v = !estimated(k)                      ? CoefficientVerdict::kNotEstimated
                                    : friction_identified(x(k), sd(k)) ? CoefficientVerdict::kIdentified
                                                                       : CoefficientVerdict::kNotExcited;
-      (k < 3 * kDof ? r.friction_verdict[k] : r.payload_verdict[k - 3 * kDof]) = v;
+      (k < 3 * kDof ? r.friction_verdict[k] : r.payload_verdict[k - 4 * kDof]) = v;
     }
     for (int i = 0; i < kDof; ++i) {
       const double e = rss(i, x);
@@ -369,9 +392,11 @@ class IdentifyEstimate {
   IdentifyReport& failed(IdentifyReport& r, IdentifyStatus s) const {
     r.status = s;
     r.friction_sd.setConstant(std::numeric_limits<double>::infinity());
+    for (int i = 0; i < kDof; ++i)
+      r.armature_sd(i) = (armature_ >> i & 1u) ? std::numeric_limits<double>::infinity() : 0;
     r.friction_verdict.fill(CoefficientVerdict::kNotExcited);
     for (int k = 0; k < 10; ++k) {
-      const bool on = estimated(3 * kDof + k);
+      const bool on = estimated(4 * kDof + k);
       r.payload_sd(k) = on ? std::numeric_limits<double>::infinity() : 0;
       r.payload_verdict[k] = on ? CoefficientVerdict::kNotExcited : CoefficientVerdict::kNotEstimated;
     }
@@ -385,8 +410,9 @@ class IdentifyEstimate {
   std::array<std::uint32_t, kDof> rows_{};  // rows summed per joint
   bool not_finite_ = false;
   std::uint16_t mask_ = 0;
-  int column_[identify::kJointColumns] = {};  // the selected local columns, in order
-  int columns_ = 0;
+  std::uint8_t armature_ = 0;
+  int column_[kDof][identify::kJointColumns] = {};  // each joint's selected local columns, in order
+  int columns_[kDof] = {};
   identify::PackedLdlt f_;  // the solve's workspace: H and its factor
   Vector D_, rhs_;
 };

@@ -235,7 +235,8 @@ void stage_step(ControlTask<S>& task, TickData<S>& t) {
   t.faults |= task.last.status;  // non_finite, singular
   // An identification run's samples: its own motion only (not its stop's, whose time is slowed).
   if (task.gen.source() == MotionSource::kExcitation && !task.gen.braking() && task.last.status == kFaultNone)
-    task.identify.tick(task.gen.running_id(), t.q, task.last.tau, task.state.adapt.qd_hat_prev, task.gains.tau_dec);
+    task.identify.tick(task.gen.running_id(), t.q, task.last.tau, motor_rates(task.io, task.state.adapt.qd_hat_prev),
+                       task.gains.tau_dec);
 }
 
 /// monitors: the drive check (drive_faults: first, the residual monitor's isolation takes its suspects),
