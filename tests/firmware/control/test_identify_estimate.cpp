@@ -500,7 +500,7 @@ TEST(IdentifyEstimate, TheExcitationsConditionStaysWithinTheBoundDownToItsSmalle
     for (const Sample& s : samples_of(scale)) e.add(s.y(payload_mask::kAll), s.w, s.Y);
     const IdentifyReport r = e.solve();
     std::printf("scale %.3f, all ten: condition %.4g\n", scale, r.condition);
-    EXPECT_LT(r.condition, params::kIdentifyMaxCondition / 5) << scale;
+    EXPECT_LT(r.condition, 2e4) << scale;  // the figures' 14 000 at most, with room
   }
   for (int i = 0; i < kDof; ++i) {
     Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
