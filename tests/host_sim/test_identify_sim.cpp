@@ -83,7 +83,7 @@ FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficien
 /// A run on the ideal plant with the realistic plant's drive train: the published encoders and the wrist's coupling,
 /// each motor with its own friction at its own rate (the plant's C^-T f(C^-1 q')). The estimate is the drives' (the
 /// regression in the drives' space: osc/runtime/identify_run.hpp); each coefficient printed against the plant's.
-IdentifyReport coupled_run(FrictionErrors& e) {
+IdentifyReport coupled_run() {
   sim::ExperimentConfig cfg;
   cfg.published_encoders = true;
   cfg.plant.coupling = true;
@@ -92,7 +92,7 @@ IdentifyReport coupled_run(FrictionErrors& e) {
   EXPECT_TRUE(sim.task().io.coupled());
   std::uint32_t taken = 0, lost = 0;
   const IdentifyReport r = run_identify(sim, payload_mask::kNone, taken, lost);
-  e = report_friction(r, *robot::kFrictionPresets[0], "the wrist coupled");
+  report_friction(r, *robot::kFrictionPresets[0], "the wrist coupled");
   return r;
 }
 
@@ -131,8 +131,7 @@ TEST(IdentifySim, TheFrictionOfTheIdealPlantFromOneRunInEveryScalar) {
 // which the model's diagonal armature lacks, biases the observer's rates there.
 TEST(IdentifySim, TheWristsCoupledDrivesAreIdentifiedInTheDrivesSpace) {
   if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's coupled wrist";
-  FrictionErrors e;
-  const IdentifyReport r = coupled_run(e);
+  const IdentifyReport r = coupled_run();
   EXPECT_EQ(r.status, IdentifyStatus::kOk);
   EXPECT_LE(r.worst_prediction_error, 0.1);
   const FrictionCoefficients& truth = *robot::kFrictionPresets[0];

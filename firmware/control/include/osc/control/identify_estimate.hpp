@@ -296,7 +296,7 @@ class IdentifyEstimate {
     return s > 0 ? s : 0;
   }
   double degrees_of_freedom(int i) const {
-    const int own = (armature_ >> i & 1u) ? 4 : 3;  // its friction and armature; a sixth of the payload's
+    const int own = estimated(identify::unknown_index(i, identify::kArmatureColumn)) ? 4 : 3;  // and a sixth of pi's
     return static_cast<double>(rows_[i]) - own - (columns_[i] - own) / static_cast<double>(kDof);
   }
   /// s_i^2 = RSS_i / (n_i - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
@@ -393,7 +393,7 @@ class IdentifyEstimate {
     r.status = s;
     r.friction_sd.setConstant(std::numeric_limits<double>::infinity());
     for (int i = 0; i < kDof; ++i)
-      r.armature_sd(i) = (armature_ >> i & 1u) ? std::numeric_limits<double>::infinity() : 0;
+      r.armature_sd(i) = estimated(3 * kDof + i) ? std::numeric_limits<double>::infinity() : 0;
     r.friction_verdict.fill(CoefficientVerdict::kNotExcited);
     for (int k = 0; k < 10; ++k) {
       const bool on = estimated(4 * kDof + k);
