@@ -363,6 +363,73 @@ TEST(Parameters, EveryGainBoundRunsAndBeyondItIsRefused) {
   EXPECT_EQ(param_set(*u, param_index("ks"), 5, 100.0), ParamStatus::kUnstableLoop);
 }
 
+// Issue 57: each drive's armature correction is the model's armature, the described plus it: against
+// the model of the arm described with 1.5 times its motors' inertia (Model::of), in A(q) too; back to
+// the described bit for bit; and a correction that would lose the sampled loop is refused by name.
+template <class S>
+void armature_correction_is_the_models() {
+  auto t = disabled_task<S>();
+  const int a = param_index("armature_correction");
+  ArmDescription heavier = robot::kArm;
+  for (LinkParams& l : heavier.links) l.motor_inertia *= 1.5;
+  const Model<S> want = Model<S>::of(heavier), described = Model<S>::of(robot::kArm);
+  for (int e = 0; e < kDof; ++e) {
+    const LinkParams& l = robot::kArm.links[e];
+    ASSERT_EQ(param_set(*t, a, e, 0.5 * l.gear_ratio * l.gear_ratio * l.motor_inertia), ParamStatus::kOk) << e;
+  }
+  const double tol = std::is_same_v<S, double> ? 1e-12 : 1e-5;
+  Data<S> got, ref;
+  const Vec6<S> q = joint_vector<S>(robot::kQStart);
+  forward_kinematics(t->model, got, q);
+  forward_kinematics(want, ref, q);
+  joint_inertia(t->model, got);
+  joint_inertia(want, ref);
+  for (int e = 0; e < kDof; ++e) {
+    EXPECT_NEAR(static_cast<double>(t->model.armature(e)), static_cast<double>(want.armature(e)), tol) << e;
+    EXPECT_NEAR(static_cast<double>(got.A(e, e)), static_cast<double>(ref.A(e, e)), 4 * tol) << e;
+    EXPECT_NEAR(param_get(*t, a, e), static_cast<double>(want.armature(e) - described.armature(e)), tol) << e;
+  }
+  for (int e = 0; e < kDof; ++e) ASSERT_EQ(param_set(*t, a, e, 0.0), ParamStatus::kOk);
+  for (int e = 0; e < kDof; ++e) EXPECT_TRUE(t->model.armature(e) == described.armature(e)) << e;
+}
+TEST(Parameters, TheArmatureCorrectionIsTheModelsDouble) { armature_correction_is_the_models<double>(); }
+TEST(Parameters, TheArmatureCorrectionIsTheModelsFloat) { armature_correction_is_the_models<float>(); }
+TEST(Parameters, TheArmatureCorrectionIsTheModelsFixed) { armature_correction_is_the_models<Fixed>(); }
+
+// A lighter armature is a larger inverse mass: with a wrist's k_i just inside the loop's bound, halving
+// the wrist drives' armature would lose the loop, and is refused unstable_loop (a set and a record alike);
+// bad values are refused by name; nothing changes.
+TEST(Parameters, AnArmatureThatLosesTheLoopIsRefused) {
+  auto t = disabled_task<double>();
+  const int a = param_index("armature_correction"), k = param_index("k"), ki = param_index("ki");
+  ASSERT_EQ(param_set(*t, k, 3, 25.0), ParamStatus::kOk);
+  double lo = params::kKi[3], hi = kParams[ki].hi_of(3);  // the bound: stable at lo
+  ASSERT_GE(param_margins(*t).loop, 1);
+  for (int n = 0; n < 40; ++n) {
+    const double mid = 0.5 * (lo + hi);
+    (param_margins(*t, ki, 3, mid).loop >= 1 && param_margins(*t, ki, 3, mid).observer > 1 ? lo : hi) = mid;
+  }
+  if (hi >= kParams[ki].hi_of(3)) GTEST_SKIP() << "k_i within its range never loses this arm's loop";
+  ASSERT_EQ(param_set(*t, ki, 3, 0.97 * lo), ParamStatus::kOk);
+  const ParamRecord before = param_capture(*t);
+  const double half = -0.5 * static_cast<double>(t->model.armature(3));
+  GainMargins m;
+  EXPECT_EQ(param_set(*t, a, 3, half, &m), ParamStatus::kUnstableLoop);
+  EXPECT_LT(m.loop, 1);
+  EXPECT_EQ(param_set(*t, a, 3, half * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, a, 3, std::numeric_limits<double>::quiet_NaN()), ParamStatus::kNotFinite);
+  EXPECT_EQ(param_set(*t, a, 6, 0.0), ParamStatus::kBadElement);
+  ParamRecord r = before;
+  r.value[param_slot(a) + 3] = static_cast<float>(half);
+  EXPECT_EQ(param_apply(*t, r), ParamStatus::kUnstableLoop);
+  const ParamRecord after = param_capture(*t);
+  for (int n = 0; n < kParamSlots; ++n) EXPECT_EQ(after.value[n], before.value[n]) << n;
+  // A heavier one is taken (smaller inverse masses), and refused under torque.
+  EXPECT_EQ(param_set(*t, a, 3, -half), ParamStatus::kOk);
+  t->machine.state = MotionState::kHolding;
+  EXPECT_EQ(param_set(*t, a, 3, 0.0), ParamStatus::kTorqueOn);
+}
+
 TEST(Parameters, Condition37OnlyWarns) {
   auto t = disabled_task<double>();
   GainMargins m;

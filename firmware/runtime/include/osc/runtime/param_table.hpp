@@ -93,6 +93,20 @@ constexpr double kPayloadInertiaLo[6] = {
 constexpr double kPayloadInertiaHi[6] = {robot::kPayloadRating.inertia, robot::kPayloadRating.inertia,
                                          robot::kPayloadRating.inertia, robot::kPayloadRating.inertia,
                                          robot::kPayloadRating.inertia, robot::kPayloadRating.inertia};
+/// The drives' armature correction's range (parameter armature_correction): each joint's within
+/// [-0.5, 3] times its described armature G^2 Jm, plus 0.01 kg m^2 above (a drive described without
+/// one). The model's armature stays at least half the described (A positive definite), and the range
+/// holds the published motor inertias' spread three times over (the PUMA's AKB86 set,
+/// robot::kDriveTrain.motor_inertia_alt: +45 / +105 / +50 % on J1-J3).
+constexpr double described_armature(int i) {
+  return robot::kArm.links[i].gear_ratio * robot::kArm.links[i].gear_ratio * robot::kArm.links[i].motor_inertia;
+}
+constexpr double kArmatureCorrectionLo[kDof] = {-0.5 * described_armature(0), -0.5 * described_armature(1),
+                                                -0.5 * described_armature(2), -0.5 * described_armature(3),
+                                                -0.5 * described_armature(4), -0.5 * described_armature(5)};
+constexpr double kArmatureCorrectionHi[kDof] = {
+    3 * described_armature(0) + 0.01, 3 * described_armature(1) + 0.01, 3 * described_armature(2) + 0.01,
+    3 * described_armature(3) + 0.01, 3 * described_armature(4) + 0.01, 3 * described_armature(5) + 0.01};
 /// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
 /// configured move maxima.
 constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
@@ -139,7 +153,11 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
   X(PayloadInertia, "payload_inertia", 6, "kg m^2", detail::kPayloadInertiaLo, detail::kPayloadInertiaHi, 0,          \
     TorqueOff, true,                                                                                                  \
     "the payload's inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz; positive "           \
-    "semi-definite (else not_physical): set the moments before the products")
+    "semi-definite (else not_physical): set the moments before the products")                                      \
+  X(ArmatureCorrection, "armature_correction", kDof, "kg m^2", detail::kArmatureCorrectionLo,                        \
+    detail::kArmatureCorrectionHi, 0, TorqueOff, true,                                                               \
+    "each drive's armature correction, added to its described G^2 Jm on the diagonal of the model's A(q) (an "       \
+    "identify run's estimate); the sampled loop stays stable at the last computed pose (else unstable_loop)")
 
 #define OSC_X_PREFIX kParam
 #define OSC_RUNTIME_PARAM_ID(Name, name, n, unit, lo, hi, def, access, persists, doc) OSC_X_CAT(OSC_X_PREFIX, Name),

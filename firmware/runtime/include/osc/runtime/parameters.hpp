@@ -136,6 +136,8 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return task.payload.com[e];
     case RuntimeParam::kParamPayloadInertia:
       return task.payload.inertia[e];
+    case RuntimeParam::kParamArmatureCorrection:
+      return task.armature_correction[e];
     case RuntimeParam::kCount:
       break;
   }
@@ -195,6 +197,9 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamPayloadInertia:
       task.set_payload(detail::payload_with(task.payload, p.runtime, e, v));
       break;
+    case RuntimeParam::kParamArmatureCorrection:
+      task.set_armature(e, v);
+      break;
     case RuntimeParam::kCount:
       break;
   }
@@ -244,11 +249,17 @@ ParamStatus param_value_status(int i, int e, double v) {
 
 /// Lambda^-1 at the pose the controller last measured (q(t - dt) of its adaptation state), computed in
 /// the path check's workspace (outside the tick, as command preparation is).
+/// With `model` in place of the task's (a candidate's armature).
+template <class S>
+Mat6<double> task_lambda_inverse(ControlTask<S>& task, const Model<S>& model) {
+  ArmOpSpace<S> os;
+  opspace_update(model, task.check_data, os, task.state.adapt.q_prev, task.state.R_ref);
+  return lambda_inverse<double>(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
+}
+
 template <class S>
 Mat6<double> task_lambda_inverse(ControlTask<S>& task) {
-  ArmOpSpace<S> os;
-  opspace_update(task.model, task.check_data, os, task.state.adapt.q_prev, task.state.R_ref);
-  return lambda_inverse<double>(task.check_data.A.template cast<double>(), os.Ja.template cast<double>());
+  return task_lambda_inverse(task, task.model);
 }
 
 /// Whether gains of these margins may run (GainMargins' rules), and which check fails first.
@@ -258,12 +269,22 @@ inline ParamStatus gain_status(const GainMargins& m) {
   return ParamStatus::kOk;
 }
 
-/// The margins of the task's gains with element e of parameter i set to v (i < 0: as they are).
+/// The margins of the task's gains with element e of parameter i set to v (i < 0: as they are): a
+/// gain's, or the model's armature's (the loop's inverse masses).
 template <class S>
 GainMargins param_margins(ControlTask<S>& task, int i = -1, int e = 0, double v = 0) {
   Gains<double> g = task.gains.template cast<double>();
   if (i >= 0 && kParams[i].gain >= 0) detail::gain_put(g, kParams[i].gain, e, v);
-  return gain_margins(g, task_lambda_inverse(task));
+  if (i < 0 || kParams[i].runtime != RuntimeParam::kParamArmatureCorrection)
+    return gain_margins(g, task_lambda_inverse(task));
+  double correction[kDof];
+  for (int k = 0; k < kDof; ++k) correction[k] = k == e ? v : task.armature_correction[k];
+  return gain_margins(g, task_lambda_inverse(task, task.with_armature(correction)));
+}
+
+/// Whether a change of parameter p is judged by the sampled loop's margins: a gain's, the armature's.
+constexpr bool param_moves_margins(const ParamInfo& p) {
+  return p.gain >= 0 || p.runtime == RuntimeParam::kParamArmatureCorrection;
 }
 
 /// Sets element e of parameter i to v, or refuses with the reason (nothing changed). For a gain,
@@ -278,7 +299,7 @@ ParamStatus param_set(ControlTask<S>& task, int i, int e, double v, GainMargins*
   if (p.runtime == RuntimeParam::kParamPayloadInertia &&
       !inertia_semidefinite(detail::payload_with(task.payload, p.runtime, e, v).inertia))
     return ParamStatus::kNotPhysical;
-  if (p.gain >= 0) {
+  if (param_moves_margins(p)) {
     const GainMargins m = param_margins(task, i, e, v);
     if (margins) *margins = m;
     if (const ParamStatus g = gain_status(m); g != ParamStatus::kOk) return g;
@@ -308,11 +329,12 @@ inline ParamRecord param_defaults() {
   return r;
 }
 
-/// The payload inertia's index in kParams.
+/// The payload inertia's and the armature correction's indices in kParams.
 constexpr int kPayloadInertiaParam = param_index("payload_inertia");
+constexpr int kArmatureParam = param_index("armature_correction");
 
-/// Applies a record when every value is valid and the gains keep the observer stable (else nothing
-/// changes: bad_record, unstable_observer). Needs the torque off.
+/// Applies a record when every value is valid and its gains and armature keep the sampled loop stable
+/// (else nothing changes: bad_record, unstable_observer, unstable_loop). Needs the torque off.
 template <class S>
 ParamStatus param_apply(ControlTask<S>& task, const ParamRecord& r) {
   if (!param_torque_off(task)) return ParamStatus::kTorqueOn;
@@ -326,7 +348,10 @@ ParamStatus param_apply(ControlTask<S>& task, const ParamRecord& r) {
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count && kParams[i].gain >= 0; ++e)
       detail::gain_put(g, kParams[i].gain, e, r.value[param_slot(i) + e]);
-  if (const ParamStatus st = gain_status(gain_margins(g, task_lambda_inverse(task))); st != ParamStatus::kOk) return st;
+  double correction[kDof];
+  for (int e = 0; e < kDof; ++e) correction[e] = r.value[param_slot(kArmatureParam) + e];
+  const Mat6<double> lambda_inv = task_lambda_inverse(task, task.with_armature(correction));
+  if (const ParamStatus st = gain_status(gain_margins(g, lambda_inv)); st != ParamStatus::kOk) return st;
   for (int i = 0; i < kParamCount; ++i)
     for (int e = 0; e < kParams[i].count; ++e) param_put(task, i, e, r.value[param_slot(i) + e]);
   return ParamStatus::kOk;

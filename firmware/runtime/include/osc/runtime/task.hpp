@@ -97,12 +97,17 @@ struct ControlTask {
   Payload payload;
   typename Model<S>::Link link6;
   Vec3<S> link6_root[2];
+  // Each drive's armature correction (parameter armature_correction: set_armature) and its described
+  // armature G^2 J_m (the diagonal of the model init took: Model::of's, uncoupled), which it corrects.
+  double armature_correction[kDof];
+  double armature_base[kDof];
   // An identification run's filter and its samples for the main loop (osc/runtime/identify_run.hpp).
   IdentifySampler<S> identify;
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
     model = m;
+    for (int i = 0; i < kDof; ++i) armature_correction[i] = 0, armature_base[i] = static_cast<double>(model.armature(i));
     gains = g;
     mode = fm;
     q_start = q0;
@@ -167,19 +172,42 @@ struct ControlTask {
   /// parameters' access), in double: compiled for size.
   [[gnu::cold]] void set_payload(const Payload& p) {
     payload = p;
-    model.link[kDof - 1] = link6;
-    model.root_diagonal[kDof - 1] = link6_root[0];
-    model.root_lower[kDof - 1] = link6_root[1];
+    model = without_payload();
     if (payload_empty(p)) return;
     const RigidBody load{p.mass,
                          {p.com[0], p.com[1], p.com[2]},
                          {p.inertia[0], p.inertia[1], p.inertia[2], p.inertia[3], p.inertia[4], p.inertia[5]}};
     model.set_inertial(kDof - 1, combine_bodies(model.inertial(kDof - 1), load));
   }
+  /// The model without the payload (link 6 as init had it), the armature as it is: an identify run's
+  /// model when it estimates the whole payload (IdentifyRun::start's bare).
+  [[gnu::cold]] Model<S> without_payload() const {
+    Model<S> m = model;
+    m.link[kDof - 1] = link6;
+    m.root_diagonal[kDof - 1] = link6_root[0];
+    m.root_lower[kDof - 1] = link6_root[1];
+    return m;
+  }
+  /// Drive i's armature correction c: the drives' armatures are then the described plus the
+  /// corrections, in the joints' space through the coupling (Model::set_drive_armature), which every
+  /// use of A(q) sees (as the payload). Outside the tick, with the torque off.
+  [[gnu::cold]] void set_armature(int i, double c) {
+    armature_correction[i] = c;
+    model = with_armature(armature_correction);
+  }
+  /// The model with the drives' armature corrections `correction` (a candidate's: the parameters' check).
+  [[gnu::cold]] Model<S> with_armature(const double (&correction)[kDof]) const {
+    double drives[kDof];
+    for (int i = 0; i < kDof; ++i) drives[i] = armature_base[i] + correction[i];
+    Model<S> m = model;
+    m.set_drive_armature(drives, io.inverse);
+    return m;
+  }
   /// The encoders and coupling of the arm (osc/robots/arm.hpp, EncoderMap): the angles, the
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
   [[gnu::cold]] void set_encoders(const EncoderMap& map) {  // set-up, in double: compiled for size
     io = IoMap<S>::of(map);
+    model = with_armature(armature_correction);  // the rotors' inertia through the coupling
     index_ticks = IndexTicks::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
