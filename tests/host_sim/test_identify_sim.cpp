@@ -3,6 +3,7 @@
 // friction and payload (the truth, which the controller never reads).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -217,14 +218,14 @@ TEST(IdentifySim, APayloadFromARoughSettingIsIdentified) {
 }
 
 /// The mean over [t0, t1] of the realistic plant's friction scale, 1 + d sin(2 pi t / P) (PlantConfig's drift).
-double mean_drift(const sim::PlantConfig& pc, double t0, double t1) {
+static double mean_drift(const sim::PlantConfig& pc, double t0, double t1) {
   if (pc.friction_drift == 0) return 1;
   const double w = 2 * kPi / pc.friction_drift_period;
   return 1 + pc.friction_drift * (std::cos(w * t0) - std::cos(w * t1)) / (w * (t1 - t0));
 }
 
 /// The plant's friction preset scaled by its drift's mean over the run that ended now and lasted `seconds`.
-FrictionCoefficients drifted(const sim::PlantConfig& pc, double now, double seconds) {
+static FrictionCoefficients drifted(const sim::PlantConfig& pc, double now, double seconds) {
   FrictionCoefficients f = pc.friction;
   const double s = mean_drift(pc, now - seconds, now);
   for (int i = 0; i < kDof; ++i) f.vis[i] *= s, f.cou[i] *= s, f.sti[i] *= s;
@@ -252,7 +253,9 @@ TEST(IdentifySim, TheRealisticPlantsFrictionWithItsArmatureSet) {
     const double truth =
         l.gear_ratio * l.gear_ratio * (robot::kDriveTrain.motor_inertia_alt.jm[i] - l.motor_inertia);
     std::printf("  armature J%d: %.4f (plant %.4f), sd %.4f\n", i + 1, first.armature(i), truth, first.armature_sd(i));
-    if (i < 3) EXPECT_NEAR(first.armature(i), truth, 0.1 * truth) << "J" << i + 1;
+    if (i < 3) {
+      EXPECT_NEAR(first.armature(i), truth, 0.1 * truth) << "J" << i + 1;
+    }
   }
   EXPECT_EQ(answer(sim, MotionVerb::kDisable, 2).outcome, CommandOutcome::kAccepted);
   for (int i = 0; i < kDof; ++i) ASSERT_EQ(param_set(sim.task(), a, i, first.armature(i)), ParamStatus::kOk) << i;
@@ -266,4 +269,59 @@ TEST(IdentifySim, TheRealisticPlantsFrictionWithItsArmatureSet) {
     for (int i = 0; i < 4; ++i)
       EXPECT_LE(std::fabs(second.friction(c * kDof + i) - t[c][i]), std::max(0.1 * t[c][i], 0.05))
           << c << " J" << i + 1;
+}
+
+/// test_motion_sim's warm and cold move (0.10, -0.08, 0.05 m with 0.3 rad of yaw, at the move maxima) from the start
+/// pose on a freshly built arm (a power-on) that first applies `record`, as a board's boot applies its stored one:
+/// the move's tracking error [m].
+static double first_move_after(const ParamRecord* record) {
+  MotionSim<double> sim(start_pose());
+  if (record) {
+    EXPECT_EQ(param_apply(sim.task(), *record), ParamStatus::kOk);
+  }
+  EXPECT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  run_ticks(sim, 300);
+  MoveRequest<double> req = test::relative<double>(0.10, -0.08, 0.05);
+  req.has_rpy = true;
+  req.rpy = Vec3<double>(0, 0, 0.3);
+  EXPECT_EQ(test::answer_move(sim, req, 7).outcome, CommandOutcome::kAccepted);
+  const test::Trace r = test::run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.done_id != 0; }, 20000);
+  EXPECT_EQ(r.faults, 0u) << fault_name(r.faults);
+  EXPECT_EQ(sim.task().report.done_id, 7u);
+  return r.tracking;
+}
+
+// Issue 57's persistence, in process: what the friction law learnt (10 s of the paper's motion), or an identify run's
+// friction set with param set, kept in a parameter record (f32, as a store keeps it) and applied at the next
+// power-on. The first move then tracks within 0.5 mm; from a cold start (theta^ = 0) it is over 1 mm (2.32 mm:
+// test_motion_sim). The virtual board's and the QEMU image's restart are not yet in this test.
+TEST(IdentifySim, AFirstMoveFromSavedFrictionIsNotAColdStart) {
+  MotionSim<double> a(start_pose());
+  EXPECT_EQ(answer(a, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  EXPECT_EQ(answer(a, MotionVerb::kPaper, 2).outcome, CommandOutcome::kAccepted);
+  run_ticks(a, 10000);
+  EXPECT_EQ(answer(a, MotionVerb::kStop, 3).outcome, CommandOutcome::kAccepted);
+  test::run_until(
+      a, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
+  EXPECT_EQ(answer(a, MotionVerb::kDisable, 4).outcome, CommandOutcome::kAccepted);
+  const ParamRecord learnt = param_capture(a.task());
+  MotionSim<double> b(test::identify_pose());
+  std::uint32_t taken = 0, lost = 0;
+  const IdentifyReport r = run_identify(b, payload_mask::kNone, taken, lost);
+  ASSERT_EQ(r.status, IdentifyStatus::kOk);
+  EXPECT_EQ(answer(b, MotionVerb::kDisable, 6).outcome, CommandOutcome::kAccepted);
+  const int vis = param_index("friction_vis");
+  for (int k = 0; k < 3 * kDof; ++k)
+    ASSERT_EQ(param_set(b.task(), vis + k / kDof, k % kDof, std::clamp(r.friction(k), 0.0, params::kThetaMax[k])),
+              ParamStatus::kOk)
+        << k;
+  const ParamRecord identified = param_capture(b.task());
+  const double cold = first_move_after(nullptr), warm = first_move_after(&learnt),
+               known = first_move_after(&identified);
+  std::printf("the first move after a power-on: cold %.3f mm, the learnt friction %.3f mm, the identified %.3f mm\n",
+              cold * 1e3, warm * 1e3, known * 1e3);
+  EXPECT_GT(cold, 1e-3);
+  EXPECT_LE(warm, 0.5e-3);
+  EXPECT_LE(known, 0.5e-3);
 }

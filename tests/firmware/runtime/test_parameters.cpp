@@ -396,9 +396,9 @@ TEST(Parameters, TheArmatureCorrectionIsTheModelsDouble) { armature_correction_i
 TEST(Parameters, TheArmatureCorrectionIsTheModelsFloat) { armature_correction_is_the_models<float>(); }
 TEST(Parameters, TheArmatureCorrectionIsTheModelsFixed) { armature_correction_is_the_models<Fixed>(); }
 
-// A lighter armature is a larger inverse mass: with a wrist's k_i just inside the loop's bound, halving
-// the wrist drives' armature would lose the loop, and is refused unstable_loop (a set and a record alike);
-// bad values are refused by name; nothing changes.
+// A lighter armature is a larger inverse mass: with a wrist's k_i just inside the loop's bound, the wrist drive's
+// armature at the bottom of its range (20 % lighter) would lose the loop, and is refused unstable_loop (a set and a
+// record alike); bad values are refused by name; nothing changes.
 TEST(Parameters, AnArmatureThatLosesTheLoopIsRefused) {
   auto t = disabled_task<double>();
   const int a = param_index("armature_correction"), k = param_index("k"), ki = param_index("ki");
@@ -412,22 +412,64 @@ TEST(Parameters, AnArmatureThatLosesTheLoopIsRefused) {
   if (hi >= kParams[ki].hi_of(3)) GTEST_SKIP() << "k_i within its range never loses this arm's loop";
   ASSERT_EQ(param_set(*t, ki, 3, 0.97 * lo), ParamStatus::kOk);
   const ParamRecord before = param_capture(*t);
-  const double half = -0.5 * static_cast<double>(t->model.armature(3));
+  const double light = kParams[a].lo_of(3);
+  EXPECT_NEAR(light, -0.2 * static_cast<double>(t->model.armature(3)), 1e-12);
   GainMargins m;
-  EXPECT_EQ(param_set(*t, a, 3, half, &m), ParamStatus::kUnstableLoop);
+  EXPECT_EQ(param_set(*t, a, 3, light, &m), ParamStatus::kUnstableLoop);
   EXPECT_LT(m.loop, 1);
-  EXPECT_EQ(param_set(*t, a, 3, half * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, a, 3, light * 1.01), ParamStatus::kOutOfRange);
   EXPECT_EQ(param_set(*t, a, 3, std::numeric_limits<double>::quiet_NaN()), ParamStatus::kNotFinite);
   EXPECT_EQ(param_set(*t, a, 6, 0.0), ParamStatus::kBadElement);
   ParamRecord r = before;
-  r.value[param_slot(a) + 3] = static_cast<float>(half);
+  r.value[param_slot(a) + 3] = static_cast<float>(light);
   EXPECT_EQ(param_apply(*t, r), ParamStatus::kUnstableLoop);
   const ParamRecord after = param_capture(*t);
   for (int n = 0; n < kParamSlots; ++n) EXPECT_EQ(after.value[n], before.value[n]) << n;
   // A heavier one is taken (smaller inverse masses), and refused under torque.
-  EXPECT_EQ(param_set(*t, a, 3, -half), ParamStatus::kOk);
+  EXPECT_EQ(param_set(*t, a, 3, -light), ParamStatus::kOk);
   t->machine.state = MotionState::kHolding;
   EXPECT_EQ(param_set(*t, a, 3, 0.0), ParamStatus::kTorqueOn);
+}
+
+// Issue 57: what the friction law has learnt is a parameter. friction_vis, _cou and _sti read theta^ as the law has
+// it now (so that param save keeps it), and a set (an identify run's, a stored record's at power-on) is where the
+// law goes on from: the controller's friction estimate at the next step is the set coefficients' (model (2)).
+TEST(Parameters, TheFrictionEstimateIsAParameter) {
+  auto t = disabled_task<double>();
+  const int vis = param_index("friction_vis"), cou = param_index("friction_cou"), sti = param_index("friction_sti");
+  ASSERT_GE(vis, 0);
+  EXPECT_EQ(cou, vis + 1);
+  EXPECT_EQ(sti, vis + 2);
+  // Read: theta^ as the law left it.
+  for (int k = 0; k < 3 * kDof; ++k) t->state.adapt.theta_hat(k) = 0.1 * (k + 1);
+  for (int k = 0; k < 3 * kDof; ++k) EXPECT_DOUBLE_EQ(param_get(*t, vis + k / kDof, k % kDof), 0.1 * (k + 1)) << k;
+  // Set: the preset's coefficients, each in its place.
+  const FrictionCoefficients& f = *robot::kFrictionPresets[0];
+  for (int e = 0; e < kDof; ++e) {
+    ASSERT_EQ(param_set(*t, vis, e, f.vis[e]), ParamStatus::kOk);
+    ASSERT_EQ(param_set(*t, cou, e, f.cou[e]), ParamStatus::kOk);
+    ASSERT_EQ(param_set(*t, sti, e, f.sti[e]), ParamStatus::kOk);
+  }
+  const Vec6<double> qd(0.3, -0.2, 0.1, -0.5, 0.4, -0.6);
+  const Vec6<double> tau = friction_estimate(t->gains, t->state.adapt.theta_hat, qd);
+  for (int i = 0; i < kDof; ++i) {
+    const double s = qd(i) > 0 ? 1 : -1;
+    const double want = f.vis[i] * qd(i) + s * (f.cou[i] + f.sti[i] * std::exp(-t->gains.tau_dec(i) * qd(i) * qd(i)));
+    EXPECT_NEAR(tau(i), want, 1e-12) << i;
+  }
+  // Within [0, theta_max], with the torque off.
+  EXPECT_EQ(param_set(*t, vis, 0, -0.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, cou, 1, params::kThetaMax[kDof + 1] * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, sti, 2, std::numeric_limits<double>::infinity()), ParamStatus::kNotFinite);
+  // A stored record (a power-on's) gives theta^ whole.
+  ParamRecord r = param_capture(*t);
+  auto u = disabled_task<double>();
+  EXPECT_EQ(u->state.adapt.theta_hat, Vec18<double>::Zero());  // a cold start
+  ASSERT_EQ(param_apply(*u, r), ParamStatus::kOk);
+  EXPECT_LT((u->state.adapt.theta_hat - t->state.adapt.theta_hat).cwiseAbs().maxCoeff(), 1e-6);  // f32 records
+  t->machine.state = MotionState::kMoving;
+  EXPECT_EQ(param_set(*t, vis, 0, 1.0), ParamStatus::kTorqueOn);
+  EXPECT_DOUBLE_EQ(t->state.adapt.theta_hat(0), f.vis[0]);
 }
 
 TEST(Parameters, Condition37OnlyWarns) {

@@ -262,7 +262,10 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_paper(task.gains.trajectory, next, cmd.id, task.gen.held_orientation());
   if (accepted && cmd.verb == MotionVerb::kStream)
     task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
-  if (accepted && cmd.verb == MotionVerb::kIdentify) task.gen.start_excitation(cmd.excitation, next, cmd.id);
+  if (accepted && cmd.verb == MotionVerb::kIdentify) {
+    task.gen.start_excitation(cmd.excitation, next, cmd.id);
+    task.identify.reset();  // its sampler primed again at the run's first tick, whatever the id
+  }
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
   if (st.machine.state == MotionState::kStopping && before != MotionState::kStopping) {

@@ -83,6 +83,20 @@ inline Payload payload_with(Payload p, RuntimeParam which, int e, double v) {
   if (which == RuntimeParam::kParamPayloadInertia) p.inertia[e] = v;
   return p;
 }
+/// The index in theta^ = [vis; cou; sti] of element e of friction_vis, _cou or _sti.
+constexpr int theta_index(RuntimeParam which, int e) {
+  return (static_cast<int>(which) - static_cast<int>(RuntimeParam::kParamFrictionVis)) * kDof + e;
+}
+/// Writes element e of a parameter of what the arm is known to be (the payload, the drives' armature, the
+/// friction law's estimate) into the task.
+template <class S>
+void model_put(ControlTask<S>& task, RuntimeParam which, int e, double v) {
+  if (which == RuntimeParam::kParamArmatureCorrection) return task.set_armature(e, v);
+  if (which == RuntimeParam::kParamFrictionVis || which == RuntimeParam::kParamFrictionCou ||
+      which == RuntimeParam::kParamFrictionSti)
+    return void(task.state.adapt.theta_hat(theta_index(which, e)) = static_cast<S>(v));
+  task.set_payload(payload_with(task.payload, which, e, v));
+}
 }  // namespace detail
 
 /// Element e of parameter i's default: a gain's paper value (Gains::paper), a runtime parameter's
@@ -138,6 +152,10 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return task.payload.inertia[e];
     case RuntimeParam::kParamArmatureCorrection:
       return task.armature_correction[e];
+    case RuntimeParam::kParamFrictionVis:
+    case RuntimeParam::kParamFrictionCou:
+    case RuntimeParam::kParamFrictionSti:
+      return static_cast<double>(task.state.adapt.theta_hat(detail::theta_index(p.runtime, e)));
     case RuntimeParam::kCount:
       break;
   }
@@ -195,10 +213,11 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamPayloadMass:
     case RuntimeParam::kParamPayloadCom:
     case RuntimeParam::kParamPayloadInertia:
-      task.set_payload(detail::payload_with(task.payload, p.runtime, e, v));
-      break;
     case RuntimeParam::kParamArmatureCorrection:
-      task.set_armature(e, v);
+    case RuntimeParam::kParamFrictionVis:
+    case RuntimeParam::kParamFrictionCou:
+    case RuntimeParam::kParamFrictionSti:
+      detail::model_put(task, p.runtime, e, v);
       break;
     case RuntimeParam::kCount:
       break;

@@ -107,7 +107,7 @@ struct ControlTask {
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
             TaskStart start = TaskStart::kPaper) {
     model = m;
-    for (int i = 0; i < kDof; ++i) armature_correction[i] = 0, armature_base[i] = static_cast<double>(model.armature(i));
+    keep_described();
     gains = g;
     mode = fm;
     q_start = q0;
@@ -159,11 +159,16 @@ struct ControlTask {
     timing = {};
     step_timing = {};
     stages = {};
-    payload = {};
     identify.reset();
+  }
+  /// The model's link 6 and drives' armatures as described (init's model), which the payload and the armature
+  /// correction then change: none of either.
+  [[gnu::cold]] void keep_described() {
+    payload = {};
     link6 = model.link[kDof - 1];
     link6_root[0] = model.root_diagonal[kDof - 1];
     link6_root[1] = model.root_lower[kDof - 1];
+    for (int i = 0; i < kDof; ++i) armature_correction[i] = 0, armature_base[i] = static_cast<double>(model.armature(i));
   }
   /// The payload at the flange (osc/robots/arm.hpp, Payload): the model's link 6 becomes link 6 and
   /// the payload together (combine_bodies), which the model's every use then sees: the controller's
