@@ -3,14 +3,12 @@
 // fixed point rounded once, where rounding each term would lose the sum (values of a few LSB).
 #include <gtest/gtest.h>
 
-#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <string_view>
 
-#include "osc/kernels/dynamics.hpp"
 #include "osc/kernels/kinematics.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/math/fixed.hpp"
@@ -110,60 +108,6 @@ TEST(Model, ARotatedFullInertiaIsRTimesTheTensorTimesRTransposed) {
 }
 
 // Terms of 0.4 LSB each: rounded one by one they vanish, their exact sum rounds to 1 LSB.
-// A coupled drive train's rotors (issue 57): the motors turn at e' = C^-1 q', so their kinetic energy is
-// 1/2 sum_k D_k e'_k^2 (D_k = G_k^2 J_m,k). The model's A(q) less its links' must be that energy's matrix, and rnea's
-// torque less its links' the rotors' C^-T D C^-1 q''. Checked against C built here from the map's terms and solved by
-// Eigen (not coupling_matrices), for the arm's own map and a map with a term below the wrist.
-TEST(Model, ACoupledDriveTrainsRotorsAreTheModelsArmature) {
-  EncoderMap lower = robot::kDriveTrain.encoders;
-  lower.coupling[lower.coupling_terms++] = {2, 1, 0.12};
-  for (const EncoderMap& map : {robot::kDriveTrain.encoders, lower}) {
-    Eigen::Matrix<double, kDof, kDof> C = Eigen::Matrix<double, kDof, kDof>::Identity();
-    for (int k = 0; k < map.coupling_terms; ++k) C(map.coupling[k].row, map.coupling[k].col) += map.coupling[k].c;
-    double drive[kDof], C_unused[kDof][kDof], inverse[kDof][kDof];
-    coupling_matrices(map, C_unused, inverse);
-    Model<double> links = Model<double>::of(robot::kArm);
-    Model<double> coupled = links;
-    for (int i = 0; i < kDof; ++i) drive[i] = links.armature(i);
-    coupled.set_drive_armature(drive, inverse);
-    links.armature.setZero();
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<double> u(-1, 1);
-    for (int n = 0; n < 5; ++n) {
-      Vec6<double> q, qd, qdd;
-      for (int i = 0; i < kDof; ++i) q(i) = u(rng), qd(i) = u(rng), qdd(i) = u(rng);
-      Data<double> a, b;
-      forward_kinematics(coupled, a, q);
-      forward_kinematics(links, b, q);
-      joint_inertia(coupled, a);
-      joint_inertia(links, b);
-      const Vec6<double> ed = C.triangularView<Eigen::UnitLower>().solve(qd);
-      double energy = 0;
-      for (int k = 0; k < kDof; ++k) energy += drive[k] * ed(k) * ed(k);
-      EXPECT_NEAR(qd.dot((a.A - b.A) * qd), energy, 1e-12 * energy) << map.name << " " << n;
-      EXPECT_LT((a.A - a.A.transpose()).cwiseAbs().maxCoeff(), 1e-15);
-      const Vec6<double> edd = C.triangularView<Eigen::UnitLower>().solve(qdd);
-      const Vec6<double> rotors = C.transpose().triangularView<Eigen::UnitUpper>().solve(
-          Vec6<double>(Eigen::Map<const Vec6<double>>(drive).cwiseProduct(edd)));
-      const Vec6<double> tau = rnea(coupled, a, qd, qdd, false).tau - rnea(links, b, qd, qdd, false).tau;
-      EXPECT_LT((tau - rotors).cwiseAbs().maxCoeff(), 1e-12) << map.name << " " << n;
-    }
-    if (map.coupling_terms == 0) {
-      EXPECT_EQ(coupled.armature_term_count, 0);
-    } else {
-      EXPECT_GT(coupled.armature_term_count, 0);
-    }
-  }
-  Model<double> uniform = Model<double>::of(robot::kArm);
-  double drive[kDof], C[kDof][kDof], inverse[kDof][kDof];
-  for (int i = 0; i < kDof; ++i) drive[i] = uniform.armature(i);
-  coupling_matrices(robot::kEncodersUniform, C, inverse);
-  const Vec6<double> before = uniform.armature;
-  uniform.set_drive_armature(drive, inverse);
-  EXPECT_EQ(uniform.armature_term_count, 0);
-  EXPECT_EQ(uniform.armature, before);  // bit for bit
-}
-
 TEST(Model, FixedPointProductsAreRoundedOnce) {
   const Fixed lsb = Fixed::lsb(), f = Fixed(0.4), zero = Fixed(0);
   ASSERT_EQ((lsb * f).raw(), 0);  // each product alone

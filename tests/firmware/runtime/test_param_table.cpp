@@ -44,7 +44,8 @@ TEST(Parameters, OneTableGainsFirstThenTheRuntimeList) {
   }
   EXPECT_EQ(gains, 7);  // knd, k, ks, ki, k_ad, tau_dec, leakage: the host's controller.* keys
   EXPECT_EQ(slots, kParamSlots);
-  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2 + 1 + 1 + 1 + 1) + (1 + 3 + 6) + 6 + 18);  // + the payload, the armature, theta^
+  EXPECT_EQ(kParamSlots, 4 * 6 + 3 + (1 + 3 + 3 + 1 + 6 + 1 + 1 + 2 + 1 + 1 + 1 + 1) + (1 + 3 + 6) + 6 +
+                             18);  // + the payload, the armature, theta^
   EXPECT_EQ(param_index("no_such"), -1);
   EXPECT_LT(kParamCount, 256);  // an index fits the frame's byte
 }

@@ -49,11 +49,6 @@ RneaOut<S> rnea(const Model<S>& model, const Data<S>& data, const Vec6In<S>& qd,
     F = f[i] + F;
     out.tau(i - 1) = dot_sum(Vec3<S>(data.R[i - 1].col(2)), N, data.vO[i - 1], F) + model.armature(i - 1) * qdd(i - 1);
   }
-  for (int k = 0; k < model.armature_term_count; ++k) {
-    const auto& t = model.armature_terms[k];
-    out.tau(t.row) += t.value * qdd(t.col);
-    out.tau(t.col) += t.value * qdd(t.row);
-  }
   return out;
 }
 
@@ -99,11 +94,6 @@ void joint_inertia(const Model<S>& model, Data<S>& data) {
     }
   }
   data.A.diagonal() += model.armature;
-  for (int k = 0; k < model.armature_term_count; ++k) {
-    const auto& t = model.armature_terms[k];
-    data.A(t.row, t.col) += t.value;
-    data.A(t.col, t.row) += t.value;
-  }
 }
 
 /// Gravity torques g(q), from the composite bodies (what rnea with gravity and no motion gives, in

@@ -138,17 +138,6 @@ struct Model {
   /// tensor that is not positive definite), its diagonal and (L_yx, L_zx, L_zy) (rotated_full_inertia). Apart
   /// from Link, whose size (the stride of link[i]) the arms without products keep.
   Vec3<S> root_diagonal[kDof], root_lower[kDof];
-  /// A coupled drive train's rotor inertia off the diagonal: the motors turn at e' = C^-1 q', so their
-  /// inertia in the joints' space is C^-T diag(G^2 J_m) C^-1 (armature holds its diagonal). Term k adds
-  /// its value to A(row, col) and A(col, row), and value q''(col) to tau(row), value q''(row) to tau(col).
-  /// None on an uncoupled arm (Model::of); set_drive_armature sets them.
-  struct ArmatureTerm {
-    int row, col;
-    S value;
-  };
-  static constexpr int kMaxArmatureTerms = kDof * (kDof - 1) / 2;
-  ArmatureTerm armature_terms[kMaxArmatureTerms];
-  int armature_term_count;
 
   /// The Cholesky factor of the tensor (Ixx, Iyy, Izz, Ixy, Ixz, Iyz) scaled by s, in double (set-up
   /// only); a pivot that is not positive (a tensor the generator would refuse) gives 0s.
@@ -199,23 +188,6 @@ struct Model {
     l.products = Vec3<S>(lit<S>(b.inertia[3]), lit<S>(b.inertia[4]), lit<S>(b.inertia[5]));
     l.diagonal = b.inertia[3] == 0 && b.inertia[4] == 0 && b.inertia[5] == 0;
     cholesky_root(b.inertia, 1.0, root_diagonal[i], root_lower[i]);
-  }
-
-  /// The drives' armatures (each drive's G^2 J_m, referred to its joint) through the coupling's
-  /// inverse C^-1 (q = C e; osc/robots/arm.hpp, coupling_matrices): the joints' rotor inertia
-  /// C^-T diag(drive) C^-1, its diagonal into armature and the rest into armature_terms. C = I: the
-  /// drives' armatures on the diagonal, no terms. In double (set-up, outside the tick).
-  void set_drive_armature(const double (&drive)[kDof], const double (&inverse)[kDof][kDof]) {
-    armature_term_count = 0;
-    for (int i = 0; i < kDof; ++i)
-      for (int j = i; j < kDof; ++j) {
-        double v = 0;
-        for (int k = 0; k < kDof; ++k) v += inverse[k][i] * drive[k] * inverse[k][j];
-        if (i == j)
-          armature(i) = lit<S>(v);
-        else if (v != 0)
-          armature_terms[armature_term_count++] = {i, j, lit<S>(v)};
-      }
   }
 
   /// Link i's body as the model has it, in double.

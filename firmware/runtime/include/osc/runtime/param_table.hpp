@@ -106,9 +106,9 @@ constexpr double described_armature(int i) {
 constexpr double kArmatureCorrectionLo[kDof] = {-0.2 * described_armature(0), -0.2 * described_armature(1),
                                                 -0.2 * described_armature(2), -0.2 * described_armature(3),
                                                 -0.2 * described_armature(4), -0.2 * described_armature(5)};
-constexpr double kArmatureCorrectionHi[kDof] = {
-    3 * described_armature(0) + 0.01, 3 * described_armature(1) + 0.01, 3 * described_armature(2) + 0.01,
-    3 * described_armature(3) + 0.01, 3 * described_armature(4) + 0.01, 3 * described_armature(5) + 0.01};
+constexpr double kArmatureCorrectionHi[kDof] = {3 * described_armature(0) + 0.01, 3 * described_armature(1) + 0.01,
+                                                3 * described_armature(2) + 0.01, 3 * described_armature(3) + 0.01,
+                                                3 * described_armature(4) + 0.01, 3 * described_armature(5) + 0.01};
 /// Homing's speeds: from 1 mm/s and 1 mrad/s (a homing that still ends within a minute) to the
 /// configured move maxima.
 constexpr double kHomeSpeedLo[2] = {1e-3, 1e-3};
@@ -155,17 +155,17 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
   X(PayloadInertia, "payload_inertia", 6, "kg m^2", detail::kPayloadInertiaLo, detail::kPayloadInertiaHi, 0,          \
     TorqueOff, true,                                                                                                  \
     "the payload's inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz; positive "           \
-    "semi-definite (else not_physical): set the moments before the products")                                      \
-  X(ArmatureCorrection, "armature_correction", kDof, "kg m^2", detail::kArmatureCorrectionLo,                        \
-    detail::kArmatureCorrectionHi, 0, TorqueOff, true,                                                               \
-    "each drive's armature correction, added to its described G^2 Jm on the diagonal of the model's A(q) (an "       \
-    "identify run's estimate); the sampled loop stays stable at the last computed pose (else unstable_loop)")     \
-  X(FrictionVis, "friction_vis", kDof, "N m s/rad", 0, params::kThetaMax, 0, TorqueOff, true,                        \
-    "the friction law's estimate theta^ (20), viscous: read, what it has learnt; set (an identify run's, a saved "   \
-    "record's at power-on), where it goes on from; within [0, the robust law's bound theta_max]")                   \
-  X(FrictionCou, "friction_cou", kDof, "N m", 0, params::kThetaMax + kDof, 0, TorqueOff, true,                       \
-    "the same of the Coulomb levels")                                                                                \
-  X(FrictionSti, "friction_sti", kDof, "N m", 0, params::kThetaMax + 2 * kDof, 0, TorqueOff, true,                   \
+    "semi-definite (else not_physical): set the moments before the products")                                         \
+  X(ArmatureCorrection, "armature_correction", kDof, "kg m^2", detail::kArmatureCorrectionLo,                         \
+    detail::kArmatureCorrectionHi, 0, TorqueOff, true,                                                                \
+    "each drive's armature correction, added to its described G^2 Jm on the diagonal of the model's A(q) (an "        \
+    "identify run's estimate); the sampled loop stays stable at the last computed pose (else unstable_loop)")         \
+  X(FrictionVis, "friction_vis", kDof, "N m s/rad", 0, params::kThetaMax, 0, TorqueOff, true,                         \
+    "the friction law's estimate theta^ (20), viscous: read, what it has learnt; set (an identify run's, a saved "    \
+    "record's at power-on), where it goes on from; within [0, the robust law's bound theta_max]")                     \
+  X(FrictionCou, "friction_cou", kDof, "N m", 0, params::kThetaMax + kDof, 0, TorqueOff, true,                        \
+    "the same of the Coulomb levels")                                                                                 \
+  X(FrictionSti, "friction_sti", kDof, "N m", 0, params::kThetaMax + 2 * kDof, 0, TorqueOff, true,                    \
     "the same of the Stribeck excesses")
 
 #define OSC_X_PREFIX kParam

@@ -168,7 +168,8 @@ struct ControlTask {
     link6 = model.link[kDof - 1];
     link6_root[0] = model.root_diagonal[kDof - 1];
     link6_root[1] = model.root_lower[kDof - 1];
-    for (int i = 0; i < kDof; ++i) armature_correction[i] = 0, armature_base[i] = static_cast<double>(model.armature(i));
+    for (int i = 0; i < kDof; ++i)
+      armature_correction[i] = 0, armature_base[i] = static_cast<double>(model.armature(i));
   }
   /// The payload at the flange (osc/robots/arm.hpp, Payload): the model's link 6 becomes link 6 and
   /// the payload together (combine_bodies), which the model's every use then sees: the controller's
@@ -193,26 +194,24 @@ struct ControlTask {
     m.root_lower[kDof - 1] = link6_root[1];
     return m;
   }
-  /// Drive i's armature correction c: the drives' armatures are then the described plus the
-  /// corrections, in the joints' space through the coupling (Model::set_drive_armature), which every
-  /// use of A(q) sees (as the payload). Outside the tick, with the torque off.
+  /// Drive i's armature correction c: the model's armature (A(q)'s diagonal) is then the described plus
+  /// the correction, which every use of A(q) sees (as the payload). On a coupled arm the rotors' inertia
+  /// C^-T diag(G^2 J_m) C^-1 has terms off the diagonal, which the model leaves out (docs/adaptation.md,
+  /// section 6). Outside the tick, with the torque off.
   [[gnu::cold]] void set_armature(int i, double c) {
     armature_correction[i] = c;
     model = with_armature(armature_correction);
   }
   /// The model with the drives' armature corrections `correction` (a candidate's: the parameters' check).
   [[gnu::cold]] Model<S> with_armature(const double (&correction)[kDof]) const {
-    double drives[kDof];
-    for (int i = 0; i < kDof; ++i) drives[i] = armature_base[i] + correction[i];
     Model<S> m = model;
-    m.set_drive_armature(drives, io.inverse);
+    for (int i = 0; i < kDof; ++i) m.armature(i) = lit<S>(armature_base[i] + correction[i]);
     return m;
   }
   /// The encoders and coupling of the arm (osc/robots/arm.hpp, EncoderMap): the angles, the
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
   [[gnu::cold]] void set_encoders(const EncoderMap& map) {  // set-up, in double: compiled for size
     io = IoMap<S>::of(map);
-    model = with_armature(armature_correction);  // the rotors' inertia through the coupling
     index_ticks = IndexTicks::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
