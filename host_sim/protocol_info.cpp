@@ -207,6 +207,7 @@ json command_protocol() {
   j["outcomes"] = motion_names<osc::CommandOutcome>();
   j["stop_categories"] = motion_names<osc::StopCategory>();
   j["completions"] = motion_names<osc::MotionCompletion>();
+  j["identify_statuses"] = coded(osc::kIdentifyStatusNames, osc::kIdentifyStatusDocs, osc::kIdentifyStatusCount);
   j["poses"] = json::array();
   for (int i = 0; i < osc::robot::kNamedPoseCount; ++i) {
     const osc::NamedPose& p = osc::robot::kNamedPoses[i];
@@ -262,6 +263,8 @@ json client_protocol() {
   j["outcomes"] = names<osc::CommandOutcome>();
   j["stop_categories"] = names<osc::StopCategory>();
   j["completions"] = names<osc::MotionCompletion>();
+  j["identify_statuses"] = json::array();
+  for (const char* n : osc::kIdentifyStatusNames) j["identify_statuses"].push_back(n);
   j["poses"] = json::array();
   for (int i = 0; i < osc::robot::kNamedPoseCount; ++i) j["poses"].push_back(osc::robot::kNamedPoses[i].name);
   j["faults"] = json::array();

@@ -17,6 +17,12 @@
 // link's errors into the state frames (field link). --inject KIND[:ARGS]@S injects a simulated
 // hardware fault or contact (injection.hpp), so that a client's fault handling can be tested.
 //
+// In process it is a board that estimates: an identify run's samples are summed after each tick, and the run's
+// estimate goes to the client as an identify frame when its motion ends (osc/link/identify_port.hpp). Its parameter
+// store is in RAM unless --param-file FILE keeps it in a file, the image of two flash sectors as a board's flash
+// holds them (file_flash.hpp, persist::FlashParamStore): a restarted simulator then applies the newest record at its
+// start, as a board's boot does, and says so on stderr ("params loaded, sequence N", or "params defaults (why)").
+//
 // A tick that starts more than a period after its deadline is an overrun: the loop catches up
 // without sleeping (at most kMaxCatchUpNs of wall time behind; further behind, the schedule
 // restarts from now: a slip) and counts them; the counts are printed at exit. SIGINT and SIGTERM
@@ -51,10 +57,13 @@
 
 #include "cli_parse.hpp"
 #include "experiment_cli.hpp"  // qemu_takes
+#include "file_flash.hpp"
 #include "injection.hpp"
 #include "linked_arm.hpp"
 #include "motion_sim.hpp"
 #include "osc/link/command_port.hpp"
+#include "osc/link/identify_port.hpp"
+#include "param_store.hpp"
 
 namespace {
 
@@ -77,6 +86,7 @@ struct Options {
   std::string elf = OSC_DEFAULT_PIL_ELF;  // the image puma_experiment --qemu runs by default
   std::string inject;                     // KIND[:ARGS]@S (injection.hpp)
   bool no_link_watch = false;             // the command link's silence does not stop a motion
+  std::string param_file;                 // the parameter store's image (empty: the store in RAM)
 };
 
 /// The master side of a pseudo-terminal whose slave is in raw mode. Frames are written whole or not
@@ -213,12 +223,27 @@ class InProcessBoard {
     watch_.heard();
     return port_.on_frame(sim_.task(), p, write);
   }
-  /// One tick; its frames to write (an answer, a state frame when due).
+  /// One tick; its frames to write (an answer, an identify run's report, a state frame when due).
   template <class Write>
   bool tick(Write&& write, std::string&) {
     if (link_watch_) watch_.before_tick(sim_.task(), port_.commanded());
     sim_.tick();
     port_.after_tick_and_poll(sim_.task(), write);  // the tick's frames; the next command into the freed mailbox
+    identify_.after_tick(sim_.task(), write);       // an identify run's samples; its report when its motion ends
+    return true;
+  }
+  /// The parameter store in the file `path` (FileFlash), as a board's in its flash: its newest record applied now,
+  /// as a board's boot applies it, and every save and load through it. The line that says what was applied (a
+  /// board's boot line) into `said`. False with a named error when the file is not a store's image.
+  bool open_store(const std::string& path, std::string& said, std::string& err) {
+    if (!flash_.open(path, err)) return false;
+    port_.set_param_storage(store_.storage());
+    osc::ParamRecord r;
+    const persist::LoadResult res = store_.load(r);
+    if (!res.loaded()) return said = std::string("defaults (") + persist::status_name(res.status) + ")", true;
+    const osc::ParamStatus st = osc::param_apply(sim_.task(), r);
+    if (st != osc::ParamStatus::kOk) return said = std::string("defaults (") + osc::param_status_name(st) + ")", true;
+    said = "loaded, sequence " + std::to_string(res.sequence);
     return true;
   }
   /// The counters of the client's link that the state frames carry.
@@ -233,8 +258,12 @@ class InProcessBoard {
  private:
   sim::MotionSim<S> sim_;
   osc::CommandPort<S> port_;
+  osc::IdentifyPort<S> identify_;
   osc::CommandLinkWatch watch_;
   bool link_watch_;
+  sim::FileFlash flash_{persist::kImageSectorWords};
+  persist::NoWatchdog no_watchdog_;
+  persist::FlashParamStore<sim::FileFlash, persist::NoWatchdog> store_{flash_, no_watchdog_};
 };
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
@@ -438,11 +467,39 @@ void build(CLI::App& app, Options& o) {
                      "; S counts simulated seconds from the start (a way to test a client's fault "
                      "handling; with --qemu the kinds the image's link carries)")
       ->type_name("KIND[:ARGS]@S");
+  app.add_option("--param-file", o.param_file,
+                 "the board's parameter store, kept in FILE as a flash image of two sectors (created erased when "
+                 "missing): at the start its newest record is applied, as a board's boot does (stderr: \"params "
+                 "loaded, sequence N\" or \"params defaults (why)\"), and param save and load go to it. Without it "
+                 "the store is in RAM, lost at exit. With --qemu the image keeps its store there (through "
+                 "semihosting) and applies it at its start; the file is the same image either way")
+      ->type_name("FILE");
   app.add_flag("--no-link-watch", o.no_link_watch,
                "a motion goes on when the client's link is silent (by default, as on a board whose encoders are "
                "local, a motion running 0.5 s without a frame from the client is stopped: link_silent; 0.5 s of the "
                "client's time, the wall clock's: 0.5 s times --speed of simulated time when above 1); in process "
                "only: with --qemu the image's link is the PIL link, and no command-link watch runs");
+}
+
+/// --param-file with --qemu: the file checked (an image of the store, or created erased: FileFlash::open) and named
+/// on the image's semihosting command line ("params=PATH", absolute: boards/common/mps2/semihost_flash.hpp), where
+/// the image keeps its store. QEMU's option list takes no comma in a value, the image's line no space.
+bool image_param_file(const std::string& file, std::vector<std::string>& qemu, std::string& err) {
+  {
+    sim::FileFlash check(persist::kImageSectorWords);
+    if (!check.open(file, err)) return err = "--param-file: " + err, false;
+  }
+  char* real = realpath(file.c_str(), nullptr);
+  const std::string path = real ? real : file;
+  std::free(real);
+  if (path.find_first_of(", ") != std::string::npos)
+    return err = "--param-file " + path + ": a path with a comma or a space cannot go on QEMU's command line", false;
+  for (std::size_t i = 0; i + 1 < qemu.size(); ++i)
+    if (qemu[i] == "-semihosting-config") {
+      qemu[i + 1] += ",arg=params=" + path;
+      return true;
+    }
+  return err = "--param-file: the image's QEMU command line has no semihosting configuration", false;
 }
 
 /// The options that the in-process controller and the image constrain differently; err on the first
@@ -477,7 +534,7 @@ bool check_options(const CLI::App& app, Options& o, sim::ExperimentConfig& cfg, 
     return err = "--scalar " + o.scalar + ": the image " + o.elf + " computes in " + name, false;
   o.scalar = name;
   cfg.scalar = image;
-  return true;
+  return o.param_file.empty() || image_param_file(o.param_file, cfg.pil_command, err);
 }
 
 /// Opens the terminal, prints its path and serves it with the board until the end.
@@ -502,6 +559,14 @@ int run(const Options& o, Board& board) {
 template <class S>
 int run_in_process(const Options& o, const sim::ExperimentConfig& cfg) {
   InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch, o.speed);
+  if (!o.param_file.empty()) {
+    std::string said, err;
+    if (!board.open_store(o.param_file, said, err)) {
+      std::fprintf(stderr, "osc_sim: --param-file: %s\n", err.c_str());
+      return 2;
+    }
+    std::fprintf(stderr, "osc_sim: params %s (%s)\n", said.c_str(), o.param_file.c_str());
+  }
   return run(o, board);
 }
 
@@ -519,6 +584,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (o.qemu) {
+    if (!o.param_file.empty())
+      std::fprintf(stderr, "osc_sim: params in %s: the image applies its newest record at its start\n",
+                   o.param_file.c_str());
     QemuBoard board(cfg, o.elf);  // the image started, its hello received, before the terminal opens
     if (!board.ok(err)) {
       std::fprintf(stderr, "osc_sim: the firmware image %s did not start: %s\n", o.elf.c_str(), err.c_str());

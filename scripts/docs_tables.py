@@ -1607,6 +1607,16 @@ def t_protocol_reasons():
     return name_rows(protocol()["command"]["reasons"])
 
 
+@table("protocol_identify", "docs/protocol.md", "protocol")
+def t_protocol_identify():
+    return field_rows(protocol()["identify_fields"])
+
+
+@table("protocol_identify_statuses", "docs/protocol.md", "protocol")
+def t_protocol_identify_statuses():
+    return name_rows(protocol()["command"]["identify_statuses"])
+
+
 @table("protocol_stop_categories", "docs/protocol.md", "protocol")
 def t_protocol_stop_categories():
     return name_rows(protocol()["command"]["stop_categories"])

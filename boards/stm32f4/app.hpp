@@ -26,6 +26,7 @@
 #include <cstdint>
 
 #include "board.hpp"
+#include "flash.hpp"  // stm32f4::FlashSectors
 #include "cortex_m.hpp"
 #include "osc/link/command_port.hpp"
 #include "osc/link/telemetry.hpp"
@@ -57,7 +58,7 @@ struct App {
   /// controller: there the command port keeps them in RAM, and the boot says so.
   stm32f4::FlashSectors<> sectors{*board.chip.flash};
   stm32f4::Safety::Stretch stretch{board.safety};
-  FlashParamStore<stm32f4::FlashSectors<>, stm32f4::Safety::Stretch> params{sectors, stretch};
+  persist::FlashParamStore<stm32f4::FlashSectors<>, stm32f4::Safety::Stretch> params{sectors, stretch};
 
   /// The board's boot (Board::init, interrupts off), the control task at the start pose, disabled
   /// (an enable command starts the torque), the boot line on the USART, then the watchdog, and the

@@ -113,7 +113,7 @@ class Safety {
   }
   void watchdog_feed() { chip_.iwdg->KR = IwdgRegs::kReload; }
   /// The watchdog at its longest (LSI / 256, reload 4095: 22 s at the fastest LSI, 33 s nominal), fed:
-  /// around a flash save, which stalls the core for up to 2 s (board/param_store.hpp).
+  /// around a flash save, which stalls the core for up to 2 s (boards/common/param_store/param_store.hpp).
   bool watchdog_stretch() { return watchdog_set(kWatchdogLongPrescaler, kWatchdogLongReload); }
   /// Back to kWatchdogReload, fed.
   bool watchdog_restore() { return watchdog_set(kWatchdogPrescaler, kWatchdogReload); }

@@ -43,10 +43,12 @@ speed_t standard_baud(int baud) {
   return B0;
 }
 
-/// A verb whose command runs a motion that ends done (done_id) or aborted: move_to, paper, stream, home.
+/// A verb whose command runs a motion that ends done (done_id) or aborted: move_to, paper, stream, home, identify.
 bool motion_verb(std::uint8_t v) {
-  return v == static_cast<std::uint8_t>(MotionVerb::kMoveTo) || v == static_cast<std::uint8_t>(MotionVerb::kPaper) ||
-         v == static_cast<std::uint8_t>(MotionVerb::kStream) || v == static_cast<std::uint8_t>(MotionVerb::kHome);
+  for (MotionVerb m :
+       {MotionVerb::kMoveTo, MotionVerb::kPaper, MotionVerb::kStream, MotionVerb::kHome, MotionVerb::kIdentify})
+    if (v == static_cast<std::uint8_t>(m)) return true;
+  return false;
 }
 
 template <class E>
@@ -260,8 +262,11 @@ void Client::dispatch() {
   pil::AnswerFrame a;
   pil::StateFrame s;
   pil::ParamAnswerFrame p;
+  pil::IdentifyFrame f;
   if (parser_.decode(p)) {
     param_answer_ = p;
+  } else if (parser_.decode(f)) {
+    identify_ = f;
   } else if (parser_.decode(a)) {
     answers_.push_back(a);
     if (answers_.size() > kHistory) answers_.pop_front();
@@ -271,6 +276,12 @@ void Client::dispatch() {
     ++states_seen_;
     if (on_state) on_state(s);
   }
+}
+
+std::optional<pil::IdentifyFrame> Client::wait_identify(std::uint32_t id, double timeout_s) {
+  const auto got = [&] { return identify_ && identify_->id == id; };
+  if (!read_until(now_s() + timeout_s, got) && !got()) return std::nullopt;
+  return identify_;
 }
 
 bool Client::read_until(double deadline, const std::function<bool()>& done) {

@@ -131,7 +131,7 @@ class Client {
   /// controller runs a command once and answers a repeat with the answer it gave).
   Outcome wait_answer(std::uint32_t id, double timeout_s);
   static constexpr double kResendS = 0.5;
-  /// The command's end: a motion (move_to, paper, stream, home) kDone when it reached its target at
+  /// The command's end: a motion (move_to, paper, stream, home, identify) kDone when it reached its target at
   /// rest, kAborted with the reason when it was aborted (`dropped`: a move still queued when the
   /// motion ahead of it was stopped, re-targeted or faulted), each from the one answer frame that
   /// names its id; a stop or a disable that stops a motion kDone at rest; any other command kDone
@@ -143,6 +143,11 @@ class Client {
   /// against this client's table (osc::kParamLayout): another firmware's table is an error.
   std::optional<pil::ParamAnswerFrame> param(std::uint8_t op, int index = 0, int element = 0, double value = 0,
                                              double timeout_s = 5);
+
+  /// The identify frame of run `id` (the estimate a board that estimates sends in the tick the run's motion ends,
+  /// right after that tick's answer: docs/protocol.md, "Identify frame"), received so far or within timeout_s;
+  /// nullopt when none came (a board that does not estimate, the QEMU images) or on an error (error()).
+  std::optional<pil::IdentifyFrame> wait_identify(std::uint32_t id, double timeout_s);
 
   /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.
   bool pump(double timeout_s);
@@ -184,6 +189,7 @@ class Client {
   std::deque<pil::AnswerFrame> answers_;  // the last kHistory answers
   std::optional<pil::StateFrame> state_;
   std::optional<pil::ParamAnswerFrame> param_answer_;  // the last param_answer frame
+  std::optional<pil::IdentifyFrame> identify_;         // the last identify frame
   std::uint64_t states_seen_ = 0;
   std::string error_;
   double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)

@@ -1,7 +1,7 @@
 // oscctl: commands a controller over the command protocol (docs/motion.md, "Clients"), on a serial
 // device or the simulator's pseudo-terminal (osc_sim --pty):
 //
-//   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop | identify
+//   oscctl --port /dev/pts/7 state | enable | disable | clear | paper | stop | home | identify [--apply]
 //   oscctl --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
 //   oscctl --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative] [--v V --a A --j J]
 //   oscctl --port /dev/pts/7 watch [--seconds S]
@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -47,9 +48,12 @@ struct Args {
   std::string param_op, param_name;  // param: the operation, the parameter's name
   std::vector<double> param_values;
   int element = -1;
+  bool apply = false;  // identify: the estimate into the parameters
 };
 
 constexpr double kDeg = osc::kPi / 180.0;
+/// How long identify waits for the estimate after the run's end [s]: the board sends it with the end's answer.
+constexpr double kIdentifyFrameWaitS = 2.0;
 
 int exit_of(const Outcome& o) { return o.ok() ? 0 : o.status == Status::kError ? 2 : 1; }
 
@@ -259,6 +263,78 @@ int param(Client& c, const Args& a) {
   return 0;
 }
 
+/// An identify frame: the verdict, then per drive each coefficient with its standard deviation, `*` where it is
+/// identified.
+void print_identify(const pil::IdentifyFrame& f) {
+  const auto status = static_cast<osc::IdentifyStatus>(f.status);
+  const char* name = f.status < osc::kIdentifyStatusCount ? osc::identify_status_name(status) : "?";
+  std::printf("identify %u: %s; %u samples, %u lost; condition %.3g; worst torque-prediction error %.1f %%\n", f.id,
+              name, f.samples, f.lost, static_cast<double>(f.condition), 100.0 * f.prediction_error);
+  if (status != osc::IdentifyStatus::kOk) return;
+  std::printf("drive  %-22s %-22s %-22s %s\n", "viscous [N m s/rad]", "Coulomb [N m]", "Stribeck [N m]",
+              "armature correction [kg m^2]");
+  for (int i = 0; i < osc::kDof; ++i) {
+    std::printf("J%d    ", i + 1);
+    for (int c = 0; c < 3; ++c) {
+      const int k = c * osc::kDof + i;
+      std::printf(" %9.4f +- %-7.4f%s", static_cast<double>(f.friction[k]), static_cast<double>(f.friction_sd[k]),
+                  (f.identified >> k) & 1u ? "* " : "  ");
+    }
+    std::printf(" %9.4f +- %.4f\n", static_cast<double>(f.armature[i]), static_cast<double>(f.armature_sd[i]));
+  }
+  std::printf("(* identified: its standard deviation within %g %% of it)\n", 100 * osc::params::kIdentifiedFraction);
+}
+
+/// identify --apply: the torque off (a disable), then the estimate's friction and armatures into friction_vis,
+/// friction_cou, friction_sti and armature_correction, each value within its element's range (an estimate below
+/// 0 is set to 0). What was set is printed; `param save` keeps it.
+int apply_identify(Client& c, const Args& a, const pil::IdentifyFrame& f) {
+  const std::uint32_t off = c.command(osc::MotionVerb::kDisable);
+  if (off == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
+  if (const Outcome o = c.wait_done(off, a.timeout); o.status != Status::kDone) return report(o);
+  const struct {
+    const char* name;
+    const float* values;
+  } sets[] = {{"friction_vis", f.friction},
+              {"friction_cou", f.friction + osc::kDof},
+              {"friction_sti", f.friction + 2 * osc::kDof},
+              {"armature_correction", f.armature}};
+  for (const auto& set : sets) {
+    const int i = osc::param_index(set.name);
+    for (int e = 0; e < osc::kParams[i].count; ++e) {
+      const auto range = c.param(pil::kParamOpGet, i, e, 0, a.timeout);
+      if (const int rc = param_status(c, range, "get")) return rc;
+      const double v = std::clamp(static_cast<double>(set.values[e]), static_cast<double>(range->lo),
+                                  static_cast<double>(range->hi));
+      const auto r = c.param(pil::kParamOpSet, i, e, v, a.timeout);
+      if (const int rc = param_status(c, r, "set")) return rc;
+      print_param(i, *r);
+    }
+  }
+  std::printf("applied, the torque off: enable goes on from them; param save keeps them for the next power-on\n");
+  return 0;
+}
+
+/// identify: the run's answer and end, then the board's estimate (its identify frame), and with --apply the
+/// estimate into the parameters. Exit 1 when the run was refused or aborted, its estimate failed, or --apply found
+/// none to apply.
+int identify(Client& c, const Args& a) {
+  const std::uint32_t id = c.command(osc::MotionVerb::kIdentify);
+  if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
+  const Outcome o = c.wait_answer(id, a.timeout);
+  if (const int rc = report(o); o.status != Status::kAccepted) return rc;
+  const Outcome d = c.wait_done(id, a.timeout);
+  const int rc = report(d);
+  const auto f = c.wait_identify(id, kIdentifyFrameWaitS);
+  if (!f) {
+    std::printf("no estimate: the board sent no identify frame (the QEMU images run the motion without estimating)\n");
+    return a.apply ? 1 : rc;
+  }
+  print_identify(*f);
+  if (f->status != static_cast<std::uint8_t>(osc::IdentifyStatus::kOk)) return 1;
+  return a.apply ? apply_identify(c, a, *f) : rc;
+}
+
 /// The param command line's own checks: a known operation and name, as many values as elements.
 bool check_param(const Args& a, std::string& err) {
   const bool named = a.param_op == "get" || a.param_op == "set";
@@ -315,10 +391,15 @@ void build(CLI::App& app, Args& a) {
       ->check(CLI::Range(0.0, 0.4));
   app.add_subcommand("state", "print the state frame: state, stop, faults, queue, reference and measured pose");
   // The verbs' meanings are the firmware's (OSC_MOTION_VERB_LIST).
-  for (osc::MotionVerb v :
-       {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear, osc::MotionVerb::kPaper,
-        osc::MotionVerb::kStop, osc::MotionVerb::kHome, osc::MotionVerb::kIdentify})
+  for (osc::MotionVerb v : {osc::MotionVerb::kEnable, osc::MotionVerb::kDisable, osc::MotionVerb::kClear,
+                            osc::MotionVerb::kPaper, osc::MotionVerb::kStop, osc::MotionVerb::kHome})
     app.add_subcommand(osc::motion_name(v), osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(v)]);
+  CLI::App* id = app.add_subcommand(
+      "identify", std::string(osc::MotionNames<osc::MotionVerb>::kDocs[static_cast<int>(osc::MotionVerb::kIdentify)]) +
+                      "; waits for its end and prints the board's estimate");
+  id->add_flag("--apply", a.apply,
+               "then the estimate's friction and armatures into the parameters friction_vis, friction_cou, "
+               "friction_sti and armature_correction (the torque off first: a disable); param save keeps them");
   std::string poses;
   for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
     poses += std::string(i ? ", " : "") + osc::robot::kNamedPoses[i].name;
@@ -366,13 +447,13 @@ int run(Client& c, const Args& a) {
   if (a.verb == "watch") return watch(c, a);
   if (a.verb == "param") return param(c, a);
   if (a.verb == "declare_pose") return declare_pose(c, a);
-  const osc::MotionVerb verb = a.verb == "enable"     ? osc::MotionVerb::kEnable
-                               : a.verb == "disable"  ? osc::MotionVerb::kDisable
-                               : a.verb == "clear"    ? osc::MotionVerb::kClear
-                               : a.verb == "paper"    ? osc::MotionVerb::kPaper
-                               : a.verb == "home"     ? osc::MotionVerb::kHome
-                               : a.verb == "identify" ? osc::MotionVerb::kIdentify
-                                                      : osc::MotionVerb::kStop;
+  if (a.verb == "identify") return identify(c, a);
+  const osc::MotionVerb verb = a.verb == "enable"    ? osc::MotionVerb::kEnable
+                               : a.verb == "disable" ? osc::MotionVerb::kDisable
+                               : a.verb == "clear"   ? osc::MotionVerb::kClear
+                               : a.verb == "paper"   ? osc::MotionVerb::kPaper
+                               : a.verb == "home"    ? osc::MotionVerb::kHome
+                                                     : osc::MotionVerb::kStop;
   return simple(c, a, verb);
 }
 

@@ -16,6 +16,11 @@
 #                                      sequence (save, reset, load in the image's RAM); the link clean at the end,
 #                                      the clients' keep-alives dropped, not relayed; a --scalar other than
 #                                      SCALAR (the image's; default float) refused first
+#   qemu_power_cycle IMAGE [SCALAR]    the image's store in a file (osc_sim --qemu --param-file): a store with
+#                                      an identify run's estimate (the virtual board in process, identify --apply,
+#                                      param save) applied by the image at its start (the value read back; the
+#                                      first move within 0.5 mm, over 1 mm from a new store); a gain the image
+#                                      saved is there after its restart
 #   oscctl_param, python_param         param: list, get, set (a gain; an unstable observer gain
 #                                      refused with its margin; a bad name or count exit 2), check, save,
 #                                      reset, load (the values back); a smaller move_linear maximum
@@ -23,6 +28,12 @@
 #                                      refused torque_on while enabled
 #   oscctl_homing, python_homing       declare_pose (refused pots_disagree, accepted, refused torque_on;
 #                                      an unknown pose exit 2), home done
+#   oscctl_power_cycle,                a power cycle with the store in a file (osc_sim --param-file), with either
+#   python_power_cycle                 client: at the identify pose, identify --apply (the estimate printed, its
+#                                      friction and armatures set) and param save; osc_sim restarted from the file
+#                                      at the start pose says "params loaded" and has them; the first move
+#                                      (first_move.py) tracks within 0.5 mm, where the same move from a new store
+#                                      (defaults) is over 1 mm; a file that is no store's image refused, exit 2
 #   python_queue                       the Python package: a slow move and two queued behind it, a stop:
 #                                      the running move aborted stop_command, each queued one aborted
 #                                      dropped (its own answer frame), the state frame's queue empty;
@@ -209,6 +220,63 @@ stream() {
   expect 0 '^accepted$' '^done$' -- "$@" disable
 }
 
+# store_estimate STORE CLIENT...: the virtual board in process with its store in STORE, at the pose where an identify
+# run passes its check on the PUMA (tests/support/motion_sim_util.hpp, identify_pose): enable, identify --apply
+# (the estimate printed and set), param save. Sets $vis, friction_vis[0] as the estimate printed it.
+store_estimate() {
+  local store=$1
+  shift
+  start_sim --speed 10 --param-file "$store" --start-pose 0 45 -180 0 74.4845 0
+  grep -q '^osc_sim: params defaults (none)' "$tmp/sim.err" || fail "a new store's start did not say defaults (none)"
+  expect 0 '^accepted$' -- "$@" --port "$port" enable
+  expect 0 '^done$' '^identify [0-9]+: ok; [0-9]+ samples, 0 lost' '^J6 ' '^friction_sti\[5\] = ' '^applied' -- \
+    "$@" --port "$port" --timeout 90 identify --apply
+  vis=$(sed -n 's/^J1 *\([0-9.]*\) .*/\1/p' "$tmp/out")
+  [ -n "$vis" ] || fail "no J1 viscous estimate printed"
+  expect 0 '^save: ok$' -- "$@" --port "$port" param save
+  stop_sim
+}
+
+# has_estimate CLIENT...: friction_vis[0] on the board is $vis (the printed estimate's 4 decimals).
+has_estimate() {
+  expect 0 '^friction_vis\[0\] = ' -- "$@" --port "$port" param get friction_vis --element 0
+  near "$(sed -n 's/^friction_vis\[0\] = \([0-9.]*\) .*/\1/p' "$tmp/out")" "$vis" 0.00006 ||
+    fail "friction_vis[0] is not the estimate $vis after the restart"
+}
+
+# first_move: first_move.py on the board; sets $mm, its tracking [mm].
+first_move() {
+  expect 0 '^first move: tracking ' -- "$py" "$(dirname "$0")/first_move.py" "$port"
+  mm=$(sed -n 's/^first move: tracking \([0-9.]*\) mm$/\1/p' "$tmp/out")
+}
+
+# within_bars WHAT WARM COLD: the first move from the stored estimate within 0.5 mm, from the defaults over 1 mm.
+within_bars() {
+  echo "$1's first move after a power cycle: $2 mm from the stored estimate, $3 mm from the defaults"
+  awk -v w="$2" 'BEGIN { exit !(w <= 0.5) }' || fail "the first move from the stored estimate: $2 mm, over 0.5"
+  awk -v c="$3" 'BEGIN { exit !(c > 1.0) }' || fail "the first move from the defaults: $3 mm, not over 1 mm"
+}
+
+# A power cycle of the virtual board with the store in a file (the case list at the top), with one client given as a
+# command prefix.
+power_cycle() {
+  local store=$tmp/params.bin warm
+  store_estimate "$store" "$@"
+  start_sim --speed 2 --param-file "$store"
+  grep -Eq '^osc_sim: params loaded, sequence [0-9]+' "$tmp/sim.err" || fail "the restart did not load the store"
+  has_estimate "$@"
+  first_move
+  warm=$mm
+  stop_sim
+  start_sim --speed 2 --param-file "$tmp/new.bin"
+  first_move
+  stop_sim
+  within_bars "the virtual board" "$warm" "$mm"
+  head -c 100 /dev/zero >"$tmp/bad.bin"
+  refuse '^osc_sim: --param-file: .*bad.bin: not a parameter store.s image \(100 bytes' -- \
+    "$sim" --pty --param-file "$tmp/bad.bin"
+}
+
 case "$case_" in
   oscctl_sequence)
     start_sim --speed 4 --no-link-watch  # a move left running between two clients: no link watch
@@ -246,6 +314,28 @@ case "$case_" in
     grep -E 'osc_sim: [0-9]+ ticks .* [1-9][0-9]* not commands' "$tmp/sim.err" || fail "no keep-alive counted"
     grep -E "osc_sim: firmware image .*: link clean" "$tmp/sim.err" || fail "the PIL link was not clean"
     ;;
+  qemu_power_cycle)
+    [ -r "$image" ] || fail "no firmware image: virtual_board.sh ... qemu_power_cycle IMAGE [SCALAR]"
+    store=$tmp/params.bin
+    store_estimate "$store" "$ctl"  # the images do not estimate: the virtual board in process does
+    # The image started on that store applies it: the value, then the first move.
+    start_sim --qemu --elf "$image" --scalar "$image_scalar" --param-file "$store"
+    has_estimate "$ctl"
+    first_move
+    warm=$mm
+    # The image writes the file: a gain saved by it is there after its restart.
+    expect 0 '^done$' -- "$ctl" --port "$port" --timeout 60 disable
+    expect 0 '^knd\[0\] = 150 ' -- "$ctl" --port "$port" param set knd --element 0 150
+    expect 0 '^save: ok$' -- "$ctl" --port "$port" param save
+    stop_sim
+    start_sim --qemu --elf "$image" --scalar "$image_scalar" --param-file "$store"
+    expect 0 '^knd\[0\] = 150 ' -- "$ctl" --port "$port" param get knd --element 0
+    stop_sim
+    start_sim --qemu --elf "$image" --scalar "$image_scalar" --param-file "$tmp/new.bin"
+    first_move
+    stop_sim
+    within_bars "the image" "$warm" "$mm"
+    ;;
   oscctl_param)
     start_sim --speed 4
     param_sequence "$ctl" --port "$port" --timeout 60
@@ -265,6 +355,12 @@ case "$case_" in
     start_sim --speed 4 --scalar float
     homing_sequence "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
+    ;;
+  oscctl_power_cycle)
+    power_cycle "$ctl"
+    ;;
+  python_power_cycle)
+    power_cycle "${pyc[@]}"
     ;;
   python_queue)
     start_sim --speed 4 --scalar float

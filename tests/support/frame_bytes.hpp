@@ -47,8 +47,9 @@ F decoded(const pil::Parser& p) {
   pil::SetpointVelocityFrame sv;
   pil::ParamFrame pf;
   pil::ParamAnswerFrame pa;
+  pil::IdentifyFrame id;
   const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
-                 p.decode(sv) + p.decode(pf) + p.decode(pa);
+                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));

@@ -106,6 +106,16 @@ inline int write(int handle, const void* p, int n) { return transfer(0x05, handl
 /// SYS_READ: reads up to n bytes, waiting for at least one; returns how many of the n were NOT read
 /// (n at the end of the input).
 inline int read(int handle, void* p, int n) { return transfer(0x06, handle, p, n); }
+/// SYS_SEEK: the file position of `handle` to byte `pos` from its start; true on success.
+inline bool seek(int handle, std::uint32_t pos) {
+  const std::uint32_t block[2] = {static_cast<std::uint32_t>(handle), pos};
+  return call(0x0A, block) == 0;
+}
+/// SYS_FLEN: the length in bytes of the file of `handle`, or -1.
+inline int file_length(int handle) {
+  const std::uint32_t block[1] = {static_cast<std::uint32_t>(handle)};
+  return call(0x0C, block);
+}
 /// SYS_GET_CMDLINE: the command line the debugger passes (QEMU: the -semihosting-config arg=
 /// values, else the -kernel file and the -append text), NUL-terminated, into buf[0..n); its length,
 /// or -1 when it does not fit.

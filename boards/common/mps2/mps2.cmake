@@ -36,6 +36,8 @@ function(osc_add_mps2_board)
 
   # Processor-in-the-loop firmware: the control task over the UART0 link to host_sim.
   osc_board_image(${B_NAME} pil_firmware ${OSC_MPS2_DIR}/pil_firmware.cpp)
+  # Its parameter store on a host file ("params=PATH" on its semihosting command line: semihost_flash.hpp).
+  target_link_libraries(pil_firmware PRIVATE param_store)
   osc_image_checks(pil_firmware)
 
   # The control path (the timer interrupt, the tick, the step) calls no routine the board's scalar
@@ -100,6 +102,16 @@ function(osc_add_virtual_board_test scalar)
   # client reads the protocol of the host build for the same arm (OSC_HOST_CLIENT_PROTOCOL_ENV).
   set_tests_properties(virtual_board_qemu_sequence PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600 ENVIRONMENT
                                                               "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
+  # A power cycle of the image (issue 57): its store in a file that a restart applies (tests/cli/virtual_board.sh
+  # qemu_power_cycle: the estimate from the PUMA's identify pose, in process).
+  if(OSC_ROBOT STREQUAL "puma560")
+    add_test(NAME virtual_board_qemu_power_cycle
+             COMMAND bash ${PROJECT_SOURCE_DIR}/tests/cli/virtual_board.sh ${OSC_SIM_BOARD} ${OSC_OSCCTL}
+                     ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/src qemu_power_cycle
+                     $<TARGET_FILE:pil_firmware> ${scalar})
+    set_tests_properties(virtual_board_qemu_power_cycle PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600
+                                                                   ENVIRONMENT "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
+  endif()
   # The command link's recovery over the image (tests/cli/link_recovery.py --qemu): the same outcomes
   # as in process.
   add_test(NAME virtual_board_qemu_link_recovery

@@ -22,6 +22,10 @@
 // The node, the frames, the ticks and what they compute are the same on both: the same run gives
 // the same torques, bit for bit (tests/host_sim/test_pil.cpp, PilQemu).
 //
+// The parameter store: with "params=PATH" on the semihosting command line (osc_sim --qemu --param-file) a host file
+// through semihosting stands for the board's flash (semihost_flash.hpp, the virtual board's image format), its
+// newest record applied before the link starts, as a board's boot applies it; without, the command port's RAM.
+//
 // The command protocol (docs/protocol.md): a command or a setpoint frame is no tick (on_byte returns
 // false); the node prepares it here in the main loop (a move's plan and path check, up to about half
 // a million instructions on the M3), never in the control interrupt, whose tick only writes the
@@ -48,6 +52,8 @@
 #include "osc/control/params.hpp"
 #include "osc/link/node.hpp"
 #include "osc/robot.hpp"
+#include "param_store.hpp"
+#include "semihost_flash.hpp"
 
 namespace {
 
@@ -85,19 +91,55 @@ void pend_tick() {
   board::control_irq_pend();  // the tick runs now
 }
 
-/// "link=semihosting" is a word of the semihosting command line (QEMU: -semihosting-config arg=...).
-bool semihosting_link_requested() {
-  char line[96];
-  const int n = board::semihost::command_line(line, sizeof line);
-  constexpr char kWord[] = "link=semihosting";
-  constexpr int kLen = sizeof kWord - 1;
-  for (int i = 0; i + kLen <= n; ++i) {
-    if (i > 0 && line[i - 1] != ' ') continue;
-    int k = 0;
-    while (k < kLen && line[i + k] == kWord[k]) ++k;
-    if (k == kLen && (i + kLen == n || line[i + kLen] == ' ')) return true;
+/// The semihosting command line (QEMU: -semihosting-config arg=..., its words joined by spaces).
+struct CommandLine {
+  char text[256];
+  int n = 0;
+  CommandLine() { n = board::semihost::command_line(text, sizeof text); }
+  /// The word starting with `prefix` (length k): the index of what follows the prefix, or -1.
+  int word(const char* prefix, int k) const {
+    for (int i = 0; i + k <= n; ++i) {
+      if (i > 0 && text[i - 1] != ' ') continue;
+      int j = 0;
+      while (j < k && text[i + j] == prefix[j]) ++j;
+      if (j == k) return i + k;
+    }
+    return -1;
   }
-  return false;
+  /// Whether `w` (length k) is a whole word of the line.
+  bool has(const char* w, int k) const {
+    const int at = word(w, k);
+    return at >= 0 && (at == n || text[at] == ' ');
+  }
+};
+
+/// "link=semihosting" is a word of the command line.
+bool semihosting_link_requested(const CommandLine& line) {
+  constexpr char kWord[] = "link=semihosting";
+  return line.has(kWord, sizeof kWord - 1);
+}
+
+// The parameter store in a host file when the command line has "params=PATH" (osc_sim --qemu --param-file: a power
+// cycle of the image), else in the command port's RAM (lost when QEMU ends). semihost_flash.hpp says why a file.
+board::SemihostFlash<persist::kImageSectorWords> g_flash;
+persist::NoWatchdog g_no_watchdog;  // a save is a few semihosting calls: no stall for the watchdog to outlast
+persist::FlashParamStore<board::SemihostFlash<persist::kImageSectorWords>, persist::NoWatchdog> g_params{g_flash,
+                                                                                                         g_no_watchdog};
+
+/// With "params=PATH": the store on that file, its newest record applied to the task as a board's boot applies it
+/// (a record the task refuses, or none: the defaults). Before the link starts; the node applies it again when the
+/// host's first frame starts the task disabled (PilNode::configure).
+void open_param_store(const CommandLine& line) {
+  constexpr char kWord[] = "params=";
+  const int at = line.word(kWord, sizeof kWord - 1);
+  if (at < 0) return;
+  char path[sizeof line.text];
+  std::uint32_t k = 0;
+  for (int i = at; i < line.n && line.text[i] != ' '; ++i) path[k++] = line.text[i];
+  path[k] = 0;
+  if (k == 0 || !g_flash.open(path, k)) return;
+  g_node.port.set_param_storage(g_params.storage());
+  g_node.port.apply_stored(g_node.task);  // and again when the host's first frame re-initialises the task (node.hpp)
 }
 
 /// The received bytes of the semihosting transport: one read's worth at a time.
@@ -149,7 +191,8 @@ extern "C" void TIMER1_Handler() { board::wake_timer_ack(); }
 
 int main() {
   board::cycle_counter_init();
-  if (semihosting_link_requested()) {
+  const CommandLine line;
+  if (semihosting_link_requested(line)) {
     g_console_in = board::semihost::open(":tt", 3, 0);
     g_console_out = board::semihost::open(":tt", 3, 4);
     if (g_console_in < 0 || g_console_out < 0) board::semihost::exit(2);
@@ -158,6 +201,7 @@ int main() {
     board::uart_init();
   }
   g_node.init(osc::joint_vector<board::Scalar>(osc::robot::kQStart), osc::FrictionMode::kAdaptive, kPeriodNs);
+  open_param_store(line);
   board::control_irq_enable();
   if (g_transport == Transport::kUart) {
     board::uart_rx_irq_enable();

@@ -5,20 +5,23 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
-from osc_client import Answer, Command, Frame, NameList, Parser, Protocol
+from osc_client import Answer, Command, Frame, NameList, Param, Parser, Protocol
 
 Reply = Callable[[Command], list[Frame]]
+ParamReply = Callable[[Param], list[Frame]]
 
 
 @dataclass
 class FakeBoard:
     """Answers each command frame the client writes through ``reply`` (the client reads the frames
-    it returns next) and keeps every frame the client sent."""
+    it returns next), each param frame through ``param_reply`` (none: no answer), and keeps every frame
+    the client sent."""
 
     protocol: Protocol
     reply: Reply
     sent: list[Frame] = field(default_factory=list)
     pending: bytes = b""
+    param_reply: ParamReply | None = None
 
     def __post_init__(self) -> None:
         self.parser = Parser(self.protocol)
@@ -35,6 +38,8 @@ class FakeBoard:
             self.sent.append(frame)
             if isinstance(frame, Command):
                 self.pending += b"".join(self.protocol.encode(f) for f in self.reply(frame))
+            elif isinstance(frame, Param) and self.param_reply is not None:
+                self.pending += b"".join(self.protocol.encode(f) for f in self.param_reply(frame))
 
     def close(self) -> None:
         pass

@@ -76,6 +76,9 @@ def test_a_corrupted_recording_changes_the_outcome(capsys: pytest.CaptureFixture
     (["--port", "/dev/null", "param", "set", "ks", "1"], "param set ks: 6 values \\(one per element"),
     (["--port", "/dev/null", "param", "get", "k_ad", "--element", "1"], "param k_ad --element 1: it has 1 element"),
     (["--port", "/dev/null", "param", "save", "ks"], "param save takes no name"),
+    (["--port", "/dev/null", "enable", "--apply"], "unrecognized arguments: --apply"),  # identify's flag only
+    (["--port", "/dev/null", "param", "list", "--apply"], "unrecognized arguments: --apply"),
+    (["--port", "/dev/null", "--apply", "identify"], "unrecognized arguments: --apply"),
 ])
 def test_bad_command_line_exits_2(argv: list[str], message: str, capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as e:

@@ -1,11 +1,14 @@
 """What becomes of a command: the client's outcomes against a scripted board."""
 from __future__ import annotations
 
+import time
+
 import pytest
 
 from fakes import FakeBoard, answer
-from osc_client import (Answer, Client, ClientError, Command, Frame, NameList, Outcome, Param, ParamAnswer,
+from osc_client import (Answer, Client, ClientError, Command, Frame, Identify, NameList, Outcome, Param, ParamAnswer,
                         PathPoint, Protocol, Setpoint, State, Status)
+from replay import ReplayTransport
 
 
 def client(p: Protocol, board: FakeBoard, keepalive: float = 0.0) -> Client:
@@ -114,6 +117,38 @@ def test_state_and_callbacks(protocol: Protocol) -> None:
     assert s is not None and s.tick == 9 and protocol.name_of(NameList.MOTION_STATES, s.state) == "holding"
     assert len(answers) == 1 and states == [s]
     assert c.state(0.05) is None  # none after this call
+
+
+def test_wait_identify_takes_the_frame_read_with_the_end(protocol: Protocol) -> None:
+    """The board sends the estimate right after the end's answer: wait_done reads it, wait_identify returns it at
+    once; another run's frame is not this one's."""
+    board = FakeBoard(protocol, lambda c: [answer(protocol, c, state="moving"), Answer(done_id=c.id),
+                                           Identify(id=c.id + 7, samples=1), Identify(id=c.id, samples=16000)])
+    c = client(protocol, board)
+    cid = c.identify()
+    assert c.wait_done(cid, 2).status == Status.DONE
+    assert c.last_identify is not None and c.last_identify.samples == 16000
+    t0 = time.monotonic()
+    f = c.wait_identify(cid, 2)
+    assert f is not None and (f.id, f.samples) == (cid, 16000) and time.monotonic() - t0 < 1
+    t0 = time.monotonic()
+    assert c.wait_identify(cid + 7, 0.2) is None  # its frame was not the last one
+    assert time.monotonic() - t0 >= 0.2
+
+
+def test_wait_identify_reads_a_frame_that_comes_later(protocol: Protocol) -> None:
+    late = protocol.encode(Identify(id=100, status=protocol.code_of(NameList.IDENTIFY_STATUSES, "aborted")))
+    c = Client(ReplayTransport([b"", b"", protocol.encode(Identify(id=99)), b"", late]), protocol=protocol,
+               keepalive=0, first_id=100)
+    f = c.wait_identify(100, 2)
+    assert f is not None and protocol.name_of(NameList.IDENTIFY_STATUSES, f.status) == "aborted"
+
+
+def test_wait_identify_without_a_frame_is_none(protocol: Protocol) -> None:
+    c = client(protocol, FakeBoard(protocol, lambda c: []))
+    t0 = time.monotonic()
+    assert c.wait_identify(100, 0.2) is None and c.last_identify is None
+    assert time.monotonic() - t0 >= 0.2
 
 
 def test_param_answer_and_another_table(protocol: Protocol) -> None:

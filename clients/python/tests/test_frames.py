@@ -3,12 +3,13 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import struct
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from osc_client import PROTOCOL_JSON, ClientError, Frame, FrameType, NameList, Parser, Protocol, State
+from osc_client import PROTOCOL_JSON, ClientError, Frame, FrameType, Identify, NameList, Parser, Protocol, State
 from osc_client.frames import FRAME_CLASSES
 from osc_client.protocol import Field, FieldValue
 
@@ -44,6 +45,35 @@ def test_round_trip(protocol: Protocol, kind: FrameType) -> None:
     (raw,) = Parser(protocol).feed(data)
     assert raw.type == kind
     assert protocol.decode(raw.type, raw.payload) == frame
+
+
+def test_identify_frame_round_trip_and_layout(protocol: Protocol) -> None:
+    """The identify frame (code 11, 217 bytes: docs/protocol.md, "Identify frame"): its fields at the documented
+    offsets, and back through the parser after a false header of its own type."""
+    f = Identify(id=0xDEADBEEF, status=protocol.code_of(NameList.IDENTIFY_STATUSES, "prediction_error"),
+                 samples=16000, lost=3, condition=1234.5, prediction_error=0.125,
+                 friction=tuple(0.25 * k - 2.0 for k in range(18)), friction_sd=tuple(0.0625 * k for k in range(18)),
+                 identified=1 << 0 | 1 << 17, armature=(0.25, -0.125, 0.0625, 0.5, 1.5, -2.0),
+                 armature_sd=(0.0078125,) * 6)
+    data = protocol.encode(f)
+    assert (len(data), data[2], data[3]) == (223, 11, 217)
+    payload = data[4:-2]
+    assert struct.unpack_from("<IBIIff", payload, 0) == (0xDEADBEEF, 3, 16000, 3, 1234.5, 0.125)
+    assert struct.unpack_from("<f", payload, 21 + 17 * 4) == (0.25 * 17 - 2.0,)  # friction[17]: Stribeck J6
+    assert struct.unpack_from("<f", payload, 93 + 4) == (0.0625,)  # friction_sd[1]
+    assert struct.unpack_from("<I6f6f", payload, 165) == (1 << 0 | 1 << 17,) + f.armature + f.armature_sd
+    false_header = protocol.sync + bytes([11, 217]) + bytes(5)  # the frame's header, then a frame cut short
+    frames = Parser(protocol).feed(b"\x00" + false_header + data + data[:100]) + Parser(protocol).feed(data)
+    assert [r.type for r in frames] == [FrameType.IDENTIFY, FrameType.IDENTIFY]
+    assert all(protocol.decode(r.type, r.payload) == f for r in frames)
+    parser = Parser(protocol)
+    assert [r for b in data for r in parser.feed(bytes([b]))] == frames[:1]  # byte by byte
+
+
+def test_identify_statuses(protocol: Protocol) -> None:
+    names = ["ok", "too_few_samples", "ill_conditioned", "prediction_error", "not_finite", "aborted"]
+    assert protocol.names(NameList.IDENTIFY_STATUSES) == names
+    assert protocol.name_of(NameList.IDENTIFY_STATUSES, 6) == "?"
 
 
 def test_empty_tuples_encode_as_zeros(protocol: Protocol) -> None:
@@ -87,6 +117,13 @@ def test_a_field_the_classes_do_not_know_is_named(tmp_path: Path) -> None:
     d = declaration()
     d["fields"]["answer"][0]["name"] = "ident"
     with pytest.raises(ClientError, match="update osc_client/frames.py"):
+        Protocol(write(tmp_path, d))
+
+
+def test_an_identify_field_the_class_does_not_know_is_named(tmp_path: Path) -> None:
+    d = declaration()
+    next(f for f in d["fields"]["identify"] if f["name"] == "armature")["name"] = "inertia"
+    with pytest.raises(ClientError, match="the identify frame declares fields .*'inertia'.*update osc_client/frames"):
         Protocol(write(tmp_path, d))
 
 

@@ -1001,7 +1001,7 @@ TEST(Stm32Flash, TheBoardsParameterStoreSavesAndLoadsTheTable) {
     void stretch() { ++stretched; }
     void restore() { ++restored; }
   } dog;
-  board::FlashParamStore<FlashSectors<Rec>, CountingWatchdog> store(sectors, dog);
+  persist::FlashParamStore<FlashSectors<Rec>, CountingWatchdog> store(sectors, dog);
   osc::ParamRecord r{};
   EXPECT_EQ(store.load(r).status, persist::LoadStatus::kNone);
   const osc::ParamStorage s = store.storage();

@@ -109,6 +109,9 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
         case pil::kParamFrame:
           out = bytes_of(decoded<pil::ParamFrame>(p));
           break;
+        case pil::kIdentifyFrame:
+          out = bytes_of(decoded<pil::IdentifyFrame>(p));
+          break;
         case pil::kParamAnswerFrame:
           out = bytes_of(decoded<pil::ParamAnswerFrame>(p));
           break;

@@ -18,7 +18,7 @@ As a program (``osc-client``, or ``python3 -m osc_client``), oscctl's verbs: see
 The parts, in the order a frame meets them:
 
 - ``protocol``: the declaration (``Protocol``): frame types, layouts, flags, names; encode, decode, CRC
-- ``frames``: each frame type as a dataclass (``Command``, ``Answer``, ``State`` ...)
+- ``frames``: each frame type as a dataclass (``Command``, ``Answer``, ``State``, ``Identify`` ...)
 - ``parser``: frames out of a byte stream, resynchronising after a bad one (``Parser``)
 - ``transport``: the byte stream (``Transport``; ``SerialTransport``, a serial device or pseudo-terminal)
 - ``client``: commands and their outcomes (``Client``, ``Outcome``, ``Status``)
@@ -27,7 +27,7 @@ The parts, in the order a frame meets them:
 """
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import (Actuator, Answer, Command, Frame, FrameType, Param, ParamAnswer, Sensor, Setpoint,
+from .frames import (Actuator, Answer, Command, Frame, FrameType, Identify, Param, ParamAnswer, Sensor, Setpoint,
                      SetpointVelocity, State, Trace)
 from .parser import Parser, RawFrame
 from .paths import PathPoint, angular_velocity, read_stream_csv, resample_path
@@ -35,7 +35,7 @@ from .protocol import PROTOCOL_JSON, NameList, Parameter, Protocol, crc16, proto
 from .transport import SerialTransport, Transport
 
 __all__ = [
-    "Actuator", "Answer", "Client", "ClientError", "Command", "Frame", "FrameType", "NameList", "Outcome",
+    "Actuator", "Answer", "Client", "ClientError", "Command", "Frame", "FrameType", "Identify", "NameList", "Outcome",
     "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser", "PathPoint", "Protocol", "RawFrame", "Sensor",
     "SerialTransport", "Setpoint", "SetpointVelocity", "State", "Status", "Trace", "Transport", "angular_velocity",
     "crc16", "protocol_path", "read_stream_csv", "resample_path",

@@ -1,6 +1,6 @@
 """osc-client: oscctl's verbs over the command protocol, the same lines printed, the same exit status.
 
-    osc-client --port /dev/pts/7 state | enable | disable | clear | paper | stop | home | identify
+    osc-client --port /dev/pts/7 state | enable | disable | clear | paper | stop | home | identify [--apply]
     osc-client --port /dev/pts/7 declare_pose start | zero | ready | stretch
     osc-client --port /dev/pts/7 move X Y Z [--rpy R P Y] [--relative] [--v V --a A --j J] [--replace] [--no-wait]
     osc-client --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
@@ -19,16 +19,18 @@ from typing import Callable, Sequence
 
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import ParamAnswer, State
+from .frames import Identify, ParamAnswer, State
 from .paths import read_stream_csv, resample_path
 from .protocol import NameList, Protocol
-from .text import answer_text, margins_text, param_line, state_change_text, state_text
+from .text import DRIVES, answer_text, identify_text, margins_text, param_line, state_change_text, state_text
 
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
 
-SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home", "identify")
+SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
 PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
+IDENTIFY_FRAME_WAIT = 2.0
+"""Seconds identify waits for the estimate after the run's end (the board sends it with the end's answer)."""
 
 
 def report(o: Outcome) -> int:
@@ -38,8 +40,7 @@ def report(o: Outcome) -> int:
 
 
 def cmd_simple(c: Client, a: argparse.Namespace) -> int:
-    """enable, disable, clear, paper, stop, home, identify: the answer; for stop, disable, home and identify the end
-    too."""
+    """enable, disable, clear, paper, stop, home: the answer; for stop, disable and home the end too."""
     cid = c.command(a.verb)
     o = c.wait_answer(cid, a.timeout)
     rc = report(o)
@@ -48,7 +49,7 @@ def cmd_simple(c: Client, a: argparse.Namespace) -> int:
     abort = c.protocol.name_of(NameList.REASONS, o.answer.abort)
     if abort != "none":  # the motion this command ended (stop, disable)
         print(f"aborted {o.answer.aborted_id}: {abort}", flush=True)
-    if a.verb not in ("stop", "disable", "home", "identify"):
+    if a.verb not in ("stop", "disable", "home"):
         return rc
     return report(c.wait_done(cid, a.timeout))
 
@@ -173,9 +174,57 @@ def cmd_param(c: Client, a: argparse.Namespace) -> int:
     return 0
 
 
+def apply_identify(c: Client, a: argparse.Namespace, f: Identify) -> int:
+    """identify --apply: the torque off (a disable), then the estimate's friction and armatures into friction_vis,
+    friction_cou, friction_sti and armature_correction, each value within its element's range (an estimate below
+    0 is set to 0). Each value set is printed; ``param save`` keeps them."""
+    o = c.wait_done(c.disable(), a.timeout)
+    if o.status != Status.DONE:
+        return report(o)
+    p = c.protocol
+    n = DRIVES
+    for name, values in (("friction_vis", f.friction[:n]), ("friction_cou", f.friction[n:2 * n]),
+                         ("friction_sti", f.friction[2 * n:]), ("armature_correction", f.armature)):
+        q = p.parameter(name)
+        if q is None or q.count != len(values):
+            raise ClientError(f"identify --apply: this protocol has no parameter {name} of {len(values)} elements")
+        for e, v in enumerate(values):
+            r = c.param("get", q.index, e, timeout=a.timeout)  # the element's range
+            if param_refused(c, r):
+                return 1
+            v = r.lo if v < r.lo else r.hi if r.hi < v else v  # std::clamp's
+            r = c.param("set", q.index, e, v, timeout=a.timeout)
+            if param_refused(c, r):
+                return 1
+            print(param_line(p, q, r))
+    print("applied, the torque off: enable goes on from them; param save keeps them for the next power-on")
+    return 0
+
+
+def cmd_identify(c: Client, a: argparse.Namespace) -> int:
+    """identify: the run's answer and end, then the board's estimate (its identify frame), and with --apply the
+    estimate into the parameters. Exit 1 when the run was refused or aborted, its estimate failed, or --apply
+    found none to apply."""
+    cid = c.identify()
+    o = c.wait_answer(cid, a.timeout)
+    rc = report(o)
+    if o.status != Status.ACCEPTED:
+        return rc
+    rc = report(c.wait_done(cid, a.timeout))
+    f = c.wait_identify(cid, IDENTIFY_FRAME_WAIT)
+    if f is None:
+        print("no estimate: the board sent no identify frame (the QEMU images run the motion without estimating)",
+              flush=True)
+        return 1 if a.apply else rc
+    print(identify_text(c.protocol, f), end="", flush=True)
+    if c.protocol.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok":
+        return 1
+    return apply_identify(c, a, f) if a.apply else rc
+
+
 VERBS: dict[str, Callable[[Client, argparse.Namespace], int]] = {
     "state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param,
-    "declare_pose": cmd_declare_pose}
+    "declare_pose": cmd_declare_pose, "identify": cmd_identify}
 
 
 def positive(text: str) -> float:
@@ -209,6 +258,11 @@ def parser() -> argparse.ArgumentParser:
     sub = ap.add_subparsers(dest="verb", required=True, metavar="VERB")
     for v in SIMPLE_VERBS:
         sub.add_parser(v, help="print the state frame" if v == "state" else f"send {v}")
+    ip = sub.add_parser("identify", help="send identify (the identification run: the excitation motion about the "
+                        "held joint angles); waits for its end and prints the board's estimate")
+    ip.add_argument("--apply", action="store_true", help="then the estimate's friction and armatures into the "
+                    "parameters friction_vis, friction_cou, friction_sti and armature_correction (the torque off "
+                    "first: a disable); param save keeps them")
     dp = sub.add_parser("declare_pose", help="the arm stands at a named pose (torque off; the pots must agree)")
     dp.add_argument("pose", help="the pose's name (osc_protocol.json's poses: start, zero, ready, stretch)")
 

@@ -15,7 +15,7 @@ from enum import Enum
 from typing import Callable, Sequence
 
 from .errors import ClientError
-from .frames import Answer, Command, Floats, Frame, Param, ParamAnswer, Setpoint, SetpointVelocity, State
+from .frames import Answer, Command, Floats, Frame, Identify, Param, ParamAnswer, Setpoint, SetpointVelocity, State
 from .parser import Parser
 from .paths import PathPoint
 from .protocol import NameList, Protocol
@@ -67,7 +67,8 @@ class Client:
 
     Each command method sends its frame and returns the command's id; ``wait_answer(id)`` waits for
     its answer, ``wait_done(id)`` for its end. While waiting the client reads every frame: answers
-    are kept (``answers``, ``on_answer``), state frames too (``latest_state``, ``on_state``).
+    are kept (``answers``, ``on_answer``), state frames too (``latest_state``, ``on_state``), and the
+    last parameter answer and identify frame (``param_answer``, ``last_identify``).
 
     A board whose encoders are local stops a running motion (aborted link_silent) when no frame comes
     from the host for 0.5 s: while it waits, the client sends a keep-alive frame (an all-zero state
@@ -93,6 +94,7 @@ class Client:
         self.latest_state: State | None = None
         self.states_seen = 0
         self.param_answer: ParamAnswer | None = None
+        self.last_identify: Identify | None = None  # the last identify frame (an identify run's estimate)
         self.on_answer: Callable[[Answer], None] | None = None
         self.on_state: Callable[[State], None] | None = None
         self._sent: dict[int, bytes] = {}  # the frames of the last SENT_KEPT commands, by id (resent unchanged)
@@ -147,7 +149,7 @@ class Client:
     def identify(self) -> int:
         """An identification run: the excitation motion about the held joint angles (80 s), planned and checked
         on the board first (refused by name: out_of_workspace, near_singular, over_limit, unstable_loop);
-        wait_done for its end."""
+        wait_done for its end, then wait_identify for the board's estimate."""
         return self.command("identify")
 
     def home(self) -> int:
@@ -263,6 +265,19 @@ class Client:
             outcome.status = Status.TIMEOUT
         return outcome
 
+    def wait_identify(self, cid: int, timeout: float = 2.0) -> Identify | None:
+        """The identify frame of the identify run ``cid``: received already, or within ``timeout`` seconds.
+
+        A board that estimates (the virtual board) sends it once, right after the answer of the tick the run's
+        motion ended in (``wait_done(cid)`` may have read it already): the estimate when the motion was done,
+        status aborted when it was aborted. None when none came: a board that does not estimate (the QEMU
+        images) runs the motion and sends none.
+        """
+        def mine() -> bool:
+            return self.last_identify is not None and self.last_identify.id == cid
+        self._read_until(time.monotonic() + timeout, mine)
+        return self.last_identify if mine() else None
+
     def pump(self, timeout: float) -> None:
         """Reads and dispatches frames (on_answer, on_state) for ``timeout`` seconds."""
         self._read_until(time.monotonic() + timeout, lambda: False)
@@ -312,6 +327,8 @@ class Client:
     def _dispatch(self, frame: Frame) -> None:
         if isinstance(frame, ParamAnswer):
             self.param_answer = frame
+        elif isinstance(frame, Identify):
+            self.last_identify = frame
         elif isinstance(frame, Answer):
             self.answers = (self.answers + [frame])[-self.HISTORY:]
             if self.on_answer:

@@ -35,6 +35,7 @@ class FrameType(str, Enum):
     SETPOINT_VELOCITY = "setpoint_velocity"
     PARAM = "param"
     PARAM_ANSWER = "param_answer"
+    IDENTIFY = "identify"
 
 
 @dataclass(frozen=True)
@@ -151,6 +152,29 @@ class ParamAnswer(Frame):
     margins: Floats = ()  # observer, its b bound, condition (37), loop (check, and a refused gain)
 
 
+@dataclass(frozen=True)
+class Identify(Frame):
+    """An identify run's estimate, sent once by a board that estimates (the virtual board), right after the
+    answer of the tick the run's motion ended in (docs/protocol.md, "Identify frame"); the QEMU images send none.
+
+    The coefficients are the drives', in the order the parameters friction_vis, friction_cou, friction_sti
+    and armature_correction take them.
+    """
+
+    TYPE = FrameType.IDENTIFY
+    id: int = 0  # the identify command's id
+    status: int = 0  # NameList.IDENTIFY_STATUSES: ok, or why there is no estimate (aborted: the run's motion was)
+    samples: int = 0  # the run's samples in the estimate
+    lost: int = 0  # samples the board's main loop missed
+    condition: float = 0.0  # the regressor's condition number
+    prediction_error: float = 0.0  # the worst joint's torque-prediction error, a fraction (rms residual / rms torque)
+    friction: Floats = ()  # viscous J1-6 [N m s/rad], Coulomb J1-6, Stribeck J1-6 [N m]; 0 when status is not ok
+    friction_sd: Floats = ()  # each coefficient's standard deviation
+    identified: int = 0  # bit k set: friction[k] identified (its standard deviation within 2.5 % of it)
+    armature: Floats = ()  # [kg m^2] each drive's armature correction (what the model's armature lacks)
+    armature_sd: Floats = ()  # their standard deviations
+
+
 # --------------------------------------------------------------------------- the PIL link's frames
 @dataclass(frozen=True)
 class Sensor(Frame):
@@ -201,6 +225,6 @@ class Trace(Frame):
 
 
 _CLASSES: tuple[type[Frame], ...] = (Sensor, Actuator, Command, Answer, State, Setpoint, Trace, SetpointVelocity,
-                                     Param, ParamAnswer)
+                                     Param, ParamAnswer, Identify)
 FRAME_CLASSES: dict[FrameType, type[Frame]] = {cls.TYPE: cls for cls in _CLASSES}
 """The class of each frame type."""

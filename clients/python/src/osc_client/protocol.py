@@ -65,6 +65,7 @@ class NameList(str, Enum):
     FAULTS = "faults"  # bit numbers, not codes: Protocol.fault_names
     PARAM_OPS = "param_ops"
     PARAM_STATUSES = "param_statuses"
+    IDENTIFY_STATUSES = "identify_statuses"  # an identify frame's status: ok, or why there is no estimate
 
 
 @dataclass(frozen=True)

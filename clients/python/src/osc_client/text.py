@@ -4,8 +4,16 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from .frames import Answer, ParamAnswer, State
+from .frames import Answer, Identify, ParamAnswer, State
 from .protocol import NameList, Parameter, Protocol
+
+IDENTIFIED_FRACTION = 0.025
+"""A coefficient is identified when its standard deviation is within this fraction of it: the firmware's
+params::kIdentifiedFraction (firmware/control/include/osc/control/params.hpp), which the protocol's JSON
+does not carry."""
+
+DRIVES = 6
+"""The drives an identify frame reports (its armature count; friction holds three coefficients each)."""
 
 
 def pose_text(x: Sequence[float]) -> str:
@@ -70,3 +78,22 @@ def margins_text(p: Protocol, a: ParamAnswer) -> str:
             f"{m[1]:.4g} 1/s^2 at the last pose)\n"
             f"loop margin {m[3]:.3g} (stable at 1 or above: the factor the gains may grow by at the last pose)\n"
             f"condition (37) {m[2]:.3g} (k_s k_nd / 2: above 1 it can hold){warn}")
+
+
+def identify_text(p: Protocol, f: Identify) -> str:
+    """An identify frame as oscctl prints it: the verdict, then (status ok) per drive each coefficient with its
+    standard deviation, ``*`` where it is identified, and the armature correction."""
+    text = ("identify %u: %s; %u samples, %u lost; condition %.3g; worst torque-prediction error %.1f %%\n"
+            % (f.id, p.name_of(NameList.IDENTIFY_STATUSES, f.status), f.samples, f.lost, f.condition,
+               100.0 * f.prediction_error))
+    if p.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok":
+        return text
+    columns = ("viscous [N m s/rad]", "Coulomb [N m]", "Stribeck [N m]", "armature correction [kg m^2]")
+    text += "drive  %-22s %-22s %-22s %s\n" % columns
+    for i in range(DRIVES):
+        text += "J%d    " % (i + 1)
+        for c in range(3):  # viscous, Coulomb, Stribeck
+            k = c * DRIVES + i
+            text += " %9.4f +- %-7.4f%s" % (f.friction[k], f.friction_sd[k], "* " if f.identified >> k & 1 else "  ")
+        text += " %9.4f +- %.4f\n" % (f.armature[i], f.armature_sd[i])
+    return text + "(* identified: its standard deviation within %g %% of it)\n" % (100 * IDENTIFIED_FRACTION)

@@ -62,6 +62,7 @@
 #include <cstdint>
 #include <limits>
 
+#include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
 #include "osc/control/identification.hpp"
 #include "osc/control/params.hpp"
 #include "osc/kernels/friction.hpp"
@@ -78,14 +79,25 @@ constexpr std::uint16_t kMassAndMoment = 0x00F;  ///< m and h = m c: the mass an
 constexpr std::uint16_t kAll = 0x3FF;
 }  // namespace payload_mask
 
-/// A run's verdict (IdentifyReport::status), the first that applies.
-enum class IdentifyStatus : std::uint8_t {
-  kOk = 0,
-  kTooFewSamples,    ///< a joint with fewer rows than params::kIdentifyMinSamples
-  kIllConditioned,   ///< the columns (nearly) dependent: condition above params::kIdentifyMaxCondition
-  kPredictionError,  ///< a joint's torque-prediction error above params::kIdentifyMaxPredictionError
-  kNotFinite         ///< a sample or the solution not finite
-};
+/// A run's verdict (IdentifyReport::status), the first that applies; aborted is the board's, for a run whose motion
+/// was aborted (a stop, a fault: no estimate).
+#define OSC_IDENTIFY_STATUS_LIST(X)                                                                               \
+  X(Ok, "ok", "the estimate is reported; each coefficient says whether it is identified")                         \
+  X(TooFewSamples, "too_few_samples", "a joint moved too little: fewer rows than params::kIdentifyMinSamples")    \
+  X(IllConditioned, "ill_conditioned",                                                                            \
+    "the columns (nearly) dependent: the condition above params::kIdentifyMaxCondition")                          \
+  X(PredictionError, "prediction_error",                                                                          \
+    "a joint's torque-prediction error above params::kIdentifyMaxPredictionError (20 %): the model does not fit") \
+  X(NotFinite, "not_finite", "a sample or the solution not finite")                                               \
+  X(Aborted, "aborted", "the run's motion was aborted (a stop, a fault, a collision): no estimate")
+
+#define OSC_X_PREFIX k
+enum class IdentifyStatus : std::uint8_t { OSC_IDENTIFY_STATUS_LIST(OSC_X_ENUMERATOR) };
+#undef OSC_X_PREFIX
+constexpr const char* kIdentifyStatusNames[] = {OSC_IDENTIFY_STATUS_LIST(OSC_X_NAME)};
+constexpr const char* kIdentifyStatusDocs[] = {OSC_IDENTIFY_STATUS_LIST(OSC_X_DOC)};
+constexpr int kIdentifyStatusCount = sizeof(kIdentifyStatusNames) / sizeof(*kIdentifyStatusNames);
+constexpr const char* identify_status_name(IdentifyStatus s) { return kIdentifyStatusNames[static_cast<int>(s)]; }
 
 /// A coefficient's verdict.
 enum class CoefficientVerdict : std::uint8_t {

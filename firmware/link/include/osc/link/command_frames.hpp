@@ -158,13 +158,13 @@ constexpr double kCommandMaxVelocity = 10.0;
 
 // X(Name, "name", meaning): what a param frame asks (the parameter table, osc/runtime/parameters.hpp).
 // Each is answered at once by a param_answer frame, in the order they come.
-#define OSC_PARAM_OP_LIST(X)                                                                                       \
-  X(Get, "get", "the element's value, its range, the table's size and layout (a listing gets each index)")         \
-  X(Set, "set", "value into the element, checked (Parameter statuses); the answer carries the value now")          \
-  X(Save, "save", "every value into the board's store (flash on the STM32F4, RAM on the QEMU boards); torque off") \
-  X(Load, "load", "the store's newest valid record applied, checked as a whole; torque off")                       \
-  X(Reset, "reset", "the table's defaults applied; torque off; the store is unchanged")                            \
-  X(Check, "check",                                                                                                \
+#define OSC_PARAM_OP_LIST(X)                                                                                           \
+  X(Get, "get", "the element's value, its range, the table's size and layout (a listing gets each index)")             \
+  X(Set, "set", "value into the element, checked (Parameter statuses); the answer carries the value now")              \
+  X(Save, "save", "every value into the board's store (STM32F4: flash; else RAM or osc_sim --param-file); torque off") \
+  X(Load, "load", "the store's newest valid record applied, checked as a whole; torque off")                           \
+  X(Reset, "reset", "the table's defaults applied; torque off; the store is unchanged")                                \
+  X(Check, "check",                                                                                                    \
     "the gains' margins as they are: margins = observer, its b bound [1/s^2], condition (37), the sampled loop")
 
 #define OSC_X_PREFIX kParamOp
@@ -210,6 +210,25 @@ constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC
   X(float, margins, [4], "1, 1/s^2, 1, 1",                                                                        \
     "set of a gain, check: the observer's stability margin (above 1: stable), its bound on b, condition (37)'s, " \
     "the sampled loop's gain margin (at least 1: stable)")
+
+// The identify frame: an identify run's estimate (osc/control/identify_estimate.hpp, IdentifyReport), sent once
+// after the run's motion ended by a board that estimates (osc/link/identify_port.hpp). The coefficients are the
+// drives' (the joints' on an uncoupled arm): model (2)'s theta in its order, viscous 1-6, Coulomb 1-6, Stribeck
+// 1-6, as the parameters friction_vis, friction_cou and friction_sti take them, and the armatures' corrections as
+// armature_correction takes them.
+#define OSC_IDENTIFY_FIELDS(X)                                                                                         \
+  X(std::uint32_t, id, , "", "the identify command's id")                                                              \
+  X(std::uint8_t, status, , "", "ok, or why there is no estimate (Identify statuses)")                                 \
+  X(std::uint32_t, samples, , "", "the run's samples in the estimate")                                                 \
+  X(std::uint32_t, lost, , "", "samples the board's main loop missed (0 on a healthy board)")                          \
+  X(float, condition, , "", "the regressor's condition number (column-normalised information matrix)")                 \
+  X(float, prediction_error, , "", "the worst joint's torque-prediction error (rms residual / rms torque)")            \
+  X(float, friction, [3 * kJoints], "N m s/rad, N m", "theta: viscous 1-6, Coulomb 1-6, Stribeck 1-6 (0 when not ok)") \
+  X(float, friction_sd, [3 * kJoints], "N m s/rad, N m", "each coefficient's standard deviation")                      \
+  X(std::uint32_t, identified, , "",                                                                                   \
+    "bit k set: friction[k] is identified (its standard deviation within params::kIdentifiedFraction of it)")          \
+  X(float, armature, [kJoints], "kg m^2", "each drive's armature correction (what the model's armature lacks)")        \
+  X(float, armature_sd, [kJoints], "kg m^2", "their standard deviations")
 
 // The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
 // (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as

@@ -118,6 +118,15 @@ class CommandPort {
 
   /// The board's parameter store (save, load); without one, the port keeps the record in RAM.
   void set_param_storage(const ParamStorage& s) { param_storage_ = s; }
+  /// The board's store's newest record applied to the task as a whole (param_apply: checked, the gains' margins
+  /// too), as a board's boot applies it: ok, or why not (no_record without a board's store, or none in it). Outside
+  /// the tick, with the torque off.
+  ParamStatus apply_stored(ControlTask<S>& task) const {
+    if (!param_storage_.load) return ParamStatus::kNoRecord;
+    ParamRecord r;
+    const ParamStatus st = param_storage_.load(param_storage_.ctx, r);
+    return st == ParamStatus::kOk ? param_apply(task, r) : st;
+  }
 
   /// A command frame into the FIFO; refused at once (queue_full) when it is full. A resend (the same
   /// frame again, nonzero id: a client that missed the answer) is not executed twice: answered

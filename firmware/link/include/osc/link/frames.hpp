@@ -106,26 +106,29 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
 // makes the struct NameFrame (its fields, in wire order), kNameFrame (its type code), kNameFields
 // (its fields as the document lists them), kNamePayload (its payload length), encode(),
 // Parser::decode() and for_each_field().
-#define OSC_FRAME_LIST(X)                                                                                             \
-  X(Sensor, 1, "sensor", "host",                                                                                      \
-    "one per control tick: the tick's encoder counts, amplifier currents and fault lines", OSC_SENSOR_FIELDS)         \
-  X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",              \
-    OSC_ACTUATOR_FIELDS)                                                                                              \
-  X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS)   \
-  X(Answer, 4, "answer", "firmware",                                                                                  \
-    "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)          \
-  X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)    \
-  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)           \
-  X(Trace, 7, "trace", "firmware",                                                                                    \
-    "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS) \
-  X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                                 \
-    "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "        \
-    "line without the setpoints' delay)",                                                                             \
-    OSC_SETPOINT_VELOCITY_FIELDS)                                                                                     \
-  X(Param, 9, "param", "host", "a parameter request: get, set, save, load, reset, check (answered at once)",          \
-    OSC_PARAM_FIELDS)                                                                                                 \
-  X(ParamAnswer, 10, "param_answer", "firmware", "the answer to each param frame, sent as it is handled",             \
-    OSC_PARAM_ANSWER_FIELDS)
+#define OSC_FRAME_LIST(X)                                                                                              \
+  X(Sensor, 1, "sensor", "host",                                                                                       \
+    "one per control tick: the tick's encoder counts, amplifier currents and fault lines", OSC_SENSOR_FIELDS)          \
+  X(Actuator, 2, "actuator", "firmware", "one per sensor frame: the tick's DAC codes and the telemetry",               \
+    OSC_ACTUATOR_FIELDS)                                                                                               \
+  X(Command, 3, "command", "host", "a client's command: answered by the tick after it arrives", OSC_COMMAND_FIELDS)    \
+  X(Answer, 4, "answer", "firmware",                                                                                   \
+    "after each tick that answered a command or ended a motion (done, aborted, at rest)", OSC_ANSWER_FIELDS)           \
+  X(State, 5, "state", "firmware", "the motion state and the poses, on request or periodically", OSC_STATE_FIELDS)     \
+  X(Setpoint, 6, "setpoint", "host", "one sample of a stream, at the stream's period", OSC_SETPOINT_FIELDS)            \
+  X(Trace, 7, "trace", "firmware",                                                                                     \
+    "after every tick's other frames, when the first sensor frame asked (configuration bit trace)", OSC_TRACE_FIELDS)  \
+  X(SetpointVelocity, 8, "setpoint_velocity", "host",                                                                  \
+    "one sample of a stream with its velocity, in place of a setpoint frame (the follower joins the sample's "         \
+    "line without the setpoints' delay)",                                                                              \
+    OSC_SETPOINT_VELOCITY_FIELDS)                                                                                      \
+  X(Param, 9, "param", "host", "a parameter request: get, set, save, load, reset, check (answered at once)",           \
+    OSC_PARAM_FIELDS)                                                                                                  \
+  X(ParamAnswer, 10, "param_answer", "firmware", "the answer to each param frame, sent as it is handled",              \
+    OSC_PARAM_ANSWER_FIELDS)                                                                                           \
+  X(Identify, 11, "identify", "firmware",                                                                              \
+    "once after an identify run's motion ends, from a board that estimates: the run's estimate, or why there is none", \
+    OSC_IDENTIFY_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

@@ -256,6 +256,9 @@ class PilNode {
       // The host's simulated arm stands at the start pose, which the host declares (as the in-process
       // simulator's arm does: sim::MotionSim): homed.
       task.homed = true;
+      // The init undid what the boot applied from the board's store (pil_firmware.cpp: a power cycle's
+      // parameters): applied again (nothing without a store).
+      port.apply_stored(task);
       if (sup.state == SupervisorState::kFault) task.machine = {MotionState::kFault, false};
     }
     if (config & pil::kConfigStateFrames) port.state_period = kStatePeriod;

@@ -4,9 +4,11 @@
 // (osc/link/command_port.hpp) hands every param frame here as it receives it.
 //
 // The store: save and load move one ParamRecord. A board gives its own (ParamStorage: the STM32F4's
-// two flash sectors); the QEMU boards and the simulator keep the record in RAM (RamParamStore), which
-// a reset of the board loses (docs/protocol.md says so). Save, load and reset need the torque off, as
-// ODrive refuses to save while armed: a record changes gains that the running observer uses.
+// two flash sectors; the QEMU images and the virtual board a file when one is named, osc_sim
+// --param-file: boards/common/param_store/param_store.hpp); without one the port keeps the record in
+// RAM (RamParamStore), which a reset of the board loses (docs/protocol.md says so). Save, load and
+// reset need the torque off, as ODrive refuses to save while armed: a record changes gains that the
+// running observer uses.
 #pragma once
 
 #include <cstdint>

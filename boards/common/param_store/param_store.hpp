@@ -1,30 +1,41 @@
-// The board's parameter store (issue 27; docs/stm32f4.md, "Parameters in flash"): the parameter
-// table's record (osc/runtime/parameters.hpp, ParamRecord) kept by persist::RecordStore in flash
-// sectors 10 and 11 (stm32f4::FlashSectors), behind the command port's ParamStorage (save, load:
-// osc/link/param_frames.hpp) and read once at boot.
+// A board's parameter store (issue 27; docs/stm32f4.md, "Parameters in flash"): the parameter table's record
+// (osc/runtime/parameters.hpp, ParamRecord) kept by persist::RecordStore on a flash medium, behind the command
+// port's ParamStorage (save, load: osc/link/param_frames.hpp) and read once at power-on. Free of any chip: the
+// STM32F4 keeps it in its flash sectors 10 and 11 (stm32f4::FlashSectors, boards/stm32f4/app.hpp), the virtual
+// board in a file (osc_sim --param-file: host_sim/file_flash.hpp, two sectors of kImageSectorWords), a host test
+// in a fake flash.
 //
-// A save stalls the core: an erase of a 128 KiB sector takes up to 2 s (DS8626), during which every
-// fetch from flash waits, the control interrupt's included. The command port only saves with the
-// torque off (the DACs at zero, the amplifier disabled), and the main loop calls it with the tick
-// masked; the watchdog, fed by the ticks every millisecond and set to 5 ms, is stretched to its
-// longest (LSI / 256, reload 4095: 22 s at the fastest LSI) around the save and set back after it
-// (Safety::watchdog_stretch / watchdog_start's values).
+// A save on the STM32F4 stalls the core: an erase of a 128 KiB sector takes up to 2 s (DS8626), during which every
+// fetch from flash waits, the control interrupt's included. The command port only saves with the torque off (the
+// DACs at zero, the amplifier disabled), and the main loop calls it with the tick masked; the watchdog, fed by the
+// ticks every millisecond and set to 5 ms, is stretched to its longest (LSI / 256, reload 4095: 22 s at the fastest
+// LSI) around the save and set back after it (Safety::watchdog_stretch / watchdog_start's values).
 #pragma once
 
 #include <cstdint>
 #include <cstring>
 
-#include "flash.hpp"
 #include "osc/link/param_frames.hpp"
-#include "record_store.hpp"
+#include "record_store.hpp"  // boards/common/persist
 
-namespace board {
+namespace persist {
+
+/// The sectors of a store kept as a file (the virtual board's --param-file): 4 KiB each, the table's record and
+/// its five words of framing with room to grow.
+constexpr std::uint32_t kImageSectorWords = 1024;
+static_assert(osc::kParamSlots + 5 <= kImageSectorWords, "a record fits a sector of the file's image");
 
 /// Whether the payload of a record is the parameter table's: its size is the layout's.
 static_assert(sizeof(osc::ParamRecord) == 4 * osc::kParamSlots, "a record is the table's slots, f32 each");
 
-/// The store over a flash medium (stm32f4::FlashSectors on the board, a fake in a host test) and a
-/// watchdog with stretch() and restore() (the board's Safety; a no-op in a test).
+/// The watchdog of a store where none runs (the host).
+struct NoWatchdog {
+  void stretch() {}
+  void restore() {}
+};
+
+/// The store over a flash medium (stm32f4::FlashSectors on the board, a file on the host, a fake in a host test) and
+/// a watchdog with stretch() and restore() (the board's Safety; NoWatchdog where none runs).
 template <class Sectors, class Watchdog>
 class FlashParamStore {
  public:
@@ -74,4 +85,4 @@ class FlashParamStore {
   persist::SaveResult last_save_{persist::SaveStatus::kSaved, 0, -1};
 };
 
-}  // namespace board
+}  // namespace persist

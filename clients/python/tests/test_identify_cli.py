@@ -1,0 +1,227 @@
+"""The command line's identify (and identify --apply) against a scripted board: the lines and exit status of
+oscctl's identify (host_sim/client/oscctl.cpp), and the frames --apply sends."""
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import pytest
+
+from fakes import FakeBoard, Reply, answer
+from osc_client import Answer, Client, Command, Frame, Identify, NameList, Param, ParamAnswer, Protocol
+from osc_client import cli
+
+FIRST_ID = 100
+NO_ESTIMATE = "no estimate: the board sent no identify frame (the QEMU images run the motion without estimating)\n"
+APPLIED = "applied, the torque off: enable goes on from them; param save keeps them for the next power-on\n"
+
+# An estimate whose figures test the C formats: %.3g's exponent, widths overflowed, halves rounded to even, a
+# negative coefficient, the identified marks (bits 0, 1, 7, 17).
+ESTIMATE = Identify(
+    status=0, samples=16000, lost=3, condition=1234.5, prediction_error=0.125,
+    friction=(1.5, 2.25, 0.75, 0.125, 0.0625, -0.046875, 10.5, 6.25, 4.75, 0.375, 0.25, 0.4375,
+              12345.5, 7.5, 5.25, 0.5, 0.3125, 0.625),
+    friction_sd=(0.015625, 0.03125, 0.25, 0.0625, 0.03125, 0.0234375, 0.5, 0.09375, 1.5, 0.125, 0.125, 0.25,
+                 1234.5, 1.0, 2.0, 0.25, 0.25, 0.0078125),
+    identified=1 << 0 | 1 << 1 | 1 << 7 | 1 << 17,
+    armature=(0.25, -0.125, 0.0625, 0.015625, 0.0078125, 0.00390625), armature_sd=(0.0078125,) * 6)
+# What oscctl's print_identify prints for it (its printf formats, run through C's printf).
+ESTIMATE_TEXT = """\
+identify 100: ok; 16000 samples, 3 lost; condition 1.23e+03; worst torque-prediction error 12.5 %
+drive  viscous [N m s/rad]    Coulomb [N m]          Stribeck [N m]         armature correction [kg m^2]
+J1        1.5000 +- 0.0156 *    10.5000 +- 0.5000    12345.5000 +- 1234.5000      0.2500 +- 0.0078
+J2        2.2500 +- 0.0312 *     6.2500 +- 0.0938 *     7.5000 +- 1.0000      -0.1250 +- 0.0078
+J3        0.7500 +- 0.2500       4.7500 +- 1.5000       5.2500 +- 2.0000       0.0625 +- 0.0078
+J4        0.1250 +- 0.0625       0.3750 +- 0.1250       0.5000 +- 0.2500       0.0156 +- 0.0078
+J5        0.0625 +- 0.0312       0.2500 +- 0.1250       0.3125 +- 0.2500       0.0078 +- 0.0078
+J6       -0.0469 +- 0.0234       0.4375 +- 0.2500       0.6250 +- 0.0078 *     0.0039 +- 0.0078
+(* identified: its standard deviation within 2.5 % of it)
+"""
+APPLIED_PARAMETERS = ("friction_vis", "friction_cou", "friction_sti", "armature_correction")
+
+
+def status(p: Protocol, name: str) -> int:
+    return p.code_of(NameList.IDENTIFY_STATUSES, name)
+
+
+def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, disable: str = "accepted") -> Reply:
+    """The identify run accepted, then done (or aborted) with the estimate after the end's answer; a disable
+    answered ``disable`` (accepted: done at once, the state disabled)."""
+    def reply(c: Command) -> list[Frame]:
+        verb = p.name_of(NameList.VERBS, c.verb)
+        if verb == "disable":
+            return [answer(p, c, disable, "busy" if disable == "refused" else "none", state="disabled")]
+        assert verb == "identify"
+        end = (Answer(aborted_id=c.id, abort=p.code_of(NameList.REASONS, abort)) if abort else Answer(done_id=c.id))
+        return [answer(p, c, state="moving"), end] + ([dataclasses.replace(estimate, id=c.id)] if estimate else [])
+    return reply
+
+
+class ParamTable:
+    """The board's parameters: get answers an element's value and range, set stores it (or is refused)."""
+
+    def __init__(self, p: Protocol, refuse: tuple[str, int, str] | None = None) -> None:
+        self.p = p
+        self.hi: dict[tuple[int, int], float] = {}  # ranges of the board's that are not the JSON's
+        self.values: dict[tuple[int, int], float] = {}
+        self.refuse = refuse  # (parameter, element, status): that set refused
+
+    def __call__(self, q: Param) -> list[Frame]:
+        p, op = self.p, self.p.name_of(NameList.PARAM_OPS, q.op)
+        (par,) = [x for x in p.parameters if x.index == q.index]
+        key = (q.index, q.element)
+        result = 0
+        if op == "set":
+            if self.refuse and (par.name, q.element) == self.refuse[:2]:
+                result = p.code_of(NameList.PARAM_STATUSES, self.refuse[2])
+            else:
+                self.values[key] = q.value
+        return [ParamAnswer(id=q.id, op=q.op, index=q.index, element=q.element, status=result,
+                            flags=p.param_flags["torque_off"], count=len(p.parameters), layout=p.param_layout,
+                            value=self.values.get(key, par.default[q.element]), lo=par.lo[q.element],
+                            hi=self.hi.get(key, par.hi[q.element]))]
+
+
+def run(p: Protocol, argv: list[str], reply: Reply, params: ParamTable | None = None) -> tuple[int, FakeBoard]:
+    board = FakeBoard(p, reply, param_reply=params)
+
+    def connect(port: str, baud: int, protocol: Protocol, keepalive: float) -> Client:
+        return Client(board, protocol=protocol, keepalive=keepalive, first_id=FIRST_ID)
+
+    return cli.main(["--port", "/dev/fake", "--timeout", "5"] + argv, connect=connect), board
+
+
+def verbs(p: Protocol, board: FakeBoard) -> list[str]:
+    return [p.name_of(NameList.VERBS, c.verb) for c in board.commands()]
+
+
+def requests(board: FakeBoard) -> list[Param]:
+    return [f for f in board.sent if isinstance(f, Param)]
+
+
+def test_the_estimate_printed_with_its_identified_marks(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    rc, board = run(protocol, ["identify"], board_run(protocol, ESTIMATE))
+    assert capsys.readouterr().out == "accepted\ndone\n" + ESTIMATE_TEXT
+    assert rc == 0
+    assert verbs(protocol, board) == ["identify"] and requests(board) == []  # nothing applied without --apply
+
+
+@pytest.mark.parametrize("apply", [False, True])
+def test_a_failed_estimate_exits_1(protocol: Protocol, apply: bool, capsys: pytest.CaptureFixture[str]) -> None:
+    failed = Identify(status=status(protocol, "ill_conditioned"), samples=900, condition=3.0e7, prediction_error=0.3)
+    rc, board = run(protocol, ["identify"] + (["--apply"] if apply else []), board_run(protocol, failed))
+    assert capsys.readouterr().out == ("accepted\ndone\nidentify 100: ill_conditioned; 900 samples, 0 lost; "
+                                       "condition 3e+07; worst torque-prediction error 30.0 %\n")
+    assert rc == 1
+    assert verbs(protocol, board) == ["identify"]  # --apply: no disable, nothing set
+
+
+def test_an_aborted_run(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    aborted = Identify(status=status(protocol, "aborted"))
+    rc, _ = run(protocol, ["identify"], board_run(protocol, aborted, abort="stop_command"))
+    assert capsys.readouterr().out == ("accepted\naborted: stop_command\nidentify 100: aborted; 0 samples, 0 lost; "
+                                       "condition 0; worst torque-prediction error 0.0 %\n")
+    assert rc == 1
+
+
+@pytest.mark.parametrize("argv, abort, out, exit", [
+    (["identify"], None, "accepted\ndone\n" + NO_ESTIMATE, 0),  # the end's status
+    (["identify"], "collision", "accepted\naborted: collision\n" + NO_ESTIMATE, 1),
+    (["identify", "--apply"], None, "accepted\ndone\n" + NO_ESTIMATE, 1),  # nothing to apply
+])
+def test_no_identify_frame(protocol: Protocol, monkeypatch: pytest.MonkeyPatch, argv: list[str], abort: str | None,
+                           out: str, exit: int, capsys: pytest.CaptureFixture[str]) -> None:
+    assert cli.IDENTIFY_FRAME_WAIT == 2.0  # oscctl's kIdentifyFrameWaitS
+    monkeypatch.setattr(cli, "IDENTIFY_FRAME_WAIT", 0.3)
+    t0 = time.monotonic()
+    rc, board = run(protocol, argv, board_run(protocol, None, abort))
+    assert time.monotonic() - t0 >= 0.3  # it waited for the frame
+    assert (rc, capsys.readouterr().out) == (exit, out)
+    assert verbs(protocol, board) == ["identify"]
+
+
+def test_a_refused_run_waits_for_no_estimate(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    t0 = time.monotonic()
+    rc, _ = run(protocol, ["identify", "--apply"], lambda c: [answer(protocol, c, "refused", "not_enabled")])
+    assert (rc, capsys.readouterr().out) == (1, "refused: not_enabled\n")
+    assert time.monotonic() - t0 < 1.5
+
+
+def test_apply_sets_the_estimate_within_the_boards_ranges(protocol: Protocol,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    friction = list(ESTIMATE.friction)
+    friction[0] = -0.5  # viscous J1 below its range (0): set to 0
+    friction[6] = 100.0  # Coulomb J1 above the board's range (50 here, 80 in the JSON): set to 50
+    armature = (0.25, -1.0, 0.0625, 0.015625, 0.0078125, 0.00390625)  # J2 below its range: set to its lo
+    estimate = dataclasses.replace(ESTIMATE, friction=tuple(friction), armature=armature)
+    table = ParamTable(protocol)
+    cou = protocol.parameter("friction_cou")
+    arm = protocol.parameter("armature_correction")
+    assert cou is not None and arm is not None and cou.hi[0] == 80
+    table.hi[(cou.index, 0)] = 50.0
+    rc, board = run(protocol, ["identify", "--apply"], board_run(protocol, estimate), table)
+    out = capsys.readouterr().out.splitlines(keepends=True)
+    assert rc == 0
+
+    # The torque off first, then per parameter and element a get (its range) and a set.
+    assert verbs(protocol, board) == ["identify", "disable"]
+    disable = board.sent.index(board.commands()[1])
+    assert not any(isinstance(f, Param) for f in board.sent[:disable])
+    indices = [q.index for name in APPLIED_PARAMETERS for q in [protocol.parameter(name)] if q is not None]
+    expected = [(op, i, e) for i in indices for e in range(6) for op in ("get", "set")]
+    sent = requests(board)
+    assert [(protocol.name_of(NameList.PARAM_OPS, q.op), q.index, q.element) for q in sent] == expected
+    lo = arm.lo[1]
+    want = ([0.0] + friction[1:5] + [0.0]  # viscous: J1's -0.5 and J6's -0.046875 below 0
+            + [50.0] + friction[7:12]  # Coulomb
+            + [80.0] + friction[13:]  # Stribeck: J1's 12345.5 above 80
+            + [0.25, lo, 0.0625, 0.015625, 0.0078125, 0.00390625])
+    assert [q.value for q in sent[1::2]] == pytest.approx(want, rel=1e-6)
+    assert [table.values[(i, e)] for i in indices for e in range(6)] == pytest.approx(want, rel=1e-6)
+
+    estimate_lines = ESTIMATE_TEXT.count("\n")  # the run's outcome, the estimate as printed, then what was set
+    assert out[:3] == ["accepted\n", "done\n", ESTIMATE_TEXT.splitlines(keepends=True)[0]]
+    assert out[3 + 1].startswith("J1       -0.5000 +- 0.0156 *   100.0000 +- 0.5000    12345.5000")
+    lines = out[2 + estimate_lines:]
+    assert len(lines) == 25 and lines[-1] == APPLIED
+    assert lines[0] == "friction_vis[0] = 0 N m s/rad (0 to 18; torque_off)\n"
+    assert lines[1] == "friction_vis[1] = 2.25 N m s/rad (0 to 30; torque_off)\n"
+    assert lines[5] == "friction_vis[5] = 0 N m s/rad (0 to 3; torque_off)\n"  # -0.046875: below 0
+    assert lines[6] == "friction_cou[0] = 50 N m (0 to 50; torque_off)\n"
+    assert lines[12] == "friction_sti[0] = 80 N m (0 to 80; torque_off)\n"  # 12345.5: the range's top
+    assert lines[19] == "armature_correction[1] = -0.464963 kg m^2 (-0.464963 to 6.984445; torque_off)\n"
+
+
+def test_apply_stops_when_the_disable_is_not_done(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    rc, board = run(protocol, ["identify", "--apply"], board_run(protocol, ESTIMATE, disable="refused"),
+                    ParamTable(protocol))
+    assert capsys.readouterr().out == "accepted\ndone\n" + ESTIMATE_TEXT + "refused: busy\n"
+    assert rc == 1
+    assert verbs(protocol, board) == ["identify", "disable"] and requests(board) == []
+
+
+def test_apply_stops_at_a_refused_set(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    table = ParamTable(protocol, refuse=("friction_cou", 2, "torque_on"))
+    rc, board = run(protocol, ["identify", "--apply"], board_run(protocol, ESTIMATE), table)
+    out = capsys.readouterr().out
+    assert out.endswith("friction_cou[0] = 10.5 N m (0 to 80; torque_off)\n"
+                        "friction_cou[1] = 6.25 N m (0 to 32; torque_off)\nrefused: torque_on\n")
+    assert APPLIED not in out and rc == 1
+    last = requests(board)[-1]
+    assert (protocol.name_of(NameList.PARAM_OPS, last.op), last.element) == ("set", 2)  # nothing after it
+
+
+def test_apply_without_a_param_answer_exits_2(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    board = FakeBoard(protocol, board_run(protocol, ESTIMATE))  # answers no param frame
+
+    def connect(port: str, baud: int, p: Protocol, keepalive: float) -> Client:
+        return Client(board, protocol=p, keepalive=keepalive, first_id=FIRST_ID)
+
+    rc = cli.main(["--port", "/dev/fake", "--timeout", "0.3", "identify", "--apply"], connect=connect)
+    captured = capsys.readouterr()
+    assert rc == 2 and "osc_client: param get: no answer within 0.3 s" in captured.err
+    assert APPLIED not in captured.out
+    vis = protocol.parameter("friction_vis")
+    assert vis is not None
+    assert [(protocol.name_of(NameList.PARAM_OPS, q.op), q.index, q.element) for q in requests(board)] == \
+        [("get", vis.index, 0)]  # the first range asked for, nothing set without it

@@ -1,0 +1,90 @@
+// The main loop's side of an identify run on a board that estimates (issue 57; docs/adaptation.md, "The identify
+// command"): the run's samples from the task's sampler summed into the estimate (osc/runtime/identify_run.hpp,
+// IdentifyRun), and when the run's motion ends, its report to the client as one identify frame
+// (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted.
+//
+// A board calls after_tick() after every tick, where its main loop reads the link (the virtual board, osc_sim,
+// after CommandPort::after_tick_and_poll): a run is followed from the tick that accepted it, and its samples, one in
+// params::kRunSampleTicks ticks, are taken while they are fresh (a sample the calls miss is counted lost). The
+// estimate's sums are doubles, about 10 kB (the information matrix of 4 x 6 + 10 unknowns), and the solve at the end
+// a few hundred thousand operations: a board with an FPU for doubles, or a host. The QEMU images do not estimate
+// yet: their identify runs the motion alone, and no identify frame comes.
+//
+// What the client does with the report: the friction goes into the parameters friction_vis, friction_cou and
+// friction_sti, the armatures into armature_correction (oscctl identify --apply; they need the torque off), and a
+// `param save` keeps them for the next power-on. Header-only, allocation-free.
+#pragma once
+
+#include <cstdint>
+
+#include "osc/link/frames.hpp"
+#include "osc/runtime/task.hpp"
+
+namespace osc {
+
+/// A run's report as its frame (f32). `friction` and `armature` hold the estimate only when the run is ok.
+inline pil::IdentifyFrame identify_frame(std::uint32_t id, const IdentifyReport& r, std::uint32_t samples,
+                                         std::uint32_t lost) {
+  pil::IdentifyFrame f;
+  f.id = id;
+  f.status = static_cast<std::uint8_t>(r.status);
+  f.samples = samples;
+  f.lost = lost;
+  f.condition = static_cast<float>(r.condition);
+  f.prediction_error = static_cast<float>(r.worst_prediction_error);
+  const bool ok = r.status == IdentifyStatus::kOk;
+  for (int k = 0; k < 3 * kDof; ++k) {
+    f.friction[k] = ok ? static_cast<float>(r.friction(k)) : 0.0f;
+    f.friction_sd[k] = static_cast<float>(r.friction_sd(k));
+    if (ok && r.friction_verdict[static_cast<std::size_t>(k)] == CoefficientVerdict::kIdentified)
+      f.identified |= 1u << k;
+  }
+  for (int i = 0; i < kDof; ++i) {
+    f.armature[i] = ok ? static_cast<float>(r.armature(i)) : 0.0f;
+    f.armature_sd[i] = static_cast<float>(r.armature_sd(i));
+  }
+  return f;
+}
+
+/// Follows the task's identify runs from the main loop and reports each one's end (the file comment).
+template <class S>
+class IdentifyPort {
+ public:
+  /// After every tick: a run accepted in it is started, its newest sample taken, and in the tick its motion ends
+  /// the identify frame written (`write(bytes, n)`, after the tick's answer frame).
+  template <class Write>
+  void after_tick(const ControlTask<S>& task, Write&& write) {
+    const MotionReport& r = task.report;
+    if (r.verb == MotionVerb::kIdentify && r.outcome == CommandOutcome::kAccepted) {
+      run_.start(r.id, payload_mask::kNone, task.model, task.without_payload(), &task.io);
+      active_ = true;
+    }
+    if (!active_) return;
+    run_.poll(task.identify);
+    const bool done = r.done_id == run_.id(), aborted = r.aborted_id == run_.id();
+    if (!done && !aborted) return;
+    active_ = false;
+    IdentifyReport report;
+    if (done)
+      report = run_.finish();
+    else
+      report.status = IdentifyStatus::kAborted;
+    ++reports_;
+    last_ = report;
+    std::uint8_t buf[pil::kMaxFrame];
+    write(buf, pil::encode(identify_frame(run_.id(), report, run_.taken(), run_.lost()), buf));
+  }
+  /// Whether a run is being followed.
+  bool active() const { return active_; }
+  /// The reports sent, and the last one.
+  std::uint32_t reports() const { return reports_; }
+  const IdentifyReport& last() const { return last_; }
+
+ private:
+  IdentifyRun<S> run_;
+  IdentifyReport last_{};
+  bool active_ = false;
+  std::uint32_t reports_ = 0;
+};
+
+}  // namespace osc

@@ -1,0 +1,133 @@
+// The main loop's side of an identify run on a board that estimates (osc/link/identify_port.hpp): the run followed
+// from the tick that accepted it, its report sent as one identify frame after the end's answer, and an aborted run's
+// frame. Over the simulated arm (MotionSim), the frames decoded from the bytes a board would send.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "motion_sim.hpp"
+#include "motion_sim_util.hpp"
+#include "osc/link/identify_port.hpp"
+#include "osc/robot.hpp"
+
+using namespace osc;
+using sim::MotionSim;
+using test::answer;
+using test::run_ticks;
+
+namespace {
+
+/// The frames a board would send, decoded, each with the tick it came after.
+struct Sent {
+  std::vector<pil::IdentifyFrame> frames;
+  std::vector<std::uint64_t> ticks;
+};
+
+/// Runs ticks with the port after each, until `until` holds after a tick or max ticks; the identify frames sent.
+template <class Until>
+void run(MotionSim<double>& sim, IdentifyPort<double>& port, Sent& sent, std::uint64_t max, Until until) {
+  pil::Parser parser;
+  const auto write = [&](const std::uint8_t* b, int n) {
+    for (int i = 0; i < n; ++i)
+      if (parser.feed(b[i]) == pil::Parser::kFrame) {
+        pil::IdentifyFrame f;
+        ASSERT_TRUE(parser.decode(f)) << "a frame other than identify from the port";
+        sent.frames.push_back(f);
+        sent.ticks.push_back(sim.task().tick);
+      }
+  };
+  for (std::uint64_t k = 0; k < max; ++k) {
+    ASSERT_EQ(sim.tick(), 0u);
+    port.after_tick(sim.task(), write);
+    if (until()) return;
+  }
+}
+
+}  // namespace
+
+/// The arm enabled and holding for half a second.
+void enable_and_hold(MotionSim<double>& sim) {
+  ASSERT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  run_ticks(sim, 500);
+}
+
+/// One run of command `id` with the port after every tick, to its end and 50 ticks more: its frames into `sent`, the
+/// tick that reported it done into `done_tick` (0: it did not end).
+void run_to_end(MotionSim<double>& sim, IdentifyPort<double>& port, Sent& sent, std::uint32_t id,
+                std::uint64_t& done_tick) {
+  sim.identify(id);
+  done_tick = 0;
+  run(sim, port, sent, excitation::kTicks + 200, [&] {
+    if (sim.task().report.done_id == id) done_tick = sim.task().tick;
+    return done_tick != 0 && sim.task().tick > done_tick + 50;
+  });
+}
+
+// Two runs on the ideal plant, the second with the same id (a client's retry): one identify frame each, after the
+// tick that reported the run done; its coefficients within issue 57's bar of the plant's (10 %, or 0.05 where that is
+// more), each marked identified exactly where its standard deviation is within params::kIdentifiedFraction of it, the
+// armatures' corrections near 0 (the model's armature is the plant's).
+TEST(IdentifyPort, EachRunsEstimateComesAsOneFrameAfterItsEnd) {
+  MotionSim<double> sim(test::identify_pose());
+  IdentifyPort<double> port;
+  ASSERT_NO_FATAL_FAILURE(enable_and_hold(sim));
+  Sent sent;
+  for (std::size_t n = 1; n <= 2; ++n) {
+    std::uint64_t done_tick = 0;
+    run_to_end(sim, port, sent, 9, done_tick);
+    ASSERT_NE(done_tick, 0u) << "run " << n << " did not end";
+    ASSERT_EQ(sent.frames.size(), n);
+    EXPECT_EQ(sent.ticks.back(), done_tick);
+    const pil::IdentifyFrame& f = sent.frames.back();
+    EXPECT_EQ(f.id, 9u);
+    ASSERT_EQ(f.status, static_cast<std::uint8_t>(IdentifyStatus::kOk));
+    EXPECT_GE(f.samples, 15900u);
+    EXPECT_EQ(f.lost, 0u);
+    EXPECT_GT(f.condition, 1.0f);
+    EXPECT_LT(f.prediction_error, static_cast<float>(params::kIdentifyMaxPredictionError));
+    const FrictionCoefficients& truth = *robot::kFrictionPresets[0];
+    const double* t[3] = {truth.vis, truth.cou, truth.sti};
+    for (int c = 0; c < 3; ++c)
+      for (int i = 0; i < kDof; ++i) {
+        const int k = c * kDof + i;
+        EXPECT_LE(std::fabs(f.friction[k] - t[c][i]), std::max(0.1 * t[c][i], 0.05)) << "coefficient " << k;
+        const bool identified = f.friction_sd[k] <= params::kIdentifiedFraction * std::fabs(f.friction[k]);
+        EXPECT_EQ(((f.identified >> k) & 1u) != 0, identified) << "coefficient " << k;
+      }
+    for (int i = 0; i < kDof; ++i) EXPECT_LE(std::fabs(f.armature[i]), 4 * f.armature_sd[i] + 1e-3) << "drive " << i;
+    EXPECT_EQ(port.reports(), n);
+    EXPECT_FALSE(port.active());
+  }
+}
+
+// A run stopped at once: one frame, status aborted, no estimate in it. Another identify at the pose where it stopped
+// is refused (the excitation's check) and sends no identify frame.
+TEST(IdentifyPort, AStoppedRunIsReportedAbortedAndARefusedOneNotAtAll) {
+  MotionSim<double> sim(test::identify_pose());
+  IdentifyPort<double> port;
+  ASSERT_NO_FATAL_FAILURE(enable_and_hold(sim));
+  Sent sent;
+  sim.identify(4);
+  run(sim, port, sent, 20, [] { return false; });
+  EXPECT_TRUE(port.active());
+  sim.command(MotionVerb::kStop, 5);
+  run(sim, port, sent, 5000, [&] { return sim.task().report.aborted_id == 4; });
+  ASSERT_EQ(sent.frames.size(), 1u);
+  const pil::IdentifyFrame& f = sent.frames.back();
+  EXPECT_EQ(f.id, 4u);
+  EXPECT_EQ(f.status, static_cast<std::uint8_t>(IdentifyStatus::kAborted));
+  EXPECT_EQ(f.identified, 0u);
+  EXPECT_TRUE(std::all_of(std::begin(f.friction), std::end(f.friction), [](float v) { return v == 0.0f; }));
+  EXPECT_FALSE(port.active());
+  run(sim, port, sent, 3000, [&] { return test::state_is(sim, MotionState::kHolding); });
+  sim.identify(6);
+  run(sim, port, sent, 1, [] { return true; });
+  ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kRefused);
+  run(sim, port, sent, 1000, [] { return false; });
+  EXPECT_EQ(sent.frames.size(), 1u);
+  EXPECT_FALSE(port.active());
+  EXPECT_EQ(port.reports(), 1u);
+}
