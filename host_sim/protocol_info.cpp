@@ -227,11 +227,12 @@ json names() {
   return out;
 }
 
-/// A frame's fields as a client lays them out: name, wire type, count (wire order, no padding).
+/// A frame's fields as a client lays them out: name, wire type, count (wire order, no padding), and the unit as
+/// declared ("m, rad": the elements in equal runs, the first half in m, the second in rad; "" for codes and counts).
 json client_fields(const pil::FrameInfo& f) {
   json out = json::array();
   for (const pil::FieldInfo& x : std::span(f.fields, static_cast<std::size_t>(f.field_count)))
-    out.push_back({{"name", x.name}, {"type", x.type}, {"count", x.count}});
+    out.push_back({{"name", x.name}, {"type", x.type}, {"count", x.count}, {"unit", x.unit}});
   return out;
 }
 

@@ -39,6 +39,11 @@
 #                                      dropped (its own answer frame), the state frame's queue empty;
 #                                      two setpoints in one write both taken (none dropped), a client
 #                                      behind its stream's schedule skipping all but the last
+#   python_record                      osc-client record: --seconds 2 (the client's clock; at --speed 4, 8 s
+#                                      of the board's) writes a CSV row per state frame, none lost (ticks
+#                                      20 apart, t = tick / 1000), a move's reference in it; SIGINT and
+#                                      SIGTERM end a recording, exit 0, its last row whole; plot error
+#                                      --seconds 2 --out FILE.png writes a PNG; a bad signal exit 2
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
@@ -419,6 +424,48 @@ assert s is not None and s.dropped == dropped, (s.dropped, dropped)
 print("ok: a burst of two setpoints, none dropped; a late client skipped", o.skipped)
 PY
     cat "$tmp/queue.out"
+    stop_sim
+    ;;
+  python_record)
+    start_sim --speed 4 --scalar float --no-link-watch  # the move goes on between two clients
+    expect 0 '^accepted$' -- "${pyc[@]}" --port "$port" --timeout 60 enable
+    # 20 mm at 5 mm/s: 4 s of the board's, 1 s of the client's, in the recording.
+    expect 0 '^accepted' -- "${pyc[@]}" --port "$port" --timeout 60 move 0 0.02 0 --relative --v 0.005 --no-wait
+    expect 0 "^record: [0-9]+ rows written to $tmp/state.csv\$" -- \
+      "${pyc[@]}" --port "$port" record "$tmp/state.csv" --seconds 2
+    # The header, then a row per state frame received (50 a second of the board's, 4 a second of its at --speed 4:
+    # about 400 in 2 s; fewer when a loaded machine slows the simulator, and a frame may be dropped by the board's
+    # terminal when the client reads late: the ticks step by multiples of 20).
+    head -1 "$tmp/state.csv" | grep -q '^tick,t,state,stop,faults,queued,running_id,dropped,x_d\[0\],' ||
+      fail "record: no header: $(head -1 "$tmp/state.csv")"
+    awk -F, 'NR == 2 { first = $1 } NR > 2 && ($1 <= tick || ($1 - tick) % 20) { print "tick " $1 " after " tick; bad = 1 }
+             NR > 1 && ($2 * 1000 - $1 > 1e-6 || $1 - $2 * 1000 > 1e-6) { print "t " $2 " at tick " $1; bad = 1 }
+             NR > 1 && NF != 27 { print "row " NR ": " NF " columns"; bad = 1 }
+             NR > 1 { tick = $1; y[$10] = 1 }
+             END { rows = NR - 1; n = 0; for (k in y) n++
+                   printf "%d rows, ticks %d to %d, %d values of x_d[1]\n", rows, first, tick, n
+                   exit bad || rows < 20 || rows > 440 || n < 2 }' "$tmp/state.csv" ||
+      fail "record: not a row per state frame (above)"
+    # SIGINT (Ctrl-C) and SIGTERM end a recording: exit 0, rows written, the last one whole.
+    for sig in INT TERM; do
+      "${pyc[@]}" --port "$port" record "$tmp/$sig.csv" 2>"$tmp/$sig.err" &
+      rec=$!
+      for _ in $(seq 200); do [ "$(wc -l 2>/dev/null <"$tmp/$sig.csv" || echo 0)" -ge 20 ] && break; sleep 0.05; done
+      kill -"$sig" "$rec"
+      wait "$rec" || fail "record ended by SIG$sig: exit $?, expected 0: $(cat "$tmp/$sig.err")"
+      cat "$tmp/$sig.err"
+      rows=$(($(wc -l <"$tmp/$sig.csv") - 1))
+      grep -q "^record: $rows rows written to $tmp/$sig.csv\$" "$tmp/$sig.err" || fail "SIG$sig: not $rows rows"
+      [ "$(tail -1 "$tmp/$sig.csv" | awk -F, '{ print NF }')" -eq 27 ] || fail "SIG$sig: the last row cut short"
+    done
+    expect 0 "^$tmp/error.png\$" -- \
+      "${pyc[@]}" --port "$port" plot error 'error[1]' 'x[1]' --seconds 2 --out "$tmp/error.png"
+    [ "$(head -c 8 "$tmp/error.png" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] ||
+      fail "plot --out: $tmp/error.png is not a PNG"
+    echo "plot --out: a PNG of $(wc -c <"$tmp/error.png") bytes"
+    refuse "no signal 'speed': the signals are state, " -- \
+      "${pyc[@]}" --port "$port" plot speed --seconds 1 --out "$tmp/speed.png"
+    [ ! -e "$tmp/speed.png" ] || fail "plot: a bad signal wrote $tmp/speed.png"
     stop_sim
     ;;
   sim_options)

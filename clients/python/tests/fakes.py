@@ -1,11 +1,12 @@
-"""A scripted board: a transport whose controller answers each command as a test says."""
+"""Scripted boards: a transport whose controller answers each command as a test says, and one that sends
+state frames."""
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Iterator
 
-from osc_client import Answer, Command, Frame, NameList, Param, Parser, Protocol
+from osc_client import Answer, Command, Frame, NameList, Param, Parser, Protocol, State
 
 Reply = Callable[[Command], list[Frame]]
 ParamReply = Callable[[Param], list[Frame]]
@@ -55,3 +56,33 @@ def answer(p: Protocol, command: Command, outcome: str = "accepted", refusal: st
     return Answer(id=command.id, verb=command.verb, outcome=p.code_of(NameList.OUTCOMES, outcome),
                   refusal=p.code_of(NameList.REASONS, refusal), state=p.code_of(NameList.MOTION_STATES, state),
                   **fields)
+
+
+@dataclass
+class StateFeed:
+    """A board that sends state frames: the next of ``frames`` at each read (after ``period`` seconds, its
+    pace), silence once they are over; it keeps every frame the client wrote (its keep-alives)."""
+
+    protocol: Protocol
+    frames: Iterator[State]
+    period: float = 0.0
+    sent: list[Frame] = field(default_factory=list)
+    closed: bool = False
+
+    def __post_init__(self) -> None:
+        self.parser = Parser(self.protocol)
+
+    def read(self, timeout: float) -> bytes:
+        if self.period:
+            time.sleep(min(timeout, self.period))
+        frame = next(self.frames, None)
+        if frame is None:
+            time.sleep(min(timeout, 0.005))
+            return b""
+        return self.protocol.encode(frame)
+
+    def write(self, data: bytes) -> None:
+        self.sent += [self.protocol.decode(raw.type, raw.payload) for raw in self.parser.feed(data)]
+
+    def close(self) -> None:
+        self.closed = True

@@ -23,6 +23,10 @@ The parts, in the order a frame meets them:
 - ``transport``: the byte stream (``Transport``; ``SerialTransport``, a serial device or pseudo-terminal)
 - ``client``: commands and their outcomes (``Client``, ``Outcome``, ``Status``)
 - ``paths``: a stream's CSV path and its setpoints (``read_stream_csv``, ``resample_path``)
+- ``record``: state frames as CSV rows (``state_columns``, ``csv_row``, ``CsvRecorder``) and named signals
+  (``parse_signal``: ``x[0]``, ``error`` ...; ``Traces``, their values over time)
+- ``plot``: signals drawn with matplotlib, a PNG or a live window (imported by ``osc_client.plot`` only:
+  matplotlib is needed by it alone)
 - ``text``, ``cli``: oscctl's output and verbs
 """
 from .client import Client, Outcome, Status
@@ -32,11 +36,15 @@ from .frames import (Actuator, Answer, Command, Frame, FrameType, Identify, Para
 from .parser import Parser, RawFrame
 from .paths import PathPoint, angular_velocity, read_stream_csv, resample_path
 from .protocol import PROTOCOL_JSON, NameList, Parameter, Protocol, crc16, protocol_path
+from .record import (Column, CsvRecorder, Signal, SignalKind, Traces, csv_header, csv_row, parse_signal,
+                     parse_signals, signal_names, state_columns, state_row)
 from .transport import SerialTransport, Transport
 
 __all__ = [
-    "Actuator", "Answer", "Client", "ClientError", "Command", "Frame", "FrameType", "Identify", "NameList", "Outcome",
-    "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser", "PathPoint", "Protocol", "RawFrame", "Sensor",
-    "SerialTransport", "Setpoint", "SetpointVelocity", "State", "Status", "Trace", "Transport", "angular_velocity",
-    "crc16", "protocol_path", "read_stream_csv", "resample_path",
+    "Actuator", "Answer", "Client", "ClientError", "Column", "Command", "CsvRecorder", "Frame", "FrameType",
+    "Identify", "NameList", "Outcome", "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser", "PathPoint",
+    "Protocol", "RawFrame", "Sensor", "SerialTransport", "Setpoint", "SetpointVelocity", "Signal", "SignalKind",
+    "State", "Status", "Trace", "Traces", "Transport", "angular_velocity", "crc16", "csv_header", "csv_row",
+    "parse_signal", "parse_signals", "protocol_path", "read_stream_csv", "resample_path", "signal_names",
+    "state_columns", "state_row",
 ]

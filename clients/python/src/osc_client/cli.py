@@ -6,6 +6,16 @@
     osc-client --port /dev/pts/7 stream FILE.csv --rate HZ [--velocity] [--relative]
     osc-client --port /dev/pts/7 watch [--seconds S]
     osc-client --port /dev/pts/7 param list | get NAME | set NAME VALUE... | save | load | reset | check
+    osc-client --port /dev/pts/7 record FILE.csv|- [--seconds S]
+    osc-client --port /dev/pts/7 plot SIGNAL... [--window W] [--seconds S]
+    osc-client --port /dev/pts/7 plot SIGNAL... --seconds S --out FILE.png
+
+record and plot are this program's own (oscctl has neither). record writes a CSV row per state frame
+(tick, t [s], then the frame's fields, vectors by element: osc_client.record) until S seconds have
+passed or SIGINT / SIGTERM (exit 0, the file whole; the rows counted on standard error). plot draws
+signals of the state frames (x[0], x_d[2], queued, error[0..2], error: osc_client.record.parse_signal)
+in a window over the last W seconds (default 10), or with --out into a PNG after S seconds (matplotlib,
+imported by plot only). Either exits 1 when no state frame came.
 
 Exit status 0: accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port or
 file (``osc_client: MESSAGE`` on standard error). Also ``python3 -m osc_client``.
@@ -13,19 +23,28 @@ file (``osc_client: MESSAGE`` on standard error). Also ``python3 -m osc_client``
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
+import os
+import signal
 import sys
-from typing import Callable, Sequence
+import time
+from types import FrameType as PythonFrame
+from typing import IO, Callable, Iterator, Sequence, TextIO
 
 from .client import Client, Outcome, Status
 from .errors import ClientError
 from .frames import Identify, ParamAnswer, State
 from .paths import read_stream_csv, resample_path
+from .plot import LivePlot, require_matplotlib, save_png
 from .protocol import NameList, Protocol
+from .record import CsvRecorder, Signal, Traces, parse_signals
 from .text import DRIVES, answer_text, identify_text, margins_text, param_line, state_change_text, state_text
 
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
+Open = Callable[[], Client]
+"""Opens the command line's client (record and plot open it once their own files are open)."""
 
 SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
 PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
@@ -222,6 +241,134 @@ def cmd_identify(c: Client, a: argparse.Namespace) -> int:
     return apply_identify(c, a, f) if a.apply else rc
 
 
+@contextlib.contextmanager
+def until_signal() -> Iterator[Callable[[], bool]]:
+    """While in it, SIGINT and SIGTERM end a recording instead of the program: what it gives tells whether
+    one came (give it as ``Client.pump``'s ``until``). Their handlers are put back after. Outside the main
+    thread no handler can be set: a KeyboardInterrupt in it ends it then, quietly too."""
+    came: list[int] = []
+
+    def handler(signum: int, frame: PythonFrame | None) -> None:
+        came.append(signum)
+
+    kept: dict[signal.Signals, Callable[[int, PythonFrame | None], object] | int | None] = {}
+    try:
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            kept[sig] = signal.signal(sig, handler)
+    except ValueError:  # not the main thread
+        pass
+    try:
+        yield lambda: bool(came)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        for sig, previous in kept.items():
+            signal.signal(sig, previous)
+
+
+def no_state_frame() -> int:
+    print("osc_client: no state frame within the time (is a controller on the port?)", file=sys.stderr)
+    return 1
+
+
+def cmd_record(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
+    """record: a CSV row per state frame until --seconds or a signal; the file opened before the port."""
+    stdout = a.file == "-"
+    where = "standard output" if stdout else a.file
+    try:
+        out: TextIO = sys.stdout if stdout else open(a.file, "w", newline="")
+    except OSError as e:
+        raise ClientError(f"record: {a.file}: cannot be written: {e.strerror or e}") from e
+    recorder: CsvRecorder | None = None
+    try:
+        with until_signal() as stopped:
+            recorder = CsvRecorder(p, out)
+            c = open_()
+            try:
+                c.on_state = recorder.write
+                c.pump(a.seconds or math.inf, stopped)
+            finally:
+                c.close()
+    except BrokenPipeError:  # record - | head: the reader has gone, the recording ends
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no error flushing it at exit
+    except OSError as e:
+        raise ClientError(f"record: {where}: {e.strerror or e}") from e
+    finally:
+        if not stdout:
+            out.close()
+        if recorder is not None:  # also after a named error (the port hung up): the file's rows are whole
+            rows = f"{recorder.rows} row" + ("" if recorder.rows == 1 else "s")
+            print(f"record: {rows} written to {where}", file=sys.stderr, flush=True)
+    return 0 if recorder is not None and recorder.rows else no_state_frame()
+
+
+def cmd_plot(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
+    """plot: the signals live in a window, or with --out into a PNG after --seconds; the signals checked, the
+    window or the PNG file opened before the port."""
+    signals = parse_signals(p, a.signals)
+    require_matplotlib()
+    if a.out:
+        return plot_png(a, p, signals, open_)
+    traces = Traces(p, signals, keep=a.window)
+    view = LivePlot(traces, a.window)
+    try:
+        with until_signal() as stopped:
+            c = open_()
+            try:
+                c.on_state = traces.add
+                deadline = time.monotonic() + (a.seconds or math.inf)
+                while view.is_open() and not stopped():
+                    left = deadline - time.monotonic()
+                    if left <= 0:
+                        break
+                    c.pump(min(left, LIVE_REDRAW), stopped)
+                    view.update()
+            finally:
+                c.close()
+    finally:
+        view.close()
+    return 0 if traces.frames else no_state_frame()
+
+
+LIVE_REDRAW = 0.1
+"""Seconds between redraws of the live view (the frames read, the link kept alive, between them)."""
+
+
+def plot_png(a: argparse.Namespace, p: Protocol, signals: Sequence[Signal], open_: Open) -> int:
+    """plot --out: the PNG file opened, the signals recorded for --seconds (or until a signal), then drawn."""
+    traces = Traces(p, signals)
+    try:
+        png: IO[bytes] = open(a.out, "wb")
+    except OSError as e:
+        raise ClientError(f"plot --out {a.out}: cannot be written: {e.strerror or e}") from e
+    done = False
+    try:
+        with png:
+            with until_signal() as stopped:
+                c = open_()
+                try:
+                    c.on_state = traces.add
+                    c.pump(a.seconds, stopped)
+                finally:
+                    c.close()
+            if traces.frames:
+                save_png(traces, png)
+                done = True
+    finally:
+        if not done and os.path.isfile(a.out):
+            with contextlib.suppress(OSError):
+                os.remove(a.out)  # no figure: no file
+    if not done:
+        return no_state_frame()
+    print(a.out, flush=True)
+    return 0
+
+
+OWN_FILE_VERBS: dict[str, Callable[[argparse.Namespace, Protocol, Open], int]] = {
+    "record": cmd_record, "plot": cmd_plot}
+"""The verbs that open a file (or a window) of their own before the port."""
+
 VERBS: dict[str, Callable[[Client, argparse.Namespace], int]] = {
     "state": cmd_state, "move": cmd_move, "stream": cmd_stream, "watch": cmd_watch, "param": cmd_param,
     "declare_pose": cmd_declare_pose, "identify": cmd_identify}
@@ -286,6 +433,20 @@ def parser() -> argparse.ArgumentParser:
     limits(s)
     w = sub.add_parser("watch", help="print state changes and every answer")
     w.add_argument("--seconds", type=positive, help="for this long (default: until interrupted)")
+    r = sub.add_parser("record", help="write a CSV row per state frame: tick, t [s], the frame's fields (vectors "
+                       "by element: x_d[0]..x_d[5], x[0]..x[5], link[0]..link[6])")
+    r.add_argument("file", help="the CSV file to write ('-': standard output)")
+    r.add_argument("--seconds", type=positive, help="for this long (default: until SIGINT or SIGTERM)")
+    pl = sub.add_parser("plot", help="draw signals of the state frames live (matplotlib), or into a PNG (--out)")
+    pl.add_argument("signals", nargs="+", metavar="SIGNAL", help="a field's element or a field (x[0], x_d[2], "
+                    "queued ...; x, x_d: m, rad), error[0..2] (x_d[k] - x[k], mm) or error (the position error's "
+                    "norm, mm)")
+    pl.add_argument("--window", type=positive, default=10.0, help="the live view's last seconds of board time "
+                    "(default 10)")
+    pl.add_argument("--seconds", type=positive, help="for this long (default: until the window is closed or "
+                    "SIGINT; required with --out)")
+    pl.add_argument("--out", metavar="PNG", help="no window: record for --seconds, then write this PNG (every "
+                    "value) and print its path")
     pm = sub.add_parser("param", help="the controller's parameters: list, get, set, save, load, reset, check")
     pm.add_argument("op", choices=PARAM_OPS)
     pm.add_argument("name", nargs="?", help="the parameter (get, set)")
@@ -320,12 +481,16 @@ def main(argv: Sequence[str] | None = None, connect: Connect = open_client) -> i
         ap.error("move: X Y Z and --rpy must be finite numbers")
     if not 50 <= a.baud <= 4000000:
         ap.error(f"--baud {a.baud}: 50 to 4000000")
+    if a.verb == "plot" and a.out is not None and a.seconds is None:
+        ap.error("plot --out: --seconds S is required (how long to record before drawing)")
     try:
         if a.verb == "stream":
             read_stream_csv(a.file)  # a bad file before the port is touched
         protocol = Protocol(a.protocol)
         if a.verb == "param":
             check_param(ap, protocol, a)
+        if a.verb in OWN_FILE_VERBS:
+            return OWN_FILE_VERBS[a.verb](a, protocol, lambda: connect(a.port, a.baud, protocol, a.keepalive))
         c = connect(a.port, a.baud, protocol, a.keepalive)
         try:
             return VERBS.get(a.verb, cmd_simple)(c, a)

@@ -278,9 +278,11 @@ class Client:
         self._read_until(time.monotonic() + timeout, mine)
         return self.last_identify if mine() else None
 
-    def pump(self, timeout: float) -> None:
-        """Reads and dispatches frames (on_answer, on_state) for ``timeout`` seconds."""
-        self._read_until(time.monotonic() + timeout, lambda: False)
+    def pump(self, timeout: float, until: Callable[[], bool] | None = None) -> bool:
+        """Reads and dispatches frames (on_answer, on_state) for ``timeout`` seconds (``inf``: for ever), or
+        until ``until()`` (checked before each read, 0.05 s at most apart), keeping the link alive; True
+        when ``until()`` ended it."""
+        return self._read_until(time.monotonic() + timeout, until or (lambda: False))
 
     # ------------------------------------------------------------------ inside
     def _new_id(self) -> int:

@@ -70,11 +70,22 @@ class NameList(str, Enum):
 
 @dataclass(frozen=True)
 class Field:
-    """One field of a frame: its name, wire type (u8, i16, u32, i32, f32) and element count."""
+    """One field of a frame: its name, wire type (u8, i16, u32, i32, f32), element count and unit as the firmware
+    declares it (``"m, rad"``: the elements in equal runs, the first run in m, the next in rad; ``""`` for codes and
+    counts)."""
 
     name: str
     type: str
     count: int
+    unit: str = ""
+
+    def unit_of(self, index: int) -> str:
+        """Element ``index``'s unit: the declared units split into equal runs of the elements ("" when they do not
+        divide the count)."""
+        units = [u.strip() for u in self.unit.split(",")] if self.unit else []
+        if not units or self.count % len(units) != 0 or not 0 <= index < self.count:
+            return ""
+        return units[index // (self.count // len(units))]
 
 
 @dataclass(frozen=True)
@@ -139,7 +150,8 @@ class Protocol:
         self.frames: dict[FrameType, FrameSpec] = {}
         for t in p["types"]:
             kind = FrameType(t["name"])
-            fields = tuple(Field(str(f["name"]), str(f["type"]), int(f["count"])) for f in p["fields"][kind.value])
+            fields = tuple(Field(str(f["name"]), str(f["type"]), int(f["count"]), str(f.get("unit", "")))
+                           for f in p["fields"][kind.value])
             layout = struct.Struct("<" + "".join(f"{f.count}{WIRE_FORMAT[f.type]}" for f in fields))
             if layout.size != t["payload"]:
                 raise ValueError(f"the {kind.value} frame's fields do not add up to its payload")
