@@ -238,12 +238,9 @@ class InProcessBoard {
   bool open_store(const std::string& path, std::string& said, std::string& err) {
     if (!flash_.open(path, err)) return false;
     port_.set_param_storage(store_.storage());
-    osc::ParamRecord r;
-    const persist::LoadResult res = store_.load(r);
-    if (!res.loaded()) return said = std::string("defaults (") + persist::status_name(res.status) + ")", true;
-    const osc::ParamStatus st = osc::param_apply(sim_.task(), r);
-    if (st != osc::ParamStatus::kOk) return said = std::string("defaults (") + osc::param_status_name(st) + ")", true;
-    said = "loaded, sequence " + std::to_string(res.sequence);
+    const persist::BootLoad b = store_.apply_to(sim_.task());
+    const char* why = b.defaults_why();
+    said = why ? std::string("defaults (") + why + ")" : "loaded, sequence " + std::to_string(b.load.sequence);
     return true;
   }
   /// The counters of the client's link that the state frames carry.

@@ -90,12 +90,9 @@ struct App {
       return l.str("in RAM (QEMU: no flash controller), defaults");
     } else {
       port.set_param_storage(params.storage());
-      osc::ParamRecord r;
-      const persist::LoadResult res = params.load(r);
-      if (!res.loaded()) return l.str("defaults (").str(persist::status_name(res.status)).str(")");
-      const osc::ParamStatus st = osc::param_apply(task, r);
-      if (st != osc::ParamStatus::kOk) return l.str("defaults (").str(osc::param_status_name(st)).str(")");
-      return l.str("loaded, sequence ").u32(res.sequence);
+      const persist::BootLoad b = params.apply_to(task);
+      if (const char* why = b.defaults_why()) return l.str("defaults (").str(why).str(")");
+      return l.str("loaded, sequence ").u32(b.load.sequence);
     }
   }
 

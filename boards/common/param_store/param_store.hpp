@@ -28,6 +28,19 @@ static_assert(osc::kParamSlots + 5 <= kImageSectorWords, "a record fits a sector
 /// Whether the payload of a record is the parameter table's: its size is the layout's.
 static_assert(sizeof(osc::ParamRecord) == 4 * osc::kParamSlots, "a record is the table's slots, f32 each");
 
+/// What a power-on found in the store and did with it (FlashParamStore::apply_to): the record's load, and whether
+/// the task took it.
+struct BootLoad {
+  LoadResult load;
+  osc::ParamStatus applied;
+  /// Why the task runs on its defaults (none, layout_mismatch, ..., or the task's refusal: bad_record, ...); nullptr
+  /// when the record was applied: "loaded, sequence load.sequence".
+  const char* defaults_why() const {
+    if (!load.loaded()) return status_name(load.status);
+    return applied == osc::ParamStatus::kOk ? nullptr : osc::param_status_name(applied);
+  }
+};
+
 /// The watchdog of a store where none runs (the host).
 struct NoWatchdog {
   void stretch() {}
@@ -53,6 +66,15 @@ class FlashParamStore {
     else if (res.loaded())
       return {persist::LoadStatus::kLayoutMismatch, res.sequence, res.length, res.sector};  // a shorter record
     return res;
+  }
+
+  /// A power-on's load: the newest valid record applied to the task as a whole (param_apply: checked, the gains'
+  /// margins too), before the interrupts start.
+  template <class S>
+  [[gnu::cold]] BootLoad apply_to(osc::ControlTask<S>& task) const {
+    osc::ParamRecord r;
+    const LoadResult res = load(r);
+    return {res, res.loaded() ? osc::param_apply(task, r) : osc::ParamStatus::kNoRecord};
   }
 
   /// The last save's result (a boot or a test reports it).

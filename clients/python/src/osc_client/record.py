@@ -116,7 +116,10 @@ def _state_fields(p: Protocol) -> tuple[Field, ...]:
 
 
 def _unit(f: Field, index: int | None) -> str:
-    return f.unit_of(0 if index is None else index) if index is not None or f.count == 1 else ""
+    """Element ``index``'s unit; a whole field's (index None) when it is a single number, else none."""
+    if index is None:
+        return f.unit_of(0) if f.count == 1 else ""
+    return f.unit_of(index)
 
 
 def state_columns(p: Protocol) -> tuple[Column, ...]:
