@@ -130,8 +130,11 @@ reference_z() { sed -n 's/^reference: [^ ]* [^ ]* \([^ ]*\) .*/\1/p' "$tmp/out";
 near() { awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; exit !(d <= tol && d >= -tol) }'; }
 
 # The sequence of the issue with one client, given as a command prefix ("$@"); watch_s: how long the
-# watch step watches (a 30 mm move at 10 mm/s in it).
+# watch step watches [s, wall], watch_v: the speed of the 30 mm move it watches [m/s]. At the virtual
+# board's speed 4 the move takes 15 s simulated, 3.8 s wall: it outlasts a client that is slow to start
+# on a loaded machine (a Python client's start took longer than the 0.8 s of a 10 mm/s move there).
 watch_s=12
+watch_v=0.002
 sequence() {
   expect 0 '^state: disabled$' '^faults: none$' -- "$@" state
   expect 1 '^refused: not_enabled' -- "$@" move 0 0.02 0 --relative
@@ -145,7 +148,7 @@ sequence() {
   near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.02 0.0005 ||
     fail "the reference moved from y = $y0 to $y1, not by 20 mm"
   # watch: the state changes and the answers of a move sent before it, up to its done.
-  expect 0 '^accepted \(id [0-9]+\)$' -- "$@" move 0 0.03 0 --relative --v 0.01 --no-wait
+  expect 0 '^accepted \(id [0-9]+\)$' -- "$@" move 0 0.03 0 --relative --v "$watch_v" --no-wait
   local id
   id=$(sed -n 's/^accepted (id \([0-9]*\))$/\1/p' "$tmp/out")
   expect 0 "^tick [0-9]+: state moving" "^tick [0-9]+: done $id; completion finished; state holding" \
@@ -311,6 +314,7 @@ case "$case_" in
       "$sim" --pty --qemu --elf "$image" --scalar "$wrong"
     start_sim --qemu --elf "$image" --scalar "$image_scalar"
     watch_s=10  # the watched move takes 3.3 s simulated; QEMU keeps real time within 0.11 s (docs/motion.md)
+    watch_v=0.01
     sequence "$ctl" --port "$port" --timeout 120
     sequence "${pyc[@]}" --port "$port" --timeout 120
     param_sequence "$ctl" --port "$port" --timeout 120  # the image's parameters, its RAM store
