@@ -82,6 +82,8 @@ class LinkedArm {
   bool setpoint(const pil::SetpointVelocityFrame& f, std::string& err) { return session_.link().send(f, err); }
   /// A param frame, for the next tick (answered before its actuator frame: replies().params).
   bool param(const pil::ParamFrame& f, std::string& err) { return session_.link().send(f, err); }
+  /// A capture frame, the same (replies().captures).
+  bool capture(const pil::CaptureFrame& f, std::string& err) { return session_.link().send(f, err); }
   /// One tick: the sensor frame, the answer's codes to the amplifiers, the plant over the sample.
   /// False when the link was lost (err: the tick and why).
   bool tick(TickView& v, std::string& err);

@@ -36,7 +36,7 @@ RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
       case pil::Parser::kFrame:
         f.type = parser.type();
         if (parser.decode(f.actuator) || parser.decode(f.answer) || parser.decode(f.state) || parser.decode(f.trace) ||
-            parser.decode(f.param_answer))
+            parser.decode(f.param_answer) || parser.decode(f.capture_data))
           return RxResult::kFrame;
         ++counters[pil::kErrHeader];  // a type the host sends
         return err = "unexpected frame type from the firmware", RxResult::kError;
@@ -61,6 +61,7 @@ void file_reply(const FirmwareFrame& f, PilReplies& replies) {
   if (f.type == pil::kStateFrame) replies.states.push_back(f.state);
   if (f.type == pil::kTraceFrame) replies.traces.push_back(f.trace);
   if (f.type == pil::kParamAnswerFrame) replies.params.push_back(f.param_answer);
+  if (f.type == pil::kCaptureDataFrame) replies.captures.push_back(f.capture_data);
 }
 }  // namespace
 
@@ -274,6 +275,7 @@ bool PilClient::send(const pil::CommandFrame& f, std::string& err) { return send
 bool PilClient::send(const pil::SetpointFrame& f, std::string& err) { return send_frame(f, err); }
 bool PilClient::send(const pil::SetpointVelocityFrame& f, std::string& err) { return send_frame(f, err); }
 bool PilClient::send(const pil::ParamFrame& f, std::string& err) { return send_frame(f, err); }
+bool PilClient::send(const pil::CaptureFrame& f, std::string& err) { return send_frame(f, err); }
 
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
   return receive_actuator(f, timeout_s, err) == Rx::kFrame;

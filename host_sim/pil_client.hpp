@@ -39,9 +39,12 @@ struct PilReplies {
   std::vector<pil::AnswerFrame> answers;
   std::vector<pil::StateFrame> states;
   std::vector<pil::TraceFrame> traces;
-  std::vector<pil::ParamAnswerFrame> params;  ///< the answers to param frames (sent as each was received)
-  bool empty() const { return answers.empty() && states.empty() && traces.empty() && params.empty(); }
-  void clear() { answers.clear(), states.clear(), traces.clear(), params.clear(); }
+  std::vector<pil::ParamAnswerFrame> params;    ///< the answers to param frames (sent as each was received)
+  std::vector<pil::CaptureDataFrame> captures;  ///< the answers to capture frames (the same)
+  bool empty() const {
+    return answers.empty() && states.empty() && traces.empty() && params.empty() && captures.empty();
+  }
+  void clear() { answers.clear(), states.clear(), traces.clear(), params.clear(), captures.clear(); }
 };
 
 /// A frame of a type the firmware sends: its type, and the frame of that type decoded.
@@ -52,6 +55,7 @@ struct FirmwareFrame {
   pil::StateFrame state;
   pil::TraceFrame trace;
   pil::ParamAnswerFrame param_answer;
+  pil::CaptureDataFrame capture_data;
 };
 
 /// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until a frame of a
@@ -93,6 +97,7 @@ class PilClient {
   bool send(const pil::SetpointFrame& f, std::string& err);
   bool send(const pil::SetpointVelocityFrame& f, std::string& err);
   bool send(const pil::ParamFrame& f, std::string& err);
+  bool send(const pil::CaptureFrame& f, std::string& err);
   bool send_raw(const std::uint8_t* p, int n, std::string& err);
   /// Waits up to timeout_s (wall clock) for one actuator frame; false on a corrupt frame (bad CRC,
   /// header or length), on silence and when the peer is gone. Junk between frames is skipped; the

@@ -137,6 +137,33 @@ json coded(const char* const* names, const char* const* docs, int n) {
   return out;
 }
 
+/// The on-board capture's lists and sizes (osc/link/capture_frames.hpp): with `docs` (the document's), codes and
+/// meanings too; a client's has the lists' names in code order.
+json capture(bool docs) {
+  json j;
+  j["channels"] = pil::kCaptureChannels;
+  j["values"] = pil::kCaptureValues;
+  j["chunk"] = pil::kCaptureChunk;
+  j["signals"] = json::array();
+  for (int i = 0; i < pil::kCaptureSignalCount; ++i) {
+    const pil::CaptureSignalInfo& s = pil::kCaptureSignals[i];
+    json e = {{"name", s.name}, {"elements", s.elements}, {"unit", s.unit}};
+    if (docs) e["code"] = i, e["doc"] = s.doc;
+    j["signals"].push_back(e);
+  }
+  const auto list = [docs](const char* const* names, const char* const* meanings, int n) {
+    if (docs) return coded(names, meanings, n);
+    json out = json::array();
+    for (int i = 0; i < n; ++i) out.push_back(names[i]);
+    return out;
+  };
+  j["ops"] = list(pil::kCaptureOpNames, pil::kCaptureOpDocs, pil::kCaptureOpCount);
+  j["triggers"] = list(pil::kCaptureTriggerNames, pil::kCaptureTriggerDocs, pil::kCaptureTriggerCount);
+  j["states"] = list(pil::kCaptureStateNames, pil::kCaptureStateDocs, pil::kCaptureStateCount);
+  j["statuses"] = list(pil::kCaptureStatusNames, pil::kCaptureStatusDocs, pil::kCaptureStatusCount);
+  return j;
+}
+
 /// The parameter table (osc/runtime/parameters.hpp): each parameter with its index, elements, unit,
 /// range and default per element, access, persistence and meaning; the operations, statuses, flags.
 json parameters(bool with_docs) {
@@ -217,6 +244,7 @@ json command_protocol() {
   }
   j["examples"] = command_examples();
   j["parameters"] = parameters(true);
+  j["capture"] = capture(true);
   return j;
 }
 
@@ -271,6 +299,7 @@ json client_protocol() {
   j["faults"] = json::array();
   for (int i = 0; i < osc::kFaultCount; ++i) j["faults"].push_back(osc::kFaultNames[i]);
   j["parameters"] = parameters(false);
+  j["capture"] = capture(false);
   return j;
 }
 

@@ -215,6 +215,7 @@ class InProcessBoard {
         watch_(static_cast<std::uint32_t>(std::lround(osc::CommandLinkWatch::kTimeoutTicks * std::max(1.0, speed)))),
         link_watch_(link_watch) {
     port_.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / state_hz);
+    port_.capture.attach(capture_ring_.data(), pil::kCaptureValues);  // a board's capture buffer
   }
   /// A complete frame from the client: a command or a setpoint is taken (true), any other type not.
   /// Any valid frame keeps the command link alive.
@@ -255,6 +256,7 @@ class InProcessBoard {
  private:
   sim::MotionSim<S> sim_;
   osc::CommandPort<S> port_;
+  std::vector<float> capture_ring_ = std::vector<float>(pil::kCaptureValues);
   osc::IdentifyPort<S> identify_;
   osc::CommandLinkWatch watch_;
   bool link_watch_;
@@ -264,8 +266,8 @@ class InProcessBoard {
 };
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
-/// client's command, setpoint and param frames onto the link before the next tick's sensor frame, the
-/// image's answer, state and param_answer frames of each tick back. No other frame goes on the link.
+/// client's command, setpoint, param and capture frames onto the link before the next tick's sensor frame, the
+/// image's answer, state, param_answer and capture_data frames of each tick back. No other frame goes on the link.
 class QemuBoard {
  public:
   QemuBoard(const sim::ExperimentConfig& cfg, const std::string& elf)
@@ -293,6 +295,11 @@ class QemuBoard {
       if (err_.empty()) arm_.param(pf, err_);
       return true;
     }
+    pil::CaptureFrame cf;
+    if (p.decode(cf)) {
+      if (err_.empty()) arm_.capture(cf, err_);
+      return true;
+    }
     return false;  // a keep-alive (a state frame) or a frame no controller takes: dropped
   }
   template <class Write>
@@ -306,6 +313,7 @@ class QemuBoard {
       write(buf, pil::encode(f, buf));
     }
     for (const pil::ParamAnswerFrame& f : arm_.replies().params) write(buf, pil::encode(f, buf));
+    for (const pil::CaptureDataFrame& f : arm_.replies().captures) write(buf, pil::encode(f, buf));
     return true;
   }
   /// The counters of the client's link that the state frames carry.

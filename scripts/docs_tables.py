@@ -1617,6 +1617,35 @@ def t_protocol_identify_statuses():
     return name_rows(protocol()["command"]["identify_statuses"])
 
 
+@table("protocol_capture", "docs/protocol.md", "protocol")
+def t_protocol_capture():
+    return field_rows(protocol()["capture_fields"])
+
+
+@table("protocol_capture_data", "docs/protocol.md", "protocol")
+def t_protocol_capture_data():
+    return field_rows(protocol()["capture_data_fields"])
+
+
+@table("protocol_capture_signals", "docs/protocol.md", "protocol")
+def t_protocol_capture_signals():
+    c = protocol()["command"]["capture"]
+    rows = [(e["code"], f"`{e['name']}`", e["elements"], e["unit"], e["doc"]) for e in c["signals"]]
+    return (markdown_table(["code", "signal", "elements", "unit", "meaning"], rows)
+            + f"\n\nUp to {c['channels']} channels; the buffer holds {c['values']} values (f32, "
+            f"{c['values'] * 4 // 1024} KiB), {c['values']} samples of one channel to {c['values'] // c['channels']} "
+            f"of {c['channels']}; a read answers up to {c['chunk']} values a frame.")
+
+
+@table("protocol_capture_lists", "docs/protocol.md", "protocol")
+def t_protocol_capture_lists():
+    c = protocol()["command"]["capture"]
+    rows = [(what, e["code"], f"`{e['name']}`", e["doc"])
+            for what, key in (("op", "ops"), ("trigger", "triggers"), ("state", "states"), ("status", "statuses"))
+            for e in c[key]]
+    return markdown_table(["list", "code", "name", "meaning"], rows)
+
+
 @table("protocol_stop_categories", "docs/protocol.md", "protocol")
 def t_protocol_stop_categories():
     return name_rows(protocol()["command"]["stop_categories"])

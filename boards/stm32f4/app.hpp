@@ -51,6 +51,7 @@ struct App {
   osc::CommandPort<float> port;
   osc::CommandPort<float>::PacedInputs paced;  ///< the port's copy of a command's inputs
   osc::CommandLinkWatch watch;
+  float capture_ring[pil::kCaptureValues] = {};  ///< the capture's buffer (osc/link/capture.hpp), 16 KiB
   pil::Parser parser;
   std::uint32_t rx_tick = 0;  ///< the tick count when the last byte was read (the in-frame timeout)
   std::uint8_t frame[pil::kMaxFrame];
@@ -71,6 +72,7 @@ struct App {
     // The arm's own encoders: per-joint resolution and the wrist coupling (robot::kDriveTrain).
     task.set_encoders(osc::robot::kDriveTrain.encoders);
     port.state_period = kStateEvery;
+    port.capture.attach(capture_ring, pil::kCaptureValues);
     cortex_m::text::Line banner;
     board.describe(banner.str("osc stm32f4: "));
     board.uart.write_blocking(banner.text());

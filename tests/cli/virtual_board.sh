@@ -16,6 +16,9 @@
 #                                      sequence (save, reset, load in the image's RAM); the link clean at the end,
 #                                      the clients' keep-alives dropped, not relayed; a --scalar other than
 #                                      SCALAR (the image's; default float) refused first
+#   qemu_capture IMAGE [SCALAR]        osc-client capture on the image (osc_sim --qemu, real time, an encoder jump
+#                                      injected at 10 s): python_capture's fault capture, the image's own capture
+#                                      frames over the PIL link
 #   qemu_power_cycle IMAGE [SCALAR]    the image's store in a file (osc_sim --qemu --param-file): a store with
 #                                      an identify run's estimate (the virtual board in process, identify --apply,
 #                                      param save) applied by the image at its start (the value read back; the
@@ -44,6 +47,17 @@
 #                                      20 apart, t = tick / 1000), a move's reference in it; SIGINT and
 #                                      SIGTERM end a recording, exit 0, its last row whole; plot error
 #                                      --seconds 2 --out FILE.png writes a PNG; a bad signal exit 2
+#   python_capture                     osc-client capture, the board's oscilloscope (--speed 2, an encoder jump
+#                                      injected at 20 s, enabled first): residual[1] residual_threshold[1]
+#                                      error[0] --trigger fault --pre 200 exit 0, triggered at the fault's tick
+#                                      (20000 to 20050; the state's faults encoder_jump after it), 200 samples
+#                                      held before it; the CSV a row per sample, the trigger's at t = 0 after
+#                                      200; the PNG's red trigger line at pre / (depth - 1) of its axes; a
+#                                      manual capture (pre 100); a fault capture with the faults latched
+#                                      already not done within --wait (exit 1, aborted); an arm refused
+#                                      bad_span (exit 1); a bad signal exit 2 with the signals listed; with a
+#                                      state frame a tick, the module's capture triggered at the tick of the
+#                                      first state frame that shows the fault
 #   sim_options                        osc_sim's bad options: named errors, exit 2, no terminal opened
 #                                      (--inject's, --no-link-watch with --qemu)
 #   sim_duration                       osc_sim --duration ends by itself, status 0, the run's counts
@@ -285,6 +299,56 @@ power_cycle() {
     "$sim" --pty --param-file "$tmp/bad.bin"
 }
 
+# The board started with an encoder jump injected at $1 s (simulated): enabled, then osc-client capture
+# residual[1] residual_threshold[1] error[0] --trigger fault --pre 200 (exit 0) triggered at the fault's tick,
+# with 200 samples before it; the state's faults encoder_jump; the CSV a row per sample, the trigger's at t = 0
+# after 200; the PNG's red trigger line at pre / (depth - 1) of its axes.
+fault_capture() {
+  local at=$1 summary trigger first
+  expect 0 '^accepted$' -- "${pyc[@]}" --port "$port" --timeout 60 enable
+  expect 0 '^armed: residual\[1\], residual_threshold\[1\], error\[0\]; trigger fault, pre 200$' \
+    '^captured 1365 samples x 3 channels, trigger tick [0-9]+ \(pre 200\), first tick [0-9]+$' \
+    "^$tmp/capture.csv\$" "^$tmp/capture.png\$" -- \
+    "${pyc[@]}" --port "$port" --timeout 60 capture 'residual[1]' 'residual_threshold[1]' 'error[0]' \
+    --trigger fault --pre 200 --wait 60 --csv "$tmp/capture.csv" --out "$tmp/capture.png"
+  summary='s/^captured .* trigger tick \([0-9]*\) (pre 200), first tick \([0-9]*\)$/\1 \2/p'
+  read -r trigger first < <(sed -n "$summary" "$tmp/out")
+  if [ -z "$trigger" ] || [ "$trigger" -lt $((at * 1000)) ] || [ "$trigger" -gt $((at * 1000 + 50)) ]; then
+    fail "capture: trigger tick $trigger, not the tick the fault injected at $at s latched ($((at * 1000)) + 50)"
+  fi
+  [ "$first" -eq $((trigger - 200)) ] || fail "capture: first tick $first, not 200 before the trigger's $trigger"
+  expect 0 '^state: fault$' '^faults: .*encoder_jump' -- "${pyc[@]}" --port "$port" --timeout 60 state
+  # The CSV: the header, a row per sample (1365: the buffer's 4096 values over 3 channels), the ticks one apart
+  # from the first tick, the trigger's row at t = 0 after 200 rows.
+  [ "$(head -1 "$tmp/capture.csv")" = 'tick,t [s],residual[1] [N m],residual_threshold[1] [N m],error[0] [m]' ] ||
+    fail "capture: the CSV's header: $(head -1 "$tmp/capture.csv")"
+  awk -F, -v first="$first" -v trigger="$trigger" '
+    NR > 1 && $1 != first + NR - 2 { print "row " NR ": tick " $1 ", expected " first + NR - 2; bad = 1 }
+    NR > 1 && NF != 5 { print "row " NR ": " NF " columns"; bad = 1 }
+    NR > 1 && $2 == "0.0" { zero = NR - 1; if ($1 != trigger) { print "t = 0 at tick " $1; bad = 1 } }
+    END { printf "capture.csv: %d rows, t = 0 in row %d (tick %d)\n", NR - 1, zero, trigger
+          exit bad || NR - 1 != 1365 || zero != 201 }' "$tmp/capture.csv" ||
+    fail "capture: the CSV is not a row per sample with the trigger's after 200 (above)"
+  # The PNG: its pure red trigger line pre / (depth - 1) of the way across the axes, whose place is fixed.
+  "$py" - "$tmp/capture.png" 200 1365 >"$tmp/png.out" 2>&1 <<'PY' || fail "capture: the PNG: $(cat "$tmp/png.out")"
+import sys
+import matplotlib.image
+from osc_client.plot import CAPTURE_DPI, CAPTURE_LEFT_IN, CAPTURE_RIGHT_IN, CAPTURE_WIDTH_IN
+path, pre, depth = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+rgb = matplotlib.image.imread(path)[:, :, :3]
+red = ((rgb[:, :, 0] > 0.99) & (rgb[:, :, 1] < 0.01) & (rgb[:, :, 2] < 0.01)).sum(axis=0)
+columns = [x for x, n in enumerate(red) if n >= 0.5 * red.max() > 0]
+assert rgb.shape[1] == CAPTURE_WIDTH_IN * CAPTURE_DPI, rgb.shape
+left, right = CAPTURE_LEFT_IN * CAPTURE_DPI, (CAPTURE_WIDTH_IN - CAPTURE_RIGHT_IN) * CAPTURE_DPI
+want = left + (right - left) * pre / (depth - 1)
+assert columns and max(columns) - min(columns) <= 4, columns
+got = sum(columns) / len(columns)
+assert abs(got - want) <= 2, (got, want)
+print(f"capture.png: the trigger's line at column {got:.1f}, {want:.1f} expected, {red.max()} pixels high")
+PY
+  cat "$tmp/png.out"
+}
+
 case "$case_" in
   oscctl_sequence)
     start_sim --speed 4 --no-link-watch  # a move left running between two clients: no link watch
@@ -470,6 +534,53 @@ PY
     refuse "no signal 'speed': the signals are state, " -- \
       "${pyc[@]}" --port "$port" plot speed --seconds 1 --out "$tmp/speed.png"
     [ ! -e "$tmp/speed.png" ] || fail "plot: a bad signal wrote $tmp/speed.png"
+    stop_sim
+    ;;
+  qemu_capture)
+    [ -r "$image" ] || fail "no firmware image: virtual_board.sh ... qemu_capture IMAGE [SCALAR]"
+    start_sim --qemu --elf "$image" --scalar "$image_scalar" --inject encoder-jump:2@10  # real time: 10 s to arm
+    fault_capture 10
+    stop_sim
+    ;;
+  python_capture)
+    # The fault comes 10 s of the wall's after the start: the enable and the arm are in by then (each a Python
+    # client's start, a few seconds on a loaded machine), and its capture is done 1164 samples (0.6 s) later.
+    start_sim --speed 2 --scalar float --inject encoder-jump:2@20
+    fault_capture 20
+    # A manual capture: triggered by the client once its 100 samples before are in.
+    expect 0 '^captured 4096 samples x 1 channel, trigger tick [0-9]+ \(pre 100\), first tick [0-9]+$' -- \
+      "${pyc[@]}" --port "$port" --timeout 60 capture 'stage_cycles[0]' --pre 100
+    # The faults latched already: no new one triggers it; aborted after --wait.
+    expect 1 '^not done within 1 s: the capture armed \(aborted\)$' -- \
+      "${pyc[@]}" --port "$port" --timeout 60 capture 'tau[0]' --trigger fault --wait 1 --csv "$tmp/none.csv"
+    [ ! -e "$tmp/none.csv" ] || fail "capture: a capture not done left $tmp/none.csv"
+    expect 1 '^refused: bad_span$' -- "${pyc[@]}" --port "$port" --timeout 60 capture 'tau[0]' 'tau[1]' --pre 2048
+    refuse "no capture signal 'speed\[0\]': the signals are error\[0..5\], " -- \
+      "${pyc[@]}" --port "$port" capture 'speed[0]'
+    stop_sim
+    # The trigger's tick is the tick whose state frame first shows the fault: a state frame each tick
+    # (--state-hz 1000), the module's capture (osc_client.capture) and the frames read in one client.
+    start_sim --speed 1 --scalar float --state-hz 1000 --inject encoder-jump:2@10  # 10 s for a client's start
+    "$py" - "$port" >"$tmp/fault.out" 2>&1 <<'PY' || fail "capture: $(cat "$tmp/fault.out")"
+import sys
+from osc_client import Client, Oscilloscope, Status
+c = Client(sys.argv[1])
+assert c.wait_answer(c.enable(), 60).status == Status.ACCEPTED
+clean, faulted = [], []
+c.on_state = lambda s: (faulted if s.faults else clean).append(s.tick)
+scope = Oscilloscope(c, 10)
+armed = scope.arm(["residual[1]", "tau[1]"], "fault", pre=200)
+assert scope.ok(armed), scope.status_name(armed)
+done = scope.wait_done(60)
+assert scope.state_name(done) == "done", scope.state_name(done)
+r = scope.read()
+# Every frame after the arm: the trigger's tick is the first faulted frame's (a frame lost: between the two).
+assert clean and faulted and clean[-1] < r.trigger_tick <= faulted[0], (clean[-1], r.trigger_tick, faulted[0])
+assert (r.pre, r.first_tick, r.ticks[r.pre]) == (200, r.trigger_tick - 200, r.trigger_tick)
+print(f"capture: trigger tick {r.trigger_tick}; state frames: the last clean at tick {clean[-1]}, the first "
+      f"faulted at {faulted[0]} ({c.protocol.fault_names(c.latest_state.faults if c.latest_state else 0)})")
+PY
+    cat "$tmp/fault.out"
     stop_sim
     ;;
   sim_options)

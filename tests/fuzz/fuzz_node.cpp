@@ -118,7 +118,7 @@ struct Driver {
   };
   static bool command_protocol(pil::FrameType t) {
     return t == pil::kCommandFrame || t == pil::kSetpointFrame || t == pil::kSetpointVelocityFrame ||
-           t == pil::kParamFrame;
+           t == pil::kParamFrame || t == pil::kCaptureFrame;
   }
   /// Any frame that ends, valid or not, is answered at once, but a command protocol's (the port's:
   /// no tick, no link error); so is a header found bad and a frame cut short.

@@ -48,8 +48,10 @@ F decoded(const pil::Parser& p) {
   pil::ParamFrame pf;
   pil::ParamAnswerFrame pa;
   pil::IdentifyFrame id;
+  pil::CaptureFrame cf;
+  pil::CaptureDataFrame cd;
   const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
-                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id);
+                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id) + p.decode(cf) + p.decode(cd);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));

@@ -102,6 +102,13 @@ function(osc_add_virtual_board_test scalar)
   # client reads the protocol of the host build for the same arm (OSC_HOST_CLIENT_PROTOCOL_ENV).
   set_tests_properties(virtual_board_qemu_sequence PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600 ENVIRONMENT
                                                               "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
+  # The image's capture (issue 58): triggered by an injected fault, read out and drawn by the Python client.
+  add_test(NAME virtual_board_qemu_capture
+           COMMAND bash ${PROJECT_SOURCE_DIR}/tests/cli/virtual_board.sh ${OSC_SIM_BOARD} ${OSC_OSCCTL}
+                   ${OSC_SYSTEM_PYTHON} ${PROJECT_SOURCE_DIR}/clients/python/src qemu_capture
+                   $<TARGET_FILE:pil_firmware> ${scalar})
+  set_tests_properties(virtual_board_qemu_capture PROPERTIES DEPENDS pil_firmware_checks TIMEOUT 600 ENVIRONMENT
+                                                             "${OSC_HOST_CLIENT_PROTOCOL_ENV}")
   # A power cycle of the image (issue 57): its store in a file that a restart applies (tests/cli/virtual_board.sh
   # qemu_power_cycle: the estimate from the PUMA's identify pose, in process).
   if(OSC_ROBOT STREQUAL "puma560")

@@ -11,6 +11,7 @@
 #include "osc/control/jerk_profile.hpp"
 #include "osc/control/sampled_loop.hpp"
 #include "osc/kernels/lu.hpp"
+#include "osc/link/capture.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
 #include "osc/robot.hpp"
@@ -422,6 +423,50 @@ void motion_kernels(const Vec6<F>& q0) {
   stream_kernels(des.x, from.R, true);
 }
 
+/// The on-board capture's cost to the tick (issue 58, osc/link/capture.hpp): sample() idle, and armed with one and
+/// with eight channels (the signals of the list in turn, from a task at the start pose), worst of 50 ticks.
+ControlTask<F> g_task;
+float g_capture_ring[pil::kCaptureValues];
+SignalCapture g_capture;
+std::uint32_t capture_worst(int channels) {
+  pil::CaptureFrame f;
+  f.op = pil::kCaptureOpArm;
+  f.channels = static_cast<std::uint8_t>(channels);
+  for (int c = 0; c < channels; ++c) f.signal[c] = static_cast<std::uint8_t>((c + 6) % pil::kCaptureSignalCount);
+  f.trigger = pil::kCaptureTriggerFault;
+  f.pre = 10;
+  f.divider = 1;
+  check("the capture arms", g_capture.handle(g_task, f).status, 0.0, 0.0);
+  std::uint32_t worst = 0;
+  for (int k = 0; k < 50; ++k) {
+    ++g_task.tick;
+    const std::uint32_t t0 = board::cycles();
+    g_capture.sample(g_task);
+    const std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst) worst = dt;
+  }
+  return worst;
+}
+void capture_kernels(const Vec6<F>& q0) {
+  g_task.init(Model<F>::of(robot::kArm), Gains<F>::paper(), FrictionMode::kAdaptive, q0, 0);
+  g_capture.attach(g_capture_ring, pil::kCaptureValues);
+  {
+    Timer t("SignalCapture::sample, idle (every tick while no capture is armed)");
+    g_capture.sample(g_task);
+  }
+  const std::uint32_t one = capture_worst(1), eight = capture_worst(8);
+  cortex_m::text::Line()
+      .str("  SignalCapture::sample, 1 channel armed, worst of 50: ")
+      .u32(one)
+      .str(" instructions")
+      .emit();
+  cortex_m::text::Line()
+      .str("  SignalCapture::sample, 8 channels armed, worst of 50: ")
+      .u32(eight)
+      .str(" instructions")
+      .emit();
+}
+
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear
 /// (the committed values are the PUMA's; another arm's fixed point is compared with the host's in
 /// closed loop, motion_tour_qemu).
@@ -494,6 +539,7 @@ int main() {
   jerk_profile_kernels();
   fixed_reference_check();
   motion_kernels(q0);
+  capture_kernels(q0);
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
   return g_failures ? 1 : 0;

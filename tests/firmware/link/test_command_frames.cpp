@@ -46,7 +46,8 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   // The identify run's estimate (issue 57): as long as the actuator frame, the largest.
   EXPECT_EQ(pil::kIdentifyFrame, 11);
   EXPECT_EQ(pil::kIdentifyPayload, 4 + 1 + 4 + 4 + 4 + 4 + 72 + 72 + 4 + 24 + 24);
-  ASSERT_EQ(pil::kFrameTypes, 11);
+  // The capture's request and answer (issue 58): test_capture_frames.cpp.
+  ASSERT_EQ(pil::kFrameTypes, 13);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -55,7 +56,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 12, 13, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 14, 15, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 // ---------------------------------------------------------------- round trips

@@ -115,6 +115,12 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
         case pil::kParamAnswerFrame:
           out = bytes_of(decoded<pil::ParamAnswerFrame>(p));
           break;
+        case pil::kCaptureFrame:
+          out = bytes_of(decoded<pil::CaptureFrame>(p));
+          break;
+        case pil::kCaptureDataFrame:
+          out = bytes_of(decoded<pil::CaptureDataFrame>(p));
+          break;
       }
       ASSERT_EQ(out, in) << info.name;
     }

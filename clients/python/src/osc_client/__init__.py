@@ -25,26 +25,31 @@ The parts, in the order a frame meets them:
 - ``paths``: a stream's CSV path and its setpoints (``read_stream_csv``, ``resample_path``)
 - ``record``: state frames as CSV rows (``state_columns``, ``csv_row``, ``CsvRecorder``) and named signals
   (``parse_signal``: ``x[0]``, ``error`` ...; ``Traces``, their values over time)
-- ``plot``: signals drawn with matplotlib, a PNG or a live window (imported by ``osc_client.plot`` only:
-  matplotlib is needed by it alone)
+- ``capture``: the board's capture, its oscilloscope (``Oscilloscope``: arm, trigger, status, read;
+  ``CaptureResult``, a capture's ticks and values; ``parse_channel``: ``residual[1]``, ``error[0]`` ...)
+- ``plot``: signals and captures drawn with matplotlib, a PNG or a live window (imported by
+  ``osc_client.plot`` only: matplotlib is needed by it alone)
 - ``text``, ``cli``: oscctl's output and verbs
 """
+from .capture import (CaptureChannel, CaptureRefused, CaptureResult, Oscilloscope, capture_signals_text,
+                      parse_channel, parse_channels)
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import (Actuator, Answer, Command, Frame, FrameType, Identify, Param, ParamAnswer, Sensor, Setpoint,
-                     SetpointVelocity, State, Trace)
+from .frames import (Actuator, Answer, Capture, CaptureData, Command, Frame, FrameType, Identify, Param, ParamAnswer,
+                     Sensor, Setpoint, SetpointVelocity, State, Trace)
 from .parser import Parser, RawFrame
 from .paths import PathPoint, angular_velocity, read_stream_csv, resample_path
-from .protocol import PROTOCOL_JSON, NameList, Parameter, Protocol, crc16, protocol_path
+from .protocol import PROTOCOL_JSON, CaptureSignal, CaptureSpec, NameList, Parameter, Protocol, crc16, protocol_path
 from .record import (Column, CsvRecorder, Signal, SignalKind, Traces, csv_header, csv_row, parse_signal,
                      parse_signals, signal_names, state_columns, state_row)
 from .transport import SerialTransport, Transport
 
 __all__ = [
-    "Actuator", "Answer", "Client", "ClientError", "Column", "Command", "CsvRecorder", "Frame", "FrameType",
-    "Identify", "NameList", "Outcome", "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser", "PathPoint",
-    "Protocol", "RawFrame", "Sensor", "SerialTransport", "Setpoint", "SetpointVelocity", "Signal", "SignalKind",
-    "State", "Status", "Trace", "Traces", "Transport", "angular_velocity", "crc16", "csv_header", "csv_row",
-    "parse_signal", "parse_signals", "protocol_path", "read_stream_csv", "resample_path", "signal_names",
-    "state_columns", "state_row",
+    "Actuator", "Answer", "Capture", "CaptureChannel", "CaptureData", "CaptureRefused", "CaptureResult",
+    "CaptureSignal", "CaptureSpec", "Client", "ClientError", "Column", "Command", "CsvRecorder", "Frame", "FrameType",
+    "Identify", "NameList", "Oscilloscope", "Outcome", "PROTOCOL_JSON", "Param", "ParamAnswer", "Parameter", "Parser",
+    "PathPoint", "Protocol", "RawFrame", "Sensor", "SerialTransport", "Setpoint", "SetpointVelocity", "Signal",
+    "SignalKind", "State", "Status", "Trace", "Traces", "Transport", "angular_velocity", "capture_signals_text",
+    "crc16", "csv_header", "csv_row", "parse_channel", "parse_channels", "parse_signal", "parse_signals",
+    "protocol_path", "read_stream_csv", "resample_path", "signal_names", "state_columns", "state_row"
 ]

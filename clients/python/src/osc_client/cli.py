@@ -9,6 +9,8 @@
     osc-client --port /dev/pts/7 record FILE.csv|- [--seconds S]
     osc-client --port /dev/pts/7 plot SIGNAL... [--window W] [--seconds S]
     osc-client --port /dev/pts/7 plot SIGNAL... --seconds S --out FILE.png
+    osc-client --port /dev/pts/7 capture SIGNAL... [--trigger T] [--level-channel K --level X] [--pre N]
+                                         [--divider D] [--wait S] [--csv FILE] [--out FILE.png]
 
 record and plot are this program's own (oscctl has neither). record writes a CSV row per state frame
 (tick, t [s], then the frame's fields, vectors by element: osc_client.record) until S seconds have
@@ -16,6 +18,13 @@ passed or SIGINT / SIGTERM (exit 0, the file whole; the rows counted on standard
 signals of the state frames (x[0], x_d[2], queued, error[0..2], error: osc_client.record.parse_signal)
 in a window over the last W seconds (default 10), or with --out into a PNG after S seconds (matplotlib,
 imported by plot only). Either exits 1 when no state frame came.
+
+capture runs the board's oscilloscope (osc_client.capture): arms it with the channels (``residual[1]``,
+``error[0]``, ``stage_cycles[3]``: an element of a signal the board declares), a trigger (manual: this
+program triggers it once the pre-trigger's samples are in), waits up to --wait seconds for it to be done
+(else aborts it, exit 1), reads it, prints ``captured N samples x C channels, trigger tick T (pre P), first
+tick F``, and writes it as CSV (--csv: tick, t [s] from the trigger, a column per channel) and a PNG (--out).
+A refused request prints ``refused: STATUS`` (exit 1).
 
 Exit status 0: accepted or done; 1: refused, aborted or timed out; 2: a bad command line, port or
 file (``osc_client: MESSAGE`` on standard error). Also ``python3 -m osc_client``.
@@ -32,20 +41,24 @@ import time
 from types import FrameType as PythonFrame
 from typing import IO, Callable, Iterator, Sequence, TextIO
 
+from .capture import DONE, MANUAL, WAITING, CaptureRefused, CaptureResult, Oscilloscope, parse_channels
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import Identify, ParamAnswer, State
+from .frames import CaptureData, FrameType, Identify, ParamAnswer, State
 from .paths import read_stream_csv, resample_path
-from .plot import LivePlot, require_matplotlib, save_png
-from .protocol import NameList, Protocol
+from .plot import LivePlot, require_matplotlib, save_capture_png, save_png
+from .protocol import NameList, Protocol, int_range
 from .record import CsvRecorder, Signal, Traces, parse_signals
-from .text import DRIVES, answer_text, identify_text, margins_text, param_line, state_change_text, state_text
+from .text import (DRIVES, answer_text, capture_text, identify_text, margins_text, param_line, state_change_text,
+                   state_text)
 
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
 Open = Callable[[], Client]
 """Opens the command line's client (record and plot open it once their own files are open)."""
 
+LEVEL_TRIGGERS = ("rising", "falling")
+"""capture's triggers that compare a channel with a level (the protocol's names: checked by the tests)."""
 SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
 PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
 IDENTIFY_FRAME_WAIT = 2.0
@@ -365,8 +378,129 @@ def plot_png(a: argparse.Namespace, p: Protocol, signals: Sequence[Signal], open
     return 0
 
 
+def check_capture(p: Protocol, a: argparse.Namespace) -> None:
+    """capture's command line against the protocol (a ClientError, exit 2, before anything is opened): the
+    channels, the trigger's name, the level's channel, the divider within its field."""
+    a.channels = parse_channels(p, a.signals)
+    triggers = p.names(NameList.CAPTURE_TRIGGERS)
+    if a.trigger not in triggers:
+        raise ClientError(f"capture --trigger {a.trigger}: one of {', '.join(triggers)}")
+    level = a.trigger in LEVEL_TRIGGERS
+    if not level and (a.level is not None or a.level_channel is not None):
+        raise ClientError(f"capture --level and --level-channel apply to --trigger {' or '.join(LEVEL_TRIGGERS)} "
+                          f"only, not {a.trigger}")
+    if level and a.level is None:
+        raise ClientError(f"capture --trigger {a.trigger} needs --level")
+    a.level = 0.0 if a.level is None else a.level
+    a.level_channel = 0 if a.level_channel is None else a.level_channel
+    if not 0 <= a.level_channel < len(a.channels):
+        raise ClientError(f"capture --level-channel {a.level_channel}: a channel of the {len(a.channels)} given, "
+                          f"0 to {len(a.channels) - 1}")
+    if not math.isfinite(a.level):
+        raise ClientError(f"capture --level {a.level}: a finite number")
+    fields = {f.name: f for f in p.frames[FrameType.CAPTURE].fields}
+    for name in ("divider", "pre"):
+        lo, hi = int_range(fields[name].type)
+        lo = max(lo, 1) if name == "divider" else lo
+        if not lo <= getattr(a, name) <= hi:
+            raise ClientError(f"capture --{name} {getattr(a, name)}: {lo} to {hi}")
+
+
+def capture_refused(scope: Oscilloscope, a: CaptureData) -> bool:
+    """Prints ``refused: STATUS`` for a refused request: True when it was."""
+    if scope.ok(a):
+        return False
+    print(f"refused: {scope.status_name(a)}", flush=True)
+    return True
+
+
+def run_capture(c: Client, a: argparse.Namespace) -> CaptureResult | None:
+    """Arms the capture, triggers it (manual), waits for it to be done, reads it: the capture, or None after a
+    refusal or a capture not done within --wait (aborted), the line saying so printed."""
+    scope = Oscilloscope(c, a.timeout)
+    armed = scope.arm(a.channels, a.trigger, a.pre, a.divider, a.level_channel, a.level)
+    if capture_refused(scope, armed):
+        return None
+    every = f", every {a.divider} ticks" if a.divider != 1 else ""
+    print(f"armed: {', '.join(ch.name for ch in a.channels)}; trigger {a.trigger}, pre {a.pre}{every}", flush=True)
+    deadline = time.monotonic() + a.wait
+    if a.trigger == MANUAL:
+        # The pre-trigger's samples first: pre samples a divider apart, one more for the tick the arm came in.
+        scope.wait_ticks((a.pre + 1) * a.divider, a.wait)
+        if capture_refused(scope, scope.trigger()):
+            return None
+    last = scope.wait_done(max(0.0, deadline - time.monotonic()))
+    state = scope.state_name(last)
+    if state in WAITING:
+        scope.abort()
+        print(f"not done within {a.wait:g} s: the capture {state} (aborted)", flush=True)
+        return None
+    if state != DONE:
+        print(f"not done: the capture {state} (aborted or armed again by another client)", flush=True)
+        return None
+    return scope.read()
+
+
+def open_text(path: str) -> TextIO:
+    """capture's CSV file opened for writing (a ClientError when it cannot be)."""
+    try:
+        return open(path, "w", newline="")
+    except OSError as e:
+        raise ClientError(f"capture: {path}: cannot be written: {e.strerror or e}") from e
+
+
+def open_binary(path: str) -> IO[bytes]:
+    """capture's PNG file opened for writing (a ClientError when it cannot be)."""
+    try:
+        return open(path, "wb")
+    except OSError as e:
+        raise ClientError(f"capture: {path}: cannot be written: {e.strerror or e}") from e
+
+
+def cmd_capture(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
+    """capture: the command line checked and the files opened before the port; the capture run, read, printed
+    and written (each file's path printed). A file is left only when written whole."""
+    check_capture(p, a)
+    if a.out:
+        require_matplotlib("capture --out")
+    paths = [path for path in (a.csv, a.out) if path]
+    with contextlib.ExitStack() as files:
+        written = False
+        try:
+            csv_file = files.enter_context(open_text(a.csv)) if a.csv else None
+            png_file = files.enter_context(open_binary(a.out)) if a.out else None
+            c = open_()
+            try:
+                result = run_capture(c, a)
+            except CaptureRefused as e:
+                print(f"refused: {e.status}", flush=True)
+                return 1
+            finally:
+                c.close()
+            if result is None:
+                return 1
+            print(capture_text(result), flush=True)
+            try:
+                if csv_file is not None:
+                    result.write_csv(csv_file)
+                if png_file is not None:
+                    save_capture_png(result, png_file)
+            except OSError as e:
+                raise ClientError(f"capture: {e.strerror or e}") from e
+            written = True
+        finally:
+            if not written:
+                files.close()
+                for path in paths:
+                    with contextlib.suppress(OSError):
+                        os.remove(path)  # no capture: no file
+    for path in paths:
+        print(path, flush=True)
+    return 0
+
+
 OWN_FILE_VERBS: dict[str, Callable[[argparse.Namespace, Protocol, Open], int]] = {
-    "record": cmd_record, "plot": cmd_plot}
+    "record": cmd_record, "plot": cmd_plot, "capture": cmd_capture}
 """The verbs that open a file (or a window) of their own before the port."""
 
 VERBS: dict[str, Callable[[Client, argparse.Namespace], int]] = {
@@ -447,6 +581,28 @@ def parser() -> argparse.ArgumentParser:
                     "SIGINT; required with --out)")
     pl.add_argument("--out", metavar="PNG", help="no window: record for --seconds, then write this PNG (every "
                     "value) and print its path")
+    cp = sub.add_parser("capture", help="the board's oscilloscope: arm a capture of signals at the tick rate, wait "
+                        "for its trigger, read it; print its ticks, write a CSV (--csv) and a PNG (--out)")
+    cp.add_argument("signals", nargs="+", metavar="SIGNAL", help="a channel: an element of a signal the board "
+                    "declares, NAME[K] (residual[1], error[0], stage_cycles[3]; docs/protocol.md, \"Capture\"); a "
+                    "signal of one element by its name alone")
+    cp.add_argument("--trigger", default=MANUAL, help="what ends the pre-trigger: a trigger the protocol declares "
+                    "(docs/protocol.md, \"Capture\": a fault latched, a command accepted, --level-channel crossing "
+                    f"--level ...); {MANUAL}, the default: this program triggers it once the pre-trigger is recorded")
+    cp.add_argument("--level-channel", type=int, metavar="K", help="a level's trigger (rising, falling) only: "
+                    "the channel compared with --level, 0 for the first SIGNAL given (default 0)")
+    cp.add_argument("--level", type=float, metavar="X", help="a level's trigger (rising, falling; required "
+                    "there) only: the level, in the channel's unit")
+    cp.add_argument("--pre", type=int, default=0, metavar="N", help="samples kept before the trigger's, below the "
+                    "samples per channel (the board's buffer / the channels) (default 0)")
+    cp.add_argument("--divider", type=int, default=1, metavar="D", help="a sample every D ticks (default 1: every "
+                    "tick)")
+    cp.add_argument("--wait", type=positive, default=30.0, metavar="S", help="seconds to wait for the capture to "
+                    "be done (default 30); then it is aborted, exit 1")
+    cp.add_argument("--csv", metavar="FILE", help="write the capture as CSV: tick, t [s] from the trigger, a "
+                    "column per channel (its name and unit)")
+    cp.add_argument("--out", metavar="PNG", help="draw the capture into this PNG (matplotlib): the channels against "
+                    "the time from the trigger, an axes per unit, the trigger a red line at t = 0")
     pm = sub.add_parser("param", help="the controller's parameters: list, get, set, save, load, reset, check")
     pm.add_argument("op", choices=PARAM_OPS)
     pm.add_argument("name", nargs="?", help="the parameter (get, set)")

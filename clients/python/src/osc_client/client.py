@@ -8,6 +8,7 @@ command protocol").
 """
 from __future__ import annotations
 
+import dataclasses
 import random
 import time
 from dataclasses import dataclass
@@ -15,7 +16,8 @@ from enum import Enum
 from typing import Callable, Sequence
 
 from .errors import ClientError
-from .frames import Answer, Command, Floats, Frame, Identify, Param, ParamAnswer, Setpoint, SetpointVelocity, State
+from .frames import (Answer, Capture, CaptureData, Command, Floats, Frame, Identify, Param, ParamAnswer, Setpoint,
+                     SetpointVelocity, State)
 from .parser import Parser
 from .paths import PathPoint
 from .protocol import NameList, Protocol
@@ -68,7 +70,8 @@ class Client:
     Each command method sends its frame and returns the command's id; ``wait_answer(id)`` waits for
     its answer, ``wait_done(id)`` for its end. While waiting the client reads every frame: answers
     are kept (``answers``, ``on_answer``), state frames too (``latest_state``, ``on_state``), and the
-    last parameter answer and identify frame (``param_answer``, ``last_identify``).
+    last parameter answer, identify frame and capture answer (``param_answer``, ``last_identify``,
+    ``capture_answer``). The board's capture (its oscilloscope) is ``osc_client.capture.Oscilloscope``'s.
 
     A board whose encoders are local stops a running motion (aborted link_silent) when no frame comes
     from the host for 0.5 s: while it waits, the client sends a keep-alive frame (an all-zero state
@@ -95,6 +98,7 @@ class Client:
         self.states_seen = 0
         self.param_answer: ParamAnswer | None = None
         self.last_identify: Identify | None = None  # the last identify frame (an identify run's estimate)
+        self.capture_answer: CaptureData | None = None  # the last capture_data frame (a capture request's answer)
         self.on_answer: Callable[[Answer], None] | None = None
         self.on_state: Callable[[State], None] | None = None
         self._sent: dict[int, bytes] = {}  # the frames of the last SENT_KEPT commands, by id (resent unchanged)
@@ -236,6 +240,23 @@ class Client:
                               "use the client of its build")
         return answer
 
+    def capture(self, request: Capture, timeout: float = 5.0) -> CaptureData:
+        """A capture request (its id replaced by a fresh one) and its capture_data answer, the one with its id.
+
+        A timeout raises ClientError (``osc_client.capture.Oscilloscope`` builds the requests).
+        """
+        cid = self._new_id()
+        self.capture_answer = None
+        self.send(dataclasses.replace(request, id=cid))
+        if not self._read_until(time.monotonic() + timeout,
+                                lambda: self.capture_answer is not None and self.capture_answer.id == cid):
+            op = self.protocol.name_of(NameList.CAPTURE_OPS, request.op)
+            raise ClientError(f"capture {op}: no answer within {timeout:g} s (a board without the capture, or "
+                              "a link that lost the frame)")
+        answer = self.capture_answer
+        assert answer is not None
+        return answer
+
     def send(self, *frames: Frame) -> None:
         """Sends frames as they are, in one write (no id given, none kept for a resend)."""
         self._write(b"".join(self.protocol.encode(f) for f in frames))
@@ -331,6 +352,8 @@ class Client:
             self.param_answer = frame
         elif isinstance(frame, Identify):
             self.last_identify = frame
+        elif isinstance(frame, CaptureData):
+            self.capture_answer = frame
         elif isinstance(frame, Answer):
             self.answers = (self.answers + [frame])[-self.HISTORY:]
             if self.on_answer:

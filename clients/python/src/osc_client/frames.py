@@ -36,6 +36,8 @@ class FrameType(str, Enum):
     PARAM = "param"
     PARAM_ANSWER = "param_answer"
     IDENTIFY = "identify"
+    CAPTURE = "capture"
+    CAPTURE_DATA = "capture_data"
 
 
 @dataclass(frozen=True)
@@ -93,6 +95,25 @@ class Param(Frame):
     index: int = 0  # the parameter's index in the table (Protocol.parameters)
     element: int = 0
     value: float = 0.0
+
+
+@dataclass(frozen=True)
+class Capture(Frame):
+    """A request of the board's capture (its oscilloscope: docs/protocol.md, "Capture"): arm, trigger, abort,
+    status or read (``NameList.CAPTURE_OPS``), answered at once by a CaptureData frame with its id."""
+
+    TYPE = FrameType.CAPTURE
+    id: int = 0  # the client's, echoed in the answer
+    op: int = 0  # NameList.CAPTURE_OPS
+    channels: int = 0  # arm: how many channels (1 to CaptureSpec.channels)
+    signal: Ints = ()  # arm: each channel's signal (an index of CaptureSpec.signals)
+    element: Ints = ()  # arm: each channel's element of its signal
+    trigger: int = 0  # arm: NameList.CAPTURE_TRIGGERS
+    level_channel: int = 0  # arm, rising or falling: the channel compared with level
+    level: float = 0.0  # that channel's level, in its unit
+    pre: int = 0  # arm: samples kept before the trigger's
+    divider: int = 0  # arm: a sample every divider ticks (1 or more)
+    offset: int = 0  # read: the first value's index, sample x channels + channel
 
 
 # --------------------------------------------------------------------------- controller to client
@@ -175,6 +196,33 @@ class Identify(Frame):
     armature_sd: Floats = ()  # their standard deviations
 
 
+@dataclass(frozen=True)
+class CaptureData(Frame):
+    """A capture frame's answer: the capture's state and set-up after it and, for a read, up to
+    ``CaptureSpec.chunk`` of its values (sample by sample, channel by channel, from ``offset``).
+
+    Sample s of a done capture is at tick ``first_tick + s * divider``; the trigger's is sample ``pre``.
+    """
+
+    TYPE = FrameType.CAPTURE_DATA
+    id: int = 0  # the request's
+    op: int = 0  # its op (NameList.CAPTURE_OPS)
+    status: int = 0  # NameList.CAPTURE_STATUSES (0: ok)
+    state: int = 0  # NameList.CAPTURE_STATES: the capture's after the request
+    channels: int = 0  # 0: idle
+    signal: Ints = ()
+    element: Ints = ()
+    trigger: int = 0
+    divider: int = 0
+    depth: int = 0  # samples per channel held (done)
+    pre: int = 0  # samples held before the trigger's (triggered, done; armed: as armed)
+    trigger_tick: int = 0  # the trigger's sample's tick, low 32 bits (triggered, done)
+    first_tick: int = 0  # the first held sample's tick, low 32 bits (done)
+    offset: int = 0  # read: the first value's index
+    count: int = 0  # read: the values this frame carries
+    values: Floats = ()  # read: values[:count]
+
+
 # --------------------------------------------------------------------------- the PIL link's frames
 @dataclass(frozen=True)
 class Sensor(Frame):
@@ -225,6 +273,6 @@ class Trace(Frame):
 
 
 _CLASSES: tuple[type[Frame], ...] = (Sensor, Actuator, Command, Answer, State, Setpoint, Trace, SetpointVelocity,
-                                     Param, ParamAnswer, Identify)
+                                     Param, ParamAnswer, Identify, Capture, CaptureData)
 FRAME_CLASSES: dict[FrameType, type[Frame]] = {cls.TYPE: cls for cls in _CLASSES}
 """The class of each frame type."""

@@ -4,9 +4,10 @@ Nothing of the wire format is typed here. ``osc_protocol --client`` writes the J
 firmware's own declarations (``scripts/client_protocol.py``; ctest ``client_protocol_json_current``
 fails when the copy in this package is stale): the sync pair, the CRC, each frame type's code,
 payload length and fields (name, wire type, count), the flags, the names of every code, the arm's
-limits and named poses, and the parameter table. The package's copy is the default arm's (the PUMA
-560); a board built for another arm takes its own build's file (``BUILD/clients/osc_protocol.json``),
-given as the path here or in the environment variable ``OSC_PROTOCOL``.
+limits and named poses, the parameter table, and the capture's signals and sizes. The package's copy
+is the default arm's (the PUMA 560); a board built for another arm takes its own build's file
+(``BUILD/clients/osc_protocol.json``), given as the path here or in the environment variable
+``OSC_PROTOCOL``.
 
 A frame on the wire (docs/protocol.md, "Framing and resynchronisation")::
 
@@ -66,6 +67,16 @@ class NameList(str, Enum):
     PARAM_OPS = "param_ops"
     PARAM_STATUSES = "param_statuses"
     IDENTIFY_STATUSES = "identify_statuses"  # an identify frame's status: ok, or why there is no estimate
+    CAPTURE_OPS = "capture_ops"  # a capture frame's op: arm, trigger, abort, status, read
+    CAPTURE_TRIGGERS = "capture_triggers"  # what ends an armed capture's pre-trigger
+    CAPTURE_STATES = "capture_states"  # where a capture is: idle, armed, triggered, done
+    CAPTURE_STATUSES = "capture_statuses"  # a capture_data frame's status: ok, or why the request was refused
+
+
+NESTED_LISTS = {NameList.PARAM_OPS: ("parameters", "ops"), NameList.PARAM_STATUSES: ("parameters", "statuses"),
+                NameList.CAPTURE_OPS: ("capture", "ops"), NameList.CAPTURE_TRIGGERS: ("capture", "triggers"),
+                NameList.CAPTURE_STATES: ("capture", "states"), NameList.CAPTURE_STATUSES: ("capture", "statuses")}
+"""The lists the declaration keeps inside an object of their own: (the object's key, the list's key)."""
 
 
 @dataclass(frozen=True)
@@ -112,6 +123,40 @@ class Parameter:
     default: Floats
     access: str  # always, or torque_off: written only with the torque off
     persists: bool  # kept by save
+
+
+@dataclass(frozen=True)
+class CaptureSignal:
+    """A signal the board's capture records (docs/protocol.md, "Capture"): its name, its elements (0 to
+    ``elements`` - 1) and their unit as the firmware declares it (``"m, rad"``: equal runs, as a field's)."""
+
+    name: str
+    code: int  # its index in the declaration: a capture frame's signal
+    elements: int
+    unit: str
+
+    def unit_of(self, element: int) -> str:
+        """Element ``element``'s unit (``Field.unit_of``'s convention)."""
+        return Field(self.name, "f32", self.elements, self.unit).unit_of(element)
+
+
+@dataclass(frozen=True)
+class CaptureSpec:
+    """The board's capture: the channels it records at once, the values its buffer holds (the samples per channel
+    are ``values // channels``), the values a capture_data frame carries, and the signals it can record."""
+
+    channels: int
+    values: int
+    chunk: int
+    signals: tuple[CaptureSignal, ...]
+
+    def signal(self, name: str) -> CaptureSignal | None:
+        """The signal of that name, or None."""
+        return next((s for s in self.signals if s.name == name), None)
+
+    def depth(self, channels: int) -> int:
+        """The samples per channel a capture of ``channels`` channels holds (at most)."""
+        return self.values // channels if channels > 0 else 0
 
 
 @dataclass(frozen=True)
@@ -170,8 +215,12 @@ class Protocol:
                       tuple(map(float, q["hi"])), tuple(map(float, q["default"])), str(q["access"]),
                       bool(q["persists"]))
             for q in params["table"])
-        lists = {kind: p[kind.value] for kind in NameList if not kind.value.startswith("param_")}
-        lists[NameList.PARAM_OPS], lists[NameList.PARAM_STATUSES] = params["ops"], params["statuses"]
+        c = p["capture"]
+        self.capture = CaptureSpec(int(c["channels"]), int(c["values"]), int(c["chunk"]), tuple(
+            CaptureSignal(str(q["name"]), code, int(q["elements"]), str(q.get("unit", "")))
+            for code, q in enumerate(c["signals"])))
+        lists = {kind: p[NESTED_LISTS[kind][0]][NESTED_LISTS[kind][1]] if kind in NESTED_LISTS else p[kind.value]
+                 for kind in NameList}
         self._names = {kind: [str(n) for n in names] for kind, names in lists.items()}
 
     # ------------------------------------------------------------------ names and flags
@@ -244,6 +293,13 @@ class Protocol:
             fields[f.name] = values[0] if f.count == 1 else tuple(values[:f.count])
             values = values[f.count:]
         return FRAME_CLASSES[kind](**fields)
+
+
+def int_range(wire_type: str) -> tuple[int, int]:
+    """The smallest and largest value of an integer wire type (u8: 0 to 255, i16: -32768 to 32767 ...)."""
+    fmt = WIRE_FORMAT[wire_type]
+    bits = 8 * struct.calcsize("<" + fmt)
+    return (-(1 << (bits - 1)), (1 << (bits - 1)) - 1) if fmt.islower() else (0, (1 << bits) - 1)
 
 
 def _flags(names: list[str]) -> dict[str, int]:

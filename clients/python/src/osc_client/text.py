@@ -2,10 +2,13 @@
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import TYPE_CHECKING, Sequence
 
 from .frames import Answer, Identify, ParamAnswer, State
 from .protocol import NameList, Parameter, Protocol
+
+if TYPE_CHECKING:
+    from .capture import CaptureResult
 
 IDENTIFIED_FRACTION = 0.025
 """A coefficient is identified when its standard deviation is within this fraction of it: the firmware's
@@ -97,3 +100,11 @@ def identify_text(p: Protocol, f: Identify) -> str:
             text += " %9.4f +- %-7.4f%s" % (f.friction[k], f.friction_sd[k], "* " if f.identified >> k & 1 else "  ")
         text += " %9.4f +- %.4f\n" % (f.armature[i], f.armature_sd[i])
     return text + "(* identified: its standard deviation within %g %% of it)\n" % (100 * IDENTIFIED_FRACTION)
+
+
+def capture_text(r: CaptureResult) -> str:
+    """A capture read, in one line: ``captured 1024 samples x 2 channels, trigger tick 4321 (pre 200), first tick
+    4121`` (and ``, every D ticks`` when it sampled less often than every tick)."""
+    every = f", every {r.divider} ticks" if r.divider != 1 else ""
+    return (f"captured {r.depth} samples x {len(r.channels)} channel" + ("s" if len(r.channels) != 1 else "") +
+            f", trigger tick {r.trigger_tick} (pre {r.pre}), first tick {r.first_tick}{every}")

@@ -26,6 +26,7 @@
 
 #include <cstdint>
 
+#include "osc/link/capture.hpp"
 #include "osc/link/commands.hpp"
 #include "osc/link/param_frames.hpp"
 
@@ -111,6 +112,12 @@ class CommandPort {
       std::uint8_t buf[pil::kMaxFrame];
       write(buf,
             pil::encode(param_answer(task, pf, param_storage_.save ? param_storage_ : ram_params_.storage()), buf));
+      return true;
+    }
+    pil::CaptureFrame cf;
+    if (p.decode(cf)) {
+      std::uint8_t buf[pil::kMaxFrame];
+      write(buf, pil::encode(capture.handle(task, cf), buf));
       return true;
     }
     return false;
@@ -232,6 +239,7 @@ class CommandPort {
   /// control interrupt): poll() does.
   template <class Write>
   void after_tick(const ControlTask<S>& task, Write&& write) {
+    capture.sample(task);
     std::uint8_t buf[pil::kMaxFrame];
     if (commanded_ && answer_due(task.report)) {
       const pil::AnswerFrame a = answer_frame(task);
@@ -252,6 +260,8 @@ class CommandPort {
   std::uint32_t resends = 0;
   /// Whether a command frame has come (answers are sent from then on).
   bool commanded() const { return commanded_; }
+  /// The on-board capture (osc/link/capture.hpp): its frames answered in receive(), sampled in after_tick().
+  SignalCapture capture;
 
  private:
   template <class Write>

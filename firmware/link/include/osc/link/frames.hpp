@@ -16,6 +16,7 @@
 
 #include "osc/control/faults.hpp"  // OSC_X_NAME, OSC_X_DOC, OSC_X_ENUMERATOR
 #include "osc/control/gains.hpp"
+#include "osc/link/capture_frames.hpp"
 #include "osc/link/command_frames.hpp"
 #include "osc/link/wire.hpp"
 #include "osc/robots/arm.hpp"
@@ -94,7 +95,7 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
     "the longest whole tick before this one (encoders to DACs, with its frame's transmission)")                      \
   X(std::uint32_t, stage_cycles, [osc::kTickStages], "cycles", "this tick's stages, in Tick stages order")           \
   X(std::uint32_t, stack_used, , "bytes", "the main stack's high-water mark")                                        \
-  X(float, theta_hat, [3 * kJoints], "N m s/rad, N m",                                                               \
+  X(float, theta_hat, [3 * kJoints], "N m s/rad, N m, N m",                                                          \
     "friction estimates: viscous of joints 1-6, then Coulomb 1-6, then Stribeck 1-6")                                \
   X(float, tau_f_hat, [kJoints], "N m", "the estimated friction torque of joints 1 to 6")                            \
   X(LinkCounters, link, , "", "the firmware's link errors since start, one u32 per kind (Link error counters)")      \
@@ -128,7 +129,11 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
     OSC_PARAM_ANSWER_FIELDS)                                                                                           \
   X(Identify, 11, "identify", "firmware",                                                                              \
     "once after an identify run's motion ends, from a board that estimates: the run's estimate, or why there is none", \
-    OSC_IDENTIFY_FIELDS)
+    OSC_IDENTIFY_FIELDS)                                                                                               \
+  X(Capture, 12, "capture", "host", "a capture request: arm, trigger, abort, status, read (answered at once)",         \
+    OSC_CAPTURE_FIELDS)                                                                                                \
+  X(CaptureData, 13, "capture_data", "firmware", "the answer to each capture frame, sent as it is handled",            \
+    OSC_CAPTURE_DATA_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

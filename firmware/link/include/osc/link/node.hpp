@@ -57,6 +57,7 @@ class PilNode {
   void init(const Vec6In<S>& q_start, FrictionMode mode, std::uint32_t period_cycles) {
     task.init(Model<S>::of(robot::kArm), Gains<S>::paper(), mode, q_start, period_cycles);
     port = {};
+    port.capture.attach(capture_ring_, pil::kCaptureValues);
     port.state_period = 0;  // none unless the first sensor frame asks (kConfigStateFrames)
     trace_ = false;
     parser_.reset();
@@ -307,7 +308,8 @@ class PilNode {
   }
 
   pil::Parser parser_;
-  pil::SensorFrame frame_;  // the latest valid sensor frame
+  float capture_ring_[pil::kCaptureValues] = {};  // the capture's buffer (osc/link/capture.hpp), 16 KiB
+  pil::SensorFrame frame_;                        // the latest valid sensor frame
   pil::LinkCounters counters_;
   std::uint32_t expected_seq_ = 0;
   std::uint32_t answer_seq_ = pil::kHelloSeq;  // sequence number of the next actuator frame

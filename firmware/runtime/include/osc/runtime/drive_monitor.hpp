@@ -79,6 +79,7 @@ struct DriveMonitor {
   std::int32_t last[kDof];          // the last code (the amplifier has had it since)
   std::int32_t lo[kDof], hi[kDof];  // the two codes' range, where the current must lie
   std::int32_t threshold[kDof];     // floor + share max(|lo|, |hi|)
+  std::int32_t distance[kDof];      // the last checked reading's distance outside [lo, hi] [DAC codes]
   std::int32_t dither[kDof];        // 2^kDitherShift times the filtered sign-weighted difference [DAC codes]
   std::int32_t base[kDof];          // 2^kDitherShift times the filtered distance outside the range [DAC codes]
   std::int8_t sign_last;            // the dither's sign in the last codes (0: none)
@@ -97,7 +98,7 @@ struct DriveMonitor {
 
   void reset() {
     for (int c = 0; c < kDof; ++c) {
-      last[c] = lo[c] = hi[c] = dither[c] = base[c] = 0;
+      last[c] = lo[c] = hi[c] = dither[c] = base[c] = distance[c] = 0;
       threshold[c] = kDriveCheck.floor;
       over[c] = 0, peak[c] = dither_peak[c] = 0;
     }
@@ -159,6 +160,7 @@ struct DriveMonitor {
     const std::int32_t above = m - hi[c], below = lo[c] - m;
     const std::int32_t error = above > 0 ? above : (below > 0 ? below : 0);
     const std::int32_t th = threshold[c];
+    distance[c] = error;
     track_peak(peak[c], error, th);
     if (2 * error > th) suspect |= static_cast<std::uint8_t>(1u << c);
     over[c] = qualify(over[c], error > th);
