@@ -385,6 +385,59 @@ void param() {
   }
 }
 
+/// fuzz_capture: steps of a capture frame (an even byte, then its 37 payload bytes) or ticks (an odd byte, how
+/// many, the faults' change).
+void capture() {
+  const auto request = [](Bytes& b, std::uint8_t op, std::initializer_list<int> signals, std::uint8_t trigger,
+                          std::uint32_t pre, std::uint32_t offset = 0, float level = 0) {
+    pil::CaptureFrame f;
+    f.op = op;
+    f.channels = static_cast<std::uint8_t>(signals.size());
+    int c = 0;
+    for (int s : signals) {
+      f.signal[c] = static_cast<std::uint8_t>(s);
+      f.element[c] = static_cast<std::uint8_t>(c % 6);
+      ++c;
+    }
+    f.trigger = trigger;
+    f.level = level;
+    f.pre = pre;
+    f.divider = 1;
+    f.offset = offset;
+    std::uint8_t buf[pil::kMaxFrame];
+    pil::encode(f, buf);
+    b.push_back(0);
+    b.insert(b.end(), buf + 4, buf + 4 + pil::kCapturePayload);
+  };
+  const auto ticks = [](Bytes& b, int n, std::uint8_t how) {
+    b.push_back(1);
+    b.push_back(static_cast<std::uint8_t>(n - 1));
+    b.push_back(how);
+  };
+  // By hand: arm two channels, a pre-trigger, the trigger, the rest, every read.
+  Bytes manual;
+  request(manual, pil::kCaptureOpArm, {pil::kCaptureSignalResidual, pil::kCaptureSignalTorque},
+          pil::kCaptureTriggerManual, 100);
+  ticks(manual, 200, 0);
+  request(manual, pil::kCaptureOpTrigger, {}, 0, 0);
+  for (int k = 0; k < 9; ++k) ticks(manual, 256, 0);
+  for (std::uint32_t offset = 0; offset <= 4096; offset += 40 * 8)
+    request(manual, pil::kCaptureOpRead, {}, 0, 0, offset);
+  put("fuzz_capture", "manual", manual);
+  // A fault's trigger over eight channels; a level's; refusals.
+  Bytes fault;
+  request(fault, pil::kCaptureOpArm, {0, 1, 2, 3, 4, 5, 6, 7}, pil::kCaptureTriggerFault, 511);
+  ticks(fault, 100, 0);
+  ticks(fault, 256, 1);
+  ticks(fault, 256, 0);
+  request(fault, pil::kCaptureOpRead, {}, 0, 0, 4000);
+  request(fault, pil::kCaptureOpArm, {pil::kCaptureSignalError}, pil::kCaptureTriggerRising, 10, 0, 0.05f);
+  for (int k = 0; k < 20; ++k) ticks(fault, 256, 0x80);
+  request(fault, pil::kCaptureOpArm, {pil::kCaptureSignalCount}, pil::kCaptureTriggerCount, 5000);
+  request(fault, pil::kCaptureOpRead, {}, 0, 0, 0);
+  put("fuzz_capture", "fault_level", fault);
+}
+
 int main(int argc, char** argv) {
   if (argc != 2) {
     std::fprintf(stderr, "usage: fuzz_make_corpus DIR (e.g. tests/fuzz/corpus)\n");
@@ -397,6 +450,7 @@ int main(int argc, char** argv) {
   supervisor();
   command();
   param();
+  capture();
   pil_client();
   cli();
   return 0;
