@@ -284,14 +284,28 @@ def no_state_frame() -> int:
     return 1
 
 
+def open_text(path: str, what: str) -> TextIO:
+    """A text file opened for writing (CSV: no newline translation); a ClientError ``WHAT: cannot be written:
+    why`` when it cannot be (``what`` names the verb and the file)."""
+    try:
+        return open(path, "w", newline="")
+    except OSError as e:
+        raise ClientError(f"{what}: cannot be written: {e.strerror or e}") from e
+
+
+def open_binary(path: str, what: str) -> IO[bytes]:
+    """A binary file (a PNG) opened for writing, as ``open_text``."""
+    try:
+        return open(path, "wb")
+    except OSError as e:
+        raise ClientError(f"{what}: cannot be written: {e.strerror or e}") from e
+
+
 def cmd_record(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
     """record: a CSV row per state frame until --seconds or a signal; the file opened before the port."""
     stdout = a.file == "-"
     where = "standard output" if stdout else a.file
-    try:
-        out: TextIO = sys.stdout if stdout else open(a.file, "w", newline="")
-    except OSError as e:
-        raise ClientError(f"record: {a.file}: cannot be written: {e.strerror or e}") from e
+    out = sys.stdout if stdout else open_text(a.file, f"record: {a.file}")
     recorder: CsvRecorder | None = None
     try:
         with until_signal() as stopped:
@@ -351,10 +365,7 @@ LIVE_REDRAW = 0.1
 def plot_png(a: argparse.Namespace, p: Protocol, signals: Sequence[Signal], open_: Open) -> int:
     """plot --out: the PNG file opened, the signals recorded for --seconds (or until a signal), then drawn."""
     traces = Traces(p, signals)
-    try:
-        png: IO[bytes] = open(a.out, "wb")
-    except OSError as e:
-        raise ClientError(f"plot --out {a.out}: cannot be written: {e.strerror or e}") from e
+    png = open_binary(a.out, f"plot --out {a.out}")
     done = False
     try:
         with png:
@@ -441,22 +452,6 @@ def run_capture(c: Client, a: argparse.Namespace) -> CaptureResult | None:
     return scope.read()
 
 
-def open_text(path: str) -> TextIO:
-    """capture's CSV file opened for writing (a ClientError when it cannot be)."""
-    try:
-        return open(path, "w", newline="")
-    except OSError as e:
-        raise ClientError(f"capture: {path}: cannot be written: {e.strerror or e}") from e
-
-
-def open_binary(path: str) -> IO[bytes]:
-    """capture's PNG file opened for writing (a ClientError when it cannot be)."""
-    try:
-        return open(path, "wb")
-    except OSError as e:
-        raise ClientError(f"capture: {path}: cannot be written: {e.strerror or e}") from e
-
-
 def cmd_capture(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
     """capture: the command line checked and the files opened before the port; the capture run, read, printed
     and written (each file's path printed). A file is left only when written whole."""
@@ -467,8 +462,8 @@ def cmd_capture(a: argparse.Namespace, p: Protocol, open_: Open) -> int:
     with contextlib.ExitStack() as files:
         written = False
         try:
-            csv_file = files.enter_context(open_text(a.csv)) if a.csv else None
-            png_file = files.enter_context(open_binary(a.out)) if a.out else None
+            csv_file = files.enter_context(open_text(a.csv, f"capture: {a.csv}")) if a.csv else None
+            png_file = files.enter_context(open_binary(a.out, f"capture: {a.out}")) if a.out else None
             c = open_()
             try:
                 result = run_capture(c, a)

@@ -76,7 +76,7 @@ class SignalCapture {
       return;
     }
     if (filled_ < depth_) ++filled_;
-    if (level_crossed(row[level_channel_])) event_ = true;
+    if (level_trigger_ && level_crossed(row[level_channel_])) event_ = true;
     if (!event_) return;
     trigger_tick_ = tick;
     trigger_slot_ = slot;
@@ -140,6 +140,7 @@ class SignalCapture {
       element_[c] = c < channels_ ? f.element[c] : std::uint8_t{0};
     }
     trigger_ = f.trigger;
+    level_trigger_ = level;
     level_channel_ = level ? f.level_channel : std::uint8_t{0};
     level_ = capture_order(f.level);
     pre_ = static_cast<int>(f.pre);
@@ -162,22 +163,21 @@ class SignalCapture {
     channels_ = 0;
     for (int c = 0; c < pil::kCaptureChannels; ++c) signal_[c] = element_[c] = 0;
     trigger_ = pil::kCaptureTriggerManual;
+    level_trigger_ = false;
     level_channel_ = 0;
     level_ = 0;
     pre_ = 0;
     divider_ = 1;
   }
 
-  /// The level trigger's test on the level channel's newest value (the first sample only records it).
+  /// A level trigger's test on the level channel's newest value (the first sample only records it).
   bool level_crossed(float value) {
     const std::int32_t v = capture_order(value), last = last_level_;
     const bool had = have_last_;
     last_level_ = v;
     have_last_ = true;
     if (!had) return false;
-    if (trigger_ == pil::kCaptureTriggerRising) return last < level_ && v >= level_;
-    if (trigger_ == pil::kCaptureTriggerFalling) return last > level_ && v <= level_;
-    return false;
+    return trigger_ == pil::kCaptureTriggerRising ? last < level_ && v >= level_ : last > level_ && v <= level_;
   }
 
   /// The answer's set-up and state.
@@ -220,6 +220,7 @@ class SignalCapture {
   std::uint8_t signal_[pil::kCaptureChannels] = {};
   std::uint8_t element_[pil::kCaptureChannels] = {};
   std::uint8_t trigger_ = pil::kCaptureTriggerManual;
+  bool level_trigger_ = false;  // rising or falling: each sample's level channel is compared
   std::uint8_t level_channel_ = 0;
   std::int32_t level_ = 0, last_level_ = 0;  // capture_order of the level and of the level channel's last value
   bool have_last_ = false;
