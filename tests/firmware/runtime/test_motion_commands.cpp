@@ -20,16 +20,16 @@ namespace {
 
 TEST(MotionCommands, EachVerbIsItsMachinesCommand) {
   using V = MotionVerb;
-  using C = MotionCommand;
-  const std::pair<V, C> table[] = {{V::kNone, C::kNone},       {V::kEnable, C::kEnable},
-                                   {V::kDisable, C::kDisable}, {V::kMoveTo, C::kMove},
-                                   {V::kPaper, C::kMove},      {V::kStop, C::kStop},
-                                   {V::kClear, C::kClear},     {V::kStream, C::kMove},
-                                   {V::kHome, C::kHome},       {V::kDeclarePose, C::kDeclarePose},
-                                   {V::kIdentify, C::kMove}};
+  using Cmd = MotionCommand;
+  const std::pair<V, Cmd> table[] = {{V::kNone, Cmd::kNone},       {V::kEnable, Cmd::kEnable},
+                                     {V::kDisable, Cmd::kDisable}, {V::kMoveTo, Cmd::kMove},
+                                     {V::kPaper, Cmd::kMove},      {V::kStop, Cmd::kStop},
+                                     {V::kClear, Cmd::kClear},     {V::kStream, Cmd::kMove},
+                                     {V::kHome, Cmd::kHome},       {V::kDeclarePose, Cmd::kDeclarePose},
+                                     {V::kIdentify, Cmd::kMove}};
   ASSERT_EQ(static_cast<int>(std::size(table)), MotionNames<V>::kCount);
   for (const auto& [v, c] : table) EXPECT_EQ(verb_command(v), c) << motion_name(v);
-  EXPECT_EQ(verb_command(static_cast<V>(200)), C::kNone);  // a code outside the list
+  EXPECT_EQ(verb_command(static_cast<V>(200)), Cmd::kNone);  // a code outside the list
   // An identify moves only as prepare_identify planned and checked it: a bare one is not marked checked (the tick
   // refuses it bad_command: test_identify_command.cpp).
   EXPECT_FALSE(prepare_command<double>(V::kIdentify, 4).checked);
