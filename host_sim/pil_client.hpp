@@ -41,10 +41,14 @@ struct PilReplies {
   std::vector<pil::TraceFrame> traces;
   std::vector<pil::ParamAnswerFrame> params;    ///< the answers to param frames (sent as each was received)
   std::vector<pil::CaptureDataFrame> captures;  ///< the answers to capture frames (the same)
+  std::vector<pil::IdentifyFrame> identifies;   ///< an identify run's estimate, after the tick its motion ended in
   bool empty() const {
-    return answers.empty() && states.empty() && traces.empty() && params.empty() && captures.empty();
+    return answers.empty() && states.empty() && traces.empty() && params.empty() && captures.empty() &&
+           identifies.empty();
   }
-  void clear() { answers.clear(), states.clear(), traces.clear(), params.clear(), captures.clear(); }
+  void clear() {
+    answers.clear(), states.clear(), traces.clear(), params.clear(), captures.clear(), identifies.clear();
+  }
 };
 
 /// A frame of a type the firmware sends: its type, and the frame of that type decoded.
@@ -56,6 +60,7 @@ struct FirmwareFrame {
   pil::TraceFrame trace;
   pil::ParamAnswerFrame param_answer;
   pil::CaptureDataFrame capture_data;
+  pil::IdentifyFrame identify;
 };
 
 /// The receive path's parsing, without I/O: feeds bytes[pos..len) to the parser until a frame of a

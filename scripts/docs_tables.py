@@ -437,12 +437,30 @@ def any_motion_bound(kernels_out, worst_out):
     return [(TIMER_ANY_MOTION, thousands(int(tick.group(1)) - int(ref.group(1)) + max(gen)))]
 
 
+TIMER_IDENTIFY = ("**worst case, an identify run** (a bound): the worst case's max with its `reference` stage's max "
+                  "replaced by `excitation_reference`'s worst tick, and `IdentifySampler::tick`'s worst tick added "
+                  "(its `step` stage's)")
+
+
+def identify_run_bound(kernels_out, worst_out):
+    """The worst case's tick during an identify run: the excitation's reference in place of the paper's, and the run's
+    sampler in the step."""
+    tick = re.search(r"control step: max (\d+), mean", worst_out)
+    ref = re.search(r"^tick stage reference, max/mean: (\d+)/", worst_out, re.M)
+    exc = re.search(r"^\s+excitation_reference, worst of \d+ ticks: (\d+) instructions$", kernels_out, re.M)
+    smp = re.search(r"^\s+IdentifySampler::tick, worst of \d+ ticks: (\d+) instructions$", kernels_out, re.M)
+    if not (tick and ref and exc and smp):
+        return []
+    return [(TIMER_IDENTIFY, thousands(int(tick.group(1)) - int(ref.group(1)) + int(exc.group(1)) +
+                                       int(smp.group(1))))]
+
+
 def timer_rows(output):
-    """The tick from rest and its worst case, each with its stages, and the worst case with any motion (output: an
-    image's printout)."""
-    worst = output("timer_worst_firmware")
+    """The tick from rest and its worst case, each with its stages, and the worst case with any motion and during an
+    identify run (output: an image's printout)."""
+    worst, kernels = output("timer_worst_firmware"), output("kernels_image")
     return (timer_step(output("timer_firmware")) + timer_step(worst, TIMER_WORST) +
-            any_motion_bound(output("kernels_image"), worst))
+            any_motion_bound(kernels, worst) + identify_run_bound(kernels, worst))
 
 
 @table("target_instructions", "docs/benchmarks.md", "m4f")

@@ -327,7 +327,9 @@ int identify(Client& c, const Args& a) {
   const int rc = report(d);
   const auto f = c.wait_identify(id, kIdentifyFrameWaitS);
   if (!f) {
-    std::printf("no estimate: the board sent no identify frame (the QEMU images run the motion without estimating)\n");
+    std::printf(
+        "no estimate: the board sent no identify frame (a board that does not estimate, as the STM32F4 app, runs the "
+        "motion alone)\n");
     return a.apply ? 1 : rc;
   }
   print_identify(*f);

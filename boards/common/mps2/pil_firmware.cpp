@@ -50,6 +50,7 @@
 
 #include "board.hpp"
 #include "osc/control/params.hpp"
+#include "osc/link/identify_port.hpp"
 #include "osc/link/node.hpp"
 #include "osc/robot.hpp"
 #include "param_store.hpp"
@@ -60,6 +61,8 @@ namespace {
 enum class Transport : std::uint8_t { kUart, kSemihosting };
 Transport g_transport = Transport::kUart;
 int g_console_in = -1, g_console_out = -1;  // semihosting handles (kSemihosting)
+
+bool g_link_up = false;  // the first byte came: the CMSDK watchdog runs
 
 struct Mps2Board {
   static void link_write(const std::uint8_t* p, int n) {
@@ -72,6 +75,16 @@ struct Mps2Board {
   static std::uint32_t stack_used() { return board::stack_used_sweep(); }  // every tick: a bounded sweep
   static void burn(std::uint32_t ns) { board::busy_wait(ns); }
   static void fault_output(bool active) { board::fault_output(active); }
+  /// Long work of the main loop's (PilNode::computing, follow_identify): every pended tick has run and in lockstep
+  /// none is due until the main loop pends it, so the watchdog pauses as while the main loop waits for the host, and
+  /// restarts from a full count after it. A hung tick still lets it expire: the work it pre-empts never ends.
+  static void computing(bool begin) {
+    if (!g_link_up) return;
+    if (begin)
+      board::watchdog_pause();
+    else
+      board::watchdog_start();
+  }
 };
 static_assert(osc::PilBoard<Mps2Board>);
 static_assert(hal::ControlHal<osc::PilNode<board::Scalar, Mps2Board>>);
@@ -89,6 +102,23 @@ volatile std::uint32_t g_ticks_pended = 0, g_ticks_run = 0;
 void pend_tick() {
   g_ticks_pended = g_ticks_pended + 1;
   board::control_irq_pend();  // the tick runs now
+}
+
+// The board's own estimate of an identify run (osc/link/identify_port.hpp): after every tick the main loop takes the
+// run's newest sample into the estimate's sums, and when the run's motion ends it solves the estimate and writes the
+// identify frame after that tick's frames. The sums and the solve are doubles (soft-float on both cores): about
+// 20 kB, static.
+osc::IdentifyPort<board::Scalar> g_identify;
+std::uint32_t g_ticks_followed = 0;
+
+/// The identify run followed after the ticks run since the last call (in lockstep one: the main loop pends each).
+void follow_identify() {
+  if (g_ticks_run == g_ticks_followed) return;
+  g_ticks_followed = g_ticks_run;
+  // The estimate's solve at the run's end: tens of millions of instructions (soft-float doubles), as long work.
+  Mps2Board::computing(true);
+  g_identify.after_tick(g_node.task, Mps2Board::link_write);
+  Mps2Board::computing(false);
 }
 
 /// The semihosting command line (QEMU: -semihosting-config arg=..., its words joined by spaces).
@@ -216,12 +246,12 @@ int main() {
   // are armed by the first byte. Virtual time runs on while the host computes its next frame, so
   // the time between frames follows the host's wall-clock time (the frames carry the longest gap
   // seen).
-  bool link_up = false;
   std::uint32_t last = board::cycles(), last_feed = last;
   for (;;) {
+    follow_identify();
     if (rx_ready()) {
-      if (!link_up) {
-        link_up = true;
+      if (!g_link_up) {
+        g_link_up = true;
         board::watchdog_start();
         last_feed = board::cycles();
       }
@@ -229,7 +259,7 @@ int main() {
       last = board::cycles();
       continue;
     }
-    if (link_up) {
+    if (g_link_up) {
       const std::uint32_t now = board::cycles();
       if (now - last > kLinkTimeoutNs) {
         g_node.on_timeout(pend_tick);
@@ -244,7 +274,7 @@ int main() {
     // Waiting for the host with every pended tick done, the watchdog pauses during the wait and
     // restarts from a full count after it: virtual time jumps while QEMU itself is descheduled,
     // and such a jump must not read as a hung firmware. A tick still pending keeps it counting.
-    const bool pause = link_up && g_ticks_run == g_ticks_pended;
+    const bool pause = g_link_up && g_ticks_run == g_ticks_pended;
     if (pause) board::watchdog_pause();
     rx_wait();
     if (pause) {

@@ -11,6 +11,7 @@
 #include "osc/control/jerk_profile.hpp"
 #include "osc/control/sampled_loop.hpp"
 #include "osc/kernels/lu.hpp"
+#include "osc/control/excitation.hpp"
 #include "osc/link/capture.hpp"
 #include "osc/runtime/control_task.hpp"
 #include "fixed_reference.hpp"
@@ -467,6 +468,61 @@ void capture_kernels(const Vec6<F>& q0) {
       .emit();
 }
 
+/// An identify run's cost (issue 57): its check (check_excitation, where the command is prepared: outside the
+/// tick), and in the tick the reference stage's excitation_reference (the Fourier series at the tick, mapped into the
+/// controller's coordinates) and the step stage's IdentifySampler::tick (the run's filter, a sample every
+/// params::kRunSampleTicks), each the worst of the run's first 2 000 ticks, from the task at the start pose.
+ExcitationMotion<F> g_excitation;
+void identify_kernels(const Vec6<F>& q0) {
+  // One whole check, as the identify command's preparation (command_prep.hpp) runs it at each scale it tries: every
+  // tick of a period, the sampled loop judged at each. On the PUMA at the tests' identify pose (q5 = 1.3 rad), at
+  // the scale it passes at, 0.64; the preparation tries 1 and 0.8 first, which fail at a tick along the way, so a
+  // refused run costs at most four of these.
+  Vec6<F> q_run = q0;
+  if (test::kPumaBuild) q_run(4) = lit<F>(1.3);
+  const ExcitationLimits<F> lim = ExcitationLimits<F>::defaults();
+  check("the excitation plans", static_cast<double>(g_excitation.plan(q_run, lim)), 0.0, 0.0);
+  g_excitation.set_scale(lit<F>(0.64));
+  ExcitationCheck<F> ec;
+  {
+    Timer t("check_excitation, one scale (10 001 ticks, the sampled loop judged at each)");
+    const loop::PathLoop gains = loop::path_loop(Gains<double>::paper(), params::kPathLoopMargin);
+    forward_kinematics(g_model, g_data, q_run);
+    ec = check_excitation(g_model, g_data, g_excitation, Mat3<F>(g_data.R[kDof]), lim, &gains);
+  }
+  if (test::kPumaBuild)
+    check("the identify pose's excitation passes at 0.64", static_cast<double>(ec.status), 0.0, 0.0);
+  g_task.gen.start_excitation(g_excitation, g_task.tick, 7);
+  std::uint32_t worst_ref = 0, worst_sample = 0;
+  MotionEvents ev;
+  const Vec6<F> dec = g_task.gains.tau_dec;
+  for (int k = 0; k < 2000; ++k) {
+    ++g_task.tick;
+    std::uint32_t t0 = board::cycles();
+    const Desired<F> des = excitation_reference(g_task, ev);
+    keep(des);
+    std::uint32_t dt = board::cycles() - t0;
+    if (dt > worst_ref) worst_ref = dt;
+    const JointSample<F> js = g_excitation.at_tick(static_cast<std::uint64_t>(k + 1));
+    t0 = board::cycles();
+    g_task.identify.tick(7, js.q, g_task.last.tau, js.qd, dec);
+    dt = board::cycles() - t0;
+    if (dt > worst_sample) worst_sample = dt;
+  }
+  cortex_m::text::Line()
+      .str("  excitation_reference, worst of 2000 ticks: ")
+      .u32(worst_ref)
+      .str(" instructions")
+      .emit();
+  cortex_m::text::Line()
+      .str("  IdentifySampler::tick, worst of 2000 ticks: ")
+      .u32(worst_sample)
+      .str(" instructions")
+      .emit();
+  check("the run's samples", static_cast<double>(g_task.identify.count), 2000.0 / params::kRunSampleTicks, 0.0);
+  check("no saturation in fixed point", math::take_arithmetic_fault<F>() ? 1.0 : 0.0, 0.0, 0.0);
+}
+
 /// In fixed point: every kernel against the host's Q12.19 results, bit for bit, and the flags clear
 /// (the committed values are the PUMA's; another arm's fixed point is compared with the host's in
 /// closed loop, motion_tour_qemu).
@@ -540,6 +596,7 @@ int main() {
   fixed_reference_check();
   motion_kernels(q0);
   capture_kernels(q0);
+  identify_kernels(q0);
   cortex_m::text::Line().str("stack used: ").u32(board::stack_used()).str(" bytes").emit();
   cortex_m::text::Line().str(g_failures ? "FAILED checks: " : "all checks passed: failures = ").i32(g_failures).emit();
   return g_failures ? 1 : 0;

@@ -7,8 +7,10 @@
 // after CommandPort::after_tick_and_poll): a run is followed from the tick that accepted it, and its samples, one in
 // params::kRunSampleTicks ticks, are taken while they are fresh (a sample the calls miss is counted lost). The
 // estimate's sums are doubles, about 10 kB (the information matrix of 4 x 6 + 10 unknowns), and the solve at the end
-// a few hundred thousand operations: a board with an FPU for doubles, or a host. The QEMU images do not estimate
-// yet: their identify runs the motion alone, and no identify frame comes.
+// a few hundred thousand operations. The virtual board and the QEMU images estimate (pil_firmware.cpp: its main loop
+// after every tick, in lockstep; the doubles soft-float there). The STM32F4 app does not yet: its timer-paced ticks
+// may run twice between two calls, and a call would then miss the tick a run is accepted or ends in (the report
+// holds the latest tick's); its identify runs the motion alone, and no identify frame comes.
 //
 // What the client does with the report: the friction goes into the parameters friction_vis, friction_cou and
 // friction_sti, the armatures into armature_correction (oscctl identify --apply; they need the torque off), and a

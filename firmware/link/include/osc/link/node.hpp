@@ -212,19 +212,38 @@ class PilNode {
     if (!parser_.decode(f)) {
       // A command or a setpoint: the port's (prepared at once once the first sensor frame has
       // configured the task). Any other valid frame is of the wrong type.
-      if (!port.receive(task, parser_, LinkWrite{})) return lost_frame(pil::kErrHeader);
-      if (configured_) port.poll(task, LinkWrite{});
+      bool taken = false;
+      computing([&] {
+        taken = port.receive(task, parser_, LinkWrite{});
+        if (taken && configured_) port.poll(task, LinkWrite{});
+      });
+      if (!taken) return lost_frame(pil::kErrHeader);
       synced_ = true;
       return 0;
     }
     if (f.seq != expected_seq_) error(pil::kErrSeq);
-    if (!configured_) configure(f.inject);  // the first valid frame configures, once
-    port.poll(task, LinkWrite{});           // a waiting command into the free mailbox, before the tick
+    if (!configured_) configure(f.inject);             // the first valid frame configures, once
+    computing([&] { port.poll(task, LinkWrite{}); });  // a waiting command into the free mailbox, before the tick
     expected_seq_ = f.seq + 1;
     answer_seq_ = f.seq;
     frame_ = f;
     fresh_ = synced_ = true;
     return 1;
+  }
+
+  /// Work of the main loop's outside the tick that may take long: a command's preparation (a move's path check; an
+  /// identify run's excitation check, about 190 million instructions on the M4F) and a param frame's (a gain's loop
+  /// check). In lockstep no tick is due meanwhile: the host waits for this frame's answer. A board that must know
+  /// (pil_firmware.cpp: its watchdog, paused as while it waits for the host) defines Board::computing(bool).
+  template <class F>
+  static void computing(F&& work) {
+    if constexpr (requires { Board::computing(true); }) {
+      Board::computing(true);
+      work();
+      Board::computing(false);
+    } else {
+      work();
+    }
   }
 
   /// Board::link_write as the port's writer.
