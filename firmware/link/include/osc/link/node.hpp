@@ -232,9 +232,10 @@ class PilNode {
   }
 
   /// Work of the main loop's outside the tick that may take long: a command's preparation (a move's path check; an
-  /// identify run's excitation check, about 190 million instructions on the M4F) and a param frame's (a gain's loop
-  /// check). In lockstep no tick is due meanwhile: the host waits for this frame's answer. A board that must know
-  /// (pil_firmware.cpp: its watchdog, paused as while it waits for the host) defines Board::computing(bool).
+  /// identify run's excitation check, up to four scales of 140 million instructions each on the M4F) and a param
+  /// frame's (a gain's loop check). In lockstep no tick is due meanwhile: the host waits for this frame's answer. A
+  /// board that must know (pil_firmware.cpp: its watchdog, paused as while it waits for the host) defines
+  /// Board::computing(bool).
   template <class F>
   static void computing(F&& work) {
     if constexpr (requires { Board::computing(true); }) {
