@@ -115,10 +115,12 @@ std::uint32_t g_ticks_followed = 0;
 void follow_identify() {
   if (g_ticks_run == g_ticks_followed) return;
   g_ticks_followed = g_ticks_run;
-  // The estimate's solve at the run's end: tens of millions of instructions (soft-float doubles), as long work.
-  Mps2Board::computing(true);
+  // The estimate's solve at the run's end: tens of millions of instructions (soft-float doubles), as long work. Only
+  // while a run is followed: otherwise the call is a check of the tick's report.
+  const bool following = g_identify.active();
+  if (following) Mps2Board::computing(true);
   g_identify.after_tick(g_node.task, Mps2Board::link_write);
-  Mps2Board::computing(false);
+  if (following) Mps2Board::computing(false);
 }
 
 /// The semihosting command line (QEMU: -semihosting-config arg=..., its words joined by spaces).

@@ -222,8 +222,8 @@ class PilNode {
       return 0;
     }
     if (f.seq != expected_seq_) error(pil::kErrSeq);
-    if (!configured_) configure(f.inject);             // the first valid frame configures, once
-    computing([&] { port.poll(task, LinkWrite{}); });  // a waiting command into the free mailbox, before the tick
+    if (!configured_) configure(f.inject);                                     // the first valid frame configures, once
+    if (port.waiting() > 0) computing([&] { port.poll(task, LinkWrite{}); });  // into the free mailbox, before the tick
     expected_seq_ = f.seq + 1;
     answer_seq_ = f.seq;
     frame_ = f;
