@@ -448,7 +448,7 @@ def identify_run_bound(kernels_out, worst_out):
     tick = re.search(r"control step: max (\d+), mean", worst_out)
     ref = re.search(r"^tick stage reference, max/mean: (\d+)/", worst_out, re.M)
     exc = re.search(r"^\s+excitation_reference, worst of \d+ ticks: (\d+) instructions$", kernels_out, re.M)
-    smp = re.search(r"^\s+IdentifySampler::tick, worst of \d+ ticks: (\d+) instructions$", kernels_out, re.M)
+    smp = re.search(r"^\s+IdentifySampler::tick.*?, worst of \d+ ticks: (\d+) instructions$", kernels_out, re.M)
     if not (tick and ref and exc and smp):
         return []
     return [(TIMER_IDENTIFY, thousands(int(tick.group(1)) - int(ref.group(1)) + int(exc.group(1)) +

@@ -4,8 +4,9 @@
 // (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted.
 //
 // A board calls after_tick() after every tick, where its main loop reads the link (the virtual board, osc_sim,
-// after CommandPort::after_tick_and_poll): a run is followed from the tick that accepted it, and its samples, one in
-// params::kRunSampleTicks ticks, are taken while they are fresh (a sample the calls miss is counted lost). The
+// after CommandPort::after_tick_and_poll): a run is followed from the tick that accepted it, and the ticks the task
+// recorded since the last call go through the run's filter (IdentifyRun::poll: up to params::kRunRingTicks behind;
+// the samples of ticks overwritten before a call are counted lost). The
 // estimate's sums are doubles, about 10 kB (the information matrix of 4 x 6 + 10 unknowns), and the solve at the end
 // a few hundred thousand operations. The virtual board and the QEMU images estimate (pil_firmware.cpp: its main loop
 // after every tick, in lockstep; the doubles soft-float there). The STM32F4 app does not yet: its timer-paced ticks
@@ -52,8 +53,8 @@ inline pil::IdentifyFrame identify_frame(std::uint32_t id, const IdentifyReport&
 template <class S>
 class IdentifyPort {
  public:
-  /// After every tick: a run accepted in it is started, its newest sample taken, and in the tick its motion ends
-  /// the identify frame written (`write(bytes, n)`, after the tick's answer frame).
+  /// After every tick: a run accepted in it is started, the run's new ticks filtered and sampled, and in the tick its
+  /// motion ends the identify frame written (`write(bytes, n)`, after the tick's answer frame).
   template <class Write>
   void after_tick(const ControlTask<S>& task, Write&& write) {
     const MotionReport& r = task.report;

@@ -1,7 +1,7 @@
 // An identification run's estimate (issue 57; docs/adaptation.md, "The identify command"): the tick's
-// side (IdentifySampler, in the task: the run's filter at 1 kHz and a sample every
-// params::kRunSampleTicks into a mailbox) and the main loop's (IdentifyRun: each sample's regression
-// rows into the weighted least squares of osc/control/identify_estimate.hpp, and the report at the end).
+// side (IdentifySampler, in the task: each tick of the run's raw signals into a ring) and the main loop's
+// (IdentifyRun: the run's filter over the ring's ticks, a sample every params::kRunSampleTicks, each sample's
+// regression rows into the weighted least squares of osc/control/identify_estimate.hpp, and the report at the end).
 //
 // The regression of a sample (identify_estimate.hpp's file comment), per joint i:
 //   y_i = F tau_i - tau_rb,i(q_f, qd_f, qdd_f) = w_i^T theta_i + Y_i pi,
@@ -15,7 +15,7 @@
 // The drives' space. On an arm whose drive train couples the joints (the PUMA's wrist: q = C e, e the motors'
 // angles referred to their joints; osc/runtime/io.hpp), each motor has its own friction and rotor, at its own rate
 // e' = C^-1 q'. The regression is then written per motor: the rows C^T y (the motors' torques), the friction and
-// armature columns at the motors' rates and accelerations (the sampler filters e', which F keeps linear: the joints'
+// armature columns at the motors' rates and accelerations (the sampler records e', which F keeps linear: the joints'
 // q_f' = C e_f'), and the payload's rows C^T Y. Each motor's row is again its own coefficients' alone, and the
 // coefficients are the drives' (the joints' on an uncoupled arm, where C = I). On the simulated PUMA with the wrist
 // coupled, J5's torque-prediction error was 29 % in the joints' space and is 2.4 % in the drives'.
@@ -23,11 +23,15 @@
 // Pairing. The torque commanded in tick n acts from the DAC's update (params::kActuationDelay after the
 // sample) to the next one; the angle of tick n is sampled at its start. Fed with the angle of tick n, the
 // torque of tick n lags it by about 0.7 ms; the torque of tick n - 1 leads it by about 0.3 ms. The
-// sampler filters the angle of tick n with the torque of tick n - 1.
+// sampler records the angle of tick n with the torque of tick n - 1.
 //
-// The mailbox is one sample and a count (a sequence lock): the tick writes both; the main loop copies the
-// sample between two reads of the count and keeps the copy when they agree (the tick pre-empts the main
-// loop, never the reverse). A sample the main loop was too slow for is counted lost (IdentifyRun::lost).
+// The ring. The filter (osc/control/identify_filter.hpp: 30 channels of two updates and six exponentials a tick) is
+// the main loop's, not the tick's: the tick writes three vectors into a ring of params::kRunRingTicks entries and
+// counts it, and the main loop filters every entry it has not yet read (the tick pre-empts the main loop, never the
+// reverse: an entry it read is checked still unwritten after the read). A main loop that falls more than the ring
+// behind loses the entries overwritten: the filter starts again at the oldest entry left (primed there, as at rest)
+// and takes no sample for params::kRunSettleTicks, and the samples not taken are counted lost (IdentifyRun::lost).
+// Lockstep boards (the virtual board, the QEMU images) read after every tick.
 #pragma once
 
 #include <cstdint>
@@ -45,39 +49,52 @@ namespace params {
 /// bandwidth apart; the samples' noise is correlated through the filter, which the estimate's factor
 /// identify::noise_correlation_factor(kRunSampleTicks) (12.7) accounts for.
 constexpr unsigned kRunSampleTicks = 5;
+/// The ring of the run's ticks between the tick and the main loop: 64 ms of slack for the main loop (a lockstep
+/// board reads after every tick; a timer-paced one's main loop runs between its ticks).
+constexpr unsigned kRunRingTicks = 64;
+/// After a gap (entries overwritten before the main loop read them) the filter starts again primed at rest and
+/// takes no sample for this many ticks: eight of its time constants (1 / kIdentifyFilterOmega = 16 ms), where the
+/// prime's error has fallen below 3e-3 of itself.
+constexpr unsigned kRunSettleTicks = 128;
 }  // namespace params
 
-/// The tick's side of a run: filters every tick of the run's motion, a sample every kRunSampleTicks.
+/// One tick of a run as the tick saw it: the measured angles, the torque commanded the tick before, the observed
+/// motors' rates.
+template <class S>
+struct IdentifyTick {
+  Vec6<S> q, tau, qd;
+};
+
+/// The tick's side of a run: each tick's signals into the ring (the file comment's "The ring").
 template <class S>
 struct IdentifySampler {
-  IdentifyFilter<S> filter;
-  IdentifySignals<S> sample{};   // the newest sample (the mailbox)
-  volatile std::uint32_t count;  // samples put since the run started (odd: none yet is no state)
-  std::uint32_t run_id;          // the run being filtered (0: none since the last reset)
-  std::uint32_t ticks;           // ticks of the run filtered
+  IdentifyTick<S> ring[params::kRunRingTicks];
+  volatile std::uint32_t ticks;  // ticks of the run recorded (the next entry: ticks % kRunRingTicks)
+  std::uint32_t run_id;          // the run being recorded (0: none since the last reset)
+  Vec6<S> dec;                   // the friction model's Stribeck decays at the run's first tick (the filter's prime)
   Vec6<S> tau_before;            // the torque commanded the tick before
 
   void reset() {
-    count = 0;
-    run_id = 0;
     ticks = 0;
+    run_id = 0;
   }
   /// One tick of run `id`: q measured, tau the step's torque, qd the observed motors' rates (C^-1 of the joints':
-  /// motor_rates), dec the friction model's Stribeck decay. The first tick of a run primes the filter (the motion
-  /// starts at rest).
-  void tick(std::uint32_t id, const Vec6<S>& q, const Vec6<S>& tau, const Vec6<S>& qd, const Vec6<S>& dec) {
+  /// motor_rates), dec the friction model's Stribeck decay. The first tick of a run starts its count (the motion
+  /// starts at rest: its torque is the tick before's too).
+  void tick(std::uint32_t id, const Vec6<S>& q, const Vec6<S>& tau, const Vec6<S>& qd, const Vec6<S>& dec_now) {
     if (id != run_id) {
       run_id = id;
       ticks = 0;
-      count = 0;
-      filter.prime(q, tau, qd, dec);
+      dec = dec_now;
       tau_before = tau;
     }
-    filter.update(q, tau_before, qd);
+    const std::uint32_t n = ticks;
+    IdentifyTick<S>& e = ring[n % params::kRunRingTicks];
+    e.q = q;
+    e.tau = tau_before;
+    e.qd = qd;
     tau_before = tau;
-    if (++ticks % params::kRunSampleTicks != 0) return;
-    sample = filter.signals();
-    count = count + 1;
+    ticks = n + 1;
   }
 };
 
@@ -95,30 +112,60 @@ class IdentifyRun {
     id_ = id;
     taken_ = 0;
     lost_ = 0;
+    next_ = 0;
+    restart_at_ = 0;
+    settled_ = 0;
     estimate_.reset(payload, identify::kAllRows);
     model_ = payload != payload_mask::kNone ? bare : model;
     with_payload_ = payload != payload_mask::kNone;
   }
-  /// The sampler's newest sample into the estimate, if it is new and whole: true when one was taken.
-  bool poll(const IdentifySampler<S>& sampler) {
-    if (sampler.run_id != id_ || id_ == 0) return false;
-    const std::uint32_t before = sampler.count;
-    if (before == taken_) return false;
-    const IdentifySignals<S> s = sampler.sample;
-    if (sampler.count != before) return false;  // the tick wrote meanwhile: the next call takes the newer
-    lost_ += before - taken_ - 1;
-    taken_ = before;
-    add(s);
-    return true;
+  /// The ring's ticks of this run not read yet, through the run's filter, a sample into the estimate every
+  /// params::kRunSampleTicks (the file comment's "The ring"): the samples taken in this call.
+  int poll(const IdentifySampler<S>& sampler) {
+    if (sampler.run_id != id_ || id_ == 0) return 0;
+    int took = 0;
+    for (;;) {
+      const std::uint32_t end = sampler.ticks;
+      if (next_ == end) return took;
+      if (end - next_ > params::kRunRingTicks) restart(end - params::kRunRingTicks);  // a gap: entries overwritten
+      const IdentifyTick<S> e = sampler.ring[next_ % params::kRunRingTicks];
+      if (sampler.ticks - next_ > params::kRunRingTicks) continue;  // overwritten while it was copied: a gap
+      took += step(e, sampler.dec);
+    }
   }
   /// The report of the run (the estimate's solve, with the filter's correlation factor).
   IdentifyReport finish() { return estimate_.solve(identify::noise_correlation_factor(params::kRunSampleTicks)); }
   std::uint32_t id() const { return id_; }
-  /// The samples summed, and those the tick put that the main loop missed (its polls too far apart).
-  std::uint32_t taken() const { return taken_ - lost_; }
+  /// The run's filter (its newest outputs: filter().signals()).
+  const IdentifyFilter<S>& filter() const { return filter_; }
+  /// The samples summed, and those a gap cost (the main loop's polls more than the ring apart).
+  std::uint32_t taken() const { return taken_; }
   std::uint32_t lost() const { return lost_; }
 
  private:
+  /// One tick of the ring through the filter (primed at the run's first tick and after a gap); 1 when it took a
+  /// sample.
+  int step(const IdentifyTick<S>& e, const Vec6<S>& dec) {
+    if (next_ == restart_at_) filter_.prime(e.q, e.tau, e.qd, dec);
+    filter_.update(e.q, e.tau, e.qd);
+    ++next_;
+    if (next_ % params::kRunSampleTicks != 0) return 0;
+    if (next_ < settled_) {
+      ++lost_;
+      return 0;
+    }
+    add(filter_.signals());
+    ++taken_;
+    return 1;
+  }
+  /// The ticks before `from` are gone: their samples lost, the filter primed again at `from`, no sample until it
+  /// settles.
+  void restart(std::uint32_t from) {
+    lost_ += from / params::kRunSampleTicks - next_ / params::kRunSampleTicks;
+    next_ = from;
+    restart_at_ = from;
+    settled_ = from + params::kRunSettleTicks;
+  }
   /// A sample's rows, in the drives' space (the file comment): s.qd and s.qdd are the motors'.
   void add(const IdentifySignals<S>& s) {
     const Vec6<S> qd = joint(s.qd), qdd = joint(s.qdd);
@@ -135,9 +182,13 @@ class IdentifyRun {
   Vec6<S> motors(const Vec6<S>& tau) const { return coupled_ ? motor_torques(io_, tau) : tau; }
 
   IdentifyEstimate estimate_;
+  IdentifyFilter<S> filter_;
   Model<S> model_{};
   Data<S> data_{};
-  std::uint32_t id_ = 0, taken_ = 0, lost_ = 0;  // taken_: the sampler's count at the last sample taken
+  std::uint32_t id_ = 0, taken_ = 0, lost_ = 0;
+  std::uint32_t next_ = 0;        // the run's next tick to read from the ring
+  std::uint32_t restart_at_ = 0;  // the tick the filter was last primed at (the run's first, or after a gap)
+  std::uint32_t settled_ = 0;     // no sample before this tick (a gap's filter settling)
   bool with_payload_ = false;
   bool coupled_ = false;
   IoMap<S> io_{};  // the drive train's coupling, where coupled_

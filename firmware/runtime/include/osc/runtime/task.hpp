@@ -101,7 +101,7 @@ struct ControlTask {
   // armature G^2 J_m (the diagonal of the model init took: Model::of's, uncoupled), which it corrects.
   double armature_correction[kDof];
   double armature_base[kDof];
-  // An identification run's filter and its samples for the main loop (osc/runtime/identify_run.hpp).
+  // An identification run's ticks for the main loop's filter and estimate (osc/runtime/identify_run.hpp).
   IdentifySampler<S> identify;
 
   void init(const Model<S>& m, const Gains<S>& g, FrictionMode fm, const Vec6In<S>& q0, std::uint32_t period = 0,
