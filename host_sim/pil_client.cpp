@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <thread>
 
 #include "osc/runtime/io.hpp"
@@ -279,7 +280,40 @@ bool PilClient::send(const pil::ParamFrame& f, std::string& err) { return send_f
 bool PilClient::send(const pil::CaptureFrame& f, std::string& err) { return send_frame(f, err); }
 
 bool PilClient::receive(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
+  computed_s_ = 0;
+  computing_cap_s_ = kComputingWaits * timeout_s;
   return receive_actuator(f, timeout_s, err) == Rx::kFrame;
+}
+
+namespace {
+/// The CPU time a process has used, user and system [s] (/proc/PID/stat's fields 14 and 15), or -1.
+double process_cpu_seconds(int pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (pid <= 0 || !std::getline(in, line)) return -1;
+  const std::size_t name_end = line.rfind(')');  // the command's name may hold spaces
+  if (name_end == std::string::npos) return -1;
+  std::istringstream fields(line.substr(name_end + 1));
+  std::string skip;
+  for (int field = 3; field < 14; ++field) fields >> skip;
+  double user = 0, system = 0;
+  if (!(fields >> user >> system)) return -1;
+  return (user + system) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+}  // namespace
+
+PilClient::CpuMark PilClient::cpu_mark() const {
+  return {std::chrono::steady_clock::now(), reaped_ ? -1.0 : process_cpu_seconds(pid_)};
+}
+
+bool PilClient::peer_computing(CpuMark& m) {
+  const CpuMark now = cpu_mark();
+  const double waited = std::chrono::duration<double>(now.at - m.at).count(), used = now.cpu_s - m.cpu_s;
+  const bool computing = m.cpu_s >= 0 && now.cpu_s >= 0 && waited > 0.05 && used >= 0.1 * waited;
+  m = now;
+  if (!computing || computed_s_ + kComputingWait > computing_cap_s_) return false;
+  computed_s_ += kComputingWait;
+  return true;
 }
 
 void PilClient::keep(const FirmwareFrame& f) { file_reply(f, replies_); }
@@ -287,9 +321,11 @@ void PilClient::keep(const FirmwareFrame& f) { file_reply(f, replies_); }
 PilClient::Rx PilClient::receive_actuator(pil::ActuatorFrame& f, double timeout_s, std::string& err) {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  const double computed_before = computed_s_;
   for (;;) {
     FirmwareFrame ff;
-    const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+    const double left =
+        std::chrono::duration<double>(deadline - Clock::now()).count() + (computed_s_ - computed_before);
     const Rx r = receive_frame(ff, std::max(left, 0.0), err);
     if (r != Rx::kFrame) return r;
     if (ff.type == pil::kActuatorFrame) {
@@ -302,7 +338,8 @@ PilClient::Rx PilClient::receive_actuator(pil::ActuatorFrame& f, double timeout_
 
 PilClient::Rx PilClient::receive_frame(FirmwareFrame& f, double timeout_s, std::string& err) {
   using Clock = std::chrono::steady_clock;
-  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  CpuMark mark = cpu_mark();
   for (;;) {
     // Parse what has arrived; bytes after a complete frame stay buffered for the next call.
     switch (parse_firmware_bytes(parser_, rx_, rx_len_, rx_pos_, f, counters_, err)) {
@@ -314,11 +351,16 @@ PilClient::Rx PilClient::receive_frame(FirmwareFrame& f, double timeout_s, std::
         break;
     }
     const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+    if (left <= 0 && peer_computing(mark)) {
+      deadline += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kComputingWait));
+      continue;
+    }
     if (left <= 0) {
       const bool short_frame = parser_.in_frame();
       ++counters_[short_frame ? pil::kErrShortFrame : pil::kErrSilence];
       return err = std::string("no actuator frame from the firmware within ") + std::to_string(timeout_s) + " s" +
-                   (short_frame ? " (a frame started but did not complete: short frame)" : ""),
+                   (short_frame ? " (a frame started but did not complete: short frame)" : "") +
+                   (computed_s_ > 0 ? " after " + std::to_string(computed_s_) + " s more while it computed" : ""),
              Rx::kSilent;
     }
     pollfd p{from_child_, POLLIN, 0};
@@ -347,11 +389,14 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
                                         std::string& err) {
   using Clock = std::chrono::steady_clock;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout_s);
+  computed_s_ = 0;
+  computing_cap_s_ = kComputingWaits * timeout_s;
+  const auto left_s = [&] { return std::chrono::duration<double>(deadline - Clock::now()).count() + computed_s_; };
   Exchange x = Exchange::kLost;
   if (send(s, err)) {
     for (;;) {
       pil::ActuatorFrame f;
-      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+      const double left = left_s();
       const Rx r = receive_actuator(f, std::max(left, 0.0), err);
       if (r != Rx::kFrame) {
         x = r == Rx::kCorrupt ? Exchange::kZeroed : Exchange::kLost;
@@ -383,7 +428,7 @@ PilClient::Exchange PilClient::exchange(const pil::SensorFrame& s, pil::Actuator
   if (traced_ && x != Exchange::kLost) {
     for (;;) {
       FirmwareFrame f;
-      const double left = std::chrono::duration<double>(deadline - Clock::now()).count();
+      const double left = left_s();
       std::string why;
       const Rx r = receive_frame(f, std::max(left, 0.0), why);
       if (r == Rx::kCorrupt) continue;  // counted; the trace may still come

@@ -11,6 +11,7 @@
 // frame the firmware writes for a tick: every frame of the tick is then in replies().
 #pragma once
 
+#include <chrono>
 #include <string>
 #include <vector>
 
@@ -107,6 +108,11 @@ class PilClient {
   /// Waits up to timeout_s (wall clock) for one actuator frame; false on a corrupt frame (bad CRC,
   /// header or length), on silence and when the peer is gone. Junk between frames is skipped; the
   /// command protocol's frames before it are collected in replies().
+  ///
+  /// A peer that is computing is not silent: at the end of a wait, a peer whose process used at least a tenth of the
+  /// wait's time on a CPU (a QEMU image's long main-loop work in lockstep, e.g. an identify command's check:
+  /// docs/firmware.md, "Watchdog") is waited for a further kComputingWait, up to kComputingWaits times the
+  /// call's timeout in all. A peer that sleeps, is stopped, or waits for a frame is silent at timeout_s.
   bool receive(pil::ActuatorFrame& f, double timeout_s, std::string& err);
 
   enum class Exchange {
@@ -148,7 +154,20 @@ class PilClient {
   /// ("exit status N", with the firmware's meaning where it has one, or "killed by signal N").
   std::string exit_description();
 
+  /// A wait's view of the peer's process: when, and the CPU time it had used then (-1: /proc does not tell).
+  struct CpuMark {
+    std::chrono::steady_clock::time_point at;
+    double cpu_s;
+  };
+  static constexpr double kComputingWait = 1.0;  ///< [s] a computing peer's further wait
+  static constexpr double kComputingWaits = 60;  ///< the further waits' cap, in the call's timeouts
+  CpuMark cpu_mark() const;
+  /// At a wait's end: whether the peer computed since `m` (a tenth of the time on a CPU) and the call's cap is not
+  /// reached; `m` moves to now.
+  bool peer_computing(CpuMark& m);
+
   int pid_ = -1;
+  double computed_s_ = 0, computing_cap_s_ = 0;  // the call's further waits so far, and their cap
   bool reaped_ = false;  // the peer ended and was waited for (exit_description); stop() only tidies up
   int wait_status_ = 0;
   int to_child_ = -1, from_child_ = -1;

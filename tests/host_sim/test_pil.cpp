@@ -190,6 +190,28 @@ TEST(PilClientErrors, PeerThatNeverAnswersTimesOut) {
   EXPECT_NE(err.find("no actuator frame from the firmware within"), std::string::npos) << err;
 }
 
+// A peer that computes (a QEMU image's long main-loop work in lockstep) is waited for: a shell's loop of about a
+// second or more of CPU, then the PIL peer's hello, against a 0.3 s wait. One that computes for ever is silent at the
+// cap, kComputingWaits (60) times the wait.
+TEST(PilClientErrors, APeerThatComputesIsWaitedForUpToTheCap) {
+  PilClient c;
+  std::string err;
+  const std::string loop = "i=0; while [ $i -lt 2000000 ]; do i=$((i+1)); done; ";
+  auto t0 = std::chrono::steady_clock::now();
+  EXPECT_TRUE(c.start({"sh", "-c", loop + "exec " + std::string(PIL_PEER_PATH)}, err, 0.3)) << err;
+  // Its hello came after the 0.3 s (the loop: 1.5 to 3 s of wall time here): only a further wait took it.
+  EXPECT_GT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 0.3);
+  c.stop();
+  PilClient d;
+  t0 = std::chrono::steady_clock::now();
+  EXPECT_FALSE(d.start({"sh", "-c", "while :; do :; done"}, err, 0.06));
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_NE(err.find("no actuator frame from the firmware within"), std::string::npos) << err;
+  EXPECT_NE(err.find("s more while it computed"), std::string::npos) << err;
+  EXPECT_GE(took, 3.0);  // 0.06 s, then three further waits of kComputingWait (1 s): the cap is 3.6 s
+  d.stop();
+}
+
 TEST(PilClientErrors, PeerThatExitsIsReported) {
   PilClient c;
   std::string err;
