@@ -26,9 +26,11 @@ struct Sent {
   std::vector<std::uint64_t> ticks;
 };
 
-/// Runs ticks with the port after each, until `until` holds after a tick or max ticks; the identify frames sent.
+/// Runs ticks with the port after each `every`-th, until `until` holds after a tick or max ticks; the identify frames
+/// sent.
 template <class Until>
-void run(MotionSim<double>& sim, IdentifyPort<double>& port, Sent& sent, std::uint64_t max, Until until) {
+void run(MotionSim<double>& sim, IdentifyPort<double>& port, Sent& sent, std::uint64_t max, Until until,
+         std::uint64_t every = 1) {
   pil::Parser parser;
   const auto write = [&](const std::uint8_t* b, int n) {
     for (int i = 0; i < n; ++i)
@@ -41,7 +43,7 @@ void run(MotionSim<double>& sim, IdentifyPort<double>& port, Sent& sent, std::ui
   };
   for (std::uint64_t k = 0; k < max; ++k) {
     ASSERT_EQ(sim.tick(), 0u);
-    port.after_tick(sim.task(), write);
+    if (sim.task().tick % every == 0) port.after_tick(sim.task(), write);
     if (until()) return;
   }
 }
@@ -130,4 +132,43 @@ TEST(IdentifyPort, AStoppedRunIsReportedAbortedAndARefusedOneNotAtAll) {
   EXPECT_EQ(sent.frames.size(), 1u);
   EXPECT_FALSE(port.active());
   EXPECT_EQ(port.reports(), 1u);
+}
+
+// A main loop that runs only every 20 ticks (a timer-paced board's, busy): it misses the ticks that accepted and ended
+// the run, yet follows it (the sampler's counts) and reads every tick it recorded (the ring holds 64): one frame, at
+// its first call after the end, with the estimate of a port called after every tick, bit for bit.
+TEST(IdentifyPort, AMainLoopThatCallsEvery20TicksGetsTheSameEstimate) {
+  Sent every_tick, every_20;
+  std::uint64_t end_tick[2] = {0, 0};
+  for (int pass = 0; pass < 2; ++pass) {
+    MotionSim<double> sim(test::identify_pose());
+    IdentifyPort<double> port;
+    ASSERT_NO_FATAL_FAILURE(enable_and_hold(sim));
+    while (sim.task().tick % 20 != 7) ASSERT_EQ(sim.tick(), 0u);  // the accept's tick is not a call's
+    sim.identify(11);
+    Sent& sent = pass == 0 ? every_tick : every_20;
+    std::uint64_t& done = end_tick[pass];
+    run(
+        sim, port, sent, excitation::kTicks + 200,
+        [&] {
+          if (sim.task().report.done_id == 11) done = sim.task().tick;
+          return done != 0 && sim.task().tick > done + 50;
+        },
+        pass == 0 ? 1 : 20);
+    ASSERT_NE(done, 0u);
+    ASSERT_EQ(sent.frames.size(), 1u) << "pass " << pass;
+    EXPECT_FALSE(port.active());
+  }
+  EXPECT_NE(end_tick[1] % 20, 0u);  // the end's tick was not a call's either
+  EXPECT_EQ(every_20.ticks[0], (end_tick[1] / 20 + 1) * 20);
+  const pil::IdentifyFrame &a = every_tick.frames[0], &b = every_20.frames[0];
+  ASSERT_EQ(a.status, static_cast<std::uint8_t>(IdentifyStatus::kOk));
+  EXPECT_EQ(b.status, a.status);
+  EXPECT_EQ(b.samples, a.samples);
+  EXPECT_EQ(b.lost, 0u);
+  for (int k = 0; k < 3 * kDof; ++k) {
+    EXPECT_EQ(b.friction[k], a.friction[k]) << "coefficient " << k;
+    EXPECT_EQ(b.friction_sd[k], a.friction_sd[k]) << "coefficient " << k;
+  }
+  EXPECT_EQ(b.identified, a.identified);
 }

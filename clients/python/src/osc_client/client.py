@@ -291,8 +291,8 @@ class Client:
 
         A board that estimates (the virtual board) sends it once, right after the answer of the tick the run's
         motion ended in (``wait_done(cid)`` may have read it already): the estimate when the motion was done,
-        status aborted when it was aborted. None when none came: a board that does not estimate (the QEMU
-        images) runs the motion and sends none.
+        status aborted when it was aborted. None when none came: a board that does not estimate (the STM32F4
+        app) runs the motion and sends none.
         """
         def mine() -> bool:
             return self.last_identify is not None and self.last_identify.id == cid

@@ -3,15 +3,15 @@
 // IdentifyRun), and when the run's motion ends, its report to the client as one identify frame
 // (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted.
 //
-// A board calls after_tick() after every tick, where its main loop reads the link (the virtual board, osc_sim,
-// after CommandPort::after_tick_and_poll): a run is followed from the tick that accepted it, and the ticks the task
+// A board calls after_tick() from its main loop, after every tick where it runs in lockstep (the virtual board,
+// osc_sim, after CommandPort::after_tick_and_poll; the QEMU images, pil_firmware.cpp), or as often as its main loop
+// runs (a timer-paced board). A run is followed from the call after the tick that accepted it, and the ticks the task
 // recorded since the last call go through the run's filter (IdentifyRun::poll: up to params::kRunRingTicks behind;
-// the samples of ticks overwritten before a call are counted lost). The
-// estimate's sums are doubles, about 10 kB (the information matrix of 4 x 6 + 10 unknowns), and the solve at the end
-// a few hundred thousand operations. The virtual board and the QEMU images estimate (pil_firmware.cpp: its main loop
-// after every tick, in lockstep; the doubles soft-float there). The STM32F4 app does not yet: its timer-paced ticks
-// may run twice between two calls, and a call would then miss the tick a run is accepted or ends in (the report
-// holds the latest tick's); its identify runs the motion alone, and no identify frame comes.
+// the samples of ticks overwritten before a call are counted lost). The run's accept and end are the sampler's
+// counts (IdentifySampler::accept, note_end), not the tick's report, which holds only the latest tick's: a call
+// that comes some ticks late misses neither. The estimate's sums are doubles, about 10 kB (the information matrix of
+// 4 x 6 + 10 unknowns), and the solve at the end a few hundred thousand operations (soft-float on the QEMU images).
+// The STM32F4 app does not call it yet: its identify runs the motion alone, and no identify frame comes.
 //
 // What the client does with the report: the friction goes into the parameters friction_vis, friction_cou and
 // friction_sti, the armatures into armature_correction (oscctl identify --apply; they need the torque off), and a
@@ -57,15 +57,18 @@ class IdentifyPort {
   /// motion ends the identify frame written (`write(bytes, n)`, after the tick's answer frame).
   template <class Write>
   void after_tick(const ControlTask<S>& task, Write&& write) {
-    const MotionReport& r = task.report;
-    if (r.verb == MotionVerb::kIdentify && r.outcome == CommandOutcome::kAccepted) {
-      run_.start(r.id, payload_mask::kNone, task.model, task.without_payload(), &task.io);
+    const IdentifySampler<S>& s = task.identify;
+    const std::uint32_t accepted = s.accepted;
+    if (accepted != followed_) {  // a run accepted since the last call
+      followed_ = accepted;
+      run_.start(s.accepted_id, payload_mask::kNone, task.model, task.without_payload(), &task.io);
       active_ = true;
     }
     if (!active_) return;
-    run_.poll(task.identify);
-    const bool done = r.done_id == run_.id(), aborted = r.aborted_id == run_.id();
-    if (!done && !aborted) return;
+    run_.poll(s);
+    if (s.ended != followed_) return;
+    const bool done = s.ended_done;
+    run_.poll(s);  // the ticks recorded before the end that the tick noted after the poll above
     active_ = false;
     IdentifyReport report;
     if (done)
@@ -86,6 +89,7 @@ class IdentifyPort {
  private:
   IdentifyRun<S> run_;
   IdentifyReport last_{};
+  std::uint32_t followed_ = 0;  // the sampler's accepted count of the run followed last
   bool active_ = false;
   std::uint32_t reports_ = 0;
 };

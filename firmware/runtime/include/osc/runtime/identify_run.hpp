@@ -73,10 +73,33 @@ struct IdentifySampler {
   std::uint32_t run_id;          // the run being recorded (0: none since the last reset)
   Vec6<S> dec;                   // the friction model's Stribeck decays at the run's first tick (the filter's prime)
   Vec6<S> tau_before;            // the torque commanded the tick before
+  // A run's accept and end, for a main loop that does not see every tick (osc/link/identify_port.hpp): the tick
+  // writes each event's fields before its count.
+  std::uint32_t accepted_id;        // the identify command accepted last
+  volatile std::uint32_t accepted;  // identify commands accepted since the reset
+  volatile std::uint32_t ended;     // the run (its `accepted` count) whose end was reported last; 0: none
+  bool ended_done;                  // that end: done (its motion complete), else aborted
 
   void reset() {
     ticks = 0;
     run_id = 0;
+    accepted_id = 0;
+    accepted = 0;
+    ended = 0;
+    ended_done = false;
+  }
+  /// An identify command `id` accepted: its run starts at the next tick it records, whatever the id.
+  void accept(std::uint32_t id) {
+    ticks = 0;
+    run_id = 0;
+    accepted_id = id;
+    accepted = accepted + 1;
+  }
+  /// The tick's report of the motions it ended (MotionReport's done_id and aborted_id): the accepted run's end, once.
+  void note_end(std::uint32_t done_id, std::uint32_t aborted_id) {
+    if (accepted == 0 || ended == accepted || (done_id != accepted_id && aborted_id != accepted_id)) return;
+    ended_done = done_id == accepted_id;
+    ended = accepted;
   }
   /// One tick of run `id`: q measured, tau the step's torque, qd the observed motors' rates (C^-1 of the joints':
   /// motor_rates), dec the friction model's Stribeck decay. The first tick of a run starts its count (the motion

@@ -264,7 +264,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
   if (accepted && cmd.verb == MotionVerb::kIdentify) {
     task.gen.start_excitation(cmd.excitation, next, cmd.id);
-    task.identify.reset();  // its sampler primed again at the run's first tick, whatever the id
+    task.identify.accept(cmd.id);  // its sampler starts again at the run's first tick, whatever the id
   }
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
@@ -315,6 +315,7 @@ bool motion_update(ControlTask<S>& task, std::uint32_t faults, bool measured, co
   if (st.abort != MotionReason::kNone) report_abort(task, before, q, yield);
   if (faults != 0) fault_motion(task, faults);
   motion_apply(task, st, before, q);
+  task.identify.note_end(rep.done_id, rep.aborted_id);                       // an identify run's end, for the main loop
   if (rep.verb != MotionVerb::kNone) task.pending.verb = MotionVerb::kNone;  // answered: taken
   return st.torque;
 }
