@@ -29,6 +29,7 @@
 #include "flash.hpp"  // stm32f4::FlashSectors
 #include "cortex_m.hpp"
 #include "osc/link/command_port.hpp"
+#include "osc/link/identify_port.hpp"
 #include "osc/link/telemetry.hpp"
 #include "osc/robot.hpp"
 #include "osc/runtime/control_task.hpp"
@@ -51,6 +52,10 @@ struct App {
   osc::CommandPort<float> port;
   osc::CommandPort<float>::PacedInputs paced;  ///< the port's copy of a command's inputs
   osc::CommandLinkWatch watch;
+  /// An identify run's estimate, followed from the main loop (osc/link/identify_port.hpp): the run's ticks from the
+  /// task's ring, at least every kServeEveryTicks ticks (the ring holds osc::params::kRunRingTicks).
+  osc::IdentifyPort<float> identify;
+  std::uint32_t served_tick = 0;                 ///< the tick count at the main loop's last serve()
   float capture_ring[pil::kCaptureValues] = {};  ///< the capture's buffer (osc/link/capture.hpp), 16 KiB
   pil::Parser parser;
   std::uint32_t rx_tick = 0;  ///< the tick count when the last byte was read (the in-frame timeout)
@@ -140,13 +145,17 @@ struct App {
     if (port.waiting() > 0)
       port.poll_paced(
           task, paced, MainWrite{board.uart}, [](auto&& f) { with_tick_masked(f); }, [this] { board.uart.pump(); });
+    identify.after_tick(task, MainWrite{board.uart});
     board.uart.pump();
   }
 
-  /// The main loop: serve(), then sleep until an interrupt (a byte, a tick) unless bytes wait.
+  /// The main loop: serve(), then sleep until an interrupt (a byte, a tick) unless bytes wait or kServeEveryTicks
+  /// ticks have passed (an identify run's ring is read within them).
   void idle() {
+    served_tick = ticks;
     serve();
-    cortex_m::sleep_while([this] { return board.uart.rx_empty() && !board.uart.busy(); });
+    cortex_m::sleep_while(
+        [this] { return board.uart.rx_empty() && !board.uart.busy() && ticks - served_tick < kServeEveryTicks; });
   }
 
   /// A command straight into the mailbox (a test image's compiled-in step, no link): false while

@@ -94,6 +94,8 @@ constexpr stm32f4::TimerDivider qemu_control_divider() {
 constexpr std::uint32_t kTelemetryBaud = 460800;
 /// An actuator frame (pil::kMaxFrame bytes, 10 bits each on the line) every 10th tick: 100 frames a second.
 constexpr std::uint32_t kTelemetryEvery = 10;
+/// The main loop serves at least this often, in ticks (an identify run's ring holds osc::params::kRunRingTicks).
+constexpr std::uint32_t kServeEveryTicks = 16;
 /// A state frame every 20th tick (osc::kStatePeriod): 50 a second.
 constexpr std::uint32_t kStateEvery = osc::kStatePeriod;
 static_assert(10u * (pil::kMaxFrame * kControlHz / kTelemetryEvery +
