@@ -145,7 +145,7 @@ struct App {
     if (port.waiting() > 0)
       port.poll_paced(
           task, paced, MainWrite{board.uart}, [](auto&& f) { with_tick_masked(f); }, [this] { board.uart.pump(); });
-    identify.after_tick(task, MainWrite{board.uart});
+    identify.after_tick(task, MainWriteWaiting{*this});
     board.uart.pump();
   }
 
@@ -187,6 +187,24 @@ struct App {
     Uart& uart;
     void operator()(const std::uint8_t* p, int n) const {
       with_tick_masked([&] { uart.offer(p, n); });
+    }
+  };
+
+  /// The main loop's writer of a frame sent once and never again (an identify run's report): it pumps the
+  /// transmitter until the queue has room, for at most kTxWaitTicks. The solve before it keeps the main loop
+  /// from pumping for about 0.2 s (27 million instructions, table target_instructions), and the tick's state and
+  /// telemetry frames may have filled the queue meanwhile.
+  struct MainWriteWaiting {
+    App& app;
+    void operator()(const std::uint8_t* p, int n) const {
+      Uart& uart = app.board.uart;
+      const std::uint32_t t0 = app.ticks;
+      for (bool taken = false; !taken; uart.pump()) {
+        const bool last = app.ticks - t0 >= kTxWaitTicks;  // then offered once more, dropped and counted if full
+        with_tick_masked([&] {
+          if (last || uart.queued() < kTxFrames) taken = uart.offer(p, n) || last;
+        });
+      }
     }
   };
 

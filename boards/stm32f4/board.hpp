@@ -113,9 +113,14 @@ constexpr int kTxFrames = 32;
 constexpr int kTxAnswerReserve = kTxAnswers + 2;
 static_assert(kTxFrames >= kTxAnswerReserve + 3 && (kTxFrames & (kTxFrames - 1)) == 0,
               "room for a tick's answers, state and telemetry, and for telemetry behind the reserve");
-/// Received bytes the ring holds: 512 bytes are 11 ms of the line, far longer than the main loop's
-/// longest busy stretch (a path check, 1 to 2 ms).
-constexpr unsigned kRxBytes = 512;
+/// Ticks the main loop waits at most for the transmit queue's room for a frame sent once (an identify report):
+/// a frame of pil::kMaxFrame bytes goes out in under 5 ms at kTelemetryBaud, and frees a slot.
+constexpr std::uint32_t kTxWaitTicks = 100;
+/// Received bytes the ring holds. The main loop's longest busy stretch is an identify command's preparation: up to
+/// four scales of its check, 140 million instructions each (table target_instructions), about 3 s at 168 MHz. A
+/// client meanwhile resends the command every 0.5 s (61 B) and keeps the link alive every 0.1 s (35 B): about
+/// 400 B/s, so 2 KiB hold 5 s of it. (A path check, 1 to 2 ms, is the longest stretch while a motion runs.)
+constexpr unsigned kRxBytes = 2048;
 
 /// Runs f with the control interrupt held off (BASEPRI at its priority), the E-stop and the USART's
 /// receive interrupt still taken: the main loop's side of what it shares with the tick (the command

@@ -146,7 +146,8 @@ class Client {
 
   /// The identify frame of run `id` (the estimate a board that estimates sends in the tick the run's motion ends,
   /// right after that tick's answer: docs/protocol.md, "Identify frame"), received so far or within timeout_s;
-  /// nullopt when none came (a board that does not estimate, the STM32F4 app) or on an error (error()).
+  /// nullopt when none came (a firmware from before the boards estimated, or the frame lost) or on an error
+  /// (error()).
   std::optional<pil::IdentifyFrame> wait_identify(std::uint32_t id, double timeout_s);
 
   /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.

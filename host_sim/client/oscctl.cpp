@@ -328,8 +328,8 @@ int identify(Client& c, const Args& a) {
   const auto f = c.wait_identify(id, kIdentifyFrameWaitS);
   if (!f) {
     std::printf(
-        "no estimate: the board sent no identify frame (a board that does not estimate, as the STM32F4 app, runs the "
-        "motion alone)\n");
+        "no estimate: the board sent no identify frame (a firmware from before the boards estimated runs the motion "
+        "alone; or the frame was lost)\n");
     return a.apply ? 1 : rc;
   }
   print_identify(*f);

@@ -12,8 +12,8 @@ from osc_client import Answer, Client, Command, Frame, Identify, NameList, Param
 from osc_client import cli
 
 FIRST_ID = 100
-NO_ESTIMATE = ("no estimate: the board sent no identify frame (a board that does not estimate, as the STM32F4 app, "
-               "runs the motion alone)\n")
+NO_ESTIMATE = ("no estimate: the board sent no identify frame (a firmware from before the boards estimated runs the "
+               "motion alone; or the frame was lost)\n")
 APPLIED = "applied, the torque off: enable goes on from them; param save keeps them for the next power-on\n"
 
 # An estimate whose figures test the C formats: %.3g's exponent, widths overflowed, halves rounded to even, a

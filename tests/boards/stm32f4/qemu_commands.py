@@ -14,8 +14,13 @@ from CLIENT_SRC: clients/python/src), as a user would drive the board over a ser
   4. stop is accepted (holding: nothing to stop) and done;
   5. disable is accepted, and the state becomes disabled;
   6. the parameters: a set of k_s while disabled is accepted and reads back, refused torque_on while
-     enabled; save, reset and load bring it back (in RAM here: QEMU models no flash controller).
-The encoders do not move in QEMU, so no motion is run. No timing is asserted: every wait is generous
+     enabled; save, reset and load bring it back (in RAM here: QEMU models no flash controller);
+  7. an identify run, followed by the board's main loop (osc/link/identify_port.hpp): the still robot
+     declared at the start pose, the wrist's gains lowered so that the run passes the sampled loop's
+     check there (at the paper's gains it is refused unstable_loop, docs/adaptation.md), accepted;
+     the encoders do not move in QEMU, so a monitor stops it (aborted), and the board sends its
+     identify frame, status aborted, with the samples its main loop took and none lost.
+The encoders do not move in QEMU, so no motion runs to its end. No timing is asserted: every wait is generous
 (the machine may be busy). Prints one line per step; exit 0 when all pass, 1 otherwise.
 """
 import re
@@ -98,7 +103,37 @@ def run(c):
           c.protocol.name_of(NameList.PARAM_STATUSES, a.status) == "torque_on" and a.value == 80.0, str(a))
     o = c.wait_answer(c.disable(), TIMEOUT)
     check("disable accepted", o.status == Status.ACCEPTED, o.text())
+    identify_aborted(c, check)  # its failures through check
     return ok
+
+
+def identify_aborted(c, check):
+    """Step 7: an identify run on the still robot, aborted by a monitor, and its identify frame."""
+    from osc_client import NameList, Status  # from CLIENT_SRC (main)
+    o = c.wait_done(c.declare_pose("start"), TIMEOUT)
+    check("declare_pose start done", o.status == Status.DONE, o.text())
+    for name, value in (("knd", 10.0), ("ks", 10.0), ("ki", 1000.0)):  # the wrist's: the roll axis is light
+        index = c.protocol.parameter(name).index
+        for e in (3, 4, 5):
+            a = c.param("set", index, e, value, timeout=TIMEOUT)
+            check(f"param set {name}[{e}] = {value:g}", a.status == 0, str(a))
+    o = c.wait_answer(c.enable(), TIMEOUT)
+    check("enable accepted", o.status == Status.ACCEPTED, o.text())
+    check("holding after enable", wait_state(c, "holding") is not None)
+    cid = c.identify()
+    o = c.wait_answer(cid, TIMEOUT)
+    check("identify accepted (prepared in the main loop: four scales' checks at most)",
+          o.status == Status.ACCEPTED, o.text())
+    o = c.wait_done(cid, TIMEOUT)
+    check("the run aborted: the encoders do not move", o.status == Status.ABORTED, o.text())
+    f = c.wait_identify(cid, TIMEOUT)
+    check("the identify frame came", f is not None)
+    if f is None:
+        return
+    status = c.protocol.name_of(NameList.IDENTIFY_STATUSES, f.status)
+    check("its status aborted", status == "aborted", status)
+    check("the main loop took the run's samples, none lost", f.samples > 0 and f.lost == 0,
+          f"{f.samples} samples, {f.lost} lost")
 
 
 def main(argv):

@@ -245,8 +245,8 @@ def cmd_identify(c: Client, a: argparse.Namespace) -> int:
     rc = report(c.wait_done(cid, a.timeout))
     f = c.wait_identify(cid, IDENTIFY_FRAME_WAIT)
     if f is None:
-        print("no estimate: the board sent no identify frame (a board that does not estimate, as the STM32F4 app, "
-              "runs the motion alone)",
+        print("no estimate: the board sent no identify frame (a firmware from before the boards estimated runs the "
+              "motion alone; or the frame was lost)",
               flush=True)
         return 1 if a.apply else rc
     print(identify_text(c.protocol, f), end="", flush=True)

@@ -289,10 +289,10 @@ class Client:
     def wait_identify(self, cid: int, timeout: float = 2.0) -> Identify | None:
         """The identify frame of the identify run ``cid``: received already, or within ``timeout`` seconds.
 
-        A board that estimates (the virtual board) sends it once, right after the answer of the tick the run's
-        motion ended in (``wait_done(cid)`` may have read it already): the estimate when the motion was done,
-        status aborted when it was aborted. None when none came: a board that does not estimate (the STM32F4
-        app) runs the motion and sends none.
+        Every board sends it once, right after the answer of the tick the run's motion ended in (the virtual
+        board, the QEMU images), or from its main loop within a few ticks of it (the STM32F4 app); ``wait_done(cid)``
+        may have read it already: the estimate when the motion was done, status aborted when it was aborted. None
+        when none came: a firmware from before the boards estimated runs the motion alone, or the frame was lost.
         """
         def mine() -> bool:
             return self.last_identify is not None and self.last_identify.id == cid

@@ -175,8 +175,8 @@ class ParamAnswer(Frame):
 
 @dataclass(frozen=True)
 class Identify(Frame):
-    """An identify run's estimate, sent once by a board that estimates (the virtual board), right after the
-    answer of the tick the run's motion ended in (docs/protocol.md, "Identify frame"); the QEMU images send none.
+    """An identify run's estimate, sent once by the board at the end of the run's motion (docs/protocol.md,
+    "Identify frame").
 
     The coefficients are the drives', in the order the parameters friction_vis, friction_cou, friction_sti
     and armature_correction take them.

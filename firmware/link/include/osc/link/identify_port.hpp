@@ -11,7 +11,7 @@
 // counts (IdentifySampler::accept, note_end), not the tick's report, which holds only the latest tick's: a call
 // that comes some ticks late misses neither. The estimate's sums are doubles, about 10 kB (the information matrix of
 // 4 x 6 + 10 unknowns), and the solve at the end a few hundred thousand operations (soft-float on the QEMU images).
-// The STM32F4 app does not call it yet: its identify runs the motion alone, and no identify frame comes.
+// The STM32F4 app calls it from its timer-paced main loop (boards/stm32f4/app.hpp), at least every 16 ticks.
 //
 // What the client does with the report: the friction goes into the parameters friction_vis, friction_cou and
 // friction_sti, the armatures into armature_correction (oscctl identify --apply; they need the torque off), and a
