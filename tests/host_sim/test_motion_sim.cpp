@@ -895,8 +895,6 @@ TEST(MotionSim, StreamRefusalsAndAStopCommand) {
 /// On every arm, at the arm's maxima (its sheet's cartesian_maxima, chosen by this test: docs/arms.md, "Speed
 /// limits").
 TEST(MotionSim, FiftySeededRandomMovesAtTheMaximaTrackWithinOneMillimetre) {
-  std::mt19937 rng(55);
-  std::uniform_real_distribution<double> d(-0.15, 0.15), a(-0.3, 0.3);
   MotionSim<double> sim(start_pose());
   ASSERT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
   run_ticks(sim, 300);
@@ -905,46 +903,18 @@ TEST(MotionSim, FiftySeededRandomMovesAtTheMaximaTrackWithinOneMillimetre) {
   ASSERT_EQ(answer(sim, MotionVerb::kStop, 3).outcome, CommandOutcome::kAccepted);
   run_until(
       sim, [](const MotionSim<double>& s) { return state_is(s, MotionState::kHolding); }, 10000);
-  int moves = 0, refused = 0;
-  double worst = 0, fastest = 0, hardest = 0, shaking = 0;
-  for (std::uint32_t id = 10; moves < 50; ++id) {
-    MoveRequest<double> req = relative<double>(d(rng), d(rng), d(rng));
-    req.has_rpy = true;
-    req.rpy = Vec3<double>(0, 0, a(rng));
-    const MotionReport rep = answer_move(sim, req, id);
-    if (rep.outcome != CommandOutcome::kAccepted) {
-      EXPECT_TRUE(rep.refusal == MotionReason::kOutOfWorkspace || rep.refusal == MotionReason::kNearSingular ||
-                  rep.refusal == MotionReason::kUnstableLoop)
-          << MotionNames<MotionReason>::kNames[static_cast<int>(rep.refusal)];
-      ASSERT_LT(++refused, 50) << "most random moves are accepted";
-      continue;
-    }
-    ++moves;
-    double speed = 0, accel = 0;
-    const Trace r = run_until(
-        sim,
-        [&](const MotionSim<double>& s) {
-          speed = std::max(speed, s.task().desired.xd.template head<3>().norm());
-          accel = std::max(accel, s.task().desired.xdd.template head<3>().norm());
-          return s.task().report.done_id == id;
-        },
-        30000);
-    ASSERT_TRUE(r.ended) << "move " << id;
-    ASSERT_EQ(r.faults, 0u) << fault_name(r.faults) << " in move " << id;
-    EXPECT_LE(r.tracking, 1e-3) << "move " << id;
-    EXPECT_LE(r.oscillation, 0.5) << "the oscillation monitor's healthy margin, move " << id;
-    EXPECT_LE(speed, params::kMoveLinear[0] * (1 + 1e-9)) << "move " << id;
-    EXPECT_LE(accel, params::kMoveLinear[1] * (1 + 1e-9)) << "move " << id;
-    worst = std::max(worst, r.tracking);
-    fastest = std::max(fastest, speed);
-    hardest = std::max(hardest, accel);
-    shaking = std::max(shaking, r.oscillation);
-    run_ticks(sim, 100);
-  }
+  const test::RandomMoves r = test::random_moves(sim, 55, 50);
+  EXPECT_EQ(r.failed_id, 0u) << "move " << r.failed_id << ": " << fault_name(r.faults) << ", refused "
+                             << MotionNames<MotionReason>::kNames[static_cast<int>(r.refusal)];
+  EXPECT_EQ(r.moves, 50) << "most random moves are accepted (" << r.refused << " refused)";
+  EXPECT_LE(r.tracking, 1e-3);
+  EXPECT_LE(r.oscillation, 0.5) << "the oscillation monitor's healthy margin";
+  EXPECT_LE(r.speed, params::kMoveLinear[0] * (1 + 1e-9));
+  EXPECT_LE(r.accel, params::kMoveLinear[1] * (1 + 1e-9));
   std::printf(
       "%s: 50 random moves (%d refused by the path check): tracking at most %.4f mm, reference speed at "
       "most %.4f m/s (maximum %.2f), acceleration at most %.4f m/s^2 (maximum %.2f); oscillation monitor at most "
       "%.3f of its limit\n",
-      robot::kArm.name, refused, worst * 1e3, fastest, params::kMoveLinear[0], hardest, params::kMoveLinear[1],
-      shaking);
+      robot::kArm.name, r.refused, r.tracking * 1e3, r.speed, params::kMoveLinear[0], r.accel, params::kMoveLinear[1],
+      r.oscillation);
 }

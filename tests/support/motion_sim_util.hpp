@@ -1,9 +1,12 @@
 // The closed-loop tests' loop over host_sim/motion_sim.hpp (the control task over the simulated arm):
 // run ticks until a predicate holds, collecting what the ticks reported, the tracking and the tip's
-// motion; a command and the tick that answers it. Shared by test_motion_sim.cpp and test_identify_command.cpp.
+// motion; a command and the tick that answers it; seeded random moves. Shared by the closed-loop tests
+// (test_motion_sim.cpp, test_identify_command.cpp, test_identify_sim.cpp, ...).
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 #include "motion_sim.hpp"
@@ -94,6 +97,58 @@ MoveRequest<S> relative(double dx, double dy, double dz) {
 template <class S>
 bool state_is(const MotionSim<S>& sim, MotionState s) {
   return sim.task().machine.state == s;
+}
+
+/// What random_moves saw: the moves run and refused, the first that failed (0: none), and the worst of the rest.
+struct RandomMoves {
+  int moves = 0, refused = 0;
+  std::uint32_t failed_id = 0;  ///< the first move refused by another name, not ended, or with a fault
+  std::uint32_t faults = 0;
+  MotionReason refusal = MotionReason::kNone;                  ///< the failed move's refusal, where it was refused
+  double tracking = 0, speed = 0, accel = 0, oscillation = 0;  ///< [m], [m/s], [m/s^2], the monitor's ratio
+};
+
+/// `count` seeded random moves from where the arm holds, ids from `first_id`: up to 15 cm along each axis and
+/// 0.3 rad about z, at the configured maxima (params::kMoveLinear). Each is accepted or refused by name by the path
+/// check (out of the workspace, near a singular pose, the loop lost on a light axis); an accepted one runs to its
+/// end, then the arm holds 100 ticks. Stops at the first failure (RandomMoves::failed_id).
+template <class S>
+RandomMoves random_moves(MotionSim<S>& sim, std::uint32_t seed, int count, std::uint32_t first_id = 10) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> d(-0.15, 0.15), a(-0.3, 0.3);
+  RandomMoves out;
+  for (std::uint32_t id = first_id; out.moves < count && out.refused < count; ++id) {
+    MoveRequest<S> req = relative<S>(d(rng), d(rng), d(rng));
+    req.has_rpy = true;
+    req.rpy = Vec3<S>(S(0), S(0), static_cast<S>(a(rng)));
+    const MotionReport rep = answer_move(sim, req, id);
+    if (rep.outcome != CommandOutcome::kAccepted) {
+      ++out.refused;
+      if (rep.refusal == MotionReason::kOutOfWorkspace || rep.refusal == MotionReason::kNearSingular ||
+          rep.refusal == MotionReason::kUnstableLoop)
+        continue;
+      out.failed_id = id, out.refusal = rep.refusal;
+      return out;
+    }
+    ++out.moves;
+    const Trace r = run_until(
+        sim,
+        [&](const MotionSim<S>& s) {
+          out.speed = std::max(out.speed, static_cast<double>(s.task().desired.xd.template head<3>().norm()));
+          out.accel = std::max(out.accel, static_cast<double>(s.task().desired.xdd.template head<3>().norm()));
+          return s.task().report.done_id == id;
+        },
+        30000);
+    out.tracking = std::max(out.tracking, r.tracking);
+    out.oscillation = std::max(out.oscillation, r.oscillation);
+    out.faults |= r.faults;
+    if (!r.ended || r.faults != 0) {
+      out.failed_id = id;
+      return out;
+    }
+    run_ticks(sim, 100);
+  }
+  return out;
 }
 
 }  // namespace osc::test
