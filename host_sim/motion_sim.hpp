@@ -52,8 +52,9 @@ class MotionSim {
   void command(osc::MotionVerb verb, std::uint32_t id) { task_->pending = osc::prepare_command<S>(verb, id); }
   /// An identification run, planned and checked about the last measured angles (prepare_identify); the
   /// check's report into `check` when given.
-  void identify(std::uint32_t id, osc::ExcitationCheck<S>* check = nullptr) {
-    task_->pending = osc::prepare_identify(*task_, id, check);
+  void identify(std::uint32_t id, osc::ExcitationCheck<S>* check = nullptr,
+                std::uint16_t payload = osc::payload_mask::kNone) {
+    task_->pending = osc::prepare_identify(*task_, id, check, payload);
   }
   /// A move_to, prepared (planned and its path checked) from where the queue will end, taken by the
   /// next tick.

@@ -56,6 +56,7 @@
 #include <vector>
 
 #include "cli_parse.hpp"
+#include "config.hpp"          // apply_setting: --plant-set
 #include "experiment_cli.hpp"  // qemu_takes
 #include "file_flash.hpp"
 #include "injection.hpp"
@@ -87,6 +88,7 @@ struct Options {
   std::string inject;                     // KIND[:ARGS]@S (injection.hpp)
   bool no_link_watch = false;             // the command link's silence does not stop a motion
   std::string param_file;                 // the parameter store's image (empty: the store in RAM)
+  std::vector<std::string> plant_sets;    // KEY=VALUE of the simulated arm's (config.hpp's plant.*)
 };
 
 /// The master side of a pseudo-terminal whose slave is in raw mode. Frames are written whole or not
@@ -210,8 +212,9 @@ double wall_seconds() {
 template <class S>
 class InProcessBoard {
  public:
-  InProcessBoard(const sim::Vec6& q0, int state_hz, const sim::Injection& inj, bool link_watch, double speed)
-      : sim_(q0, inj),
+  InProcessBoard(const sim::Vec6& q0, int state_hz, const sim::Injection& inj, bool link_watch, double speed,
+                 const sim::PlantConfig& plant = {})
+      : sim_(q0, inj, plant),
         watch_(static_cast<std::uint32_t>(std::lround(osc::CommandLinkWatch::kTimeoutTicks * std::max(1.0, speed)))),
         link_watch_(link_watch) {
     port_.state_period = static_cast<std::uint32_t>(osc::params::kControlHz / state_hz);
@@ -267,8 +270,8 @@ class InProcessBoard {
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
 /// client's command, setpoint, param and capture frames onto the link before the next tick's sensor frame, the
-/// image's answer, state, param_answer and capture_data frames of each tick back, and its identify frame when a run
-/// ends. No other frame goes on the link.
+/// image's answer, state, param_answer and capture_data frames of each tick back, and its identify frame (and
+/// identify_payload frame) when a run ends. No other frame goes on the link.
 class QemuBoard {
  public:
   QemuBoard(const sim::ExperimentConfig& cfg, const std::string& elf)
@@ -316,6 +319,7 @@ class QemuBoard {
     for (const pil::ParamAnswerFrame& f : arm_.replies().params) write(buf, pil::encode(f, buf));
     for (const pil::CaptureDataFrame& f : arm_.replies().captures) write(buf, pil::encode(f, buf));
     for (const pil::IdentifyFrame& f : arm_.replies().identifies) write(buf, pil::encode(f, buf));
+    for (const pil::IdentifyPayloadFrame& f : arm_.replies().identify_payloads) write(buf, pil::encode(f, buf));
     return true;
   }
   /// The counters of the client's link that the state frames carry.
@@ -486,6 +490,13 @@ void build(CLI::App& app, Options& o) {
                "local, a motion running 0.5 s without a frame from the client is stopped: link_silent; 0.5 s of the "
                "client's time, the wall clock's: 0.5 s times --speed of simulated time when above 1); in process "
                "only: with --qemu the image's link is the PIL link, and no command-link watch runs");
+  app.add_option("--plant-set", o.plant_sets,
+                 "set one of the simulated arm's keys, as puma_experiment --plant-set (its --print-config lists "
+                 "plant.*), e.g. --plant-set payload_mass=1.5 for a payload the controller's model is not told "
+                 "(param set payload_mass, or identify --payload --apply, tells it); repeatable; in process and "
+                 "with --qemu alike (the arm is simulated here)")
+      ->type_name("KEY=VALUE")
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
 }
 
 /// --param-file with --qemu: the file checked (an image of the store, or created erased: FileFlash::open) and named
@@ -519,6 +530,11 @@ bool check_options(const CLI::App& app, Options& o, sim::ExperimentConfig& cfg, 
            false;
   if (!o.inject.empty() || app.count("--inject") > 0)
     if (!sim::parse_injection(o.inject, cfg.injection, err)) return err = "--inject: " + err, false;
+  sim::Settings plant;  // the simulated arm's keys, checked by the configuration's table
+  for (const std::string& a : o.plant_sets)
+    if (!sim::apply_setting("plant." + a, plant, err)) return err = "--plant-set: " + err, false;
+  if (!sim::validate_settings(plant, err)) return err = "--plant-set: " + err, false;
+  cfg.plant = plant.base.plant;
   if (!o.qemu) {
     if (app.count("--elf") > 0) return err = "--elf applies with --qemu only", false;
     return start_pose(o, cfg.q_start, err);
@@ -565,7 +581,7 @@ int run(const Options& o, Board& board) {
 
 template <class S>
 int run_in_process(const Options& o, const sim::ExperimentConfig& cfg) {
-  InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch, o.speed);
+  InProcessBoard<S> board(cfg.q_start, o.state_hz, cfg.injection, !o.no_link_watch, o.speed, cfg.plant);
   if (!o.param_file.empty()) {
     std::string said, err;
     if (!board.open_store(o.param_file, said, err)) {

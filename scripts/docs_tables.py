@@ -1704,6 +1704,11 @@ def t_protocol_identify():
     return field_rows(protocol()["identify_fields"])
 
 
+@table("protocol_identify_payload", "docs/protocol.md", "protocol")
+def t_protocol_identify_payload():
+    return field_rows(protocol()["identify_payload_fields"])
+
+
 @table("protocol_identify_statuses", "docs/protocol.md", "protocol")
 def t_protocol_identify_statuses():
     return name_rows(protocol()["command"]["identify_statuses"])

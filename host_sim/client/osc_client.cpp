@@ -242,11 +242,13 @@ bool Client::send(const std::uint8_t* buf, int n) {
   return false;
 }
 
-std::uint32_t Client::command(MotionVerb verb, const MoveRequest<double>& req) {
+std::uint32_t Client::command(MotionVerb verb, const MoveRequest<double>& req, std::uint8_t flags) {
   const std::uint32_t id = next_id_++;
   if (next_id_ == 0) next_id_ = 1;
   std::uint8_t buf[pil::kMaxFrame];
-  const int n = encode_command(id, verb, req, buf);
+  pil::CommandFrame f = frame_from_command(id, verb, req);
+  f.flags = static_cast<std::uint8_t>(f.flags | flags);
+  const int n = pil::encode(f, buf);
   sent_.emplace_back(id, std::vector<std::uint8_t>(buf, buf + n));
   if (sent_.size() > kSentKept) sent_.pop_front();
   return send(buf, n) ? id : 0;
@@ -263,10 +265,13 @@ void Client::dispatch() {
   pil::StateFrame s;
   pil::ParamAnswerFrame p;
   pil::IdentifyFrame f;
+  pil::IdentifyPayloadFrame fp;
   if (parser_.decode(p)) {
     param_answer_ = p;
   } else if (parser_.decode(f)) {
     identify_ = f;
+  } else if (parser_.decode(fp)) {
+    identify_payload_ = fp;
   } else if (parser_.decode(a)) {
     answers_.push_back(a);
     if (answers_.size() > kHistory) answers_.pop_front();
@@ -282,6 +287,12 @@ std::optional<pil::IdentifyFrame> Client::wait_identify(std::uint32_t id, double
   const auto got = [&] { return identify_ && identify_->id == id; };
   if (!read_until(now_s() + timeout_s, got) && !got()) return std::nullopt;
   return identify_;
+}
+
+std::optional<pil::IdentifyPayloadFrame> Client::wait_identify_payload(std::uint32_t id, double timeout_s) {
+  const auto got = [&] { return identify_payload_ && identify_payload_->id == id; };
+  if (!read_until(now_s() + timeout_s, got) && !got()) return std::nullopt;
+  return identify_payload_;
 }
 
 bool Client::read_until(double deadline, const std::function<bool()>& done) {

@@ -112,7 +112,12 @@ class Client {
   std::uint32_t clear() { return command(MotionVerb::kClear); }
   std::uint32_t paper() { return command(MotionVerb::kPaper); }
   std::uint32_t move_to(const MoveRequest<double>& req) { return command(MotionVerb::kMoveTo, req); }
-  std::uint32_t command(MotionVerb verb, const MoveRequest<double>& req = {});
+  /// An identify run; with `payload` (the flag payload) its estimate of the payload at the flange too.
+  std::uint32_t identify(bool payload = false) {
+    return command(MotionVerb::kIdentify, {}, payload ? pil::kFlagPayload : std::uint8_t{0});
+  }
+  /// A command frame of `verb` from `req`, with the command flags `flags` added (Command flags).
+  std::uint32_t command(MotionVerb verb, const MoveRequest<double>& req = {}, std::uint8_t flags = 0);
 
   /// A stream: the stream command (period 1000 / rate_hz ms, a whole number from 1 to 100; relative;
   /// limits when given), its answer awaited, then one setpoint frame per period paced by the wall
@@ -149,6 +154,9 @@ class Client {
   /// nullopt when none came (a firmware from before the boards estimated, or the frame lost) or on an error
   /// (error()).
   std::optional<pil::IdentifyFrame> wait_identify(std::uint32_t id, double timeout_s);
+  /// The identify_payload frame of run `id` (the payload's estimate of a run asked with the flag payload, right
+  /// after its identify frame), received so far or within timeout_s; nullopt when none came or on an error.
+  std::optional<pil::IdentifyPayloadFrame> wait_identify_payload(std::uint32_t id, double timeout_s);
 
   /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.
   bool pump(double timeout_s);
@@ -189,8 +197,9 @@ class Client {
   std::uint32_t next_id_;
   std::deque<pil::AnswerFrame> answers_;  // the last kHistory answers
   std::optional<pil::StateFrame> state_;
-  std::optional<pil::ParamAnswerFrame> param_answer_;  // the last param_answer frame
-  std::optional<pil::IdentifyFrame> identify_;         // the last identify frame
+  std::optional<pil::ParamAnswerFrame> param_answer_;          // the last param_answer frame
+  std::optional<pil::IdentifyFrame> identify_;                 // the last identify frame
+  std::optional<pil::IdentifyPayloadFrame> identify_payload_;  // the last identify_payload frame
   std::uint64_t states_seen_ = 0;
   std::string error_;
   double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)

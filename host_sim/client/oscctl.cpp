@@ -48,7 +48,8 @@ struct Args {
   std::string param_op, param_name;  // param: the operation, the parameter's name
   std::vector<double> param_values;
   int element = -1;
-  bool apply = false;  // identify: the estimate into the parameters
+  bool apply = false;    // identify: the estimate into the parameters
+  bool payload = false;  // identify: the payload's estimate too (the flag payload)
 };
 
 constexpr double kDeg = osc::kPi / 180.0;
@@ -285,10 +286,59 @@ void print_identify(const pil::IdentifyFrame& f) {
   std::printf("(* identified: its standard deviation within %g %% of it)\n", 100 * osc::params::kIdentifiedFraction);
 }
 
+/// An identify_payload frame: the payload's mass, centre of mass and inertia about it, then the standard deviations
+/// of the estimated parameters (mass, first moment m c, inertia about frame 6's origin), `*` where identified.
+void print_identify_payload(const pil::IdentifyPayloadFrame& f) {
+  const auto star = [&](int k) { return (f.identified >> k) & 1u ? "*" : ""; };
+  const auto d = [](float v) { return static_cast<double>(v); };
+  if (f.status != static_cast<std::uint8_t>(osc::IdentifyStatus::kOk)) return;
+  std::printf("payload: mass %.4f kg +- %.4f%s, centre of mass (%.2f, %.2f, %.2f) mm\n", d(f.mass), d(f.pi_sd[0]),
+              star(0), 1e3 * d(f.com[0]), 1e3 * d(f.com[1]), 1e3 * d(f.com[2]));
+  std::printf("  inertia about it (Ixx Iyy Izz Ixy Ixz Iyz) [kg m^2]:");
+  for (float v : f.inertia) std::printf(" %.4g", d(v));
+  std::printf("\n  standard deviations: m c [kg m]");
+  for (int k = 1; k < 4; ++k) std::printf(" %.2g%s", d(f.pi_sd[k]), star(k));
+  std::printf("; inertia about frame 6's origin (Ixx Ixy Ixz Iyy Iyz Izz) [kg m^2]");
+  for (int k = 4; k < 10; ++k) std::printf(" %.2g%s", d(f.pi_sd[k]), star(k));
+  std::printf("\n");
+}
+
+/// identify --payload --apply: the payload's estimate into payload_mass, payload_com and payload_inertia (the torque
+/// off already). The inertia goes in zeroed first, then its moments before its products; where the parameters refuse
+/// it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass), it is zeroed again
+/// and left so, and said. A mass within
+/// two of its standard deviations of 0 is no payload (its centre of mass is noise over noise): all of it set to 0.
+int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadFrame& f) {
+  const auto set = [&](const char* name, int e, double v, bool quiet_refusal = false) -> int {
+    const auto r = c.param(pil::kParamOpSet, osc::param_index(name), e, v, a.timeout);
+    if (quiet_refusal && r &&
+        (r->status == static_cast<std::uint8_t>(osc::ParamStatus::kNotPhysical) ||
+         r->status == static_cast<std::uint8_t>(osc::ParamStatus::kOutOfRange)))
+      return -1;
+    if (const int rc = param_status(c, r, "set")) return rc;
+    print_param(osc::param_index(name), *r);
+    return 0;
+  };
+  const bool none = !(f.mass > 2 * f.pi_sd[0]);
+  const double keep = none ? 0.0 : 1.0;
+  int rc = set("payload_mass", 0, keep * static_cast<double>(f.mass));
+  for (int k = 0; k < 3 && rc == 0; ++k) rc = set("payload_com", k, keep * static_cast<double>(f.com[k]));
+  for (int k = 0; k < 6 && rc == 0; ++k) rc = set("payload_inertia", k, 0.0);
+  if (none && rc == 0) std::printf("payload: none found (its mass within 2 standard deviations of 0): set to none\n");
+  for (int k = 0; k < 6 && rc == 0 && !none; ++k)
+    rc = set("payload_inertia", k, static_cast<double>(f.inertia[k]), true);
+  if (rc != -1) return rc;  // all of it set, or an error
+  for (int k = 0; k < 6; ++k)
+    if (const int z = set("payload_inertia", k, 0.0)) return z;
+  std::printf("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n");
+  return 0;
+}
+
 /// identify --apply: the torque off (a disable), then the estimate's friction and armatures into friction_vis,
 /// friction_cou, friction_sti and armature_correction, each value within its element's range (an estimate below
-/// 0 is set to 0). What was set is printed; `param save` keeps it.
-int apply_identify(Client& c, const Args& a, const pil::IdentifyFrame& f) {
+/// 0 is set to 0), and the payload's estimate when given (apply_identify_payload). What was set is printed; `param
+/// save` keeps it.
+int apply_identify(Client& c, const Args& a, const pil::IdentifyFrame& f, const pil::IdentifyPayloadFrame* p) {
   const std::uint32_t off = c.command(osc::MotionVerb::kDisable);
   if (off == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
   if (const Outcome o = c.wait_done(off, a.timeout); o.status != Status::kDone) return report(o);
@@ -311,6 +361,8 @@ int apply_identify(Client& c, const Args& a, const pil::IdentifyFrame& f) {
       print_param(i, *r);
     }
   }
+  if (p)
+    if (const int rc = apply_identify_payload(c, a, *p)) return rc;
   std::printf("applied, the torque off: enable goes on from them; param save keeps them for the next power-on\n");
   return 0;
 }
@@ -319,7 +371,7 @@ int apply_identify(Client& c, const Args& a, const pil::IdentifyFrame& f) {
 /// estimate into the parameters. Exit 1 when the run was refused or aborted, its estimate failed, or --apply found
 /// none to apply.
 int identify(Client& c, const Args& a) {
-  const std::uint32_t id = c.command(osc::MotionVerb::kIdentify);
+  const std::uint32_t id = c.identify(a.payload);
   if (id == 0) return report({Status::kError, 0, osc::MotionReason::kNone, 0, c.error(), {}});
   const Outcome o = c.wait_answer(id, a.timeout);
   if (const int rc = report(o); o.status != Status::kAccepted) return rc;
@@ -333,8 +385,16 @@ int identify(Client& c, const Args& a) {
     return a.apply ? 1 : rc;
   }
   print_identify(*f);
-  if (f->status != static_cast<std::uint8_t>(osc::IdentifyStatus::kOk)) return 1;
-  return a.apply ? apply_identify(c, a, *f) : rc;
+  std::optional<pil::IdentifyPayloadFrame> p;
+  if (a.payload) {
+    p = c.wait_identify_payload(id, kIdentifyFrameWaitS);
+    if (p)
+      print_identify_payload(*p);
+    else
+      std::printf("no payload estimate: the board sent no identify_payload frame\n");
+  }
+  if (f->status != static_cast<std::uint8_t>(osc::IdentifyStatus::kOk) || (a.payload && !p)) return 1;
+  return a.apply ? apply_identify(c, a, *f, p ? &*p : nullptr) : rc;
 }
 
 /// The param command line's own checks: a known operation and name, as many values as elements.
@@ -401,7 +461,11 @@ void build(CLI::App& app, Args& a) {
                       "; waits for its end and prints the board's estimate");
   id->add_flag("--apply", a.apply,
                "then the estimate's friction and armatures into the parameters friction_vis, friction_cou, "
-               "friction_sti and armature_correction (the torque off first: a disable); param save keeps them");
+               "friction_sti and armature_correction (the torque off first: a disable), with --payload the payload's "
+               "into payload_mass, payload_com and payload_inertia; param save keeps them");
+  id->add_flag("--payload", a.payload,
+               "estimate the payload at the flange too: its mass, centre of mass and inertia (all ten of its inertial "
+               "parameters, with the arm's own model: the whole payload, whatever is set)");
   std::string poses;
   for (int i = 0; i < osc::robot::kNamedPoseCount; ++i)
     poses += std::string(i ? ", " : "") + osc::robot::kNamedPoses[i].name;

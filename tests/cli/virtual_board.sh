@@ -38,6 +38,10 @@
 #                                      at the start pose says "params loaded" and has them; the first move
 #                                      (first_move.py) tracks within 0.5 mm, where the same move from a new store
 #                                      (defaults) is over 1 mm; a file that is no store's image refused, exit 2
+#   oscctl_payload, python_payload     identify --payload --apply with either client: the arm carrying 1.5 kg at
+#                                      (0, 0.05, 0.08) m (osc_sim --plant-set), the model a rough setting of it; the
+#                                      estimate printed within issue 57's bars (mass 3 %, centre of mass 5 mm),
+#                                      applied, payload_mass read back
 #   python_queue                       the Python package: a slow move and two queued behind it, a stop:
 #                                      the running move aborted stop_command, each queued one aborted
 #                                      dropped (its own answer frame), the state frame's queue empty;
@@ -248,7 +252,10 @@ stream() {
 # (the estimate printed and set), param save. Sets $vis, friction_vis[0] as the estimate printed it.
 # The board store_estimate runs the identification on: osc_sim's options (the virtual board in process by default,
 # started at the identify pose: the wrist bent to q5 = 74.4845 deg, where the run passes the loop's check).
-estimate_board=(--speed 10 --start-pose 0 45 -180 0 74.4845 0)
+# No link watch: at --speed 10 the watch's 0.5 s of the client's is 5 s simulated, and a loaded machine's simulator that
+# catches up on its ticks in a burst ran them past a keep-alive not yet read (link_silent, seen once in 886 tests at
+# -j4). The watch has its own test (link_recovery.py, link_silent).
+estimate_board=(--speed 10 --no-link-watch --start-pose 0 45 -180 0 74.4845 0)
 # A board that starts at the start pose (an image) moves there first: the wrist centre stays, the hand pitches from
 # 90 to 60.52 deg (q5 from 45 deg). Then a disable and an enable: the controller's orientation coordinates are
 # relative to the pose of the enable, and 30 deg from it the run's loop check refuses unstable_loop (docs/adaptation.md,
@@ -293,6 +300,30 @@ within_bars() {
   echo "$1's first move after a power cycle: $2 mm from the stored estimate, $3 mm from the defaults"
   awk -v w="$2" 'BEGIN { exit !(w <= 0.5) }' || fail "the first move from the stored estimate: $2 mm, over 0.5"
   awk -v c="$3" 'BEGIN { exit !(c > 1.0) }' || fail "the first move from the defaults: $3 mm, not over 1 mm"
+}
+
+# identify --payload --apply with one client (a command prefix): the virtual board's arm carries 1.5 kg at
+# (0, 0.05, 0.08) m (--plant-set), its model a rough setting of it (10 % light, the centre of mass 10 % short); the
+# estimate printed within issue 57's bars (mass 3 %, centre of mass 5 mm), applied, and read back.
+payload_identify() {
+  start_sim "${estimate_board[@]}" --plant-set payload_mass=1.5 --plant-set 'payload_com=[0, 0.05, 0.08]'
+  expect 0 '^payload_mass = 1.35 ' -- "$@" --port "$port" param set payload_mass 1.35
+  expect 0 '^payload_com\[2\] = 0.072 ' -- "$@" --port "$port" param set payload_com 0 0.045 0.072
+  expect 0 '^accepted$' -- "$@" --port "$port" enable
+  expect 0 '^identify [0-9]+: ok; ' '^payload: mass ' '^payload_mass = ' '^payload_com\[2\] = ' '^applied' -- \
+    "$@" --port "$port" --timeout 300 identify --payload --apply
+  "$py" - "$tmp/out" <<'PY' || fail "the payload's estimate is not within issue 57's bars"
+import math, re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r"^payload: mass ([0-9.]+) kg \+- [0-9.]+\*?, centre of mass \(([-0-9.]+), ([-0-9.]+), ([-0-9.]+)\) mm$",
+              text, re.M)
+mass, com = float(m.group(1)), [float(m.group(k)) for k in (2, 3, 4)]
+off = math.dist(com, (0.0, 50.0, 80.0))
+print(f"payload over the link: {mass:.4f} kg ({100 * (mass / 1.5 - 1):+.2f} %), centre of mass {off:.2f} mm off")
+sys.exit(not (abs(mass - 1.5) <= 0.03 * 1.5 and off <= 5.0))
+PY
+  expect 0 '^payload_mass = 1\.[45]' -- "$@" --port "$port" param get payload_mass
+  stop_sim
 }
 
 # A power cycle of the virtual board with the store in a file (the case list at the top), with one client given as a
@@ -480,6 +511,12 @@ PY
   python_power_cycle)
     power_cycle "${pyc[@]}"
     ;;
+  oscctl_payload)
+    payload_identify "$ctl"
+    ;;
+  python_payload)
+    payload_identify "${pyc[@]}"
+    ;;
   python_queue)
     start_sim --speed 4 --scalar float
     "$py" - "$port" >"$tmp/queue.out" 2>&1 <<'PY' || fail "$(cat "$tmp/queue.out")"
@@ -637,6 +674,8 @@ PY
     expect 2 'osc_sim: --speed' -- "$sim" --pty --speed 0
     expect 2 'osc_sim: --duration' -- "$sim" --pty --duration -1
     expect 2 'osc_sim: .*--bogus' -- "$sim" --pty --bogus
+    refuse 'osc_sim: --plant-set: plant.payload_mass: ' -- "$sim" --pty --plant-set payload_mass=-1
+    refuse 'osc_sim: --plant-set: .*plant.bogus' -- "$sim" --pty --plant-set bogus=1
     # --qemu's: the image named with --qemu only, present, an MPS2 PIL image; what it compiles in.
     refuse 'osc_sim: --elf applies with --qemu only' -- "$sim" --pty --elf "$sim"
     refuse "osc_sim: firmware image $tmp/none.elf not found" -- "$sim" --pty --qemu --elf "$tmp/none.elf"

@@ -50,8 +50,9 @@ F decoded(const pil::Parser& p) {
   pil::IdentifyFrame id;
   pil::CaptureFrame cf;
   pil::CaptureDataFrame cd;
+  pil::IdentifyPayloadFrame ip;
   const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
-                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id) + p.decode(cf) + p.decode(cd);
+                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id) + p.decode(cf) + p.decode(cd) + p.decode(ip);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));

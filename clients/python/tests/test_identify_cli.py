@@ -8,7 +8,7 @@ import time
 import pytest
 
 from fakes import FakeBoard, Reply, answer
-from osc_client import Answer, Client, Command, Frame, Identify, NameList, Param, ParamAnswer, Protocol
+from osc_client import Answer, Client, Command, Frame, Identify, IdentifyPayload, NameList, Param, ParamAnswer, Protocol
 from osc_client import cli
 
 FIRST_ID = 100
@@ -40,32 +40,48 @@ J6       -0.0469 +- 0.0234       0.4375 +- 0.2500       0.6250 +- 0.0078 *     0
 """
 APPLIED_PARAMETERS = ("friction_vis", "friction_cou", "friction_sti", "armature_correction")
 
+# A payload estimate (f32 values) and what oscctl's print_identify_payload prints for it (C's printf).
+PAYLOAD = IdentifyPayload(
+    status=0, mass=1.49875, com=(0.000125, 0.05, 0.0799), inertia=(0.001, 0.002, 0.0005, -0.0001, 0.0, 0.00025),
+    pi_sd=(0.0021, 0.0003, 0.0002, 0.0004, 0.001, 0.0005, 0.0006, 0.0011, 0.0007, 0.0009), identified=0b1111)
+PAYLOAD_TEXT = """\
+payload: mass 1.4987 kg +- 0.0021*, centre of mass (0.13, 50.00, 79.90) mm
+  inertia about it (Ixx Iyy Izz Ixy Ixz Iyz) [kg m^2]: 0.001 0.002 0.0005 -0.0001 0 0.00025
+  standard deviations: m c [kg m] 0.0003* 0.0002* 0.0004*; inertia about frame 6's origin (Ixx Ixy Ixz Iyy Iyz Izz) \
+[kg m^2] 0.001 0.0005 0.0006 0.0011 0.0007 0.0009
+"""
+NO_PAYLOAD = "no payload estimate: the board sent no identify_payload frame\n"
+
 
 def status(p: Protocol, name: str) -> int:
     return p.code_of(NameList.IDENTIFY_STATUSES, name)
 
 
-def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, disable: str = "accepted") -> Reply:
-    """The identify run accepted, then done (or aborted) with the estimate after the end's answer; a disable
-    answered ``disable`` (accepted: done at once, the state disabled)."""
+def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, disable: str = "accepted",
+              payload: IdentifyPayload | None = None) -> Reply:
+    """The identify run accepted, then done (or aborted) with the estimate after the end's answer (and the payload's
+    right after it, when given); a disable answered ``disable`` (accepted: done at once, the state disabled)."""
     def reply(c: Command) -> list[Frame]:
         verb = p.name_of(NameList.VERBS, c.verb)
         if verb == "disable":
             return [answer(p, c, disable, "busy" if disable == "refused" else "none", state="disabled")]
         assert verb == "identify"
         end = (Answer(aborted_id=c.id, abort=p.code_of(NameList.REASONS, abort)) if abort else Answer(done_id=c.id))
-        return [answer(p, c, state="moving"), end] + ([dataclasses.replace(estimate, id=c.id)] if estimate else [])
+        frames: list[Frame] = [answer(p, c, state="moving"), end]
+        frames += [dataclasses.replace(estimate, id=c.id)] if estimate else []
+        return frames + ([dataclasses.replace(payload, id=c.id)] if payload else [])
     return reply
 
 
 class ParamTable:
     """The board's parameters: get answers an element's value and range, set stores it (or is refused)."""
 
-    def __init__(self, p: Protocol, refuse: tuple[str, int, str] | None = None) -> None:
+    def __init__(self, p: Protocol, refuse: tuple[str, int, str] | None = None, nonzero: bool = False) -> None:
         self.p = p
         self.hi: dict[tuple[int, int], float] = {}  # ranges of the board's that are not the JSON's
         self.values: dict[tuple[int, int], float] = {}
         self.refuse = refuse  # (parameter, element, status): that set refused
+        self.nonzero = nonzero  # ... only when its value is not 0 (as not_physical refuses an inertia)
 
     def __call__(self, q: Param) -> list[Frame]:
         p, op = self.p, self.p.name_of(NameList.PARAM_OPS, q.op)
@@ -73,7 +89,7 @@ class ParamTable:
         key = (q.index, q.element)
         result = 0
         if op == "set":
-            if self.refuse and (par.name, q.element) == self.refuse[:2]:
+            if self.refuse and (par.name, q.element) == self.refuse[:2] and (q.value != 0 or not self.nonzero):
                 result = p.code_of(NameList.PARAM_STATUSES, self.refuse[2])
             else:
                 self.values[key] = q.value
@@ -228,3 +244,77 @@ def test_apply_without_a_param_answer_exits_2(protocol: Protocol, capsys: pytest
     assert vis is not None
     assert [(protocol.name_of(NameList.PARAM_OPS, q.op), q.index, q.element) for q in requests(board)] == \
         [("get", vis.index, 0)]  # the first range asked for, nothing set without it
+
+
+def test_the_payload_flag_and_its_estimate_printed(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    rc, board = run(protocol, ["identify", "--payload"], board_run(protocol, ESTIMATE, payload=PAYLOAD))
+    assert capsys.readouterr().out == "accepted\ndone\n" + ESTIMATE_TEXT + PAYLOAD_TEXT
+    assert rc == 0
+    (command,) = board.commands()
+    assert command.flags == protocol.command_flags["payload"]
+    rc, board = run(protocol, ["identify"], board_run(protocol, ESTIMATE))
+    assert rc == 0 and board.commands()[0].flags == 0  # without --payload, no flag
+
+
+def test_no_payload_frame_exits_1(protocol: Protocol, monkeypatch: pytest.MonkeyPatch,
+                                  capsys: pytest.CaptureFixture[str]) -> None:
+    monkeypatch.setattr(cli, "IDENTIFY_FRAME_WAIT", 0.3)
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE))
+    assert (rc, capsys.readouterr().out) == (1, "accepted\ndone\n" + ESTIMATE_TEXT + NO_PAYLOAD)
+    assert verbs(protocol, board) == ["identify"]  # nothing applied
+
+
+def payload_sets(protocol: Protocol, board: FakeBoard) -> list[tuple[str, int, float]]:
+    """The payload's sets --apply sent: (parameter, element, value)."""
+    names = {q.index: q.name for q in protocol.parameters}
+    return [(names[q.index], q.element, q.value) for q in requests(board)
+            if names[q.index].startswith("payload_") and protocol.name_of(NameList.PARAM_OPS, q.op) == "set"]
+
+
+def test_apply_sets_the_payload_after_the_friction(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    table = ParamTable(protocol)
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE, payload=PAYLOAD),
+                    table)
+    out = capsys.readouterr().out
+    assert rc == 0 and out.endswith(APPLIED)
+    # The mass, the centre of mass, the inertia zeroed, then its moments before its products (the parameter's order).
+    want = ([("payload_mass", 0, PAYLOAD.mass)] + [("payload_com", k, PAYLOAD.com[k]) for k in range(3)]
+            + [("payload_inertia", k, 0.0) for k in range(6)]
+            + [("payload_inertia", k, PAYLOAD.inertia[k]) for k in range(6)])
+    got = payload_sets(protocol, board)
+    assert [(n, e) for n, e, _ in got] == [(n, e) for n, e, _ in want]
+    assert [v for _, _, v in got] == pytest.approx([v for _, _, v in want], rel=1e-6)
+    last_friction = max(i for i, q in enumerate(requests(board)) if q.index == protocol.parameter(
+        "armature_correction").index)  # type: ignore[union-attr]
+    first_payload = min(i for i, q in enumerate(requests(board)) if q.index == protocol.parameter(
+        "payload_mass").index)  # type: ignore[union-attr]
+    assert last_friction < first_payload
+    assert "payload_mass = 1.49875 kg" in out
+
+
+@pytest.mark.parametrize("refusal", ["not_physical", "out_of_range"])
+def test_an_unphysical_payload_inertia_is_left_at_zero(protocol: Protocol, refusal: str,
+                                                       capsys: pytest.CaptureFixture[str]) -> None:
+    table = ParamTable(protocol, refuse=("payload_inertia", 3, refusal), nonzero=True)
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE, payload=PAYLOAD),
+                    table)
+    out = capsys.readouterr().out
+    assert rc == 0 and out.endswith("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n"
+                                    + APPLIED)
+    inertia = protocol.parameter("payload_inertia")
+    assert inertia is not None
+    assert [table.values[(inertia.index, k)] for k in range(6)] == [0.0] * 6  # zeroed again after the refusal
+    assert payload_sets(protocol, board)[-6:] == [("payload_inertia", k, 0.0) for k in range(6)]
+
+
+def test_a_mass_within_two_sigma_of_zero_is_no_payload(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    noise = dataclasses.replace(PAYLOAD, mass=0.001, com=(3.0, -2.0, 5.0), pi_sd=(0.002,) + PAYLOAD.pi_sd[1:])
+    table = ParamTable(protocol)
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE, payload=noise),
+                    table)
+    out = capsys.readouterr().out
+    assert rc == 0 and out.endswith("payload: none found (its mass within 2 standard deviations of 0): set to none\n"
+                                    + APPLIED)
+    want = ([("payload_mass", 0, 0.0)] + [("payload_com", k, 0.0) for k in range(3)]
+            + [("payload_inertia", k, 0.0) for k in range(6)])
+    assert payload_sets(protocol, board) == want  # the noise's centre of mass (metres away) not sent

@@ -47,7 +47,10 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kIdentifyFrame, 11);
   EXPECT_EQ(pil::kIdentifyPayload, 4 + 1 + 4 + 4 + 4 + 4 + 72 + 72 + 4 + 24 + 24);
   // The capture's request and answer (issue 58): test_capture_frames.cpp.
-  ASSERT_EQ(pil::kFrameTypes, 13);
+  // The identify run's payload estimate (issue 57): id, status, mass, com, inertia, pi's sd, identified.
+  EXPECT_EQ(pil::kIdentifyPayloadFrame, 14);
+  EXPECT_EQ(pil::kIdentifyPayloadPayload, 4 + 1 + 4 + 12 + 24 + 40 + 4);
+  ASSERT_EQ(pil::kFrameTypes, 14);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -56,7 +59,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 14, 15, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 15, 16, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 // ---------------------------------------------------------------- round trips
@@ -84,12 +87,22 @@ TEST(CommandFrames, CommandRoundTripsFieldByField) {
 }
 
 TEST(CommandFrames, EveryFlagAndEveryCombination) {
-  ASSERT_EQ(pil::kCommandFlagCount, 4);
+  ASSERT_EQ(pil::kCommandFlagCount, 5);
   EXPECT_STREQ(pil::kCommandFlagNames[pil::kFlagBitRelative], "relative");
   EXPECT_STREQ(pil::kCommandFlagNames[pil::kFlagBitHasRpy], "has_rpy");
   EXPECT_STREQ(pil::kCommandFlagNames[pil::kFlagBitReplace], "replace");
   EXPECT_STREQ(pil::kCommandFlagNames[pil::kFlagBitHasLimits], "has_limits");
-  EXPECT_EQ(pil::kCommandFlagsKnown, 0x0F);
+  EXPECT_STREQ(pil::kCommandFlagNames[pil::kFlagBitPayload], "payload");
+  EXPECT_EQ(pil::kCommandFlagsKnown, 0x1F);
+  // payload qualifies an identify: its run estimates all ten of the payload's parameters; without it, none.
+  pil::CommandFrame id = frame_from_command<double>(7, MotionVerb::kIdentify);
+  EXPECT_EQ(identify_payload_mask(id), payload_mask::kNone);
+  id.flags = pil::kFlagPayload;
+  EXPECT_EQ(identify_payload_mask(id), payload_mask::kAll);
+  MoveRequest<double> ignored;
+  MotionVerb v;
+  EXPECT_EQ(command_from_frame(id, ignored, v), MotionReason::kNone);
+  EXPECT_EQ(v, MotionVerb::kIdentify);
   for (int flags = 0; flags < 16; ++flags) {
     pil::CommandFrame f = move_frame();
     f.flags = static_cast<std::uint8_t>(flags);

@@ -121,6 +121,9 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
         case pil::kCaptureDataFrame:
           out = bytes_of(decoded<pil::CaptureDataFrame>(p));
           break;
+        case pil::kIdentifyPayloadFrame:
+          out = bytes_of(decoded<pil::IdentifyPayloadFrame>(p));
+          break;
       }
       ASSERT_EQ(out, in) << info.name;
     }
@@ -214,7 +217,7 @@ struct BadField {
 const BadField kBad[] = {
     {"verb one past the list", [](pil::CommandFrame& f) { f.verb = MotionNames<MotionVerb>::kCount; }},
     {"verb 255", [](pil::CommandFrame& f) { f.verb = 255; }},
-    {"flag bit 4", [](pil::CommandFrame& f) { f.flags |= 1u << 4; }},
+    {"flag bit 5", [](pil::CommandFrame& f) { f.flags |= 1u << 5; }},
     {"flag bit 7", [](pil::CommandFrame& f) { f.flags |= 1u << 7; }},
     {"position NaN", [](pil::CommandFrame& f) { f.position[1] = kNaN; }},
     {"position +inf", [](pil::CommandFrame& f) { f.position[0] = kInf; }},

@@ -44,13 +44,13 @@ from typing import IO, Callable, Iterator, Sequence, TextIO
 from .capture import DONE, MANUAL, WAITING, CaptureRefused, CaptureResult, Oscilloscope, parse_channels
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import CaptureData, FrameType, Identify, ParamAnswer, State
+from .frames import CaptureData, FrameType, Identify, IdentifyPayload, ParamAnswer, State
 from .paths import read_stream_csv, resample_path
 from .plot import LivePlot, require_matplotlib, save_capture_png, save_png
 from .protocol import NameList, Protocol, int_range
 from .record import CsvRecorder, Signal, Traces, parse_signals
-from .text import (DRIVES, answer_text, capture_text, identify_text, margins_text, param_line, state_change_text,
-                   state_text)
+from .text import (DRIVES, answer_text, capture_text, identify_payload_text, identify_text, margins_text, param_line,
+                   state_change_text, state_text)
 
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
@@ -206,10 +206,50 @@ def cmd_param(c: Client, a: argparse.Namespace) -> int:
     return 0
 
 
-def apply_identify(c: Client, a: argparse.Namespace, f: Identify) -> int:
+def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload) -> int:
+    """identify --payload --apply: the payload's estimate into payload_mass, payload_com and payload_inertia (the
+    torque off already), as oscctl's: the inertia zeroed first, then its moments before its products; where the
+    parameters refuse it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass)
+    it is zeroed again, left so, and said. A mass within two of its standard deviations of 0 is no payload: all of
+    it set to 0."""
+    p = c.protocol
+
+    def put(name: str, e: int, v: float, quiet: bool = False) -> int:
+        q = p.parameter(name)
+        if q is None:
+            raise ClientError(f"identify --apply: this protocol has no parameter {name}")
+        r = c.param("set", q.index, e, v, timeout=a.timeout)
+        if quiet and p.name_of(NameList.PARAM_STATUSES, r.status) in ("not_physical", "out_of_range"):
+            return -1
+        if param_refused(c, r):
+            return 1
+        print(param_line(p, q, r))
+        return 0
+    none = not f.mass > 2 * f.pi_sd[0]
+    keep = 0.0 if none else 1.0
+    rc = put("payload_mass", 0, keep * f.mass)
+    for k in range(3):
+        rc = rc or put("payload_com", k, keep * f.com[k])
+    for k in range(6):
+        rc = rc or put("payload_inertia", k, 0.0)
+    if none and rc == 0:
+        print("payload: none found (its mass within 2 standard deviations of 0): set to none")
+    for k in range(6):
+        rc = rc or (0 if none else put("payload_inertia", k, f.inertia[k], quiet=True))
+    if rc != -1:
+        return rc  # all of it set, or refused
+    for k in range(6):
+        if put("payload_inertia", k, 0.0):
+            return 1
+    print("payload_inertia: refused (the estimate's noise about a point mass): left at 0")
+    return 0
+
+
+def apply_identify(c: Client, a: argparse.Namespace, f: Identify, fp: IdentifyPayload | None = None) -> int:
     """identify --apply: the torque off (a disable), then the estimate's friction and armatures into friction_vis,
     friction_cou, friction_sti and armature_correction, each value within its element's range (an estimate below
-    0 is set to 0). Each value set is printed; ``param save`` keeps them."""
+    0 is set to 0), and the payload's estimate when given (apply_identify_payload). Each value set is printed;
+    ``param save`` keeps them."""
     o = c.wait_done(c.disable(), a.timeout)
     if o.status != Status.DONE:
         return report(o)
@@ -229,6 +269,10 @@ def apply_identify(c: Client, a: argparse.Namespace, f: Identify) -> int:
             if param_refused(c, r):
                 return 1
             print(param_line(p, q, r))
+    if fp is not None:
+        rc = apply_identify_payload(c, a, fp)
+        if rc:
+            return rc
     print("applied, the torque off: enable goes on from them; param save keeps them for the next power-on")
     return 0
 
@@ -237,7 +281,7 @@ def cmd_identify(c: Client, a: argparse.Namespace) -> int:
     """identify: the run's answer and end, then the board's estimate (its identify frame), and with --apply the
     estimate into the parameters. Exit 1 when the run was refused or aborted, its estimate failed, or --apply
     found none to apply."""
-    cid = c.identify()
+    cid = c.identify(payload=a.payload)
     o = c.wait_answer(cid, a.timeout)
     rc = report(o)
     if o.status != Status.ACCEPTED:
@@ -250,9 +294,14 @@ def cmd_identify(c: Client, a: argparse.Namespace) -> int:
               flush=True)
         return 1 if a.apply else rc
     print(identify_text(c.protocol, f), end="", flush=True)
-    if c.protocol.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok":
+    fp = None
+    if a.payload:
+        fp = c.wait_identify_payload(cid, IDENTIFY_FRAME_WAIT)
+        print(identify_payload_text(c.protocol, fp) if fp is not None
+              else "no payload estimate: the board sent no identify_payload frame\n", end="", flush=True)
+    if c.protocol.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok" or (a.payload and fp is None):
         return 1
-    return apply_identify(c, a, f) if a.apply else rc
+    return apply_identify(c, a, f, fp) if a.apply else rc
 
 
 @contextlib.contextmanager
@@ -539,7 +588,11 @@ def parser() -> argparse.ArgumentParser:
                         "held joint angles); waits for its end and prints the board's estimate")
     ip.add_argument("--apply", action="store_true", help="then the estimate's friction and armatures into the "
                     "parameters friction_vis, friction_cou, friction_sti and armature_correction (the torque off "
-                    "first: a disable); param save keeps them")
+                    "first: a disable), with --payload the payload's into payload_mass, payload_com and "
+                    "payload_inertia; param save keeps them")
+    ip.add_argument("--payload", action="store_true", help="estimate the payload at the flange too: its mass, "
+                    "centre of mass and inertia (all ten of its inertial parameters, with the arm's own model: the "
+                    "whole payload, whatever is set)")
     dp = sub.add_parser("declare_pose", help="the arm stands at a named pose (torque off; the pots must agree)")
     dp.add_argument("pose", help="the pose's name (osc_protocol.json's poses: start, zero, ready, stretch)")
 

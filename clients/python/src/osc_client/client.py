@@ -16,8 +16,8 @@ from enum import Enum
 from typing import Callable, Sequence
 
 from .errors import ClientError
-from .frames import (Answer, Capture, CaptureData, Command, Floats, Frame, Identify, Param, ParamAnswer, Setpoint,
-                     SetpointVelocity, State)
+from .frames import (Answer, Capture, CaptureData, Command, Floats, Frame, Identify, IdentifyPayload, Param,
+                     ParamAnswer, Setpoint, SetpointVelocity, State)
 from .parser import Parser
 from .paths import PathPoint
 from .protocol import NameList, Protocol
@@ -98,6 +98,7 @@ class Client:
         self.states_seen = 0
         self.param_answer: ParamAnswer | None = None
         self.last_identify: Identify | None = None  # the last identify frame (an identify run's estimate)
+        self.last_identify_payload: IdentifyPayload | None = None  # the last identify_payload frame
         self.capture_answer: CaptureData | None = None  # the last capture_data frame (a capture request's answer)
         self.on_answer: Callable[[Answer], None] | None = None
         self.on_state: Callable[[State], None] | None = None
@@ -111,7 +112,7 @@ class Client:
     # ------------------------------------------------------------------ commands: each returns its id
     def command(self, verb: str, position: Sequence[float] = (0.0, 0.0, 0.0), rpy: Sequence[float] | None = None,
                 relative: bool = False, replace: bool = False, limits: Sequence[float] | None = None,
-                period: int = 0) -> int:
+                period: int = 0, payload: bool = False) -> int:
         """Sends one command frame; its id.
 
         ``verb``: a name of NameList.VERBS; ``rpy`` [rad] or None; ``limits``: six numbers (linear v,
@@ -120,7 +121,8 @@ class Client:
         cid = self._new_id()
         flag = self.protocol.command_flags
         flags = ((flag["relative"] if relative else 0) | (flag["has_rpy"] if rpy else 0)
-                 | (flag["replace"] if replace else 0) | (flag["has_limits"] if limits else 0))
+                 | (flag["replace"] if replace else 0) | (flag["has_limits"] if limits else 0)
+                 | (flag["payload"] if payload else 0))
         frame = self.protocol.encode(Command(
             id=cid, verb=self.protocol.code_of(NameList.VERBS, verb), flags=flags, position=tuple(position),
             rpy=tuple(rpy or ()), limits=tuple(limits or ()), period=period))
@@ -150,11 +152,12 @@ class Client:
         """The paper's motion (trajectory (68))."""
         return self.command("paper")
 
-    def identify(self) -> int:
+    def identify(self, payload: bool = False) -> int:
         """An identification run: the excitation motion about the held joint angles (80 s), planned and checked
         on the board first (refused by name: out_of_workspace, near_singular, over_limit, unstable_loop);
-        wait_done for its end, then wait_identify for the board's estimate."""
-        return self.command("identify")
+        wait_done for its end, then wait_identify for the board's estimate. With ``payload`` (the flag payload) the
+        run estimates the payload at the flange too: wait_identify_payload."""
+        return self.command("identify", payload=payload)
 
     def home(self) -> int:
         """Homing: each motor to its index pulse from the pots' coarse angles; wait_done for its end."""
@@ -299,6 +302,14 @@ class Client:
         self._read_until(time.monotonic() + timeout, mine)
         return self.last_identify if mine() else None
 
+    def wait_identify_payload(self, cid: int, timeout: float = 2.0) -> IdentifyPayload | None:
+        """The identify_payload frame of the identify run ``cid`` (asked with ``payload``), sent right after its
+        identify frame: received already, or within ``timeout`` seconds; None when none came."""
+        def mine() -> bool:
+            return self.last_identify_payload is not None and self.last_identify_payload.id == cid
+        self._read_until(time.monotonic() + timeout, mine)
+        return self.last_identify_payload if mine() else None
+
     def pump(self, timeout: float, until: Callable[[], bool] | None = None) -> bool:
         """Reads and dispatches frames (on_answer, on_state) for ``timeout`` seconds (``inf``: for ever), or
         until ``until()`` (checked before each read, 0.05 s at most apart), keeping the link alive; True
@@ -352,6 +363,8 @@ class Client:
             self.param_answer = frame
         elif isinstance(frame, Identify):
             self.last_identify = frame
+        elif isinstance(frame, IdentifyPayload):
+            self.last_identify_payload = frame
         elif isinstance(frame, CaptureData):
             self.capture_answer = frame
         elif isinstance(frame, Answer):

@@ -38,6 +38,7 @@ class FrameType(str, Enum):
     IDENTIFY = "identify"
     CAPTURE = "capture"
     CAPTURE_DATA = "capture_data"
+    IDENTIFY_PAYLOAD = "identify_payload"
 
 
 @dataclass(frozen=True)
@@ -197,6 +198,26 @@ class Identify(Frame):
 
 
 @dataclass(frozen=True)
+class IdentifyPayload(Frame):
+    """An identify run's estimate of the payload at the flange (the run asked with the command flag payload),
+    right after its identify frame (docs/protocol.md, "Identify_payload frame").
+
+    mass, com and inertia are in the form the parameters payload_mass, payload_com and payload_inertia take them;
+    pi_sd and identified are the estimated parameters': the mass, its first moment m c (frame 6), its inertia about
+    frame 6's origin (Ixx, Ixy, Ixz, Iyy, Iyz, Izz).
+    """
+
+    TYPE = FrameType.IDENTIFY_PAYLOAD
+    id: int = 0  # the identify command's id
+    status: int = 0  # NameList.IDENTIFY_STATUSES: the run's
+    mass: float = 0.0  # [kg]; 0 when status is not ok
+    com: Floats = ()  # [m] its centre of mass in frame 6
+    inertia: Floats = ()  # [kg m^2] about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz
+    pi_sd: Floats = ()  # the standard deviations: m [kg], m c [kg m], inertia about frame 6's origin [kg m^2]
+    identified: int = 0  # bit k set: the k-th of those is identified
+
+
+@dataclass(frozen=True)
 class CaptureData(Frame):
     """A capture frame's answer: the capture's state and set-up after it and, for a read, up to
     ``CaptureSpec.chunk`` of its values (sample by sample, channel by channel, from ``offset``).
@@ -273,6 +294,6 @@ class Trace(Frame):
 
 
 _CLASSES: tuple[type[Frame], ...] = (Sensor, Actuator, Command, Answer, State, Setpoint, Trace, SetpointVelocity,
-                                     Param, ParamAnswer, Identify, Capture, CaptureData)
+                                     Param, ParamAnswer, Identify, Capture, CaptureData, IdentifyPayload)
 FRAME_CLASSES: dict[FrameType, type[Frame]] = {cls.TYPE: cls for cls in _CLASSES}
 """The class of each frame type."""

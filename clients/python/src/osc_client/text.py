@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Sequence
 
-from .frames import Answer, Identify, ParamAnswer, State
+from .frames import Answer, Identify, IdentifyPayload, ParamAnswer, State
 from .protocol import NameList, Parameter, Protocol
 
 if TYPE_CHECKING:
@@ -100,6 +100,22 @@ def identify_text(p: Protocol, f: Identify) -> str:
             text += " %9.4f +- %-7.4f%s" % (f.friction[k], f.friction_sd[k], "* " if f.identified >> k & 1 else "  ")
         text += " %9.4f +- %.4f\n" % (f.armature[i], f.armature_sd[i])
     return text + "(* identified: its standard deviation within %g %% of it)\n" % (100 * IDENTIFIED_FRACTION)
+
+
+def identify_payload_text(p: Protocol, f: IdentifyPayload) -> str:
+    """An identify_payload frame as oscctl prints it (status ok): the mass, the centre of mass and the inertia about
+    it, then the estimated parameters' standard deviations, ``*`` where identified; "" otherwise."""
+    if p.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok":
+        return ""
+
+    def star(k: int) -> str:
+        return "*" if f.identified >> k & 1 else ""
+    text = ("payload: mass %.4f kg +- %.4f%s, centre of mass (%.2f, %.2f, %.2f) mm\n"
+            % (f.mass, f.pi_sd[0], star(0), 1e3 * f.com[0], 1e3 * f.com[1], 1e3 * f.com[2]))
+    text += "  inertia about it (Ixx Iyy Izz Ixy Ixz Iyz) [kg m^2]:" + "".join(" %.4g" % v for v in f.inertia) + "\n"
+    text += "  standard deviations: m c [kg m]" + "".join(" %.2g%s" % (f.pi_sd[k], star(k)) for k in range(1, 4))
+    text += "; inertia about frame 6's origin (Ixx Ixy Ixz Iyy Iyz Izz) [kg m^2]"
+    return text + "".join(" %.2g%s" % (f.pi_sd[k], star(k)) for k in range(4, 10)) + "\n"
 
 
 def capture_text(r: CaptureResult) -> str:

@@ -21,17 +21,20 @@
 namespace pil {
 
 // X(Name, "name", meaning): the command frame's flag bits, bit k for the k-th entry. They qualify a
-// move_to (relative and has_limits a stream too); other verbs ignore them. A bit outside this list
-// makes the command bad_command.
-#define OSC_COMMAND_FLAG_LIST(X)                                                                              \
-  X(Relative, "relative",                                                                                     \
-    "position is an offset from where the queue ends, rpy a rotation applied to its orientation (both in "    \
-    "the base frame); otherwise both are absolute. stream: its setpoints are, from the pose it starts at")    \
-  X(HasRpy, "has_rpy", "rpy gives the target orientation; otherwise the orientation stays as it is")          \
-  X(Replace, "replace",                                                                                       \
-    "re-target: brake the running motion along its path, drop the queued moves, move from where it comes to " \
-    "rest; otherwise the move is queued")                                                                     \
-  X(HasLimits, "has_limits", "limits apply to this move or stream; otherwise the configured maxima (Command checks)")
+// move_to (relative and has_limits a stream too; payload an identify); other verbs ignore them. A bit
+// outside this list makes the command bad_command.
+#define OSC_COMMAND_FLAG_LIST(X)                                                                                      \
+  X(Relative, "relative",                                                                                             \
+    "position is an offset from where the queue ends, rpy a rotation applied to its orientation (both in "            \
+    "the base frame); otherwise both are absolute. stream: its setpoints are, from the pose it starts at")            \
+  X(HasRpy, "has_rpy", "rpy gives the target orientation; otherwise the orientation stays as it is")                  \
+  X(Replace, "replace",                                                                                               \
+    "re-target: brake the running motion along its path, drop the queued moves, move from where it comes to "         \
+    "rest; otherwise the move is queued")                                                                             \
+  X(HasLimits, "has_limits", "limits apply to this move or stream; otherwise the configured maxima (Command checks)") \
+  X(Payload, "payload",                                                                                               \
+    "identify: estimate the payload at the flange too, all ten of its inertial parameters (an identify_payload "      \
+    "frame follows the identify frame)")
 
 // The masks of a list of flag bits: `LIST(OSC_X_FLAG_MASK)` with OSC_X_PREFIX the bits' prefix
 // (the enumerators) and OSC_X_MASK the masks'.
@@ -229,6 +232,24 @@ constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC
     "bit k set: friction[k] is identified (its standard deviation within params::kIdentifiedFraction of it)")          \
   X(float, armature, [kJoints], "kg m^2", "each drive's armature correction (what the model's armature lacks)")        \
   X(float, armature_sd, [kJoints], "kg m^2", "their standard deviations")
+
+// The identify_payload frame: an identify run's estimate of the payload at the flange (the run asked with the
+// command flag payload; osc/kernels/payload.hpp), sent right after its identify frame. The mass, centre of mass and
+// inertia are in the form the parameters payload_mass, payload_com and payload_inertia take them (0 when the run is
+// not ok); the standard deviations and the verdicts are the estimated parameters' pi: the mass, its first moment
+// m c (frame 6) and its inertia about frame 6's origin (Ixx, Ixy, Ixz, Iyy, Iyz, Izz).
+#define OSC_IDENTIFY_PAYLOAD_FIELDS(X)                                                                                 \
+  X(std::uint32_t, id, , "", "the identify command's id")                                                              \
+  X(std::uint8_t, status, , "", "the run's: ok, or why there is no estimate (Identify statuses)")                      \
+  X(float, mass, , "kg", "the payload's mass")                                                                         \
+  X(float, com, [3], "m", "its centre of mass in frame 6")                                                             \
+  X(float, inertia, [6], "kg m^2", "its inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz") \
+  X(float, pi_sd, [10], "kg, kg m, kg m^2",                                                                            \
+    "the standard deviations of the estimated parameters: m; m c (x, y, z); the inertia about frame 6's origin "       \
+    "(Ixx, Ixy, Ixz, Iyy, Iyz, Izz)")                                                                                  \
+  X(std::uint32_t, identified, , "",                                                                                   \
+    "bit k set: the k-th of those parameters is identified (its standard deviation within "                            \
+    "params::kIdentifiedFraction of it)")
 
 // The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
 // (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as

@@ -100,6 +100,11 @@ MotionReason command_from_frame(const pil::CommandFrame& f, MoveRequest<S>& req,
   return MotionReason::kNone;
 }
 
+/// The payload's entries an identify command's run estimates too (payload_mask): all ten with the flag payload.
+inline std::uint16_t identify_payload_mask(const pil::CommandFrame& f) {
+  return (f.flags & pil::kFlagPayload) != 0 ? payload_mask::kAll : payload_mask::kNone;
+}
+
 /// A command frame, ready for the task's mailbox (ControlTask::pending) at tick `next_tick`: decoded
 /// (command_from_frame), then prepared (prepare_move for move_to, prepare_command otherwise; `max`:
 /// the configured limits). A bad frame gives a command refused with bad_command.

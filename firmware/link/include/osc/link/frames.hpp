@@ -133,7 +133,10 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
   X(Capture, 12, "capture", "host", "a capture request: arm, trigger, abort, status, read (answered at once)",         \
     OSC_CAPTURE_FIELDS)                                                                                                \
   X(CaptureData, 13, "capture_data", "firmware", "the answer to each capture frame, sent as it is handled",            \
-    OSC_CAPTURE_DATA_FIELDS)
+    OSC_CAPTURE_DATA_FIELDS)                                                                                           \
+  X(IdentifyPayload, 14, "identify_payload", "firmware",                                                               \
+    "right after the identify frame of a run asked with the flag payload: its estimate of the payload at the flange",  \
+    OSC_IDENTIFY_PAYLOAD_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

@@ -1,7 +1,9 @@
 // The main loop's side of an identify run on a board that estimates (issue 57; docs/adaptation.md, "The identify
 // command"): the run's samples from the task's sampler summed into the estimate (osc/runtime/identify_run.hpp,
 // IdentifyRun), and when the run's motion ends, its report to the client as one identify frame
-// (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted.
+// (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted; a run
+// asked with the command flag payload estimates the payload at the flange too and sends it in an identify_payload
+// frame right after.
 //
 // A board calls after_tick() from its main loop, after every tick where it runs in lockstep (the virtual board,
 // osc_sim, after CommandPort::after_tick_and_poll; the QEMU images, pil_firmware.cpp), or as often as its main loop
@@ -49,6 +51,25 @@ inline pil::IdentifyFrame identify_frame(std::uint32_t id, const IdentifyReport&
   return f;
 }
 
+/// A run's payload estimate as its frame (f32): the body (mass, centre of mass, inertia about it) when the run is ok,
+/// the estimated parameters' sigma and verdicts always.
+inline pil::IdentifyPayloadFrame identify_payload_frame(std::uint32_t id, const IdentifyReport& r) {
+  pil::IdentifyPayloadFrame f;
+  f.id = id;
+  f.status = static_cast<std::uint8_t>(r.status);
+  if (r.status == IdentifyStatus::kOk) {
+    const Payload b = PayloadParams<double>::of(r.payload).body();
+    f.mass = static_cast<float>(b.mass);
+    for (int k = 0; k < 3; ++k) f.com[k] = static_cast<float>(b.com[k]);
+    for (int k = 0; k < 6; ++k) f.inertia[k] = static_cast<float>(b.inertia[k]);
+  }
+  for (int k = 0; k < 10; ++k) {
+    f.pi_sd[k] = static_cast<float>(r.payload_sd(k));
+    if (r.payload_verdict[static_cast<std::size_t>(k)] == CoefficientVerdict::kIdentified) f.identified |= 1u << k;
+  }
+  return f;
+}
+
 /// Follows the task's identify runs from the main loop and reports each one's end (the file comment).
 template <class S>
 class IdentifyPort {
@@ -61,7 +82,7 @@ class IdentifyPort {
     const std::uint32_t accepted = s.accepted;
     if (accepted != followed_) {  // a run accepted since the last call
       followed_ = accepted;
-      run_.start(s.accepted_id, payload_mask::kNone, task.model, task.without_payload(), &task.io);
+      run_.start(s.accepted_id, s.accepted_payload, task.model, task.without_payload(), &task.io);
       active_ = true;
     }
     if (!active_) return;
@@ -79,6 +100,7 @@ class IdentifyPort {
     last_ = report;
     std::uint8_t buf[pil::kMaxFrame];
     write(buf, pil::encode(identify_frame(run_.id(), report, run_.taken(), run_.lost()), buf));
+    if (run_.payload() != payload_mask::kNone) write(buf, pil::encode(identify_payload_frame(run_.id(), report), buf));
   }
   /// Whether a run is being followed.
   bool active() const { return active_; }

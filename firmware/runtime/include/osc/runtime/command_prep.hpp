@@ -8,6 +8,7 @@
 #include <cstdint>
 
 #include "osc/control/excitation.hpp"
+#include "osc/control/identify_estimate.hpp"  // payload_mask
 #include "osc/control/path_check.hpp"
 #include "osc/runtime/homing.hpp"
 #include "osc/runtime/motion_commands.hpp"
@@ -99,13 +100,16 @@ constexpr MotionReason excitation_refusal(ExcitationStatus s) {
 
 /// The same about the joint angles q (a paced board's copy of the last measured ones), with the
 /// controller's reference orientation R_ref and its gains (the sampled loop's test, as a move's path
-/// check: unstable_loop), in the workspace `data`.
+/// check: unstable_loop), in the workspace `data`. payload: the payload's entries the run estimates too
+/// (payload_mask).
 template <class S>
 TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains, Data<S>& data, const Vec6<S>& q,
-                                   const Mat3<S>& R_ref, std::uint32_t id, ExcitationCheck<S>* check) {
+                                   const Mat3<S>& R_ref, std::uint32_t id, ExcitationCheck<S>* check,
+                                   std::uint16_t payload = payload_mask::kNone) {
   TaskCommand<S> c;
   c.verb = MotionVerb::kIdentify;
   c.id = id;
+  c.payload = payload;
   const loop::PathLoop loop = loop::path_loop(gains.template cast<double>(), params::kPathLoopMargin);
   const ExcitationCheck<S> r =
       prepare_excitation(model, data, q, R_ref, ExcitationLimits<S>::defaults(), c.excitation, &loop);
@@ -121,9 +125,10 @@ TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains,
 /// name rather than stopped halfway. Whether the arm holds there (else not_enabled, busy) is the tick's to
 /// decide. `check`, when given, receives the check's report (which joint, which tick, the peaks).
 template <class S>
-TaskCommand<S> prepare_identify(ControlTask<S>& task, std::uint32_t id, ExcitationCheck<S>* check = nullptr) {
+TaskCommand<S> prepare_identify(ControlTask<S>& task, std::uint32_t id, ExcitationCheck<S>* check = nullptr,
+                                std::uint16_t payload = payload_mask::kNone) {
   return prepare_identify_at(task.model, task.gains, task.check_data, task.state.adapt.q_prev, task.state.R_ref, id,
-                             check);
+                             check, payload);
 }
 
 /// Puts a setpoint of stream `id` (with its velocity, or none) into the task's mailbox for the next

@@ -76,6 +76,7 @@ struct IdentifySampler {
   // A run's accept and end, for a main loop that does not see every tick (osc/link/identify_port.hpp): the tick
   // writes each event's fields before its count.
   std::uint32_t accepted_id;        // the identify command accepted last
+  std::uint16_t accepted_payload;   // ... and the payload's entries it estimates too (payload_mask)
   volatile std::uint32_t accepted;  // identify commands accepted since the reset
   volatile std::uint32_t ended;     // the run (its `accepted` count) whose end was reported last; 0: none
   bool ended_done;                  // that end: done (its motion complete), else aborted
@@ -84,15 +85,18 @@ struct IdentifySampler {
     ticks = 0;
     run_id = 0;
     accepted_id = 0;
+    accepted_payload = payload_mask::kNone;
     accepted = 0;
     ended = 0;
     ended_done = false;
   }
-  /// An identify command `id` accepted: its run starts at the next tick it records, whatever the id.
-  void accept(std::uint32_t id) {
+  /// An identify command `id` accepted, estimating the payload's entries `payload` (payload_mask) too: its run starts
+  /// at the next tick it records, whatever the id.
+  void accept(std::uint32_t id, std::uint16_t payload = payload_mask::kNone) {
     ticks = 0;
     run_id = 0;
     accepted_id = id;
+    accepted_payload = payload;
     accepted = accepted + 1;
   }
   /// The tick's report of the motions it ended (MotionReport's done_id and aborted_id): the accepted run's end, once.
@@ -159,6 +163,8 @@ class IdentifyRun {
   /// The report of the run (the estimate's solve, with the filter's correlation factor).
   IdentifyReport finish() { return estimate_.solve(identify::noise_correlation_factor(params::kRunSampleTicks)); }
   std::uint32_t id() const { return id_; }
+  /// The payload's entries the run estimates (payload_mask).
+  std::uint16_t payload() const { return estimate_.mask(); }
   /// The run's filter (its newest outputs: filter().signals()).
   const IdentifyFilter<S>& filter() const { return filter_; }
   /// The samples summed, and those a gap cost (the main loop's polls more than the ring apart).

@@ -95,7 +95,8 @@ struct TaskCommand {
   bool relative = false;                       ///< stream: setpoints relative to where it starts
   CartesianLimits<S> limits{};                 ///< stream: its limits
   ExcitationMotion<S> excitation{};            ///< identify: the motion, planned and checked
-  bool checked = false;  ///< identify: planned and checked by prepare_identify (else the tick refuses it)
+  std::uint16_t payload = 0;  ///< identify: the payload's entries estimated too (payload_mask; 0: none)
+  bool checked = false;       ///< identify: planned and checked by prepare_identify (else the tick refuses it)
 };
 
 /// One setpoint of a stream, ready for the next tick (prepare_setpoint): the follower's target in

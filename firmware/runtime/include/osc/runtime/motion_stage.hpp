@@ -264,7 +264,7 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
     task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
   if (accepted && cmd.verb == MotionVerb::kIdentify) {
     task.gen.start_excitation(cmd.excitation, next, cmd.id);
-    task.identify.accept(cmd.id);  // its sampler starts again at the run's first tick, whatever the id
+    task.identify.accept(cmd.id, cmd.payload);  // its sampler starts again at the run's first tick, whatever the id
   }
   // Into yielding, the motion is dropped; out of it, the pose reached is held.
   if ((st.machine.state == MotionState::kYielding) != (before == MotionState::kYielding)) hold_measured_pose(task, q);
