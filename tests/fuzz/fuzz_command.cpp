@@ -47,7 +47,7 @@ const osc::CartesianLimits<double> kMax = osc::CartesianLimits<double>::defaults
 
 /// The command checks of docs/protocol.md, written from the document (not from the code).
 bool valid_by_the_document(const pil::CommandFrame& f) {
-  if (f.verb > 10 || (f.flags & 0xF0) != 0) return false;             // verbs 0 to 10: none ... declare_pose, identify
+  if (f.verb > 10 || (f.flags & 0xE0) != 0) return false;             // verbs 0 to 10; flags 0 to 4 (payload)
   if (f.verb == 7 && (f.period < 1 || f.period > 100)) return false;  // stream: 1 to 100 ms
   for (int i = 0; i < 3; ++i) {
     if (std::isnan(f.position[i]) || std::isinf(f.position[i]) || f.position[i] < -10.0f || f.position[i] > 10.0f)
@@ -122,8 +122,13 @@ struct Checker {
     if (why == MotionReason::kNone) {
       std::uint8_t a[pil::kMaxFrame], b[pil::kMaxFrame];
       const int n = pil::encode(f, a);
-      FUZZ_CHECK(osc::encode_command(f.id, verb, req, b) == n);
+      // The request gives the frame back, but for identify's flag payload, which no request carries (a client adds
+      // it: osc_client's identify(payload)).
+      pil::CommandFrame g = osc::frame_from_command(f.id, verb, req);
+      g.flags = static_cast<std::uint8_t>(g.flags | (f.flags & pil::kFlagPayload));
+      FUZZ_CHECK(pil::encode(g, b) == n);
       FUZZ_CHECK(std::memcmp(a, b, static_cast<std::size_t>(n)) == 0);
+      FUZZ_CHECK((f.flags & pil::kFlagPayload) != 0 || osc::encode_command(f.id, verb, req, b) == n);
     }
     const osc::TaskCommand<double> c = osc::prepare_frame_command(gen, kMax, next_tick, kHz, f);
     FUZZ_CHECK(c.id == f.id);
