@@ -151,7 +151,9 @@ TEST(FrictionIdentification, TheReportedSigmaCoversThePlantsFrictionOver20Seeds)
     std::printf("coverage %s J%d: %d/%d within 2 sigma, %d within 3, largest %.2f sigma, claimed in %d\n", names[v / 6],
                 v % 6 + 1, within2[v], kSeeds, within3[v], largest[v], claimed[v]);
     all2 += within2[v], all3 += within3[v];
-    if (v >= 18) EXPECT_EQ(claimed[v], kSeeds) << "the sum of J" << v - 17;
+    if (v >= 18) {
+      EXPECT_EQ(claimed[v], kSeeds) << "the sum of J" << v - 17;
+    }
   }
   std::printf("coverage: %d of %d within 2 sigma (%.1f %%), %d within 3\n", all2, kSeeds * kValues,
               100.0 * all2 / (kSeeds * kValues), all3);
