@@ -306,8 +306,8 @@ void print_identify_payload(const pil::IdentifyPayloadFrame& f) {
 /// identify --payload --apply: the payload's estimate into payload_mass, payload_com and payload_inertia (the torque
 /// off already). The inertia goes in zeroed first, then its moments before its products; where the parameters refuse
 /// it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass), it is zeroed again
-/// and left so, and said. A mass within
-/// two of its standard deviations of 0 is no payload (its centre of mass is noise over noise): all of it set to 0.
+/// and left so, and said. A mass within two of its standard deviations of 0 is no payload (its centre of mass is
+/// noise over noise): all of it set to 0.
 int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadFrame& f) {
   const auto set = [&](const char* name, int e, double v, bool quiet_refusal = false) -> int {
     const auto r = c.param(pil::kParamOpSet, osc::param_index(name), e, v, a.timeout);

@@ -537,7 +537,7 @@ void identify_kernels(const Vec6<F>& q0) {
   // The solve at the run's end (main loop, once): the three passes of the weighted least squares and the report's
   // sigmas, in doubles (soft-float on both cores). Its cost does not depend on the samples taken; the rest of the
   // period first (untimed), so that every joint has its rows and the solve goes all the way.
-  for (int k = 2000; k < static_cast<int>(params::kExcitationPeriod * params::kControlHz); ++k) {
+  for (int k = 2000; k < static_cast<int>(excitation::kPeriodTicks); ++k) {
     ++g_task.tick;
     const JointSample<F> js = g_excitation.at_tick(static_cast<std::uint64_t>(k + 1));
     g_task.identify.tick(7, js.q, g_task.last.tau, js.qd, dec);
