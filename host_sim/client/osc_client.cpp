@@ -166,6 +166,16 @@ std::string fault_names(std::uint32_t bits) {
   return s;
 }
 
+std::string friction_fit_text(std::uint8_t checked, std::uint8_t stale) {
+  std::string t;
+  for (int i = 0; i < kDof; ++i) {
+    t += i ? ", J" : "J";
+    t += std::to_string(i + 1);
+    t += !(checked >> i & 1u) ? " -" : (stale >> i & 1u) ? " stale" : " fits";
+  }
+  return t;
+}
+
 std::string state_text(const pil::StateFrame& s) {
   std::string t;
   t += std::string("state: ") + name_of<MotionState>(s.state) + "\n";
@@ -177,6 +187,7 @@ std::string state_text(const pil::StateFrame& s) {
   t += "measured: " + pose_text(s.x) + "\n";
   t += "dropped: " + std::to_string(s.dropped) + "\n";
   t += "tick: " + std::to_string(s.tick) + "\n";
+  t += "friction_fit: " + friction_fit_text(s.friction_checked, s.friction_stale) + "\n";
   return t;
 }
 

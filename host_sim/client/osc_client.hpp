@@ -98,6 +98,9 @@ struct Outcome {
 std::string fault_names(std::uint32_t bits);
 /// A state frame as lines: state, stop, faults, queued, running id, reference and measured pose.
 std::string state_text(const pil::StateFrame& s);
+/// "J1 fits, J2 stale, J3 -, ...": each joint's friction as set, checked by the momentum law (fits, stale) or not yet
+/// (-): the state frame's friction_checked and friction_stale.
+std::string friction_fit_text(std::uint8_t checked, std::uint8_t stale);
 /// An answer frame as one line: the command answered, a motion done or aborted, a completion.
 std::string answer_text(const pil::AnswerFrame& a);
 

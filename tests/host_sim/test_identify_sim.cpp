@@ -382,3 +382,100 @@ TEST(IdentifySim, AFirstMoveFromSavedFrictionIsNotAColdStart) {
   EXPECT_LE(warm, 0.5e-3);
   EXPECT_LE(known, 0.5e-3);
 }
+
+/// Issue 57's stale saved friction in closed loop: an arm built afresh (a power-on) on `plant` applies the friction
+/// `saved` (as a board's boot applies its stored record) and runs the paper's motion for `seconds`. Returns each
+/// joint's verdict (the state frame's friction_checked and friction_stale, FrictionIdentifier::checked and stale)
+/// and the time of its first check [s] (-1 none).
+struct FitVerdict {
+  std::uint8_t checked = 0, stale = 0;
+  double at[kDof] = {-1, -1, -1, -1, -1, -1};
+};
+static FitVerdict fit_after_power_on(const sim::PlantConfig& plant, const FrictionCoefficients& saved, double seconds,
+                                     const sim::SensorConfig& sensors = {}) {
+  MotionSim<double> sim(start_pose(), {}, plant, FrictionMode::kAdaptive, Gains<double>::paper(), sensors);
+  const char* names[3] = {"friction_vis", "friction_cou", "friction_sti"};
+  const double* values[3] = {saved.vis, saved.cou, saved.sti};
+  for (int c = 0; c < 3; ++c)
+    for (int i = 0; i < kDof; ++i)
+      EXPECT_EQ(param_set(sim.task(), param_index(names[c]), i, values[c][i]), ParamStatus::kOk) << names[c] << i;
+  EXPECT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  EXPECT_EQ(answer(sim, MotionVerb::kPaper, 2).outcome, CommandOutcome::kAccepted);
+  FitVerdict v;
+  std::uint32_t faults = 0;
+  const auto& id = sim.task().state.adapt.identifier;
+  for (long k = 0; k < static_cast<long>(seconds * params::kControlHz); ++k) {
+    faults |= sim.tick();
+    for (int i = 0; i < kDof; ++i)
+      if (v.at[i] < 0 && (id.checked() >> i & 1u)) v.at[i] = sim.plant().time();
+  }
+  EXPECT_EQ(faults, 0u) << fault_name(faults);
+  v.checked = id.checked();
+  v.stale = id.stale;
+  for (int i = 0; i < kDof; ++i)
+    std::printf("  J%d: %s at %.1f s; breakaway set %.3f, now %.3f N m\n", i + 1,
+                !(v.checked >> i & 1u) ? "not checked"
+                : (v.stale >> i & 1u)  ? "stale"
+                                       : "fits",
+                v.at[i], saved.cou[i] + saved.sti[i],
+                sim.task().state.adapt.theta_hat(kDof + i) + sim.task().state.adapt.theta_hat(2 * kDof + i));
+  return v;
+}
+
+// A saved friction that fits is checked and found to fit; one that no longer fits the arm (the arm's J2 friction 40 %
+// above it, J1's 40 % below) is reported stale on those joints within the paper's motion, and the others still fit;
+// one 10 % off, within params::kSavedFitFraction, fits. The saved friction is the plant's (an identification that was
+// exact); the ideal plant with the paper's friction.
+TEST(IdentifySim, ASavedFrictionThatNoLongerFitsTheArmIsReportedStale) {
+  const sim::PlantConfig plant;
+  const FrictionCoefficients saved = plant.friction;
+  std::printf("the plant's friction, saved:\n");
+  const FitVerdict same = fit_after_power_on(plant, saved, 120);
+  sim::PlantConfig changed = plant;
+  for (auto [i, f] : {std::pair{0, 0.6}, std::pair{1, 1.4}})
+    changed.friction.vis[i] *= f, changed.friction.cou[i] *= f, changed.friction.sti[i] *= f;
+  std::printf("J1's friction 40 %% below the saved, J2's 40 %% above:\n");
+  const FitVerdict stale = fit_after_power_on(changed, saved, 120);
+  sim::PlantConfig near = plant;
+  for (int i = 0; i < kDof; ++i) near.friction.vis[i] *= 1.1, near.friction.cou[i] *= 1.1, near.friction.sti[i] *= 1.1;
+  std::printf("every joint's friction 10 %% above the saved:\n");
+  const FitVerdict within = fit_after_power_on(near, saved, 120);
+  // Every joint is checked on the paper's motion, within 30 s (J1, the slowest; measured 29.7-29.8 s).
+  for (const FitVerdict* v : {&same, &stale, &within}) {
+    EXPECT_EQ(v->checked, 0x3Fu);
+    for (int i = 0; i < kDof; ++i) EXPECT_LE(v->at[i], 35.0) << i;
+  }
+  EXPECT_EQ(same.stale, 0u);
+  EXPECT_EQ(stale.stale, 0x3u);
+  EXPECT_EQ(within.stale, 0u);
+}
+
+// The same on the realistic plant (every feature at its mid value, the friction drifting +-30 % an hour), the saved
+// friction what the law learnt there in the paper's 120 s (param_capture, as param save keeps it): after a power-on
+// the same arm's is found to fit, and with J2's friction 40 % above it, stale.
+TEST(IdentifySim, OnTheRealisticPlantWhatTheLawLearntFitsAfterAPowerOn) {
+  if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's realistic plant";
+  sim::ExperimentConfig cfg;
+  ASSERT_TRUE(sim::apply_plant_preset("realistic", cfg));
+  MotionSim<double> a(start_pose(), {}, cfg.plant, FrictionMode::kAdaptive, Gains<double>::paper(),
+                      cfg.sensor_config());
+  EXPECT_EQ(answer(a, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+  EXPECT_EQ(answer(a, MotionVerb::kPaper, 2).outcome, CommandOutcome::kAccepted);
+  const auto tr = run_ticks(a, 120000);
+  EXPECT_EQ(tr.faults, 0u) << fault_name(tr.faults);
+  FrictionCoefficients learnt{};
+  for (int i = 0; i < kDof; ++i) {
+    const Vec18<double>& th = a.task().state.adapt.theta_hat;
+    learnt.vis[i] = static_cast<float>(th(i)), learnt.cou[i] = static_cast<float>(th(kDof + i));
+    learnt.sti[i] = static_cast<float>(th(2 * kDof + i));
+  }
+  std::printf("realistic, what the law learnt, saved:\n");
+  const FitVerdict same = fit_after_power_on(cfg.plant, learnt, 120, cfg.sensor_config());
+  sim::PlantConfig changed = cfg.plant;
+  changed.friction.vis[1] *= 1.4, changed.friction.cou[1] *= 1.4, changed.friction.sti[1] *= 1.4;
+  std::printf("realistic, J2's friction 40 %% above:\n");
+  const FitVerdict stale = fit_after_power_on(changed, learnt, 120, cfg.sensor_config());
+  EXPECT_EQ(same.stale, 0u);
+  EXPECT_EQ(stale.stale & 0x2u, 0x2u);
+  EXPECT_EQ(same.checked, 0x3Fu);
+}

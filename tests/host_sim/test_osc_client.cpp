@@ -293,6 +293,10 @@ TEST(OscClientText, NamesAreTheFirmwares) {
   s.stop = static_cast<std::uint8_t>(osc::StopCategory::kCategory2);
   const std::string text = osc::client::state_text(s);
   EXPECT_NE(text.find("state: stopping\nstop: category_2\nfaults: none\n"), std::string::npos) << text;
+  // The saved friction's check (issue 57): J1 and J2 checked, J2 stale, the others not yet.
+  s.friction_checked = 0x3, s.friction_stale = 0x2;
+  EXPECT_NE(osc::client::state_text(s).find("friction_fit: J1 fits, J2 stale, J3 -, J4 -, J5 -, J6 -\n"),
+            std::string::npos);
   pil::AnswerFrame a;
   a.id = 9, a.verb = static_cast<std::uint8_t>(osc::MotionVerb::kMoveTo);
   a.outcome = static_cast<std::uint8_t>(osc::CommandOutcome::kRefused);

@@ -167,3 +167,10 @@ def test_osc_protocol_names_another_file(tmp_path: Path, monkeypatch: pytest.Mon
 def test_frame_classes_are_frozen() -> None:
     with pytest.raises(dataclasses.FrozenInstanceError):
         State().tick = 1  # type: ignore[misc]
+
+
+def test_the_state_texts_friction_fit(protocol: Protocol) -> None:
+    """The saved friction's check (issue 57): J1 and J2 checked, J2 stale, the others not yet; as oscctl prints it."""
+    from osc_client.text import state_text
+    text = state_text(protocol, State(x_d=(0.0,) * 6, x=(0.0,) * 6, friction_checked=0x3, friction_stale=0x2))
+    assert "friction_fit: J1 fits, J2 stale, J3 -, J4 -, J5 -, J6 -\n" in text

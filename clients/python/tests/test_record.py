@@ -22,19 +22,20 @@ from fakes import StateFeed
 
 HEADER = ("tick,t,state,stop,faults,queued,running_id,dropped,"
           "x_d[0],x_d[1],x_d[2],x_d[3],x_d[4],x_d[5],x[0],x[1],x[2],x[3],x[4],x[5],"
-          "link[0],link[1],link[2],link[3],link[4],link[5],link[6]")
+          "link[0],link[1],link[2],link[3],link[4],link[5],link[6],friction_checked,friction_stale")
 FRAMES = (
     State(state=1, x_d=(0.4318, 0.15, 0.4, 0.0, 1.5, -0.25), x=(0.4318, 0.15, 0.4, 0.0, 1.5, -0.25), tick=1000),
     State(state=2, queued=1, running_id=7, x_d=(0.4318, 0.16, 0.4, 0.0, 1.5, -0.25),
           x=(0.4318, 0.157, 0.404, 0.0, 1.5, -0.25), tick=1020, link=(1, 0, 0, 3, 0, 0, 0)),
     State(state=2, stop=1, faults=1 << 5, running_id=7, dropped=2, x_d=(0.4318, 0.17, 0.4, 0.0, 1.5, -0.25),
-          x=(0.4318, 0.168, 0.401, 0.0, 1.5, -0.25), tick=1040, link=(1, 0, 0, 3, 0, 0, 2)),
+          x=(0.4318, 0.168, 0.401, 0.0, 1.5, -0.25), tick=1040, link=(1, 0, 0, 3, 0, 0, 2), friction_checked=3,
+          friction_stale=2),
 )
 """Three state frames of a board: holding, then moving (one queued, a link error), then a fault latched."""
 CSV = HEADER + "\n" + "".join(row + "\n" for row in (
-    "1000,1.0,1,0,0,0,0,0,0.4318,0.15,0.4,0.0,1.5,-0.25,0.4318,0.15,0.4,0.0,1.5,-0.25,0,0,0,0,0,0,0",
-    "1020,1.02,2,0,0,1,7,0,0.4318,0.16,0.4,0.0,1.5,-0.25,0.4318,0.157,0.404,0.0,1.5,-0.25,1,0,0,3,0,0,0",
-    "1040,1.04,2,1,32,0,7,2,0.4318,0.17,0.4,0.0,1.5,-0.25,0.4318,0.168,0.401,0.0,1.5,-0.25,1,0,0,3,0,0,2"))
+    "1000,1.0,1,0,0,0,0,0,0.4318,0.15,0.4,0.0,1.5,-0.25,0.4318,0.15,0.4,0.0,1.5,-0.25,0,0,0,0,0,0,0,0,0",
+    "1020,1.02,2,0,0,1,7,0,0.4318,0.16,0.4,0.0,1.5,-0.25,0.4318,0.157,0.404,0.0,1.5,-0.25,1,0,0,3,0,0,0,0,0",
+    "1040,1.04,2,1,32,0,7,2,0.4318,0.17,0.4,0.0,1.5,-0.25,0.4318,0.168,0.401,0.0,1.5,-0.25,1,0,0,3,0,0,2,3,2"))
 """What record writes of FRAMES, as they come over the wire (32-bit floats)."""
 
 
@@ -212,7 +213,7 @@ def test_signal_names(protocol: Protocol, name: str, signal_name: str, kind: Sig
 
 
 VALID = ("the signals are state, stop, faults, queued, running_id, dropped, x_d[0..5], x[0..5], tick, link[0..6], "
-         "error, error[0..2]")
+         "friction_checked, friction_stale, error, error[0..2]")
 
 
 @pytest.mark.parametrize("name, message", [
@@ -234,7 +235,7 @@ def test_bad_signal_names_are_named_errors(protocol: Protocol, name: str, messag
 
 def test_every_signal_name_parses(protocol: Protocol) -> None:
     names = signal_names(protocol)
-    assert len(names) == 6 + 6 + 6 + 1 + 7 + 4 and names[-4:] == ["error", "error[0]", "error[1]", "error[2]"]
+    assert len(names) == 6 + 6 + 6 + 1 + 7 + 2 + 4 and names[-4:] == ["error", "error[0]", "error[1]", "error[2]"]
     assert [parse_signal(protocol, n).name for n in names] == names
 
 

@@ -36,7 +36,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   EXPECT_EQ(pil::kCommandPayload, 4 + 1 + 1 + 12 + 12 + 24 + 1);
   EXPECT_EQ(pil::kSetpointPayload, 4 + 1 + 12 + 12);
   EXPECT_EQ(pil::kAnswerPayload, 4 + 1 + 1 + 1 + 4 + 4 + 4 + 1 + 1 + 1 + 1 + 1 + 4);
-  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4 + 4 * pil::kLinkErrorKinds);
+  EXPECT_EQ(pil::kStatePayload, 1 + 1 + 4 + 1 + 4 + 4 + 24 + 24 + 4 + 4 * pil::kLinkErrorKinds + 1 + 1);
   EXPECT_EQ(pil::kTracePayload, 4 + 4 + 1 + 3 * 24 + 36);
   EXPECT_EQ(pil::kParamFrame, 9);
   EXPECT_EQ(pil::kParamAnswerFrame, 10);
@@ -126,6 +126,7 @@ TEST(CommandFrames, StateRoundTripsFieldByField) {
   for (int i = 0; i < 6; ++i) s.x_d[i] = 0.5f * static_cast<float>(i) - 1.0f, s.x[i] = -0.25f * static_cast<float>(i);
   s.tick = 0xFFFFFFFEu;
   for (int k = 0; k < pil::kLinkErrorKinds; ++k) s.link.count[k] = 1000u * static_cast<std::uint32_t>(k) + 7u;
+  s.friction_checked = 0x3F, s.friction_stale = 0x21;
   const pil::StateFrame t = decoded<pil::StateFrame>(parsed(bytes_of(s)));
   EXPECT_EQ(t.state, s.state);
   EXPECT_EQ(t.stop, s.stop);
@@ -137,6 +138,8 @@ TEST(CommandFrames, StateRoundTripsFieldByField) {
   }
   EXPECT_EQ(t.tick, s.tick);
   for (int k = 0; k < pil::kLinkErrorKinds; ++k) EXPECT_EQ(t.link.count[k], s.link.count[k]) << k;
+  EXPECT_EQ(t.friction_checked, s.friction_checked);
+  EXPECT_EQ(t.friction_stale, s.friction_stale);
 }
 
 }  // namespace

@@ -553,6 +553,14 @@ TEST_F(TaskFrames, StateFrameOfATask) {
   const Pose<double> to = move_target(from, req);
   EXPECT_LT((to.R - from.R).norm(), 1e-6);
   EXPECT_LT((to.p - from.p).norm(), 1e-6);
+  // The saved friction's check is the momentum law's (FrictionIdentifier::checked and stale): nothing set, none.
+  EXPECT_EQ(s.friction_checked, 0);
+  EXPECT_EQ(s.friction_stale, 0);
+  FrictionIdentifier<double>& id = node->task.state.adapt.identifier;
+  id.judged[0] = 0x1, id.judged[1] = 0x6, id.stale = 0x4;
+  const pil::StateFrame v = state_frame_from_task(node->task);
+  EXPECT_EQ(v.friction_checked, 0x7);
+  EXPECT_EQ(v.friction_stale, 0x4);
 }
 
 TEST_F(TaskFrames, ACommandIsAnsweredInTheTickAfterItArrives) {

@@ -153,6 +153,8 @@ class State(Frame):
     x: Floats = ()  # the measured pose
     tick: int = 0
     link: Ints = ()  # the command link's error counters (OSC_LINK_ERROR_LIST's order)
+    friction_checked: int = 0  # joints (bit i: joint i + 1) whose set friction the momentum law has checked
+    friction_stale: int = 0  # of those, the joints whose set friction no longer fits the arm
 
 
 @dataclass(frozen=True)

@@ -223,8 +223,8 @@ def signal_names(p: Protocol) -> list[str]:
 
 
 def signals_text(p: Protocol) -> str:
-    """The signals' names in short: ``state, stop, ..., x_d[0..5], x[0..5], tick, link[0..6], error,
-    error[0..2]``."""
+    """The signals' names in short: ``state, stop, ..., x_d[0..5], x[0..5], tick, link[0..6], friction_checked,
+    friction_stale, error, error[0..2]``."""
     names = [f.name if f.count == 1 else f"{f.name}[0..{f.count - 1}]" for f in _state_fields(p)]
     if _has_error(p):
         names += [ERROR, f"{ERROR}[0..{ERROR_AXES - 1}]"]

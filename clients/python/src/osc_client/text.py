@@ -35,7 +35,15 @@ def state_text(p: Protocol, s: State) -> str:
             f"reference: {pose_text(s.x_d)}\n"
             f"measured: {pose_text(s.x)}\n"
             f"dropped: {s.dropped}\n"
-            f"tick: {s.tick}\n")
+            f"tick: {s.tick}\n"
+            f"friction_fit: {friction_fit_text(s.friction_checked, s.friction_stale)}\n")
+
+
+def friction_fit_text(checked: int, stale: int) -> str:
+    """``J1 fits, J2 stale, J3 -, ...``: each joint's friction as set, checked by the momentum law (fits, stale) or
+    not yet (-): the state frame's friction_checked and friction_stale."""
+    return ", ".join(f"J{i + 1} " + ("-" if not checked >> i & 1 else "stale" if stale >> i & 1 else "fits")
+                     for i in range(DRIVES))
 
 
 def state_change_text(p: Protocol, s: State) -> str:

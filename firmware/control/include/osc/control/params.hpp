@@ -299,6 +299,14 @@ constexpr double kIdentifyDrift = 0.3;
 constexpr int kIdentifyNoiseSamples = 256;
 /// A coefficient is reported identified when its standard deviation is at most this fraction of it.
 constexpr double kIdentifiedFraction = 0.025;
+/// A friction set (a saved record applied at power-on, an identify run's applied: FrictionIdentifier::seed) is
+/// checked once per joint and coefficient, the viscous and the breakaway torque (Coulomb + Stribeck), when the
+/// momentum law first knows it within kIdentifiedFraction of the set value (FrictionIdentifier::judge): it no longer
+/// fits the arm (stale) when it lies more than this fraction of itself from the law's estimate. The torque it
+/// predicts is then more than 20 % off, the identification run's own failure bar (kIdentifyMaxPredictionError,
+/// Servotronix's RelTeMax); the bar is eight of the estimate's standard deviations then, so that a set that fits
+/// (within 10 %, four of them) is not called stale, nor one 30 % off found to fit.
+constexpr double kSavedFitFraction = 0.2;
 /// The residual monitor's travel check takes each joint's identified viscous coefficient and
 /// breakaway torque (Coulomb + Stribeck) at this many standard deviations above its estimate, in
 /// place of the band's top (FrictionIdentifier::prove; docs/safety.md, "The identified band"): in

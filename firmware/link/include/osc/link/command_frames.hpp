@@ -157,7 +157,13 @@ constexpr double kCommandMaxVelocity = 10.0;
     "the number of the last tick run (0: the first; 0xFFFFFFFF before it), low 32 bits")                        \
   X(LinkCounters, link, , "",                                                                                   \
     "the errors counted since start on the link this frame goes over, as its receiver at the controller's end " \
-    "sees the client's bytes: one u32 per kind (Link error counters; seq_errors and timeouts stay 0)")
+    "sees the client's bytes: one u32 per kind (Link error counters; seq_errors and timeouts stay 0)")          \
+  X(std::uint8_t, friction_checked, , "",                                                                       \
+    "joints (bit i: joint i + 1) whose friction as set (a saved record at power-on, an identify applied) the "  \
+    "momentum law has checked: once per coefficient, when it first knew it within 2.5 % of the set value")      \
+  X(std::uint8_t, friction_stale, , "",                                                                         \
+    "of those, the joints whose set friction lay more than params::kSavedFitFraction (20 %) off what the law "  \
+    "identified: it no longer fits the arm (the law goes on from the data; param save keeps what it learns)")
 
 // X(Name, "name", meaning): what a param frame asks (the parameter table, osc/runtime/parameters.hpp).
 // Each is answered at once by a param_answer frame, in the order they come.

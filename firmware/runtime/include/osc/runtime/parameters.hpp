@@ -93,8 +93,11 @@ template <class S>
 void model_put(ControlTask<S>& task, RuntimeParam which, int e, double v) {
   if (which == RuntimeParam::kParamArmatureCorrection) return task.set_armature(e, v);
   if (which == RuntimeParam::kParamFrictionVis || which == RuntimeParam::kParamFrictionCou ||
-      which == RuntimeParam::kParamFrictionSti)
-    return void(task.state.adapt.theta_hat(theta_index(which, e)) = static_cast<S>(v));
+      which == RuntimeParam::kParamFrictionSti) {
+    AdaptationState<S>& ad = task.state.adapt;  // the momentum law goes on from it, and checks it (seed)
+    ad.theta_hat(theta_index(which, e)) = static_cast<S>(v);
+    return ad.identifier.seed(e, ad.theta_hat);
+  }
   task.set_payload(payload_with(task.payload, which, e, v));
 }
 }  // namespace detail
