@@ -786,7 +786,7 @@ def identification_report():
     return "\n".join(lines)
 
 
-@table("sigma_coverage", "docs/adaptation.md", "host")
+@table("sigma_coverage", "docs/adaptation.md", "long")
 def sigma_coverage():
     """The momentum law's reported sigma on the paper's 120 s run over 20 seeds (test_identification_loop)."""
     out = test_output("test_identification_loop", "*20Seeds*")
@@ -809,7 +809,7 @@ def sigma_coverage():
     return "\n".join(lines)
 
 
-@table("payload_identified", "docs/adaptation.md", "host")
+@table("payload_identified", "docs/adaptation.md", "long")
 def payload_identified():
     """Payloads identified from a rough setting, then set: the paper's motion and 50 random moves
     (test_identify_sim)."""

@@ -2,7 +2,7 @@
 # The long runs, which CI does not run (docs/long_runs.md): every generated table of kind "long" in
 # docs/ (scripts/docs_tables.py --kind long: the QEMU experiment, the fault-injection matrix, the
 # one-hour runs of every law, plant and scalar, the monitors' margins, the residual monitor's runs,
-# the host benchmarks), regenerated in place, then the four-hour soak of the default law
+# the identify run's sweeps, the host benchmarks), regenerated in place, then the four-hour soak of the default law
 # (docs/adaptation.md, section 5; scripts/soak_hours.py). Hours of simulated time, most of an hour of
 # wall time on the 2-core machine. The host tests of label "long" are not these: `ctest --preset
 # host` runs them, in scripts/test.sh and CI.
@@ -41,7 +41,8 @@ status=0
 tables_result="not run"
 if ((tables)); then
   bash scripts/configure.sh host
-  cmake --build --preset host --target puma_experiment osc_bench
+  # the test binaries of the tables of 20-seed and nine-payload sweeps (sigma_coverage, payload_identified)
+  cmake --build --preset host --target puma_experiment osc_bench test_identification_loop test_identify_sim
   bash scripts/configure.sh m4f
   cmake --build --preset m4f --target pil_firmware  # the QEMU experiment's image
   stage builds
