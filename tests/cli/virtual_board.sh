@@ -271,10 +271,8 @@ store_estimate() {
   grep -Eq '^osc_sim: params (defaults \(none\)|in .*: the image applies)' "$tmp/sim.err" ||
     fail "a new store's start did not say defaults (none), or the image's store"
   expect 0 '^accepted$' -- "$@" --port "$port" enable
-  if [ ${#estimate_move[@]} -gt 0 ]; then
+  if [ ${#estimate_move[@]} -gt 0 ]; then  # then identify there: the run takes its orientation where it starts
     expect 0 '^done$' -- "$@" --port "$port" "${estimate_move[@]}"
-    expect 0 '^done$' -- "$@" --port "$port" disable
-    expect 0 '^accepted$' -- "$@" --port "$port" enable
   fi
   expect 0 '^done$' '^identify [0-9]+: ok; [0-9]+ samples, 0 lost' '^J6 ' '^friction_sti\[5\] = ' '^applied' -- \
     "$@" --port "$port" --timeout 300 identify --apply

@@ -11,6 +11,7 @@
 #include <cstdio>
 
 #include "motion_sim.hpp"
+#include "osc/link/commands.hpp"
 #include "motion_sim_util.hpp"
 #include "test_util.hpp"
 
@@ -64,12 +65,10 @@ MotionReport answer_identify(MotionSim<S>& sim, std::uint32_t id, ExcitationChec
   return sim.task().report;
 }
 
-/// The whole run in scalar S: accepted, within its limits every tick, done after its 80 s, holding where
-/// it started. Returns the envelope.
+/// The whole run in scalar S on an arm that holds: accepted, within its limits every tick, done after its 80 s,
+/// holding where it started. Returns the envelope.
 template <class S>
-Envelope whole_run() {
-  MotionSim<S> sim(test::identify_pose());
-  enable_and_settle(sim);
+Envelope run_to_its_end(MotionSim<S>& sim) {
   const sim::Vec3 tip0 = sim.tip();
   const V6 q0 = sim.plant().q();
   ExcitationCheck<S> check;
@@ -114,12 +113,61 @@ Envelope whole_run() {
   return env;
 }
 
+/// The same from the runs' pose, enabled there.
+template <class S>
+Envelope whole_run() {
+  MotionSim<S> sim(test::identify_pose());
+  enable_and_settle(sim);
+  return run_to_its_end(sim);
+}
+
 TEST(IdentifyCommand, RunsItsExcitationWithinItsLimitsAndEndsDoneWhereItStarted) { whole_run<double>(); }
 TEST(IdentifyCommand, RunsInFloat) { whole_run<float>(); }
 TEST(IdentifyCommand, RunsInFixedPoint) { whole_run<Fixed>(); }
 
 // A stop brakes the run along its path (its time slowed to rest) and holds; the run is aborted
 // stop_command; every tick stays within the limits.
+// An identify after a move that turned the wrist by 30 degrees (the QEMU power cycle's: from the start pose, enabled
+// there, to the runs' pose, q5 from 45 to 74.5 degrees). The run takes its orientation coordinates where it starts
+// (prepare_identify_at; the tick's controller_rereference), so it runs as from an enable there: before, the
+// coordinates of the enable's pose, 30 degrees away, made its loop check refuse it unstable_loop, and a disable and
+// an enable at the runs' pose were needed. The reference pose the state frame reports does not move at the accept.
+TEST(IdentifyCommand, RunsAfterAMoveThatTurnedTheWristWithoutAnEnableThere) {
+  if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's poses";
+  MotionSim<double> sim(start_pose());
+  enable_and_settle(sim);
+  MoveRequest<double> req;
+  req.position = Vec3<double>(0.5963, -0.1500, -0.0144);
+  req.has_rpy = true;
+  req.rpy = Vec3<double>(0, 60.52 * M_PI / 180, 0);
+  ASSERT_EQ(test::answer_move(sim, req, 3).outcome, CommandOutcome::kAccepted);
+  run_until(
+      sim, [](const MotionSim<double>& s) { return s.task().report.done_id == 3; }, 20000);
+  run_ticks(sim, 500);
+  ASSERT_TRUE(state_is(sim, MotionState::kHolding));
+  EXPECT_NEAR(sim.plant().q()(4), test::identify_pose()(4), 2e-3);
+  const pil::StateFrame before = state_frame_from_task(sim.task());
+  const Mat3<double> R_enable = sim.task().state.R_ref;
+  {  // in the enable's coordinates, as before, the check refuses the run
+    ControlTask<double>& t = sim.task();
+    const loop::PathLoop loop = loop::path_loop(t.gains, params::kPathLoopMargin);
+    ExcitationMotion<double> motion;
+    const ExcitationCheck<double> old =
+        prepare_excitation(t.model, t.check_data, Vec6<double>(t.state.adapt.q_prev), R_enable,
+                           ExcitationLimits<double>::defaults(), motion, &loop);
+    EXPECT_EQ(old.status, ExcitationStatus::kUnstableLoop);
+  }
+  const Envelope env = run_to_its_end(sim);
+  EXPECT_GT(env.room, 0.0);
+  // The controller was re-referenced at the run's start: 30 degrees from the enable's orientation.
+  const double turned = Eigen::AngleAxisd(sim.task().state.R_ref * R_enable.transpose()).angle();
+  EXPECT_NEAR(turned * 180 / M_PI, 29.5, 1.0);
+  const pil::StateFrame after = state_frame_from_task(sim.task());
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(after.x_d[i], before.x_d[i], 0.5e-3) << i;
+  const auto R_of = [](const float* x) { return rpy_rotation<double>(Vec3<double>(x[3], x[4], x[5])); };
+  EXPECT_LT((R_of(after.x_d) - R_of(before.x_d)).norm(), 2e-3);
+}
+
 TEST(IdentifyCommand, AStopBrakesItAlongItsPathAndHolds) {
   MotionSim<double> sim(test::identify_pose());
   enable_and_settle(sim);

@@ -84,11 +84,10 @@ struct StepOutput {
 };
 
 namespace detail {
-/// The observer at the measured pose q: x^ = x(q), y = -k x~ = 0; the orientation coordinates taken
-/// relative to the orientation at q (R_ref).
+/// The observer at the pose whose forward kinematics st.data holds: x^ = x there, y = -k x~ = 0; the
+/// orientation coordinates taken relative to the orientation there (R_ref).
 template <class S>
-void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
-  forward_kinematics(model, st.data, q);
+void observer_here(ControllerState<S>& st) {
   st.R_ref = st.data.R[kDof];
   st.obs.x_hat << st.data.o[kDof], Vec3<S>::Zero();
   st.obs.y.setZero();
@@ -100,6 +99,12 @@ void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<
   // The pivoted LU's rcond by halves (its first step exact), a 1 ms lag on a singular stop whose margin is
   // a factor 2 (motion_stage.hpp); the block factor's is cheap and exact.
   if constexpr (requires { st.os.Jf.rcond_by_halves(); }) st.os.Jf.rcond_by_halves();
+}
+/// The observer at the measured pose q (observer_here, after the forward kinematics at q).
+template <class S>
+void observer_start(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
+  forward_kinematics(model, st.data, q);
+  observer_here(st);
 }
 }  // namespace detail
 
@@ -117,6 +122,20 @@ void controller_init(const Model<S>& model, ControllerState<S>& st, const Vec6In
 template <class S>
 void controller_restart(const Model<S>& model, ControllerState<S>& st, const Vec6In<S>& q) {
   detail::observer_start(model, st, q);
+  adaptation_restart(st.adapt, Vec6<S>(q));
+}
+
+/// Re-references the controller at the pose of the step just taken, q (holding, at rest: where an identify run
+/// starts): the orientation coordinates taken relative to the orientation there and the observer restarted there,
+/// as controller_restart does, without its forward kinematics (the step's, in st.data). The step's operational
+/// coordinates and analytic Jacobian are put in the new coordinates, for a reference taken from them in the next
+/// tick (excitation_reference): x with phi = 0, where E(phi) = I and J_a is the geometric Jacobian. What the
+/// adaptation learnt is kept.
+template <class S>
+void controller_rereference(ControllerState<S>& st, const Vec6In<S>& q) {
+  detail::observer_here(st);
+  st.os.x = st.obs.x_hat;
+  st.os.Ja = st.data.J;
   adaptation_restart(st.adapt, Vec6<S>(q));
 }
 

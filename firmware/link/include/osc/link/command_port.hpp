@@ -211,9 +211,8 @@ class CommandPort {
       if (c.verb == MotionVerb::kHome && c.refusal == MotionReason::kNone)
         c = prepare_home(in.gen, in.home_limits, task.model, task.check_data, task.io, in.q_measured, in.frame.id);
       if (c.verb == MotionVerb::kIdentify)
-        c = prepare_identify_at(task.model, task.gains, task.check_data, in.q_measured, in.gen.reference_orientation(),
-                                in.frame.id, static_cast<ExcitationCheck<S>*>(nullptr),
-                                identify_payload_mask(in.frame));
+        c = prepare_identify_at(task.model, task.gains, task.check_data, in.q_measured, in.frame.id,
+                                static_cast<ExcitationCheck<S>*>(nullptr), identify_payload_mask(in.frame));
       const bool has_path = c.verb == MotionVerb::kMoveTo || c.verb == MotionVerb::kHome;
       if (has_path && c.refusal == MotionReason::kNone) {
         const Vec6<S>& seed = c.brake ? in.q_measured : in.q_queue_end;

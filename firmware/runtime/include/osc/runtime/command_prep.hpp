@@ -98,21 +98,24 @@ constexpr MotionReason excitation_refusal(ExcitationStatus s) {
   return MotionReason::kOutOfWorkspace;
 }
 
-/// The same about the joint angles q (a paced board's copy of the last measured ones), with the
-/// controller's reference orientation R_ref and its gains (the sampled loop's test, as a move's path
-/// check: unstable_loop), in the workspace `data`. payload: the payload's entries the run estimates too
-/// (payload_mask).
+/// The same about the joint angles q (a paced board's copy of the last measured ones), in the orientation
+/// coordinates of the orientation at q (the run's own: the tick re-references the controller there as the run
+/// starts, controller_rereference, wherever the enable was) and with the controller's gains (the sampled loop's
+/// test, as a move's path check: unstable_loop), in the workspace `data`. payload: the payload's entries the run
+/// estimates too (payload_mask).
 template <class S>
 TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains, Data<S>& data, const Vec6<S>& q,
-                                   const Mat3<S>& R_ref, std::uint32_t id, ExcitationCheck<S>* check,
+                                   std::uint32_t id, ExcitationCheck<S>* check,
                                    std::uint16_t payload = payload_mask::kNone) {
   TaskCommand<S> c;
   c.verb = MotionVerb::kIdentify;
   c.id = id;
   c.payload = payload;
   const loop::PathLoop loop = loop::path_loop(gains.template cast<double>(), params::kPathLoopMargin);
+  forward_kinematics(model, data, q);
+  const Mat3<S> R_start = data.R[kDof];
   const ExcitationCheck<S> r =
-      prepare_excitation(model, data, q, R_ref, ExcitationLimits<S>::defaults(), c.excitation, &loop);
+      prepare_excitation(model, data, q, R_start, ExcitationLimits<S>::defaults(), c.excitation, &loop);
   c.refusal = excitation_refusal(r.status);
   c.checked = true;
   if (check) *check = r;
@@ -127,8 +130,7 @@ TaskCommand<S> prepare_identify_at(const Model<S>& model, const Gains<S>& gains,
 template <class S>
 TaskCommand<S> prepare_identify(ControlTask<S>& task, std::uint32_t id, ExcitationCheck<S>* check = nullptr,
                                 std::uint16_t payload = payload_mask::kNone) {
-  return prepare_identify_at(task.model, task.gains, task.check_data, task.state.adapt.q_prev, task.state.R_ref, id,
-                             check, payload);
+  return prepare_identify_at(task.model, task.gains, task.check_data, task.state.adapt.q_prev, id, check, payload);
 }
 
 /// Puts a setpoint of stream `id` (with its velocity, or none) into the task's mailbox for the next

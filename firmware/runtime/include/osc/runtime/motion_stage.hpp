@@ -263,6 +263,10 @@ void motion_apply(ControlTask<S>& task, const MotionStep& st, MotionState before
   if (accepted && cmd.verb == MotionVerb::kStream)
     task.gen.start_stream(cmd.period, cmd.relative, cmd.limits, cmd.id, task.stream_timeout_ticks);
   if (accepted && cmd.verb == MotionVerb::kIdentify) {
+    // The run's orientation coordinates are those of where it starts (its check's, prepare_identify_at), wherever
+    // the enable was: the controller re-referenced here, at rest, and the pose held in them.
+    controller_rereference(task.state, q);
+    hold_measured_pose(task, q);
     task.gen.start_excitation(cmd.excitation, next, cmd.id);
     task.identify.accept(cmd.id, cmd.payload);  // its sampler starts again at the run's first tick, whatever the id
   }
