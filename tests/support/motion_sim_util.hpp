@@ -106,6 +106,10 @@ struct RandomMoves {
   std::uint32_t faults = 0;
   MotionReason refusal = MotionReason::kNone;                  ///< the failed move's refusal, where it was refused
   double tracking = 0, speed = 0, accel = 0, oscillation = 0;  ///< [m], [m/s], [m/s^2], the monitor's ratio
+  double tracking_sum = 0;                                     ///< each accepted move's largest |x_d - x|, summed [m]
+  /// The mean over the accepted moves of each one's largest |x_d - x| [m]: steadier than the largest of all, which one
+  /// move sets (a move accepted or refused by a hair changes the sequence after it).
+  double mean_tracking() const { return moves ? tracking_sum / moves : 0.0; }
 };
 
 /// `count` seeded random moves from where the arm holds, ids from `first_id`: up to 15 cm along each axis and
@@ -140,6 +144,7 @@ RandomMoves random_moves(MotionSim<S>& sim, std::uint32_t seed, int count, std::
         },
         30000);
     out.tracking = std::max(out.tracking, r.tracking);
+    out.tracking_sum += r.tracking;
     out.oscillation = std::max(out.oscillation, r.oscillation);
     out.faults |= r.faults;
     if (!r.ended || r.faults != 0) {

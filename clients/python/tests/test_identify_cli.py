@@ -3,7 +3,9 @@ oscctl's identify (host_sim/client/oscctl.cpp), and the frames --apply sends."""
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
+from pathlib import Path
 
 import pytest
 
@@ -148,7 +150,9 @@ def test_an_aborted_run(protocol: Protocol, capsys: pytest.CaptureFixture[str]) 
 ])
 def test_no_identify_frame(protocol: Protocol, monkeypatch: pytest.MonkeyPatch, argv: list[str], abort: str | None,
                            out: str, exit: int, capsys: pytest.CaptureFixture[str]) -> None:
-    assert cli.IDENTIFY_FRAME_WAIT == 2.0  # oscctl's kIdentifyFrameWaitS
+    oscctl = (Path(__file__).resolve().parents[3] / "host_sim" / "client" / "oscctl.cpp").read_text()
+    wait = re.search(r"constexpr double kIdentifyFrameWaitS = ([0-9.]+);", oscctl)
+    assert wait and cli.IDENTIFY_FRAME_WAIT == float(wait.group(1)) == 10.0  # oscctl's, the same
     monkeypatch.setattr(cli, "IDENTIFY_FRAME_WAIT", 0.3)
     t0 = time.monotonic()
     rc, board = run(protocol, argv, board_run(protocol, None, abort))

@@ -335,9 +335,9 @@ TEST(FrictionIdentifier, ConsiderUpdateIsSchmidtsFilter) {
   EXPECT_NEAR(id.P[0](1, 1), P(1, 1) - Ph(1) * Ph(1) / var, 1e-12);
 }
 
-// Issue 57's stale saved friction (FrictionIdentifier::seed and judge). A friction set (a saved record at power-on,
-// an identify run's applied) is where the estimate goes on from: a sample that tells nothing leaves theta^ as set
-// (before the seed, the law's first update wrote its prior's 0 over it). The set friction is judged once per
+// Issue 57's stale saved friction (FrictionIdentifier::seed, FrictionFit::judge). A friction set (a saved record at
+// power-on, an identify run's applied) is where the estimate goes on from: a sample that tells nothing leaves theta^ as
+// set (before the seed, the law's first update wrote its prior's 0 over it). The set friction is judged once per
 // coefficient, when the law first identifies it params::kIdentifyNoiseSamples updates or more after the set: the
 // truth's and 10 % below it fit; 40 % above is stale, and stays stale as the estimate moves on to the truth; a fit
 // one stays fit when the friction later drifts by 30 % (temperature: the law's to follow); a new set starts the check
@@ -372,22 +372,22 @@ void judges_a_set_friction() {
     for (int k : {1, kDof + 1, 2 * kDof + 1})
       EXPECT_NEAR(static_cast<double>(theta(k)), static_cast<double>(set(k)), 1e-5) << k;
     feed(id, theta, d);
-    EXPECT_EQ(id.checked(), factor > 0 ? 1u << 1 : 0u);  // J2 only: the others have no samples
-    EXPECT_EQ(id.stale, factor > 1.2 ? 1u << 1 : 0u);
-    EXPECT_EQ(id.judged[1], factor > 0 ? 1u << 1 : 0u);  // the breakaway's verdict is among them
+    EXPECT_EQ(id.fit.checked(), factor > 0 ? 1u << 1 : 0u);  // J2 only: the others have no samples
+    EXPECT_EQ(id.fit.stale, factor > 1.2 ? 1u << 1 : 0u);
+    EXPECT_EQ(id.fit.judged[1], factor > 0 ? 1u << 1 : 0u);  // the breakaway's verdict is among them
     EXPECT_NEAR(sum_of(theta), breakaway, 0.05 * breakaway);
     // The verdict is made once: the friction drifting 30 % up later changes none.
-    const std::uint8_t stale = id.stale;
+    const std::uint8_t stale = id.fit.stale;
     feed(id, theta, later);
     EXPECT_NEAR(sum_of(theta), 1.3 * breakaway, 0.05 * breakaway);
-    EXPECT_EQ(id.stale, stale);
+    EXPECT_EQ(id.fit.stale, stale);
     // A new set, the truth's again, is judged anew against the warmer data: more than 20 % off, stale.
     if (factor != 1.0) continue;
     theta(kDof + 1) = S(truth(1)), theta(2 * kDof + 1) = S(truth(2));
     id.seed(1, theta);
-    EXPECT_EQ(id.checked(), 0u);
+    EXPECT_EQ(id.fit.checked(), 0u);
     feed(id, theta, later);
-    EXPECT_EQ(id.stale, 1u << 1);
+    EXPECT_EQ(id.fit.stale, 1u << 1);
   }
 }
 TEST(FrictionIdentifier, ASetFrictionIsWhereItGoesOnFromAndIsJudgedOnceDouble) { judges_a_set_friction<double>(); }

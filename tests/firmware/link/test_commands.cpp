@@ -557,7 +557,7 @@ TEST_F(TaskFrames, StateFrameOfATask) {
   EXPECT_EQ(s.friction_checked, 0);
   EXPECT_EQ(s.friction_stale, 0);
   FrictionIdentifier<double>& id = node->task.state.adapt.identifier;
-  id.judged[0] = 0x1, id.judged[1] = 0x6, id.stale = 0x4;
+  id.fit.judged[0] = 0x1, id.fit.judged[1] = 0x6, id.fit.stale = 0x4;
   const pil::StateFrame v = state_frame_from_task(node->task);
   EXPECT_EQ(v.friction_checked, 0x7);
   EXPECT_EQ(v.friction_stale, 0x4);

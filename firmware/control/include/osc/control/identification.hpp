@@ -45,6 +45,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "osc/control/friction_fit.hpp"
 #include "osc/control/params.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/robot.hpp"
@@ -114,15 +115,8 @@ struct FrictionIdentifier {
   /// The friction as far as the identification proves it (prove), for the residual monitor's travel
   /// check: the band's tops (robot::kModelErrorBounds) until a coefficient is identified.
   FrictionBounds<S> proven;
-  /// The friction set last (seed: a saved record at power-on, an identify run's applied), each joint's viscous
-  /// coefficient (row 0) and breakaway torque (row 1, Coulomb + Stribeck) in its units; 0 where none is set.
-  Eigen::Matrix<S, 2, kDof> given;
-  /// The fit check of the set friction (judge), bit i joint i: judged[c], coefficient c (0 viscous, 1 breakaway)
-  /// compared once with the law's first identification of it since the set; stale, a comparison found it more
-  /// than params::kSavedFitFraction off.
-  std::uint8_t judged[2];
-  std::uint8_t stale;
-  std::uint32_t seeded[kDof];  // updates[i] at joint i's last set: judge waits params::kIdentifyNoiseSamples more
+  /// The fit check of the friction set last (seed: a saved record at power-on, an identify run's applied).
+  FrictionFit<S> fit;
   static constexpr double kPerHour = 3600.0 * params::kControlHz / params::kIdentifyEvery;  // updates per hour
 
   /// The prior: theta^ anywhere from 0 to the band's top (robot::kModelErrorBounds), no counters.
@@ -132,15 +126,13 @@ struct FrictionIdentifier {
       z[i].setZero();
       innovation2(i) = S(-1);  // none yet (update)
       updates[i] = 0;
-      seeded[i] = 0;
       outliers[i] = 0;
       moments[i].setZero();
       block[i].setZero();
       block_count[i] = 0;
     }
     split_excitation.setZero();
-    given.setZero();
-    judged[0] = judged[1] = stale = 0;
+    fit.reset();
     turn = 0;
     for (int i = 0; i < kDof; ++i) proven.vis(i) = top(0, i), proven.breakaway(i) = top(1, i);
   }
@@ -205,50 +197,22 @@ struct FrictionIdentifier {
     const Vec4 bounded = project(i, th, theta_max);
     for (int c = 0; c < 3; ++c) theta(c * kDof + i) = bounded(c) * unscale(i);
     ++updates[i];
-    judge(i);
+    for (int c = 0; c < 2; ++c) fit.judge(i, c, z[i](c), P[i](c, c), updates[i]);
     return IdentifyOutcome::kUpdated;
   }
 
   /// Joint i's friction set to theta^'s (a friction parameter set: a saved record applied at power-on, an
   /// identify run's applied): the estimate starts from it, with the prior's covariance (where the law goes on
   /// from, not what it knows: the data move it where they tell otherwise, and the split, which the task's motion
-  /// seldom tells, stays). It is the reference of the joint's fit check (judge), which starts again.
+  /// seldom tells, stays). It is the reference of the joint's fit check (fit), which starts again.
   void seed(int i, const Vec18<S>& theta) {
     const S sc = scale(i), sti = theta(2 * kDof + i) * sc, sum = theta(kDof + i) * sc + sti;
     z[i](0) = theta(i) * sc;
     z[i](1) = sum;
     z[i](2) = sti;
     P[i] = prior(i);
-    seeded[i] = updates[i];
-    given(0, i) = z[i](0);
-    given(1, i) = sum;
-    const auto keep = static_cast<std::uint8_t>(~(1u << i));
-    judged[0] &= keep, judged[1] &= keep, stale &= keep;
+    fit.set(i, z[i](0), sum, updates[i]);
   }
-  /// Joints whose set friction has been checked (judged), a bit each.
-  std::uint8_t checked() const { return static_cast<std::uint8_t>(judged[0] | judged[1]); }
-
-  /// The fit check of joint i's set friction (given), after each update: the first time since the set that the
-  /// law knows coefficient c within params::kIdentifiedFraction of the set value (its standard deviation: the
-  /// bar, params::kSavedFitFraction of it, is then eight of them, whether the arm's is lower or higher) with at least
-  /// params::kIdentifyNoiseSamples updates since the set (the noise measure's window: before it the estimate is still
-  /// on its way from the set value, and its deviation not yet the data's), the set one is judged, once: stale when
-  /// it lies more than params::kSavedFitFraction of itself from the estimate. Later drift (temperature: the band's
-  /// +-30 %) is the law's to follow, not a verdict on what was set.
-  void judge(int i) {
-    static constexpr S kFraction = lit<S>(params::kIdentifiedFraction);
-    static constexpr S kFit = lit<S>(params::kSavedFitFraction);
-    const auto bit = static_cast<std::uint8_t>(1u << i);
-    const bool settled = updates[i] - seeded[i] >= static_cast<std::uint32_t>(params::kIdentifyNoiseSamples);
-    for (int c = 0; c < 2; ++c) {
-      const S ref = given(c, i), f = kFraction * ref, d = z[i](c) - ref, lim = kFit * ref;
-      const bool open = settled && !(judged[c] & bit) && ref > S(0) && P[i](c, c) <= f * f;
-      if (!open && !params::kTickWorstCase) continue;
-      judged[c] |= bit;
-      if (d > lim || -d > lim) stale |= bit;
-    }
-  }
-
   /// Joint i's proven friction (proven), from its estimate z and covariance P as they stand (the
   /// drift included: while a joint is not sampled, P grows back and the bound with it). Its viscous
   /// coefficient and its breakaway torque are each at most z plus params::kTravelIdentifiedSd

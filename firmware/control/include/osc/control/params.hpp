@@ -301,7 +301,7 @@ constexpr int kIdentifyNoiseSamples = 256;
 constexpr double kIdentifiedFraction = 0.025;
 /// A friction set (a saved record applied at power-on, an identify run's applied: FrictionIdentifier::seed) is
 /// checked once per joint and coefficient, the viscous and the breakaway torque (Coulomb + Stribeck), when the
-/// momentum law first knows it within kIdentifiedFraction of the set value (FrictionIdentifier::judge): it no longer
+/// momentum law first knows it within kIdentifiedFraction of the set value (FrictionFit::judge): it no longer
 /// fits the arm (stale) when it lies more than this fraction of itself from the law's estimate. The torque it
 /// predicts is then more than 20 % off, the identification run's own failure bar (kIdentifyMaxPredictionError,
 /// Servotronix's RelTeMax); the bar is eight of the estimate's standard deviations then, so that a set that fits

@@ -320,8 +320,8 @@ pil::StateFrame state_frame_from_task(const ControlTask<S>& task) {
   }
   detail::pose_floats<S>(task.state.data.o[kDof], task.state.data.R[kDof], f.x);
   f.tick = static_cast<std::uint32_t>(task.tick - 1);
-  f.friction_checked = task.state.adapt.identifier.checked();
-  f.friction_stale = task.state.adapt.identifier.stale;
+  f.friction_checked = task.state.adapt.identifier.fit.checked();
+  f.friction_stale = task.state.adapt.identifier.fit.stale;
   return f;
 }
 
