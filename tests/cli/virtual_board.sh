@@ -254,15 +254,14 @@ stream() {
 # run passes its check on the PUMA (tests/support/motion_sim_util.hpp, identify_pose): enable, identify --apply
 # (the estimate printed and set), param save. Sets $vis, friction_vis[0] as the estimate printed it.
 # The board store_estimate runs the identification on: osc_sim's options (the virtual board in process by default,
-# started at the identify pose: the wrist bent to q5 = 74.4845 deg, where the run passes the loop's check).
+# started at the identify pose: the wrist bent to q5 = 68.7549 deg (1.2 rad), where the run passes the loop's check).
 # No link watch: at --speed 10 the watch's 0.5 s of the client's is 5 s simulated, and a loaded machine's simulator that
 # catches up on its ticks in a burst ran them past a keep-alive not yet read (link_silent, seen once in 886 tests at
 # -j4). The watch has its own test (link_recovery.py, link_silent).
-estimate_board=(--speed 10 --no-link-watch --start-pose 0 45 -180 0 74.4845 0)
+estimate_board=(--speed 10 --no-link-watch --start-pose 0 45 -180 0 68.7549 0)
 # A board that starts at the start pose (an image) moves there first: the wrist centre stays, the hand pitches from
-# 90 to 60.52 deg (q5 from 45 deg). Then a disable and an enable: the controller's orientation coordinates are
-# relative to the pose of the enable, and 30 deg from it the run's loop check refuses unstable_loop (docs/adaptation.md,
-# "The identify command").
+# 90 to 66.2451 deg (q5 from 45 deg), and the run takes its orientation coordinates there (docs/adaptation.md, "The
+# identify command").
 estimate_move=()
 store_estimate() {
   local store=$1
@@ -456,7 +455,7 @@ case "$case_" in
     mv "$tmp/estimate.out" "$tmp/estimate_host.out"
     rm -f "$store"
     estimate_board=(--qemu --elf "$image" --scalar "$image_scalar" --speed 4)
-    estimate_move=(move 0.5963 -0.1500 -0.0144 --rpy 0 60.52 0)
+    estimate_move=(move 0.5963 -0.1500 -0.0144 --rpy 0 66.2451 0)
     store_estimate "$store" "$ctl"
     "$py" - "$tmp/estimate_host.out" "$tmp/estimate.out" <<'PY' || fail "the image's estimate differs from the virtual board's"
 import re, sys

@@ -52,13 +52,16 @@ IdentifyReport run_identify(MotionSim<S>& sim, std::uint16_t payload, std::uint3
 }
 
 /// How far a run's friction is from the plant's: the largest error over issue 57's bar (10 % of the coefficient, or
-/// 0.05 in its unit where that is more), over the reported sigma, and of a Coulomb + Stribeck sum relative to it.
+/// 0.05 in its unit where that is more), over the reported sigma, and of a Coulomb + Stribeck sum relative to it; and
+/// the largest reported sigma over the issue's bar for it (2.5 % of the coefficient, with the same floor, 0.05).
+/// `except`: the coefficient kinds (bit c: 0 vis, 1 cou, 2 sti) left out of `bar` and `sd`.
 struct FrictionErrors {
-  double bar = 0, sigmas = 0, sum = 0;
+  double bar = 0, sigmas = 0, sum = 0, sd = 0;
 };
 
 /// Prints each coefficient against the plant's, with its sigma; returns the errors.
-FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficients& truth, const char* what) {
+FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficients& truth, const char* what,
+                               unsigned except = 0) {
   const double* t[3] = {truth.vis, truth.cou, truth.sti};
   const char* names[3] = {"vis", "cou", "sti"};
   FrictionErrors e;
@@ -68,8 +71,10 @@ FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficien
       const double error = std::fabs(r.friction(k) - t[c][i]);
       std::printf("  %s J%d: %8.4f (plant %8.4f), sd %.4f (%.1f %%), error %.1f sd\n", names[c], i + 1, r.friction(k),
                   t[c][i], r.friction_sd(k), 100 * r.friction_sd(k) / t[c][i], error / r.friction_sd(k));
-      e.bar = std::max(e.bar, error / std::max(0.1 * t[c][i], 0.05));
       e.sigmas = std::max(e.sigmas, error / r.friction_sd(k));
+      if (except >> c & 1u) continue;
+      e.bar = std::max(e.bar, error / std::max(0.1 * t[c][i], 0.05));
+      e.sd = std::max(e.sd, r.friction_sd(k) / std::max(0.025 * t[c][i], 0.05));
     }
   for (int i = 0; i < kDof; ++i) {
     const double sum = r.friction(kDof + i) + r.friction(2 * kDof + i), plant = truth.cou[i] + truth.sti[i];
@@ -77,9 +82,9 @@ FrictionErrors report_friction(const IdentifyReport& r, const FrictionCoefficien
   }
   std::printf(
       "%s: condition %.0f; prediction error %.3f (J%d); status %d; worst error %.2f of the bar, %.1f sd; the "
-      "sums within %.2f %%\n",
+      "sums within %.2f %%; the largest sd %.2f of its bar\n",
       what, r.condition, r.worst_prediction_error, r.worst_joint + 1, static_cast<int>(r.status), e.bar, e.sigmas,
-      100 * e.sum);
+      100 * e.sum, e.sd);
   return e;
 }
 
@@ -99,19 +104,21 @@ IdentifyReport coupled_run() {
   return r;
 }
 
-/// One run on the ideal plant from the runs' pose (0.64 of the design) in scalar S: every sample taken, the run's
-/// estimate ok, every coefficient within issue 57's bar (10 %, or 0.05 where that is more) and within 3 of its
-/// reported sigma, and each joint's Coulomb + Stribeck sum, the friction at the onset of motion, within 1 %.
+/// One run on the ideal plant with the friction preset `preset` from the runs' pose (0.656 of the design) in scalar S:
+/// every sample taken, the run's estimate ok, every coefficient within 3 of its reported sigma, and each joint's
+/// Coulomb + Stribeck sum, the friction at the onset of motion, within 1 %. The errors over issue 57's bars are the
+/// caller's to judge (`except` as report_friction's).
 template <class S>
-FrictionErrors ideal_plant_run(const char* what) {
-  MotionSim<S> sim(test::identify_pose());
+FrictionErrors ideal_plant_run(const char* what, int preset = 0, unsigned except = 0) {
+  sim::PlantConfig pc;
+  pc.friction = *robot::kFrictionPresets[preset];
+  MotionSim<S> sim(test::identify_pose(), {}, pc);
   std::uint32_t taken = 0, lost = 0;
   const IdentifyReport r = run_identify(sim, payload_mask::kNone, taken, lost);
   EXPECT_EQ(r.status, IdentifyStatus::kOk) << what;
   EXPECT_EQ(lost, 0u) << what;
   EXPECT_GE(taken, 15900u) << what;  // 80 000 ticks, one sample in kRunSampleTicks
-  const FrictionErrors e = report_friction(r, *robot::kFrictionPresets[0], what);
-  EXPECT_LE(e.bar, 1.0) << what;
+  const FrictionErrors e = report_friction(r, *robot::kFrictionPresets[preset], what, except);
   EXPECT_LE(e.sigmas, 3.0) << what;
   EXPECT_LE(e.sum, 0.01) << what;
   return e;
@@ -119,18 +126,31 @@ FrictionErrors ideal_plant_run(const char* what) {
 
 }  // namespace
 
-// Measured, the worst coefficient's error over the bar and over its sigma, and the worst sum's: double 0.75, 1.5
-// sigma, 0.12 %; float 0.86, 1.4, 0.13 %; Q12.19 0.73, 1.4, 0.17 %. Condition 61 600-61 900.
+// The paper's friction: every coefficient within issue 57's bar, and its sigma within the issue's 2.5 % with the bar's
+// floor (0.05 in its unit). Measured (docs/adaptation.md, section 6): MEASURED_PAPER.
 TEST(IdentifySim, TheFrictionOfTheIdealPlantFromOneRunInEveryScalar) {
-  ideal_plant_run<double>("double");
-  ideal_plant_run<float>("float");
-  ideal_plant_run<fixed::Q<19>>("Q12.19");
+  for (const FrictionErrors& e :
+       {ideal_plant_run<double>("double"), ideal_plant_run<float>("float"), ideal_plant_run<fixed::Q<19>>("Q12.19")}) {
+    EXPECT_LE(e.bar, 1.0);
+    if (test::kPumaBuild) EXPECT_LE(e.sd, 1.0);  // the UR5e's sigma at its start pose: not measured yet
+  }
+}
+
+// Corke's friction (no Stribeck term; J1's Coulomb level 26 N m): the viscous and Coulomb coefficients within the bar
+// and their sigma within 2.5 %, or 0.05 in the unit. Not the Stribeck levels, all 0: the bar is the floor, 0.05 N m,
+// and J1's split is known to MEASURED_CORKE (J1's residual noise is 0.13 N m, twice the paper
+// preset's), which the report says: its estimate is within 3 of its sigma.
+TEST(IdentifySim, TheCorkeFrictionOfTheIdealPlantFromOneRun) {
+  if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's presets";
+  const FrictionErrors e = ideal_plant_run<double>("double, corke", 1, 1u << 2);
+  EXPECT_LE(e.bar, 1.0);
+  EXPECT_LE(e.sd, 1.0);
 }
 
 // The wrist's coupling (the PUMA's q6 = e6 + 0.013 e4 - 0.18 e5) and the published encoders: in the joints' space J5's
 // torque-prediction error was 23 % and the run failed (prediction_error); in the drives' space it is ok (measured
-// 4.6 %, J6). J1 and J2 are within the bar. Not yet (measured, docs/adaptation.md): J3's Stribeck term 2.6 times the
-// bar (0.45 against 0.6) and J5, J6 up to 5.7 times (4.3 sigma): the rotors' inertia coupled through C, C^-T J_m C^-1,
+// 4.3 %, J6). J1 and J2 are within the bar. Not yet (measured, docs/adaptation.md): J3's Stribeck term 2.2 times the
+// bar and J5, J6 up to 4.4 times (J6's viscous, 3.6 sigma): the rotors' inertia coupled through C, C^-T J_m C^-1,
 // which the model's diagonal armature lacks, biases the observer's rates there.
 TEST(IdentifySim, TheWristsCoupledDrivesAreIdentifiedInTheDrivesSpace) {
   if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's coupled wrist";

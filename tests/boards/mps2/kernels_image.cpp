@@ -477,14 +477,14 @@ ExcitationMotion<F> g_excitation;
 IdentifyRun<F> g_identify_run;
 void identify_kernels(const Vec6<F>& q0) {
   // One whole check, as the identify command's preparation (command_prep.hpp) runs it at each scale it tries: every
-  // tick of a period, the sampled loop judged at each. On the PUMA at the tests' identify pose (q5 = 1.3 rad), at
-  // the scale it passes at, 0.64; the preparation tries 1 and 0.8 first, which fail at a tick along the way, so a
-  // refused run costs at most four of these.
+  // tick of a period, the sampled loop judged at each. On the PUMA at the tests' identify pose (q5 = 1.2 rad), at
+  // the scale it passes at, 0.656; the preparation checks 1, then 0.729 and 0.590 and 0.656 (halving), the failing
+  // ones stopping at a tick along the way, so a run costs at most four of these (excitation_check.hpp).
   Vec6<F> q_run = q0;
-  if (test::kPumaBuild) q_run(4) = lit<F>(1.3);
+  if (test::kPumaBuild) q_run(4) = lit<F>(1.2);
   const ExcitationLimits<F> lim = ExcitationLimits<F>::defaults();
   check("the excitation plans", static_cast<double>(g_excitation.plan(q_run, lim)), 0.0, 0.0);
-  g_excitation.set_scale(lit<F>(0.64));
+  g_excitation.set_scale(lit<F>(0.6561));
   ExcitationCheck<F> ec;
   {
     Timer t("check_excitation, one scale (10 001 ticks, the sampled loop judged at each)");
@@ -493,7 +493,7 @@ void identify_kernels(const Vec6<F>& q0) {
     ec = check_excitation(g_model, g_data, g_excitation, Mat3<F>(g_data.R[kDof]), lim, &gains);
   }
   if (test::kPumaBuild)
-    check("the identify pose's excitation passes at 0.64", static_cast<double>(ec.status), 0.0, 0.0);
+    check("the identify pose's excitation passes at 0.656", static_cast<double>(ec.status), 0.0, 0.0);
   g_task.gen.start_excitation(g_excitation, g_task.tick, 7);
   g_identify_run.start(7, payload_mask::kNone, g_model, g_model);
   std::uint32_t worst_ref = 0, worst_record = 0, worst_poll = 0;

@@ -312,14 +312,14 @@ TEST(Excitation, AShrunkenTorqueLimitIsOverLimit) {
   EXPECT_EQ(p.check.status, ExcitationStatus::kOverLimit);
   EXPECT_EQ(p.check.joint, 1);
   EXPECT_GE(p.check.tick, 0);
-  // Refused after the last cut: 0.8^3 = 0.512 >= kExcitationMinScale > 0.8^4.
-  EXPECT_EQ(excitation::kAttempts, 4);
+  // Refused after the last cut: 0.9^6 = 0.531 >= kExcitationMinScale > 0.9^7 = 0.478.
+  EXPECT_EQ(excitation::kAttempts, 7);
   EXPECT_NEAR(p.check.scale, std::pow(params::kExcitationScaleStep, excitation::kAttempts - 1), 1e-15);
 }
 
 TEST(Excitation, ALimitTheDesignJustMissesIsMetAtACutAmplitude) {
   // J1's torque limit just above what the motion needs at two cuts below the scale the start pose is
-  // accepted at (the PUMA's 1: 0.64): refused at the two scales above it, run at it.
+  // accepted at (the PUMA's 1: 0.81): refused at the two scales above it, run at it.
   const Prepared<double> base = prepare<double>(start_pose());
   ASSERT_EQ(base.check.status, ExcitationStatus::kOk);
   const double target = base.check.scale * params::kExcitationScaleStep * params::kExcitationScaleStep;

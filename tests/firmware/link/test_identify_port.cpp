@@ -158,8 +158,8 @@ TEST(IdentifyPort, ARunWithThePayloadFlagSendsThePayloadRightAfterItsEstimate) {
               static_cast<double>(p.mass), 1e3 * off, static_cast<double>(p.pi_sd[0]));
 }
 
-// A run stopped at once: one frame, status aborted, no estimate in it. Another identify at the pose where it stopped
-// is refused (the excitation's check) and sends no identify frame.
+// A run stopped at once: one frame, status aborted, no estimate in it. Another identify while the arm still brakes is
+// refused (busy: the run it aborted still brakes) and sends no identify frame.
 TEST(IdentifyPort, AStoppedRunIsReportedAbortedAndARefusedOneNotAtAll) {
   MotionSim<double> sim(test::identify_pose());
   IdentifyPort<double> port;
@@ -177,10 +177,12 @@ TEST(IdentifyPort, AStoppedRunIsReportedAbortedAndARefusedOneNotAtAll) {
   EXPECT_EQ(f.identified, 0u);
   EXPECT_TRUE(std::all_of(std::begin(f.friction), std::end(f.friction), [](float v) { return v == 0.0f; }));
   EXPECT_FALSE(port.active());
-  run(sim, port, sent, 3000, [&] { return test::state_is(sim, MotionState::kHolding); });
+  ASSERT_TRUE(test::state_is(sim, MotionState::kStopping));
   sim.identify(6);
   run(sim, port, sent, 1, [] { return true; });
   ASSERT_EQ(sim.task().report.outcome, CommandOutcome::kRefused);
+  EXPECT_EQ(sim.task().report.refusal, MotionReason::kBusy) << motion_name(sim.task().report.refusal);
+  run(sim, port, sent, 3000, [&] { return test::state_is(sim, MotionState::kHolding); });
   run(sim, port, sent, 1000, [] { return false; });
   EXPECT_EQ(sent.frames.size(), 1u);
   EXPECT_FALSE(port.active());

@@ -34,9 +34,11 @@
 // fill of the room between q0 and its limits less kExcitationPositionMargin (the row's peaks over a
 // period's samples at the control rate, in the scalar itself). A joint that starts within the margin,
 // or whose room cuts its gain below kExcitationMinScale of the speed's, refuses the motion (out of
-// workspace). The torque and the singularities are the check's: prepare_excitation plans, checks, and
-// where the check fails tries again with every gain times kExcitationScaleStep (the motion nearer q0,
-// slower) while the factor stays at least kExcitationMinScale; then it refuses with the last reason.
+// workspace). The torque and the singularities are the check's: prepare_excitation plans and checks at the
+// largest scale of every gain, of 1, s, s^2, ... (s = kExcitationScaleStep, while at least kExcitationMinScale),
+// that passes: full scale, then the rest by halving their range (a smaller swing passes where a larger one does:
+// its speeds, torques and room; where the loop's or the singularity test does not, a smaller scale that passed is
+// kept, and every run is checked in full at its scale). None: refused with the last check's (the smallest's) reason.
 //
 // The check (check_excitation) samples every tick the controller would be given: tick n of the motion
 // is tick n mod P of its period (P = T params::kControlHz, ExcitationMotion::at_tick), so the ticks
@@ -54,7 +56,8 @@
 //                    top without decay, the strongest the arm may have; the other 20 % is the controller's.
 // The refusals are a move's (osc/runtime/motion_states.hpp: out_of_workspace, over_limit, near_singular,
 // unstable_loop). Cost: per tick of the check (P + 1 = 10 001) a forward kinematics, the Jacobians'
-// factors and a Newton-Euler pass (and the loop's test), at most four checks; when the command is
+// factors and a Newton-Euler pass (and the loop's test), at most four checks (the seven scales of 0.9: 1 and
+// three halvings); when the command is
 // prepared, outside the tick. In fixed point the flags raised before it are kept, its own discarded.
 #pragma once
 
@@ -103,6 +106,13 @@ constexpr int attempts() {
   return n;
 }
 constexpr int kAttempts = attempts();
+/// The scale of try k: kExcitationScaleStep^k, multiplied out in S (the same rounding at every call).
+template <class S>
+S scale_of(int k) {
+  S scale(1);
+  for (int i = 0; i < k; ++i) scale *= lit<S>(params::kExcitationScaleStep);
+  return scale;
+}
 
 /// Whether every row of the design solves (C) and moves (its sums exact: small integers).
 constexpr bool design_valid() {
@@ -329,122 +339,7 @@ class ExcitationMotion {
   int refused_ = -1;
 };
 
-/// What check_excitation found.
-template <class S>
-struct ExcitationCheck {
-  ExcitationStatus status = ExcitationStatus::kOk;
-  /// The first failing tick of the period (0 .. P), -1 when kOk or when the plan refused.
-  std::int32_t tick = -1;
-  /// The joint that failed (-1: none, or the singularity test).
-  int joint = -1;
-  /// The gains' scale the motion was checked at (prepare_excitation).
-  S scale = S(1);
-  /// Over the ticks checked: each joint's largest |qd| [rad/s] and |tau| + |tau_f| [N m], the smallest
-  /// room of a joint to its nearer bound of [q_min, q_max] (the limits less the margin) [rad], the smallest
-  /// reciprocal condition of the Jacobian.
-  Vec6<S> speed = Vec6<S>::Zero(), torque = Vec6<S>::Zero();
-  S clearance = lit<S>(path_check::kNoClearance);
-  S rcond = S(1);
-};
-
-namespace excitation {
-/// The joint-limit and speed tests of a sample; r's extremes updated.
-template <class S>
-ExcitationStatus kinematic_limits(const JointSample<S>& d, const ExcitationLimits<S>& lim, ExcitationCheck<S>& r) {
-  for (int i = 0; i < kDof; ++i) {
-    const S lo = d.q(i) - lim.q_min(i), hi = lim.q_max(i) - d.q(i), c = lo < hi ? lo : hi;
-    if (c < r.clearance) r.clearance = c;
-    if (math::abs(d.qd(i)) > r.speed(i)) r.speed(i) = math::abs(d.qd(i));
-    if (!(lo >= S(0) && hi >= S(0))) {
-      r.joint = i;
-      return ExcitationStatus::kOutOfWorkspace;
-    }
-  }
-  for (int i = 0; i < kDof; ++i)
-    if (!(math::abs(d.qd(i)) <= lim.speed(i))) {
-      r.joint = i;
-      return ExcitationStatus::kOverLimit;
-    }
-  return ExcitationStatus::kOk;
-}
-
-/// The torque test of a sample (data: forward kinematics at d.q): the rigid-body torque of (1) by rnea
-/// and the strongest friction's, each joint's magnitudes summed; r's extremes updated.
-template <class S>
-ExcitationStatus torque_limits(const Model<S>& model, const Data<S>& data, const JointSample<S>& d,
-                               const ExcitationLimits<S>& lim, ExcitationCheck<S>& r) {
-  const Vec6<S> tau = rnea(model, data, d.qd, d.qdd, true).tau;
-  const Vec6<S> tau_f = friction_torque(lim.friction, d.qd);
-  int over = -1;
-  for (int i = 0; i < kDof; ++i) {
-    const S need = math::abs(tau(i)) + math::abs(tau_f(i));
-    if (need > r.torque(i)) r.torque(i) = need;
-    if (over < 0 && !(need <= lim.torque(i))) over = i;
-  }
-  if (over < 0) return ExcitationStatus::kOk;
-  r.joint = over;
-  return ExcitationStatus::kOverLimit;
-}
-}  // namespace excitation
-
-/// Checks every tick of `motion` (the file comment's "The check"); R_ref is the controller's reference
-/// orientation, data the kernels' workspace (overwritten). The first failure stops it.
-/// loop: the gains' sampled-loop test at every tick (loop::path_loop, as a move's path check; none: not
-/// judged): an axis whose loop is unstable there fails it (kUnstableLoop), unless it was so at q0 already
-/// and is no lighter (path_check::unstable_loop).
-template <class S>
-ExcitationCheck<S> check_excitation(const Model<S>& model, Data<S>& data, const ExcitationMotion<S>& motion,
-                                    const Mat3<S>& R_ref, const ExcitationLimits<S>& lim,
-                                    const loop::PathLoop* loop = nullptr) {
-  const std::uint32_t before = math::take_arithmetic_flags<S>();  // the caller's, put back on return
-  ExcitationCheck<S> r;
-  r.scale = motion.scale();
-  path_check::SingularityTrace<S> trace;
-  PathCheck<S> singular;  // near_singular's smallest rcond
-  ArmJacobianFactor<S> Jf;
-  path_check::LoopTrace loop_trace;
-  for (std::uint32_t n = 0; n <= excitation::kPeriodTicks; ++n) {
-    const JointSample<S> d = motion.at_tick(n);
-    ExcitationStatus s = excitation::kinematic_limits(d, lim, r);
-    if (s == ExcitationStatus::kOk) {
-      path_check::evaluate(model, data, Jf, d.q);
-      if (path_check::near_singular(data, Jf, R_ref, trace, singular)) s = ExcitationStatus::kNearSingular;
-    }
-    if (s == ExcitationStatus::kOk && loop && path_check::unstable_loop(model, data, R_ref, *loop, loop_trace))
-      s = ExcitationStatus::kUnstableLoop;
-    if (s == ExcitationStatus::kOk) s = excitation::torque_limits(model, data, d, lim, r);
-    if (s != ExcitationStatus::kOk) {
-      r.status = s;
-      r.tick = static_cast<std::int32_t>(n);
-      break;
-    }
-  }
-  r.rcond = singular.rcond;
-  math::restore_arithmetic_flags<S>(before);  // the check's own discarded
-  return r;
-}
-
-/// Plans the motion about q0 (the arm at rest there) and checks it, with every gain cut by
-/// kExcitationScaleStep at each failed check while the cut stays within kExcitationMinScale: kOk with
-/// the motion to run, or the plan's refusal, or the last check's.
-template <class S>
-ExcitationCheck<S> prepare_excitation(const Model<S>& model, Data<S>& data, const Vec6<S>& q0, const Mat3<S>& R_ref,
-                                      const ExcitationLimits<S>& lim, ExcitationMotion<S>& motion,
-                                      const loop::PathLoop* loop = nullptr) {
-  ExcitationCheck<S> r;
-  r.status = motion.plan(q0, lim);
-  if (r.status != ExcitationStatus::kOk) {
-    r.joint = motion.refused_joint();
-    return r;
-  }
-  S scale(1);
-  for (int attempt = 0; attempt < excitation::kAttempts; ++attempt) {
-    motion.set_scale(scale);
-    r = check_excitation(model, data, motion, R_ref, lim, loop);
-    if (r.status == ExcitationStatus::kOk) break;
-    scale *= lit<S>(params::kExcitationScaleStep);
-  }
-  return r;
-}
-
 }  // namespace osc
+
+// The check and the preparation (check_excitation, prepare_excitation), in their own header.
+#include "osc/control/excitation_check.hpp"
