@@ -837,8 +837,9 @@ def payload_identified():
 
 
 # The heaviest of payload_identified's payloads on the arm, not set in the model.
+PAYLOAD_COM = "[0.03,-0.03,0.09]"  # the payload tables' centre of mass [m], frame 6
 PAYLOAD_UNSET = ["--mode", "adaptive", "--duration", "120", "--plant-set", "payload_mass=2.5",
-                 "--plant-set", "payload_com=[0.03,-0.03,0.09]"]
+                 "--plant-set", f"payload_com={PAYLOAD_COM}"]
 
 
 @table("payload_unset", "docs/adaptation.md", "host")
@@ -859,9 +860,6 @@ def payload_unset():
     return "\n".join(lines)
 
 
-PAYLOAD_STALE_COM = "[0.03,-0.03,0.09]"
-
-
 @table("payload_stale", "docs/adaptation.md", "host")
 def payload_stale():
     """A payload set in the model that the arm no longer carries (a saved tool taken off): the paper's experiment."""
@@ -872,7 +870,7 @@ def payload_stale():
     for mass in ("0.5", "1.5", "2.5"):
         for monitor in ("on", "trial"):
             args = ("--mode", "adaptive", "--duration", "120", "--set", f"run.payload_mass={mass}",
-                    "--set", f"run.payload_com={PAYLOAD_STALE_COM}", "--set", f"run.residual_monitor={monitor}")
+                    "--set", f"run.payload_com={PAYLOAD_COM}", "--set", f"run.residual_monitor={monitor}")
             EXPECTED_FAULTS.add(args)
             r = run_of(experiment(*args), "adaptive")
             fault = f"{', '.join(r['faults'])}, {r['fault_time_s']:.3f} s" if r["faults"] else "none"
