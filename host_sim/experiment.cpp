@@ -78,7 +78,7 @@ class LocalController {
   }
   /// The counter jumps by n, as if the task had been running that much longer: the trajectory's
   /// start stays (its time grows by n, the point of the jump), while the monitors' recent history
-  /// (each encoder's last change, a run over the threshold, the enable's ramp) moves with the clock,
+  /// (each encoder's last change, a run over the threshold, the enable's ramp and prime) moves with the clock,
   /// as it would have in a task that had been running.
   void skip_ticks(std::uint64_t n) {
     task_->tick += n;
@@ -86,6 +86,7 @@ class LocalController {
     task_->residual.activity.shift(n);
     task_->stuck.activity.shift(n);
     for (std::uint64_t& t : task_->residual.over_since) t += n;
+    task_->residual.primed_at += n;
   }
   void finish(ExperimentResult& res) {
     for (int i = 0; i < 6; ++i) res.stuck_peak[i] = static_cast<double>(task_->stuck.peak(i));
@@ -108,6 +109,10 @@ class LocalController {
       res.residual_detected_s = static_cast<double>(m.detected_tick) / osc::params::kControlHz;
       res.residual_fault = m.detected;
       res.residual_joint = static_cast<unsigned char>(m.joint);  // set: 0..5
+      res.residual_weight = m.flange.fitted;
+      res.residual_weight_kg = static_cast<double>(m.flange.mass);
+      res.residual_weight_offset_m = static_cast<double>(m.flange.offset);
+      res.residual_weight_misfit = static_cast<double>(m.flange.misfit);
     }
     const osc::DriveMonitor& d = task_->drive;
     for (int c = 0; c < 6; ++c) {

@@ -273,6 +273,9 @@ void StuckMonitorPeaks::to_json(Json& j) const {
   j["oscillation_monitor_peak_ratio"] = json_array(oscillation_peak_ratio, 6);
   j["residual_monitor_travel_ratio"] = json_array(travel_peak_ratio, 6);
   j["residual_monitor_detection"] = residual_detection_json(residual_detected_s, residual_fault, residual_joint);
+  if (residual_weight)
+    j["residual_monitor_detection"]["weight"] = Json{
+        {"mass_kg", residual_weight_kg}, {"offset_m", residual_weight_offset_m}, {"misfit", residual_weight_misfit}};
   j["drive_check_peak_ratio"] = json_array(drive_peak_ratio, 6);
   j["drive_check_dither_fade"] = json_array(dither_peak_fade, 6);
   j["drive_check_detection"] = residual_detection_json(drive_detected_s, drive_fault, drive_channel);

@@ -171,6 +171,10 @@ struct StuckMonitorPeaks {
   double residual_detected_s = -1;        ///< the residual monitor's first detection [s] (-1: none)
   std::uint32_t residual_fault = 0;       ///< ... its fault
   int residual_joint = -1;                ///< ... its joint (0-based)
+  /// ... its residual as a weight at the flange, where the payload check fitted one (osc/runtime/payload_check.hpp):
+  /// mass [kg] (> 0: the model's beyond the arm's), its centre of mass's horizontal offset [m], the misfit.
+  bool residual_weight = false;
+  double residual_weight_kg = 0, residual_weight_offset_m = 0, residual_weight_misfit = 0;
   double position_peak_ratio[6] = {};     ///< the position cross-check's largest |d - d_ref| / band per joint
   double oscillation_peak_ratio[6] = {};  ///< the oscillation monitor's largest half-rate amplitude / limit per joint
   double travel_peak_ratio[6] = {};       ///< the travel check's largest least travel / its limit per joint (0: off)

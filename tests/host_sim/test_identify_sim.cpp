@@ -502,3 +502,31 @@ TEST(IdentifySim, OnTheRealisticPlantWhatTheLawLearntFitsAfterAPowerOn) {
   EXPECT_EQ(stale.stale & 0x2u, 0x2u);
   EXPECT_EQ(same.checked, 0x3Fu);
 }
+
+// A payload the model has wrong, enabled and holding at the runs' pose (docs/safety.md, "A payload the model has
+// wrong"): 1.5 and 2.5 kg at (0.03, -0.03, 0.09) m on the arm and none in the model, and the same set in the model
+// and none on the arm. Each is a category-0 stop within the first second after the enable, as before; the one the
+// residual monitor names, named payload_mismatch, the sign of the mass it records the case's.
+TEST(IdentifySim, APayloadTheModelHasWrongIsNamedAtTheEnable) {
+  Payload p;
+  p.com[0] = 0.03, p.com[1] = -0.03, p.com[2] = 0.09;
+  for (const double mass : {1.5, 2.5})
+    for (const bool on_arm : {true, false}) {
+      p.mass = mass;
+      sim::PlantConfig pc;
+      if (on_arm) pc.payload = p;
+      MotionSim<double> sim(test::identify_pose(), {}, pc);
+      if (!on_arm) sim.task().set_payload(p);
+      EXPECT_EQ(answer(sim, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+      const std::uint32_t faults = run_ticks(sim, 1000).faults;
+      const ResidualMonitor<double>& m = sim.task().residual;
+      std::printf(
+          "%.1f kg %s: %s at %.3f s after the enable; the residual as a weight %.3f kg, %.1f mm off, misfit "
+          "%.4f\n",
+          mass, on_arm ? "on the arm, not set" : "set, not on the arm", fault_name(faults),
+          static_cast<double>(m.detected_tick - m.primed_at) / params::kControlHz, m.flange.mass, 1e3 * m.flange.offset,
+          m.flange.misfit);
+      EXPECT_NE(faults, 0u) << mass << on_arm;
+      if (faults == kFaultPayloadMismatch) EXPECT_EQ(m.flange.mass < 0, on_arm) << mass;
+    }
+}

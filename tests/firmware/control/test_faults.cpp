@@ -16,12 +16,12 @@ using namespace osc;
 namespace {
 
 TEST(Faults, TheBitsAreTheCatalogueInOrderAndTheMaskIsEveryBit) {
-  const char* const names[] = {"non_finite",        "encoder_jump",  "saturation",   "singular",
-                               "overrun",           "link_lost",     "link_corrupt", "encoder_range",
-                               "encoder_stuck",     "tracking",      "theta_bounds", "estop",
-                               "overflow",          "dac_bus",       "drive_fault",  "collision",
-                               "position_mismatch", "index_missing", "unstable",     "current_sense"};
-  ASSERT_EQ(kFaultCount, 20);
+  const char* const names[] = {
+      "non_finite",   "encoder_jump",  "saturation",      "singular",  "overrun",           "link_lost",
+      "link_corrupt", "encoder_range", "encoder_stuck",   "tracking",  "theta_bounds",      "estop",
+      "overflow",     "dac_bus",       "drive_fault",     "collision", "position_mismatch", "index_missing",
+      "unstable",     "current_sense", "payload_mismatch"};
+  ASSERT_EQ(kFaultCount, 21);
   ASSERT_EQ(static_cast<int>(sizeof(names) / sizeof(*names)), kFaultCount);
   std::set<std::string> seen;
   for (int i = 0; i < kFaultCount; ++i) {
@@ -38,7 +38,7 @@ TEST(Faults, TheBitsAreTheCatalogueInOrderAndTheMaskIsEveryBit) {
   EXPECT_EQ(kFaultIndexMissing, 1u << 17);
   EXPECT_EQ(kFaultUnstable, 1u << 18);
   EXPECT_EQ(kFaultCurrentSense, 1u << 19);
-  EXPECT_EQ(kAllFaults, 0xFFFFFu);  // 20 bits, nothing above
+  EXPECT_EQ(kAllFaults, 0x1FFFFFu);  // 21 bits, nothing above
 }
 
 TEST(Faults, AWordIsNamedByItsLowestBit) {

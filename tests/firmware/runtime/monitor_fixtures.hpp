@@ -24,7 +24,9 @@ TYPED_TEST_SUITE(Monitors, Scalars);
 /// A rigid arm frozen at the start pose's inertia, gravity torques and no friction, simulated
 /// exactly in double: A qdd = tau + tau_ext - g. The monitor gets the true velocity as its q^dot, so
 /// the residual is the external torque through the first-order filter alone:
-/// r_n = tau_ext (1 - (1 - K dt)^n), exactly.
+/// r_n = tau_ext (1 - (1 - K dt)^n), exactly. With `jacobian`, the monitor gets frame 6's Jacobian at the start pose
+/// as the control step gives it (its payload check, osc/runtime/payload_check.hpp; the wrist's velocity noise from
+/// its axes, which raises J4's and J6's thresholds); without, neither.
 template <class S>
 struct ResidualRig {
   Mat6<double> A;
@@ -35,13 +37,17 @@ struct ResidualRig {
   std::uint64_t tick = 0;
   double dt = params::kDt;
   const FrictionBounds<S>* proven = nullptr;  // the identification's friction (the travel check's)
+  Mat6<S> J;
+  bool jacobian = false;
 
   ResidualRig() {
     Model<double> model = Model<double>::of(robot::kArm);
     Data<double> data;
     forward_kinematics(model, data, joint_vector<double>(robot::kQStart));
     joint_inertia(model, data);
+    geometric_jacobian(data);
     A = data.A;
+    J = data.J.cast<S>();
     g << 0, 40, 10, 0.1, 0.5, 0.01;
     tau = g;  // holds the arm
     Vec6<S> quantum;
@@ -62,7 +68,7 @@ struct ResidualRig {
     const Mat6<S> As = A.cast<S>();
     const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
     Vec6<S> decay = Vec6<S>::Ones();
-    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr, proven};
+    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr, proven, jacobian ? &J : nullptr};
     const std::uint32_t f = m.check(in, io, counts, moved, tick, tick % params::kResidualTurnEvery == 0);
     m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
     if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);

@@ -38,7 +38,9 @@ namespace osc {
   X(Unstable, "unstable",                                                                                          \
     "a torque (less its friction compensation) oscillated at half the tick rate beyond its bound: the loop lost")  \
   X(CurrentSense, "current_sense",                                                                                 \
-    "an amplifier's current monitor read off its scale (beyond any current its amplifier gives): the drive check")
+    "an amplifier's current monitor read off its scale (beyond any current its amplifier gives): the drive check") \
+  X(PayloadMismatch, "payload_mismatch",                                                                           \
+    "after an enable, the residual is the weight of a payload set and not on the arm, or on it and not set")
 
 // The name and the meaning of an entry of an X-macro list of the form X(Name, "name", meaning):
 // `{LIST(OSC_X_NAME)}` is the array of its names, `{LIST(OSC_X_DOC)}` of its meanings.

@@ -259,6 +259,19 @@ constexpr bool kResidualMonitorArmed = true;
 /// exceeds this many counts must have counted: its encoder (or something holding the joint) is at
 /// fault. One count is the geometry (the next edge, or the last one back); the second is margin.
 constexpr double kResidualTravelCounts = 2;
+/// A payload the model has wrong (osc/runtime/payload_check.hpp; docs/safety.md, "A payload the model has wrong"):
+/// within kPayloadCheckTicks of an enable (the arm held still), a finding of the residual monitor whose residual is
+/// the weight of a point mass at the flange is payload_mismatch, not encoder_stuck or collision:
+/// - at most kPayloadFitMisfit of the residual's square left unexplained by the best such weight, and at least
+///   kPayloadSpread of it off its largest joint (one joint's torque is that joint's drive or encoder);
+/// - a weight of kPayloadMismatchMass or more (and at most twice the arm's rated payload);
+/// - the fit's 3x3 system is taken only where its determinant is at least kPayloadFitConditioning times its trace
+///   cubed (a pose where a weight's three columns differ).
+constexpr int kPayloadCheckTicks = 1000;
+constexpr double kPayloadFitMisfit = 0.02;
+constexpr double kPayloadSpread = 0.005;
+constexpr double kPayloadMismatchMass = 0.2;
+constexpr double kPayloadFitConditioning = 1e-4;
 /// The drive check (osc/runtime/drive_monitor.hpp; docs/safety.md, "The drive check"), on a HAL with
 /// current readback:
 /// - its threshold is kDriveMargin times the stated bounds of the amplifiers' and the current monitors'

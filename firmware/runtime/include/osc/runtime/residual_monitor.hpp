@@ -14,6 +14,7 @@
 #include "osc/runtime/drive_monitor.hpp"
 #include "osc/runtime/encoder_monitors.hpp"
 #include "osc/runtime/io.hpp"
+#include "osc/runtime/payload_check.hpp"
 #include "osc/runtime/residual_constants.hpp"
 
 namespace osc {
@@ -86,6 +87,8 @@ struct ResidualMonitor {
   std::uint64_t detected_tick;     // ... its tick
   std::int8_t joint;               // ... its joint (0-based), -1 none
   bool primed;                     // a previous step is on record
+  std::uint64_t primed_at = 0;     // the tick it primed at (an enable): payload_mismatch's window
+  FlangeWeight<S> flange{};        // the first detection's residual as a weight at the flange (payload_check.hpp)
   /// Its detections are faults, in place of StuckEncoderMonitor's (else only recorded).
   bool armed = params::kResidualMonitorArmed;
   /// The user's collision thresholds [N m] (ControlTask::set_collision): a collision is reported
@@ -175,6 +178,7 @@ struct ResidualMonitor {
     activity.reset();
     joint = -1;
     detected = 0;
+    flange = FlangeWeight<S>{};
     detected_tick = 0;
     primed = false;
     contact_noted = false;
@@ -268,13 +272,14 @@ struct ResidualMonitor {
     if (prime) {
       for (int i = 0; i < kDof; ++i) over[i] = 0;
       primed = true;
+      primed_at = tick;
       return 0;
     }
     d = r - r_slow;
     int worst = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) qualify_joint(i, tick, worst, worst_ratio);
-    return decide(worst, moved_too_far, io, tick);
+    return decide(worst, moved_too_far, io, tick, in.J);
   }
 
   /// r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})], every joint; the
@@ -306,21 +311,8 @@ struct ResidualMonitor {
   }
 
   /// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over
-  /// its thresholds, classified; a collision below the collision floor is none. The first fault is
-  /// recorded (detected, joint, detected_tick); reported only when armed.
-  std::uint32_t decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick) {
-    std::uint32_t kind;
-    if (moved_too_far >= 0) {
-      worst = moved_too_far;
-      kind = classify_travel(worst);
-    } else {
-      if (worst < 0) return 0;
-      kind = classify(worst, io, tick);
-    }
-    if (kind == kFaultCollision && !beyond_collision_floor(moved_too_far < 0)) return 0;
-    if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick;
-    return armed ? kind : 0u;
-  }
+  /// its thresholds, classified (residual_travel.hpp).
+  std::uint32_t decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick, const Mat6<S>* J);
 
   /// Joint i's residual within `fraction` of its thresholds on both channels (ratio_of(i) <= fraction, undivided).
   bool within(int i, S fraction) const {

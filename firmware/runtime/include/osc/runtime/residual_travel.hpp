@@ -164,4 +164,34 @@ inline std::uint32_t ResidualMonitor<S>::classify_travel(int i) const {
   return kFaultEncoderStuck;
 }
 
+/// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over its
+/// thresholds, classified; a collision below the collision floor is none. Within params::kPayloadCheckTicks of the
+/// prime (an enable), a finding is payload_mismatch where the residual is the weight of a point mass at the flange
+/// (J: frame 6's Jacobian; payload_check.hpp), unless the drive check suspects the joint's drive. An encoder that
+/// counted fast and fell silent is no evidence then: a weight the model does not know drops the arm at the enable
+/// until the controller catches it, and a joint whose encoder froze while it moved would leave a residual on its
+/// own joint, no weight's. The first fault is recorded (detected, joint, detected_tick, flange); reported only when
+/// armed.
+template <class S>
+inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick,
+                                                const Mat6<S>* J) {
+  std::uint32_t kind;
+  if (moved_too_far >= 0) {
+    worst = moved_too_far;
+    kind = classify_travel(worst);
+  } else {
+    if (worst < 0) return 0;
+    kind = classify(worst, io, tick);
+  }
+  const bool drive = kind == kFaultDriveFault && drives_checked;  // the current readback's, not the residual's
+  FlangeWeight<S> weight{};
+  if (!drive && J && tick - primed_at <= static_cast<std::uint64_t>(params::kPayloadCheckTicks)) {
+    weight = flange_weight(*J, r);
+    if (payload_mismatch(weight)) kind = kFaultPayloadMismatch;
+  }
+  if (kind == kFaultCollision && !beyond_collision_floor(moved_too_far < 0)) return 0;
+  if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick, flange = weight;
+  return armed ? kind : 0u;
+}
+
 }  // namespace osc
