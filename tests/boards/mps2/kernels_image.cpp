@@ -78,6 +78,19 @@ ArmOpSpace<F> g_os;
 ControllerState<F> g_state;
 
 /// The joint-space kernels at qn, against the published gravity, inertia and Coriolis values.
+/// The payload check's fit (osc/runtime/payload_check.hpp), which runs in a tick that detects within a second of an
+/// enable: the residual as a weight at the flange. Here 2.5 kg's weight at frame 6's origin and a horizontal moment, at
+/// the pose joint_space_kernels left in g_data; the fit gives the mass back.
+void payload_check_kernel() {
+  const Vec6<F> r = g_data.J.row(2).transpose() * lit<F>(2.5 * robot::kArm.gravity) +
+                    g_data.J.row(3).transpose() * lit<F>(0.5) - g_data.J.row(4).transpose() * lit<F>(0.25);
+  FlangeWeight<F> w;
+  {
+    Timer t("flange_weight (the payload check's fit, in a tick that detects within a second of an enable)");
+    w = flange_weight(g_data.J, r);
+  }
+  check("flange_weight: the mass of 2.5 kg's weight", static_cast<double>(w.mass), 2.5, 0.01);
+}
 void joint_space_kernels(const Vec6<F>& qn, const Vec6<F>& qd) {
   Vec6<F> one, g, c, tau;
   one.setOnes();
@@ -618,6 +631,7 @@ int main() {
   Vec6<F> qd;
   qd << 1, 2, 3, 1, 2, 3;
   joint_space_kernels(qn, qd);
+  payload_check_kernel();
   const Vec6<F> fr = friction_kernels(qd);
   operational_inertia_kernels(q0, qn);
   operational_force_kernels(qd, fr);
