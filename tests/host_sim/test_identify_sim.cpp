@@ -505,8 +505,9 @@ TEST(IdentifySim, OnTheRealisticPlantWhatTheLawLearntFitsAfterAPowerOn) {
 
 // A payload the model has wrong, enabled and holding at the runs' pose (docs/safety.md, "A payload the model has
 // wrong"): 1.5 and 2.5 kg at (0.03, -0.03, 0.09) m on the arm and none in the model, and the same set in the model
-// and none on the arm. Each is a category-0 stop within the first second after the enable, as before; the one the
-// residual monitor names, named payload_mismatch, the sign of the mass it records the case's.
+// and none on the arm. Each is a category-0 stop within the first second after the enable, named payload_mismatch
+// (before the held-pose rule: encoder_stuck, the travel check's), the sign of the mass it records the case's.
+// Static friction holds part of the weight, so that the residual is less than it and no clean weight.
 TEST(IdentifySim, APayloadTheModelHasWrongIsNamedAtTheEnable) {
   Payload p;
   p.com[0] = 0.03, p.com[1] = -0.03, p.com[2] = 0.09;
@@ -526,7 +527,40 @@ TEST(IdentifySim, APayloadTheModelHasWrongIsNamedAtTheEnable) {
           mass, on_arm ? "on the arm, not set" : "set, not on the arm", fault_name(faults),
           static_cast<double>(m.detected_tick - m.primed_at) / params::kControlHz, m.flange.mass, 1e3 * m.flange.offset,
           m.flange.misfit);
-      EXPECT_NE(faults, 0u) << mass << on_arm;
-      if (faults == kFaultPayloadMismatch) EXPECT_EQ(m.flange.mass < 0, on_arm) << mass;
+      EXPECT_EQ(faults, kFaultPayloadMismatch) << mass << on_arm;
+      EXPECT_EQ(m.flange.mass < 0, on_arm) << mass;
+      EXPECT_LT(std::fabs(m.flange.mass), mass) << mass;
     }
+}
+
+// The held-pose rule's other side: an encoder that sticks while the arm holds its pose with the model right shows
+// nothing, and one that sticks while the arm moves, within the first second after the enable too, is encoder_stuck,
+// never payload_mismatch. Each joint's encoder stuck 0.2 s after the enable; a move from 0.1 s (each joint's own:
+// the start pose with that joint 0.3 rad further, the other joints where they are). Measured: held, nothing but
+// J5's position_mismatch (the potentiometer's cross-check); moving, encoder_stuck on the joint 0.21-0.31 s after
+// the enable.
+TEST(IdentifySim, AStuckEncoderIsNoPayloadWhetherTheArmHoldsOrMoves) {
+  const V6 q0 = test::identify_pose();
+  for (int j = 0; j < kDof; ++j) {
+    sim::Injection inj;
+    inj.enabled = true, inj.kind = sim::InjectionKind::kEncoderStuck, inj.joint = j, inj.at = 0.2;
+    MotionSim<double> held(q0, inj);
+    EXPECT_EQ(answer(held, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+    const std::uint32_t at_rest = run_ticks(held, 2000).faults;
+    MotionSim<double> moving(q0, inj);
+    EXPECT_EQ(answer(moving, MotionVerb::kEnable, 1).outcome, CommandOutcome::kAccepted);
+    run_ticks(moving, 100);
+    V6 q = q0;
+    q(j) += 0.3;
+    moving.move_to(test::to_joint_pose(q), 2);
+    const std::uint32_t faults = run_ticks(moving, 2000).faults;
+    const ResidualMonitor<double>& m = moving.task().residual;
+    std::printf("J%d's encoder stuck at 0.2 s: holding, %s; moving, %s at %.3f s after the enable (J%d)\n", j + 1,
+                fault_name(at_rest), fault_name(faults),
+                static_cast<double>(m.detected_tick - m.primed_at) / params::kControlHz, m.joint + 1);
+    EXPECT_EQ(at_rest & kFaultPayloadMismatch, 0u) << j;
+    EXPECT_EQ(m.detected, kFaultEncoderStuck) << j;  // the residual monitor's first finding
+    EXPECT_NE(faults & kFaultEncoderStuck, 0u) << j;
+    EXPECT_EQ(faults & kFaultPayloadMismatch, 0u) << j;
+  }
 }

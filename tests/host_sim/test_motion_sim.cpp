@@ -30,6 +30,7 @@ using test::run_ticks;
 using test::run_until;
 using test::start_pose;
 using test::state_is;
+using test::to_joint_pose;
 using test::Trace;
 
 namespace {
@@ -247,18 +248,6 @@ TEST(MotionSim, PaperMotionByCommandThenAStopAlongItsPath) {
   ASSERT_TRUE(r.ended);
   EXPECT_EQ(r.faults, 0u);
   EXPECT_TRUE(state_is(sim, MotionState::kHolding));
-}
-
-/// A move to the pose of joint angles q (absolute position and orientation).
-MoveRequest<double> to_joint_pose(const V6& q) {
-  Model<double> model = Model<double>::of(robot::kArm);
-  Data<double> data;
-  forward_kinematics(model, data, q);
-  MoveRequest<double> r;
-  r.position = data.o[kDof];
-  r.has_rpy = true;
-  r.rpy = orientation_coordinates<double>(data.R[kDof], Mat3<double>::Identity());
-  return r;
 }
 
 /// The arm enabled with joint 1 at 0.05 rad from its limit of 160 deg, and a move a quarter turn

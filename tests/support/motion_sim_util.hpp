@@ -97,6 +97,18 @@ MoveRequest<S> relative(double dx, double dy, double dz) {
   return r;
 }
 
+/// A move to the pose of joint angles q (absolute position and orientation).
+inline MoveRequest<double> to_joint_pose(const sim::Vec6& q) {
+  Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  forward_kinematics(model, data, q);
+  MoveRequest<double> r;
+  r.position = data.o[kDof];
+  r.has_rpy = true;
+  r.rpy = orientation_coordinates<double>(data.R[kDof], Mat3<double>::Identity());
+  return r;
+}
+
 template <class S>
 bool state_is(const MotionSim<S>& sim, MotionState s) {
   return sim.task().machine.state == s;

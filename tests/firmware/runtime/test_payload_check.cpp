@@ -184,3 +184,46 @@ TYPED_TEST(Monitors, AWeightAtTheEnableIsAPayloadMismatch) {
   EXPECT_GE(payload_fault(blind, weight, -1, kind), 0);
   EXPECT_NE(kind, kFaultPayloadMismatch) << fault_name(kind);
 }
+
+// The held-pose rule (ResidualMonitor::decide): the rig held at the start pose from the enable (ResidualMonitor::
+// holding), the drives short of what was asked of them (or a load the model lacks) by 20 N m on J3 alone, or by 30 and
+// -15 N m on J2 and J3 (no weight's shape). Each is encoder_stuck when the arm has not held since the enable, or when
+// the finding comes after the first second. Held, within it: one joint's is drive_fault, two joints' payload_mismatch;
+// with the drives measured (the drive check ran), its suspect decides: a suspect drive, drive_fault, none,
+// payload_mismatch.
+TYPED_TEST(Monitors, AFindingAtAPoseHeldSinceTheEnableIsNoStuckEncoder) {
+  using S = TypeParam;
+  Vec6<double> one = Vec6<double>::Zero(), two = Vec6<double>::Zero();
+  one(2) = 20;
+  two(1) = 30, two(2) = -15;
+  const auto kind_of = [](const Vec6<double>& torque, bool holding, int wait, bool checked, std::uint8_t suspect) {
+    ResidualRig<S> rig;
+    rig.m.holding = holding;
+    rig.m.drives_checked = checked;
+    rig.m.drive_suspect = suspect;
+    std::uint32_t kind = 0;
+    EXPECT_GE(payload_fault(rig, torque, wait, kind), 0);
+    return kind;
+  };
+  EXPECT_EQ(kind_of(one, false, 0, false, 0), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(two, false, 0, false, 0), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(one, true, 1100, false, 0), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(one, true, 0, false, 0), kFaultDriveFault);
+  EXPECT_EQ(kind_of(two, true, 0, false, 0), kFaultPayloadMismatch);
+  EXPECT_EQ(kind_of(one, true, 0, true, 0), kFaultPayloadMismatch);
+  EXPECT_EQ(kind_of(one, true, 0, true, 1u << 2), kFaultDriveFault);
+  EXPECT_EQ(kind_of(two, true, 0, true, 1u << 1), kFaultDriveFault);
+}
+
+// residual_spread: the share of r's square off its largest joint, as a hand computation gives it, in every scalar.
+TYPED_TEST(Monitors, TheResidualsSpreadIsItsShareOffItsLargestJoint) {
+  using S = TypeParam;
+  Vec6<S> r = Vec6<S>::Zero();
+  EXPECT_EQ(residual_spread(r), S(0));
+  r(1) = S(4);
+  EXPECT_EQ(residual_spread(r), S(0));
+  r(2) = S(-3);  // 9 of 25 off J2
+  EXPECT_NEAR(static_cast<double>(residual_spread(r)), 9.0 / 25.0, 1e-4);
+  r(4) = S(2);  // 13 of 29
+  EXPECT_NEAR(static_cast<double>(residual_spread(r)), 13.0 / 29.0, 1e-4);
+}

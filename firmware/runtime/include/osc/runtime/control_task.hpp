@@ -85,6 +85,7 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const bool turn = even_step(task.state);
   task.residual.sample_joint = identify && turn ? momentum_turn(task.state.adapt) : -1;
   task.residual.contact = task.machine.state == MotionState::kYielding || task.contact;
+  task.residual.holding = task.machine.state == MotionState::kHolding;
   faults |= task.residual.check(in, task.io, counts, moved, task.tick, turn);
   // The momentum law's stage of the control law, on the sample the residual monitor's last turn took, in the
   // step after it (the one that computes Psi, not the thresholds).

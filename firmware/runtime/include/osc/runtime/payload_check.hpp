@@ -24,6 +24,18 @@ struct FlangeWeight {
   bool fitted = false;
 };
 
+/// The share of r's square off its largest joint (FlangeWeight::spread); 0 where r is all but 0. On r scaled to a
+/// largest |r_i| of 1, as flange_weight's.
+template <class S>
+S residual_spread(const Vec6<S>& r) {
+  S scale = S(0);
+  for (int i = 0; i < kDof; ++i) scale = math::abs(r(i)) > scale ? math::abs(r(i)) : scale;
+  if (scale <= lit<S>(1e-3)) return S(0);
+  S all = S(0);
+  for (int i = 0; i < kDof; ++i) all += (r(i) / scale) * (r(i) / scale);
+  return S(1) - S(1) / all;  // the largest |r_i / scale| is 1
+}
+
 /// The least-squares weight of r (J: the geometric Jacobian [v; w] of frame 6's origin, base frame, gravity
 /// along -z). Its three columns are J's rows 2 (the origin's vertical rate), 3 and 4 (the horizontal components
 /// of the joints' axes): a 3x3 system by its cofactors, on r scaled to a largest |r_i| of 1, so that no product
@@ -61,7 +73,7 @@ FlangeWeight<S> flange_weight(const Mat6<S>& J, const Vec6<S>& r) {
     all += u(i) * u(i);
   }
   w.misfit = miss / all;
-  w.spread = S(1) - S(1) / all;  // the largest |u_i| is 1
+  w.spread = residual_spread(r);
   w.mass = x[0] * scale / lit<S>(robot::kArm.gravity);
   const S moment = math::sqrt(x[1] * x[1] + x[2] * x[2]), force = math::abs(x[0]);
   w.offset = force > lit<S>(1e-3) * moment ? moment / force : lit<S>(1000);

@@ -122,6 +122,9 @@ struct ResidualMonitor {
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
   bool contact_noted = false;  // the contact error_floor holds (note_contact())
+  /// Set by the task each tick: the arm holds a pose, no motion commanded (MotionState::kHolding).
+  bool holding = false;
+  bool held = false;  // ... at every step since the prime: a stuck encoder has had nothing to show (decide())
   /// Set by the task on a HAL with current readback (DriveMonitor): the drive check ran, the channels it suspects.
   bool drives_checked = false;
   std::uint8_t drive_suspect = 0;
@@ -182,6 +185,7 @@ struct ResidualMonitor {
     detected_tick = 0;
     primed = false;
     contact_noted = false;
+    held = false;
     for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
   }
   /// The velocity estimate's noise on the wrist, this step. The observer's q^dot = J^-1 (y + k x~)
@@ -256,6 +260,7 @@ struct ResidualMonitor {
     sample.settled = false;
     if (contact != contact_noted) note_contact();
     const bool prime = !primed;  // the first step after a reset: no previous step to difference
+    held = (prime || held) && holding;
     if (prime) {
       if (!turn) return 0;
       qd_prev = qd_turn = in.qd;

@@ -166,12 +166,18 @@ inline std::uint32_t ResidualMonitor<S>::classify_travel(int i) const {
 
 /// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over its
 /// thresholds, classified; a collision below the collision floor is none. Within params::kPayloadCheckTicks of the
-/// prime (an enable), a finding is payload_mismatch where the residual is the weight of a point mass at the flange
-/// (J: frame 6's Jacobian; payload_check.hpp), unless the drive check suspects the joint's drive. An encoder that
-/// counted fast and fell silent is no evidence then: a weight the model does not know drops the arm at the enable
-/// until the controller catches it, and a joint whose encoder froze while it moved would leave a residual on its
-/// own joint, no weight's. The first fault is recorded (detected, joint, detected_tick, flange); reported only when
-/// armed.
+/// prime (an enable), unless the drive check suspects the joint's drive, a finding is payload_mismatch:
+///  - where the residual is the weight of a point mass at the flange (J: frame 6's Jacobian; payload_check.hpp). An
+///    encoder that counted fast and fell silent is no evidence then: a weight the model does not know drops the arm
+///    at the enable until the controller catches it, and a joint whose encoder froze while it moved would leave a
+///    residual on its own joint, no weight's;
+///  - or where it would be encoder_stuck and the arm has held its pose since the prime (held). A stuck encoder has
+///    nothing to show there: with the model's gravity the arm's, the torque that holds it holds it whatever the
+///    encoder reads. A joint driven beyond that and held, or a residual after a silence, is a load the model has
+///    wrong; static friction holds part of it, so that the residual is no clean weight (the weight found is less).
+///    A residual on one joint alone (less than params::kPayloadSpread of its square off it) may be that joint's drive
+///    as well: drive_fault. With the drives checked, the drive check decides (classify()'s rule).
+/// The first fault is recorded (detected, joint, detected_tick, flange); reported only when armed.
 template <class S>
 inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick,
                                                 const Mat6<S>* J) {
@@ -185,9 +191,15 @@ inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, co
   }
   const bool drive = kind == kFaultDriveFault && drives_checked;  // the current readback's, not the residual's
   FlangeWeight<S> weight{};
-  if (!drive && J && tick - primed_at <= static_cast<std::uint64_t>(params::kPayloadCheckTicks)) {
-    weight = flange_weight(*J, r);
-    if (payload_mismatch(weight)) kind = kFaultPayloadMismatch;
+  if (!drive && tick - primed_at <= static_cast<std::uint64_t>(params::kPayloadCheckTicks)) {
+    if (J) weight = flange_weight(*J, r);
+    if (J && payload_mismatch(weight)) {
+      kind = kFaultPayloadMismatch;
+    } else if (kind == kFaultEncoderStuck && held) {
+      const bool one_joint = residual_spread(r) < lit<S>(params::kPayloadSpread);
+      const bool its_drive = drives_checked ? drive_suspected(drive_suspect, worst, io) : one_joint;
+      kind = its_drive ? kFaultDriveFault : kFaultPayloadMismatch;
+    }
   }
   if (kind == kFaultCollision && !beyond_collision_floor(moved_too_far < 0)) return 0;
   if (detected == 0) detected = kind, joint = static_cast<std::int8_t>(worst), detected_tick = tick, flange = weight;
