@@ -233,6 +233,39 @@ homing_sequence() {
 
 # A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
 # setpoints, then again (from where that ended) with the path's velocity (--velocity).
+# stream_path CLIENT... -- STREAM ARGS...: the stream run to its end (accepted, done). A client that fell behind its
+# schedule (its warning) on a loaded machine has its stream aborted stale_stream by the board, as it must be: at the
+# slowest rate, 10 Hz, two periods are 0.2 s (seen once, a CI run beside two builds on two cores). That stream is run
+# again, up to twice, from where the arm stopped; y0 and z0 are then where it was held.
+stream_path() {
+  local client=() attempt
+  while [ "$1" != "--" ]; do
+    client+=("$1")
+    shift
+  done
+  shift
+  for attempt in 1 2 3; do
+    "${client[@]}" "$@" >"$tmp/out" 2>&1
+    local rc=$?
+    echo "\$ ${client[0]##*/} ${client[*]:1} $* -> $rc"
+    sed 's/^/    /' "$tmp/out"
+    if [ "$rc" -eq 1 ] && grep -q 'aborted: stale_stream' "$tmp/out" && grep -q 'fell behind' "$tmp/out"; then
+      echo "    (the client fell behind on a loaded machine: the stream again, attempt $((attempt + 1)))"
+      local k
+      for k in $(seq 50); do
+        "${client[@]}" state >"$tmp/out" 2>&1 && grep -q '^state: holding$' "$tmp/out" && break
+        sleep 0.1
+      done
+      y0=$(reference_y) z0=$(reference_z)
+      continue
+    fi
+    [ "$rc" -eq 0 ] || fail "exit status $rc, expected 0"
+    grep -Eq '^accepted \(id [0-9]+\)$' "$tmp/out" && grep -q '^done$' "$tmp/out" || fail "the stream did not end done"
+    return 0
+  done
+  fail "the stream was stale three times"
+}
+
 stream() {
   printf 't, x, y, z\n# 10 mm along y, then along z\n0, 0, 0, 0\n0.6, 0, 0.01, 0\n1.2, 0, 0.01, 0.01\n' >"$tmp/path.csv"
   expect 0 '^accepted$' -- "$@" enable
@@ -240,7 +273,7 @@ stream() {
   local y0 y1 z0 z1 opt
   for opt in "" --velocity; do
     y0=$(reference_y) z0=$(reference_z)
-    expect 0 '^accepted \(id [0-9]+\)$' '^done$' -- "$@" stream "$tmp/path.csv" --rate 10 --relative $opt
+    stream_path "$@" -- stream "$tmp/path.csv" --rate 10 --relative $opt
     expect 0 '^state: holding$' '^dropped: 0$' -- "$@" state
     y1=$(reference_y) z1=$(reference_z)
     near "$(awk -v a="$y1" -v b="$y0" 'BEGIN { print a - b }')" 0.01 0.0005 &&
