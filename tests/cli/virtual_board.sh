@@ -122,18 +122,24 @@ stop_sim() {
 
 # expect STATUS PATTERN... -- COMMAND...: runs COMMAND; its exit status must be STATUS and each
 # PATTERN (an extended regular expression) must match a line of its output (stdout and stderr).
+# show COMMAND...: runs it into $tmp/out and prints the command, its exit status and its output; the status in rc (the
+# caller's local).
+show() {
+  "$@" >"$tmp/out" 2>&1
+  rc=$?
+  echo "\$ ${1##*/} ${*:2} -> $rc"
+  sed 's/^/    /' "$tmp/out"
+}
+
 expect() {
-  local want=$1 patterns=()
+  local want=$1 patterns=() rc
   shift
   while [ "$1" != "--" ]; do
     patterns+=("$1")
     shift
   done
   shift
-  "$@" >"$tmp/out" 2>&1
-  local rc=$?
-  echo "\$ ${1##*/} ${*:2} -> $rc"
-  sed 's/^/    /' "$tmp/out"
+  show "$@"
   [ "$rc" -eq "$want" ] || fail "exit status $rc, expected $want"
   for p in "${patterns[@]}"; do
     grep -Eq -- "$p" "$tmp/out" || fail "no line matching '$p'"
@@ -231,24 +237,19 @@ homing_sequence() {
   expect 0 '^accepted$' '^done$' -- "$@" disable
 }
 
-# A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
-# setpoints, then again (from where that ended) with the path's velocity (--velocity).
 # stream_path CLIENT... -- STREAM ARGS...: the stream run to its end (accepted, done). A client that fell behind its
 # schedule (its warning) on a loaded machine has its stream aborted stale_stream by the board, as it must be: at the
 # slowest rate, 10 Hz, two periods are 0.2 s (seen once, a CI run beside two builds on two cores). That stream is run
 # again, up to twice, from where the arm stopped; y0 and z0 are then where it was held.
 stream_path() {
-  local client=() attempt
+  local client=() attempt rc
   while [ "$1" != "--" ]; do
     client+=("$1")
     shift
   done
   shift
   for attempt in 1 2 3; do
-    "${client[@]}" "$@" >"$tmp/out" 2>&1
-    local rc=$?
-    echo "\$ ${client[0]##*/} ${client[*]:1} $* -> $rc"
-    sed 's/^/    /' "$tmp/out"
+    show "${client[@]}" "$@"
     if [ "$rc" -eq 1 ] && grep -q 'aborted: stale_stream' "$tmp/out" && grep -q 'fell behind' "$tmp/out"; then
       echo "    (the client fell behind on a loaded machine: the stream again, attempt $((attempt + 1)))"
       local k
@@ -266,6 +267,8 @@ stream_path() {
   fail "the stream was stale three times"
 }
 
+# A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
+# setpoints, then again (from where that ended) with the path's velocity (--velocity).
 stream() {
   printf 't, x, y, z\n# 10 mm along y, then along z\n0, 0, 0, 0\n0.6, 0, 0.01, 0\n1.2, 0, 0.01, 0.01\n' >"$tmp/path.csv"
   expect 0 '^accepted$' -- "$@" enable

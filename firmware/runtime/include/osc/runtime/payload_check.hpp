@@ -24,16 +24,26 @@ struct FlangeWeight {
   bool fitted = false;
 };
 
-/// The share of r's square off its largest joint (FlangeWeight::spread); 0 where r is all but 0. On r scaled to a
-/// largest |r_i| of 1, as flange_weight's.
+/// r scaled to a largest |r_i| of 1, into u: returns that largest |r_i|, or 0 where r is all but 0 (every |r_i|
+/// within 1e-3 N m; u then untouched). The first pass of flange_weight and residual_spread: no product of theirs
+/// leaves the fixed-point range.
 template <class S>
-S residual_spread(const Vec6<S>& r) {
+S scaled_residual(const Vec6<S>& r, Vec6<S>& u) {
   S scale = S(0);
   for (int i = 0; i < kDof; ++i) scale = math::abs(r(i)) > scale ? math::abs(r(i)) : scale;
   if (scale <= lit<S>(1e-3)) return S(0);
+  u = r / scale;
+  return scale;
+}
+
+/// The share of r's square off its largest joint (FlangeWeight::spread); 0 where r is all but 0.
+template <class S>
+S residual_spread(const Vec6<S>& r) {
+  Vec6<S> u;
+  if (scaled_residual(r, u) == S(0)) return S(0);
   S all = S(0);
-  for (int i = 0; i < kDof; ++i) all += (r(i) / scale) * (r(i) / scale);
-  return S(1) - S(1) / all;  // the largest |r_i / scale| is 1
+  for (int i = 0; i < kDof; ++i) all += u(i) * u(i);
+  return S(1) - S(1) / all;  // the largest |u_i| is 1
 }
 
 /// The least-squares weight of r (J: the geometric Jacobian [v; w] of frame 6's origin, base frame, gravity
@@ -44,10 +54,9 @@ S residual_spread(const Vec6<S>& r) {
 template <class S>
 FlangeWeight<S> flange_weight(const Mat6<S>& J, const Vec6<S>& r) {
   FlangeWeight<S> w;
-  S scale = S(0);
-  for (int i = 0; i < kDof; ++i) scale = math::abs(r(i)) > scale ? math::abs(r(i)) : scale;
-  if (scale <= lit<S>(1e-3)) return w;
-  const Vec6<S> u = r / scale;
+  Vec6<S> u;
+  const S scale = scaled_residual(r, u);
+  if (scale == S(0)) return w;
   S m[3][3], b[3];
   for (int a = 0; a < 3; ++a) {
     b[a] = J.row(2 + a).dot(u);
@@ -73,7 +82,7 @@ FlangeWeight<S> flange_weight(const Mat6<S>& J, const Vec6<S>& r) {
     all += u(i) * u(i);
   }
   w.misfit = miss / all;
-  w.spread = residual_spread(r);
+  w.spread = S(1) - S(1) / all;  // residual_spread(r): the largest |u_i| is 1
   w.mass = x[0] * scale / lit<S>(robot::kArm.gravity);
   const S moment = math::sqrt(x[1] * x[1] + x[2] * x[2]), force = math::abs(x[0]);
   w.offset = force > lit<S>(1e-3) * moment ? moment / force : lit<S>(1000);

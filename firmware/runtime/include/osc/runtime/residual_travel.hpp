@@ -193,7 +193,7 @@ inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, co
   FlangeWeight<S> weight{};
   if (!drive && tick - primed_at <= static_cast<std::uint64_t>(params::kPayloadCheckTicks)) {
     if (J) weight = flange_weight(*J, r);
-    if (J && payload_mismatch(weight)) {
+    if (payload_mismatch(weight)) {  // never without J: the weight is then not fitted
       kind = kFaultPayloadMismatch;
     } else if (kind == kFaultEncoderStuck && held) {
       const bool one_joint = residual_spread(r) < lit<S>(params::kPayloadSpread);
