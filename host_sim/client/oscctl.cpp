@@ -310,7 +310,7 @@ void print_identify_payload(const pil::IdentifyPayloadFrame& f) {
 /// off already). The inertia goes in zeroed first, then its moments before its products; where the parameters refuse
 /// it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass), it is zeroed again
 /// and left so, and said. A mass within two of its standard deviations of 0 is no payload (its centre of mass is
-/// noise over noise): all of it set to 0.
+/// noise over noise): all of it set to 0. Then payload_allowance goes back to 0: the payload is identified.
 int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadFrame& f) {
   const auto set = [&](const char* name, int e, double v, bool quiet_refusal = false) -> int {
     const auto r = c.param(pil::kParamOpSet, osc::param_index(name), e, v, a.timeout);
@@ -330,11 +330,13 @@ int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadF
   if (none && rc == 0) std::printf("payload: none found (its mass within 2 standard deviations of 0): set to none\n");
   for (int k = 0; k < 6 && rc == 0 && !none; ++k)
     rc = set("payload_inertia", k, static_cast<double>(f.inertia[k]), true);
-  if (rc != -1) return rc;  // all of it set, or an error
-  for (int k = 0; k < 6; ++k)
-    if (const int z = set("payload_inertia", k, 0.0)) return z;
-  std::printf("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n");
-  return 0;
+  if (rc == -1) {
+    for (int k = 0; k < 6; ++k)
+      if (const int z = set("payload_inertia", k, 0.0)) return z;
+    std::printf("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n");
+    rc = 0;
+  }
+  return rc != 0 ? rc : set("payload_allowance", 0, 0.0);
 }
 
 /// identify --apply: the torque off (a disable), then the estimate's friction and armatures into friction_vis,

@@ -242,6 +242,44 @@ TEST(Parameters, ABadPayloadIsRefusedByName) {
   EXPECT_DOUBLE_EQ(t->payload.inertia[4], 0.0);
 }
 
+// The payload allowance (a payload not yet identified): set, each joint's floor of the residual monitor's model
+// error takes the allowance's torque (the mass's weight at flange_lever(), by hand), in every scalar; refused by
+// name below 0, beyond the rating, NaN, under torque; not saved: a record holds its default, 0, and a load or a
+// power-on starts from it.
+template <class S>
+void payload_allowance_raises_the_floor() {
+  auto t = disabled_task<S>();
+  const int a = param_index("payload_allowance");
+  const Vec6<S> floor = t->residual.error_floor;
+  ASSERT_EQ(param_set(*t, a, 0, 2.0), ParamStatus::kOk);
+  EXPECT_DOUBLE_EQ(param_get(*t, a, 0), 2.0);
+  for (int i = 0; i < kDof; ++i) {
+    const double expected = 2.0 * robot::kArm.gravity * flange_lever(i);
+    EXPECT_NEAR(static_cast<double>(t->residual.allowance(i)), expected, 1e-4 * expected) << i;
+    EXPECT_NEAR(static_cast<double>(t->residual.error_floor(i) - floor(i)), expected, 1e-4 * expected + 1e-5) << i;
+  }
+  ParamRecord r = param_capture(*t);
+  EXPECT_EQ(r.value[param_slot(a)], 0.0f);
+  ASSERT_EQ(param_apply(*t, r), ParamStatus::kOk);
+  EXPECT_EQ(param_get(*t, a, 0), 0.0);
+  EXPECT_EQ(t->residual.allowance(1), S(0));
+}
+TEST(Parameters, ThePayloadAllowanceRaisesTheResidualFloorDouble) { payload_allowance_raises_the_floor<double>(); }
+TEST(Parameters, ThePayloadAllowanceRaisesTheResidualFloorFloat) { payload_allowance_raises_the_floor<float>(); }
+TEST(Parameters, ThePayloadAllowanceRaisesTheResidualFloorFixed) { payload_allowance_raises_the_floor<Fixed>(); }
+
+TEST(Parameters, ABadPayloadAllowanceIsRefusedByName) {
+  auto t = disabled_task<double>();
+  const int a = param_index("payload_allowance");
+  EXPECT_EQ(param_set(*t, a, 0, -0.1), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, a, 0, robot::kPayloadRating.mass * 1.01), ParamStatus::kOutOfRange);
+  EXPECT_EQ(param_set(*t, a, 0, std::numeric_limits<double>::quiet_NaN()), ParamStatus::kNotFinite);
+  t->machine.state = MotionState::kHolding;
+  EXPECT_EQ(param_set(*t, a, 0, 1.0), ParamStatus::kTorqueOn);
+  EXPECT_EQ(param_get(*t, a, 0), 0.0);
+  EXPECT_EQ(kParams[a].persists, false);
+}
+
 // The torque-on states are one list (motion_powered): a torque_off parameter is written in exactly the
 // states of the machine's list the tick does not power (disabled, fault), checked here against the
 // list written out, and against the state machine's own torque; an unreadable state code is refused.

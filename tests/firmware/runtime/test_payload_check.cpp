@@ -227,3 +227,27 @@ TYPED_TEST(Monitors, TheResidualsSpreadIsItsShareOffItsLargestJoint) {
   r(4) = S(2);  // 13 of 29
   EXPECT_NEAR(static_cast<double>(residual_spread(r)), 13.0 / 29.0, 1e-4);
 }
+
+// flange_lever: at 2 000 random poses the flange's origin is never farther from joint i's axis than the lever less
+// the payload's reach, and the farthest seen is within 20 % of it on the arm's joints (the bound is not loose); the
+// wrist's axes pass through the flange's origin on the PUMA (its lever is the reach alone).
+TEST(PayloadCheck, TheFlangeLeverBoundsTheFlangesDistanceFromEachAxis) {
+  test::RandomStates rs;
+  const Model<double> model = Model<double>::of(robot::kArm);
+  Data<double> data;
+  double farthest[kDof] = {};
+  for (int k = 0; k < 2000; ++k) {
+    forward_kinematics(model, data, rs.q_nonsingular());
+    for (int i = 0; i < kDof; ++i) {
+      const Vec3<double> d = data.o[kDof] - data.o[i], z = data.R[i].col(2);
+      farthest[i] = std::max(farthest[i], (d - d.dot(z) * z).norm());
+    }
+  }
+  const double reach = 1.7320508 * robot::kPayloadRating.com_reach;
+  for (int i = 0; i < kDof; ++i) {
+    std::printf("J%d: the flange at most %.3f m from the axis, the lever %.3f m (less the reach)\n", i + 1, farthest[i],
+                flange_lever(i) - reach);
+    EXPECT_LE(farthest[i], flange_lever(i) - reach + 1e-9) << i;
+    if (flange_lever(i) - reach > 1e-3) EXPECT_GE(farthest[i], 0.8 * (flange_lever(i) - reach)) << i;
+  }
+}

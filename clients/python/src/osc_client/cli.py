@@ -213,7 +213,7 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
     torque off already), as oscctl's: the inertia zeroed first, then its moments before its products; where the
     parameters refuse it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass)
     it is zeroed again, left so, and said. A mass within two of its standard deviations of 0 is no payload: all of
-    it set to 0."""
+    it set to 0. Then payload_allowance goes back to 0 where the board has it: the payload is identified."""
     p = c.protocol
 
     def put(name: str, e: int, v: float, quiet: bool = False) -> int:
@@ -238,13 +238,15 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
         print("payload: none found (its mass within 2 standard deviations of 0): set to none")
     for k in range(6):
         rc = rc or (0 if none else put("payload_inertia", k, f.inertia[k], quiet=True))
-    if rc != -1:
-        return rc  # all of it set, or refused
-    for k in range(6):
-        if put("payload_inertia", k, 0.0):
-            return 1
-    print("payload_inertia: refused (the estimate's noise about a point mass): left at 0")
-    return 0
+    if rc == -1:
+        for k in range(6):
+            if put("payload_inertia", k, 0.0):
+                return 1
+        print("payload_inertia: refused (the estimate's noise about a point mass): left at 0")
+        rc = 0
+    if rc or p.parameter("payload_allowance") is None:
+        return rc  # refused, or a board without the allowance
+    return put("payload_allowance", 0, 0.0)
 
 
 def apply_identify(c: Client, a: argparse.Namespace, f: Identify, fp: IdentifyPayload | None = None) -> int:

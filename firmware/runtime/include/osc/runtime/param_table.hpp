@@ -156,6 +156,10 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     TorqueOff, true,                                                                                                  \
     "the payload's inertia about its centre of mass, frame-6 axes: Ixx, Iyy, Izz, Ixy, Ixz, Iyz; positive "           \
     "semi-definite (else not_physical): set the moments before the products")                                         \
+  X(PayloadAllowance, "payload_allowance", 1, "kg", 0, robot::kPayloadRating.mass, 0, TorqueOff, false,               \
+    "a payload not yet identified: the residual monitor allows a weight of up to this mass either way at the "        \
+    "flange (its thresholds raised by it: less sensitive to a collision); set before the enable of an identify "      \
+    "run with --payload, whose --apply sets it back to 0; not saved (0 at power-on)")                                 \
   X(ArmatureCorrection, "armature_correction", kDof, "kg m^2", detail::kArmatureCorrectionLo,                         \
     detail::kArmatureCorrectionHi, 0, TorqueOff, true,                                                                \
     "each drive's armature correction, added to its described G^2 Jm on the diagonal of the model's A(q) (an "        \

@@ -153,6 +153,8 @@ double param_get(const ControlTask<S>& task, int i, int e) {
       return task.payload.com[e];
     case RuntimeParam::kParamPayloadInertia:
       return task.payload.inertia[e];
+    case RuntimeParam::kParamPayloadAllowance:
+      return static_cast<double>(task.residual.allowance_mass);
     case RuntimeParam::kParamArmatureCorrection:
       return task.armature_correction[e];
     case RuntimeParam::kParamFrictionVis:
@@ -212,6 +214,9 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
       break;
     case RuntimeParam::kParamDitherHalfPeriod:
       task.dither_half = static_cast<std::uint8_t>(v);
+      break;
+    case RuntimeParam::kParamPayloadAllowance:
+      task.residual.set_allowance(v);
       break;
     case RuntimeParam::kParamPayloadMass:
     case RuntimeParam::kParamPayloadCom:
@@ -330,7 +335,8 @@ ParamStatus param_set(ControlTask<S>& task, int i, int e, double v, GainMargins*
   return ParamStatus::kOk;
 }
 
-/// Every parameter's value in one record (the slots in table order), as a store keeps it.
+/// Every parameter's value in one record (the slots in table order), as a store keeps it: a parameter that does not
+/// persist (ParamInfo::persists) at its default.
 struct ParamRecord {
   float value[kParamSlots];
 };
@@ -339,7 +345,9 @@ template <class S>
 ParamRecord param_capture(const ControlTask<S>& task) {
   ParamRecord r{};
   for (int i = 0; i < kParamCount; ++i)
-    for (int e = 0; e < kParams[i].count; ++e) r.value[param_slot(i) + e] = static_cast<float>(param_get(task, i, e));
+    for (int e = 0; e < kParams[i].count; ++e)
+      r.value[param_slot(i) + e] =
+          static_cast<float>(kParams[i].persists ? param_get(task, i, e) : param_default(i, e));
   return r;
 }
 

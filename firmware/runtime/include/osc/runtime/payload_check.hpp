@@ -4,6 +4,8 @@
 // flange (ResidualMonitor::decide, osc/runtime/residual_travel.hpp).
 #pragma once
 
+#include <cmath>
+
 #include "osc/control/params.hpp"
 #include "osc/kernels/model.hpp"
 #include "osc/math/scalar.hpp"
@@ -23,6 +25,25 @@ struct FlangeWeight {
   S spread = S(0);  // 1 - max r_i^2 / |r|^2: the share of the residual off its largest joint
   bool fitted = false;
 };
+
+/// The farthest the flange's origin is from joint i's axis, at any pose [m]: the arm's placements from joint i on
+/// (the first across the axis alone, its offset along it taken out), each at its length. With the rated reach of a
+/// payload's centre of mass off the flange (sqrt(3) com_reach), joint i's lever on a weight at the flange.
+inline double flange_lever(int i) {
+  const double* own = robot::kArm.links[i].placement.p;
+  double lever = std::sqrt(own[0] * own[0] + own[1] * own[1]);
+  for (int k = i + 1; k < kDof; ++k) {
+    const double* p = robot::kArm.links[k].placement.p;
+    lever += std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
+  }
+  return lever + 1.7320508 * robot::kPayloadRating.com_reach;
+}
+
+/// The most a payload of `mass` [kg] can load joint i at rest [N m]: its weight at flange_lever(i). A payload not
+/// yet identified, up to that mass either way (the parameter payload_allowance), adds it to the residual monitor's
+/// floor of the model's error (ResidualMonitor::set_allowance); at the identify run's speeds its inertial torques
+/// are within that and the thresholds' own (docs/safety.md, "A payload not yet identified").
+inline double allowance_torque(double mass, int i) { return mass * robot::kArm.gravity * flange_lever(i); }
 
 /// r scaled to a largest |r_i| of 1, into u: returns that largest |r_i|, or 0 where r is all but 0 (every |r_i|
 /// within 1e-3 N m; u then untouched). The first pass of flange_weight and residual_spread: no product of theirs

@@ -121,7 +121,9 @@ struct ResidualMonitor {
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
-  bool contact_noted = false;  // the contact error_floor holds (note_contact())
+  bool contact_noted = false;           // the contact error_floor holds (note_contact())
+  S allowance_mass = S(0);              // the payload allowance [kg] (set_allowance())
+  Vec6<S> allowance = Vec6<S>::Zero();  // ... each joint's torque of it [N m]
   /// Set by the task each tick: the arm holds a pose, no motion commanded (MotionState::kHolding).
   bool holding = false;
   bool held = false;  // ... at every step since the prime: a stuck encoder has had nothing to show (decide())
@@ -219,7 +221,14 @@ struct ResidualMonitor {
   static constexpr int kMixedNoiseBefore = 2;
   void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last);
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
-  S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i]; }
+  S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i] + allowance(i); }
+  /// The payload allowance, `mass` [kg] either way (the parameter payload_allowance; set with the torque off): each
+  /// joint's allowance_torque() in its floor (the absolute channel, the travel check) and twice in its change channel.
+  void set_allowance(double mass) {
+    allowance_mass = static_cast<S>(mass);
+    for (int i = 0; i < kDof; ++i) allowance(i) = static_cast<S>(allowance_torque(mass, i));
+    for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
+  }
   /// The contact the task reports (contact) began or ended. Its push, which the model does not know,
   /// stays in r while it lasts and would be judged against thresholds meant for the model's error (a
   /// firm push on a yielding arm named a drive_fault). When it begins, each joint's floor, its

@@ -227,8 +227,9 @@ inline S ResidualMonitor<S>::update_thresholds(const FrictionError& e, const Cha
   const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
                      mul_add(c.vis_hi[i], velocity_noise(i),
                              S(2) * mul_add(e.sliding ? stillness(i) : S(1), e.still, cross_friction(i)));
-  const S model =
-      mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis), c.armature_delta[i] * m.da[i]);
+  // A payload not yet identified (the allowance): its weight's change over the pose, from one side to the other.
+  const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
+                          mul_add(c.armature_delta[i], m.da[i], S(2) * allowance(i)));
   const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
   change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
   return loop;
