@@ -149,8 +149,9 @@ TEST(GainKeys, EveryRuntimeParameterIsAHostKeyWithTheTablesRanges) {
     EXPECT_NE(yaml.find("\n  " + key.substr(4) + ": " + def), std::string::npos) << key << " default " << def;
   }
   // move_linear, move_angular, stream_timeout, pots, home_speed, drive_check, dither_amplitude, dither_half_period,
-  // payload_mass, payload_com, payload_inertia, armature_correction, friction_vis, friction_cou, friction_sti
-  EXPECT_EQ(generated, 15);
+  // payload_mass, payload_com, payload_inertia, payload_allowance, armature_correction, friction_vis, friction_cou,
+  // friction_sti
+  EXPECT_EQ(generated, 16);
 }
 
 }  // namespace

@@ -300,8 +300,8 @@ TEST(IdentifySim, PayloadsFromARoughSettingAreIdentifiedAndTrackWhenSet) {
 
 // A payload not yet identified (docs/safety.md, "A payload not yet identified"): none in the model, 0.5, 1.5 and
 // 2.5 kg at (0.03, -0.03, 0.09) m on the arm, the parameter payload_allowance at the payload's own mass (a
-// datasheet's) and at the rating. The arm holds 1.5 s after the enable and the identify run estimates the payload with no
-// fault: its mass within 3 %, its centre of mass within 5 mm (issue 57's bars); the residual monitor's largest ratio
+// datasheet's) and at the rating. The arm holds 1.5 s after the enable and the identify run estimates the payload with
+// no fault: its mass within 3 %, its centre of mass within 5 mm (issue 57's bars); the residual monitor's largest ratio
 // is printed. Without the allowance the same enable stops within the second (payload_mismatch: the held-pose rule)
 // for 1.5 and 2.5 kg.
 TEST(IdentifySim, APayloadNotYetIdentifiedIsIdentifiedWithTheAllowance) {

@@ -17,6 +17,9 @@ FIRST_ID = 100
 NO_ESTIMATE = ("no estimate: the board sent no identify frame (a firmware from before the boards estimated runs the "
                "motion alone; or the frame was lost)\n")
 APPLIED = "applied, the torque off: enable goes on from them; param save keeps them for the next power-on\n"
+# The last set of identify --payload --apply: the payload identified, the allowance for one not yet is withdrawn.
+ALLOWANCE_ZEROED = "payload_allowance = 0 kg (0 to 2.5; torque_off)\n"
+ALLOWANCE_SET = ("payload_allowance", 0, 0.0)
 
 # An estimate whose figures test the C formats: %.3g's exponent, widths overflowed, halves rounded to even, a
 # negative coefficient, the identified marks (bits 0, 1, 7, 17).
@@ -284,7 +287,7 @@ def test_apply_sets_the_payload_after_the_friction(protocol: Protocol, capsys: p
     # The mass, the centre of mass, the inertia zeroed, then its moments before its products (the parameter's order).
     want = ([("payload_mass", 0, PAYLOAD.mass)] + [("payload_com", k, PAYLOAD.com[k]) for k in range(3)]
             + [("payload_inertia", k, 0.0) for k in range(6)]
-            + [("payload_inertia", k, PAYLOAD.inertia[k]) for k in range(6)])
+            + [("payload_inertia", k, PAYLOAD.inertia[k]) for k in range(6)] + [ALLOWANCE_SET])
     got = payload_sets(protocol, board)
     assert [(n, e) for n, e, _ in got] == [(n, e) for n, e, _ in want]
     assert [v for _, _, v in got] == pytest.approx([v for _, _, v in want], rel=1e-6)
@@ -293,7 +296,7 @@ def test_apply_sets_the_payload_after_the_friction(protocol: Protocol, capsys: p
     first_payload = min(i for i, q in enumerate(requests(board)) if q.index == protocol.parameter(
         "payload_mass").index)  # type: ignore[union-attr]
     assert last_friction < first_payload
-    assert "payload_mass = 1.49875 kg" in out
+    assert "payload_mass = 1.49875 kg" in out and out.endswith(ALLOWANCE_ZEROED + APPLIED)
 
 
 @pytest.mark.parametrize("refusal", ["not_physical", "out_of_range"])
@@ -304,11 +307,11 @@ def test_an_unphysical_payload_inertia_is_left_at_zero(protocol: Protocol, refus
                     table)
     out = capsys.readouterr().out
     assert rc == 0 and out.endswith("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n"
-                                    + APPLIED)
+                                    + ALLOWANCE_ZEROED + APPLIED)
     inertia = protocol.parameter("payload_inertia")
     assert inertia is not None
     assert [table.values[(inertia.index, k)] for k in range(6)] == [0.0] * 6  # zeroed again after the refusal
-    assert payload_sets(protocol, board)[-6:] == [("payload_inertia", k, 0.0) for k in range(6)]
+    assert payload_sets(protocol, board)[-7:] == [("payload_inertia", k, 0.0) for k in range(6)] + [ALLOWANCE_SET]
 
 
 def test_a_mass_within_two_sigma_of_zero_is_no_payload(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
@@ -318,7 +321,15 @@ def test_a_mass_within_two_sigma_of_zero_is_no_payload(protocol: Protocol, capsy
                     table)
     out = capsys.readouterr().out
     assert rc == 0 and out.endswith("payload: none found (its mass within 2 standard deviations of 0): set to none\n"
-                                    + APPLIED)
+                                    + ALLOWANCE_ZEROED + APPLIED)
     want = ([("payload_mass", 0, 0.0)] + [("payload_com", k, 0.0) for k in range(3)]
-            + [("payload_inertia", k, 0.0) for k in range(6)])
+            + [("payload_inertia", k, 0.0) for k in range(6)] + [ALLOWANCE_SET])
     assert payload_sets(protocol, board) == want  # the noise's centre of mass (metres away) not sent
+
+
+def test_a_refused_payload_leaves_the_allowance(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    table = ParamTable(protocol, refuse=("payload_com", 1, "out_of_range"))
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE, payload=PAYLOAD),
+                    table)
+    assert rc == 1 and "refused: out_of_range" in capsys.readouterr().out
+    assert [n for n, _, _ in payload_sets(protocol, board)] == ["payload_mass", "payload_com", "payload_com"]

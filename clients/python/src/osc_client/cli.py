@@ -213,7 +213,7 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
     torque off already), as oscctl's: the inertia zeroed first, then its moments before its products; where the
     parameters refuse it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass)
     it is zeroed again, left so, and said. A mass within two of its standard deviations of 0 is no payload: all of
-    it set to 0. Then payload_allowance goes back to 0 where the board has it: the payload is identified."""
+    it set to 0. Then payload_allowance goes back to 0: the payload is identified."""
     p = c.protocol
 
     def put(name: str, e: int, v: float, quiet: bool = False) -> int:
@@ -244,9 +244,7 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
                 return 1
         print("payload_inertia: refused (the estimate's noise about a point mass): left at 0")
         rc = 0
-    if rc or p.parameter("payload_allowance") is None:
-        return rc  # refused, or a board without the allowance
-    return put("payload_allowance", 0, 0.0)
+    return rc or put("payload_allowance", 0, 0.0)
 
 
 def apply_identify(c: Client, a: argparse.Namespace, f: Identify, fp: IdentifyPayload | None = None) -> int:

@@ -100,6 +100,34 @@ void model_put(ControlTask<S>& task, RuntimeParam which, int e, double v) {
   }
   task.set_payload(payload_with(task.payload, which, e, v));
 }
+/// Writes a monitor's parameter (the residual monitor's, the drive check's and its dither) into the task.
+template <class S>
+void monitor_put(ControlTask<S>& task, RuntimeParam which, int e, double v) {
+  switch (which) {
+    case RuntimeParam::kParamCollisionThreshold:
+      task.residual.collision_floor(e) = static_cast<S>(v);
+      break;
+    case RuntimeParam::kParamResidualMonitor:
+      task.residual.armed = v != 0;
+      break;
+    case RuntimeParam::kParamPayloadAllowance:
+      task.residual.set_allowance(v);
+      break;
+    case RuntimeParam::kParamDriveCheck:
+      if ((v != 0) != task.drive_check) task.drive.reset(), task.set_dither(task.dither_fraction);
+      task.drive_check = v != 0;
+      if (!task.drive_check) task.residual.drives_checked = false;
+      break;
+    case RuntimeParam::kParamDitherAmplitude:
+      task.set_dither(v);
+      break;
+    case RuntimeParam::kParamDitherHalfPeriod:
+      task.dither_half = static_cast<std::uint8_t>(v);
+      break;
+    default:  // not a monitor's (param_put)
+      break;
+  }
+}
 }  // namespace detail
 
 /// Element e of parameter i's default: a gain's paper value (Gains::paper), a runtime parameter's
@@ -188,9 +216,6 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamCollisionReaction:
       task.collision_reaction = static_cast<CollisionReaction>(static_cast<int>(v));
       break;
-    case RuntimeParam::kParamCollisionThreshold:
-      task.residual.collision_floor(e) = static_cast<S>(v);
-      break;
     case RuntimeParam::kParamStreamTimeout:
       task.stream_timeout_ticks = static_cast<std::uint32_t>(std::lround(v * params::kControlHz));
       break;
@@ -201,22 +226,13 @@ void param_put(ControlTask<S>& task, int i, int e, double v) {
     case RuntimeParam::kParamHomeSpeed:
       task.home_speed[e] = static_cast<S>(v);
       break;
+    case RuntimeParam::kParamCollisionThreshold:
     case RuntimeParam::kParamResidualMonitor:
-      task.residual.armed = v != 0;
-      break;
-    case RuntimeParam::kParamDriveCheck:
-      if ((v != 0) != task.drive_check) task.drive.reset(), task.set_dither(task.dither_fraction);
-      task.drive_check = v != 0;
-      if (!task.drive_check) task.residual.drives_checked = false;
-      break;
-    case RuntimeParam::kParamDitherAmplitude:
-      task.set_dither(v);
-      break;
-    case RuntimeParam::kParamDitherHalfPeriod:
-      task.dither_half = static_cast<std::uint8_t>(v);
-      break;
     case RuntimeParam::kParamPayloadAllowance:
-      task.residual.set_allowance(v);
+    case RuntimeParam::kParamDriveCheck:
+    case RuntimeParam::kParamDitherAmplitude:
+    case RuntimeParam::kParamDitherHalfPeriod:
+      detail::monitor_put(task, p.runtime, e, v);
       break;
     case RuntimeParam::kParamPayloadMass:
     case RuntimeParam::kParamPayloadCom:

@@ -41,8 +41,8 @@ inline double flange_lever(int i) {
 
 /// The most a payload of `mass` [kg] can load joint i at rest [N m]: its weight at flange_lever(i). A payload not
 /// yet identified, up to that mass either way (the parameter payload_allowance), adds it to the residual monitor's
-/// floor of the model's error (ResidualMonitor::set_allowance); at the identify run's speeds its inertial torques
-/// are within that and the thresholds' own (docs/safety.md, "A payload not yet identified").
+/// floor of the model's error and the share of it a motion can change to its change channel
+/// (ResidualMonitor::set_allowance, allowance_change; docs/safety.md, "A payload not yet identified").
 inline double allowance_torque(double mass, int i) { return mass * robot::kArm.gravity * flange_lever(i); }
 
 /// r scaled to a largest |r_i| of 1, into u: returns that largest |r_i|, or 0 where r is all but 0 (every |r_i|

@@ -121,9 +121,9 @@ struct ResidualMonitor {
   /// Set by the task each tick: the arm yields, or holds against a contact it reacted to, whose
   /// force the model does not know: the travel check waits (it restarts every tick).
   bool contact = false;
-  bool contact_noted = false;           // the contact error_floor holds (note_contact())
-  S allowance_mass = S(0);              // the payload allowance [kg] (set_allowance())
-  Vec6<S> allowance = Vec6<S>::Zero();  // ... each joint's torque of it [N m]
+  bool contact_noted = false;  // the contact error_floor holds (note_contact())
+  S allowance_mass = S(0);     // the payload allowance [kg] (set_allowance()); each joint's torque of it [N m], its
+  Vec6<S> allowance = Vec6<S>::Zero(), allowance_reach = Vec6<S>::Zero();  // farthest lever over g [s^2]
   /// Set by the task each tick: the arm holds a pose, no motion commanded (MotionState::kHolding).
   bool holding = false;
   bool held = false;  // ... at every step since the prime: a stuck encoder has had nothing to show (decide())
@@ -222,10 +222,12 @@ struct ResidualMonitor {
   void mixed_noise(const Mat6<S>& J, const ArmJacobianFactor<S>& Jf, int first, int last);
   /// Joint i's floor out of contact: its amplifier's offset bound and the coupled motors' friction.
   S rest_floor(int i) const { return cross_friction(i) + kResidualConstants<S>.offset[i] + allowance(i); }
-  /// The payload allowance, `mass` [kg] either way (the parameter payload_allowance; set with the torque off): each
-  /// joint's allowance_torque() in its floor (the absolute channel, the travel check) and twice in its change channel.
+  /// The payload allowance, `mass` [kg] either way (the parameter payload_allowance, torque off): each joint's
+  /// allowance_torque() in its floor (the absolute channel, the travel check), and the share of it the turn's motion
+  /// can change in its change channel (allowance_change()).
   void set_allowance(double mass) {
     allowance_mass = static_cast<S>(mass);
+    for (int i = 0; i < kDof; ++i) allowance_reach(i) = static_cast<S>(flange_lever(i) / robot::kArm.gravity);
     for (int i = 0; i < kDof; ++i) allowance(i) = static_cast<S>(allowance_torque(mass, i));
     for (int i = 0; i < kDof; ++i) error_floor(i) = rest_floor(i);
   }
@@ -342,12 +344,13 @@ struct ResidualMonitor {
   /// A turn's joint motion and A's rows against it: per joint, the speed beyond which it may count as moving
   /// (its noise, and its lag at the acceleration filtered before this turn), the filtered acceleration's size
   /// and change (q^dot's change over the turn, filtered as r), and |A| times the accelerations, their changes
-  /// and the velocity noise.
+  /// and the velocity noise; the share of the payload allowance's torque the change channel can see.
   struct Motion {
     S moving_speed[kDof], a[kDof], da[kDof];
-    S inertia[kDof], inertia_change[kDof], noise[kDof];
+    S inertia[kDof], inertia_change[kDof], noise[kDof], allowance;  // allowance: allowance_change()
   };
   Motion motion(const ResidualInput<S>& in);
+  S allowance_change(const ResidualInput<S>& in, const Motion& m) const;
   /// y filtered toward x at the gain g (K dt): y + g (x - y), one rounding.
   static void low_pass(S& y, S x, S g) { y = math::mul_add(g, x - y, y); }
   /// A joint's regressor changes (their filtered values less their slow parts), signed.

@@ -99,6 +99,8 @@ inline auto ResidualMonitor<S>::motion(const ResidualInput<S>& in) -> Motion {
     m.inertia[j] = m.inertia_change[j] = m.noise[j] = S(0);
   }
   qd_turn = in.qd;
+  m.allowance = S(0);
+  if (allowance_mass > S(0)) m.allowance = allowance_change(in, m);
   // Column by column: each of A's coefficients is read once.
   for (int j = 0; j < kDof; ++j)
     for (int i = 0; i < kDof; ++i) {
@@ -108,6 +110,25 @@ inline auto ResidualMonitor<S>::motion(const ResidualInput<S>& in) -> Motion {
       m.noise[i] = math::mul_add(mag, velocity_noise(j), m.noise[i]);
     }
   return m;
+}
+
+/// The share of a payload's torque error that the change channel can see, this turn (Motion::allowance), at most 2
+/// (its weight's torque from one side to the other). allowance(i), m g l_i with l_i = flange_lever(i), bounds:
+/// - its weight's torque's rate by that times w = sum_j |q^dot_j| (joint j turns the weight about an axis, or moves
+///   axis i with it, at most l_i from it), which the change channel sees as the rate over the slow filter's gain (a
+///   ramp's r - r_slow);
+/// - its inertial torques, m l_i times the flange's acceleration, by that times (sum_j l_j |q^dot^dot_j| + l_0 w^2)
+///   / g: the accelerations' change (Motion::da) for the first, twice the whole for the second.
+/// At rest 0: a hold's and a slow motion's collision sensitivity is the channel's own (docs/safety.md, "A payload not
+/// yet identified").
+template <class S>
+inline S ResidualMonitor<S>::allowance_change(const ResidualInput<S>& in, const Motion& m) const {
+  static constexpr S kSlowPeriod = lit<S>(1.0 / params::kResidualSlowGain);
+  S w = S(0), inertial = S(0);
+  for (int j = 0; j < kDof; ++j)
+    w += math::abs(in.qd(j)), inertial = math::mul_add(allowance_reach(j), m.da[j], inertial);
+  const S share = math::mul_add(w, kSlowPeriod, math::mul_add(S(2) * allowance_reach(0) * w, w, inertial));
+  return share < S(2) ? share : S(2);
 }
 
 /// Joint i's friction against the band (FrictionError), `f` at its strongest; `moving` is the speed
@@ -227,9 +248,9 @@ inline S ResidualMonitor<S>::update_thresholds(const FrictionError& e, const Cha
   const S friction = mul_add(e.dv, abs(ch.vis), mul_add(e.dc, abs(ch.cou), mul_add(e.ds, abs(ch.sti), abs(learnt)))) +
                      mul_add(c.vis_hi[i], velocity_noise(i),
                              S(2) * mul_add(e.sliding ? stillness(i) : S(1), e.still, cross_friction(i)));
-  // A payload not yet identified (the allowance): its weight's change over the pose, from one side to the other.
+  // A payload not yet identified: the allowance's torque times its share that changes (Motion::allowance).
   const S model = mul_add(c.link_inertia, m.inertia_change[i] + abs(ch.gravity) + abs(ch.coriolis),
-                          mul_add(c.armature_delta[i], m.da[i], S(2) * allowance(i)));
+                          mul_add(c.armature_delta[i], m.da[i], m.allowance * allowance(i)));
   const S amplifier = mul_add(c.amp_gain, abs(ch.torque), mul_add(c.ripple, reg[kTorqueSize](i), loop));
   change_threshold(i) = mul_add(c.peak_margin[i], friction + model + amplifier, margin_quantum);
   return loop;
