@@ -100,8 +100,10 @@ void run(fuzz::Input& in, bool torque_on) {
       lo_slot = hi_slot = param_slot(f.index) + f.element;
       // The stream timeout is kept in whole ticks: read back within half a tick.
       const double tick = p.gain < 0 && p.runtime == RuntimeParam::kParamStreamTimeout ? 0.5e-3 : 0.0;
-      FUZZ_CHECK(std::fabs(static_cast<double>(after.value[lo_slot]) - static_cast<double>(f.value)) <=
+      // Read from the task: a parameter that does not persist is at its default in a record (param_capture).
+      FUZZ_CHECK(std::fabs(param_get(task, f.index, f.element) - static_cast<double>(f.value)) <=
                  resolution<S>(f.value) + 1e-6 * std::fabs(static_cast<double>(f.value)) + tick);
+      if (!p.persists) FUZZ_CHECK(after.value[lo_slot] == static_cast<float>(param_default(f.index, f.element)));
       FUZZ_CHECK(!torque_on || p.access == ParamAccess::kAlways);
       (void)every;  // a kEvery gain is one slot: its vector is set whole, and read from element 0
     } else if ((f.op == pil::kParamOpLoad || f.op == pil::kParamOpReset) && status == ParamStatus::kOk) {
