@@ -133,9 +133,12 @@ class PtyMaster {
     const ssize_t r = ::read(fd_, buf, static_cast<std::size_t>(n));
     return r > 0 ? static_cast<int>(r) : 0;
   }
-  /// A frame for the client: queued whole, or dropped (no client, or the buffer full).
+  /// A frame for the client: queued whole, or dropped (no client, or the buffer full). A state frame, which the
+  /// next one supersedes, takes at most half the buffer: behind a client that fell behind, an answer or an identify
+  /// run's report still finds room (state frames had filled it, and the report was lost).
   void queue(const std::uint8_t* b, int n) {
-    if (!connected_ || out_.size() + static_cast<std::size_t>(n) > kOutputBytes) {
+    const bool state = n > 2 && b[2] == pil::kStateFrame;
+    if (!connected_ || out_.size() + static_cast<std::size_t>(n) > (state ? kOutputBytes / 2 : kOutputBytes)) {
       ++dropped_;
       return;
     }

@@ -82,16 +82,21 @@ pyc=("$py" -m osc_client)  # the Python client's command line
 tmp=$(mktemp -d)
 sim_pid=
 port=
+# The board stopped, where it runs: it prints its counts at its exit (frames out dropped, overruns, slips).
+end_sim() {
+  [ -n "$sim_pid" ] || return 0
+  kill -TERM "$sim_pid" 2>/dev/null
+  wait "$sim_pid" 2>/dev/null || true
+  sim_pid=
+}
 cleanup() {
-  if [ -n "$sim_pid" ]; then
-    kill -TERM "$sim_pid" 2>/dev/null
-    wait "$sim_pid" 2>/dev/null
-  fi
+  end_sim
   rm -rf "$tmp"
 }
 trap cleanup EXIT
 fail() {
   echo "FAIL: $*"
+  end_sim
   [ -s "$tmp/sim.err" ] && sed 's/^/  osc_sim: /' "$tmp/sim.err"
   exit 1
 }
@@ -570,6 +575,29 @@ PY
     ;;
   python_payload)
     payload_identify "${pyc[@]}"
+    ;;
+  python_slow_reader)
+    # A client that reads nothing for the whole identify run (its keep-alives off): the state frames the board sends
+    # meanwhile fill its output buffer, and must not crowd out the run's end (the done answer) and its estimate, which
+    # are read afterwards (a client that fell behind under load lost the identify frame once).
+    start_sim "${estimate_board[@]}"
+    "$py" - "$port" >"$tmp/slow.out" 2>&1 <<'PY' || fail "$(cat "$tmp/slow.out")"
+import sys
+import time
+from osc_client import Client, Status
+c = Client(sys.argv[1], keepalive=0)
+assert c.wait_answer(c.enable(), 60).status == Status.ACCEPTED
+cid = c.identify()
+time.sleep(12)  # the run: 90 s simulated at --speed 10, unread
+assert c.wait_answer(cid, 60).status == Status.ACCEPTED
+assert c.wait_done(cid, 60).status == Status.DONE
+f = c.wait_identify(cid, 10)
+assert f is not None, "the identify frame was lost"
+print("ok: the run's end and its estimate after 12 s unread")
+PY
+    cat "$tmp/slow.out"
+    stop_sim
+    grep -E 'frames out dropped' "$tmp/sim.err"
     ;;
   python_queue)
     start_sim --speed 4 --scalar float
