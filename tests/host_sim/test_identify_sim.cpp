@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "motion_sim.hpp"
 #include "motion_sim_util.hpp"
 #include "experiment.hpp"
+#include "injection.hpp"
 #include "plant_preset.hpp"
 #include "osc/runtime/parameters.hpp"
 #include "osc/runtime/identify_run.hpp"
@@ -572,6 +574,41 @@ TEST(IdentifySim, APayloadTheModelHasWrongIsNamedAtTheEnable) {
       EXPECT_EQ(m.flange.mass < 0, on_arm) << mass;
       EXPECT_LT(std::fabs(m.flange.mass), mass) << mass;
     }
+}
+
+// A payload set and not on the arm when a motion starts at the enable (docs/safety.md, "A payload the model has
+// wrong"; docs/adaptation.md, table payload_stale): the paper's experiment with 1.5 and 2.5 kg at (0.03, -0.03, 0.09) m
+// in the model and none on the arm. J5 counts away from its reference, which has all but not moved (4 and 12 counts
+// by 0.108 and 0.082 s), what a stuck encoder cannot show (ResidualMonitor::off_reference): payload_mismatch on J5
+// (before the rule: encoder_stuck), the mass recorded positive (the model's beyond the arm's). An encoder that sticks
+// at the same motion's start (each joint's at 0.05 s, no payload) is not: encoder_stuck or the potentiometer's
+// position_mismatch, never payload_mismatch or drive_fault.
+TEST(IdentifySim, AStalePayloadAtAMotionsStartIsNamedAndAStuckEncoderThereIsNot) {
+  const double com[3] = {0.03, -0.03, 0.09};
+  for (const double mass : {1.5, 2.5}) {
+    sim::ExperimentConfig c;
+    c.duration = 0.5;
+    c.params[param_slot(param_index("payload_mass"))] = mass;
+    for (int k = 0; k < 3; ++k) c.params[param_slot(param_index("payload_com")) + k] = com[k];
+    const sim::ExperimentResult r = sim::run_experiment(c);
+    std::printf("%.1f kg set, none on the arm: %s at %.3f s on J%d, the residual as a weight %.3f kg\n", mass,
+                fault_name(r.status), r.fault_time, r.residual_joint + 1, r.residual_weight_kg);
+    EXPECT_EQ(r.status, kFaultPayloadMismatch) << mass;
+    EXPECT_LE(r.fault_time, 0.15) << mass;
+    EXPECT_EQ(r.residual_joint, 4) << mass;
+    EXPECT_GT(r.residual_weight_kg, 0) << mass;
+  }
+  for (int j = 1; j <= kDof; ++j) {
+    sim::ExperimentConfig c;
+    c.duration = 2;
+    const std::string spec = "encoder-stuck:" + std::to_string(j) + "@0.05";
+    std::string err;
+    ASSERT_TRUE(sim::parse_injection(spec.c_str(), c.injection, err)) << err;
+    const sim::ExperimentResult r = sim::run_experiment(c);
+    std::printf("J%d's encoder stuck at 0.05 s: %s at %.3f s\n", j, fault_name(r.status), r.fault_time);
+    EXPECT_NE(r.status, 0u) << j;
+    EXPECT_EQ(r.status & (kFaultPayloadMismatch | kFaultDriveFault), 0u) << j;
+  }
 }
 
 // The held-pose rule's other side: an encoder that sticks while the arm holds its pose with the model right shows

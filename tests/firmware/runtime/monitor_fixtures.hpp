@@ -39,6 +39,9 @@ struct ResidualRig {
   const FrictionBounds<S>* proven = nullptr;  // the identification's friction (the travel check's)
   Mat6<S> J;
   bool jacobian = false;
+  /// The step's operational space and tracking error (ResidualMonitor::off_reference), or nullptr: none.
+  const ArmOpSpace<S>* os = nullptr;
+  Vec6<S> e = Vec6<S>::Zero();
 
   ResidualRig() {
     Model<double> model = Model<double>::of(robot::kArm);
@@ -68,7 +71,8 @@ struct ResidualRig {
     const Mat6<S> As = A.cast<S>();
     const Vec6<S> gs = g.cast<S>(), zero = Vec6<S>::Zero(), qds = qd.cast<S>();
     Vec6<S> decay = Vec6<S>::Ones();
-    const ResidualInput<S> in{As, gs, gs, zero, qds, decay, nullptr, proven, jacobian ? &J : nullptr};
+    const ResidualInput<S> in{
+        As, gs, gs, zero, qds, decay, nullptr, proven, jacobian ? &J : nullptr, os, os ? &e : nullptr};
     const std::uint32_t f = m.check(in, io, counts, moved, tick, tick % params::kResidualTurnEvery == 0);
     m.applied(free ? Vec6<S>(tau.cast<S>()) : Vec6<S>((tau - tau_ext).cast<S>()));
     if (free) qd += dt * A.ldlt().solve(tau + tau_ext - g);

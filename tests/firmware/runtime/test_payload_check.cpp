@@ -13,6 +13,7 @@
 #include "kdl_puma.hpp"
 #include "monitor_fixtures.hpp"
 #include "osc/kernels/kinematics.hpp"
+#include "osc/kernels/opspace.hpp"
 #include "osc/math/q_eigen.hpp"
 #include "osc/runtime/payload_check.hpp"
 #include "test_util.hpp"
@@ -213,6 +214,53 @@ TYPED_TEST(Monitors, AFindingAtAPoseHeldSinceTheEnableIsNoStuckEncoder) {
   EXPECT_EQ(kind_of(one, true, 0, true, 0), kFaultPayloadMismatch);
   EXPECT_EQ(kind_of(one, true, 0, true, 1u << 2), kFaultDriveFault);
   EXPECT_EQ(kind_of(two, true, 0, true, 1u << 1), kFaultDriveFault);
+}
+
+// The rule of a joint moved off its reference (ResidualMonitor::off_reference), in the rig with a motion commanded
+// (not holding): the drives short by 20 N m on J3 alone, or by -8 and 20 N m on J2 and J3 (no weight's shape), while
+// J2 and J3 count `m` counts the way of their shortfall after the enable (pushed off by a load the drives do not
+// hold), one every 10 ticks, and the step's tracking error puts each one's reference `toward` counts that way from its
+// reading (the operational space at the start pose, e = Ja dq; negative: back). Counted 4 with the reference 4 back,
+// within the first second: one joint's is drive_fault, two joints' payload_mismatch. The reference where the reading
+// is or further on, back by 1 count only, 2 counts counted (the margin's), after the first second, or without the
+// step's operational space: encoder_stuck.
+TYPED_TEST(Monitors, AJointMovedOffItsReferenceSinceTheEnableIsNoStuckEncoder) {
+  using S = TypeParam;
+  Model<S> model = Model<S>::of(robot::kArm);
+  Data<S> data;
+  ArmOpSpace<S> os;
+  forward_kinematics(model, data, joint_vector<S>(robot::kQStart));
+  opspace_update(model, data, os, joint_vector<S>(robot::kQStart), data.R[kDof]);
+  Vec6<double> one = Vec6<double>::Zero(), two = Vec6<double>::Zero();
+  one(2) = 20;
+  two(1) = -8, two(2) = 20;
+  const auto kind_of = [&](const Vec6<double>& torque, int m, double toward, int wait, bool with_os) {
+    ResidualRig<S> rig;
+    rig.m.armed = true;
+    rig.jacobian = true;
+    Vec6<S> dq = Vec6<S>::Zero();
+    for (const int j : {1, 2}) dq(j) = static_cast<S>((torque(j) < 0 ? -toward : toward) / counts_per_rad(j));
+    rig.e = os.Ja * dq;
+    if (with_os) rig.os = &os;
+    std::uint32_t kind = 0;
+    for (int n = 0; n < wait + 2000 && kind == 0; ++n) {
+      const int k = n - wait;
+      const bool count = k > 0 && k % 10 == 0 && k / 10 <= m;
+      const bool counting[kDof] = {false, count, count, false, false, false};
+      for (const int j : {1, 2})
+        if (count && torque(j) < 0) rig.counts[j] -= 2;  // the rig counts up: one down
+      kind = rig.step(k < 0 ? Vec6<double>::Zero() : torque, counting, false);
+    }
+    return kind;
+  };
+  EXPECT_EQ(kind_of(one, 4, -4, 0, true), kFaultDriveFault);
+  EXPECT_EQ(kind_of(two, 4, -4, 0, true), kFaultPayloadMismatch);
+  EXPECT_EQ(kind_of(one, 4, 0, 0, true), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(two, 4, 3, 0, true), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(one, 4, -1, 0, true), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(two, 2, -4, 0, true), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(one, 4, -4, 1100, true), kFaultEncoderStuck);
+  EXPECT_EQ(kind_of(two, 4, -4, 0, false), kFaultEncoderStuck);
 }
 
 // residual_spread: the share of r's square off its largest joint, as a hand computation gives it, in every scalar.

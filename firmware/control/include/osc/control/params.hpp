@@ -272,6 +272,11 @@ constexpr double kPayloadFitMisfit = 0.02;
 constexpr double kPayloadSpread = 0.005;
 constexpr double kPayloadMismatchMass = 0.2;
 constexpr double kPayloadFitConditioning = 1e-4;
+/// ... and within that window, a finding that would be encoder_stuck on a joint that has counted more than this many
+/// counts one way since the enable while its reference lies more than this many the other way from its reading (it
+/// was moved off its reference, which a stuck encoder cannot show: ResidualMonitor::off_reference) is a load the model
+/// has wrong or a drive, as at a pose held since the enable.
+constexpr int kPayloadAwayCounts = 2;
 /// The drive check (osc/runtime/drive_monitor.hpp; docs/safety.md, "The drive check"), on a HAL with
 /// current readback:
 /// - its threshold is kDriveMargin times the stated bounds of the amplifiers' and the current monitors'

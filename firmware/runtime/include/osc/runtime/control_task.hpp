@@ -80,7 +80,8 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             adaptive ? &ad.theta_hat : nullptr,
                             identify ? &ad.identifier.proven : nullptr,
                             &task.state.data.J,
-                            &task.state.os};
+                            &task.state.os,
+                            &out.e};
   // The residual monitor's turn: the controller's even steps, whose model turn leaves the time for it.
   const bool turn = even_step(task.state);
   task.residual.sample_joint = identify && turn ? momentum_turn(task.state.adapt) : -1;

@@ -126,6 +126,9 @@ struct ResidualInput {
   /// whose mixing of the encoders' quanta the velocity estimate carries (ResidualMonitor::mixed_noise);
   /// nullptr as J.
   const ArmOpSpace<S>* os = nullptr;
+  /// The step's tracking error x_d - x (StepOutput::e), or nullptr: in joint space through os's factor, where the
+  /// reference has taken each joint (ResidualMonitor::off_reference).
+  const Vec6<S>* e = nullptr;
 };
 
 }  // namespace osc

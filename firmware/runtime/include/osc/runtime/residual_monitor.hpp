@@ -130,6 +130,7 @@ struct ResidualMonitor {
   /// Set by the task on a HAL with current readback (DriveMonitor): the drive check ran, the channels it suspects.
   bool drives_checked = false;
   std::uint8_t drive_suspect = 0;
+  std::int32_t primed_counts[kDof] = {};  // the encoders' readings at the prime (off_reference())
 
   /// The encoders' quantum [rad at each joint] and the observer's gains k: the velocity estimate q^dot =
   /// J^-1 (y + k x~) carries each encoder's quantisation error (within half a count of its mean) times the largest k.
@@ -252,8 +253,7 @@ struct ResidualMonitor {
       d(i) = S(0);
     }
   }
-  /// The next step starts afresh (a tick without a step: the torque was off).
-  void unprime() { primed = false; }
+  void unprime() { primed = false; }  // the next step starts afresh (a tick without a step: the torque was off)
   /// The joint torque that reached the arm over the period that follows this tick.
   void applied(const Vec6<S>& tau) {
     tau_last = tau_prev;
@@ -286,7 +286,7 @@ struct ResidualMonitor {
     qd_prev = in.qd;
     bias_prev = in.bias;
     if (prime) {
-      for (int i = 0; i < kDof; ++i) over[i] = 0;
+      for (int i = 0; i < kDof; ++i) over[i] = 0, primed_counts[i] = counts[i];
       primed = true;
       primed_at = tick;
       return 0;
@@ -295,7 +295,7 @@ struct ResidualMonitor {
     int worst = -1;
     S worst_ratio = S(0);
     for (int i = 0; i < kDof; ++i) qualify_joint(i, tick, worst, worst_ratio);
-    return decide(worst, moved_too_far, io, tick, in.J);
+    return worst < 0 && moved_too_far < 0 ? 0u : decide(worst, moved_too_far, io, tick, in, counts);  // a finding
   }
 
   /// r_k = (1 - K dt) r_{k-1} + K [A_k (q^dot_k - q^dot_{k-1}) + dt (n_{k-1} - tau_{k-1})], every joint; the
@@ -326,9 +326,9 @@ struct ResidualMonitor {
     if (over[i] >= params::kResidualQualifyTicks && ratio > worst_ratio) worst = i, worst_ratio = ratio;
   }
 
-  /// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over
-  /// its thresholds, classified (residual_travel.hpp).
-  std::uint32_t decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick, const Mat6<S>* J);
+  /// The step's fault (residual_travel.hpp): a joint that moved too far first, else the worst over its thresholds.
+  std::uint32_t decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick, const ResidualInput<S>& in,
+                       const std::int32_t counts[kDof]);
 
   /// Joint i's residual within `fraction` of its thresholds on both channels (ratio_of(i) <= fraction, undivided).
   bool within(int i, S fraction) const {
@@ -438,10 +438,10 @@ struct ResidualMonitor {
   void count_bounds(int i, S change);
   S advance(Way& w, int i, S force, const Friction& f, S a_min, S a_max);
   std::uint32_t classify_travel(int i) const;
+  bool off_reference(const ResidualInput<S>& in, const std::int32_t counts[kDof], int i) const;
   /// Channel c fell silent before joint i's residual rose, and not long before (residual_travel.hpp).
   bool silent_first(int c, int i, std::uint64_t tick) const;
-  /// The kind of a qualified residual on joint i, the worst (residual_travel.hpp).
-  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const;
+  std::uint32_t classify(int i, const IoMap<S>& io, std::uint64_t tick) const;  // a qualified residual's kind
 };
 
 }  // namespace osc

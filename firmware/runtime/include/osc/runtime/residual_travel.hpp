@@ -164,6 +164,25 @@ inline std::uint32_t ResidualMonitor<S>::classify_travel(int i) const {
   return kFaultEncoderStuck;
 }
 
+/// Joint i moved off its reference since the prime (decide(), params::kPayloadAwayCounts = n): its encoder has
+/// counted m, more than n counts one way, and the reference lies more than n counts the other way from its reading
+/// (the step's tracking error in joint space, J^-1 e through the step's factor: small in the first second). Where the
+/// reference has gone since, p = m + J^-1 e, that puts the reading outside [min(0, p), max(0, p)] by more than n
+/// counts. A stuck encoder reads a pose its joint had while it tracked the reference, within that range (a reference
+/// that turned back within the second aside); a load the model has wrong, or a drive short of its torque, moves the
+/// joint off it: it counted away, and the controller pushes it back. Not on a joint whose encoder reads other joints
+/// too (a coupled wrist's: no travel check either), whose counts are no joint's.
+template <class S>
+inline bool ResidualMonitor<S>::off_reference(const ResidualInput<S>& in, const std::int32_t counts[kDof],
+                                              int i) const {
+  if (in.os == nullptr || in.e == nullptr || travel_limit(i) == S(0)) return false;  // 0: its encoder reads others
+  const std::int32_t m = counts[i] - primed_counts[i];
+  if (m <= params::kPayloadAwayCounts && m >= -params::kPayloadAwayCounts) return false;
+  const S toward = in.os->Jf.solve(*in.e)(i);  // the reference from the reading [rad]
+  const S margin = lit<S>(2.0 * params::kPayloadAwayCounts) * half_quantum(i);
+  return m > 0 ? toward < -margin : toward > margin;
+}
+
 /// The step's fault: a joint that moved too far (the travel check) first, else the worst joint over its
 /// thresholds, classified; a collision below the collision floor is none. Within params::kPayloadCheckTicks of the
 /// prime (an enable), unless the drive check suspects the joint's drive, a finding is payload_mismatch:
@@ -171,16 +190,20 @@ inline std::uint32_t ResidualMonitor<S>::classify_travel(int i) const {
 ///    encoder that counted fast and fell silent is no evidence then: a weight the model does not know drops the arm
 ///    at the enable until the controller catches it, and a joint whose encoder froze while it moved would leave a
 ///    residual on its own joint, no weight's;
-///  - or where it would be encoder_stuck and the arm has held its pose since the prime (held). A stuck encoder has
-///    nothing to show there: with the model's gravity the arm's, the torque that holds it holds it whatever the
-///    encoder reads. A joint driven beyond that and held, or a residual after a silence, is a load the model has
+///  - or where it would be encoder_stuck and the arm has held its pose since the prime (held), or its joint has
+///    moved off its reference since (off_reference(): the same evidence while a motion has gone nowhere). A stuck
+///    encoder has nothing to show there: with the model's gravity the arm's, the torque that holds it holds it whatever
+///    the encoder reads. A joint driven beyond that and held, or a residual after a silence, is a load the model has
 ///    wrong; static friction holds part of it, so that the residual is no clean weight (the weight found is less).
 ///    A residual on one joint alone (less than params::kPayloadSpread of its square off it) may be that joint's drive
 ///    as well: drive_fault. With the drives checked, the drive check decides (classify()'s rule).
-/// The first fault is recorded (detected, joint, detected_tick, flange); reported only when armed.
+/// The first fault is recorded (detected, joint, detected_tick, flange); reported only when armed. Out of line: a
+/// finding is rare, and check()'s every tick carries none of it.
 template <class S>
-inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, const IoMap<S>& io, std::uint64_t tick,
-                                                const Mat6<S>* J) {
+[[gnu::noinline]] inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, const IoMap<S>& io,
+                                                                  std::uint64_t tick, const ResidualInput<S>& in,
+                                                                  const std::int32_t counts[kDof]) {
+  const Mat6<S>* J = in.J;
   std::uint32_t kind;
   if (moved_too_far >= 0) {
     worst = moved_too_far;
@@ -195,7 +218,7 @@ inline std::uint32_t ResidualMonitor<S>::decide(int worst, int moved_too_far, co
     if (J) weight = flange_weight(*J, r);
     if (payload_mismatch(weight)) {  // never without J: the weight is then not fitted
       kind = kFaultPayloadMismatch;
-    } else if (kind == kFaultEncoderStuck && held) {
+    } else if (kind == kFaultEncoderStuck && (held || off_reference(in, counts, worst))) {
       const bool one_joint = residual_spread(r) < lit<S>(params::kPayloadSpread);
       const bool its_drive = drives_checked ? drive_suspected(drive_suspect, worst, io) : one_joint;
       kind = its_drive ? kFaultDriveFault : kFaultPayloadMismatch;
