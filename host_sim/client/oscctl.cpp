@@ -308,9 +308,9 @@ void print_identify_payload(const pil::IdentifyPayloadFrame& f) {
 
 /// identify --payload --apply: the payload's estimate into payload_mass, payload_com and payload_inertia (the torque
 /// off already). The inertia goes in zeroed first, then its moments before its products; where the parameters refuse
-/// it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass), it is zeroed again
-/// and left so, and said. A mass within two of its standard deviations of 0 is no payload (its centre of mass is
-/// noise over noise): all of it set to 0. Then payload_allowance goes back to 0: the payload is identified.
+/// it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass), it is zeroed again,
+/// products first, and left so, and said. A mass within two of its standard deviations of 0 is no payload (its centre
+/// of mass is noise over noise): all of it set to 0. Then payload_allowance goes back to 0: the payload is identified.
 int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadFrame& f) {
   const auto set = [&](const char* name, int e, double v, bool quiet_refusal = false) -> int {
     const auto r = c.param(pil::kParamOpSet, osc::param_index(name), e, v, a.timeout);
@@ -331,7 +331,9 @@ int apply_identify_payload(Client& c, const Args& a, const pil::IdentifyPayloadF
   for (int k = 0; k < 6 && rc == 0 && !none; ++k)
     rc = set("payload_inertia", k, static_cast<double>(f.inertia[k]), true);
   if (rc == -1) {
-    for (int k = 0; k < 6; ++k)
+    // Back in the reverse order: each zero returns to a tensor the board accepted on the way (a moment zeroed
+    // before the products would leave a product beside a zero moment, which is not positive semidefinite).
+    for (int k = 5; k >= 0; --k)
       if (const int z = set("payload_inertia", k, 0.0)) return z;
     std::printf("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n");
     rc = 0;

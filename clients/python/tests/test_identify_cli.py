@@ -81,12 +81,31 @@ def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, 
 class ParamTable:
     """The board's parameters: get answers an element's value and range, set stores it (or is refused)."""
 
-    def __init__(self, p: Protocol, refuse: tuple[str, int, str] | None = None, nonzero: bool = False) -> None:
+    def __init__(self, p: Protocol, refuse: tuple[str, int, str] | None = None, nonzero: bool = False,
+                 semidefinite: bool = False) -> None:
         self.p = p
         self.hi: dict[tuple[int, int], float] = {}  # ranges of the board's that are not the JSON's
         self.values: dict[tuple[int, int], float] = {}
         self.refuse = refuse  # (parameter, element, status): that set refused
         self.nonzero = nonzero  # ... only when its value is not 0 (as not_physical refuses an inertia)
+        # The board's own check (osc/runtime/parameters.hpp, param_set): a payload_inertia that would leave the
+        # tensor not positive semidefinite is refused not_physical.
+        self.semidefinite = semidefinite
+
+    def inertia_after(self, element: int, value: float) -> list[float]:
+        par = self.p.parameter("payload_inertia")
+        assert par is not None
+        v = [self.values.get((par.index, k), par.default[k]) for k in range(6)]
+        v[element] = value
+        return v
+
+    @staticmethod
+    def semidefinite_tensor(v: list[float]) -> bool:
+        """(Ixx, Iyy, Izz, Ixy, Ixz, Iyz): every principal minor of the tensor at least 0 (a tolerance of 1e-15)."""
+        xx, yy, zz, xy, xz, yz = v
+        minors = [xx, yy, zz, xx * yy - xy * xy, xx * zz - xz * xz, yy * zz - yz * yz,
+                  xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz)]
+        return all(m >= -1e-15 for m in minors)
 
     def __call__(self, q: Param) -> list[Frame]:
         p, op = self.p, self.p.name_of(NameList.PARAM_OPS, q.op)
@@ -96,6 +115,9 @@ class ParamTable:
         if op == "set":
             if self.refuse and (par.name, q.element) == self.refuse[:2] and (q.value != 0 or not self.nonzero):
                 result = p.code_of(NameList.PARAM_STATUSES, self.refuse[2])
+            elif (self.semidefinite and par.name == "payload_inertia"
+                  and not self.semidefinite_tensor(self.inertia_after(q.element, q.value))):
+                result = p.code_of(NameList.PARAM_STATUSES, "not_physical")
             else:
                 self.values[key] = q.value
         return [ParamAnswer(id=q.id, op=q.op, index=q.index, element=q.element, status=result,
@@ -311,7 +333,31 @@ def test_an_unphysical_payload_inertia_is_left_at_zero(protocol: Protocol, refus
     inertia = protocol.parameter("payload_inertia")
     assert inertia is not None
     assert [table.values[(inertia.index, k)] for k in range(6)] == [0.0] * 6  # zeroed again after the refusal
-    assert payload_sets(protocol, board)[-7:] == [("payload_inertia", k, 0.0) for k in range(6)] + [ALLOWANCE_SET]
+    # ... products first (back through the tensors the board took on the way)
+    assert payload_sets(protocol, board)[-7:] == [("payload_inertia", k, 0.0) for k in (5, 4, 3, 2, 1, 0)] + [
+        ALLOWANCE_SET]
+
+
+# An estimate whose inertia the board's own check refuses at its second product (the tensor with Ixz is not
+# positive semidefinite: Ixx Izz < Ixz^2), from a clean CI run's virtual_board_python_payload at 388e174 (1.5 kg at
+# (0, 50, 80) mm, a point mass; a loaded machine's run). Zeroed in the order it was set, the first zero (Ixx beside
+# Ixy) was refused too and --apply failed; zeroed back, products first, each zero is a tensor the board took.
+def test_a_payload_inertia_refused_at_a_product_is_zeroed_back_through_accepted_tensors(
+        protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:
+    estimate = dataclasses.replace(PAYLOAD, mass=1.49917, com=(9.805e-05, 0.05001128, 0.08000287),
+                                   inertia=(3.321478e-05, 0.0007360125, 0.0006375952, -0.0001205887, -0.0004576,
+                                            -9.127e-05))
+    table = ParamTable(protocol, semidefinite=True)
+    assert not table.semidefinite_tensor([3.321478e-05, 0.0007360125, 0.0006375952, -0.0001205887, -0.0004576, 0.0])
+    assert not table.semidefinite_tensor([0.0, 0.0007360125, 0.0006375952, -0.0001205887, 0.0, 0.0])
+    rc, board = run(protocol, ["identify", "--payload", "--apply"], board_run(protocol, ESTIMATE, payload=estimate),
+                    table)
+    out = capsys.readouterr().out
+    assert rc == 0 and out.endswith("payload_inertia: refused (the estimate's noise about a point mass): left at 0\n"
+                                    + ALLOWANCE_ZEROED + APPLIED), out
+    inertia = protocol.parameter("payload_inertia")
+    assert inertia is not None
+    assert [table.values[(inertia.index, k)] for k in range(6)] == [0.0] * 6
 
 
 def test_a_mass_within_two_sigma_of_zero_is_no_payload(protocol: Protocol, capsys: pytest.CaptureFixture[str]) -> None:

@@ -212,8 +212,8 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
     """identify --payload --apply: the payload's estimate into payload_mass, payload_com and payload_inertia (the
     torque off already), as oscctl's: the inertia zeroed first, then its moments before its products; where the
     parameters refuse it (not_physical, or a moment below 0 out_of_range: an estimate's noise about a point mass)
-    it is zeroed again, left so, and said. A mass within two of its standard deviations of 0 is no payload: all of
-    it set to 0. Then payload_allowance goes back to 0: the payload is identified."""
+    it is zeroed again, products first, left so, and said. A mass within two of its standard deviations of 0 is no
+    payload: all of it set to 0. Then payload_allowance goes back to 0: the payload is identified."""
     p = c.protocol
 
     def put(name: str, e: int, v: float, quiet: bool = False) -> int:
@@ -239,7 +239,9 @@ def apply_identify_payload(c: Client, a: argparse.Namespace, f: IdentifyPayload)
     for k in range(6):
         rc = rc or (0 if none else put("payload_inertia", k, f.inertia[k], quiet=True))
     if rc == -1:
-        for k in range(6):
+        # Back in the reverse order: each zero returns to a tensor the board accepted on the way (a moment zeroed
+        # before the products would leave a product beside a zero moment, which is not positive semidefinite).
+        for k in reversed(range(6)):
             if put("payload_inertia", k, 0.0):
                 return 1
         print("payload_inertia: refused (the estimate's noise about a point mass): left at 0")
