@@ -274,12 +274,11 @@ stream_path() {
 
 # A path of 10 mm along y, then 10 mm along z, streamed at 10 Hz from where the arm holds: plain
 # setpoints, then again (from where that ended) with the path's velocity (--velocity).
-# The stream cases' board: no link watch. The stream's subject is the setpoints' path; the watch (0.5 s of a client's
+# The stream cases' board runs without the link watch (--no-link-watch). The stream's subject is the setpoints' path; the watch (0.5 s of a client's
 # silence while a motion runs: link_silent) has its own test (link_recovery.py). In a clean CI run at 388e174, with
 # the long suite beside it (four busy processes on two cores), both clients' streams stopped link_silent in the same
 # minute within 1 s of the stream's start, the board itself on time (worst lag 10.5 ms): a client starved of the CPU
 # for 0.4 s beyond its 0.1 s keep-alive.
-stream_board=(--no-link-watch)
 stream() {
   printf 't, x, y, z\n# 10 mm along y, then along z\n0, 0, 0, 0\n0.6, 0, 0.01, 0\n1.2, 0, 0.01, 0.01\n' >"$tmp/path.csv"
   expect 0 '^accepted$' -- "$@" enable
@@ -378,7 +377,7 @@ PY
 power_cycle() {
   local store=$tmp/params.bin warm
   store_estimate "$store" "$@"
-  # No link watch (as the stream's board, stream_board): first_move.py's subject is the first move's tracking, and a
+  # No link watch (as the stream cases' board): first_move.py's subject is the first move's tracking, and a
   # loaded machine's clean CI run at 388e174 stopped it link_silent.
   start_sim --speed 2 --no-link-watch --param-file "$store"
   grep -Eq '^osc_sim: params loaded, sequence [0-9]+' "$tmp/sim.err" || fail "the restart did not load the store"
@@ -467,12 +466,12 @@ case "$case_" in
     stop_sim
     ;;
   oscctl_stream)
-    start_sim --state-hz 100 "${stream_board[@]}"
+    start_sim --state-hz 100 --no-link-watch
     stream "$ctl" --port "$port" --timeout 60
     stop_sim
     ;;
   python_stream)
-    start_sim "${stream_board[@]}"
+    start_sim --no-link-watch
     stream "${pyc[@]}" --port "$port" --timeout 60
     stop_sim
     ;;
