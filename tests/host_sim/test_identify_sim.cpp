@@ -108,9 +108,7 @@ std::unique_ptr<MotionSim<double>> coupled_sim() {
 IdentifyReport coupled_run() {
   const auto sim = coupled_sim();
   std::uint32_t taken = 0, lost = 0;
-  const IdentifyReport r = run_identify(*sim, payload_mask::kNone, taken, lost);
-  report_friction(r, *robot::kFrictionPresets[0], "the wrist coupled");
-  return r;
+  return run_identify(*sim, payload_mask::kNone, taken, lost);
 }
 
 /// One run on the ideal plant with the friction preset `preset` from the runs' pose (0.656 of the design) in scalar S:
@@ -157,22 +155,19 @@ TEST(IdentifySim, TheCorkeFrictionOfTheIdealPlantFromOneRun) {
 }
 
 // The wrist's coupling (the PUMA's q6 = e6 + 0.013 e4 - 0.18 e5) and the published encoders: in the joints' space J5's
-// torque-prediction error was 23 % and the run failed (prediction_error); in the drives' space it is ok (measured
-// 4.3 %, J6). J1, J2 and J5 are within the bar (J5 within 0.2 sigma since the rotors are in the drives' rows; 1.3-1.7
-// sigma before). Not yet (measured, docs/adaptation.md, "The friction law on a coupled arm"): J3's Stribeck term 2.2
-// times the bar and J6 up to 4.4 times (its viscous, 3.6 sigma). The observer's rates carry the friction law's error:
-// its model (2) is the joints', the plant's the motors'; with theta^ at the plant's own, in the joints' structure the
-// worst is 4.1 times the bar, in the drives' 0.2 (a trial on the branch drives-friction-trial).
+// torque-prediction error was 23 % and the run failed (prediction_error); in the drives' space it is ok. Every
+// coefficient within issue 57's bar and its sigma within its own since the friction law is the drives' too (measured
+// 0.84 of the bar, the largest sigma 0.94 of its bar, prediction error 1.1 %, J5): with model (2) the joints' (the
+// law's tau_f^ = W(q^dot^) theta^ against the plant's C^-T W(C^-1 q^dot) theta) the observer's rates carried its error,
+// J6 4.4 times the bar and J3's Stribeck term 2.2 times (docs/adaptation.md, "The friction law on a coupled arm").
 TEST(IdentifySim, TheWristsCoupledDrivesAreIdentifiedInTheDrivesSpace) {
   if (!test::kPumaBuild) GTEST_SKIP() << "the PUMA's coupled wrist";
   const IdentifyReport r = coupled_run();
   EXPECT_EQ(r.status, IdentifyStatus::kOk);
-  EXPECT_LE(r.worst_prediction_error, 0.1);
-  const FrictionCoefficients& truth = *robot::kFrictionPresets[0];
-  const double* t[3] = {truth.vis, truth.cou, truth.sti};
-  for (int c = 0; c < 3; ++c)
-    for (int i : {0, 1, 4})
-      EXPECT_LE(std::fabs(r.friction(c * kDof + i) - t[c][i]), std::max(0.1 * t[c][i], 0.05)) << c << " J" << i + 1;
+  EXPECT_LE(r.worst_prediction_error, 0.05);
+  const FrictionErrors e = report_friction(r, *robot::kFrictionPresets[0], "the wrist coupled");
+  EXPECT_LE(e.bar, 1.0);
+  EXPECT_LE(e.sd, 1.0);
 }
 
 // The regression's model of a coupled drive train (osc/runtime/identify_run.hpp, "The rotors"), apart from the
@@ -399,10 +394,10 @@ static FrictionCoefficients drifted(const sim::PlantConfig& pc, double now, doub
 // the amplifiers' lag, gains and offsets, ripple, backlash, elastic joints, the friction's drift, the current check's
 // dither). The first run finds the drives' armature (the AKB86 motors' 0.36 / 2.43 / 0.29 kg m^2 more on J1-J3), set
 // with the parameter armature_correction before a second run, which reuses the command id (every sample taken). The
-// truth is the plant's preset times its drift's mean over the run. Measured: the armatures 0.333 / 2.512 / 0.337 (J3
-// 18 % off); the second run's J1 within the bar, J4's viscous term 1.3 times it, J2 4.3-5.1 times, J3's Stribeck
-// 3.9, J5 and J6 up to 8.6 (8.0 from q5 = 1.2 rad, J5's Stribeck: the observer's rates on the coupled wrist,
-// docs/adaptation.md, "The friction law on a coupled arm").
+// truth is the plant's preset times its drift's mean over the run. Measured: the armatures 0.331 / 2.507 / 0.333 (J3
+// 16 % off); the second run's J1 and J6 within the bar (J6 since the friction law is the drives' on a coupled arm:
+// it was 6.4 times the bar), J4's viscous term 1.4 times it, J2 up to 4.1 times, J3's Stribeck 3.6, J5's Stribeck
+// 8.7 (its Coulomb / Stribeck split, the sum within 1 %; docs/adaptation.md, "The drives' armature in the model").
 // With the coupled rotors' inertia C^-T J_m C^-1 in the model (commit 27fcb2d, taken back: docs/adaptation.md) the
 // armatures came out within 7.6 % and every coefficient of J1-J4 within the bar (0.98 of it at worst).
 TEST(IdentifySim, TheRealisticPlantsFrictionWithItsArmatureSet) {

@@ -244,6 +244,82 @@ TEST_F(Stages, RobustLawUsesTheOlderRegressorLeaksAndProjects) {
   EXPECT_GT(clipped_lo, 0);
 }
 
+/// The arm's coupled drive train (the PUMA's wrist; a map with a term below the wrist on an arm without one): C built
+/// here from the map's terms, dense, and the model's DriveCoupling of C^-1.
+struct CoupledTrain {
+  Mat6<double> C = Mat6<double>::Identity();
+  DriveCoupling<double> drives;
+  CoupledTrain() {
+    EncoderMap map = robot::kDriveTrain.encoders;
+    if (map.coupling_terms == 0) map.coupling[map.coupling_terms++] = {5, 4, -0.18};
+    for (int k = 0; k < map.coupling_terms; ++k) C(map.coupling[k].row, map.coupling[k].col) += map.coupling[k].c;
+    double c[kDof][kDof], inverse[kDof][kDof];
+    coupling_matrices(map, c, inverse);
+    drives = DriveCoupling<double>::of(inverse);
+  }
+  Vec6<double> motors(const Vec6<double>& qd) const { return C.triangularView<Eigen::UnitLower>().solve(qd); }
+  Vec6<double> joints(const Vec6<double>& f) const { return C.transpose().triangularView<Eigen::UnitUpper>().solve(f); }
+};
+
+// On a coupled drive train (q = C e) each motor has model (2)'s friction at its own rate: the step's estimate is
+// C^-T f(C^-1 q^dot) (against the friction model at C^-1 q^dot, C solved here by Eigen), and the paper's law (67)
+// takes the motors' error C^-1 Dq against the motors' regressor (the joints' regressor C^-T W transposed).
+TEST_F(Stages, OnACoupledDriveTrainTheFrictionIsEachMotorsAtItsRate) {
+  const CoupledTrain train;
+  ASSERT_TRUE(train.drives.coupled());
+  const Vec6<double> qd = v6(0.2, -0.1, 0.3, 0.5, -0.3, 0.05);
+  EXPECT_LT((motor_rates(train.drives, qd) - train.motors(qd)).cwiseAbs().maxCoeff(), 1e-15);
+  EXPECT_LT((joint_torques_of_motors(train.drives, qd) - train.joints(qd)).cwiseAbs().maxCoeff(), 1e-15);
+  // J6's motor turns the other way from its joint here (e6' = q6' - 0.013 q4' + 0.18 q5' < 0 < q6').
+  const Vec6<double> e = train.motors(qd);
+  EXPECT_LT(e(5) * qd(5), 0.0);
+
+  // The step's estimate, from a controller whose observer moves at qd: the coupled model's against the same step
+  // of the uncoupled one (the estimate does not feed back within a step).
+  Vec18<double> theta;
+  for (int i = 0; i < 18; ++i) theta(i) = 0.3 + 0.1 * i;
+  Model<double> coupled = model;
+  coupled.drives = train.drives;
+  StepOutput<double> out[2];
+  Vec6<double> qd_hat[2];
+  for (int m = 0; m < 2; ++m) {
+    auto st = std::make_unique<ControllerState<double>>();
+    controller_init(model, *st, q);
+    st->adapt.theta_hat = theta;
+    opspace_update(model, st->data, st->os, q, st->R_ref);
+    st->obs.y = st->os.Ja * qd;  // the observer's velocity (x~ = 0): q^dot = qd
+    out[m] = control_step(m ? coupled : model, G, FrictionMode::kAdaptive, *st, q, Desired<double>{os.x, {}, {}});
+    ASSERT_EQ(out[m].status, kFaultNone);
+    qd_hat[m] = st->adapt.qd_hat_prev;
+  }
+  EXPECT_LT((qd_hat[0] - qd).cwiseAbs().maxCoeff(), 1e-9);
+  FrictionParams<double> fp;
+  fp.vis = theta.head<6>(), fp.cou = theta.segment<6>(6), fp.sti = theta.tail<6>(), fp.dec = G.tau_dec;
+  EXPECT_LT((out[0].tau_f_hat - friction_torque(fp, qd_hat[0])).cwiseAbs().maxCoeff(), 1e-12);
+  const Vec6<double> want = train.joints(friction_torque(fp, Vec6<double>(train.motors(qd_hat[1]))));
+  EXPECT_LT((out[1].tau_f_hat - want).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_GT((out[1].tau_f_hat - out[0].tau_f_hat).cwiseAbs().maxCoeff(), 0.1);  // J6's sign, J5's share
+
+  // (67) on the motors' error.
+  G.adaptation = AdaptationLaw::kPaper;
+  AdaptationState<double> a{};
+  a.theta_hat.setConstant(1.0);
+  a.q_prev = q;
+  a.qd_hat_prev = qd;
+  a.w_prev = friction_regressor_diagonals(train.motors(qd), G.tau_dec);
+  a.samples = 1;
+  const Vec6<double> q1 = q + v6(1e-4, -2e-4, 3e-4, 2e-4, 5e-4, -6e-4);
+  const Vec18<double> t = adaptation_step(G, a, q1, train.drives);
+  const Vec6<double> Dq = train.motors(Vec6<double>(q1 - q - qd * G.dt)), w = train.motors(qd);
+  for (int i = 0; i < kDof; ++i) {
+    const double sg = w(i) > 0 ? 1 : (w(i) < 0 ? -1 : 0);
+    EXPECT_NEAR(t(i), 1 - 500 * w(i) * Dq(i), 1e-12) << i;
+    EXPECT_NEAR(t(6 + i), 1 - 500 * sg * Dq(i), 1e-12) << i;
+    EXPECT_NEAR(t(12 + i), 1 - 500 * sg * std::exp(-w(i) * w(i)) * Dq(i), 1e-12) << i;
+  }
+  EXPECT_NE(t(11), adaptation_step(G, a, q1)(11));  // J6's Coulomb: not the joints' law
+}
+
 TEST_F(Stages, ForceCommandIsEquations31_36) {
   const Vec3<double> p0 = data.o[kDof] + Vec3<double>(0.01, -0.02, 0.005);
   const Desired<double> d = trajectory(kPaperTrajectory, p0, 3.3);

@@ -259,6 +259,42 @@ TEST(Excitation, AcceptedAtTheStartPoseEveryTickWithinTheBoundsByKdl) {
   EXPECT_GE(p.check.rcond, params::kPathMinRcond);
 }
 
+// On a coupled drive train (q = C e, the PUMA's wrist: model.drives) each motor's friction is at its own rate: the
+// check's strongest friction is C^-T f(C^-1 q^dot), C solved here by Eigen from the encoders' map, every tick of the
+// period, and differs from the joints' own on the wrist.
+TEST(Excitation, OnACoupledDriveTrainTheCheckTakesEachMotorsFrictionAtItsRate) {
+  EncoderMap map = robot::kDriveTrain.encoders;
+  if (map.coupling_terms == 0) map.coupling[map.coupling_terms++] = {5, 4, -0.18};  // an arm without: a coupling
+  Mat6<double> C = Mat6<double>::Identity();
+  for (int k = 0; k < map.coupling_terms; ++k) C(map.coupling[k].row, map.coupling[k].col) += map.coupling[k].c;
+  double c[kDof][kDof], inverse[kDof][kDof];
+  coupling_matrices(map, c, inverse);
+  Model<double> coupled = model<double>();
+  coupled.drives = DriveCoupling<double>::of(inverse);
+  ASSERT_TRUE(coupled.drives.coupled());
+  const Prepared<double> p = prepare<double>(start_pose());
+  ASSERT_EQ(p.check.status, ExcitationStatus::kOk);
+  const ExcitationLimits<double> lim = ExcitationLimits<double>::defaults();
+  const ExcitationCheck<double> r =
+      check_excitation(coupled, workspace<double>(), p.motion, orientation_at(start_pose()), lim);
+  ASSERT_EQ(r.status, ExcitationStatus::kOk);
+  Vec6<double> want = Vec6<double>::Zero();
+  for (std::uint32_t n = 0; n <= P; ++n) {
+    const JointSample<double> d = p.motion.at_tick(n);
+    Data<double>& data = workspace<double>();
+    forward_kinematics(coupled, data, d.q);
+    const Vec6<double> tau = rnea(coupled, data, d.qd, d.qdd, true).tau;
+    const Vec6<double> e = C.triangularView<Eigen::UnitLower>().solve(d.qd);
+    Vec6<double> f;
+    for (int i = 0; i < kDof; ++i)  // the limits' friction (2): viscous and breakaway, no decay
+      f(i) = lim.friction.vis(i) * e(i) + lim.friction.cou(i) * (e(i) > 0 ? 1.0 : (e(i) < 0 ? -1.0 : 0.0));
+    const Vec6<double> tau_f = C.transpose().triangularView<Eigen::UnitUpper>().solve(f);
+    for (int i = 0; i < kDof; ++i) want(i) = std::max(want(i), std::abs(tau(i)) + std::abs(tau_f(i)));
+  }
+  for (int i = 0; i < kDof; ++i) EXPECT_NEAR(r.torque(i), want(i), 1e-9 * want(i)) << "J" << i + 1;
+  EXPECT_GT((r.torque - p.check.torque).cwiseAbs().maxCoeff(), 1e-3);  // the wrist's
+}
+
 // ---------------------------------------------------------------- refusals
 
 TEST(Excitation, AStartWithinTheMarginOfALimitIsOutOfWorkspace) {

@@ -62,7 +62,7 @@ TEST(IoMap, TheInverseIsTheCouplingsInverse) {
   for (int i = 0; i < kDof; ++i)
     for (int j = 0; j < kDof; ++j) inv(i, j) = io.inverse[i][j];
   EXPECT_LT((published_coupling() * inv - M6::Identity()).cwiseAbs().maxCoeff(), 1e-15);
-  EXPECT_EQ(io.inverse_terms, 3);  // C^-1 has the same three off-diagonal places
+  EXPECT_EQ(io.drives.terms, 3);  // C^-1 has the same three off-diagonal places
 }
 
 TYPED_TEST(IoMaps, UncoupledMapsAreTodaysPerJointConversionBitForBit) {

@@ -74,17 +74,28 @@ Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Ve
   return q - a.q_prev - a.qd_hat_prev * G.dt;
 }
 
+/// (67)'s error as the motors see it: C^-1 Dq on a coupled drive train, whose friction regressor is the motors'
+/// (the joints' regressor C^-T W, so that its transpose times Dq is W^T C^-1 Dq).
+template <class S>
+Vec6<S> motor_increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q,
+                              const DriveCoupling<S>& drives) {
+  const Vec6<S> Dq = increment_error(G, a, q);
+  return drives.coupled() ? motor_rates(drives, Dq) : Dq;
+}
+
 /// The paper's law (26) in its sampled form (67).
 template <class S>
-Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
-  const Vec6<S> Dq = increment_error(G, a, q);
+Vec18<S> adaptation_paper(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q,
+                          const DriveCoupling<S>& drives = {}) {
+  const Vec6<S> Dq = motor_increment_error(G, a, q, drives);
   return a.theta_hat - G.kad * a.w_prev.transpose_times(Dq);
 }
 
 /// The robust law: (67)'s error Dq, the regressor at q^dot(t-2dt), leakage, projection.
 template <class S>
-Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
-  const Vec6<S> Dq = increment_error(G, a, q);
+Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q,
+                           const DriveCoupling<S>& drives = {}) {
+  const Vec6<S> Dq = motor_increment_error(G, a, q, drives);
   Vec18<S> theta = a.theta_hat - G.leakage * (G.dt * a.theta_hat);
   theta -= G.kad * a.w_prev2.transpose_times(Dq);
   for (int i = 0; i < 3 * kDof; ++i) {
@@ -97,10 +108,11 @@ Vec18<S> adaptation_robust(const Gains<S>& G, const AdaptationState<S>& a, const
 /// theta^(t) by the law the gains select, paper (67) or robust; unchanged until the law has the
 /// samples it needs. The `momentum` law leaves it as it is here: its stage is adaptation_identify.
 template <class S>
-Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q) {
+Vec18<S> adaptation_step(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q,
+                         const DriveCoupling<S>& drives = {}) {
   if (G.adaptation == AdaptationLaw::kMomentum) return a.theta_hat;
-  if (G.adaptation == AdaptationLaw::kRobust) return a.samples >= 2 ? adaptation_robust(G, a, q) : a.theta_hat;
-  return a.samples >= 1 ? adaptation_paper(G, a, q) : a.theta_hat;
+  if (G.adaptation == AdaptationLaw::kRobust) return a.samples >= 2 ? adaptation_robust(G, a, q, drives) : a.theta_hat;
+  return a.samples >= 1 ? adaptation_paper(G, a, q, drives) : a.theta_hat;
 }
 
 /// The joint whose friction sample the momentum law takes in this tick (the residual monitor takes it

@@ -211,12 +211,16 @@ void control_step(const Model<S>& model, const Gains<S>& G, FrictionMode mode, C
   // the step (adaptation_identify), so it is used as it is, without a copy.
   const bool updates = adaptive && G.adaptation != AdaptationLaw::kMomentum;
   Vec18<S> theta_next;
-  if (updates) theta_next = adaptation_step(G, st.adapt, q);
+  if (updates) theta_next = adaptation_step(G, st.adapt, q, model.drives);
   const Vec18<S>& theta_hat = updates ? theta_next : st.adapt.theta_hat;
   const ObserverOutput<S> ob = observer_output(G, os, st.obs.x_hat, st.obs.y);
-  // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples.
-  const RegressorDiagonals<S> w = friction_regressor_diagonals(ob.qd_hat, G.tau_dec);
-  const Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
+  // The regressor at q^dot(t): the friction estimate now, the adaptation in the next two samples. On a coupled
+  // drive train each motor's, at the motors' rates C^-1 q^dot, its torques to the joints through C^-T.
+  const bool coupled = model.drives.coupled();
+  const RegressorDiagonals<S> w =
+      friction_regressor_diagonals(coupled ? motor_rates(model.drives, ob.qd_hat) : ob.qd_hat, G.tau_dec);
+  Vec6<S> tau_f_hat = adaptive ? friction_estimate(w, theta_hat) : Vec6<S>(Vec6<S>::Zero());
+  if (coupled) tau_f_hat = joint_torques_of_motors(model.drives, tau_f_hat);
   const ForceCommand<S> c = force_command(model, G, st.data, os, d, ob, tau_f_hat, st.psi, turn.velocity);
   const Vec6<S> tau = joint_torques(os, c.F);
   const ObserverState<S> next = observer_update(G, os, st.obs.x_hat, st.obs.y, ob.x_tilde, c.F, c.bias);

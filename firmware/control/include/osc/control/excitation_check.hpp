@@ -52,12 +52,16 @@ ExcitationStatus kinematic_limits(const JointSample<S>& d, const ExcitationLimit
 }
 
 /// The torque test of a sample (data: forward kinematics at d.q): the rigid-body torque of (1) by rnea
-/// and the strongest friction's, each joint's magnitudes summed; r's extremes updated.
+/// and the strongest friction's (the drives', model.drives), each joint's magnitudes summed; r's extremes updated.
 template <class S>
 ExcitationStatus torque_limits(const Model<S>& model, const Data<S>& data, const JointSample<S>& d,
                                const ExcitationLimits<S>& lim, ExcitationCheck<S>& r) {
   const Vec6<S> tau = rnea(model, data, d.qd, d.qdd, true).tau;
-  const Vec6<S> tau_f = friction_torque(lim.friction, d.qd);
+  // On a coupled drive train each motor's friction at its rate, to the joints through C^-T (DriveCoupling).
+  const Vec6<S> tau_f =
+      model.drives.coupled()
+          ? joint_torques_of_motors(model.drives, friction_torque(lim.friction, motor_rates(model.drives, d.qd)))
+          : friction_torque(lim.friction, d.qd);
   int over = -1;
   for (int i = 0; i < kDof; ++i) {
     const S need = math::abs(tau(i)) + math::abs(tau_f(i));

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstdint>
 #include <type_traits>
 #include <utility>
 
@@ -115,6 +116,49 @@ constexpr PlacementForm placement_form(const Placement& P) {
   return f;
 }
 
+/// A drive train that couples the joints (q = C e, C unit lower triangular: osc/robots/arm.hpp, EncoderMap; e the
+/// motors' angles referred to their joints): the terms of C^-1 below its diagonal. Each motor turns at e' = C^-1 q'
+/// and carries C^T tau, so model (2)'s friction, each motor's own at its own rate, is C^-T f(C^-1 q') in the joints'
+/// space (osc/control/controller.hpp). No terms: an uncoupled arm (C = I), the motors' rates the joints'.
+template <class S>
+struct DriveCoupling {
+  static constexpr int kMaxTerms = kDof * (kDof - 1) / 2;
+  int terms = 0;
+  std::int8_t row[kMaxTerms]{}, col[kMaxTerms]{};
+  S c[kMaxTerms]{};
+
+  bool coupled() const { return terms != 0; }
+  /// From C^-1 (set-up, in double).
+  [[gnu::cold]] static DriveCoupling of(const double (&inverse)[kDof][kDof]) {
+    DriveCoupling d{};
+    for (int i = 0; i < kDof; ++i)
+      for (int j = 0; j < i; ++j)
+        if (inverse[i][j] != 0) {
+          const int k = d.terms++;
+          d.row[k] = static_cast<std::int8_t>(i);
+          d.col[k] = static_cast<std::int8_t>(j);
+          d.c[k] = lit<S>(inverse[i][j]);
+        }
+    return d;
+  }
+};
+
+/// The motors' rates, referred to their joints, of joint rates qd: C^-1 qd.
+template <class S>
+Vec6<S> motor_rates(const DriveCoupling<S>& d, const Vec6<S>& qd) {
+  Vec6<S> r = qd;
+  for (int k = 0; k < d.terms; ++k) r(d.row[k]) += d.c[k] * qd(d.col[k]);
+  return r;
+}
+
+/// The joint torques that motor torques tau_m (referred to their joints) give: C^-T tau_m.
+template <class S>
+Vec6<S> joint_torques_of_motors(const DriveCoupling<S>& d, const Vec6<S>& tau_m) {
+  Vec6<S> t = tau_m;
+  for (int k = 0; k < d.terms; ++k) t(d.col[k]) += d.c[k] * tau_m(d.row[k]);
+  return t;
+}
+
 /// Constant parameters of a 6-joint revolute arm (osc/robots/arm.hpp), in the kernel's scalar.
 template <class S>
 struct Model {
@@ -134,6 +178,9 @@ struct Model {
   Link link[kDof];
   Vec6<S> armature;  // G^2 * Jm, added to the diagonal of A(q)
   S gravity;         // along -z of the base frame
+  /// The drive train's coupling (none from Model::of: ControlTask::set_encoders sets the arm's), through which
+  /// the friction is each motor's (DriveCoupling).
+  DriveCoupling<S> drives;
   /// Of each link with products: its tensor's Cholesky factor L (I = L L^T, lower; the generator refuses a
   /// tensor that is not positive definite), its diagonal and (L_yx, L_zx, L_zy) (rotated_full_inertia). Apart
   /// from Link, whose size (the stride of link[i]) the arms without products keep.

@@ -40,6 +40,20 @@ MomentumSample<S> momentum_sample(const ResidualMonitor<S>& m) {
   return {i, m.sample, m.within(i, kMaxRatio), half * half, kCorrelation[i]};
 }
 
+/// The stuck-encoder monitor's check of a completed step, per encoder channel: a coupled motor turns with C^-1 qd
+/// and carries C^T tau. The joint rates the reference commands, J^-1 x_d dot, with the step's J.
+template <class S>
+std::uint32_t stuck_encoder_check(ControlTask<S>& task, const std::int32_t counts[kDof], const bool moved[kDof],
+                                  bool homing) {
+  const StepOutput<S>& out = task.last;
+  Vec6<S> tau_m, rate_m;
+  const Vec6<S> qd_ref = task.state.os.Jf.solve(task.desired.xd);
+  const bool coupled = task.io.coupled();
+  const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
+  const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, qd_ref)) : qd_ref;
+  return task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad, homing);
+}
+
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
 /// stuck-encoder, tracking and friction-estimate monitors (osc/runtime/monitors.hpp).
 template <class S>
@@ -57,20 +71,15 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
     task.stuck.restart = true;
   else if (task.machine.state == MotionState::kYielding || task.contact)
     task.stuck.reset(true);
-  else {
-    // Per encoder channel: a coupled motor turns with C^-1 qd and carries C^T tau. The joint rates the
-    // reference commands, J^-1 x_d dot, with the step's J.
-    Vec6<S> tau_m, rate_m;
-    const Vec6<S> qd_ref = task.state.os.Jf.solve(task.desired.xd);
-    const bool coupled = task.io.coupled();
-    const Vec6<S>& tau = coupled ? (tau_m = motor_torques(task.io, out.tau)) : out.tau;
-    const Vec6<S>& rate = coupled ? (rate_m = motor_rates(task.io, qd_ref)) : qd_ref;
-    faults = task.stuck.check(tau, rate, counts, moved, task.tick, task.gains.dt, task.io.counts_per_rad, homing);
-  }
+  else
+    faults = stuck_encoder_check(task, counts, moved, homing);
   const AdaptationState<S>& ad = task.state.adapt;
   const bool adaptive = task.mode == FrictionMode::kAdaptive;
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
   const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
+  const bool coupled_friction = task.model.drives.coupled();
+  Vec6<S> rate_m;
+  if (coupled_friction) rate_m = motor_rates(task.io, ad.qd_hat_prev);
   const ResidualInput<S> in{task.state.data.A,
                             task.state.os.g,
                             out.tau_bias,
@@ -81,7 +90,9 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
                             identify ? &ad.identifier.proven : nullptr,
                             &task.state.data.J,
                             &task.state.os,
-                            &out.e};
+                            &out.e,
+                            coupled_friction ? &task.io : nullptr,
+                            coupled_friction ? &rate_m : nullptr};
   // The residual monitor's turn: the controller's even steps, whose model turn leaves the time for it.
   const bool turn = even_step(task.state);
   task.residual.sample_joint = identify && turn ? momentum_turn(task.state.adapt) : -1;

@@ -49,13 +49,11 @@ S counts_to_angle(int joint, std::int32_t counts, S q_at_zero) {
 /// triangular C by forward substitution.
 template <class S>
 struct IoMap {
-  static constexpr int kMaxInverseTerms = kDof * (kDof - 1) / 2;
   Vec6<math::io_scalar_t<S>> counts_per_rad;
-  int terms, inverse_terms;
+  int terms;
   std::int8_t row[kMaxCouplingTerms], col[kMaxCouplingTerms];
   S c[kMaxCouplingTerms];
-  std::int8_t inverse_row[kMaxInverseTerms], inverse_col[kMaxInverseTerms];
-  S inverse_c[kMaxInverseTerms];
+  DriveCoupling<S> drives;     // C^-1's terms (the motors' rates from the joints')
   double inverse[kDof][kDof];  // C^-1, for the monitors' set-up
 
   bool coupled() const { return terms != 0; }
@@ -72,15 +70,7 @@ struct IoMap {
     }
     double C[kDof][kDof];
     coupling_matrices(map, C, m.inverse);
-    m.inverse_terms = 0;
-    for (int i = 0; i < kDof; ++i)
-      for (int j = 0; j < i; ++j)
-        if (m.inverse[i][j] != 0) {
-          const int k = m.inverse_terms++;
-          m.inverse_row[k] = static_cast<std::int8_t>(i);
-          m.inverse_col[k] = static_cast<std::int8_t>(j);
-          m.inverse_c[k] = lit<S>(m.inverse[i][j]);
-        }
+    m.drives = DriveCoupling<S>::of(m.inverse);
     return m;
   }
 };
@@ -126,20 +116,14 @@ Vec6<S> motor_torques(const IoMap<S>& io, const Vec6<S>& tau) {
   return t;
 }
 
-/// The motors' rates, referred to their joints, of joint rates qd: C^-1 qd.
+/// The motors' rates of joint rates qd, C^-1 qd, and the joint torques of motor torques, C^-T tau_m (DriveCoupling).
 template <class S>
 Vec6<S> motor_rates(const IoMap<S>& io, const Vec6<S>& qd) {
-  Vec6<S> r = qd;
-  for (int k = 0; k < io.inverse_terms; ++k) r(io.inverse_row[k]) += io.inverse_c[k] * qd(io.inverse_col[k]);
-  return r;
+  return motor_rates(io.drives, qd);
 }
-
-/// The joint torques that motor torques tau_m (referred to their joints) give: C^-T tau_m.
 template <class S>
 Vec6<S> joint_torques_of_motors(const IoMap<S>& io, const Vec6<S>& tau_m) {
-  Vec6<S> t = tau_m;
-  for (int k = 0; k < io.inverse_terms; ++k) t(io.inverse_col[k]) += io.inverse_c[k] * tau_m(io.inverse_row[k]);
-  return t;
+  return joint_torques_of_motors(io.drives, tau_m);
 }
 
 /// The DAC scale [codes per N m] and torque limit [N m] of each joint in the scalar W, built at

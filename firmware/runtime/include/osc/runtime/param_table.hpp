@@ -165,8 +165,9 @@ constexpr double kHomeSpeedHi[2] = {params::kMoveLinear[0], params::kMoveAngular
     "each drive's armature correction, added to its described G^2 Jm on the diagonal of the model's A(q) (an "        \
     "identify run's estimate); the sampled loop stays stable at the last computed pose (else unstable_loop)")         \
   X(FrictionVis, "friction_vis", kDof, "N m s/rad", 0, params::kThetaMax, 0, TorqueOff, true,                         \
-    "the friction law's estimate theta^ (20), viscous: read, what it has learnt; set (an identify run's, a saved "    \
-    "record's at power-on), where it goes on from; within [0, the robust law's bound theta_max]")                     \
+    "the friction law's estimate theta^ (20), viscous, each drive's (a joint's if uncoupled): read, what it has "     \
+    "learnt; set (an identify run's, a saved record's at power-on), where it goes on from; within [0, the robust "    \
+    "law's bound theta_max]")                                                                                         \
   X(FrictionCou, "friction_cou", kDof, "N m", 0, params::kThetaMax + kDof, 0, TorqueOff, true,                        \
     "the same of the Coulomb levels")                                                                                 \
   X(FrictionSti, "friction_sti", kDof, "N m", 0, params::kThetaMax + 2 * kDof, 0, TorqueOff, true,                    \

@@ -129,6 +129,10 @@ struct ResidualInput {
   /// The step's tracking error x_d - x (StepOutput::e), or nullptr: in joint space through os's factor, where the
   /// reference has taken each joint (ResidualMonitor::off_reference).
   const Vec6<S>* e = nullptr;
+  /// A coupled drive train (ControlTask::io), whose friction is each motor's at the motors' rates (DriveCoupling):
+  /// the friction regressors and the momentum law's samples are then the motors', or nullptr: the joints' (C = I).
+  const IoMap<S>* io = nullptr;
+  const Vec6<S>* rate = nullptr;  // with io: the motors' rates C^-1 q^dot
 };
 
 }  // namespace osc

@@ -364,22 +364,8 @@ struct ResidualMonitor {
     for (int k = 0; k < kRegressors; ++k) reg[k].setZero(), reg_slow[k].setZero();
     stillness.setOnes();  // until each joint is seen moving, its static friction may change at any time
   }
-  /// Joint i's friction sample, on a turn: r is this tick's, the filtered regressors still the last turn's, as
-  /// the friction in r is of the periods before (n_{k-1}). Settled: moving, its encoder counting, since
-  /// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
-  /// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
-  /// noise is a share of the viscous column, and its errors in the variables a bias): its own row's,
-  /// noise_base, without the wrist's mixing (wrist_noise()), which would leave the paper's slow wrist
-  /// motion to its few fast samples: J4's Coulomb / Stribeck split learnt from them, J4's and J6's
-  /// residuals reached 0.42 and 0.53 of their thresholds on the paper's motion (0.29 with this).
-  void take_sample(int i, const FrictionError& e) {
-    static constexpr std::array<S, kDof> kSettled = settled_stillness();
-    sample.y = reg[kEstimate](i) - r(i);
-    sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
-    sample.gravity = reg[kGravity](i);
-    static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
-    sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * noise_base(i);
-  }
+  /// Joint i's friction sample, on a turn (residual_thresholds.hpp).
+  void take_sample(int i, const FrictionError& e, const IoMap<S>* io);
   /// The stillness envelope after kIdentifySettle / K seconds of motion: (1 - kSlow dt kTurn)^turns.
   static constexpr std::array<S, kDof> settled_stillness() {
     std::array<S, kDof> s{};

@@ -37,7 +37,7 @@ inline int ResidualMonitor<S>::turn_pass(const ResidualInput<S>& in, const bool 
       bound(i) = b;
     } else {
       low_pass(bound(i), b, c.turn_gain_dt[i]);
-      if (i == sample_joint) take_sample(i, e);
+      if (i == sample_joint) take_sample(i, e, in.io);
       ch = update_change(in, e, t, i);
     }
     const S loop = update_thresholds(e, ch, m, i);
@@ -174,8 +174,10 @@ template <class S>
 inline S ResidualMonitor<S>::pointwise_bound(const ResidualInput<S>& in, const FrictionError& e, int i, S model) const {
   const ResidualConstants<S>& c = kResidualConstants<S>;
   using math::mul_add;
-  // Moving: the band's distance from the estimate, coefficient by coefficient.
-  const S friction = e.sliding ? mul_add(math::abs(in.qd(i)), e.dv,
+  // Moving: the band's distance from the estimate, coefficient by coefficient, at the motor's rate (the joint's
+  // where C = I: ResidualInput::io; the other motors' friction through a coupling is cross_friction's).
+  const S rate = in.rate ? (*in.rate)(i) : in.qd(i);
+  const S friction = e.sliding ? mul_add(math::abs(rate), e.dv,
                                          mul_add(in.decay(i), e.ds, mul_add(c.vis_hi[i], velocity_noise(i), e.dc)))
                                : e.still;
   return friction + model;
@@ -205,7 +207,8 @@ inline auto ResidualMonitor<S>::update_change(const ResidualInput<S>& in, const 
                                               int i) -> Changes {
   const ResidualConstants<S>& c = kResidualConstants<S>;
   const S Ks = c.slow_dt, Kdt = c.turn_gain_dt[i], half = lit<S>(0.5);
-  const S qd = in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
+  // The friction's regressors at the motor's rate (the joint's where C = I: ResidualInput::io).
+  const S qd = in.rate ? (*in.rate)(i) : in.qd(i), sign = qd > S(0) ? S(1) : (qd < S(0) ? S(-1) : S(0));
   // Filtered as r, then slowly: the regressor's change.
   const auto band = [&](int k, S phi) {
     low_pass(reg[k](i), phi, Kdt);
@@ -224,6 +227,29 @@ inline auto ResidualMonitor<S>::update_change(const ResidualInput<S>& in, const 
   low_pass(r_slow(i), half * (r(i) + r_last(i)), Ks);  // d = r - r_slow: check(), every step
   stillness(i) = e.moving ? stillness(i) - Ks * stillness(i) : S(1);
   return ch;
+}
+
+/// Joint i's friction sample, on a turn: r is this tick's, the filtered regressors still the last turn's, as
+/// the friction in r is of the periods before (n_{k-1}). Settled: moving, its encoder counting, since
+/// params::kIdentifySettle time constants of the filter (the stillness envelope has decayed that
+/// far), and its filtered speed params::kIdentifyMinSpeed times its velocity noise (slower, the
+/// noise is a share of the viscous column, and its errors in the variables a bias): its own row's,
+/// noise_base, without the wrist's mixing (wrist_noise()), which would leave the paper's slow wrist
+/// motion to its few fast samples: J4's Coulomb / Stribeck split learnt from them, J4's and J6's
+/// residuals reached 0.42 and 0.53 of their thresholds on the paper's motion (0.29 with this).
+/// On a coupled drive train (io) the sample is motor i's: its torque (C^T (tau_f^ - r))_i, the terms of the
+/// joints after i (C is lower triangular) filtered with the same gain (the wrist's), and their filtered values
+/// the last turn's as i's (this pass reaches them after i).
+template <class S>
+inline void ResidualMonitor<S>::take_sample(int i, const FrictionError& e, const IoMap<S>* io) {
+  static constexpr std::array<S, kDof> kSettled = settled_stillness();
+  sample.y = reg[kEstimate](i) - r(i);
+  for (int k = 0; io && k < io->terms; ++k)
+    if (io->col[k] == i) sample.y += io->c[k] * (reg[kEstimate](io->row[k]) - r(io->row[k]));
+  sample.phi = Vec3<S>(reg[kVis](i), reg[kCou](i), reg[kSti](i));
+  sample.gravity = reg[kGravity](i);
+  static constexpr S kMinSpeed = lit<S>(params::kIdentifyMinSpeed);
+  sample.settled = e.moving && stillness(i) <= kSettled[i] && math::abs(sample.phi(0)) > kMinSpeed * noise_base(i);
 }
 
 /// Joint i's thresholds: the filtered bound, the inertias' error on the filtered accelerations, and

@@ -212,6 +212,7 @@ struct ControlTask {
   /// torques' DAC channels, the plausible readings and steps, the stuck-encoder monitor's channels.
   [[gnu::cold]] void set_encoders(const EncoderMap& map) {  // set-up, in double: compiled for size
     io = IoMap<S>::of(map);
+    model.drives = io.drives;  // the friction each motor's (DriveCoupling)
     index_ticks = IndexTicks::of(map);
     double q0[kDof];
     for (int i = 0; i < kDof; ++i) q0[i] = static_cast<double>(q_start(i));
