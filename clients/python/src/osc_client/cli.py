@@ -63,7 +63,7 @@ SIMPLE_VERBS = ("state", "enable", "disable", "clear", "paper", "stop", "home")
 PARAM_OPS = ("list", "get", "set", "save", "load", "reset", "check")
 IDENTIFY_FRAME_WAIT = 10.0
 """Seconds identify waits for the estimate after the run's end (oscctl's kIdentifyFrameWaitS): the board solves it
-after the end (26 million instructions: 0.2 s on the F407, seconds on a slow core or a loaded simulator) and sends it
+after the end (38 million instructions: 0.25 s on the F407, seconds on a slow core or a loaded simulator) and sends it
 at once; the wait ends when it comes."""
 
 

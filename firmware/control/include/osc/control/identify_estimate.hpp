@@ -8,15 +8,18 @@
 // theta_i = (vis_i, cou_i, sti_i), Y_i the payload regressor's row and pi the payload's parameters, all ten or the
 // subset a mask selects. Optionally a joint's row also carries dI_i qdd_i, dI_i the correction to the model's
 // armature (the rotor's inertia referred to the joint, G^2 J_m: the PUMA's two published sets differ by 2.4 kg m^2
-// on J2, which left out goes into the friction and fails the run on its prediction error). A run that moves estimates
-// all ten: about the flange a payload's inertia is mostly m |c|^2 (1.5 kg at 87 mm: 0.012 of its 0.014 kg m^2), and
-// left out it goes into the friction and the centre of mass (on the excitation 2.3 mm, 0.16 %, a friction coefficient 9
+// on J2, which left out goes into the friction and fails the run on its prediction error), and -b_i, b_i the torque
+// the drive adds to the one commanded (an amplifier's offset: 0.1 % of J5's range moved its Coulomb / Stribeck split by
+// 0.43 N m, 8.5 times issue 57's bar, with the sum unchanged: test_identify_sim, "*Offset*"). A run that moves
+// estimates all ten: about the flange a payload's inertia is mostly m |c|^2 (1.5 kg at 87 mm: 0.012 of its 0.014 kg
+// m^2), and left out it goes into the friction and the centre of mass (on the excitation 2.3 mm, 0.16 %, a friction
+// coefficient 9
 // %: test_identify_estimate.cpp); the mass and first moments alone (payload_mask::kMassAndMoment) are for poses held
 // still. Friction is per joint (Property 4), the payload common to all: the information matrix is block-arrowed, the
 // friction blocks coupled only through pi.
 //
-// The sums. Per joint, of phi = (w_i, Y_i) (13 columns): the symmetric block sum phi phi^T, its right-hand side
-// sum phi y, sum y^2 and the count. In double on every target: a run's 10^4 samples of products of regressors
+// The sums. Per joint, of phi = (w_i, qdd_i, 1, Y_i) (15 columns): the symmetric block sum phi phi^T, its right-hand
+// side sum phi y, sum y^2 and the count. In double on every target: a run's 10^4 samples of products of regressors
 // spanning 10^3 in size need more than float's 24 bits or Q12.19's resolution, and an accumulator that rounds a
 // sample's share away biases the estimate; the samples arrive at 100 Hz at most, outside the control tick. Any
 // parameter vector's residual sum of squares per joint follows from them: RSS_i = sum y^2 - 2 x^T b_i + x^T M_i x.
@@ -50,10 +53,10 @@
 // params::kIdentifyMaxCondition), kPredictionError (a joint's prediction error above
 // params::kIdentifyMaxPredictionError), else kOk.
 //
-// Size and cost: the sums 10.1 kB, the solve's workspace (H and its factor packed in one matrix, a member so that the
-// board's stack does not hold it) 10 kB; a sample 6 x 105 multiply-adds with the armatures and the payload's ten (6 x
-// 10 without the payload); a solve three factorisations of 34 x 34, 34 solves and at most 2 x 200 power iterations,
-// once per run. No heap.
+// Size and cost: the sums 11.6 kB, the solve's workspace (H and its factor packed in one matrix, a member so that the
+// board's stack does not hold it) 13.8 kB; a sample 6 x 120 multiply-adds with the armatures, the offsets and the
+// payload's ten (6 x 15 without the payload); a solve three factorisations of 40 x 40, 40 solves and at most 2 x 200
+// power iterations, once per run. No heap.
 #pragma once
 
 #include <algorithm>
@@ -114,6 +117,9 @@ struct IdentifyReport {
   /// The joints' armature corrections (what the model's armature lacks, N m s^2/rad: 0 where not estimated).
   Vec6<double> armature = Vec6<double>::Zero();
   Vec6<double> armature_sd = Vec6<double>::Zero();
+  /// The torque each drive adds to the one commanded, a constant (an amplifier's offset, N m: 0 where not estimated).
+  Vec6<double> offset = Vec6<double>::Zero();
+  Vec6<double> offset_sd = Vec6<double>::Zero();
   PayloadVector<double> payload = PayloadVector<double>::Zero();  ///< pi (0 where not estimated)
   PayloadVector<double> payload_sd = PayloadVector<double>::Zero();
   std::array<CoefficientVerdict, 3 * kDof> friction_verdict{};
@@ -132,18 +138,19 @@ struct IdentifyReport {
 
 namespace identify {
 constexpr std::uint8_t kAllRows = (1u << kDof) - 1;  // every joint's row of a sample
-constexpr int kJointColumns = 14;   // a joint's phi: its 3 friction columns, its armature's, and the payload's 10
-constexpr int kArmatureColumn = 3;  // the armature's local column; the payload's follow it
-constexpr int kPayloadColumn = 4;
-constexpr int kUnknowns = 4 * kDof + 10;          // theta, the armatures' corrections and pi
+constexpr int kJointColumns = 15;   // a joint's phi: its 3 friction columns, its armature's, its offset's, pi's 10
+constexpr int kArmatureColumn = 3;  // the armature's local column, then the offset's; the payload's follow them
+constexpr int kOffsetColumn = 4;
+constexpr int kPayloadColumn = 5;
+constexpr int kUnknowns = 5 * kDof + 10;          // theta, the armatures' corrections, the offsets and pi
 constexpr int kPowerIterations = 200;             // the condition's estimate: at most, each way
 constexpr double kPowerTolerance = 1e-6;          // ... or until the Rayleigh quotient moves less than this (relative)
 constexpr double kVarianceFloor = 1e-24;          // [N^2 m^2]: a joint whose model fits exactly still gets a weight
 constexpr double kRelativeVarianceFloor = 1e-12;  // ... and at least this of its mean square
 
-/// Where a joint's local column l (0-2 friction, 3 armature, 4-13 pi) sits among the unknowns.
+/// Where a joint's local column l (0-2 friction, 3 armature, 4 offset, 5-14 pi) sits among the unknowns.
 constexpr int unknown_index(int joint, int l) {
-  return l <= kArmatureColumn ? l * kDof + joint : 4 * kDof + l - kPayloadColumn;
+  return l < kPayloadColumn ? l * kDof + joint : 5 * kDof + l - kPayloadColumn;
 }
 
 using Matrix = Eigen::Matrix<double, kUnknowns, kUnknowns>;
@@ -154,7 +161,7 @@ using Vector = Eigen::Matrix<double, kUnknowns, 1>;
 /// kUnknowns epsilon, H's diagonal being 1 (column-normalised), is singular to working precision. Loops, not
 /// LdltFactor (osc/kernels/opspace.hpp), which unrolls each row for the tick's 6 x 6: at 28 x 28 the estimate's code
 /// took 72 kB of an M4F build with it and takes 12 kB with this, for a factorisation that runs three times a run;
-/// and H and its factor share one matrix (9.2 kB at 34 x 34).
+/// and H and its factor share one matrix (12.8 kB at 40 x 40).
 struct PackedLdlt {
   Matrix m;
   Vector d;
@@ -207,11 +214,12 @@ class IdentifyEstimate {
 
   explicit IdentifyEstimate(std::uint16_t payload = payload_mask::kNone) { reset(payload); }
 
-  /// Clears the sums; `payload` selects pi's entries (payload_mask), `armature` the joints whose armature correction
-  /// is estimated (bit i for joint i; none by default).
-  void reset(std::uint16_t payload, std::uint8_t armature = 0) {
+  /// Clears the sums; `payload` selects pi's entries (payload_mask), `armature` and `offset` the joints whose armature
+  /// correction and torque offset are estimated (bit i for joint i; none by default).
+  void reset(std::uint16_t payload, std::uint8_t armature = 0, std::uint8_t offset = 0) {
     mask_ = static_cast<std::uint16_t>(payload & payload_mask::kAll);
     armature_ = static_cast<std::uint8_t>(armature & identify::kAllRows);
+    offset_ = static_cast<std::uint8_t>(offset & identify::kAllRows);
     for (int i = 0; i < kDof; ++i) {
       columns_[i] = 0;
       for (int l = 0; l < identify::kJointColumns; ++l)
@@ -239,6 +247,7 @@ class IdentifyEstimate {
       phi[i][0] = static_cast<double>(w.vis(i)), phi[i][1] = static_cast<double>(w.cou(i));
       phi[i][2] = static_cast<double>(w.sti(i));
       phi[i][identify::kArmatureColumn] = static_cast<double>(qdd(i));
+      phi[i][identify::kOffsetColumn] = -1;  // b_i, added by the drive: y_i is short of it
       for (int k = 0; k < 10; ++k) phi[i][identify::kPayloadColumn + k] = static_cast<double>(Y(i, k));
       for (int c = 0; c < columns_[i]; ++c) finite = finite && std::isfinite(phi[i][column_[i][c]]);
       finite = finite && std::isfinite(yd[i]);
@@ -308,7 +317,7 @@ class IdentifyEstimate {
     return s > 0 ? s : 0;
   }
   double degrees_of_freedom(int i) const {
-    const int own = estimated(identify::unknown_index(i, identify::kArmatureColumn)) ? 4 : 3;  // and a sixth of pi's
+    const int own = 3 + (armature_ >> i & 1u) + (offset_ >> i & 1u);  // and a sixth of pi's
     return static_cast<double>(rows_[i]) - own - (columns_[i] - own) / static_cast<double>(kDof);
   }
   /// s_i^2 = RSS_i / (n_i - p_i), at least kRelativeVarianceFloor of y_i's mean square and kVarianceFloor.
@@ -342,7 +351,9 @@ class IdentifyEstimate {
   }
 
   bool estimated(int k) const {
-    return k < 3 * kDof || (k < 4 * kDof ? (armature_ >> (k - 3 * kDof) & 1u) : (mask_ >> (k - 4 * kDof) & 1u));
+    if (k < 3 * kDof) return true;
+    if (k < 5 * kDof) return (k < 4 * kDof ? armature_ >> (k - 3 * kDof) : offset_ >> (k - 4 * kDof)) & 1u;
+    return mask_ >> (k - 5 * kDof) & 1u;
   }
 
   /// The report of the solution x, f_ the factor of its weights (the file comment's "What it reports").
@@ -357,13 +368,14 @@ class IdentifyEstimate {
       }
     r.friction = x.head<3 * kDof>(), r.friction_sd = sd.head<3 * kDof>();
     r.armature = x.segment<kDof>(3 * kDof), r.armature_sd = sd.segment<kDof>(3 * kDof);
+    r.offset = x.segment<kDof>(4 * kDof), r.offset_sd = sd.segment<kDof>(4 * kDof);
     r.payload = x.tail<10>(), r.payload_sd = sd.tail<10>();
     for (int k = 0; k < identify::kUnknowns; ++k) {
-      if (k >= 3 * kDof && k < 4 * kDof) continue;  // an armature's correction: judged against the arm's (the caller)
+      if (k >= 3 * kDof && k < 5 * kDof) continue;  // an armature's correction, an offset: judged by the caller
       const CoefficientVerdict v = !estimated(k)                      ? CoefficientVerdict::kNotEstimated
                                    : friction_identified(x(k), sd(k)) ? CoefficientVerdict::kIdentified
                                                                       : CoefficientVerdict::kNotExcited;
-      (k < 3 * kDof ? r.friction_verdict[k] : r.payload_verdict[k - 4 * kDof]) = v;
+      (k < 3 * kDof ? r.friction_verdict[k] : r.payload_verdict[k - 5 * kDof]) = v;
     }
     for (int i = 0; i < kDof; ++i) {
       const double e = rss(i, x);
@@ -404,11 +416,13 @@ class IdentifyEstimate {
   IdentifyReport& failed(IdentifyReport& r, IdentifyStatus s) const {
     r.status = s;
     r.friction_sd.setConstant(std::numeric_limits<double>::infinity());
-    for (int i = 0; i < kDof; ++i)
+    for (int i = 0; i < kDof; ++i) {
       r.armature_sd(i) = estimated(3 * kDof + i) ? std::numeric_limits<double>::infinity() : 0;
+      r.offset_sd(i) = estimated(4 * kDof + i) ? std::numeric_limits<double>::infinity() : 0;
+    }
     r.friction_verdict.fill(CoefficientVerdict::kNotExcited);
     for (int k = 0; k < 10; ++k) {
-      const bool on = estimated(4 * kDof + k);
+      const bool on = estimated(5 * kDof + k);
       r.payload_sd(k) = on ? std::numeric_limits<double>::infinity() : 0;
       r.payload_verdict[k] = on ? CoefficientVerdict::kNotExcited : CoefficientVerdict::kNotEstimated;
     }
@@ -422,7 +436,7 @@ class IdentifyEstimate {
   std::array<std::uint32_t, kDof> rows_{};  // rows summed per joint
   bool not_finite_ = false;
   std::uint16_t mask_ = 0;
-  std::uint8_t armature_ = 0;
+  std::uint8_t armature_ = 0, offset_ = 0;
   int column_[kDof][identify::kJointColumns] = {};  // each joint's selected local columns, in order
   int columns_[kDof] = {};
   identify::PackedLdlt f_;  // the solve's workspace: H and its factor

@@ -4,12 +4,13 @@
 // regression rows into the weighted least squares of osc/control/identify_estimate.hpp, and the report at the end).
 //
 // The regression of a sample (identify_estimate.hpp's file comment), per joint i:
-//   y_i = F tau_i - tau_rb,i(q_f, qd_f, qdd_f) = w_i^T theta_i + Y_i pi,
+//   y_i = F tau_i - tau_rb,i(q_f, qd_f, qdd_f) = w_i^T theta_i + dI_i qdd_i - b_i + Y_i pi,
 // tau the torque the controller commanded, tau_rb the model's rigid-body torque (rnea, armature included) at
-// the filtered angles and their derivatives, w_i the filtered friction columns, Y the payload regressor
-// (osc/kernels/payload.hpp) there. With the payload estimated the model is the arm's own, link 6 without
-// the payload parameters set (so that pi is the whole payload, not a correction to the one set); without,
-// the model as it is, the payload set included, and the friction alone is estimated. A joint's row is left out
+// the filtered angles and their derivatives, w_i the filtered friction columns, dI_i the drive's armature correction,
+// b_i the torque its drive adds to the one commanded (an amplifier's offset; a constant through F, whose DC gain is
+// 1), Y the payload regressor (osc/kernels/payload.hpp) there. With the payload estimated the model is the arm's own,
+// link 6 without the payload parameters set (so that pi is the whole payload, not a correction to the one set);
+// without, the model as it is, the payload set included, and the friction alone is estimated. A joint's row is left out
 // about its reversals (identify::moving_rows, params::kIdentifyMinRowSpeed says why).
 //
 // The drives' space. On an arm whose drive train couples the joints (the PUMA's wrist: q = C e, e the motors'
@@ -136,7 +137,7 @@ template <class S>
 class IdentifyRun {
  public:
   /// A run `id` starts: the estimate cleared, the payload's entries `payload` (payload_mask) estimated too, and
-  /// every drive's armature correction. bare: the arm's model without a payload (the task's own with
+  /// every drive's armature correction and torque offset. bare: the arm's model without a payload (the task's own with
   /// payload_empty), for the payload's run. io: the drive train's coupling (the task's; none: uncoupled).
   void start(std::uint32_t id, std::uint16_t payload, const Model<S>& model, const Model<S>& bare,
              const IoMap<S>* io = nullptr) {
@@ -148,7 +149,7 @@ class IdentifyRun {
     next_ = 0;
     restart_at_ = 0;
     settled_ = 0;
-    estimate_.reset(payload, identify::kAllRows);
+    estimate_.reset(payload, identify::kAllRows, identify::kAllRows);
     model_ = payload != payload_mask::kNone ? bare : model;
     with_payload_ = payload != payload_mask::kNone;
     rotors_ = model_.armature;
