@@ -38,7 +38,7 @@ RxResult parse_firmware_bytes(pil::Parser& parser, const std::uint8_t* bytes, in
         f.type = parser.type();
         if (parser.decode(f.actuator) || parser.decode(f.answer) || parser.decode(f.state) || parser.decode(f.trace) ||
             parser.decode(f.param_answer) || parser.decode(f.capture_data) || parser.decode(f.identify) ||
-            parser.decode(f.identify_payload))
+            parser.decode(f.identify_offset) || parser.decode(f.identify_payload))
           return RxResult::kFrame;
         ++counters[pil::kErrHeader];  // a type the host sends
         return err = "unexpected frame type from the firmware", RxResult::kError;
@@ -65,6 +65,7 @@ void file_reply(const FirmwareFrame& f, PilReplies& replies) {
   if (f.type == pil::kParamAnswerFrame) replies.params.push_back(f.param_answer);
   if (f.type == pil::kCaptureDataFrame) replies.captures.push_back(f.capture_data);
   if (f.type == pil::kIdentifyFrame) replies.identifies.push_back(f.identify);
+  if (f.type == pil::kIdentifyOffsetFrame) replies.identify_offsets.push_back(f.identify_offset);
   if (f.type == pil::kIdentifyPayloadFrame) replies.identify_payloads.push_back(f.identify_payload);
 }
 }  // namespace

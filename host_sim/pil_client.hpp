@@ -43,14 +43,15 @@ struct PilReplies {
   std::vector<pil::ParamAnswerFrame> params;    ///< the answers to param frames (sent as each was received)
   std::vector<pil::CaptureDataFrame> captures;  ///< the answers to capture frames (the same)
   std::vector<pil::IdentifyFrame> identifies;   ///< an identify run's estimate, after the tick its motion ended in
-  std::vector<pil::IdentifyPayloadFrame> identify_payloads;  ///< its payload's, right after (the flag payload)
+  std::vector<pil::IdentifyOffsetFrame> identify_offsets;    ///< its drives' torque offsets, right after
+  std::vector<pil::IdentifyPayloadFrame> identify_payloads;  ///< its payload's, after those (the flag payload)
   bool empty() const {
     return answers.empty() && states.empty() && traces.empty() && params.empty() && captures.empty() &&
-           identifies.empty() && identify_payloads.empty();
+           identifies.empty() && identify_offsets.empty() && identify_payloads.empty();
   }
   void clear() {
     answers.clear(), states.clear(), traces.clear(), params.clear(), captures.clear(), identifies.clear();
-    identify_payloads.clear();
+    identify_offsets.clear(), identify_payloads.clear();
   }
 };
 
@@ -64,6 +65,7 @@ struct FirmwareFrame {
   pil::ParamAnswerFrame param_answer;
   pil::CaptureDataFrame capture_data;
   pil::IdentifyFrame identify;
+  pil::IdentifyOffsetFrame identify_offset;
   pil::IdentifyPayloadFrame identify_payload;
 };
 

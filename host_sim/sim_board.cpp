@@ -273,8 +273,8 @@ class InProcessBoard {
 
 /// The controller of a PIL image in QEMU over the link, the simulated arm here (linked_arm.hpp): the
 /// client's command, setpoint, param and capture frames onto the link before the next tick's sensor frame, the
-/// image's answer, state, param_answer and capture_data frames of each tick back, and its identify frame (and
-/// identify_payload frame) when a run ends. No other frame goes on the link.
+/// image's answer, state, param_answer and capture_data frames of each tick back, and its identify and
+/// identify_offset frames (and identify_payload frame) when a run ends. No other frame goes on the link.
 class QemuBoard {
  public:
   QemuBoard(const sim::ExperimentConfig& cfg, const std::string& elf)
@@ -322,6 +322,7 @@ class QemuBoard {
     for (const pil::ParamAnswerFrame& f : arm_.replies().params) write(buf, pil::encode(f, buf));
     for (const pil::CaptureDataFrame& f : arm_.replies().captures) write(buf, pil::encode(f, buf));
     for (const pil::IdentifyFrame& f : arm_.replies().identifies) write(buf, pil::encode(f, buf));
+    for (const pil::IdentifyOffsetFrame& f : arm_.replies().identify_offsets) write(buf, pil::encode(f, buf));
     for (const pil::IdentifyPayloadFrame& f : arm_.replies().identify_payloads) write(buf, pil::encode(f, buf));
     return true;
   }

@@ -1726,6 +1726,11 @@ def t_protocol_identify():
     return field_rows(protocol()["identify_fields"])
 
 
+@table("protocol_identify_offset", "docs/protocol.md", "protocol")
+def t_protocol_identify_offset():
+    return field_rows(protocol()["identify_offset_fields"])
+
+
 @table("protocol_identify_payload", "docs/protocol.md", "protocol")
 def t_protocol_identify_payload():
     return field_rows(protocol()["identify_payload_fields"])

@@ -277,12 +277,15 @@ void Client::dispatch() {
   pil::ParamAnswerFrame p;
   pil::IdentifyFrame f;
   pil::IdentifyPayloadFrame fp;
+  pil::IdentifyOffsetFrame fo;
   if (parser_.decode(p)) {
     param_answer_ = p;
   } else if (parser_.decode(f)) {
     identify_ = f;
   } else if (parser_.decode(fp)) {
     identify_payload_ = fp;
+  } else if (parser_.decode(fo)) {
+    identify_offset_ = fo;
   } else if (parser_.decode(a)) {
     answers_.push_back(a);
     if (answers_.size() > kHistory) answers_.pop_front();
@@ -294,16 +297,23 @@ void Client::dispatch() {
   }
 }
 
-std::optional<pil::IdentifyFrame> Client::wait_identify(std::uint32_t id, double timeout_s) {
-  const auto got = [&] { return identify_ && identify_->id == id; };
+template <class F>
+std::optional<F> Client::wait_run_frame(const std::optional<F>& last, std::uint32_t id, double timeout_s) {
+  const auto got = [&] { return last && last->id == id; };
   if (!read_until(now_s() + timeout_s, got) && !got()) return std::nullopt;
-  return identify_;
+  return last;
+}
+
+std::optional<pil::IdentifyFrame> Client::wait_identify(std::uint32_t id, double timeout_s) {
+  return wait_run_frame(identify_, id, timeout_s);
 }
 
 std::optional<pil::IdentifyPayloadFrame> Client::wait_identify_payload(std::uint32_t id, double timeout_s) {
-  const auto got = [&] { return identify_payload_ && identify_payload_->id == id; };
-  if (!read_until(now_s() + timeout_s, got) && !got()) return std::nullopt;
-  return identify_payload_;
+  return wait_run_frame(identify_payload_, id, timeout_s);
+}
+
+std::optional<pil::IdentifyOffsetFrame> Client::wait_identify_offset(std::uint32_t id, double timeout_s) {
+  return wait_run_frame(identify_offset_, id, timeout_s);
 }
 
 bool Client::read_until(double deadline, const std::function<bool()>& done) {

@@ -160,6 +160,9 @@ class Client {
   /// The identify_payload frame of run `id` (the payload's estimate of a run asked with the flag payload, right
   /// after its identify frame), received so far or within timeout_s; nullopt when none came or on an error.
   std::optional<pil::IdentifyPayloadFrame> wait_identify_payload(std::uint32_t id, double timeout_s);
+  /// The identify_offset frame of run `id` (each drive's torque offset, right after its identify frame), received so
+  /// far or within timeout_s; nullopt when none came (a firmware from before it was sent) or on an error.
+  std::optional<pil::IdentifyOffsetFrame> wait_identify_offset(std::uint32_t id, double timeout_s);
 
   /// Reads and dispatches frames for timeout_s (on_answer, on_state); false on a transport error.
   bool pump(double timeout_s);
@@ -184,6 +187,9 @@ class Client {
   /// an error.
   bool read_until(double deadline, const std::function<bool()>& done);
   void dispatch();
+  /// The last frame of a run's kind (`last`) once it is run `id`'s, received so far or within timeout_s.
+  template <class F>
+  std::optional<F> wait_run_frame(const std::optional<F>& last, std::uint32_t id, double timeout_s);
   /// A parser result and the further events of the bytes already received: frames dispatched,
   /// errors counted.
   void take(pil::Parser::Result r);
@@ -203,6 +209,7 @@ class Client {
   std::optional<pil::ParamAnswerFrame> param_answer_;          // the last param_answer frame
   std::optional<pil::IdentifyFrame> identify_;                 // the last identify frame
   std::optional<pil::IdentifyPayloadFrame> identify_payload_;  // the last identify_payload frame
+  std::optional<pil::IdentifyOffsetFrame> identify_offset_;    // the last identify_offset frame
   std::uint64_t states_seen_ = 0;
   std::string error_;
   double last_write_s_ = 0;  // steady clock [s] of the last frame sent (the keep-alive)

@@ -289,6 +289,16 @@ void print_identify(const pil::IdentifyFrame& f) {
   std::printf("(* identified: its standard deviation within %g %% of it)\n", 100 * osc::params::kIdentifiedFraction);
 }
 
+/// An identify_offset frame: each drive's torque offset with its standard deviation, on one line (reported; no
+/// parameter takes it).
+void print_identify_offset(const pil::IdentifyOffsetFrame& f) {
+  if (f.status != static_cast<std::uint8_t>(osc::IdentifyStatus::kOk)) return;
+  std::printf("torque offset [N m] (what each drive adds to the torque commanded; reported, not applied):");
+  for (int i = 0; i < osc::kDof; ++i)
+    std::printf(" J%d %.4f +- %.4f", i + 1, static_cast<double>(f.offset[i]), static_cast<double>(f.offset_sd[i]));
+  std::printf("\n");
+}
+
 /// An identify_payload frame: the payload's mass, centre of mass and inertia about it, then the standard deviations
 /// of the estimated parameters (mass, first moment m c, inertia about frame 6's origin), `*` where identified.
 void print_identify_payload(const pil::IdentifyPayloadFrame& f) {
@@ -392,6 +402,10 @@ int identify(Client& c, const Args& a) {
     return a.apply ? 1 : rc;
   }
   print_identify(*f);
+  if (const auto fo = c.wait_identify_offset(id, kIdentifyFrameWaitS))
+    print_identify_offset(*fo);
+  else
+    std::printf("no offset estimate: the board sent no identify_offset frame\n");
   std::optional<pil::IdentifyPayloadFrame> p;
   if (a.payload) {
     p = c.wait_identify_payload(id, kIdentifyFrameWaitS);

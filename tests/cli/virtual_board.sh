@@ -319,7 +319,8 @@ store_estimate() {
   if [ ${#estimate_move[@]} -gt 0 ]; then  # then identify there: the run takes its orientation where it starts
     expect 0 '^done$' -- "$@" --port "$port" "${estimate_move[@]}"
   fi
-  expect 0 '^done$' '^identify [0-9]+: ok; [0-9]+ samples, 0 lost' '^J6 ' '^friction_sti\[5\] = ' '^applied' -- \
+  expect 0 '^done$' '^identify [0-9]+: ok; [0-9]+ samples, 0 lost' '^J6 ' '^torque offset \[N m\] .* J6 ' \
+    '^friction_sti\[5\] = ' '^applied' -- \
     "$@" --port "$port" --timeout 300 identify --apply
   cp "$tmp/out" "$tmp/estimate.out"
   vis=$(sed -n 's/^J1 *\([0-9.]*\) .*/\1/p' "$tmp/out")
@@ -356,7 +357,8 @@ payload_identify() {
   expect 0 '^payload_mass = 1.35 ' -- "$@" --port "$port" param set payload_mass 1.35
   expect 0 '^payload_com\[2\] = 0.072 ' -- "$@" --port "$port" param set payload_com 0 0.045 0.072
   expect 0 '^accepted$' -- "$@" --port "$port" enable
-  expect 0 '^identify [0-9]+: ok; ' '^payload: mass ' '^payload_mass = ' '^payload_com\[2\] = ' '^applied' -- \
+  expect 0 '^identify [0-9]+: ok; ' '^torque offset \[N m\] ' '^payload: mass ' '^payload_mass = ' \
+    '^payload_com\[2\] = ' '^applied' -- \
     "$@" --port "$port" --timeout 300 identify --payload --apply
   "$py" - "$tmp/out" <<'PY' || fail "the payload's estimate is not within issue 57's bars"
 import math, re, sys
@@ -600,6 +602,7 @@ assert c.wait_answer(cid, 60).status == Status.ACCEPTED
 assert c.wait_done(cid, 60).status == Status.DONE
 f = c.wait_identify(cid, 10)
 assert f is not None, "the identify frame was lost"
+assert c.wait_identify_offset(cid, 10) is not None, "the identify_offset frame was lost"
 print("ok: the run's end and its estimate after 12 s unread")
 PY
     cat "$tmp/slow.out"

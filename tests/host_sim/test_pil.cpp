@@ -552,7 +552,7 @@ TEST_F(Link, CorruptedFrameGetsZeroCodesAtOnceRepeatedOnesLatch) {
 
 TEST_F(Link, BadHeaderIsAnsweredAtOnceWithZeroCodes) {
   healthy(5);
-  expect_zeroed_once(answer(with(frame(), 2, 0x0E)), pil::kErrHeader);  // type 0x0F: unknown
+  expect_zeroed_once(answer(with(frame(), 2, 0x1E)), pil::kErrHeader);  // type 0x1F: unknown
   // The rest of it: the bytes after its first, scanned again.
   EXPECT_EQ(last.link[pil::kErrJunk], static_cast<std::uint32_t>(pil::kSensorPayload + pil::kOverhead - 1));
 }

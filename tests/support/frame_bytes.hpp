@@ -51,8 +51,10 @@ F decoded(const pil::Parser& p) {
   pil::CaptureFrame cf;
   pil::CaptureDataFrame cd;
   pil::IdentifyPayloadFrame ip;
+  pil::IdentifyOffsetFrame io;
   const int ok = p.decode(s) + p.decode(a) + p.decode(c) + p.decode(n) + p.decode(t) + p.decode(sp) + p.decode(tr) +
-                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id) + p.decode(cf) + p.decode(cd) + p.decode(ip);
+                 p.decode(sv) + p.decode(pf) + p.decode(pa) + p.decode(id) + p.decode(cf) + p.decode(cd) +
+                 p.decode(ip) + p.decode(io);
   EXPECT_EQ(ok, 1);
   F f;
   EXPECT_TRUE(p.decode(f));

@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from fakes import FakeBoard, Reply, answer
-from osc_client import Answer, Client, Command, Frame, Identify, IdentifyPayload, NameList, Param, ParamAnswer, Protocol
+from osc_client import (Answer, Client, Command, Frame, Identify, IdentifyOffset, IdentifyPayload, NameList, Param,
+                        ParamAnswer, Protocol)
 from osc_client import cli
 
 FIRST_ID = 100
@@ -31,8 +32,16 @@ ESTIMATE = Identify(
                  1234.5, 1.0, 2.0, 0.25, 0.25, 0.0078125),
     identified=1 << 0 | 1 << 1 | 1 << 7 | 1 << 17,
     armature=(0.25, -0.125, 0.0625, 0.015625, 0.0078125, 0.00390625), armature_sd=(0.0078125,) * 6)
-# What oscctl's print_identify prints for it (its printf formats, run through C's printf).
-ESTIMATE_TEXT = """\
+# Each drive's torque offset (the identify_offset frame right after it; a negative one, one rounded to -0.0001, a
+# zero) and what oscctl's print_identify_offset prints for it.
+OFFSET = IdentifyOffset(status=0, offset=(0.0125, -0.05, 0.00390625, 0.0, -0.0001, 0.25),
+                        offset_sd=(0.001, 0.0078125, 0.5, 0.03125, 0.0001, 12.5))
+OFFSET_TEXT = ("torque offset [N m] (what each drive adds to the torque commanded; reported, not applied):"
+               " J1 0.0125 +- 0.0010 J2 -0.0500 +- 0.0078 J3 0.0039 +- 0.5000 J4 0.0000 +- 0.0312"
+               " J5 -0.0001 +- 0.0001 J6 0.2500 +- 12.5000\n")
+NO_OFFSET = "no offset estimate: the board sent no identify_offset frame\n"
+# What oscctl's print_identify prints for it (its printf formats, run through C's printf), then the offsets'.
+TABLE_TEXT = """\
 identify 100: ok; 16000 samples, 3 lost; condition 1.23e+03; worst torque-prediction error 12.5 %
 drive  viscous [N m s/rad]    Coulomb [N m]          Stribeck [N m]         armature correction [kg m^2]
 J1        1.5000 +- 0.0156 *    10.5000 +- 0.5000    12345.5000 +- 1234.5000      0.2500 +- 0.0078
@@ -43,6 +52,7 @@ J5        0.0625 +- 0.0312       0.2500 +- 0.1250       0.3125 +- 0.2500       0
 J6       -0.0469 +- 0.0234       0.4375 +- 0.2500       0.6250 +- 0.0078 *     0.0039 +- 0.0078
 (* identified: its standard deviation within 2.5 % of it)
 """
+ESTIMATE_TEXT = TABLE_TEXT + OFFSET_TEXT
 APPLIED_PARAMETERS = ("friction_vis", "friction_cou", "friction_sti", "armature_correction")
 
 # A payload estimate (f32 values) and what oscctl's print_identify_payload prints for it (C's printf).
@@ -63,9 +73,10 @@ def status(p: Protocol, name: str) -> int:
 
 
 def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, disable: str = "accepted",
-              payload: IdentifyPayload | None = None) -> Reply:
-    """The identify run accepted, then done (or aborted) with the estimate after the end's answer (and the payload's
-    right after it, when given); a disable answered ``disable`` (accepted: done at once, the state disabled)."""
+              payload: IdentifyPayload | None = None, offset: bool = True) -> Reply:
+    """The identify run accepted, then done (or aborted) with the estimate after the end's answer, right after it
+    OFFSET with the estimate's status (unless not ``offset``: a firmware from before that frame), and the payload's
+    when given; a disable answered ``disable`` (accepted: done at once, the state disabled)."""
     def reply(c: Command) -> list[Frame]:
         verb = p.name_of(NameList.VERBS, c.verb)
         if verb == "disable":
@@ -74,6 +85,7 @@ def board_run(p: Protocol, estimate: Identify | None, abort: str | None = None, 
         end = (Answer(aborted_id=c.id, abort=p.code_of(NameList.REASONS, abort)) if abort else Answer(done_id=c.id))
         frames: list[Frame] = [answer(p, c, state="moving"), end]
         frames += [dataclasses.replace(estimate, id=c.id)] if estimate else []
+        frames += [dataclasses.replace(OFFSET, id=c.id, status=estimate.status)] if estimate and offset else []
         return frames + ([dataclasses.replace(payload, id=c.id)] if payload else [])
     return reply
 
@@ -184,6 +196,21 @@ def test_no_identify_frame(protocol: Protocol, monkeypatch: pytest.MonkeyPatch, 
     assert time.monotonic() - t0 >= 0.3  # it waited for the frame
     assert (rc, capsys.readouterr().out) == (exit, out)
     assert verbs(protocol, board) == ["identify"]
+
+
+@pytest.mark.parametrize("apply", [False, True])
+def test_no_identify_offset_frame_is_said_and_not_a_failure(protocol: Protocol, monkeypatch: pytest.MonkeyPatch,
+                                                            apply: bool, capsys: pytest.CaptureFixture[str]) -> None:
+    """A firmware from before the identify_offset frame: the estimate printed, the offsets' absence said, and the run
+    is no failure for it (the offsets are reported, never applied): --apply goes on."""
+    monkeypatch.setattr(cli, "IDENTIFY_FRAME_WAIT", 0.3)
+    rc, board = run(protocol, ["identify"] + (["--apply"] if apply else []),
+                    board_run(protocol, ESTIMATE, offset=False), ParamTable(protocol))
+    out = capsys.readouterr().out
+    assert out.startswith("accepted\ndone\n" + TABLE_TEXT + NO_OFFSET)
+    assert rc == 0
+    assert verbs(protocol, board) == (["identify", "disable"] if apply else ["identify"])
+    assert out.endswith(APPLIED) == apply
 
 
 def test_a_refused_run_waits_for_no_estimate(protocol: Protocol, capsys: pytest.CaptureFixture[str],

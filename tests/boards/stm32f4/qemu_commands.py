@@ -19,7 +19,8 @@ from CLIENT_SRC: clients/python/src), as a user would drive the board over a ser
      declared at the start pose, the wrist's gains lowered so that the run passes the sampled loop's
      check there (at the paper's gains it is refused unstable_loop, docs/adaptation.md), accepted;
      the encoders do not move in QEMU, so a monitor stops it (aborted), and the board sends its
-     identify frame, status aborted, with the samples its main loop took and none lost.
+     identify frame, status aborted, with the samples its main loop took and none lost, and its identify_offset
+     frame.
 The encoders do not move in QEMU, so no motion runs to its end. No timing is asserted: every wait is generous
 (the machine may be busy). Prints one line per step; exit 0 when all pass, 1 otherwise.
 """
@@ -134,6 +135,9 @@ def identify_aborted(c, check):
     check("its status aborted", status == "aborted", status)
     check("the main loop took the run's samples, none lost", f.samples > 0 and f.lost == 0,
           f"{f.samples} samples, {f.lost} lost")
+    fo = c.wait_identify_offset(cid, TIMEOUT)
+    check("the identify_offset frame came right after it, status aborted",
+          fo is not None and c.protocol.name_of(NameList.IDENTIFY_STATUSES, fo.status) == "aborted", str(fo))
 
 
 def main(argv):

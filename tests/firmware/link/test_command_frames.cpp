@@ -50,7 +50,10 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
   // The identify run's payload estimate (issue 57): id, status, mass, com, inertia, pi's sd, identified.
   EXPECT_EQ(pil::kIdentifyPayloadFrame, 14);
   EXPECT_EQ(pil::kIdentifyPayloadPayload, 4 + 1 + 4 + 12 + 24 + 40 + 4);
-  ASSERT_EQ(pil::kFrameTypes, 14);
+  // Each drive's torque offset from the run (issue 57): id, status, offset, its sd.
+  EXPECT_EQ(pil::kIdentifyOffsetFrame, 15);
+  EXPECT_EQ(pil::kIdentifyOffsetPayload, 4 + 1 + 24 + 24);
+  ASSERT_EQ(pil::kFrameTypes, 15);
   for (const pil::FrameInfo& f : pil::kFrames) {
     EXPECT_LT(f.payload, 256) << f.name;
     EXPECT_LE(f.payload, pil::kActuatorPayload) << f.name;
@@ -59,7 +62,7 @@ TEST(CommandFrames, PayloadLengthsFixedAndEachFitsItsByte) {
     for (int i = 0; i < f.field_count; ++i) bytes += f.fields[i].bytes;
     EXPECT_EQ(bytes, f.payload) << f.name;
   }
-  for (int t : {0, 15, 16, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
+  for (int t : {0, 16, 17, 0x5A, 0xA5, 255}) EXPECT_EQ(pil::payload_length(static_cast<std::uint8_t>(t)), -1) << t;
 }
 
 // ---------------------------------------------------------------- round trips

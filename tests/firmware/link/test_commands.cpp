@@ -124,6 +124,9 @@ TEST(CommandFrames, EveryFrameTypeRoundTripsThroughTheParser) {
         case pil::kIdentifyPayloadFrame:
           out = bytes_of(decoded<pil::IdentifyPayloadFrame>(p));
           break;
+        case pil::kIdentifyOffsetFrame:
+          out = bytes_of(decoded<pil::IdentifyOffsetFrame>(p));
+          break;
       }
       ASSERT_EQ(out, in) << info.name;
     }

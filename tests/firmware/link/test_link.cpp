@@ -146,7 +146,7 @@ const ErrorCase kCases[] = {
     {"BadCrc", pil::kErrCrc, kFaultLinkCorrupt, 1, 0,
      [](LinkNode& t) { return t.lockstep(with(t.frame(), 10, 0x40)); }},
     {"BadHeader", pil::kErrHeader, kFaultLinkCorrupt, 1, 0,
-     [](LinkNode& t) { return t.lockstep(with(t.frame(), 2, 0x0E)); }},  // type 0x0F: unknown
+     [](LinkNode& t) { return t.lockstep(with(t.frame(), 2, 0x1E)); }},  // type 0x1F: unknown
     {"BadLength", pil::kErrLength, kFaultLinkCorrupt, 1, 0,
      [](LinkNode& t) { return t.lockstep(with(t.frame(), 3, 0x01)); }},
     {"JunkBetweenFrames", pil::kErrJunk, kFaultLinkCorrupt, 1, 0,
@@ -244,7 +244,7 @@ INSTANTIATE_TEST_SUITE_P(Lockstep, EachLinkError, ::testing::ValuesIn(kCases),
 
 TEST_F(LinkNode, JunkAfterAnErrorBelongsToIt) {
   healthy(3);
-  const Answers a = lockstep(with(frame(), 2, 0x0E));  // type 0x0F, unknown: answered at its 4th byte
+  const Answers a = lockstep(with(frame(), 2, 0x1E));  // type 0x1F, unknown: answered at its 4th byte
   ASSERT_EQ(a.size(), 1u);
   EXPECT_EQ(node->link_counters()[pil::kErrHeader], 1u);
   // Its rest: the frame gives up its first byte, the bytes after it are scanned again and are junk.
@@ -320,7 +320,7 @@ TEST_F(LinkNode, TimerPacedFrameLateWithinTheAllowanceIsNoError) {
 TEST_F(LinkNode, TimerPacedCorruptionZeroesTheNextTick) {
   const std::function<Bytes(LinkNode&)> corrupt[] = {
       [](LinkNode& t) { return with(t.frame(), 10, 0x40); },  // bad CRC
-      [](LinkNode& t) { return with(t.frame(), 2, 0x0E); },   // bad header (type 0x0F)
+      [](LinkNode& t) { return with(t.frame(), 2, 0x1E); },   // bad header (type 0x1F)
       [](LinkNode& t) { return with(t.frame(), 3, 0x01); },   // bad length
       [](LinkNode&) {
         return Bytes{0x01, 0x02, 0x03};

@@ -35,8 +35,8 @@ from .capture import (CaptureChannel, CaptureRefused, CaptureResult, Oscilloscop
                       parse_channel, parse_channels)
 from .client import Client, Outcome, Status
 from .errors import ClientError
-from .frames import (Actuator, Answer, Capture, CaptureData, Command, Frame, FrameType, Identify, IdentifyPayload,
-                     Param, ParamAnswer, Sensor, Setpoint, SetpointVelocity, State, Trace)
+from .frames import (Actuator, Answer, Capture, CaptureData, Command, Frame, FrameType, Identify, IdentifyOffset,
+                     IdentifyPayload, Param, ParamAnswer, Sensor, Setpoint, SetpointVelocity, State, Trace)
 from .parser import Parser, RawFrame
 from .paths import PathPoint, angular_velocity, read_stream_csv, resample_path
 from .protocol import PROTOCOL_JSON, CaptureSignal, CaptureSpec, NameList, Parameter, Protocol, crc16, protocol_path
@@ -47,8 +47,8 @@ from .transport import SerialTransport, Transport
 __all__ = [
     "Actuator", "Answer", "Capture", "CaptureChannel", "CaptureData", "CaptureRefused", "CaptureResult",
     "CaptureSignal", "CaptureSpec", "Client", "ClientError", "Column", "Command", "CsvRecorder", "Frame", "FrameType",
-    "Identify", "IdentifyPayload", "NameList", "Oscilloscope", "Outcome", "PROTOCOL_JSON", "Param", "ParamAnswer",
-    "Parameter", "Parser", "PathPoint", "Protocol", "RawFrame", "Sensor", "SerialTransport", "Setpoint",
+    "Identify", "IdentifyOffset", "IdentifyPayload", "NameList", "Oscilloscope", "Outcome", "PROTOCOL_JSON", "Param",
+    "ParamAnswer", "Parameter", "Parser", "PathPoint", "Protocol", "RawFrame", "Sensor", "SerialTransport", "Setpoint",
     "SetpointVelocity", "Signal", "SignalKind", "State", "Status", "Trace", "Traces", "Transport", "angular_velocity",
     "capture_signals_text", "crc16", "csv_header", "csv_row", "parse_channel", "parse_channels", "parse_signal",
     "parse_signals", "protocol_path", "read_stream_csv", "resample_path", "signal_names", "state_columns", "state_row"

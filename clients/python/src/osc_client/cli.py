@@ -49,8 +49,8 @@ from .paths import read_stream_csv, resample_path
 from .plot import LivePlot, require_matplotlib, save_capture_png, save_png
 from .protocol import NameList, Protocol, int_range
 from .record import CsvRecorder, Signal, Traces, parse_signals
-from .text import (DRIVES, answer_text, capture_text, identify_payload_text, identify_text, margins_text, param_line,
-                   state_change_text, state_text)
+from .text import (DRIVES, answer_text, capture_text, identify_offset_text, identify_payload_text, identify_text,
+                   margins_text, param_line, state_change_text, state_text)
 
 Connect = Callable[[str, int, Protocol, float], Client]
 """Opens the client of a port: (port, baud, protocol, keepalive)."""
@@ -298,6 +298,9 @@ def cmd_identify(c: Client, a: argparse.Namespace) -> int:
               flush=True)
         return 1 if a.apply else rc
     print(identify_text(c.protocol, f), end="", flush=True)
+    fo = c.wait_identify_offset(cid, IDENTIFY_FRAME_WAIT)
+    print(identify_offset_text(c.protocol, fo) if fo is not None
+          else "no offset estimate: the board sent no identify_offset frame\n", end="", flush=True)
     fp = None
     if a.payload:
         fp = c.wait_identify_payload(cid, IDENTIFY_FRAME_WAIT)

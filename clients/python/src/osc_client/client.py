@@ -13,15 +13,18 @@ import random
 import time
 from dataclasses import dataclass
 from enum import Enum
-from typing import Callable, Sequence
+from typing import Callable, Sequence, TypeVar
 
 from .errors import ClientError
-from .frames import (Answer, Capture, CaptureData, Command, Floats, Frame, Identify, IdentifyPayload, Param,
-                     ParamAnswer, Setpoint, SetpointVelocity, State)
+from .frames import (Answer, Capture, CaptureData, Command, Floats, Frame, Identify, IdentifyOffset, IdentifyPayload,
+                     Param, ParamAnswer, Setpoint, SetpointVelocity, State)
 from .parser import Parser
 from .paths import PathPoint
 from .protocol import NameList, Protocol
 from .transport import SerialTransport, Transport
+
+RunFrame = TypeVar("RunFrame", Identify, IdentifyOffset, IdentifyPayload)
+"""A frame a board sends at the end of an identify run."""
 
 MOTION_VERBS = ("move_to", "paper", "stream", "home", "identify")
 """The verbs whose acceptance starts a motion, which ends later (done or aborted)."""
@@ -99,6 +102,7 @@ class Client:
         self.param_answer: ParamAnswer | None = None
         self.last_identify: Identify | None = None  # the last identify frame (an identify run's estimate)
         self.last_identify_payload: IdentifyPayload | None = None  # the last identify_payload frame
+        self.last_identify_offset: IdentifyOffset | None = None  # the last identify_offset frame
         self.capture_answer: CaptureData | None = None  # the last capture_data frame (a capture request's answer)
         self.on_answer: Callable[[Answer], None] | None = None
         self.on_state: Callable[[State], None] | None = None
@@ -297,18 +301,27 @@ class Client:
         may have read it already: the estimate when the motion was done, status aborted when it was aborted. None
         when none came: a firmware from before the boards estimated runs the motion alone, or the frame was lost.
         """
-        def mine() -> bool:
-            return self.last_identify is not None and self.last_identify.id == cid
-        self._read_until(time.monotonic() + timeout, mine)
-        return self.last_identify if mine() else None
+        return self._wait_run_frame(lambda: self.last_identify, cid, timeout)
+
+    def wait_identify_offset(self, cid: int, timeout: float = 2.0) -> IdentifyOffset | None:
+        """The identify_offset frame of the identify run ``cid`` (each drive's torque offset), sent right after its
+        identify frame: received already, or within ``timeout`` seconds; None when none came (a firmware from
+        before it was sent)."""
+        return self._wait_run_frame(lambda: self.last_identify_offset, cid, timeout)
 
     def wait_identify_payload(self, cid: int, timeout: float = 2.0) -> IdentifyPayload | None:
-        """The identify_payload frame of the identify run ``cid`` (asked with ``payload``), sent right after its
-        identify frame: received already, or within ``timeout`` seconds; None when none came."""
+        """The identify_payload frame of the identify run ``cid`` (asked with ``payload``), sent after its identify
+        and identify_offset frames: received already, or within ``timeout`` seconds; None when none came."""
+        return self._wait_run_frame(lambda: self.last_identify_payload, cid, timeout)
+
+    def _wait_run_frame(self, last: Callable[[], RunFrame | None], cid: int, timeout: float) -> RunFrame | None:
+        """The last frame of a run's kind (``last()``) once it is run ``cid``'s: received already, or within
+        ``timeout`` seconds."""
         def mine() -> bool:
-            return self.last_identify_payload is not None and self.last_identify_payload.id == cid
+            f = last()
+            return f is not None and f.id == cid
         self._read_until(time.monotonic() + timeout, mine)
-        return self.last_identify_payload if mine() else None
+        return last() if mine() else None
 
     def pump(self, timeout: float, until: Callable[[], bool] | None = None) -> bool:
         """Reads and dispatches frames (on_answer, on_state) for ``timeout`` seconds (``inf``: for ever), or
@@ -365,6 +378,8 @@ class Client:
             self.last_identify = frame
         elif isinstance(frame, IdentifyPayload):
             self.last_identify_payload = frame
+        elif isinstance(frame, IdentifyOffset):
+            self.last_identify_offset = frame
         elif isinstance(frame, CaptureData):
             self.capture_answer = frame
         elif isinstance(frame, Answer):

@@ -39,6 +39,7 @@ class FrameType(str, Enum):
     CAPTURE = "capture"
     CAPTURE_DATA = "capture_data"
     IDENTIFY_PAYLOAD = "identify_payload"
+    IDENTIFY_OFFSET = "identify_offset"
 
 
 @dataclass(frozen=True)
@@ -220,6 +221,19 @@ class IdentifyPayload(Frame):
 
 
 @dataclass(frozen=True)
+class IdentifyOffset(Frame):
+    """An identify run's estimate of each drive's torque offset, right after its identify frame (docs/protocol.md,
+    "Identify_offset frame"): the constant torque each drive adds to the one commanded. Reported; no parameter
+    takes it."""
+
+    TYPE = FrameType.IDENTIFY_OFFSET
+    id: int = 0  # the identify command's id
+    status: int = 0  # NameList.IDENTIFY_STATUSES: the run's
+    offset: Floats = ()  # [N m] J1-6; 0 when status is not ok
+    offset_sd: Floats = ()  # [N m] their standard deviations
+
+
+@dataclass(frozen=True)
 class CaptureData(Frame):
     """A capture frame's answer: the capture's state and set-up after it and, for a read, up to
     ``CaptureSpec.chunk`` of its values (sample by sample, channel by channel, from ``offset``).
@@ -296,6 +310,7 @@ class Trace(Frame):
 
 
 _CLASSES: tuple[type[Frame], ...] = (Sensor, Actuator, Command, Answer, State, Setpoint, Trace, SetpointVelocity,
-                                     Param, ParamAnswer, Identify, Capture, CaptureData, IdentifyPayload)
+                                     Param, ParamAnswer, Identify, Capture, CaptureData, IdentifyPayload,
+                                     IdentifyOffset)
 FRAME_CLASSES: dict[FrameType, type[Frame]] = {cls.TYPE: cls for cls in _CLASSES}
 """The class of each frame type."""

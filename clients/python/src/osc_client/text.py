@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Sequence
 
-from .frames import Answer, Identify, IdentifyPayload, ParamAnswer, State
+from .frames import Answer, Identify, IdentifyOffset, IdentifyPayload, ParamAnswer, State
 from .protocol import NameList, Parameter, Protocol
 
 if TYPE_CHECKING:
@@ -108,6 +108,15 @@ def identify_text(p: Protocol, f: Identify) -> str:
             text += " %9.4f +- %-7.4f%s" % (f.friction[k], f.friction_sd[k], "* " if f.identified >> k & 1 else "  ")
         text += " %9.4f +- %.4f\n" % (f.armature[i], f.armature_sd[i])
     return text + "(* identified: its standard deviation within %g %% of it)\n" % (100 * IDENTIFIED_FRACTION)
+
+
+def identify_offset_text(p: Protocol, f: IdentifyOffset) -> str:
+    """An identify_offset frame as oscctl prints it (status ok): each drive's torque offset with its standard
+    deviation, on one line; "" otherwise."""
+    if p.name_of(NameList.IDENTIFY_STATUSES, f.status) != "ok":
+        return ""
+    return ("torque offset [N m] (what each drive adds to the torque commanded; reported, not applied):"
+            + "".join(" J%d %.4f +- %.4f" % (i + 1, f.offset[i], f.offset_sd[i]) for i in range(DRIVES)) + "\n")
 
 
 def identify_payload_text(p: Protocol, f: IdentifyPayload) -> str:

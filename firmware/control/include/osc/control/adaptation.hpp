@@ -79,8 +79,7 @@ Vec6<S> increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Ve
 template <class S>
 Vec6<S> motor_increment_error(const Gains<S>& G, const AdaptationState<S>& a, const Vec6<S>& q,
                               const DriveCoupling<S>& drives) {
-  const Vec6<S> Dq = increment_error(G, a, q);
-  return drives.coupled() ? motor_rates(drives, Dq) : Dq;
+  return motor_rates(drives, increment_error(G, a, q));  // Dq itself on an uncoupled arm (no terms)
 }
 
 /// The paper's law (26) in its sampled form (67).

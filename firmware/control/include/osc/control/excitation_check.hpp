@@ -57,11 +57,9 @@ template <class S>
 ExcitationStatus torque_limits(const Model<S>& model, const Data<S>& data, const JointSample<S>& d,
                                const ExcitationLimits<S>& lim, ExcitationCheck<S>& r) {
   const Vec6<S> tau = rnea(model, data, d.qd, d.qdd, true).tau;
-  // On a coupled drive train each motor's friction at its rate, to the joints through C^-T (DriveCoupling).
+  // Each motor's friction at its rate, to the joints through C^-T (DriveCoupling: the identity on an uncoupled arm).
   const Vec6<S> tau_f =
-      model.drives.coupled()
-          ? joint_torques_of_motors(model.drives, friction_torque(lim.friction, motor_rates(model.drives, d.qd)))
-          : friction_torque(lim.friction, d.qd);
+      joint_torques_of_motors(model.drives, friction_torque(lim.friction, motor_rates(model.drives, d.qd)));
   int over = -1;
   for (int i = 0; i < kDof; ++i) {
     const S need = math::abs(tau(i)) + math::abs(tau_f(i));

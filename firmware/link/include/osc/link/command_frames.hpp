@@ -257,6 +257,18 @@ constexpr const char* kParamFlagDocs[kParamFlagCount] = {OSC_PARAM_FLAG_LIST(OSC
     "bit k set: the k-th of those parameters is identified (its standard deviation within "                            \
     "params::kIdentifiedFraction of it)")
 
+// The identify_offset frame: an identify run's estimate of each drive's torque offset b_i (osc/control/
+// identify_estimate.hpp, IdentifyReport::offset), sent right after every identify frame. b_i is the constant torque
+// the drive adds to the one commanded (an amplifier's or a current sensor's offset, a constant load the model lacks);
+// the estimate keeps it out of the friction's Coulomb and Stribeck terms. It is reported, not compensated: no
+// parameter takes it (docs/adaptation.md, "Each drive's torque offset").
+#define OSC_IDENTIFY_OFFSET_FIELDS(X)                                                             \
+  X(std::uint32_t, id, , "", "the identify command's id")                                         \
+  X(std::uint8_t, status, , "", "the run's: ok, or why there is no estimate (Identify statuses)") \
+  X(float, offset, [kJoints], "N m",                                                              \
+    "each drive's torque offset, the torque it adds to the one commanded (0 when not ok)")        \
+  X(float, offset_sd, [kJoints], "N m", "their standard deviations")
+
 // The trace frame: what a host needs to follow a commanded run tick by tick as the controller saw it
 // (puma_experiment --motion --qemu: the tracking error and the reference's own maxima, the same as
 // the in-process controller's). A Q12.19 number below 32 in magnitude is exact in f32, and so is

@@ -136,7 +136,11 @@ constexpr std::uint8_t config_adaptation(osc::AdaptationLaw law) {
     OSC_CAPTURE_DATA_FIELDS)                                                                                           \
   X(IdentifyPayload, 14, "identify_payload", "firmware",                                                               \
     "right after the identify frame of a run asked with the flag payload: its estimate of the payload at the flange",  \
-    OSC_IDENTIFY_PAYLOAD_FIELDS)
+    OSC_IDENTIFY_PAYLOAD_FIELDS)                                                                                       \
+  X(IdentifyOffset, 15, "identify_offset", "firmware",                                                                 \
+    "right after every identify frame (before an identify_payload frame): the run's estimate of each drive's torque "  \
+    "offset",                                                                                                          \
+    OSC_IDENTIFY_OFFSET_FIELDS)
 
 #define OSC_FRAME_TYPE(Name, code, name, from, when, FIELDS) k##Name##Frame = code,
 enum FrameType : std::uint8_t { OSC_FRAME_LIST(OSC_FRAME_TYPE) };

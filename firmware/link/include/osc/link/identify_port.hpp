@@ -1,9 +1,9 @@
 // The main loop's side of an identify run on a board that estimates (issue 57; docs/adaptation.md, "The identify
 // command"): the run's samples from the task's sampler summed into the estimate (osc/runtime/identify_run.hpp,
 // IdentifyRun), and when the run's motion ends, its report to the client as one identify frame
-// (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted; a run
-// asked with the command flag payload estimates the payload at the flange too and sends it in an identify_payload
-// frame right after.
+// (osc/link/command_frames.hpp): the estimate when the motion was done, status `aborted` when it was aborted, and
+// right after it an identify_offset frame (each drive's torque offset); a run asked with the command flag payload
+// estimates the payload at the flange too and sends it in an identify_payload frame after those.
 //
 // A board calls after_tick() from its main loop, after every tick where it runs in lockstep (the virtual board,
 // osc_sim, after CommandPort::after_tick_and_poll; the QEMU images, pil_firmware.cpp), or as often as its main loop
@@ -47,6 +47,20 @@ inline pil::IdentifyFrame identify_frame(std::uint32_t id, const IdentifyReport&
   for (int i = 0; i < kDof; ++i) {
     f.armature[i] = ok ? static_cast<float>(r.armature(i)) : 0.0f;
     f.armature_sd[i] = static_cast<float>(r.armature_sd(i));
+  }
+  return f;
+}
+
+/// A run's estimate of each drive's torque offset as its frame (f32): the offsets when the run is ok, their sigma
+/// always.
+inline pil::IdentifyOffsetFrame identify_offset_frame(std::uint32_t id, const IdentifyReport& r) {
+  pil::IdentifyOffsetFrame f;
+  f.id = id;
+  f.status = static_cast<std::uint8_t>(r.status);
+  const bool ok = r.status == IdentifyStatus::kOk;
+  for (int i = 0; i < kDof; ++i) {
+    f.offset[i] = ok ? static_cast<float>(r.offset(i)) : 0.0f;
+    f.offset_sd[i] = static_cast<float>(r.offset_sd(i));
   }
   return f;
 }
@@ -100,6 +114,7 @@ class IdentifyPort {
     last_ = report;
     std::uint8_t buf[pil::kMaxFrame];
     write(buf, pil::encode(identify_frame(run_.id(), report, run_.taken(), run_.lost()), buf));
+    write(buf, pil::encode(identify_offset_frame(run_.id(), report), buf));
     if (run_.payload() != payload_mask::kNone) write(buf, pil::encode(identify_payload_frame(run_.id(), report), buf));
   }
   /// Whether a run is being followed.

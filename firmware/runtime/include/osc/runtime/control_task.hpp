@@ -79,7 +79,7 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
   const bool coupled_friction = task.model.drives.coupled();
   Vec6<S> rate_m;
-  if (coupled_friction) rate_m = motor_rates(task.io, ad.qd_hat_prev);
+  if (coupled_friction) rate_m = motor_rates(task.model.drives, ad.qd_hat_prev);
   const ResidualInput<S> in{task.state.data.A,
                             task.state.os.g,
                             out.tau_bias,
