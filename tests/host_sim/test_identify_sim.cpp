@@ -139,7 +139,9 @@ TEST(IdentifySim, TheFrictionOfTheIdealPlantFromOneRunInEveryScalar) {
   for (const FrictionErrors& e :
        {ideal_plant_run<double>("double"), ideal_plant_run<float>("float"), ideal_plant_run<fixed::Q<19>>("Q12.19")}) {
     EXPECT_LE(e.bar, 1.0);
-    if (test::kPumaBuild) EXPECT_LE(e.sd, 1.0);  // the UR5e's sigma at its start pose: not measured yet
+    if (test::kPumaBuild) {
+      EXPECT_LE(e.sd, 1.0);  // the UR5e's sigma at its start pose: not measured yet
+    }
   }
 }
 

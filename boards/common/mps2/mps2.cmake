@@ -58,7 +58,8 @@ function(osc_add_mps2_board)
   set_tests_properties(timer_firmware_qemu PROPERTIES PASS_REGULAR_EXPRESSION "timer_firmware: pass")
   # The same image measuring the tick's worst case (docs/benchmarks.md): the momentum law's gates
   # open and its blocks of 4 samples (params::kTickWorstCase), so that its 200 ticks hold Kalman
-  # updates and folds although the arm is at rest. A measurement image only.
+  # updates and folds although the arm is at rest, and the arm's own encoders (robot::kDriveTrain: on
+  # the PUMA the coupled wrist, whose friction law is the drives'). A measurement image only.
   osc_board_image(${B_NAME} timer_worst_firmware ${OSC_MPS2_TESTS_DIR}/timer_firmware.cpp)
   target_compile_definitions(timer_worst_firmware PRIVATE OSC_TICK_WORST_CASE)
   add_test(NAME timer_worst_firmware_qemu COMMAND timer_worst_firmware)

@@ -113,6 +113,11 @@ int main() {
   const cortex_m::ResetCause cause = board::reset_cause();
   g_task.init(osc::Model<board::Scalar>::of(osc::robot::kArm), osc::Gains<board::Scalar>::paper(),
               osc::FrictionMode::kAdaptive, osc::joint_vector<board::Scalar>(osc::robot::kQStart), kPeriodNs);
+#ifdef OSC_TICK_WORST_CASE
+  // The arm's own encoders, as the STM32F4 board runs them (its app.hpp): on the PUMA the coupled wrist, whose
+  // friction law is the drives' (C^-T W(C^-1 qd^) theta^) and whose monitors take the motors' rates.
+  g_task.set_encoders(osc::robot::kDriveTrain.encoders);
+#endif
   board::watchdog_start();
   board::control_timer_start(board::kControlHz);
   while (g_ticks < kTicks) {

@@ -60,7 +60,9 @@ TEST(ExcitationCheck, ItRunsAtTheLargestScaleThatPassesInAtMostFourChecks) {
     const double s = excitation::scale_of<double>(k);
     ExcitationLimits<double> lim = ExcitationLimits<double>::defaults();
     lim.torque(0) = j1_torque_at(s) * (1 + 1e-9);
-    if (k > 0) ASSERT_GT(j1_torque_at(excitation::scale_of<double>(k - 1)), lim.torque(0)) << k;
+    if (k > 0) {
+      ASSERT_GT(j1_torque_at(excitation::scale_of<double>(k - 1)), lim.torque(0)) << k;
+    }
     ExcitationMotion<double> m;
     const ExcitationCheck<double> c =
         prepare_excitation(arm_model(), kernels_data(), q_start(), orientation_of(q_start()), lim, m);

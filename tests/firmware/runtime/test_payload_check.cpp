@@ -296,6 +296,8 @@ TEST(PayloadCheck, TheFlangeLeverBoundsTheFlangesDistanceFromEachAxis) {
     std::printf("J%d: the flange at most %.3f m from the axis, the lever %.3f m (less the reach)\n", i + 1, farthest[i],
                 flange_lever(i) - reach);
     EXPECT_LE(farthest[i], flange_lever(i) - reach + 1e-9) << i;
-    if (flange_lever(i) - reach > 1e-3) EXPECT_GE(farthest[i], 0.8 * (flange_lever(i) - reach)) << i;
+    if (flange_lever(i) - reach > 1e-3) {
+      EXPECT_GE(farthest[i], 0.8 * (flange_lever(i) - reach)) << i;
+    }
   }
 }

@@ -56,8 +56,10 @@ std::uint32_t stuck_encoder_check(ControlTask<S>& task, const std::int32_t count
 
 /// The checks of a completed step against what the controller commanded (docs/safety.md): the
 /// stuck-encoder, tracking and friction-estimate monitors (osc/runtime/monitors.hpp).
+/// rate_m: the motors' rates C^-1 q^dot^ of the step (stage_step's; unread on an uncoupled arm).
 template <class S>
-std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t counts[kDof], const bool moved[kDof]) {
+std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t counts[kDof], const bool moved[kDof],
+                                  const Vec6<S>& rate_m) {
   const StepOutput<S>& out = task.last;
   // The stuck-encoder monitor (docs/safety.md): off where the residual monitor is armed (its residual
   // and travel check judge every encoder), restarting from the tick it next runs; a trial's fitted
@@ -78,8 +80,6 @@ std::uint32_t step_monitor_faults(ControlTask<S>& task, const std::int32_t count
   const Vec6<S> decay = ad.w_prev.sti.cwiseAbs();
   const bool identify = adaptive && task.gains.adaptation == AdaptationLaw::kMomentum;
   const bool coupled_friction = task.model.drives.coupled();
-  Vec6<S> rate_m;
-  if (coupled_friction) rate_m = motor_rates(task.model.drives, ad.qd_hat_prev);
   const ResidualInput<S> in{task.state.data.A,
                             task.state.os.g,
                             out.tau_bias,
@@ -202,6 +202,8 @@ struct TickData {
   bool clipped = false;    // a DAC code was clipped at its range
   bool torque = false;     // the supervisor and the motion state machine let torque reach the DACs
   std::int8_t dither = 0;  // the test dither's sign in the step's codes (0: none)
+  // The step's motor rates C^-1 q^dot^ (stage_step), where a coupled friction law or an identify run reads them.
+  Vec6<S> rate_m;
 };
 
 /// read: the HAL's I/O faults (E-stop, drives) and the encoder sample.
@@ -247,9 +249,10 @@ void stage_step(ControlTask<S>& task, TickData<S>& t) {
   control_step(task.model, task.gains, task.mode, task.state, t.q, task.desired, task.last);
   t.faults |= task.last.status;  // non_finite, singular
   // An identification run's samples: its own motion only (not its stop's, whose time is slowed).
-  if (task.gen.source() == MotionSource::kExcitation && !task.gen.braking() && task.last.status == kFaultNone)
-    task.identify.tick(task.gen.running_id(), t.q, task.last.tau, motor_rates(task.io, task.state.adapt.qd_hat_prev),
-                       task.gains.tau_dec);
+  const bool sample =
+      task.gen.source() == MotionSource::kExcitation && !task.gen.braking() && task.last.status == kFaultNone;
+  if (sample || task.model.drives.coupled()) t.rate_m = motor_rates(task.model.drives, task.state.adapt.qd_hat_prev);
+  if (sample) task.identify.tick(task.gen.running_id(), t.q, task.last.tau, t.rate_m, task.gains.tau_dec);
 }
 
 /// monitors: the drive check (drive_faults: first, the residual monitor's isolation takes its suspects),
@@ -259,7 +262,7 @@ void stage_step(ControlTask<S>& task, TickData<S>& t) {
 template <class S, hal::ControlHal Hal>
 void stage_monitors(ControlTask<S>& task, Hal& hal, TickData<S>& t) {
   t.faults |= drive_faults(task, hal);
-  if (t.stepped && task.last.status == kFaultNone) t.faults |= step_monitor_faults(task, t.counts, t.moved);
+  if (t.stepped && task.last.status == kFaultNone) t.faults |= step_monitor_faults(task, t.counts, t.moved, t.rate_m);
   if (t.measured) t.faults |= position_faults(task, hal, t.q);
   t.collision = take_collision(task, t.faults);
 }
